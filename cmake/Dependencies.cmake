@@ -1,0 +1,18 @@
+# Every dependency comes from a Debian package (see README) and is found here.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(SUNDIALS 6.4 REQUIRED COMPONENTS cvode arkode nvecserial
+             sunlinsolklu sunlinsolpcg sunlinsolspgmr sunmatrixsparse)
+find_package(HDF5 REQUIRED COMPONENTS C)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(OpenMP REQUIRED COMPONENTS CXX)
+if(FRICTHERM_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+
+# HDF5's FindHDF5 gives variables, not a target: wrap them once.
+if(NOT TARGET frictherm_hdf5)
+  add_library(frictherm_hdf5 INTERFACE)
+  target_include_directories(frictherm_hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
+  target_link_libraries(frictherm_hdf5 INTERFACE ${HDF5_C_LIBRARIES})
+  target_compile_definitions(frictherm_hdf5 INTERFACE ${HDF5_C_DEFINITIONS} ${HDF5_DEFINITIONS})
+endif()

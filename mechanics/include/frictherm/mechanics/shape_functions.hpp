@@ -1,0 +1,152 @@
+#pragma once
+// Shape functions as tensor products of 1D kernels, evaluated per particle into a compact stencil
+// (base node + 1D weights and derivatives per direction). Particle loops are templated on the kernel,
+// so the choice costs no virtual call: `dispatch_shape(kind, f)` calls f(Kernel{}) once per pass.
+#include <frictherm/mechanics/grid.hpp>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::mechanics {
+
+enum class ShapeKind { linear, ugimp, quadratic_bspline };
+
+ShapeKind shape_kind_from_string(const std::string& name);  // throws std::invalid_argument
+const char* to_string(ShapeKind kind);
+
+/// 1D weights of one particle: nodes base, base+1, ..., base+K-1 along one direction.
+template <int K>
+struct Weights1D {
+  int base = 0;
+  double w[K];
+  double dw[K];
+};
+
+/// Bilinear / trilinear hat functions (K = 2).
+struct LinearKernel {
+  static constexpr int K = 2;
+  static void eval(double x, double lo, double h, double inv_h, double /*lp*/, Weights1D<K>& out) {
+    const double s = (x - lo) * inv_h;
+    const int j = static_cast<int>(std::floor(s));
+    const double xi = s - j;
+    out.base = j;
+    out.w[0] = 1.0 - xi;
+    out.w[1] = xi;
+    out.dw[0] = -inv_h;
+    out.dw[1] = inv_h;
+    (void)h;
+  }
+};
+
+/// Undeformed GIMP (Bardenhagen & Kober 2004): hat function convolved with the particle's
+/// characteristic function of half-width lp <= h/2, which stays at its initial size (K = 3).
+struct UGIMPKernel {
+  static constexpr int K = 3;
+  static double weight(double d, double h, double lp, double& grad) {
+    const double a = std::fabs(d);
+    const double sgn = d < 0.0 ? -1.0 : 1.0;
+    if (a < lp) {
+      grad = -d / (h * lp);
+      return 1.0 - (d * d + lp * lp) / (2.0 * h * lp);
+    }
+    if (a < h - lp) {
+      grad = -sgn / h;
+      return 1.0 - a / h;
+    }
+    if (a < h + lp) {
+      const double r = h + lp - a;
+      grad = -sgn * r / (2.0 * h * lp);
+      return r * r / (4.0 * h * lp);
+    }
+    grad = 0.0;
+    return 0.0;
+  }
+  static void eval(double x, double lo, double h, double inv_h, double lp, Weights1D<K>& out) {
+    const double s = (x - lo) * inv_h;
+    const int j = static_cast<int>(std::floor(s));
+    out.base = (s - j < 0.5) ? j - 1 : j;
+    for (int a = 0; a < K; ++a) {
+      const double d = x - (lo + h * (out.base + a));
+      out.w[a] = weight(d, h, lp, out.dw[a]);
+    }
+  }
+};
+
+/// Node-centred uniform quadratic B-spline, support 1.5 h (K = 3).
+struct QuadraticBSplineKernel {
+  static constexpr int K = 3;
+  static void eval(double x, double lo, double /*h*/, double inv_h, double /*lp*/, Weights1D<K>& out) {
+    const double s = (x - lo) * inv_h;
+    const int k = static_cast<int>(std::floor(s + 0.5));
+    const double xi = s - k;  // in [-0.5, 0.5)
+    out.base = k - 1;
+    const double a = 0.5 - xi, b = 0.5 + xi;
+    out.w[0] = 0.5 * a * a;
+    out.w[1] = 0.75 - xi * xi;
+    out.w[2] = 0.5 * b * b;
+    out.dw[0] = -a * inv_h;
+    out.dw[1] = -2.0 * xi * inv_h;
+    out.dw[2] = b * inv_h;
+  }
+};
+
+/// Tensor-product stencil of one particle: Dim sets of 1D weights.
+template <int Dim, class Kernel>
+struct Stencil {
+  static constexpr int K = Kernel::K;
+  static constexpr int node_count = (Dim == 2) ? K * K : K * K * K;
+  Weights1D<K> axis[Dim];
+
+  /// Fill from position x and particle half-widths lp (uGIMP only uses lp).
+  void evaluate(const Grid<Dim>& g, const Vec<Dim>& x, const Vec<Dim>& lp) {
+    for (int d = 0; d < Dim; ++d)
+      Kernel::eval(x[d], g.lo()[d], g.cell_size()[d], g.inverse_cell_size()[d], lp[d], axis[d]);
+  }
+
+  /// Calls f(node_index, S_ip, G_ip) for every node of the stencil (zero weights included).
+  template <class F>
+  void for_each(const Grid<Dim>& g, F&& f) const {
+    const IVec<Dim>& st = g.strides();
+    if constexpr (Dim == 2) {
+      const int b0 = axis[0].base + Grid<Dim>::ghost, b1 = axis[1].base + Grid<Dim>::ghost;
+      for (int j = 0; j < K; ++j) {
+        const double wy = axis[1].w[j], dwy = axis[1].dw[j];
+        const int row = (b1 + j) * st[1];
+        for (int i = 0; i < K; ++i) {
+          const double wx = axis[0].w[i];
+          Vec<2> grad(axis[0].dw[i] * wy, wx * dwy);
+          f(row + b0 + i, wx * wy, grad);
+        }
+      }
+    } else {
+      const int b0 = axis[0].base + Grid<Dim>::ghost, b1 = axis[1].base + Grid<Dim>::ghost,
+                b2 = axis[2].base + Grid<Dim>::ghost;
+      for (int k = 0; k < K; ++k) {
+        const double wz = axis[2].w[k], dwz = axis[2].dw[k];
+        for (int j = 0; j < K; ++j) {
+          const double wy = axis[1].w[j], dwy = axis[1].dw[j];
+          const int row = (b2 + k) * st[2] + (b1 + j) * st[1];
+          for (int i = 0; i < K; ++i) {
+            const double wx = axis[0].w[i], dwx = axis[0].dw[i];
+            Vec<3> grad(dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
+            f(row + b0 + i, wx * wy * wz, grad);
+          }
+        }
+      }
+    }
+  }
+};
+
+/// Calls f(Kernel{}) with the kernel type named by kind: the one runtime switch per pass.
+template <class F>
+decltype(auto) dispatch_shape(ShapeKind kind, F&& f) {
+  switch (kind) {
+    case ShapeKind::linear: return f(LinearKernel{});
+    case ShapeKind::ugimp: return f(UGIMPKernel{});
+    case ShapeKind::quadratic_bspline: return f(QuadraticBSplineKernel{});
+  }
+  throw std::logic_error("unknown shape function kind");
+}
+
+}  // namespace frictherm::mechanics

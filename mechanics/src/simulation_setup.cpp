@@ -1,0 +1,300 @@
+// Simulation set-up: materials, bodies filled with particles, boundary conditions and loads.
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+namespace frictherm::mechanics {
+
+UpdateScheme update_scheme_from_string(const std::string& name) {
+  if (name == "usf") return UpdateScheme::usf;
+  if (name == "usl") return UpdateScheme::usl;
+  if (name == "musl") return UpdateScheme::musl;
+  throw std::invalid_argument("unknown update scheme '" + name + "' (expected usf, usl or musl)");
+}
+
+const char* to_string(UpdateScheme s) {
+  switch (s) {
+    case UpdateScheme::usf: return "usf";
+    case UpdateScheme::usl: return "usl";
+    case UpdateScheme::musl: return "musl";
+  }
+  return "?";
+}
+
+template <int Dim>
+void NodalFields<Dim>::resize(std::size_t n) {
+  mass.assign(n, 0.0);
+  momentum.assign(n, Vec<Dim>::Zero());
+  force.assign(n, Vec<Dim>::Zero());
+  velocity.assign(n, Vec<Dim>::Zero());
+  acceleration.assign(n, Vec<Dim>::Zero());
+}
+
+template <int Dim>
+void NodalFields<Dim>::clear_accumulators() {
+  std::fill(mass.begin(), mass.end(), 0.0);
+  std::fill(momentum.begin(), momentum.end(), Vec<Dim>::Zero());
+  std::fill(force.begin(), force.end(), Vec<Dim>::Zero());
+}
+
+template <int Dim>
+Simulation<Dim>::Simulation(const Grid<Dim>& grid, const SimulationOptions& options) : grid_(grid), opt_(options) {
+  if (Dim == 3) opt_.analysis = Analysis::three_d;
+  if (Dim == 2 && opt_.analysis == Analysis::three_d)
+    throw std::invalid_argument("a 2D simulation needs analysis plane_strain or plane_stress");
+  if (!(opt_.cfl > 0.0 && opt_.cfl <= 1.0)) throw std::invalid_argument("CFL factor must be in (0, 1]");
+  if (Dim == 2 && !(opt_.thickness > 0.0)) throw std::invalid_argument("thickness must be > 0");
+  nodes_.resize(grid_.node_count());
+  fixed_mask_.assign(grid_.node_count(), 0);
+  rigid_mask_.assign(grid_.node_count(), 0);
+  rigid_velocity_.assign(grid_.node_count(), Vec<Dim>::Zero());
+}
+
+template <int Dim>
+int Simulation<Dim>::add_material(const Material& m) {
+  if (finalized_) throw std::logic_error("materials must be added before the simulation is finalized");
+  if (!(m.density > 0.0)) throw std::invalid_argument("material '" + m.name + "': density must be > 0");
+  if (!m.is_rigid()) {
+    if (!(m.youngs_modulus > 0.0)) throw std::invalid_argument("material '" + m.name + "': E must be > 0");
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
+      throw std::invalid_argument("material '" + m.name + "': Poisson ratio must be in (-1, 0.5)");
+    if (m.kind == MaterialKind::neo_hookean && opt_.analysis == Analysis::plane_stress)
+      throw std::invalid_argument("material '" + m.name + "': neo_hookean needs plane_strain or 3D");
+  }
+  materials_.push_back(m);
+  return static_cast<int>(materials_.size()) - 1;
+}
+
+template <int Dim>
+int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region, int ppc, const Vec<Dim>& velocity,
+                              double temperature) {
+  if (finalized_) throw std::logic_error("bodies must be added before the simulation is finalized");
+  if (ppc < 1) throw std::invalid_argument("body '" + name + "': particles per cell must be >= 1");
+  if (taken_ppc_ != 0 && taken_ppc_ != ppc)
+    throw std::invalid_argument("body '" + name + "': every body must use the same particles per cell");
+  const Vec<Dim> blo = region.box_lo(), bhi = region.box_hi();
+  const Vec<Dim>& h = grid_.cell_size();
+  IVec<Dim> n_fine{};  // fine lattice: ppc points per cell per direction over the whole grid
+  std::size_t total = 1;
+  for (int d = 0; d < Dim; ++d) {
+    n_fine[d] = grid_.cells()[d] * ppc;
+    total *= static_cast<std::size_t>(n_fine[d]);
+  }
+  if (taken_.empty()) taken_.assign(total, 0);
+  taken_ppc_ = ppc;
+  const int body_id = static_cast<int>(bodies_.size());
+  Vec<Dim> lp;
+  double V = grid_.cell_volume() / std::pow(static_cast<double>(ppc), Dim);
+  if (Dim == 2) V *= opt_.thickness;
+  for (int d = 0; d < Dim; ++d) lp[d] = 0.5 * h[d] / ppc;
+  IVec<Dim> a_lo{}, a_hi{};
+  for (int d = 0; d < Dim; ++d) {
+    const double s = (blo[d] - grid_.lo()[d]) / h[d] * ppc - 0.5;
+    const double e = (bhi[d] - grid_.lo()[d]) / h[d] * ppc - 0.5;
+    a_lo[d] = std::max(0, static_cast<int>(std::floor(s)));
+    a_hi[d] = std::min(n_fine[d] - 1, static_cast<int>(std::ceil(e)));
+  }
+  const std::size_t before = p_.size();
+  IVec<Dim> a = a_lo;
+  bool done = false;
+  for (int d = 0; d < Dim; ++d)
+    if (a_lo[d] > a_hi[d]) done = true;
+  while (!done) {
+    Vec<Dim> x;
+    std::size_t flat = 0, stride = 1;
+    for (int d = 0; d < Dim; ++d) {
+      x[d] = grid_.lo()[d] + (a[d] + 0.5) * h[d] / ppc;
+      flat += static_cast<std::size_t>(a[d]) * stride;
+      stride *= static_cast<std::size_t>(n_fine[d]);
+    }
+    const int mat = region.material_at(x);
+    if (mat >= 0 && !taken_[flat]) {
+      if (mat >= static_cast<int>(materials_.size()))
+        throw std::invalid_argument("body '" + name + "' refers to material id " + std::to_string(mat) +
+                                    " that does not exist");
+      taken_[flat] = 1;
+      p_.add(x, lp, materials_[static_cast<std::size_t>(mat)].density * V, V, mat, body_id, temperature);
+      p_.velocity.back() = velocity;
+    }
+    for (int d = 0; d < Dim; ++d) {  // odometer increment over the box of lattice points
+      if (++a[d] <= a_hi[d]) break;
+      a[d] = a_lo[d];
+      if (d == Dim - 1) done = true;
+    }
+  }
+  const std::size_t count = p_.size() - before;
+  if (count == 0) {
+    std::ostringstream msg;
+    msg << "body '" << name << "' has no particles: its region lies outside the grid or in space already filled";
+    throw std::invalid_argument(msg.str());
+  }
+  bodies_.push_back(BodyInfo{name, count});
+  return body_id;
+}
+
+template <int Dim>
+void Simulation<Dim>::fix_face(const FixedFace& face) {
+  if (face.axis < 0 || face.axis >= Dim) throw std::invalid_argument("fixed face axis out of range");
+  faces_.push_back(face);
+  const IVec<Dim>& nn = grid_.nodes_per_dim();
+  for (std::size_t k = 0; k < grid_.node_count(); ++k) {
+    const IVec<Dim> i = grid_.node_lattice(static_cast<int>(k));
+    const int last = nn[face.axis] - 1 - 2 * Grid<Dim>::ghost;  // = cells[axis]
+    const bool on = face.upper ? i[face.axis] >= last : i[face.axis] <= 0;
+    if (!on) continue;
+    for (int d = 0; d < Dim; ++d)
+      if (face.components[static_cast<std::size_t>(d)]) fixed_mask_[k] |= static_cast<std::uint8_t>(1u << d);
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::add_point_load(const PointLoad<Dim>& load) {
+  point_loads_.push_back(load);
+  if (finalized_) resolve_loads();
+}
+
+template <int Dim>
+void Simulation<Dim>::add_edge_traction(const EdgeTraction<Dim>& load) {
+  if (load.axis < 0 || load.axis >= Dim) throw std::invalid_argument("traction axis out of range");
+  tractions_.push_back(load);
+  if (finalized_) resolve_loads();
+}
+
+template <int Dim>
+void Simulation<Dim>::finalize() {
+  if (finalized_) return;
+  if (p_.size() == 0) throw std::invalid_argument("the simulation has no particles");
+  // Group particles by material (stable, so body order is kept inside a material).
+  std::vector<std::size_t> order(p_.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [this](std::size_t a, std::size_t b) { return p_.material[a] < p_.material[b]; });
+  p_.permute(order);
+  material_begin_.assign(materials_.size(), 0);
+  material_end_.assign(materials_.size(), 0);
+  for (std::size_t m = 0, k = 0; m < materials_.size(); ++m) {
+    material_begin_[m] = k;
+    while (k < p_.size() && p_.material[k] == static_cast<int>(m)) ++k;
+    material_end_[m] = k;
+  }
+  taken_.clear();
+  taken_.shrink_to_fit();
+  empty_node_mass_ = 1e-12 * *std::max_element(p_.mass.begin(), p_.mass.end());
+  finalized_ = true;
+  resolve_loads();
+}
+
+template <int Dim>
+void Simulation<Dim>::resolve_loads() {
+  resolved_loads_.clear();
+  const auto n = p_.size();
+  for (const auto& L : point_loads_) {
+    std::vector<std::size_t> chosen;
+    if (L.use_box) {
+      for (std::size_t k = 0; k < n; ++k) {
+        if (L.body >= 0 && p_.body[k] != L.body) continue;
+        bool in = true;
+        for (int d = 0; d < Dim; ++d) in = in && p_.position[k][d] >= L.box_lo[d] && p_.position[k][d] <= L.box_hi[d];
+        if (in) chosen.push_back(k);
+      }
+    } else {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t arg = n;
+      for (std::size_t k = 0; k < n; ++k) {
+        if (L.body >= 0 && p_.body[k] != L.body) continue;
+        const double r = (p_.position[k] - L.point).squaredNorm();
+        if (r < best) best = r, arg = k;
+      }
+      if (arg < n) chosen.push_back(arg);
+    }
+    if (chosen.empty()) throw std::invalid_argument("a point load selects no particle");
+    for (std::size_t k : chosen)
+      resolved_loads_.push_back({k, L.force / static_cast<double>(chosen.size()), &L.scale});
+  }
+  for (const auto& T : tractions_) {
+    // Outer particle layer of the body on the chosen side: within half a particle of its extreme.
+    double extreme = T.upper ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < n; ++k)
+      if (p_.body[k] == T.body)
+        extreme = T.upper ? std::max(extreme, p_.position[k][T.axis]) : std::min(extreme, p_.position[k][T.axis]);
+    bool any = false;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (p_.body[k] != T.body) continue;
+      if (std::fabs(p_.position[k][T.axis] - extreme) > 0.5 * p_.half_size[k][T.axis]) continue;
+      double area = 1.0;
+      for (int d = 0; d < Dim; ++d)
+        if (d != T.axis) area *= 2.0 * p_.half_size[k][d];
+      if (Dim == 2) area *= opt_.thickness;
+      resolved_loads_.push_back({k, T.traction * area, &T.scale});
+      any = true;
+    }
+    if (!any) throw std::invalid_argument("an edge traction selects no particle");
+  }
+}
+
+template <int Dim>
+double Simulation<Dim>::stable_time_step() const {
+  double cmax = 0.0;
+  const std::size_t n = p_.size();
+  for (std::size_t m = 0; m < materials_.size(); ++m) {
+    const Material& mat = materials_[m];
+    const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
+    if (mat.is_rigid()) continue;
+    const double c0 = mat.p_wave_speed(opt_.analysis);
+    const bool nh = mat.kind == MaterialKind::neo_hookean;
+    double local = 0.0;
+#pragma omp parallel for reduction(max : local) schedule(static)
+    for (std::size_t k = b; k < e; ++k) {
+      if (!finalized_ && p_.material[k] != static_cast<int>(m)) continue;
+      const double c = nh ? mat.wave_speed(opt_.analysis, p_.volume[k] / p_.initial_volume[k]) : c0;
+      local = std::max(local, c + p_.velocity[k].norm());
+    }
+    cmax = std::max(cmax, local);
+  }
+  for (const Material& mat : materials_)  // rigid bodies move material through the grid too
+    if (mat.is_rigid()) cmax = std::max(cmax, mat.rigid_velocity_at(time_).norm());
+  if (cmax <= 0.0) return opt_.max_time_step;
+  return std::min(opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step);
+}
+
+template <int Dim>
+double Simulation<Dim>::kinetic_energy() const {
+  double e = 0.0;
+  for (std::size_t k = 0; k < p_.size(); ++k)
+    if (!materials_[static_cast<std::size_t>(p_.material[k])].is_rigid()) e += 0.5 * p_.mass[k] * p_.velocity[k].squaredNorm();
+  return e;
+}
+
+template <int Dim>
+double Simulation<Dim>::strain_energy() const {
+  double e = 0.0;
+  for (std::size_t k = 0; k < p_.size(); ++k) {
+    const Material& m = materials_[static_cast<std::size_t>(p_.material[k])];
+    if (m.kind == MaterialKind::neo_hookean)
+      e += p_.initial_volume[k] *
+           neo_hookean_energy_density<Dim>(p_.deformation_gradient[k], m.lame_lambda(), m.shear_modulus());
+    else if (m.kind == MaterialKind::linear_elastic)
+      e += p_.volume[k] * linear_elastic_energy_density<Dim>(p_.stress[k], p_.stress_zz[k], m.youngs_modulus,
+                                                              m.poisson_ratio, opt_.analysis);
+  }
+  return e;
+}
+
+template <int Dim>
+Vec<Dim> Simulation<Dim>::linear_momentum() const {
+  Vec<Dim> P = Vec<Dim>::Zero();
+  for (std::size_t k = 0; k < p_.size(); ++k)
+    if (!materials_[static_cast<std::size_t>(p_.material[k])].is_rigid()) P += p_.mass[k] * p_.velocity[k];
+  return P;
+}
+
+template struct NodalFields<2>;
+template struct NodalFields<3>;
+template class Simulation<2>;
+template class Simulation<3>;
+
+}  // namespace frictherm::mechanics
