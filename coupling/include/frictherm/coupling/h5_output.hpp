@@ -1,0 +1,89 @@
+#pragma once
+// One HDF5 file per run, written so that a run that dies keeps what it already wrote.
+//
+// Layout (all datasets little-endian; names are the contract the plotting scripts rely on):
+//   /                      attrs: format = "frictherm-output", format_version = 1, dim
+//   /meta/<key>            scalar datasets: fixed-length UTF-8 strings or doubles
+//   /snapshots/000000 ...  one group per snapshot, attrs step (int64) and time (double);
+//                          datasets (n) for one component, (n, components) otherwise
+//   /failure               the state a failed run stopped in (same shape), attr message
+//   /series/<column>       extendible 1-D doubles, /series/time first; attr columns on /series
+//                          lists the column names in declared order
+//   /xdmf/polyvertex_<n>   int32 0..n-1, the Polyvertex connectivity the XDMF file points at
+// Beside RUN.h5 an XDMF file RUN.xdmf (ParaView: Xdmf3ReaderS) lists every ended snapshot.
+//
+// Not thread-safe (the serial HDF5 library is not): use one thread for all output calls.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling {
+
+struct H5OutputOptions {
+  /// Series rows kept in memory before they are written (and the file flushed).
+  std::size_t series_batch_rows = 64;
+  /// Write RUN.xdmf beside RUN.h5 (rewritten after every ended snapshot).
+  bool write_xdmf = true;
+};
+
+class H5Output {
+ public:
+  /// Creates or truncates `path`. dim is 2 or 3. Throws std::runtime_error naming the file when it
+  /// cannot be created (missing directory, no permission, ...).
+  H5Output(const std::string& path, int dim, H5OutputOptions options = {});
+  /// Calls close(); errors are reported on std::cerr, never thrown. An unfinished snapshot
+  /// (begin_* without end_snapshot) is discarded.
+  ~H5Output();
+  H5Output(const H5Output&) = delete;
+  H5Output& operator=(const H5Output&) = delete;
+  H5Output(H5Output&&) noexcept;
+  H5Output& operator=(H5Output&&) noexcept;
+
+  /// Run metadata under /meta/<key> (key: no '/', not empty). Writing a key again replaces it.
+  /// The file is flushed after each call.
+  void write_metadata(const std::string& key, const std::string& value);
+  void write_metadata(const std::string& key, double value);
+
+  /// Starts particle snapshot number snapshot_count(). Fields follow, then end_snapshot().
+  void begin_snapshot(long step, double time);
+  /// n rows x components doubles, row-major. Conventional names: position (n x dim, required for
+  /// the XDMF geometry), velocity, displacement (n x dim), stress (n x dim*dim), mass, volume,
+  /// temperature, ... Every field of one snapshot must have the same n.
+  void snapshot_field(const std::string& name, const double* data, std::size_t n, int components);
+  /// Integer per-particle field (material id, body id).
+  void snapshot_field(const std::string& name, const std::int32_t* data, std::size_t n);
+  /// Links the snapshot into the file, writes pending series rows, flushes the file (H5Fflush)
+  /// and rewrites the XDMF file (temporary file, then rename). Only ended snapshots are visible
+  /// in the file: one interrupted mid-way is never half-present.
+  void end_snapshot();
+  /// Starts the failure snapshot /failure (fields as for begin_snapshot, then end_snapshot()).
+  /// Discards an unfinished regular snapshot. A second failure replaces the first.
+  void begin_failure(long step, double time, const std::string& message);
+  bool in_snapshot() const;
+
+  /// Declares the series columns once; names.front() must be "time".
+  void declare_series(const std::vector<std::string>& names);
+  /// One row, in declared column order. Buffered; written every series_batch_rows rows, at
+  /// end_snapshot() and at flush().
+  void append_series(const std::vector<double>& row);
+  std::size_t series_rows() const;  // rows appended so far (written or buffered)
+
+  /// Writes buffered series rows and flushes the file to the operating system.
+  void flush();
+  /// Flushes, rewrites the XDMF file and closes the file. Further calls throw std::logic_error.
+  void close();
+
+  std::size_t snapshot_count() const;  // ended regular snapshots
+  const std::string& path() const;
+  const std::string& xdmf_path() const;
+  int dim() const;
+
+ private:
+  struct Impl;
+  Impl& live() const;  // throws std::logic_error once closed or moved from
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace frictherm::coupling

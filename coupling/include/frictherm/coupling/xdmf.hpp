@@ -1,0 +1,49 @@
+#pragma once
+// XDMF 3 text for particle snapshots stored in HDF5 (read by ParaView's Xdmf3ReaderS).
+// One temporal collection; one Uniform grid per snapshot with Polyvertex topology (one vertex
+// cell per particle, connectivity 0..n-1 read from the HDF5 file), geometry from the snapshot's
+// `position` dataset (XY in 2D, XYZ in 3D) and every other field as a node-centred Attribute.
+// Heavy data is referenced by the HDF5 file's name relative to the XDMF file.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling {
+
+struct XdmfField {
+  std::string name;     // dataset name inside the snapshot group
+  int components = 1;   // columns of the (n, components) dataset; 1 for an (n) dataset
+  bool integer = false; // int32 rather than float64
+};
+
+struct XdmfGrid {
+  std::string name;          // grid name shown by ParaView (e.g. "000012" or "failure")
+  std::string h5_group;      // absolute HDF5 group path, e.g. "/snapshots/000012"
+  std::string connectivity;  // absolute HDF5 path of the int32 dataset 0..points-1
+  long step = 0;
+  double time = 0.0;
+  std::size_t points = 0;
+  std::vector<XdmfField> fields;  // must include "position" with `dim` components
+};
+
+/// "Scalar" (1), "Vector" (dim), in 3D "Tensor" (9) and "Tensor6" (6), otherwise "Matrix".
+std::string xdmf_attribute_type(int components, int dim);
+
+/// The XML of one grid (indented for the temporal collection). Throws std::invalid_argument when
+/// the grid has no position field of `dim` components or no points.
+std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name, int dim);
+
+/// A whole XDMF document around already rendered grids (see xdmf_grid_xml).
+std::string xdmf_document(const std::vector<std::string>& grid_xml);
+
+/// Writes `text` to `path` atomically: `path`.tmp is written, then renamed over `path`, so a
+/// reader never sees a half-written file. Throws std::runtime_error naming the file.
+void write_text_atomically(const std::string& path, const std::string& text);
+
+/// RUN.h5 -> RUN.xdmf (also for .hdf5/.he5; any other name gets .xdmf appended).
+std::string xdmf_path_for(const std::string& h5_path);
+
+/// Escapes &, <, >, " and ' for XML text and attribute values.
+std::string xml_escape(const std::string& text);
+
+}  // namespace frictherm::coupling

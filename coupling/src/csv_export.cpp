@@ -1,0 +1,167 @@
+#include <frictherm/coupling/csv_export.hpp>
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <ostream>
+#include <stdexcept>
+
+namespace frictherm::coupling {
+namespace {
+
+// Minimal RAII for the reader (the writer's richer helpers live in h5_output.cpp).
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() {
+    if (id_ >= 0) closer_(id_);
+  }
+  hid_t get() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*closer_)(hid_t);
+};
+
+class Quiet {  // no HDF5 error printing; failures become exceptions
+ public:
+  Quiet() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  Quiet(const Quiet&) = delete;
+  Quiet& operator=(const Quiet&) = delete;
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+[[noreturn]] void fail(const std::string& file, const std::string& what) {
+  std::string reason;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_UPWARD,
+      [](unsigned n, const H5E_error2_t* err, void* out) -> herr_t {
+        auto& text = *static_cast<std::string*>(out);
+        if (n < 2 && err->desc != nullptr && *err->desc != '\0') {
+          text += (text.empty() ? "" : "; ") + std::string(err->desc);
+        }
+        return 0;
+      },
+      &reason);
+  throw std::runtime_error("HDF5 file '" + file + "': " + what + (reason.empty() ? "" : " (" + reason + ")"));
+}
+hid_t check_id(hid_t id, const std::string& file, const std::string& what) {
+  if (id < 0) fail(file, what);
+  return id;
+}
+void check(herr_t status, const std::string& file, const std::string& what) {
+  if (status < 0) fail(file, what);
+}
+
+std::string csv_name(const std::string& name) {
+  if (name.find_first_of(",\"\r\n") == std::string::npos) return name;
+  std::string quoted = "\"";
+  for (const char c : name) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + '"';
+}
+
+void put_number(std::ostream& out, double value) {
+  if (std::isnan(value)) {
+    out << "nan";
+  } else if (std::isinf(value)) {
+    out << (value > 0 ? "inf" : "-inf");
+  } else {
+    char buf[64];
+    const auto result = std::to_chars(buf, buf + sizeof buf, value);
+    out.write(buf, result.ptr - buf);
+  }
+}
+
+}  // namespace
+
+SeriesTable read_series(const std::string& h5_path) {
+  const Quiet quiet;
+  SeriesTable table;
+  const Handle f{check_id(H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), h5_path, "cannot open the file"),
+                 H5Fclose};
+  if (H5Lexists(f.get(), "series", H5P_DEFAULT) <= 0) return table;
+  const Handle g{check_id(H5Gopen2(f.get(), "series", H5P_DEFAULT), h5_path, "cannot open /series"), H5Gclose};
+  if (H5Aexists(g.get(), "columns") > 0) {
+    const Handle a{check_id(H5Aopen(g.get(), "columns", H5P_DEFAULT), h5_path, "cannot open /series attribute columns"),
+                   H5Aclose};
+    const Handle t{check_id(H5Aget_type(a.get()), h5_path, "cannot read the type of /series attribute columns"),
+                   H5Tclose};
+    const Handle s{check_id(H5Aget_space(a.get()), h5_path, "cannot read /series attribute columns"), H5Sclose};
+    const std::size_t size = H5Tget_size(t.get());
+    const hssize_t count = H5Sget_simple_extent_npoints(s.get());
+    if (H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) > 0 || size == 0 || count < 0) {
+      fail(h5_path, "/series attribute columns is not a fixed-length string array");
+    }
+    std::string packed(size * static_cast<std::size_t>(count), '\0');
+    check(H5Aread(a.get(), t.get(), packed.data()), h5_path, "cannot read /series attribute columns");
+    for (hssize_t i = 0; i < count; ++i) {
+      std::string name = packed.substr(static_cast<std::size_t>(i) * size, size);
+      name.resize(std::min(name.size(), name.find('\0')));
+      table.names.push_back(name);
+    }
+  } else {  // a file not written by H5Output: every dataset, "time" first
+    hsize_t idx = 0;
+    check(H5Literate(g.get(), H5_INDEX_NAME, H5_ITER_INC, &idx,
+                     [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
+                       static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+                       return 0;
+                     },
+                     &table.names),
+          h5_path, "cannot list /series");
+    std::stable_partition(table.names.begin(), table.names.end(), [](const std::string& n) { return n == "time"; });
+  }
+  std::size_t rows = std::numeric_limits<std::size_t>::max();
+  for (const auto& name : table.names) {
+    const std::string where = "/series/" + name;
+    const Handle d{check_id(H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT), h5_path, "cannot open " + where), H5Dclose};
+    const Handle s{check_id(H5Dget_space(d.get()), h5_path, "cannot read the shape of " + where), H5Sclose};
+    const hssize_t n = H5Sget_simple_extent_npoints(s.get());
+    if (n < 0 || H5Sget_simple_extent_ndims(s.get()) != 1) fail(h5_path, where + " is not a 1-D dataset");
+    std::vector<double> column(static_cast<std::size_t>(n));
+    if (n > 0) {
+      check(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, column.data()), h5_path,
+            "cannot read " + where);
+    }
+    rows = std::min(rows, column.size());
+    table.columns.push_back(std::move(column));
+  }
+  for (auto& c : table.columns) c.resize(rows);
+  return table;
+}
+
+void write_series_csv(const SeriesTable& table, std::ostream& out) {
+  if (table.names.empty()) return;
+  for (std::size_t j = 0; j < table.names.size(); ++j) out << (j ? "," : "") << csv_name(table.names[j]);
+  out << '\n';
+  const std::size_t rows = table.rows();
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t j = 0; j < table.columns.size(); ++j) {
+      if (j) out << ',';
+      put_number(out, table.columns[j][r]);
+    }
+    out << '\n';
+  }
+}
+
+void export_series_csv(const std::string& h5_path, std::ostream& out) {
+  write_series_csv(read_series(h5_path), out);
+  out.flush();
+  if (!out) throw std::runtime_error("export of the series of '" + h5_path + "': writing the CSV failed");
+}
+
+}  // namespace frictherm::coupling
