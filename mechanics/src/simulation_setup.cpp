@@ -247,7 +247,7 @@ double Simulation<Dim>::stable_time_step() const {
     const double c0 = mat.p_wave_speed(opt_.analysis);
     const bool nh = mat.kind == MaterialKind::neo_hookean;
     double local = 0.0;
-#pragma omp parallel for reduction(max : local) schedule(static)
+#pragma omp parallel for num_threads(threads_) reduction(max : local) schedule(static)
     for (std::size_t k = b; k < e; ++k) {
       if (!finalized_ && p_.material[k] != static_cast<int>(m)) continue;
       const double c = nh ? mat.wave_speed(opt_.analysis, p_.volume[k] / p_.initial_volume[k]) : c0;

@@ -37,7 +37,11 @@ double Simulation<Dim>::step(double dt_limit) {
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::step_with(double dt) {
-  const int nthreads = omp_get_max_threads();
+  // Below ~2000 particles per thread the fork/join and the scatter-buffer reduction cost more than
+  // the particle work they share.
+  const int max_threads = omp_get_max_threads();
+  threads_ = std::max(1, std::min(max_threads, static_cast<int>(p_.size() / 2000)));
+  const int nthreads = threads_;
   if (static_cast<int>(thread_nodes_.size()) != nthreads - 1) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, nthreads - 1)));
     for (auto& t : thread_nodes_) t.resize(grid_.node_count());
@@ -49,7 +53,7 @@ void Simulation<Dim>::step_with(double dt) {
     map_rigid_particles<Kernel>(t);
     apply_velocity_bc(nodes_.momentum, nullptr);
     const double mmin = empty_node_mass_;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static)
     for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
       nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
     update_stress<Kernel>(nodes_.velocity, dt);
@@ -81,7 +85,7 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   nodes_.clear_accumulators();
-#pragma omp parallel
+#pragma omp parallel num_threads(threads_)
   {
     const int tid = omp_get_thread_num();
     NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
@@ -129,7 +133,7 @@ template <class Kernel>
 void Simulation<Dim>::add_internal_forces() {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
-#pragma omp parallel
+#pragma omp parallel num_threads(threads_)
   {
     const int tid = omp_get_thread_num();
     NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
@@ -187,7 +191,7 @@ void Simulation<Dim>::map_external_loads(double t) {
 template <int Dim>
 void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const {
   const std::size_t n = momentum.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     if (rigid_mask_[i]) {
       momentum[i] = nodes_.mass[i] * rigid_velocity_[i];
@@ -209,7 +213,7 @@ void Simulation<Dim>::update_grid(double dt) {
   apply_velocity_bc(nodes_.momentum, &nodes_.force);
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     const double m = nodes_.mass[i];
     if (m > mmin) {
@@ -222,7 +226,7 @@ void Simulation<Dim>::update_grid(double dt) {
   }
   // Boundary conditions hold for the new velocity too (rigid: v_rigid, fixed: 0). Since the force was
   // constrained consistently, only rigid nodes whose prescribed velocity changed need fixing.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     if (rigid_mask_[i] && nodes_.mass[i] > mmin) nodes_.velocity[i] = rigid_velocity_[i];
   }
@@ -240,7 +244,7 @@ long Simulation<Dim>::update_particles(double dt) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (materials_[m].is_rigid()) continue;
     const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
-#pragma omp parallel for schedule(static) reduction(min : bad) reduction(+ : work)
+#pragma omp parallel for num_threads(threads_) schedule(static) reduction(min : bad) reduction(+ : work)
     for (long kk = b; kk < e; ++kk) {
       const std::size_t k = static_cast<std::size_t>(kk);
       Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
@@ -307,7 +311,7 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::remap_momentum() {
   auto& st = stencils<Kernel>();
-#pragma omp parallel
+#pragma omp parallel num_threads(threads_)
   {
     const int tid = omp_get_thread_num();
     NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
@@ -330,7 +334,7 @@ void Simulation<Dim>::remap_momentum() {
   }
   apply_velocity_bc(nodes_.momentum, nullptr);
   const double mmin = empty_node_mass_;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
     nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
 }
@@ -346,7 +350,7 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
     if (mat.is_rigid()) continue;
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
     const bool nh = mat.kind == MaterialKind::neo_hookean;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(threads_) schedule(static)
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
       st[k].for_each(grid_, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });

@@ -16,7 +16,7 @@ using namespace frictherm::mechanics;
 namespace {
 
 template <int Dim>
-std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shape, UpdateScheme scheme) {
+std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int ppc = 2) {
   const double h = Dim == 2 ? 0.05 : 0.1;
   const int n = Dim == 2 ? 40 : 20;
   IVec<Dim> cells;
@@ -34,7 +34,7 @@ std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shap
   m.poisson_ratio = 0.4;
   const int mat = sim.add_material(m);
   const Vec<Dim> c = Vec<Dim>::Constant(0.5 * n * h);
-  sim.add_body("disk", *make_ellipse<Dim>(c, Vec<Dim>::Constant(0.25 * n * h), 0.0, mat), 2, Vec<Dim>::Zero());
+  sim.add_body("disk", *make_ellipse<Dim>(c, Vec<Dim>::Constant(0.25 * n * h), 0.0, mat), ppc, Vec<Dim>::Zero());
   // Translation + rotation about z + a non-uniform radial pulse, so stress waves develop.
   auto& p = sim.particles();
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -48,7 +48,8 @@ std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shap
 template <int Dim>
 void spin_and_check(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int threads) {
   omp_set_num_threads(threads);
-  auto owned = spinning_disk<Dim>(kind, shape, scheme);
+  // The simulation threads only above ~2000 particles per thread: 4 per cell per direction then.
+  auto owned = spinning_disk<Dim>(kind, shape, scheme, threads > 1 ? 4 : 2);
   Simulation<Dim>& sim = *owned;
   const auto& p = sim.particles();
   const Vec<Dim> P0 = sim.linear_momentum();

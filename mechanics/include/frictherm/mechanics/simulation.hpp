@@ -143,7 +143,8 @@ class Simulation {
   long step_ = 0;
   double last_dt_ = 0.0;
   double external_work_ = 0.0;
-  double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
+  double empty_node_mass_ = 0.0;
+  int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
 };
 
 extern template class Simulation<2>;
