@@ -1,0 +1,112 @@
+// thermal::Problem validation and right-hand side (unit).
+#include "grids.hpp"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace ft = frictherm::thermal;
+using thermal_test::make_grid_1d;
+using thermal_test::Material;
+
+namespace {
+
+template <class F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "<no exception>";
+}
+
+ft::SparseMatrix dense_to_sparse(const Eigen::MatrixXd& a) { return a.sparseView(); }
+
+}  // namespace
+
+TEST(ThermalProblem, RejectsNonPositiveMass) {
+  const auto g = make_grid_1d(4, 0.0, 1.0, Material{});
+  Eigen::VectorXd m = g.mass;
+  m[1] = -1.0;
+  const auto msg = message_of([&] { ft::Problem p(m, g.k); });
+  EXPECT_NE(msg.find("M[1]"), std::string::npos) << msg;
+  m[1] = 0.0;
+  EXPECT_THROW(ft::Problem(m, g.k), std::invalid_argument);
+}
+
+TEST(ThermalProblem, RejectsSizeMismatchAsymmetryAndNegativeDiagonal) {
+  const auto g = make_grid_1d(4, 0.0, 1.0, Material{});
+  const Eigen::VectorXd m3 = g.mass.head(3);
+  EXPECT_NE(message_of([&] { ft::Problem p(m3, g.k); }).find("size mismatch"), std::string::npos);
+
+  Eigen::MatrixXd a = Eigen::MatrixXd(g.k);
+  a(0, 1) = -2.0;  // K(0,1) != K(1,0)
+  const auto msg = message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); });
+  EXPECT_NE(msg.find("not symmetric"), std::string::npos) << msg;
+
+  a = -Eigen::MatrixXd(g.k);
+  EXPECT_NE(message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); }).find("< 0"), std::string::npos);
+}
+
+TEST(ThermalProblem, RejectsBadNodesSourcesAndStates) {
+  auto p = make_grid_1d(4, 0.0, 1.0, Material{}).problem();
+  EXPECT_THROW(p.set_dirichlet(4, 1.0), std::invalid_argument);
+  EXPECT_THROW(p.add_flux(-1, 1.0), std::invalid_argument);
+  EXPECT_THROW(p.add_convection(0, -1.0, 300.0), std::invalid_argument);
+  EXPECT_THROW(p.set_source(Eigen::VectorXd::Ones(3)), std::invalid_argument);
+  EXPECT_THROW(p.set_source_ramp(Eigen::VectorXd::Ones(4), Eigen::VectorXd::Ones(4), 1.0, 1.0),
+               std::invalid_argument);
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(4);
+  t[2] = std::nan("");
+  EXPECT_THROW(p.check_state(t), std::invalid_argument);
+  EXPECT_THROW(p.check_state(Eigen::VectorXd::Zero(5)), std::invalid_argument);
+}
+
+TEST(ThermalProblem, HeatRateHasEveryTerm) {
+  // 3 nodes, dx = 1, ρc = 1: lumped M = (0.5, 1, 0.5), conductance 1 between neighbours.
+  const auto g = make_grid_1d(3, 0.0, 2.0, Material{1.0, 1.0});
+  ft::Problem p = g.problem();
+  p.set_source(Eigen::Vector3d(1.0, 0.0, 0.0));
+  p.add_flux(1, 2.0);
+  p.add_convection(2, 0.5, 10.0);
+  const Eigen::Vector3d temp(1.0, 2.0, 4.0);
+  Eigen::VectorXd w(3);
+  p.heat_rate(0.0, temp, w);
+  // w = −K T + q + f + hA (T_inf − T), by hand:
+  EXPECT_DOUBLE_EQ(w[0], -(1.0 - 2.0) + 1.0);
+  EXPECT_DOUBLE_EQ(w[1], -(-1.0 + 2.0 * 2.0 - 4.0) + 2.0);
+  EXPECT_DOUBLE_EQ(w[2], -(-2.0 + 4.0) + 0.5 * (10.0 - 4.0));
+  EXPECT_DOUBLE_EQ(p.boundary_and_source_power(0.0, temp), 1.0 + 2.0 + 3.0);
+  Eigen::VectorXd f(3);
+  p.rhs(0.0, temp, f);
+  EXPECT_DOUBLE_EQ(f[1], w[1] / 1.0);  // M_1 = 1
+  EXPECT_DOUBLE_EQ(f[0], w[0] / 0.5);  // M_0 = 0.5
+  p.set_dirichlet(0, 7.0);
+  p.heat_rate(0.0, temp, w);
+  EXPECT_EQ(w[0], 0.0);  // fixed node: dT/dt = 0
+  Eigen::VectorXd t2 = temp;
+  p.apply_dirichlet(t2);
+  EXPECT_EQ(t2[0], 7.0);
+}
+
+TEST(ThermalProblem, SourceRampIsLinearAndClamped) {
+  auto p = make_grid_1d(2, 0.0, 1.0, Material{}).problem();
+  p.set_source_ramp(Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(3.0, 4.0), 10.0, 12.0);
+  EXPECT_DOUBLE_EQ(p.source(11.0)[0], 2.0);  // q0 + (t−t0)/(t1−t0)(q1−q0)
+  EXPECT_DOUBLE_EQ(p.source(11.5)[1], 3.0);
+  EXPECT_DOUBLE_EQ(p.source(5.0)[0], 1.0);   // held at q0 before the window
+  EXPECT_DOUBLE_EQ(p.source(20.0)[1], 4.0);  // and at q1 after it
+}
+
+TEST(ThermalProblem, RevisionTracksOperatorChangesOnly) {
+  auto p = make_grid_1d(3, 0.0, 1.0, Material{}).problem();
+  const auto r0 = p.revision();
+  p.set_source(Eigen::VectorXd::Ones(3));
+  EXPECT_EQ(p.revision(), r0);  // sources do not change the Jacobian
+  p.add_convection(1, 1.0, 0.0);
+  EXPECT_NE(p.revision(), r0);
+  const auto q = make_grid_1d(3, 0.0, 1.0, Material{}).problem();
+  EXPECT_NE(q.revision(), p.revision());  // unique across objects
+}

@@ -1,0 +1,97 @@
+// Semi-discrete heat equation on a set of nodes (design §3, Nairn et al. 2018 eq. 37–38):
+//
+//   M dT/dt = −K T + q(t) + f + hA ⊙ (T_inf − T),      T_d fixed on Dirichlet nodes d,
+//
+// with M the diagonal (lumped) heat capacity [J/K], K the symmetric conductance matrix [W/K],
+// q(t) nodal sources [W] (constant, or linear in time over a window), f prescribed nodal heat
+// inputs [W] (flux boundaries) and hA ⊙ (T_inf − T) convective exchange [W].
+// The module knows nothing about where M and K come from (MPM, FD or FE grids).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <cstdint>
+#include <vector>
+
+namespace frictherm::thermal {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+using Index = Eigen::Index;
+
+class Problem {
+ public:
+  // Throws std::invalid_argument if M has a non-positive or non-finite entry, if K is not
+  // square of the same size, not symmetric (|K_ij − K_ji| > symmetry_tol·max|K|), has a
+  // non-finite entry or a negative diagonal. K is assumed positive semi-definite; only these
+  // necessary conditions are checked.
+  Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol = 1e-12);
+
+  Index size() const { return mass_.size(); }
+  const Eigen::VectorXd& mass() const { return mass_; }
+  const SparseMatrix& conductance() const { return k_; }
+
+  // ---- sources q(t) [W per node] ----
+  // Constant in time.
+  void set_source(Eigen::VectorXd q);
+  // Linear over [t0, t1]: q(t) = q0 + (t − t0)/(t1 − t0)·(q1 − q0); held at q0 before t0 and
+  // at q1 after t1. Requires t1 > t0.
+  void set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1, double t0, double t1);
+  void clear_source();
+  bool has_source() const { return has_source_; }
+  // q(t), the total source per node (zeros without a source).
+  Eigen::VectorXd source(double t) const;
+
+  // ---- boundaries ----
+  // Fixes node's temperature [K]. Its equation becomes dT/dt = 0.
+  void set_dirichlet(Index node, double temperature);
+  void clear_dirichlet();
+  bool is_dirichlet(Index node) const { return fixed_[static_cast<std::size_t>(node)] != 0; }
+  const std::vector<Index>& dirichlet_nodes() const { return dirichlet_nodes_; }
+  // Adds a prescribed heat input [W] to a node (a flux boundary times its nodal area).
+  void add_flux(Index node, double watts);
+  // Adds convective exchange hA [W/K] with an ambient at T_inf [K] to a node.
+  void add_convection(Index node, double h_times_area, double t_inf);
+  void clear_boundaries();  // fluxes and convection (not Dirichlet nodes)
+  const Eigen::VectorXd& flux() const { return flux_; }
+  const Eigen::VectorXd& convection_coefficients() const { return ha_; }
+
+  // ---- evaluation ----
+  // Nodal heat rate w = −K T + q(t) + f + hA ⊙ (T_inf − T) [W]; zero on Dirichlet nodes.
+  void heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                 Eigen::Ref<Eigen::VectorXd> w) const;
+  // dT/dt = M⁻¹ w.
+  void rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+           Eigen::Ref<Eigen::VectorXd> dTdt) const;
+  // Σ over free nodes of q(t) + f + hA ⊙ (T_inf − T) [W]: the power entering through sources
+  // and boundaries (conduction only moves heat between nodes since K has zero row sums).
+  double boundary_and_source_power(double t, const Eigen::VectorXd& temperature) const;
+  // Σ_i M_i T_i [J] (thermal-notes §4 invariant).
+  double thermal_energy(const Eigen::VectorXd& temperature) const;
+  // Writes the Dirichlet values into T.
+  void apply_dirichlet(Eigen::VectorXd& temperature) const;
+  // Throws std::invalid_argument unless T has size() finite entries.
+  void check_state(const Eigen::VectorXd& temperature) const;
+
+  // Changes whenever M, K or a boundary changes (not when sources change); integrators use it
+  // to know when to rebuild Jacobians. Unique across all Problem objects.
+  std::uint64_t revision() const { return revision_; }
+
+ private:
+  void check_node(Index node, const char* what) const;
+  void check_source_vector(const Eigen::VectorXd& q, const char* what) const;
+  void touch();
+
+  Eigen::VectorXd mass_;
+  SparseMatrix k_;
+  bool has_source_ = false;
+  Eigen::VectorXd q0_, q1_;
+  double ramp_t0_ = 0.0, ramp_t1_ = 0.0;
+  std::vector<unsigned char> fixed_;
+  std::vector<Index> dirichlet_nodes_;
+  Eigen::VectorXd fixed_value_;
+  Eigen::VectorXd flux_, ha_, ha_tinf_;
+  std::uint64_t revision_ = 0;
+};
+
+}  // namespace frictherm::thermal

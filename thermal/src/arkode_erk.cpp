@@ -1,0 +1,42 @@
+#include "arkode_integrators.hpp"
+
+#include <arkode/arkode_erkstep.h>
+
+namespace frictherm::thermal::detail {
+
+ArkodeErk::ArkodeErk(const IntegratorOptions& options)
+    : SundialsIntegrator("arkode_erk", options, parse_linear_solver("arkode_erk", options.linear_solver)) {}
+
+void ArkodeErk::create(double t0) {
+  mem_ = MemPtr(ERKStepCreate(&OdeSystem::rhs, t0, y_.get(), ctx_.get()), MemDeleter{&ERKStepFree});
+  check_ptr(mem_.get(), "ERKStepCreate", name_);
+  void* mem = mem_.get();
+  check(ERKStepSetErrHandlerFn(mem, &ErrorSink::handler, &sink_), "ERKStepSetErrHandlerFn");
+  check(ERKStepSVtolerances(mem, opt_.rtol, abstol_.get()), "ERKStepSVtolerances");
+  check(ERKStepSetUserData(mem, &sys_), "ERKStepSetUserData");
+  check(ERKStepSetMaxNumSteps(mem, opt_.max_steps), "ERKStepSetMaxNumSteps");
+}
+
+void ArkodeErk::reinit(double t0) {
+  check(ERKStepReInit(mem_.get(), &OdeSystem::rhs, t0, y_.get()), "ERKStepReInit");
+}
+
+int ArkodeErk::evolve(double t1) {
+  check(ERKStepSetStopTime(mem_.get(), t1), "ERKStepSetStopTime");
+  sunrealtype tret = 0.0;
+  return ERKStepEvolve(mem_.get(), t1, y_.get(), &tret, ARK_NORMAL);
+}
+
+IntegratorStats ArkodeErk::counters() const {
+  IntegratorStats s;
+  void* mem = mem_.get();
+  if (mem == nullptr) return s;
+  ERKStepGetNumSteps(mem, &s.steps);
+  ERKStepGetNumRhsEvals(mem, &s.rhs_evals);
+  ERKStepGetNumErrTestFails(mem, &s.error_test_failures);
+  return s;
+}
+
+FlagNameFn ArkodeErk::flag_name_fn() const { return &ERKStepGetReturnFlagName; }
+
+}  // namespace frictherm::thermal::detail

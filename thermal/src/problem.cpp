@@ -1,0 +1,224 @@
+#include "frictherm/thermal/problem.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::thermal {
+namespace {
+
+std::uint64_t next_revision() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
+[[noreturn]] void fail(const std::string& msg) { throw std::invalid_argument("thermal::Problem: " + msg); }
+
+}  // namespace
+
+Problem::Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol)
+    : mass_(std::move(mass)), k_(std::move(conductance)) {
+  const Index n = mass_.size();
+  if (n == 0) fail("the mass vector M is empty (need at least one node)");
+  for (Index i = 0; i < n; ++i) {
+    if (!std::isfinite(mass_[i]) || mass_[i] <= 0.0) {
+      std::ostringstream os;
+      os << "heat capacity M[" << i << "] = " << mass_[i]
+         << " J/K must be finite and > 0 (remove empty nodes before building the problem)";
+      fail(os.str());
+    }
+  }
+  if (k_.rows() != n || k_.cols() != n) {
+    std::ostringstream os;
+    os << "size mismatch: M has " << n << " nodes but K is " << k_.rows() << "x" << k_.cols();
+    fail(os.str());
+  }
+  k_.makeCompressed();
+  double kmax = 0.0;
+  for (Index r = 0; r < n; ++r) {
+    for (SparseMatrix::InnerIterator it(k_, r); it; ++it) {
+      if (!std::isfinite(it.value())) {
+        std::ostringstream os;
+        os << "K(" << r << "," << it.col() << ") is not finite";
+        fail(os.str());
+      }
+      kmax = std::max(kmax, std::abs(it.value()));
+    }
+  }
+  const SparseMatrix kt = k_.transpose();
+  const SparseMatrix diff = k_ - kt;
+  for (Index r = 0; r < n; ++r) {
+    for (SparseMatrix::InnerIterator it(diff, r); it; ++it) {
+      if (std::abs(it.value()) > symmetry_tol * kmax) {
+        std::ostringstream os;
+        os << "K is not symmetric: K(" << r << "," << it.col() << ") − K(" << it.col() << "," << r
+           << ") = " << it.value() << " (tolerance " << symmetry_tol * kmax << ")";
+        fail(os.str());
+      }
+    }
+    if (k_.coeff(r, r) < 0.0) {
+      std::ostringstream os;
+      os << "K(" << r << "," << r << ") = " << k_.coeff(r, r) << " < 0: K must be positive semi-definite";
+      fail(os.str());
+    }
+  }
+  fixed_.assign(static_cast<std::size_t>(n), 0);
+  fixed_value_ = Eigen::VectorXd::Zero(n);
+  flux_ = Eigen::VectorXd::Zero(n);
+  ha_ = Eigen::VectorXd::Zero(n);
+  ha_tinf_ = Eigen::VectorXd::Zero(n);
+  revision_ = next_revision();
+}
+
+void Problem::touch() { revision_ = next_revision(); }
+
+void Problem::check_node(Index node, const char* what) const {
+  if (node < 0 || node >= size()) {
+    std::ostringstream os;
+    os << what << ": node " << node << " out of range [0, " << size() << ")";
+    fail(os.str());
+  }
+}
+
+void Problem::check_source_vector(const Eigen::VectorXd& q, const char* what) const {
+  if (q.size() != size()) {
+    std::ostringstream os;
+    os << what << ": size mismatch, source has " << q.size() << " entries for " << size() << " nodes";
+    fail(os.str());
+  }
+  if (!q.allFinite()) fail(std::string(what) + ": source has a non-finite entry");
+}
+
+void Problem::set_source(Eigen::VectorXd q) {
+  check_source_vector(q, "set_source");
+  q0_ = std::move(q);
+  q1_ = q0_;
+  ramp_t0_ = ramp_t1_ = 0.0;
+  has_source_ = true;
+}
+
+void Problem::set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1, double t0, double t1) {
+  check_source_vector(q0, "set_source_ramp (q0)");
+  check_source_vector(q1, "set_source_ramp (q1)");
+  if (!(std::isfinite(t0) && std::isfinite(t1) && t1 > t0)) {
+    std::ostringstream os;
+    os << "set_source_ramp: need finite t1 > t0, got [" << t0 << ", " << t1 << "]";
+    fail(os.str());
+  }
+  q0_ = std::move(q0);
+  q1_ = std::move(q1);
+  ramp_t0_ = t0;
+  ramp_t1_ = t1;
+  has_source_ = true;
+}
+
+void Problem::clear_source() {
+  has_source_ = false;
+  q0_.resize(0);
+  q1_.resize(0);
+}
+
+Eigen::VectorXd Problem::source(double t) const {
+  if (!has_source_) return Eigen::VectorXd::Zero(size());
+  if (ramp_t1_ <= ramp_t0_) return q0_;
+  // Linear waveform over the window, clamped outside it.
+  const double s = std::clamp((t - ramp_t0_) / (ramp_t1_ - ramp_t0_), 0.0, 1.0);
+  return q0_ + s * (q1_ - q0_);
+}
+
+void Problem::set_dirichlet(Index node, double temperature) {
+  check_node(node, "set_dirichlet");
+  if (!std::isfinite(temperature)) fail("set_dirichlet: temperature must be finite");
+  auto& flag = fixed_[static_cast<std::size_t>(node)];
+  if (!flag) {
+    flag = 1;
+    dirichlet_nodes_.push_back(node);
+  }
+  fixed_value_[node] = temperature;
+  touch();
+}
+
+void Problem::clear_dirichlet() {
+  std::fill(fixed_.begin(), fixed_.end(), 0);
+  dirichlet_nodes_.clear();
+  fixed_value_.setZero();
+  touch();
+}
+
+void Problem::add_flux(Index node, double watts) {
+  check_node(node, "add_flux");
+  if (!std::isfinite(watts)) fail("add_flux: heat input must be finite");
+  flux_[node] += watts;
+  touch();
+}
+
+void Problem::add_convection(Index node, double h_times_area, double t_inf) {
+  check_node(node, "add_convection");
+  if (!std::isfinite(h_times_area) || h_times_area < 0.0) {
+    std::ostringstream os;
+    os << "add_convection: hA = " << h_times_area << " W/K must be finite and >= 0";
+    fail(os.str());
+  }
+  if (!std::isfinite(t_inf)) fail("add_convection: ambient temperature must be finite");
+  ha_[node] += h_times_area;
+  ha_tinf_[node] += h_times_area * t_inf;
+  touch();
+}
+
+void Problem::clear_boundaries() {
+  flux_.setZero();
+  ha_.setZero();
+  ha_tinf_.setZero();
+  touch();
+}
+
+void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                        Eigen::Ref<Eigen::VectorXd> w) const {
+  // w = −K T + q(t) + f + hA ⊙ (T_inf − T)   (eq. 37 right-hand side plus boundaries)
+  w.noalias() = -(k_ * temperature);
+  w += flux_ + ha_tinf_ - ha_.cwiseProduct(temperature);
+  if (has_source_) {
+    if (ramp_t1_ <= ramp_t0_) {
+      w += q0_;
+    } else {
+      const double s = std::clamp((t - ramp_t0_) / (ramp_t1_ - ramp_t0_), 0.0, 1.0);
+      w += (1.0 - s) * q0_ + s * q1_;
+    }
+  }
+  for (Index d : dirichlet_nodes_) w[d] = 0.0;
+}
+
+void Problem::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                  Eigen::Ref<Eigen::VectorXd> dTdt) const {
+  heat_rate(t, temperature, dTdt);
+  dTdt.array() /= mass_.array();
+}
+
+double Problem::boundary_and_source_power(double t, const Eigen::VectorXd& temperature) const {
+  Eigen::VectorXd p = source(t) + flux_ + ha_tinf_ - ha_.cwiseProduct(temperature);
+  for (Index d : dirichlet_nodes_) p[d] = 0.0;
+  return p.sum();
+}
+
+double Problem::thermal_energy(const Eigen::VectorXd& temperature) const {
+  return mass_.dot(temperature);
+}
+
+void Problem::apply_dirichlet(Eigen::VectorXd& temperature) const {
+  for (Index d : dirichlet_nodes_) temperature[d] = fixed_value_[d];
+}
+
+void Problem::check_state(const Eigen::VectorXd& temperature) const {
+  if (temperature.size() != size()) {
+    std::ostringstream os;
+    os << "size mismatch: temperature vector has " << temperature.size() << " entries for " << size()
+       << " nodes";
+    fail(os.str());
+  }
+  if (!temperature.allFinite()) fail("temperature vector has a non-finite entry");
+}
+
+}  // namespace frictherm::thermal

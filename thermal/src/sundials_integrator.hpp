@@ -1,0 +1,68 @@
+// Shared window logic of the SUNDIALS-backed integrators (thermal-notes §1). Internal header.
+//
+// Each advance(problem, T, t0, t1) is one window. The solver is
+//  * rebuilt when the problem's M, K or boundaries changed (new Jacobian and pattern),
+//  * re-initialised (history cleared) when T was changed outside, t0 is not the previous t1,
+//    or options.reinit_every_window is set,
+//  * otherwise continued with its history (source changes between windows are then handled
+//    by error control, which the notes found cheaper unless the jumps are large).
+// The stop time is set before every window (6.4.1: tstop stays set after tout == tstop).
+// Counters are accumulated before any re-init, since ReInit zeroes them.
+#pragma once
+
+#include "ode_system.hpp"
+#include "sundials_support.hpp"
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+namespace frictherm::thermal::detail {
+
+enum class LinearSolverKind { Klu, Pcg, FixedPoint, None };
+
+// Parses options.linear_solver for the named integrator (see IntegratorOptions).
+LinearSolverKind parse_linear_solver(const std::string& integrator, const std::string& value);
+
+class SundialsIntegrator : public Integrator {
+ public:
+  SundialsIntegrator(std::string name, const IntegratorOptions& options, LinearSolverKind lin);
+  void advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1) final;
+  std::string name() const override { return name_; }
+
+ protected:
+  virtual void release() = 0;                  // free solver memory and solvers
+  virtual void create(double t0) = 0;          // y_ holds the initial state
+  virtual void reinit(double t0) = 0;          // y_ holds the new state
+  virtual int evolve(double t1) = 0;           // set stop time, integrate into y_, return flag
+  virtual IntegratorStats counters() const = 0;  // as reported by SUNDIALS since (re)init
+  virtual FlagNameFn flag_name_fn() const = 0;
+  virtual const char* evolve_call() const = 0;  // "CVode", "ARKStepEvolve" …
+
+  void check(int flag, const char* call) const {
+    check_flag(flag, call, name_, flag_name_fn(), sink_);
+  }
+  void on_reset_stats() override;
+
+  std::string name_;
+  IntegratorOptions opt_;
+  LinearSolverKind lin_;
+  ContextPtr ctx_;
+  NVectorPtr y_, abstol_;
+  OdeSystem sys_;
+  ErrorSink sink_;
+
+ private:
+  void absorb_counters();  // base_ += counters() − offset_
+  void refresh_stats();
+
+  bool built_ = false;
+  std::uint64_t revision_ = 0;
+  double t_last_ = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd t_state_last_;
+  IntegratorStats base_, offset_;
+  double wall_ = 0.0;
+  long reinits_ = 0;
+};
+
+}  // namespace frictherm::thermal::detail
