@@ -1,0 +1,58 @@
+#pragma once
+// The `frictherm` command-line program: subcommands and their argument handling.
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace frictherm::cli {
+
+/// Exit codes of the program.
+enum ExitCode { kOk = 0, kSimulationFailed = 1, kUsage = 2 };
+
+/// A mistake on the command line; `command` names the subcommand ("" for the program).
+class UsageError : public std::runtime_error {
+ public:
+  UsageError(const std::string& command, const std::string& what) : std::runtime_error(what), command_(command) {}
+  const std::string& command() const { return command_; }
+
+ private:
+  std::string command_;
+};
+
+/// An option a subcommand accepts: its spellings and whether it takes a value.
+struct OptionSpec {
+  std::vector<std::string> names;  // e.g. {"-o", "--output"}; the first long name is the key
+  bool takes_value = false;
+  std::string key;                 // name in ParsedArgs::options
+  bool repeatable = false;         // may be given several times (values collected in ParsedArgs::lists)
+};
+
+struct ParsedArgs {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> options;  // key -> value ("" for flags); the last one if repeatable
+  std::map<std::string, std::vector<std::string>> lists;  // key -> every value of a repeatable option
+  bool help = false;
+  bool has(const std::string& key) const { return options.count(key) != 0; }
+};
+
+/// Parses `args` (the words after the subcommand). Accepts "--name value", "--name=value", "-o value",
+/// "-h"/"--help" and "--" (the rest is positional). Throws UsageError on unknown options or a
+/// missing value.
+ParsedArgs parse_args(const std::string& command, const std::vector<std::string>& args,
+                      const std::vector<OptionSpec>& spec);
+
+/// Exactly one positional argument named `what` (e.g. "SCENE").
+const std::string& single_positional(const std::string& command, const ParsedArgs& a, const std::string& what);
+
+int run_command(const std::vector<std::string>& args, const std::string& command_line);
+int validate_command(const std::vector<std::string>& args);
+int export_csv_command(const std::vector<std::string>& args);
+
+/// Help texts (printed to stdout by --help).
+extern const char* const kProgramHelp;
+extern const char* const kRunHelp;
+extern const char* const kValidateHelp;
+extern const char* const kExportCsvHelp;
+
+}  // namespace frictherm::cli

@@ -1,0 +1,147 @@
+// The subcommands: run, validate, export-csv.
+#include "cli.hpp"
+
+#include <frictherm/coupling/csv_export.hpp>
+#include <frictherm/coupling/runner.hpp>
+#include <frictherm/coupling/scene.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+namespace frictherm::cli {
+
+namespace {
+
+const OptionSpec kSetOption{{"-s", "--set"}, true, "set", true};
+
+/// Loads a scene with the --set overrides; a problem becomes "frictherm: SCENE: message" and exit
+/// code 2 (returned as false).
+bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene) {
+  try {
+    std::vector<coupling::SceneOverride> overrides;
+    if (a.lists.count("set"))
+      for (const auto& assignment : a.lists.at("set")) overrides.push_back(coupling::parse_override(assignment));
+    scene = coupling::load_scene(path, overrides);
+    return true;
+  } catch (const coupling::SceneError& e) {
+    std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    return false;
+  }
+}
+
+int positive_int(const std::string& command, const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  long v = 0;
+  try {
+    v = std::stol(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || v < 1 || v > 1024)
+    throw UsageError(command, "option '" + option + "' expects an integer in [1, 1024], got '" + text + "'");
+  return static_cast<int>(v);
+}
+
+}  // namespace
+
+int run_command(const std::vector<std::string>& args, const std::string& command_line) {
+  const ParsedArgs a = parse_args("run", args,
+                                  {{{"-o", "--output"}, true, "output"},
+                                   {{"-t", "--threads"}, true, "threads"},
+                                   {{"-q", "--quiet"}, false, "quiet"},
+                                   kSetOption});
+  if (a.help) {
+    std::cout << kRunHelp;
+    return kOk;
+  }
+  const std::string& path = single_positional("run", a, "SCENE");
+  coupling::RunOptions opt;
+  if (a.has("threads")) opt.threads = positive_int("run", "--threads", a.options.at("threads"));
+  if (a.has("output")) opt.output = a.options.at("output");
+  opt.quiet = a.has("quiet");
+  opt.command_line = command_line;
+  coupling::Scene scene;
+  if (!load(path, a, scene)) return kUsage;
+  coupling::RunResult r;
+  try {
+    r = coupling::run_scene(scene, opt);
+  } catch (const coupling::SceneError& e) {
+    std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    return kUsage;
+  } catch (const coupling::OutputError& e) {
+    std::cerr << "frictherm: " << e.what() << '\n';
+    return kUsage;
+  } catch (const std::exception& e) {
+    std::cerr << "frictherm: run of " << path << " failed: " << e.what() << '\n';
+    return kSimulationFailed;
+  }
+  if (r.status == coupling::RunResult::Status::failed) {
+    std::cerr << "frictherm: simulation failed: " << r.message << ". Kept in " << r.output << ": " << r.snapshots
+              << " snapshots written before the failure, the failing state under /failure and the time series.\n";
+    return kSimulationFailed;
+  }
+  if (!opt.quiet) {
+    std::printf("wrote %s: %zu snapshots, %zu series rows; %ld steps to t = %g s in %.2f s (%zu particles)\n",
+                r.output.c_str(), r.snapshots, r.series_rows, r.steps, r.time, r.wall_time, r.particles);
+  }
+  return kOk;
+}
+
+int validate_command(const std::vector<std::string>& args) {
+  const ParsedArgs a = parse_args("validate", args, {kSetOption});
+  if (a.help) {
+    std::cout << kValidateHelp;
+    return kOk;
+  }
+  const std::string& path = single_positional("validate", a, "SCENE");
+  coupling::Scene scene;
+  if (!load(path, a, scene)) return kUsage;
+  try {
+    coupling::describe_scene(scene, std::cout);
+  } catch (const coupling::SceneError& e) {
+    std::cout.flush();
+    std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    return kUsage;
+  }
+  std::cout << "ok\n";
+  return kOk;
+}
+
+int export_csv_command(const std::vector<std::string>& args) {
+  const ParsedArgs a = parse_args("export-csv", args, {{{"-o", "--output"}, true, "output"}});
+  if (a.help) {
+    std::cout << kExportCsvHelp;
+    return kOk;
+  }
+  const std::string& path = single_positional("export-csv", a, "RUN.h5");
+  if (!std::ifstream(path)) {
+    std::cerr << "frictherm: cannot open '" << path << "'\n";
+    return kUsage;
+  }
+  try {
+    if (a.has("output")) {
+      const std::string& out_path = a.options.at("output");
+      std::ofstream out(out_path);
+      if (!out) {
+        std::cerr << "frictherm: cannot create '" << out_path << "'\n";
+        return kUsage;
+      }
+      coupling::export_series_csv(path, out);
+      out.close();
+      if (!out) {
+        std::cerr << "frictherm: cannot write '" << out_path << "'\n";
+        return kUsage;
+      }
+    } else {
+      coupling::export_series_csv(path, std::cout);
+      std::cout.flush();
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "frictherm: " << e.what() << '\n';
+    return kUsage;
+  }
+  return kOk;
+}
+
+}  // namespace frictherm::cli

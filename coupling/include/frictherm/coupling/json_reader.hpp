@@ -1,0 +1,130 @@
+#pragma once
+// A validating reader over nlohmann::json that remembers where it is in the document.
+//
+// Every reader holds one JSON value and its key path (e.g. `bodies[1].shape.radius`). Getters check
+// presence, type and range, and every mistake becomes one SceneError whose message starts with the
+// key path and says what was expected and what was found:
+//   materials.steel.poisson_ratio: expected a number in (-1, 0.5), got 0.7
+// Object readers remember each key they were asked about (present or not); finish() then rejects any
+// other key, listing the keys allowed at that place.
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling {
+
+/// The JSON type scenes are read into (objects keep the file's key order).
+using Json = nlohmann::ordered_json;
+
+/// Any mistake in a scene: malformed JSON, unknown key, wrong type, value out of range, ...
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A closed, open or half-open interval of allowed numbers.
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;
+  bool hi_open = false;
+
+  static Range any() { return {}; }
+  static Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
+  static Range non_negative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static Range open(double a, double b) { return {a, b, true, true}; }          // (a, b)
+  static Range left_open(double a, double b) { return {a, b, true, false}; }    // (a, b]
+  static Range closed(double a, double b) { return {a, b, false, false}; }      // [a, b]
+
+  bool contains(double x) const;
+  /// "a number", "a number > 0", "a number >= 0", "a number in (-1, 0.5)", ...
+  std::string describe() const;
+};
+
+/// Short description of a JSON value for messages: 0.7, "text", true, null, an array of 3 elements, an object.
+std::string describe_json(const Json& value);
+
+/// Formats a number for messages (shortest of %g with up to 10 significant digits).
+std::string format_number(double x);
+
+class JsonReader {
+ public:
+  /// `path` is the key path of `value` ("" for the document root).
+  JsonReader(const Json& value, std::string path);
+
+  const Json& json() const { return *value_; }
+  const std::string& path() const { return path_; }
+  /// Path of a member: "grid" + "lo" -> "grid.lo"; the root + "grid" -> "grid".
+  std::string member_path(const std::string& key) const;
+
+  // ---- errors --------------------------------------------------------------------------------------
+  /// Throws SceneError("<path>: <message>").
+  [[noreturn]] void fail(const std::string& message) const;
+  /// Throws SceneError("<path>: expected <what>, got <this value>").
+  [[noreturn]] void expected(const std::string& what) const;
+
+  // ---- this value -----------------------------------------------------------------------------------
+  bool is_object() const { return value_->is_object(); }
+  bool is_array() const { return value_->is_array(); }
+  bool is_number() const { return value_->is_number(); }
+  bool is_string() const { return value_->is_string(); }
+
+  double as_number(const Range& range = Range::any()) const;
+  /// An integer (a JSON number with no fractional part, 1e3 included) in [min, max].
+  long as_integer(long min = std::numeric_limits<long>::min(), long max = std::numeric_limits<long>::max()) const;
+  std::string as_string() const;
+  bool as_bool() const;
+  /// A string equal to one of `choices`.
+  std::string as_choice(const std::vector<std::string>& choices) const;
+  /// An array of exactly `n` numbers, each in `range`.
+  std::vector<double> as_vector(std::size_t n, const Range& range = Range::any()) const;
+  /// An array of numbers of any length >= min_size.
+  std::vector<double> as_number_list(std::size_t min_size = 0, const Range& range = Range::any()) const;
+
+  /// Requires an array (of at least min_size elements) and returns a reader per element, path `p[i]`.
+  std::vector<JsonReader> elements(std::size_t min_size = 0) const;
+  /// Requires an object and returns its keys in file order (for maps such as `materials`). Every key
+  /// counts as known.
+  std::vector<std::string> keys() const;
+
+  // ---- members of an object (the value must be an object: checked on construction of the first query)
+  /// Marks `key` as known and says whether it is present.
+  bool has(const std::string& key) const;
+  /// A required member; `what` describes it in the "missing" message.
+  JsonReader at(const std::string& key, const std::string& what = "") const;
+  /// An optional member.
+  std::optional<JsonReader> find(const std::string& key) const;
+
+  double number(const std::string& key, const Range& range = Range::any()) const;
+  double number(const std::string& key, double default_value, const Range& range) const;
+  long integer(const std::string& key, long min, long max) const;
+  long integer(const std::string& key, long default_value, long min, long max) const;
+  std::string string(const std::string& key) const;
+  std::string string(const std::string& key, const std::string& default_value) const;
+  std::string choice(const std::string& key, const std::vector<std::string>& choices) const;
+  std::string choice(const std::string& key, const std::vector<std::string>& choices,
+                     const std::string& default_value) const;
+  std::vector<double> vector(const std::string& key, std::size_t n, const Range& range = Range::any()) const;
+
+  /// Rejects members that no query asked about: "<path>.<key>: unknown key (allowed here: a, b, c)".
+  void finish() const;
+
+ private:
+  void require_object() const;
+  void mark(const std::string& key) const;
+
+  const Json* value_;
+  std::string path_;
+  mutable std::vector<std::string> known_;  // keys asked about, in query order
+};
+
+/// Parses scene text (comments allowed). Malformed JSON becomes a SceneError
+/// "malformed JSON at line L, column C: <detail>".
+Json parse_json_text(const std::string& text);
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,54 @@
+#pragma once
+// The run loop: scene -> mechanics::Simulation -> HDF5 output.
+//
+//   RunOptions opt;  opt.output = "out.h5";
+//   RunResult r = run_scene(load_scene("bar.json"), opt);
+//   return r.exit_code();   // 0 completed, 1 the simulation failed
+//
+// The loop clamps time steps so that the run lands exactly on every snapshot time and on end_time.
+// A mechanics::SimulationError (a blow-up, a particle leaving the grid) ends the run: the failing
+// state goes to /failure, the file is flushed and everything written before stays readable.
+#include <frictherm/coupling/scene.hpp>
+
+#include <iosfwd>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+
+/// The output file cannot be created (missing folder, no permission, ...): nothing has run.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct RunOptions {
+  std::string output;        // HDF5 file; empty: the scene's output.file
+  int threads = 0;           // OpenMP threads; 0: the scene's run.threads, else OpenMP's default
+  bool quiet = false;        // no progress line and no notes
+  enum class Progress { automatic, always, never };
+  Progress progress = Progress::automatic;  // automatic: only when stderr is a terminal
+  std::string command_line;  // stored in the metadata
+  std::ostream* log = nullptr;  // notes (e.g. "stopped at max_steps"); nullptr: std::cerr
+};
+
+struct RunResult {
+  enum class Status { completed, stopped_at_max_steps, failed };
+  Status status = Status::completed;
+  std::string output;        // the HDF5 file written
+  long steps = 0;
+  double time = 0.0;         // simulated time reached (s)
+  double wall_time = 0.0;    // s
+  std::size_t snapshots = 0; // regular snapshots written (the failure state not counted)
+  std::size_t series_rows = 0;
+  std::size_t particles = 0;
+  std::string message;       // the SimulationError's message when failed
+  int exit_code() const { return status == Status::failed ? 1 : 0; }
+};
+
+/// Runs a validated scene. Throws SceneError if the simulation cannot be built (e.g. a body with no
+/// particles), OutputError if the output file cannot be created, and std::runtime_error if writing
+/// fails later; a failing simulation is not an exception: it is reported in the result.
+RunResult run_scene(const Scene& scene, const RunOptions& options = {});
+
+}  // namespace frictherm::coupling

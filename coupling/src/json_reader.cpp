@@ -1,0 +1,254 @@
+#include <frictherm/coupling/json_reader.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace frictherm::coupling {
+
+bool Range::contains(double x) const {
+  if (!std::isfinite(x)) return false;
+  const bool above = lo_open ? x > lo : x >= lo;
+  const bool below = hi_open ? x < hi : x <= hi;
+  return above && below;
+}
+
+std::string Range::describe() const {
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (!has_lo && !has_hi) return "a number";
+  if (has_lo && !has_hi) return std::string("a number ") + (lo_open ? "> " : ">= ") + format_number(lo);
+  if (!has_lo) return std::string("a number ") + (hi_open ? "< " : "<= ") + format_number(hi);
+  return std::string("a number in ") + (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) +
+         (hi_open ? ")" : "]");
+}
+
+std::string format_number(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", x);
+  return buf;
+}
+
+std::string describe_json(const Json& v) {
+  switch (v.type()) {
+    case Json::value_t::null: return "null";
+    case Json::value_t::boolean: return v.get<bool>() ? "true" : "false";
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned: return v.dump();
+    case Json::value_t::number_float: return format_number(v.get<double>());
+    case Json::value_t::string: {
+      std::string s = v.get<std::string>();
+      if (s.size() > 40) s = s.substr(0, 37) + "...";
+      return "\"" + s + "\"";
+    }
+    case Json::value_t::array: {
+      const std::size_t n = v.size();
+      return n == 1 ? "an array of 1 element" : "an array of " + std::to_string(n) + " elements";
+    }
+    case Json::value_t::object: return "an object";
+    default: return "a value of unsupported type";
+  }
+}
+
+JsonReader::JsonReader(const Json& value, std::string path) : value_(&value), path_(std::move(path)) {}
+
+std::string JsonReader::member_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void JsonReader::fail(const std::string& message) const {
+  throw SceneError((path_.empty() ? std::string("scene") : path_) + ": " + message);
+}
+
+void JsonReader::expected(const std::string& what) const {
+  fail("expected " + what + ", got " + describe_json(*value_));
+}
+
+double JsonReader::as_number(const Range& range) const {
+  if (!value_->is_number()) expected(range.describe());
+  const double x = value_->get<double>();
+  if (!range.contains(x)) expected(range.describe());
+  return x;
+}
+
+long JsonReader::as_integer(long min, long max) const {
+  std::string what = "an integer";
+  if (min != std::numeric_limits<long>::min() && max != std::numeric_limits<long>::max())
+    what += " in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  else if (min != std::numeric_limits<long>::min())
+    what += " >= " + std::to_string(min);
+  else if (max != std::numeric_limits<long>::max())
+    what += " <= " + std::to_string(max);
+  if (!value_->is_number()) expected(what);
+  const double x = value_->get<double>();
+  if (!std::isfinite(x) || std::floor(x) != x || x < static_cast<double>(min) || x > static_cast<double>(max))
+    expected(what);
+  return value_->is_number_float() ? static_cast<long>(x) : value_->get<long>();
+}
+
+std::string JsonReader::as_string() const {
+  if (!value_->is_string()) expected("a string");
+  return value_->get<std::string>();
+}
+
+bool JsonReader::as_bool() const {
+  if (!value_->is_boolean()) expected("true or false");
+  return value_->get<bool>();
+}
+
+std::string JsonReader::as_choice(const std::vector<std::string>& choices) const {
+  std::string what = choices.size() == 1 ? "\"" + choices[0] + "\"" : "one of ";
+  if (choices.size() > 1)
+    for (std::size_t k = 0; k < choices.size(); ++k) what += (k ? ", \"" : "\"") + choices[k] + "\"";
+  if (!value_->is_string()) expected(what);
+  const std::string s = value_->get<std::string>();
+  if (std::find(choices.begin(), choices.end(), s) == choices.end()) expected(what);
+  return s;
+}
+
+std::vector<double> JsonReader::as_vector(std::size_t n, const Range& range) const {
+  const std::string what =
+      "an array of " + std::to_string(n) + (n == 1 ? " number" : " numbers") + " (one per dimension)";
+  if (!value_->is_array() || value_->size() != n) expected(what);
+  std::vector<double> out;
+  out.reserve(n);
+  for (const JsonReader& e : elements()) out.push_back(e.as_number(range));
+  return out;
+}
+
+std::vector<double> JsonReader::as_number_list(std::size_t min_size, const Range& range) const {
+  if (!value_->is_array() || value_->size() < min_size)
+    expected("an array of " + (min_size > 0 ? "at least " + std::to_string(min_size) + " " : std::string()) +
+             "numbers");
+  std::vector<double> out;
+  out.reserve(value_->size());
+  for (const JsonReader& e : elements()) out.push_back(e.as_number(range));
+  return out;
+}
+
+std::vector<JsonReader> JsonReader::elements(std::size_t min_size) const {
+  if (!value_->is_array() || value_->size() < min_size)
+    expected(min_size > 0 ? "an array of at least " + std::to_string(min_size) +
+                                (min_size == 1 ? " element" : " elements")
+                          : std::string("an array"));
+  std::vector<JsonReader> out;
+  out.reserve(value_->size());
+  for (std::size_t i = 0; i < value_->size(); ++i)
+    out.emplace_back((*value_)[i], path_ + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+std::vector<std::string> JsonReader::keys() const {
+  require_object();
+  std::vector<std::string> out;
+  for (auto it = value_->begin(); it != value_->end(); ++it) {
+    out.push_back(it.key());
+    mark(it.key());
+  }
+  return out;
+}
+
+void JsonReader::require_object() const {
+  if (!value_->is_object()) expected("an object");
+}
+
+void JsonReader::mark(const std::string& key) const {
+  if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
+}
+
+bool JsonReader::has(const std::string& key) const {
+  require_object();
+  mark(key);
+  return value_->contains(key);
+}
+
+JsonReader JsonReader::at(const std::string& key, const std::string& what) const {
+  if (!has(key)) {
+    const std::string p = member_path(key);
+    throw SceneError(p + ": required key missing" + (what.empty() ? std::string() : " (expected " + what + ")"));
+  }
+  return JsonReader(value_->at(key), member_path(key));
+}
+
+std::optional<JsonReader> JsonReader::find(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  return JsonReader(value_->at(key), member_path(key));
+}
+
+double JsonReader::number(const std::string& key, const Range& range) const {
+  return at(key, range.describe()).as_number(range);
+}
+
+double JsonReader::number(const std::string& key, double default_value, const Range& range) const {
+  const auto v = find(key);
+  return v ? v->as_number(range) : default_value;
+}
+
+long JsonReader::integer(const std::string& key, long min, long max) const {
+  return at(key, "an integer").as_integer(min, max);
+}
+
+long JsonReader::integer(const std::string& key, long default_value, long min, long max) const {
+  const auto v = find(key);
+  return v ? v->as_integer(min, max) : default_value;
+}
+
+std::string JsonReader::string(const std::string& key) const { return at(key, "a string").as_string(); }
+
+std::string JsonReader::string(const std::string& key, const std::string& default_value) const {
+  const auto v = find(key);
+  return v ? v->as_string() : default_value;
+}
+
+std::string JsonReader::choice(const std::string& key, const std::vector<std::string>& choices) const {
+  return at(key, "a string").as_choice(choices);
+}
+
+std::string JsonReader::choice(const std::string& key, const std::vector<std::string>& choices,
+                               const std::string& default_value) const {
+  const auto v = find(key);
+  return v ? v->as_choice(choices) : default_value;
+}
+
+std::vector<double> JsonReader::vector(const std::string& key, std::size_t n, const Range& range) const {
+  return at(key, "an array of " + std::to_string(n) + " numbers").as_vector(n, range);
+}
+
+void JsonReader::finish() const {
+  require_object();
+  for (auto it = value_->begin(); it != value_->end(); ++it) {
+    if (std::find(known_.begin(), known_.end(), it.key()) != known_.end()) continue;
+    std::string allowed;
+    for (const std::string& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
+    throw SceneError(member_path(it.key()) + ": unknown key" +
+                     (allowed.empty() ? std::string(" (no keys are allowed here)")
+                                      : " (allowed here: " + allowed + ")"));
+  }
+}
+
+Json parse_json_text(const std::string& text) {
+  try {
+    return Json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    // Line and column of the byte where parsing stopped (e.byte is 1-based).
+    const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
+    std::size_t line = 1, column = 1;
+    for (std::size_t k = 0; k < end; ++k) {
+      if (text[k] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column 5: detail".
+    std::string detail = e.what();
+    const std::size_t colon = detail.find(": ", detail.find("parse error"));
+    if (colon != std::string::npos) detail = detail.substr(colon + 2);
+    std::ostringstream msg;
+    msg << "malformed JSON at line " << line << ", column " << column << ": " << detail;
+    throw SceneError(msg.str());
+  }
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,159 @@
+// The run loop: build the simulation, step to end_time landing on every snapshot time, write
+// snapshots and series, and keep the failing state when the simulation breaks down.
+#include "runner_detail.hpp"
+
+#include <frictherm/mechanics/errors.hpp>
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+
+namespace frictherm::coupling {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+bool show_progress(const RunOptions& o) {
+  if (o.quiet || o.progress == RunOptions::Progress::never) return false;
+  if (o.progress == RunOptions::Progress::always) return true;
+  return isatty(STDERR_FILENO) != 0;
+}
+
+template <int Dim>
+class Run {
+ public:
+  Run(const Scene& scene, const RunOptions& options) : s_(scene), o_(options) {}
+
+  RunResult execute() {
+    const Clock::time_point t0 = Clock::now();
+    sim_ = build_simulation<Dim>(s_);
+    const int threads = o_.threads > 0 ? o_.threads : s_.threads;
+    if (threads > 0) omp_set_num_threads(threads);
+    r_.output = o_.output.empty() ? s_.output.file : o_.output;
+    r_.particles = sim_->particles().size();
+    H5Output out = open_output();
+    out_ = &out;
+    detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
+    out.declare_series(detail::series_names(Dim));
+    series();
+    snapshot();
+    std::ostream& log = o_.log ? *o_.log : std::cerr;
+    detail::ProgressLine progress(std::cerr, show_progress(o_), s_.end_time);
+    try {
+      loop(progress);
+    } catch (const mechanics::SimulationError& e) {
+      progress.finish();
+      out.begin_failure(e.step(), e.time(), e.what());
+      detail::write_fields<Dim>(out, *sim_, snapshot_field_names(Dim));
+      out.end_snapshot();
+      r_.status = RunResult::Status::failed;
+      r_.message = e.what();
+      out.write_metadata("failure", r_.message);
+    }
+    progress.finish();
+    if (r_.status != RunResult::Status::failed) {
+      if (last_series_step_ != sim_->step_count()) series();
+      if (last_snapshot_step_ != sim_->step_count()) snapshot();
+    }
+    if (r_.status == RunResult::Status::stopped_at_max_steps && !o_.quiet)
+      log << "frictherm: note: stopped at run.max_steps = " << s_.max_steps << " (t = " << sim_->time()
+          << " s of end_time " << s_.end_time << " s)\n";
+    r_.steps = sim_->step_count();
+    r_.time = sim_->time();
+    r_.wall_time = seconds_since(t0);
+    r_.snapshots = out.snapshot_count();
+    r_.series_rows = out.series_rows();
+    const char* status = r_.status == RunResult::Status::failed               ? "failed"
+                         : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
+                                                                                : "completed";
+    out.write_metadata("status", status);
+    out.write_metadata("steps", static_cast<double>(r_.steps));
+    out.write_metadata("final_time", r_.time);
+    out.write_metadata("wall_time", r_.wall_time);
+    out.close();
+    out_ = nullptr;
+    return r_;
+  }
+
+ private:
+  H5Output open_output() const {
+    try {
+      return H5Output(r_.output, Dim);
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+  }
+
+  void loop(detail::ProgressLine& progress) {
+    const double T = s_.end_time;
+    const double eps = 1e-10 * T;
+    const double snap_dt = s_.output.snapshot_interval;
+    const double series_dt = s_.output.series_interval;
+    long snap_k = 1;
+    double next_snap = std::min(snap_dt, T);
+    double next_series = series_dt;
+    while (sim_->time() < T - eps) {
+      if (s_.max_steps > 0 && sim_->step_count() >= s_.max_steps) {
+        r_.status = RunResult::Status::stopped_at_max_steps;
+        return;
+      }
+      // Land exactly on the next snapshot time (or end_time); split the last stretch into two
+      // similar steps rather than a full step and a sliver.
+      double limit = next_snap - sim_->time();
+      if (sim_->step_count() == 0 || limit < 3.0 * sim_->last_time_step()) {
+        const double stable = sim_->stable_time_step();
+        if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
+      }
+      sim_->step(limit);
+      const double t = sim_->time();
+      if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {
+        series();
+        if (series_dt > 0.0) next_series = (std::floor(t / series_dt + 1e-9) + 1.0) * series_dt;
+      }
+      if (t >= next_snap - eps) {
+        snapshot();
+        for (;;) {  // the next snapshot time after t
+          ++snap_k;
+          next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
+          if (next_snap > t + eps || next_snap >= T) break;
+        }
+      }
+      progress.update(sim_->step_count(), t);
+    }
+  }
+
+  void series() {
+    out_->append_series(detail::series_row<Dim>(*sim_));
+    last_series_step_ = sim_->step_count();
+  }
+
+  void snapshot() {
+    out_->begin_snapshot(sim_->step_count(), sim_->time());
+    detail::write_fields<Dim>(*out_, *sim_, s_.output.fields);
+    out_->end_snapshot();
+    last_snapshot_step_ = sim_->step_count();
+  }
+
+  const Scene& s_;
+  const RunOptions& o_;
+  std::unique_ptr<mechanics::Simulation<Dim>> sim_;
+  H5Output* out_ = nullptr;
+  RunResult r_;
+  long last_series_step_ = -1;
+  long last_snapshot_step_ = -1;
+};
+
+}  // namespace
+
+RunResult run_scene(const Scene& scene, const RunOptions& options) {
+  if (scene.dimension == 2) return Run<2>(scene, options).execute();
+  return Run<3>(scene, options).execute();
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,129 @@
+// What the run loop writes: snapshot fields, series rows and run metadata.
+#include "runner_detail.hpp"
+
+#include <omp.h>
+
+#include <ctime>
+#include <sstream>
+
+namespace frictherm::coupling::detail {
+
+std::vector<std::string> series_names(int dim) {
+  std::vector<std::string> n{"time",          "step",          "dt",        "kinetic_energy",
+                             "strain_energy", "total_energy",  "external_work"};
+  const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
+  for (int d = 0; d < dim; ++d) n.emplace_back(axes[d]);
+  return n;
+}
+
+template <int Dim>
+std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
+  const double ke = sim.kinetic_energy(), se = sim.strain_energy();
+  std::vector<double> row{sim.time(), static_cast<double>(sim.step_count()), sim.last_time_step(), ke, se,
+                          ke + se,    sim.external_work()};
+  const auto P = sim.linear_momentum();
+  for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+  return row;
+}
+
+template <int Dim>
+void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields) {
+  const auto& p = sim.particles();
+  const std::size_t n = p.size();
+  std::vector<double> buf;
+  auto vectors = [&](const std::string& name, auto&& get) {
+    buf.resize(n * Dim);
+    for (std::size_t k = 0; k < n; ++k) {
+      const mechanics::Vec<Dim> v = get(k);
+      for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = v[d];
+    }
+    out.snapshot_field(name, buf.data(), n, Dim);
+  };
+  auto scalars = [&](const std::string& name, const std::vector<double>& v) { out.snapshot_field(name, v.data(), n, 1); };
+  for (const std::string& f : fields) {
+    if (f == "position") {
+      vectors(f, [&](std::size_t k) { return p.position[k]; });
+    } else if (f == "velocity") {
+      vectors(f, [&](std::size_t k) { return p.velocity[k]; });
+    } else if (f == "displacement") {
+      vectors(f, [&](std::size_t k) { return mechanics::Vec<Dim>(p.position[k] - p.initial_position[k]); });
+    } else if (f == "stress") {
+      buf.resize(n * Dim * Dim);
+      for (std::size_t k = 0; k < n; ++k)
+        for (int i = 0; i < Dim; ++i)
+          for (int j = 0; j < Dim; ++j) buf[(k * Dim + static_cast<std::size_t>(i)) * Dim + static_cast<std::size_t>(j)] = p.stress[k](i, j);
+      out.snapshot_field(f, buf.data(), n, Dim * Dim);
+    } else if (f == "stress_zz") {
+      scalars(f, p.stress_zz);
+    } else if (f == "mass") {
+      scalars(f, p.mass);
+    } else if (f == "volume") {
+      scalars(f, p.volume);
+    } else if (f == "temperature") {
+      scalars(f, p.temperature);
+    } else if (f == "material") {
+      out.snapshot_field(f, p.material.data(), n);
+    } else if (f == "body") {
+      out.snapshot_field(f, p.body.data(), n);
+    }
+  }
+}
+
+template <int Dim>
+void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simulation<Dim>& sim,
+                          const RunOptions& options) {
+  out.write_metadata("scene", s.text);
+  out.write_metadata("scene_file", s.source);
+  std::string overrides;
+  for (const auto& o : s.overrides) overrides += (overrides.empty() ? "" : "\n") + o.path + "=" + o.value;
+  if (!overrides.empty()) out.write_metadata("overrides", overrides);
+  out.write_metadata("version", FRICTHERM_VERSION);
+  out.write_metadata("command_line", options.command_line);
+  char date[64] = "";
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  if (localtime_r(&now, &local)) std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S%z", &local);
+  out.write_metadata("start_date", date);
+  out.write_metadata("status", "running");
+  out.write_metadata("dimension", static_cast<double>(Dim));
+  if (Dim == 2) {
+    out.write_metadata("analysis", s.options.analysis == mechanics::Analysis::plane_stress ? "plane_stress" : "plane_strain");
+    out.write_metadata("thickness", s.options.thickness);
+  }
+  out.write_metadata("particle_count", static_cast<double>(sim.particles().size()));
+  out.write_metadata("threads", static_cast<double>(omp_get_max_threads()));
+  const auto& g = sim.grid();
+  std::ostringstream grid, materials, bodies;
+  grid.precision(10);
+  grid << "lo";
+  for (int d = 0; d < Dim; ++d) grid << ' ' << g.lo()[d];
+  grid << "; hi";
+  for (int d = 0; d < Dim; ++d) grid << ' ' << g.hi()[d];
+  grid << "; cells";
+  for (int d = 0; d < Dim; ++d) grid << ' ' << g.cells()[static_cast<std::size_t>(d)];
+  grid << "; cell_size";
+  for (int d = 0; d < Dim; ++d) grid << ' ' << g.cell_size()[d];
+  out.write_metadata("grid", grid.str());
+  out.write_metadata("cell_size", g.min_cell_size());
+  for (std::size_t m = 0; m < sim.materials().size(); ++m)
+    materials << (m ? "; " : "") << m << ' ' << sim.materials()[m].name << ' '
+              << mechanics::to_string(sim.materials()[m].kind);
+  out.write_metadata("materials", materials.str());
+  for (std::size_t b = 0; b < sim.bodies().size(); ++b) bodies << (b ? "; " : "") << b << ' ' << sim.bodies()[b].name;
+  out.write_metadata("bodies", bodies.str());
+  const auto& o = sim.options();
+  out.write_metadata("shape_function", mechanics::to_string(o.shape));
+  out.write_metadata("scheme", mechanics::to_string(o.scheme));
+  out.write_metadata("cfl", o.cfl);
+  out.write_metadata("end_time", s.end_time);
+}
+
+#define FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(D)                                                                \
+  template std::vector<double> series_row<D>(const mechanics::Simulation<D>&);                               \
+  template void write_fields<D>(H5Output&, const mechanics::Simulation<D>&, const std::vector<std::string>&); \
+  template void write_start_metadata<D>(H5Output&, const Scene&, const mechanics::Simulation<D>&, const RunOptions&);
+FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(2)
+FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(3)
+#undef FRICTHERM_INSTANTIATE_RUNNER_OUTPUT
+
+}  // namespace frictherm::coupling::detail

@@ -1,0 +1,301 @@
+// Scene parsing: the document root, grid, materials, solver, run and output sections.
+// Bodies and loads live in scene_bodies.cpp and scene_loads.cpp.
+#include "scene_detail.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace frictherm::coupling {
+
+using detail::ParseContext;
+using detail::read_vec;
+
+namespace {
+
+const char* const kAxisNames[3] = {"x", "y", "z"};
+
+void parse_grid(const JsonReader& root, Scene& s) {
+  const JsonReader grid = root.at("grid", "an object with lo, hi and cell_size or cells");
+  const int dim = s.dimension;
+  const JsonReader lo_r = grid.at("lo", "an array of " + std::to_string(dim) + " numbers");
+  const JsonReader hi_r = grid.at("hi", "an array of " + std::to_string(dim) + " numbers");
+  s.grid_lo = read_vec(lo_r, dim);
+  s.grid_hi = read_vec(hi_r, dim);
+  for (int d = 0; d < dim; ++d)
+    if (!(s.grid_hi[d] > s.grid_lo[d]))
+      hi_r.fail(std::string("expected every component greater than grid.lo's, but ") + kAxisNames[d] + " hi = " +
+                format_number(s.grid_hi[d]) + " <= lo = " + format_number(s.grid_lo[d]));
+  const bool has_h = grid.has("cell_size"), has_n = grid.has("cells");
+  if (has_h == has_n) grid.fail("expected exactly one of cell_size (m) or cells (count per direction)");
+  double total = 1.0;
+  if (has_h) {
+    const JsonReader h = grid.at("cell_size");
+    if (h.is_number()) {
+      const double v = h.as_number(Range::positive());
+      for (int d = 0; d < dim; ++d) s.cell_size[d] = v;
+    } else {
+      s.cell_size = read_vec(h, dim, Range::positive());
+    }
+    for (int d = 0; d < dim; ++d) {
+      const double extent = s.grid_hi[d] - s.grid_lo[d];
+      const double n = extent / s.cell_size[d];
+      const double r = std::round(n);
+      if (r < 1.0 || std::fabs(n - r) > 1e-6 * std::max(1.0, n))
+        h.fail(std::string("expected a cell size that divides hi - lo evenly, but in ") + kAxisNames[d] + " " +
+               format_number(extent) + " m / " + format_number(s.cell_size[d]) + " m = " + format_number(n) +
+               " cells");
+      if (r > 1e7) h.fail("expected at most 10^7 cells per direction, got " + format_number(r));
+      s.cells[d] = static_cast<int>(r);
+      s.cell_size[d] = extent / r;  // exact division of [lo, hi]
+      total *= r;
+    }
+  } else {
+    const JsonReader n = grid.at("cells");
+    if (!n.is_array() || n.json().size() != static_cast<std::size_t>(dim))
+      n.expected("an array of " + std::to_string(dim) + " integers (cells per direction)");
+    const auto items = n.elements();
+    for (int d = 0; d < dim; ++d) {
+      s.cells[d] = static_cast<int>(items[static_cast<std::size_t>(d)].as_integer(1, 10000000));
+      s.cell_size[d] = (s.grid_hi[d] - s.grid_lo[d]) / s.cells[d];
+      total *= s.cells[d];
+    }
+  }
+  if (total > 5e7) grid.fail("the grid has " + format_number(total) + " cells; expected at most 5e7");
+  grid.finish();
+}
+
+mechanics::Material parse_material(const JsonReader& m, const std::string& name, const Scene& s) {
+  mechanics::Material mat;
+  mat.name = name;
+  const JsonReader type = m.at("type", "\"linear_elastic\", \"neo_hookean\" or \"rigid\"");
+  mat.kind = mechanics::material_kind_from_string(type.as_choice({"linear_elastic", "neo_hookean", "rigid"}));
+  if (mat.is_rigid()) {
+    mat.density = m.number("density", 1000.0, Range::positive());
+    const auto v = m.find("velocity");
+    if (v) {
+      const std::string what = "an array of " + std::to_string(s.dimension) +
+                               " time functions (numbers or {\"type\": ...} objects), one per dimension";
+      if (!v->is_array() || v->json().size() != static_cast<std::size_t>(s.dimension)) v->expected(what);
+      for (const JsonReader& f : v->elements()) mat.rigid_velocity.push_back(parse_time_function(f));
+    } else {
+      mat.rigid_velocity.assign(static_cast<std::size_t>(s.dimension), mechanics::TimeFunction::constant(0.0));
+    }
+  } else {
+    if (mat.kind == mechanics::MaterialKind::neo_hookean && s.options.analysis == mechanics::Analysis::plane_stress)
+      type.fail("neo_hookean needs \"analysis\": \"plane_strain\" or a 3D scene, not plane_stress");
+    mat.density = m.number("density", Range::positive());
+    mat.youngs_modulus = m.number("youngs_modulus", Range::positive());
+    mat.poisson_ratio = m.number("poisson_ratio", Range::open(-1.0, 0.5));
+  }
+  m.finish();
+  return mat;
+}
+
+void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
+  const JsonReader mats = root.at("materials", "an object mapping material names to their properties");
+  const auto names = mats.keys();
+  if (names.empty()) mats.expected("at least one material");
+  for (const std::string& name : names) {
+    const JsonReader m = mats.at(name);
+    if (name.empty()) m.fail("material names must not be empty");
+    if (!m.is_object()) m.expected("an object with the material's type and properties");
+    s.materials.push_back(parse_material(m, name, s));
+    ctx.material_names.push_back(name);
+  }
+  mats.finish();
+}
+
+void parse_solver(const JsonReader& root, Scene& s) {
+  const auto solver = root.find("solver");
+  if (!solver) return;
+  s.options.shape = mechanics::shape_kind_from_string(
+      solver->choice("shape_function", {"linear", "ugimp", "quadratic_bspline"}, "ugimp"));
+  s.options.scheme = mechanics::update_scheme_from_string(solver->choice("scheme", {"usf", "usl", "musl"}, "musl"));
+  s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
+  if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
+  solver->finish();
+}
+
+void parse_run(const JsonReader& root, Scene& s) {
+  const JsonReader run = root.at("run", "an object with at least end_time (s)");
+  s.end_time = run.number("end_time", Range::positive());
+  s.max_steps = run.integer("max_steps", 0, 1, std::numeric_limits<long>::max());
+  s.threads = static_cast<int>(run.integer("threads", 0, 1, 1024));
+  run.finish();
+}
+
+void parse_output(const JsonReader& root, Scene& s) {
+  OutputSpec& o = s.output;
+  o.file = s.name + ".h5";
+  o.snapshot_interval = s.end_time / 20.0;
+  o.series_interval = s.end_time / 5000.0;
+  o.fields = snapshot_field_names(s.dimension);
+  const auto out = root.find("output");
+  if (!out) return;
+  o.file = out->string("file", o.file);
+  if (o.file.empty()) out->at("file").expected("a file name");
+  const bool has_interval = out->has("snapshot_interval"), has_count = out->has("snapshot_count");
+  if (has_interval && has_count) out->fail("expected snapshot_interval or snapshot_count, not both");
+  if (has_interval) o.snapshot_interval = out->number("snapshot_interval", Range::positive());
+  if (has_count) o.snapshot_interval = s.end_time / static_cast<double>(out->integer("snapshot_count", 1, 1000000));
+  o.series_interval = out->number("series_interval", o.series_interval, Range::non_negative());
+  if (const auto f = out->find("fields")) {
+    const auto known = snapshot_field_names(s.dimension);
+    std::vector<std::string> fields{"position"};  // the XDMF geometry: always written
+    for (const JsonReader& e : f->elements(1)) {
+      const std::string name = e.as_choice(known);
+      if (std::find(fields.begin(), fields.end(), name) == fields.end()) fields.push_back(name);
+    }
+    o.fields = fields;
+  }
+  out->finish();
+}
+
+/// "bodies[0].velocity" -> "/bodies/0/velocity".
+Json::json_pointer pointer_of(const std::string& path) {
+  if (path.empty() || path.back() == '.' || path.front() == '.' || path.front() == '[')
+    throw SceneError("--set " + path + ": expected a key path such as solver.cfl or bodies[0].velocity");
+  std::string p;
+  std::string token;
+  auto flush = [&] {
+    if (token.empty()) throw SceneError("--set " + path + ": expected a key path such as solver.cfl or bodies[0].velocity");
+    std::string escaped;
+    for (char c : token) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    p += "/" + escaped;
+    token.clear();
+  };
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const char c = path[i];
+    if (c == '.') {
+      if (i > 0 && path[i - 1] == ']') continue;
+      flush();
+    } else if (c == '[') {
+      flush();
+      const std::size_t close = path.find(']', i);
+      if (close == std::string::npos) throw SceneError("--set " + path + ": missing ']'");
+      token = path.substr(i + 1, close - i - 1);
+      if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos)
+        throw SceneError("--set " + path + ": expected an index in [...]");
+      flush();
+      i = close;
+    } else {
+      token += c;
+    }
+  }
+  if (!token.empty() || p.empty()) flush();
+  return Json::json_pointer(p);
+}
+
+void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
+  for (const SceneOverride& o : overrides) {
+    Json value;
+    try {
+      value = Json::parse(o.value);
+    } catch (const Json::parse_error&) {
+      value = o.value;  // a bare word: a string
+    }
+    try {
+      doc[pointer_of(o.path)] = value;
+    } catch (const Json::exception&) {
+      throw SceneError("--set " + o.path + ": cannot set this key (a part of its path is not an object or array)");
+    }
+  }
+}
+
+}  // namespace
+
+SceneOverride parse_override(const std::string& assignment) {
+  const std::size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw SceneError("--set " + assignment + ": expected KEY.PATH=VALUE, e.g. solver.cfl=0.3");
+  return {assignment.substr(0, eq), assignment.substr(eq + 1)};
+}
+
+std::vector<std::string> snapshot_field_names(int dimension) {
+  std::vector<std::string> f{"position", "velocity", "displacement", "stress"};
+  if (dimension == 2) f.push_back("stress_zz");
+  for (const char* n : {"mass", "volume", "temperature", "material", "body"}) f.emplace_back(n);
+  return f;
+}
+
+std::vector<std::string> face_names(int dimension) {
+  std::vector<std::string> f;
+  for (int d = 0; d < dimension; ++d) {
+    f.push_back(std::string(kAxisNames[d]) + "_min");
+    f.push_back(std::string(kAxisNames[d]) + "_max");
+  }
+  return f;
+}
+
+Scene parse_scene(const std::string& text, const std::string& source, const std::string& base_dir,
+                  const std::string& name, const std::vector<SceneOverride>& overrides) {
+  Json doc = parse_json_text(text);
+  apply_overrides(doc, overrides);
+  const JsonReader root(doc, "");
+  if (!doc.is_object()) root.expected("a JSON object at the top level of the scene");
+  for (const char* later : {"thermal", "coupling", "contact"})
+    if (doc.contains(later))
+      throw SceneError(std::string(later) + ": not supported by this version of frictherm (" FRICTHERM_VERSION
+                                            "); it handles single-field mechanics only. Remove the \"" +
+                       later + "\" section.");
+  // Unknown top-level keys first, so a misspelt section is reported as such.
+  for (const char* key : {"units", "description", "dimension", "analysis", "thickness", "grid", "materials",
+                          "bodies", "boundary", "loads", "solver", "run", "output"})
+    root.has(key);
+  root.finish();
+
+  Scene s;
+  s.text = text;
+  s.overrides = overrides;
+  s.source = source;
+  s.name = name;
+  s.description = root.string("description", "");
+  if (const auto u = root.find("units")) u->as_choice({"SI"});
+  s.dimension = static_cast<int>(root.at("dimension", "2 or 3").as_integer(2, 3));
+  if (s.dimension == 2) {
+    s.options.analysis = root.choice("analysis", {"plane_strain", "plane_stress"}, "plane_strain") == "plane_stress"
+                             ? mechanics::Analysis::plane_stress
+                             : mechanics::Analysis::plane_strain;
+    s.options.thickness = root.number("thickness", 1.0, Range::positive());
+  } else {
+    s.options.analysis = mechanics::Analysis::three_d;
+    for (const char* key : {"analysis", "thickness"})
+      if (const auto v = root.find(key)) v->fail("only for 2D scenes (a 3D scene is always fully three-dimensional)");
+  }
+
+  ParseContext ctx;
+  ctx.dim = s.dimension;
+  ctx.base_dir = base_dir;
+  parse_grid(root, s);
+  parse_materials(root, s, ctx);
+  parse_run(root, s);  // before bodies and output: defaults depend on end_time
+  detail::parse_bodies(root, s, ctx);
+  detail::parse_boundary(root, s, ctx);
+  detail::parse_loads(root, s, ctx);
+  parse_solver(root, s);
+  parse_output(root, s);
+  return s;
+}
+
+Scene load_scene(const std::string& path, const std::vector<SceneOverride>& overrides) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError("cannot read scene file '" + path + "': it is a folder");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError("cannot open scene file '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw SceneError("cannot read scene file '" + path + "'");
+  // Folder of the scene (for relative image paths) and its name (default output file).
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = name.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) name = name.substr(0, dot);
+  if (name.empty()) name = "scene";
+  return parse_scene(text.str(), path, dir, name, overrides);
+}
+
+}  // namespace frictherm::coupling

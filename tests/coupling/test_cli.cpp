@@ -1,0 +1,211 @@
+// The frictherm program, run as a user would: help, validate, run, export-csv, a failing run.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result frictherm(const std::string& args) {
+  const std::string cmd = std::string("'") + FRICTHERM_EXE + "' " + args + " 2>&1";
+  Result r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+/// A fresh folder per test (tests may run in parallel).
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("frictherm_cli_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  fs::path dir_;
+};
+
+const char* const kTinyScene = R"({
+  // a small block moving slowly: a few dozen steps
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
+              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+  "run": {"end_time": 2e-3, "threads": 1},
+  "output": {"snapshot_count": 4}
+})";
+
+// A body thrown at 2000 m/s leaves the grid after about 30 steps (t ~ 4e-4 s), after several snapshots.
+const char* const kBlowUpScene = R"({
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [1.0, 0.2], "cell_size": 0.05},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "bullet", "material": "soft", "velocity": [2000, 0],
+              "shape": {"type": "rectangle", "lo": [0.1, 0.05], "hi": [0.2, 0.15]}}],
+  "run": {"end_time": 1e-2, "threads": 1},
+  "output": {"snapshot_interval": 1e-4}
+})";
+
+int count_snapshots(const std::string& h5, bool& has_failure) {
+  has_failure = false;
+  const hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return -1;
+  hsize_t n = 0;
+  const hid_t g = H5Gopen2(f, "/snapshots", H5P_DEFAULT);
+  if (g >= 0) {
+    H5G_info_t info;
+    if (H5Gget_info(g, &info) >= 0) n = info.nlinks;
+    H5Gclose(g);
+  }
+  has_failure = H5Lexists(f, "/failure", H5P_DEFAULT) > 0;
+  H5Fclose(f);
+  return static_cast<int>(n);
+}
+
+}  // namespace
+
+TEST_F(Cli, HelpAndVersion) {
+  for (const char* args : {"--help", "help", "run --help", "validate --help", "export-csv --help", "help run"}) {
+    const Result r = frictherm(args);
+    EXPECT_EQ(r.code, 0) << args;
+    EXPECT_THAT(r.output, HasSubstr("usage: frictherm")) << args;
+  }
+  const Result v = frictherm("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_THAT(v.output, StartsWith("frictherm "));
+}
+
+TEST_F(Cli, BadArgumentsExitTwoWithOneMessage) {
+  for (const char* args : {"", "fly", "run", "run a.json b.json", "run x.json --frobnicate", "run x.json --threads 0",
+                           "export-csv", "validate --output"}) {
+    const Result r = frictherm(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
+    EXPECT_THAT(r.output, StartsWith("frictherm")) << args;
+  }
+  const Result missing = frictherm("validate " + path("nope.json"));
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_THAT(missing.output, HasSubstr("cannot open scene file"));
+  const Result folder = frictherm("run " + dir_.string());
+  EXPECT_EQ(folder.code, 2);
+  EXPECT_THAT(folder.output, HasSubstr("it is a folder"));
+  const Result no_dir = frictherm("run " + write("tiny.json", kTinyScene) + " -o " + path("no/such/folder/x.h5"));
+  EXPECT_EQ(no_dir.code, 2) << no_dir.output;
+  EXPECT_THAT(no_dir.output, HasSubstr("no/such/folder/x.h5"));
+}
+
+TEST_F(Cli, ValidateGoodAndBadScenes) {
+  const Result ok = frictherm("validate " + write("tiny.json", kTinyScene));
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_THAT(ok.output, HasSubstr("48 particles"));
+  EXPECT_THAT(ok.output, HasSubstr("time step"));
+  EXPECT_THAT(ok.output, ::testing::EndsWith("ok\n"));
+  std::string bad = kTinyScene;
+  bad.replace(bad.find("\"density\": 1000"), 15, "\"density\": -1");
+  const Result err = frictherm("validate " + write("bad.json", bad));
+  EXPECT_EQ(err.code, 2);
+  EXPECT_THAT(err.output, HasSubstr("materials.soft.density: expected a number > 0, got -1"));
+  EXPECT_EQ(std::count(err.output.begin(), err.output.end(), '\n'), 1) << err.output;
+}
+
+TEST_F(Cli, RunWritesHdf5AndExportCsv) {
+  const std::string scene = write("tiny.json", kTinyScene);
+  const std::string out = path("run.h5");
+  const Result r = frictherm("run " + scene + " -o " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("5 snapshots"));
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(path("run.xdmf")));
+  bool failed = true;
+  EXPECT_EQ(count_snapshots(out, failed), 5);  // t = 0 and 4 more, the last at end_time
+  EXPECT_FALSE(failed);
+
+  const Result csv = frictherm("export-csv " + out);
+  ASSERT_EQ(csv.code, 0) << csv.output;
+  EXPECT_THAT(csv.output, StartsWith("time,step,dt,kinetic_energy,strain_energy,total_energy,external_work,"
+                                     "momentum_x,momentum_y\n"));
+  std::istringstream lines(csv.output);
+  std::string line, last;
+  int rows = -1;
+  while (std::getline(lines, line)) ++rows, last = line;
+  EXPECT_GT(rows, 10);
+  EXPECT_THAT(last, StartsWith("0.002,"));  // the run lands exactly on end_time
+
+  const Result to_file = frictherm("export-csv " + out + " -o " + path("series.csv"));
+  EXPECT_EQ(to_file.code, 0);
+  std::ifstream in(path("series.csv"));
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), csv.output);
+
+  const Result quiet = frictherm("run " + scene + " --output=" + path("q.h5") + " --quiet --threads 1");
+  EXPECT_EQ(quiet.code, 0);
+  EXPECT_EQ(quiet.output, "");
+
+  // --set for sweeps: a changed snapshot count shows in the output.
+  const Result set = frictherm("run " + scene + " -o " + path("s.h5") + " --set output.snapshot_count=2");
+  EXPECT_EQ(set.code, 0) << set.output;
+  EXPECT_THAT(set.output, HasSubstr("3 snapshots"));
+  const Result bad_set = frictherm("validate " + scene + " --set solver.cfl=0");
+  EXPECT_EQ(bad_set.code, 2);
+  EXPECT_THAT(bad_set.output, HasSubstr("solver.cfl: expected a number in (0, 1], got 0"));
+}
+
+TEST_F(Cli, BlowUpExitsOneAndKeepsEarlierSnapshots) {
+  const std::string out = path("blowup.h5");
+  const Result r = frictherm("run " + write("blowup.json", kBlowUpScene) + " -o " + out);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("simulation failed"));
+  EXPECT_THAT(r.output, HasSubstr("particle"));
+  EXPECT_THAT(r.output, HasSubstr("of body 'bullet' left the grid"));
+  bool failure = false;
+  EXPECT_GE(count_snapshots(out, failure), 3);  // t = 0, 1e-4, 2e-4, ... before leaving at ~4e-4
+  EXPECT_TRUE(failure);
+  const Result csv = frictherm("export-csv " + out);
+  EXPECT_EQ(csv.code, 0);
+  EXPECT_THAT(csv.output, StartsWith("time,"));
+  const Result missing = frictherm("export-csv " + path("none.h5"));
+  EXPECT_EQ(missing.code, 2);
+}
+
+TEST_F(Cli, EveryExampleValidates) {
+  const fs::path examples = fs::path(FRICTHERM_SOURCE_DIR) / "examples";
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(examples)) {
+    if (e.path().extension() != ".json") continue;
+    ++n;
+    const Result r = frictherm("validate '" + e.path().string() + "'");
+    EXPECT_EQ(r.code, 0) << e.path() << "\n" << r.output;
+    EXPECT_THAT(r.output, ::testing::EndsWith("ok\n")) << e.path();
+  }
+  EXPECT_GE(n, 5);
+}

@@ -1,0 +1,180 @@
+// Scene validation: one test per class of mistake; every message must name the key path.
+#include "test_scene_support.hpp"
+
+#include <gmock/gmock.h>
+
+using frictherm::coupling::Json;
+using frictherm::coupling::parse_scene;
+using frictherm::coupling::test::good_scene;
+using frictherm::coupling::test::scene_error;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+TEST(SceneValidation, GoodSceneParses) { EXPECT_NO_THROW(parse_scene(good_scene().dump())); }
+
+TEST(SceneValidation, MalformedJsonGivesLineAndColumn) {
+  const std::string text = "{\n  \"dimension\": 2,\n  \"grid\": {\"lo\": [0, 0],, \"hi\": [1, 1]}\n}\n";
+  const std::string msg = scene_error(text);
+  EXPECT_THAT(msg, StartsWith("malformed JSON at line 3, column"));
+  const std::string unterminated = scene_error(std::string("{\"dimension\": 2,\n\"grid\": {"));
+  EXPECT_THAT(unterminated, HasSubstr("malformed JSON at line 2"));
+}
+
+TEST(SceneValidation, CommentsAreAllowed) {
+  std::string text = good_scene().dump(2);
+  text = "// a comment\n/* another */\n" + text;
+  EXPECT_NO_THROW(parse_scene(text));
+}
+
+TEST(SceneValidation, UnknownKeyNamesPathAndAllowedKeys) {
+  Json s = good_scene();
+  s["grid"]["cellsize"] = 0.01;
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("grid.cellsize: unknown key"), HasSubstr("cell_size")));
+  s = good_scene();
+  s["bodies"][0]["shape"]["radius"] = 0.1;
+  EXPECT_THAT(scene_error(s), StartsWith("bodies[0].shape.radius: unknown key (allowed here: type, lo, hi)"));
+  s = good_scene();
+  s["bodys"] = Json::array();
+  EXPECT_THAT(scene_error(s), StartsWith("bodys: unknown key"));
+  s = good_scene();
+  s["materials"]["steel"]["yield_stress"] = 1e8;
+  EXPECT_THAT(scene_error(s), StartsWith("materials.steel.yield_stress: unknown key"));
+}
+
+TEST(SceneValidation, WrongTypeNamesPathExpectedAndGot) {
+  Json s = good_scene();
+  s["run"]["end_time"] = "soon";
+  EXPECT_EQ(scene_error(s), "run.end_time: expected a number > 0, got \"soon\"");
+  s = good_scene();
+  s["bodies"] = Json::object();
+  EXPECT_THAT(scene_error(s), StartsWith("bodies: expected an array"));
+  s = good_scene();
+  s["dimension"] = 2.5;
+  EXPECT_EQ(scene_error(s), "dimension: expected an integer in [2, 3], got 2.5");
+  s = good_scene();
+  s["bodies"][0]["particles_per_cell"] = "two";
+  EXPECT_THAT(scene_error(s), StartsWith("bodies[0].particles_per_cell: expected an integer"));
+}
+
+TEST(SceneValidation, DensityMustBePositive) {
+  for (double rho : {0.0, -7850.0}) {
+    Json s = good_scene();
+    s["materials"]["steel"]["density"] = rho;
+    EXPECT_THAT(scene_error(s), StartsWith("materials.steel.density: expected a number > 0, got"));
+  }
+  Json s = good_scene();
+  s["materials"]["steel"].erase("density");
+  EXPECT_THAT(scene_error(s), StartsWith("materials.steel.density: required key missing"));
+}
+
+TEST(SceneValidation, PoissonRatioOutOfRange) {
+  Json s = good_scene();
+  s["materials"]["steel"]["poisson_ratio"] = 0.7;
+  EXPECT_EQ(scene_error(s), "materials.steel.poisson_ratio: expected a number in (-1, 0.5), got 0.7");
+  for (double nu : {0.5, -1.0}) {
+    s["materials"]["steel"]["poisson_ratio"] = nu;
+    EXPECT_THAT(scene_error(s), StartsWith("materials.steel.poisson_ratio: expected a number in (-1, 0.5)"));
+  }
+}
+
+TEST(SceneValidation, BodyOutsideGridNamesShapeAndGridExtent) {
+  Json s = good_scene();
+  s["bodies"].push_back(Json::parse(R"({"name": "disk", "material": "steel",
+      "shape": {"type": "disk", "center": [0.19, 0.05], "radius": 0.02}})"));
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("bodies[1].shape: "), HasSubstr("not inside the grid"),
+                                    HasSubstr("(0, 0) to (0.2, 0.1)")));
+}
+
+TEST(SceneValidation, CflFactorMustBeInZeroOne) {
+  for (double c : {0.0, -0.1, 1.5}) {
+    Json s = good_scene();
+    s["solver"] = {{"cfl", c}};
+    EXPECT_THAT(scene_error(s), StartsWith("solver.cfl: expected a number in (0, 1], got"));
+  }
+  Json s = good_scene();
+  s["solver"] = {{"cfl", 1.0}};
+  EXPECT_NO_THROW(parse_scene(s.dump()));
+}
+
+TEST(SceneValidation, VectorLengthMustMatchDimension) {
+  Json s = good_scene();
+  s["grid"]["lo"] = {0, 0, 0};
+  EXPECT_EQ(scene_error(s),
+            "grid.lo: expected an array of 2 numbers (one per dimension), got an array of 3 elements");
+  s = good_scene();
+  s["bodies"][0]["velocity"] = {1.0};
+  EXPECT_THAT(scene_error(s), StartsWith("bodies[0].velocity: expected an array of 2 numbers"));
+  s = good_scene();
+  s["loads"] = {{"gravity", {0, 0, -9.81}}};
+  EXPECT_THAT(scene_error(s), StartsWith("loads.gravity: expected an array of 2 numbers"));
+}
+
+TEST(SceneValidation, UnknownMaterialOrBodyName) {
+  Json s = good_scene();
+  s["bodies"][0]["material"] = "stel";
+  EXPECT_EQ(scene_error(s), "bodies[0].material: unknown material \"stel\" (materials defined: \"steel\")");
+  s = good_scene();
+  s["loads"] = Json::parse(R"({"traction": [{"body": "blok", "face": "x_max", "traction": [1e6, 0]}]})");
+  EXPECT_THAT(scene_error(s), StartsWith("loads.traction[0].body: unknown body \"blok\""));
+  s = good_scene();
+  s["bodies"].push_back(s["bodies"][0]);
+  EXPECT_THAT(scene_error(s), StartsWith("bodies[1].name: the name \"block\" is already used by bodies[0]"));
+}
+
+TEST(SceneValidation, MissingImageFile) {
+  Json s = good_scene();
+  s["bodies"][0] = Json::parse(R"({"name": "img", "shape": {"type": "image", "file": "no_such_image.pgm",
+      "origin": [0, 0], "pixel_size": 0.001, "levels": [{"range": [0, 255], "material": "steel"}]}})");
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("bodies[0].shape.file: "), HasSubstr("no_such_image.pgm")));
+}
+
+TEST(SceneValidation, LaterSectionsAreNotSupportedYet) {
+  for (const char* key : {"thermal", "coupling", "contact"}) {
+    Json s = good_scene();
+    s[key] = Json::object();
+    EXPECT_THAT(scene_error(s), AllOf(StartsWith(std::string(key) + ": "), HasSubstr("not supported by this version")));
+  }
+}
+
+TEST(SceneValidation, RequiredKeysAndChoices) {
+  Json s = good_scene();
+  s["run"].erase("end_time");
+  EXPECT_THAT(scene_error(s), StartsWith("run.end_time: required key missing"));
+  s = good_scene();
+  s["units"] = "mm";
+  EXPECT_EQ(scene_error(s), "units: expected \"SI\", got \"mm\"");
+  s = good_scene();
+  s["solver"] = {{"scheme", "rk4"}};
+  EXPECT_EQ(scene_error(s), "solver.scheme: expected one of \"usf\", \"usl\", \"musl\", got \"rk4\"");
+  s = good_scene();
+  s["boundary"] = Json::parse(R"({"fixed": [{"face": "z_min"}]})");
+  EXPECT_THAT(scene_error(s), StartsWith("boundary.fixed[0].face: expected one of"));
+}
+
+TEST(SceneValidation, DimensionSpecificKeys) {
+  Json s = good_scene();
+  s["dimension"] = 3;
+  s["analysis"] = "plane_strain";
+  EXPECT_THAT(scene_error(s), StartsWith("analysis: only for 2D scenes"));
+  s = good_scene();
+  s["analysis"] = "plane_stress";
+  s["materials"]["steel"]["type"] = "neo_hookean";
+  EXPECT_THAT(scene_error(s), StartsWith("materials.steel.type: neo_hookean needs"));
+}
+
+TEST(SceneValidation, GridMustDivideEvenly) {
+  Json s = good_scene();
+  s["grid"]["cell_size"] = 0.03;
+  EXPECT_THAT(scene_error(s), StartsWith("grid.cell_size: expected a cell size that divides hi - lo evenly"));
+  s = good_scene();
+  s["grid"]["cells"] = {20, 10};
+  EXPECT_THAT(scene_error(s), StartsWith("grid: expected exactly one of cell_size"));
+}
+
+TEST(SceneValidation, BodyWithoutParticlesIsNamedWhenBuilt) {
+  Json s = good_scene();
+  Json copy = s["bodies"][0];
+  copy["name"] = "shadow";  // same region: every point already taken by the first body
+  s["bodies"].push_back(copy);
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("bodies[1]: "), HasSubstr("no particles")));
+}
