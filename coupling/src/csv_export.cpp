@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include "h5_util.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -12,58 +14,11 @@
 namespace frictherm::coupling {
 namespace {
 
-// Minimal RAII for the reader (the writer's richer helpers live in h5_output.cpp).
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  ~Handle() {
-    if (id_ >= 0) closer_(id_);
-  }
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*closer_)(hid_t);
-};
-
-class Quiet {  // no HDF5 error printing; failures become exceptions
- public:
-  Quiet() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  Quiet(const Quiet&) = delete;
-  Quiet& operator=(const Quiet&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-[[noreturn]] void fail(const std::string& file, const std::string& what) {
-  std::string reason;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* err, void* out) -> herr_t {
-        auto& text = *static_cast<std::string*>(out);
-        if (n < 2 && err->desc != nullptr && *err->desc != '\0') {
-          text += (text.empty() ? "" : "; ") + std::string(err->desc);
-        }
-        return 0;
-      },
-      &reason);
-  throw std::runtime_error("HDF5 file '" + file + "': " + what + (reason.empty() ? "" : " (" + reason + ")"));
-}
-hid_t check_id(hid_t id, const std::string& file, const std::string& what) {
-  if (id < 0) fail(file, what);
-  return id;
-}
-void check(herr_t status, const std::string& file, const std::string& what) {
-  if (status < 0) fail(file, what);
-}
+using h5detail::check;
+using h5detail::check_id;
+using h5detail::fail;
+using h5detail::Handle;
+using h5detail::Quiet;
 
 std::string csv_name(const std::string& name) {
   if (name.find_first_of(",\"\r\n") == std::string::npos) return name;

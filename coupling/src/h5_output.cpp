@@ -23,6 +23,8 @@
 
 #include <hdf5.h>
 
+#include "h5_util.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -36,72 +38,11 @@ namespace {
 
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 
-// Owns one hid_t and closes it with the matching H5?close.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle() = default;
-  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
-  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) {
-    other.id_ = H5I_INVALID_HID;
-  }
-  Handle& operator=(Handle&& other) noexcept {
-    if (this != &other) {
-      reset();
-      std::swap(id_, other.id_);
-      closer_ = other.closer_;
-    }
-    return *this;
-  }
-  ~Handle() { reset(); }
-  void reset() {
-    if (id_ >= 0 && closer_ != nullptr) closer_(id_);
-    id_ = H5I_INVALID_HID;
-  }
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_ = H5I_INVALID_HID;
-  Closer closer_ = nullptr;
-};
-
-// Silences HDF5's automatic error printing for one library call sequence; errors become
-// exceptions carrying the innermost HDF5 descriptions instead.
-class Quiet {
- public:
-  Quiet() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  Quiet(const Quiet&) = delete;
-  Quiet& operator=(const Quiet&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-herr_t collect_error(unsigned n, const H5E_error2_t* err, void* out) {
-  auto& text = *static_cast<std::string*>(out);
-  if (n < 2 && err->desc != nullptr && *err->desc != '\0') {
-    text += (text.empty() ? "" : "; ") + std::string(err->desc);
-  }
-  return 0;
-}
-
-[[noreturn]] void fail(const std::string& file, const std::string& what) {
-  std::string reason;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &reason);  // innermost cause first
-  throw std::runtime_error("HDF5 file '" + file + "': " + what + (reason.empty() ? "" : " (" + reason + ")"));
-}
-hid_t check_id(hid_t id, const std::string& file, const std::string& what) {
-  if (id < 0) fail(file, what);
-  return id;
-}
-void check(herr_t status, const std::string& file, const std::string& what) {
-  if (status < 0) fail(file, what);
-}
+using h5detail::check;
+using h5detail::check_id;
+using h5detail::fail;
+using h5detail::Handle;
+using h5detail::Quiet;
 
 void check_name(const std::string& name, const char* kind) {
   if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..") {
