@@ -51,11 +51,7 @@ void Simulation<Dim>::step_with(double dt) {
   if (opt_.scheme == UpdateScheme::usf) {
     map_to_grid<Kernel>(dt, /*with_forces=*/false);
     map_rigid_particles<Kernel>(t);
-    apply_velocity_bc(nodes_.momentum, nullptr);
-    const double mmin = empty_node_mass_;
-#pragma omp parallel for num_threads(threads_) schedule(static)
-    for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
-      nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+    velocity_from_momentum();
     update_stress<Kernel>(nodes_.velocity, dt);
     add_internal_forces<Kernel>();
   } else {
@@ -207,6 +203,16 @@ void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::ve
   }
 }
 
+// v_i = p_i / m_i after the velocity boundary conditions on p_i; empty nodes get no velocity.
+template <int Dim>
+void Simulation<Dim>::velocity_from_momentum() {
+  apply_velocity_bc(nodes_.momentum, nullptr);
+  const double mmin = empty_node_mass_;
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
+    nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+}
+
 // p_i^{n+1} = p_i^n + f_i dt; a_i = (p^{n+1} − p^n)/(m_i dt) after boundary conditions on both.
 template <int Dim>
 void Simulation<Dim>::update_grid(double dt) {
@@ -332,11 +338,7 @@ void Simulation<Dim>::remap_momentum() {
         for (const auto& b : thread_nodes_) nodes_.momentum[i] += b.momentum[i];
     }
   }
-  apply_velocity_bc(nodes_.momentum, nullptr);
-  const double mmin = empty_node_mass_;
-#pragma omp parallel for num_threads(threads_) schedule(static)
-  for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
-    nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+  velocity_from_momentum();
 }
 
 // Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
@@ -369,6 +371,7 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   template double Simulation<D>::step(double);                                                       \
   template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*) const;  \
   template void Simulation<D>::update_grid(double);                                                  \
+  template void Simulation<D>::velocity_from_momentum();                                                  \
   template void Simulation<D>::move_rigid_particles(double, double);                                 \
   template void Simulation<D>::check_particle(long, double) const;
 FRICTHERM_INSTANTIATE_STEP(2)

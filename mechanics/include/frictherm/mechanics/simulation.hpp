@@ -108,6 +108,7 @@ class Simulation {
   template <class Kernel> std::vector<Stencil<Dim, Kernel>>& stencils();
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const;
   void update_grid(double dt);
+  void velocity_from_momentum();
   void move_rigid_particles(double dt, double t);
   void check_particle(long bad, double dt) const;
   void resolve_loads();
