@@ -1,4 +1,5 @@
 // String names of the mechanics enums: the vocabulary scenes use.
+#include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
 
@@ -37,5 +38,44 @@ const char* to_string(MaterialKind kind) {
   }
   return "?";
 }
+
+NormalMethod normal_method_from_string(const std::string& name) {
+  if (name == "mvg") return NormalMethod::max_volume_gradient;
+  if (name == "avg") return NormalMethod::average_volume_gradient;
+  throw std::invalid_argument("unknown contact normal '" + name + "' (expected mvg, avg or a vector)");
+}
+
+const char* to_string(NormalMethod m) {
+  switch (m) {
+    case NormalMethod::max_volume_gradient: return "mvg";
+    case NormalMethod::average_volume_gradient: return "avg";
+    case NormalMethod::specified: return "specified";
+  }
+  return "?";
+}
+
+SeparationMethod separation_method_from_string(const std::string& name) {
+  if (name == "position") return SeparationMethod::position;
+  if (name == "displacement") return SeparationMethod::displacement;
+  if (name == "velocity_only") return SeparationMethod::velocity_only;
+  throw std::invalid_argument("unknown contact separation '" + name + "' (expected position, displacement or velocity_only)");
+}
+
+const char* to_string(SeparationMethod m) {
+  switch (m) {
+    case SeparationMethod::position: return "position";
+    case SeparationMethod::displacement: return "displacement";
+    case SeparationMethod::velocity_only: return "velocity_only";
+  }
+  return "?";
+}
+
+HeatingOrder heating_order_from_string(const std::string& name) {
+  if (name == "first") return HeatingOrder::first;
+  if (name == "second") return HeatingOrder::second;
+  throw std::invalid_argument("unknown heating order '" + name + "' (expected first or second)");
+}
+
+const char* to_string(HeatingOrder o) { return o == HeatingOrder::first ? "first" : "second"; }
 
 }  // namespace frictherm::mechanics

@@ -26,22 +26,6 @@ const char* to_string(UpdateScheme s) {
 }
 
 template <int Dim>
-void NodalFields<Dim>::resize(std::size_t n) {
-  mass.assign(n, 0.0);
-  momentum.assign(n, Vec<Dim>::Zero());
-  force.assign(n, Vec<Dim>::Zero());
-  velocity.assign(n, Vec<Dim>::Zero());
-  acceleration.assign(n, Vec<Dim>::Zero());
-}
-
-template <int Dim>
-void NodalFields<Dim>::clear_accumulators() {
-  std::fill(mass.begin(), mass.end(), 0.0);
-  std::fill(momentum.begin(), momentum.end(), Vec<Dim>::Zero());
-  std::fill(force.begin(), force.end(), Vec<Dim>::Zero());
-}
-
-template <int Dim>
 Simulation<Dim>::Simulation(const Grid<Dim>& grid, const SimulationOptions& options) : grid_(grid), opt_(options) {
   if (Dim == 3) opt_.analysis = Analysis::three_d;
   if (Dim == 2 && opt_.analysis == Analysis::three_d)
@@ -185,6 +169,7 @@ void Simulation<Dim>::finalize() {
   taken_.shrink_to_fit();
   empty_node_mass_ = 1e-12 * *std::max_element(p_.mass.begin(), p_.mass.end());
   finalized_ = true;
+  init_fields();
   resolve_loads();
 }
 
@@ -292,8 +277,6 @@ Vec<Dim> Simulation<Dim>::linear_momentum() const {
   return P;
 }
 
-template struct NodalFields<2>;
-template struct NodalFields<3>;
 template class Simulation<2>;
 template class Simulation<3>;
 

@@ -1,11 +1,14 @@
-// One explicit MPM step: particle-to-grid, grid momentum update, grid-to-particle, stress update.
-// Particle loops are templated on the shape-function kernel (static dispatch) and threaded with
-// OpenMP; scatters go to per-thread nodal buffers that are summed afterwards.
+// One explicit MPM step: particle-to-grid, contact, grid momentum update, grid-to-particle, stress
+// update. Particle loops are templated on the shape-function kernel (static dispatch) and threaded
+// with OpenMP; scatters go to per-thread nodal buffers that are summed afterwards. Every particle
+// scatters into the slots of its material's velocity field (field_of_material_), so the same loops
+// serve the shared single field and the per-material fields of multimaterial contact.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <omp.h>
 
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -41,22 +44,32 @@ void Simulation<Dim>::step_with(double dt) {
   // the particle work they share.
   const int max_threads = omp_get_max_threads();
   threads_ = std::max(1, std::min(max_threads, static_cast<int>(p_.size() / 2000)));
-  const int nthreads = threads_;
-  if (static_cast<int>(thread_nodes_.size()) != nthreads - 1) {
-    thread_nodes_.resize(static_cast<std::size_t>(std::max(0, nthreads - 1)));
-    for (auto& t : thread_nodes_) t.resize(grid_.node_count());
+  if (static_cast<int>(thread_nodes_.size()) != threads_ - 1) {
+    thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
+    for (auto& t : thread_nodes_) t.resize(nodes_.mass.size(), contact_);
   }
   stencils<Kernel>().resize(p_.size());
   const double t = time_;
-  if (opt_.scheme == UpdateScheme::usf) {
-    map_to_grid<Kernel>(dt, /*with_forces=*/false);
+  for (std::size_t f = 0; f < fields_.size(); ++f)
+    if (fields_[f].rigid)
+      field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
+  if (contact_) {
+    evaluate_stencils<Kernel>();  // also lays out the per-material boxes of nodes
+    std::fill(work_first_.begin(), work_first_.end(), 0.0);
+    std::fill(work_second_.begin(), work_second_.end(), 0.0);
+  }
+  const bool usf = opt_.scheme == UpdateScheme::usf;
+  map_to_grid<Kernel>(dt, /*with_forces=*/!usf);
+  if (contact_) {
+    find_contact_nodes();
+    resolve_contact(ContactPass::extrapolated, dt);
+  } else {
     map_rigid_particles<Kernel>(t);
+  }
+  if (usf) {
     velocity_from_momentum();
     update_stress<Kernel>(nodes_.velocity, dt);
     add_internal_forces<Kernel>();
-  } else {
-    map_to_grid<Kernel>(dt, /*with_forces=*/true);
-    map_rigid_particles<Kernel>(t);
   }
   map_external_loads<Kernel>(t);
   update_grid(dt);
@@ -66,20 +79,47 @@ void Simulation<Dim>::step_with(double dt) {
   ++step_;
   check_particle(bad, dt);
   if (opt_.scheme == UpdateScheme::musl) {
-    remap_momentum<Kernel>();
+    remap_momentum<Kernel>(dt);
     update_stress<Kernel>(nodes_.velocity, dt);
   } else if (opt_.scheme == UpdateScheme::usl) {
     update_stress<Kernel>(nodes_.velocity, dt);
   }
 }
 
+// Contact: every particle's stencil (rigid ones too), and per material the box of nodes it reaches.
+template <int Dim>
+template <class Kernel>
+void Simulation<Dim>::evaluate_stencils() {
+  auto& st = stencils<Kernel>();
+  for (std::size_t m = 0; m < materials_.size(); ++m) {
+    int lo[Dim], hi[Dim];
+    for (int d = 0; d < Dim; ++d) lo[d] = INT_MAX, hi[d] = INT_MIN;
+    const std::size_t b = material_begin_[m], e = material_end_[m];
+#pragma omp parallel for num_threads(threads_) schedule(static) reduction(min : lo[:Dim]) reduction(max : hi[:Dim])
+    for (std::size_t k = b; k < e; ++k) {
+      st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+      const IVec<Dim> f = st[k].first_node();
+      for (int d = 0; d < Dim; ++d) {
+        lo[d] = std::min(lo[d], f[d]);
+        hi[d] = std::max(hi[d], f[d] + Kernel::K - 1);
+      }
+    }
+    for (int d = 0; d < Dim; ++d) box_lo_[m][d] = lo[d], box_hi_[m][d] = hi[d];
+  }
+  layout_fields(box_lo_, box_hi_);
+}
+
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:
-// m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p, f_i = Σ (−V_p σ_p G_ip + S_ip m_p g).
+// m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p, f_i = Σ (−V_p σ_p G_ip + S_ip m_p g) (Nairn 2018 eqs. 1–3);
+// with contact also Σ S_ip m_p x_p (or the displacement x_p − x_p^(0)), Ω = Σ S_ip V_p and
+// g = Σ G_ip V_p per material (eqs. 4–6, 9). Rigid materials only mark their presence (mass,
+// position, domain): their velocity is prescribed.
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
+  const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
   nodes_.clear_accumulators();
 #pragma omp parallel num_threads(threads_)
   {
@@ -87,40 +127,54 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
     NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
     if (tid != 0) acc.clear_accumulators();
     for (std::size_t m = 0; m < materials_.size(); ++m) {
-      if (materials_[m].is_rigid()) continue;
+      const int f = field_of_material_[m];
+      if (f < 0) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+      const bool rigid = materials_[m].is_rigid();
+      if (!contact_) {
 #pragma omp for schedule(static) nowait
-      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-        Stencil<Dim, Kernel>& s = st[k];
-        s.evaluate(grid_, p_.position[k], p_.half_size[k]);
-        const double mp = p_.mass[k];
-        const Vec<Dim> mv = mp * p_.velocity[k];
-        const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
-        const Vec<Dim> mg = mp * g;
-        if (with_forces) {
-          s.for_each(grid_, [&](int i, double S, const Vec<Dim>& G) {
+        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+          Stencil<Dim, Kernel>& s = st[k];
+          s.evaluate(grid_, p_.position[k], p_.half_size[k]);
+          const double mp = p_.mass[k];
+          const Vec<Dim> mv = mp * p_.velocity[k];
+          const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
+          const Vec<Dim> mg = mp * g;
+          if (with_forces) {
+            s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
+              acc.mass[i] += S * mp;
+              acc.momentum[i] += S * mv;
+              acc.force[i] += S * mg - Vsig * G;
+            });
+          } else {
+            s.for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+              acc.mass[i] += S * mp;
+              acc.momentum[i] += S * mv;
+            });
+          }
+        }
+      } else {
+        const bool forces = with_forces && !rigid;
+#pragma omp for schedule(static) nowait
+        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+          const double mp = p_.mass[k], Vp = p_.volume[k];
+          const Vec<Dim> mv = mp * p_.velocity[k];
+          const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
+          const Mat<Dim> Vsig = Vp * p_.stress[k];
+          const Vec<Dim> mg = mp * g;
+          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
             acc.mass[i] += S * mp;
             acc.momentum[i] += S * mv;
-            acc.force[i] += S * mg - Vsig * G;
-          });
-        } else {
-          s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
-            acc.mass[i] += S * mp;
-            acc.momentum[i] += S * mv;
+            if (forces) acc.force[i] += S * mg - Vsig * G;
+            acc.mass_position[i] += S * mx;
+            acc.domain[i] += S * Vp;
+            acc.domain_gradient[i] += Vp * G;
           });
         }
       }
     }
-#pragma omp barrier
-    if (!thread_nodes_.empty()) {
-#pragma omp for schedule(static)
-      for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
-        for (const auto& b : thread_nodes_) {
-          nodes_.mass[i] += b.mass[i];
-          nodes_.momentum[i] += b.momentum[i];
-          nodes_.force[i] += b.force[i];
-        }
-    }
   }
+  reduce_thread_buffers(true, true, with_forces, contact_);
 }
 
 // USF: internal and body forces from the freshly updated stress.
@@ -135,24 +189,21 @@ void Simulation<Dim>::add_internal_forces() {
     NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
     if (tid != 0) std::fill(acc.force.begin(), acc.force.end(), Vec<Dim>::Zero());
     for (std::size_t m = 0; m < materials_.size(); ++m) {
-      if (materials_[m].is_rigid()) continue;
+      const int f = field_of_material_[m];
+      if (f < 0 || materials_[m].is_rigid()) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
         const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
         const Vec<Dim> mg = p_.mass[k] * g;
-        st[k].for_each(grid_, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
+        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
       }
     }
-#pragma omp barrier
-    if (!thread_nodes_.empty()) {
-#pragma omp for schedule(static)
-      for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
-        for (const auto& b : thread_nodes_) nodes_.force[i] += b.force[i];
-    }
   }
+  reduce_thread_buffers(false, false, true, false);
 }
 
-// Nodes touched by a rigid material take its prescribed velocity (single velocity field).
+// Without contact, nodes touched by a rigid material take its prescribed velocity (single field).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_rigid_particles(double t) {
@@ -179,62 +230,10 @@ void Simulation<Dim>::map_external_loads(double t) {
   auto& st = stencils<Kernel>();
   for (const auto& L : resolved_loads_) {
     const Vec<Dim> f = L.force * (*L.scale)(t);
-    st[L.particle].for_each(grid_, [&](int i, double S, const Vec<Dim>&) { nodes_.force[i] += S * f; });
-  }
-}
-
-// Fixed components are zeroed; rigid nodes take m_i v_rigid and no force.
-template <int Dim>
-void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const {
-  const std::size_t n = momentum.size();
-#pragma omp parallel for num_threads(threads_) schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (rigid_mask_[i]) {
-      momentum[i] = nodes_.mass[i] * rigid_velocity_[i];
-      if (force) (*force)[i].setZero();
-    }
-    if (const std::uint8_t mask = fixed_mask_[i]) {
-      for (int d = 0; d < Dim; ++d)
-        if (mask & (1u << d)) {
-          momentum[i][d] = 0.0;
-          if (force) (*force)[i][d] = 0.0;
-        }
-    }
-  }
-}
-
-// v_i = p_i / m_i after the velocity boundary conditions on p_i; empty nodes get no velocity.
-template <int Dim>
-void Simulation<Dim>::velocity_from_momentum() {
-  apply_velocity_bc(nodes_.momentum, nullptr);
-  const double mmin = empty_node_mass_;
-#pragma omp parallel for num_threads(threads_) schedule(static)
-  for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
-    nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
-}
-
-// p_i^{n+1} = p_i^n + f_i dt; a_i = (p^{n+1} − p^n)/(m_i dt) after boundary conditions on both.
-template <int Dim>
-void Simulation<Dim>::update_grid(double dt) {
-  apply_velocity_bc(nodes_.momentum, &nodes_.force);
-  const double mmin = empty_node_mass_;
-  const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for num_threads(threads_) schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    const double m = nodes_.mass[i];
-    if (m > mmin) {
-      nodes_.velocity[i] = (nodes_.momentum[i] + nodes_.force[i] * dt) / m;
-      nodes_.acceleration[i] = nodes_.force[i] / m;
-    } else {
-      nodes_.velocity[i].setZero();
-      nodes_.acceleration[i].setZero();
-    }
-  }
-  // Boundary conditions hold for the new velocity too (rigid: v_rigid, fixed: 0). Since the force was
-  // constrained consistently, only rigid nodes whose prescribed velocity changed need fixing.
-#pragma omp parallel for num_threads(threads_) schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (rigid_mask_[i] && nodes_.mass[i] > mmin) nodes_.velocity[i] = rigid_velocity_[i];
+    const int fi = field_of_material_[static_cast<std::size_t>(p_.material[L.particle])];
+    if (fi < 0) continue;
+    st[L.particle].for_each(fields_[static_cast<std::size_t>(fi)].index,
+                            [&](int i, double S, const Vec<Dim>&) { nodes_.force[i] += S * f; });
   }
 }
 
@@ -248,13 +247,15 @@ long Simulation<Dim>::update_particles(double dt) {
   double work = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (materials_[m].is_rigid()) continue;
+    const int f = field_of_material_[m];
+    if (f < 0 || materials_[m].is_rigid()) continue;
+    const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
     const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
 #pragma omp parallel for num_threads(threads_) schedule(static) reduction(min : bad) reduction(+ : work)
     for (long kk = b; kk < e; ++kk) {
       const std::size_t k = static_cast<std::size_t>(kk);
       Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
-      st[k].for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
+      st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
         a += S * nodes_.acceleration[i];
         v += S * nodes_.velocity[i];
       });
@@ -271,51 +272,11 @@ long Simulation<Dim>::update_particles(double dt) {
   return bad == std::numeric_limits<long>::max() ? -1 : bad;
 }
 
-template <int Dim>
-void Simulation<Dim>::move_rigid_particles(double dt, double t) {
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (!materials_[m].is_rigid()) continue;
-    const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
-    const Vec<Dim> dx = ((materials_[m].rigid_velocity_at(t + dt) + materials_[m].rigid_velocity_at(t)) * 0.5 * dt)
-                            .template head<Dim>();
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-      p_.velocity[k] = v;
-      p_.position[k] += dx;
-    }
-  }
-}
-
-template <int Dim>
-void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
-  long k = bad;
-  for (std::size_t j = 0; k < 0 && j < p_.size(); ++j)  // rigid particles are checked here
-    if (materials_[static_cast<std::size_t>(p_.material[j])].is_rigid() && !grid_.contains(p_.position[j]))
-      k = static_cast<long>(j);
-  if (k < 0) return;
-  const std::size_t u = static_cast<std::size_t>(k);
-  std::ostringstream msg;
-  msg.precision(6);
-  const bool finite = p_.velocity[u].allFinite() && p_.position[u].allFinite();
-  msg << "step " << step_ << ", t = " << time_ << " s: particle " << k << " of body '"
-      << bodies_[static_cast<std::size_t>(p_.body[u])].name << "' ";
-  if (!finite) {
-    msg << "has a non-finite velocity or position (the step blew up; try a smaller CFL factor)";
-  } else {
-    msg << "left the grid at (";
-    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << p_.position[u][d];
-    msg << ") m; grid spans (";
-    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << grid_.lo()[d];
-    msg << ") to (";
-    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << grid_.hi()[d];
-    msg << ") m";
-  }
-  throw SimulationError(msg.str(), step_, time_, k);
-}
-
-// MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p.
+// MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p; with
+// contact, contact is resolved again on the remapped momenta.
 template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::remap_momentum() {
+void Simulation<Dim>::remap_momentum(double dt) {
   auto& st = stencils<Kernel>();
 #pragma omp parallel num_threads(threads_)
   {
@@ -324,20 +285,18 @@ void Simulation<Dim>::remap_momentum() {
     std::fill(acc.momentum.begin(), acc.momentum.end(), Vec<Dim>::Zero());
 #pragma omp barrier
     for (std::size_t m = 0; m < materials_.size(); ++m) {
-      if (materials_[m].is_rigid()) continue;
+      const int f = field_of_material_[m];
+      if (f < 0 || materials_[m].is_rigid()) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
         const Vec<Dim> mv = p_.mass[k] * p_.velocity[k];
-        st[k].for_each(grid_, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
+        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
       }
     }
-#pragma omp barrier
-    if (!thread_nodes_.empty()) {
-#pragma omp for schedule(static)
-      for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
-        for (const auto& b : thread_nodes_) nodes_.momentum[i] += b.momentum[i];
-    }
   }
+  reduce_thread_buffers(false, true, false, false);
+  if (contact_) resolve_contact(ContactPass::remapped, dt);
   velocity_from_momentum();
 }
 
@@ -349,13 +308,15 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   const Analysis an = opt_.analysis;
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const Material& mat = materials_[m];
-    if (mat.is_rigid()) continue;
+    const int f = field_of_material_[m];
+    if (mat.is_rigid() || f < 0) continue;
+    const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
     const bool nh = mat.kind == MaterialKind::neo_hookean;
 #pragma omp parallel for num_threads(threads_) schedule(static)
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
-      st[k].for_each(grid_, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });
+      st[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });
       Mat<Dim>& F = p_.deformation_gradient[k];
       F = (Mat<Dim>::Identity() + dt * L) * F;
       p_.volume[k] = F.determinant() * p_.initial_volume[k];
@@ -367,13 +328,7 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   }
 }
 
-#define FRICTHERM_INSTANTIATE_STEP(D)                                                                \
-  template double Simulation<D>::step(double);                                                       \
-  template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*) const;  \
-  template void Simulation<D>::update_grid(double);                                                  \
-  template void Simulation<D>::velocity_from_momentum();                                                  \
-  template void Simulation<D>::move_rigid_particles(double, double);                                 \
-  template void Simulation<D>::check_particle(long, double) const;
+#define FRICTHERM_INSTANTIATE_STEP(D) template double Simulation<D>::step(double);
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)
 #undef FRICTHERM_INSTANTIATE_STEP

@@ -5,6 +5,7 @@
 #include <frictherm/mechanics/grid.hpp>
 
 #include <cmath>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +15,14 @@ enum class ShapeKind { linear, ugimp, quadratic_bspline };
 
 ShapeKind shape_kind_from_string(const std::string& name);  // throws std::invalid_argument
 const char* to_string(ShapeKind kind);
+
+/// Maps a node's lattice coordinates L (counted from the first ghost node) to a storage index
+/// shift + Σ_d L_d stride_d: the whole grid (stride = grid strides, shift 0) or a box of it.
+template <int Dim>
+struct NodeIndexer {
+  IVec<Dim> stride{};
+  int shift = 0;
+};
 
 /// 1D weights of one particle: nodes base, base+1, ..., base+K-1 along one direction.
 template <int K>
@@ -104,33 +113,45 @@ struct Stencil {
       Kernel::eval(x[d], g.lo()[d], g.cell_size()[d], g.inverse_cell_size()[d], lp[d], axis[d]);
   }
 
+  /// Lowest node of the stencil along each axis, in lattice coordinates counted from the first
+  /// (ghost) node: 0 .. nodes_per_dim - 1.
+  IVec<Dim> first_node() const {
+    IVec<Dim> b;
+    for (int d = 0; d < Dim; ++d) b[d] = axis[d].base + Grid<Dim>::ghost;
+    return b;
+  }
+
   /// Calls f(node_index, S_ip, G_ip) for every node of the stencil (zero weights included).
   template <class F>
   void for_each(const Grid<Dim>& g, F&& f) const {
-    const IVec<Dim>& st = g.strides();
+    for_each(NodeIndexer<Dim>{g.strides(), 0}, std::forward<F>(f));
+  }
+
+  /// Same, with node indices given by an indexer (e.g. slots of one material's velocity field).
+  template <class F>
+  void for_each(const NodeIndexer<Dim>& ix, F&& f) const {
+    const IVec<Dim>& st = ix.stride;
+    const IVec<Dim> b = first_node();
     if constexpr (Dim == 2) {
-      const int b0 = axis[0].base + Grid<Dim>::ghost, b1 = axis[1].base + Grid<Dim>::ghost;
       for (int j = 0; j < K; ++j) {
         const double wy = axis[1].w[j], dwy = axis[1].dw[j];
-        const int row = (b1 + j) * st[1];
+        const int row = ix.shift + (b[1] + j) * st[1] + b[0] * st[0];
         for (int i = 0; i < K; ++i) {
           const double wx = axis[0].w[i];
           Vec<2> grad(axis[0].dw[i] * wy, wx * dwy);
-          f(row + b0 + i, wx * wy, grad);
+          f(row + i * st[0], wx * wy, grad);
         }
       }
     } else {
-      const int b0 = axis[0].base + Grid<Dim>::ghost, b1 = axis[1].base + Grid<Dim>::ghost,
-                b2 = axis[2].base + Grid<Dim>::ghost;
       for (int k = 0; k < K; ++k) {
         const double wz = axis[2].w[k], dwz = axis[2].dw[k];
         for (int j = 0; j < K; ++j) {
           const double wy = axis[1].w[j], dwy = axis[1].dw[j];
-          const int row = (b2 + k) * st[2] + (b1 + j) * st[1];
+          const int row = ix.shift + (b[2] + k) * st[2] + (b[1] + j) * st[1] + b[0] * st[0];
           for (int i = 0; i < K; ++i) {
             const double wx = axis[0].w[i], dwx = axis[0].dw[i];
             Vec<3> grad(dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
-            f(row + b0 + i, wx * wy * wz, grad);
+            f(row + i * st[0], wx * wy * wz, grad);
           }
         }
       }

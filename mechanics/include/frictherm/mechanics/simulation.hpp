@@ -1,5 +1,8 @@
 #pragma once
-// Explicit MPM for single-velocity-field bodies (contact comes in its own module).
+// Explicit MPM. Without contact all deformable materials share one velocity field (contact "for
+// free": stick, no interpenetration). With contact enabled (enable_contact) every material has its
+// own velocity field over the box of nodes its particles touch, and nodes reached by two or more
+// materials resolve contact with a friction law per material pair (contact.hpp).
 //
 // Update schemes (Buzzi et al. 2008; Nairn 2003):
 //   USF  - stress updated from the extrapolated nodal velocities before the forces are computed;
@@ -8,6 +11,7 @@
 //          removes the small-mass-node noise of USL while keeping its energy behaviour).
 // Time step: dt = C * min(h) / max_p (c_p + |v_p|), with C the CFL factor and c_p the particle's
 // dilatational wave speed (Nairn 2018 eq. 45 with the particle speed added).
+#include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/loads.hpp>
@@ -36,7 +40,8 @@ struct SimulationOptions {
   Vec<3> gravity = Vec<3>::Zero();             // body force per unit mass (m/s^2)
 };
 
-/// Nodal fields of the background grid (one velocity field).
+/// Nodal fields, one entry per slot: a grid node of one velocity field (without contact the single
+/// field covers the whole grid and slot = node index).
 template <int Dim>
 struct NodalFields {
   std::vector<double> mass;
@@ -44,8 +49,31 @@ struct NodalFields {
   std::vector<Vec<Dim>> force;
   std::vector<Vec<Dim>> velocity;      // v_i^{n+1} after the momentum update
   std::vector<Vec<Dim>> acceleration;  // (p^{n+1} - p^n) / (m dt), boundary conditions applied
-  void resize(std::size_t n);
+  // Contact only (empty otherwise): Σ S m x (or Σ S m (x − x0)), Ω = Σ S V, g = Σ G V (eqs. 4–6, 9).
+  std::vector<Vec<Dim>> mass_position;
+  std::vector<double> domain;
+  std::vector<Vec<Dim>> domain_gradient;
+  void resize(std::size_t n, bool with_contact = false);
   void clear_accumulators();
+};
+
+/// One velocity field: the nodes of a box of the grid, stored in slots first .. first + count − 1.
+template <int Dim>
+struct VelocityField {
+  int material = -1;          // -1: the shared field of all deformable materials (no contact)
+  bool rigid = false;
+  IVec<Dim> lo{};             // first node of the box (lattice counted from the first ghost node)
+  IVec<Dim> extent{};         // nodes per direction
+  std::size_t first = 0, count = 0;
+  NodeIndexer<Dim> index;     // lattice -> slot
+};
+
+/// Counters of the last step's contact resolution.
+struct ContactStats {
+  long contact_nodes = 0;     // nodes with two or more materials
+  long multi_nodes = 0;       // of which with three or more (lumped virtual material, eqs. 39–40)
+  long sliding_nodes = 0;     // node-pairs sliding in the momentum-update pass
+  long guarded = 0;           // materials left out because their mass fraction was below min_mass_fraction
 };
 
 struct BodyInfo {
@@ -67,6 +95,10 @@ class Simulation {
   void fix_face(const FixedFace& face);
   void add_point_load(const PointLoad<Dim>& load);
   void add_edge_traction(const EdgeTraction<Dim>& load);
+  /// Turns on multimaterial contact (one velocity field per material); before finalize().
+  void enable_contact(const ContactOptions& options);
+  /// Settings of one material pair (order matters only for a specified normal: from a to b).
+  void set_contact_pair(int material_a, int material_b, const ContactPairSettings& settings);
   /// Groups particles by material and resolves loads; called by the first step if not before.
   void finalize();
 
@@ -84,6 +116,21 @@ class Simulation {
   const Particles<Dim>& particles() const { return p_; }
   Particles<Dim>& particles() { return p_; }
   const NodalFields<Dim>& nodes() const { return nodes_; }
+  const std::vector<VelocityField<Dim>>& fields() const { return fields_; }
+  /// Grid node of each slot of nodes().
+  const std::vector<int>& slot_nodes() const { return slot_node_; }
+  bool contact_enabled() const { return contact_; }
+  const ContactOptions& contact_options() const { return contact_opt_; }
+  const ContactPairSettings& contact_pair(int material_a, int material_b) const;
+  const ContactStats& contact_stats() const { return contact_stats_; }
+  /// Frictional work of the last step per grid node (J), added once per contact node (eqs. 27, 34,
+  /// 36, 40): what the coupling hands to the thermal solver. All zeros without contact.
+  const std::vector<double>& frictional_work(HeatingOrder order) const {
+    return order == HeatingOrder::first ? work_first_ : work_second_;
+  }
+  /// Frictional work since the start (J): all pairs, or the unordered pair (a, b).
+  double cumulative_frictional_work(HeatingOrder order) const;
+  double cumulative_frictional_work(HeatingOrder order, int material_a, int material_b) const;
   const std::vector<Material>& materials() const { return materials_; }
   const std::vector<BodyInfo>& bodies() const { return bodies_; }
   double time() const { return time_; }
@@ -102,13 +149,21 @@ class Simulation {
   template <class Kernel> void add_internal_forces();
   template <class Kernel> void map_rigid_particles(double t);
   template <class Kernel> void map_external_loads(double t);
-  template <class Kernel> void remap_momentum();
+  template <class Kernel> void remap_momentum(double dt);
   template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
   template <class Kernel> long update_particles(double dt);
   template <class Kernel> std::vector<Stencil<Dim, Kernel>>& stencils();
+  template <class Kernel> void evaluate_stencils();
+  template <class Kernel> void map_rigid_fields();
+  void init_fields();
+  void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
+  void reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const;
   void update_grid(double dt);
   void velocity_from_momentum();
+  enum class ContactPass { extrapolated, updated, remapped };
+  void find_contact_nodes();
+  void resolve_contact(ContactPass pass, double dt);
   void move_rigid_particles(double dt, double t);
   void check_particle(long bad, double dt) const;
   void resolve_loads();
@@ -120,6 +175,20 @@ class Simulation {
   std::vector<BodyInfo> bodies_;
   std::vector<std::size_t> material_begin_, material_end_;  // particle ranges after finalize()
   NodalFields<Dim> nodes_;
+  std::vector<VelocityField<Dim>> fields_;
+  std::vector<int> field_of_material_;  // -1: rigid material without contact (handled by rigid_mask_)
+  std::vector<int> slot_node_;
+  std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
+  std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
+  bool contact_ = false;
+  ContactOptions contact_opt_;
+  std::vector<ContactPairSettings> pair_settings_;  // [0] = default
+  std::vector<int> pair_index_;                     // materials² -> pair_settings_ index
+  std::vector<std::pair<int, int>> contact_entries_;  // (node, slot) of multi-material nodes, by node
+  std::vector<std::uint16_t> node_field_count_;
+  std::vector<double> work_first_, work_second_;    // per grid node, last step
+  std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
+  ContactStats contact_stats_;
   std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1)
   std::vector<std::uint8_t> fixed_mask_;        // bit d set: velocity component d fixed to 0
   std::vector<std::uint8_t> rigid_mask_;        // 1: node driven by a rigid material
@@ -144,8 +213,8 @@ class Simulation {
   long step_ = 0;
   double last_dt_ = 0.0;
   double external_work_ = 0.0;
-  double empty_node_mass_ = 0.0;
-  int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
+  double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
+  int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves
 };
 
 extern template class Simulation<2>;

@@ -1,0 +1,311 @@
+// Multimaterial contact at nodes that carry two or more materials (Nairn, Bardenhagen & Smith 2018
+// §2.2–2.12): normal, detection, contact area, stick change and friction law, consistent forces and
+// frictional work. Sign convention in contact.hpp: n̂ points from material a to material b.
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace frictherm::mechanics {
+namespace {
+
+/// One material's (or a lumped virtual material's) nodal quantities at a contact node.
+template <int Dim>
+struct ContactSide {
+  double mass = 0.0;                  // m_{i,j}; for a rigid material only a presence weight
+  Vec<Dim> momentum = Vec<Dim>::Zero();
+  Vec<Dim> force = Vec<Dim>::Zero();
+  Vec<Dim> mass_position = Vec<Dim>::Zero();  // Σ S m x (or m Δx)
+  double domain = 0.0;                        // Ω_{i,j}
+  Vec<Dim> domain_gradient = Vec<Dim>::Zero();  // g_{i,j}
+  bool rigid = false;
+  Vec<Dim> rigid_velocity = Vec<Dim>::Zero();
+  Vec<Dim> rigid_acceleration = Vec<Dim>::Zero();
+
+  void add(const ContactSide& o) {
+    mass += o.mass;
+    momentum += o.momentum;
+    force += o.force;
+    mass_position += o.mass_position;
+    domain += o.domain;
+    domain_gradient += o.domain_gradient;
+  }
+};
+
+/// Result of one material pair at one node: the momentum change of material a and its friction work.
+template <int Dim>
+struct PairChange {
+  bool changed = false;
+  bool sliding = false;
+  Vec<Dim> dp = Vec<Dim>::Zero();  // Δp'_{i,a}
+  double work_first = 0.0, work_second = 0.0;
+  double reduced_mass = 0.0;
+};
+
+struct PairContext {
+  const ContactPairSettings* settings;
+  SeparationMethod separation;
+  double position_correction;
+  double cell_volume;  // of the node's cell (2D: times thickness), m^3
+  double dt;
+  bool heat;           // the momentum-update pass: compute frictional work
+};
+
+template <int Dim>
+PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const Vec<Dim>& h,
+                             const PairContext& c) {
+  PairChange<Dim> out;
+  // Normal from a to b (eq. 7 and §2.3): specified, maximum or average volume gradient.
+  Vec<Dim> n;
+  const ContactPairSettings& s = *c.settings;
+  if (s.normal == NormalMethod::specified) {
+    n = s.normal_vector.template head<Dim>();
+  } else if (s.normal == NormalMethod::max_volume_gradient) {
+    const double ga = a.domain_gradient.norm(), gb = b.domain_gradient.norm();
+    if (!(std::max(ga, gb) > 0.0)) return out;
+    n = ga >= gb ? Vec<Dim>(a.domain_gradient / ga) : Vec<Dim>(-b.domain_gradient / gb);
+  } else {
+    n = (a.domain * a.domain_gradient - b.domain * b.domain_gradient) / (a.domain + b.domain);
+    const double len = n.norm();
+    if (!(len > 0.0)) return out;
+    n /= len;
+  }
+  // Effective cell thickness across the interface, exact for rectangular cells: h⊥ = 1/|n ⊘ h|.
+  const double h_perp = 1.0 / n.cwiseQuotient(h).norm();
+
+  const Vec<Dim> va = a.momentum / a.mass;
+  const Vec<Dim> vb = b.rigid ? b.rigid_velocity : Vec<Dim>(b.momentum / b.mass);
+  const bool approaching = (vb - va).dot(n) < 0.0;
+  double separation = -1.0;  // velocity-only detection: contact whenever approaching
+  if (c.separation == SeparationMethod::position)  // eq. 8
+    separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n) - c.position_correction * h_perp;
+  else if (c.separation == SeparationMethod::displacement)  // eqs. 9–10
+    separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n);
+  const bool in_contact = approaching && separation < 0.0;
+
+  // Stick momentum change and reduced mass (eqs. 12–14); a rigid b has v_c = v_b, m_red = m_a.
+  Vec<Dim> dp_stick;
+  if (b.rigid) {
+    dp_stick = a.mass * vb - a.momentum;
+    out.reduced_mass = a.mass;
+  } else {
+    dp_stick = (a.mass * b.momentum - b.mass * a.momentum) / (a.mass + b.mass);
+    out.reduced_mass = a.mass * b.mass / (a.mass + b.mass);
+  }
+  const double d_n = dp_stick.dot(n);  // eq. 15
+  const Vec<Dim> t_vec = dp_stick - d_n * n;
+  const double d_t = t_vec.norm();
+  const double area = std::sqrt(2.0 * c.cell_volume * std::min(a.domain, b.domain)) / h_perp;  // eq. 11
+  if (!(area > 0.0)) return out;
+
+  if (!in_contact) {  // separated: only an adhesive interface with tensile strength may hold (eq. 25)
+    const double N = -d_n / (area * c.dt), S_stick = d_t / (area * c.dt);
+    if (s.law.holds_when_separated(S_stick, N)) {
+      out.changed = true;
+      out.dp = dp_stick;
+    }
+    return out;
+  }
+  const FrictionOutcome f = s.law.in_contact(ContactImpulse{d_n, d_t, out.reduced_mass, area, c.dt});
+  out.changed = true;
+  if (f.stick || !(d_t > 0.0)) {
+    out.dp = dp_stick;
+    return out;
+  }
+  const Vec<Dim> t_hat = t_vec / d_t;
+  out.sliding = true;
+  out.dp = d_n * n + f.slide_impulse * t_hat;  // eq. 17
+  if (c.heat) {
+    // Relative force tangential component f_t (eqs. 29–30); rigid b: Δf_a = m_a a_b − f_a.
+    const Vec<Dim> df = b.rigid ? Vec<Dim>(a.mass * b.rigid_acceleration - a.force)
+                                : Vec<Dim>((a.mass * b.force - b.mass * a.force) / (a.mass + b.mass));
+    out.work_first = frictional_work_first_order(f.slide_impulse, d_t, out.reduced_mass);  // eq. 27
+    out.work_second =
+        frictional_work_second_order(f.slide_impulse, d_t, df.dot(t_hat), out.reduced_mass, c.dt);  // eqs. 34, 36
+  }
+  return out;
+}
+
+}  // namespace
+
+// Lists (node, slot) for every node where two or more fields have mass, sorted by node; within a
+// node the slots come in material order because fields are laid out in material order.
+template <int Dim>
+void Simulation<Dim>::find_contact_nodes() {
+  std::fill(node_field_count_.begin(), node_field_count_.end(), std::uint16_t{0});
+  const double mmin = empty_node_mass_;
+  const std::size_t total = nodes_.mass.size();
+  for (std::size_t s = 0; s < total; ++s)
+    if (nodes_.mass[s] > mmin) ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
+  contact_entries_.clear();
+  for (std::size_t s = 0; s < total; ++s) {
+    const int node = slot_node_[s];
+    if (nodes_.mass[s] > mmin && node_field_count_[static_cast<std::size_t>(node)] >= 2)
+      contact_entries_.emplace_back(node, static_cast<int>(s));
+  }
+  std::sort(contact_entries_.begin(), contact_entries_.end());
+}
+
+template <int Dim>
+void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
+  const bool heat = pass == ContactPass::updated;
+  const bool forces = pass == ContactPass::updated;
+  const std::size_t nm = materials_.size();
+  // Field of a slot: fields are contiguous and in material order.
+  auto field_of_slot = [&](int slot) {
+    std::size_t f = 0;
+    while (fields_[f].first + fields_[f].count <= static_cast<std::size_t>(slot)) ++f;
+    return f;
+  };
+  Vec<Dim> h = grid_.cell_size();
+  const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
+  PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, cell_volume, dt, heat};
+  if (heat) contact_stats_ = ContactStats{};
+
+  std::vector<ContactSide<Dim>> sides;
+  std::vector<int> slots, mats;
+  std::vector<Vec<Dim>> dps;
+  sides.reserve(8), slots.reserve(8), mats.reserve(8), dps.reserve(8);
+  auto apply = [&](int slot, const Vec<Dim>& dp) {
+    nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
+    if (forces) nodes_.force[static_cast<std::size_t>(slot)] += dp / dt;  // eq. 19
+  };
+  auto add_work = [&](int node, int ma, int mb, double w1, double w2) {
+    if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
+    work_first_[static_cast<std::size_t>(node)] += w1;
+    work_second_[static_cast<std::size_t>(node)] += w2;
+    const std::size_t k = static_cast<std::size_t>(std::min(ma, mb)) * nm + static_cast<std::size_t>(std::max(ma, mb));
+    pair_work_first_[k] += w1;
+    pair_work_second_[k] += w2;
+  };
+
+  for (std::size_t e = 0; e < contact_entries_.size();) {
+    const int node = contact_entries_[e].first;
+    std::size_t end = e;
+    while (end < contact_entries_.size() && contact_entries_[end].first == node) ++end;
+    // Gather the materials at this node; slivers below min_mass_fraction take no part.
+    sides.clear(), slots.clear(), mats.clear();
+    double node_mass = 0.0;
+    for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].second)];
+    for (std::size_t q = e; q < end; ++q) {
+      const int slot = contact_entries_[q].second;
+      const std::size_t su = static_cast<std::size_t>(slot);
+      if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
+        if (heat) ++contact_stats_.guarded;
+        continue;
+      }
+      const std::size_t f = field_of_slot(slot);
+      ContactSide<Dim> sd;
+      sd.mass = nodes_.mass[su];
+      sd.momentum = nodes_.momentum[su];
+      sd.force = nodes_.force[su];
+      sd.mass_position = nodes_.mass_position[su];
+      sd.domain = nodes_.domain[su];
+      sd.domain_gradient = nodes_.domain_gradient[su];
+      sd.rigid = fields_[f].rigid;
+      if (sd.rigid) {
+        const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
+        sd.rigid_velocity = field_velocity_[f];
+        sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
+      }
+      sides.push_back(sd);
+      slots.push_back(slot);
+      mats.push_back(fields_[f].material);
+    }
+    const std::size_t count = sides.size();
+    if (heat) {
+      ++contact_stats_.contact_nodes;
+      if (count > 2) ++contact_stats_.multi_nodes;
+    }
+    if (count == 2) {
+      // Two materials: a is the deformable one when the other is rigid.
+      std::size_t ia = 0, ib = 1;
+      if (sides[0].rigid) std::swap(ia, ib);
+      if (!sides[ia].rigid) {
+        ctx.settings = &contact_pair(mats[ia], mats[ib]);
+        const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
+        if (r.changed) {
+          apply(slots[ia], r.dp);
+          if (!sides[ib].rigid) apply(slots[ib], Vec<Dim>(-r.dp));
+        }
+        if (r.sliding && heat) {
+          ++contact_stats_.sliding_nodes;
+          add_work(node, mats[ia], mats[ib], r.work_first, r.work_second);
+        }
+      }
+    } else if (count > 2) {
+      // Three or more: each material against the others lumped into one virtual material; its
+      // change is applied to it alone, frictional work summed with eq. 40 (1/m_red = Σ_j 1/m_j, eq. 39).
+      bool any_rigid = false;
+      double inv_mred = 0.0, total = 0.0;
+      for (const auto& sd : sides) {
+        any_rigid = any_rigid || sd.rigid;
+        if (!sd.rigid) inv_mred += 1.0 / sd.mass, total += sd.mass;
+      }
+      const double m_red_node = 1.0 / inv_mred;
+      dps.assign(count, Vec<Dim>::Zero());
+      for (std::size_t a = 0; a < count; ++a) {
+        if (sides[a].rigid) continue;
+        ContactSide<Dim> rest;
+        std::size_t dominant = count;
+        double rigid_weight = -1.0;
+        for (std::size_t j = 0; j < count; ++j) {
+          if (j == a) continue;
+          rest.add(sides[j]);
+          if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
+          if (sides[j].rigid && sides[j].mass > rigid_weight) {  // a rigid neighbour dominates the lump
+            rigid_weight = sides[j].mass;
+            rest.rigid = true;
+            rest.rigid_velocity = sides[j].rigid_velocity;
+            rest.rigid_acceleration = sides[j].rigid_acceleration;
+          }
+        }
+        ctx.settings = &contact_pair(mats[a], mats[dominant]);
+        const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
+        if (r.changed) dps[a] = r.dp;
+        if (r.sliding && heat) {
+          ++contact_stats_.sliding_nodes;
+          const double w = m_red_node / sides[a].mass;  // eq. 40
+          add_work(node, mats[a], mats[dominant], w * r.work_first, w * r.work_second);
+        }
+      }
+      if (!any_rigid) {
+        // The lumped changes need not cancel; removing their mass-weighted mean keeps the node's total
+        // momentum exact without changing any relative velocity (an addition to the paper's §2.12).
+        Vec<Dim> residual = Vec<Dim>::Zero();
+        for (const auto& d : dps) residual += d;
+        for (std::size_t a = 0; a < count; ++a) dps[a] -= (sides[a].mass / total) * residual;
+      }
+      for (std::size_t a = 0; a < count; ++a)
+        if (!sides[a].rigid) apply(slots[a], dps[a]);
+    }
+    e = end;
+  }
+}
+
+template <int Dim>
+double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order) const {
+  const auto& w = order == HeatingOrder::first ? pair_work_first_ : pair_work_second_;
+  double sum = 0.0;
+  for (double x : w) sum += x;
+  return sum;
+}
+
+template <int Dim>
+double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order, int a, int b) const {
+  const auto& w = order == HeatingOrder::first ? pair_work_first_ : pair_work_second_;
+  const std::size_t nm = materials_.size();
+  if (w.size() != nm * nm || a < 0 || b < 0 || static_cast<std::size_t>(a) >= nm || static_cast<std::size_t>(b) >= nm) return 0.0;
+  return w[static_cast<std::size_t>(std::min(a, b)) * nm + static_cast<std::size_t>(std::max(a, b))];
+}
+
+#define FRICTHERM_INSTANTIATE_CONTACT(D)                                              \
+  template void Simulation<D>::find_contact_nodes();                                  \
+  template void Simulation<D>::resolve_contact(ContactPass, double);                  \
+  template double Simulation<D>::cumulative_frictional_work(HeatingOrder) const;      \
+  template double Simulation<D>::cumulative_frictional_work(HeatingOrder, int, int) const;
+FRICTHERM_INSTANTIATE_CONTACT(2)
+FRICTHERM_INSTANTIATE_CONTACT(3)
+#undef FRICTHERM_INSTANTIATE_CONTACT
+
+}  // namespace frictherm::mechanics

@@ -1,0 +1,312 @@
+// Velocity fields and the grid momentum update: the layout of the fields' slots, the per-thread
+// buffer reduction, velocity boundary conditions, p ← p + f dt, and rigid-body motion.
+#include <frictherm/mechanics/errors.hpp>
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <sstream>
+
+namespace frictherm::mechanics {
+
+template <int Dim>
+void NodalFields<Dim>::resize(std::size_t n, bool with_contact) {
+  mass.assign(n, 0.0);
+  momentum.assign(n, Vec<Dim>::Zero());
+  force.assign(n, Vec<Dim>::Zero());
+  velocity.assign(n, Vec<Dim>::Zero());
+  acceleration.assign(n, Vec<Dim>::Zero());
+  const std::size_t nc = with_contact ? n : 0;
+  mass_position.assign(nc, Vec<Dim>::Zero());
+  domain.assign(nc, 0.0);
+  domain_gradient.assign(nc, Vec<Dim>::Zero());
+}
+
+template <int Dim>
+void NodalFields<Dim>::clear_accumulators() {
+  std::fill(mass.begin(), mass.end(), 0.0);
+  std::fill(momentum.begin(), momentum.end(), Vec<Dim>::Zero());
+  std::fill(force.begin(), force.end(), Vec<Dim>::Zero());
+  std::fill(mass_position.begin(), mass_position.end(), Vec<Dim>::Zero());
+  std::fill(domain.begin(), domain.end(), 0.0);
+  std::fill(domain_gradient.begin(), domain_gradient.end(), Vec<Dim>::Zero());
+}
+
+template <int Dim>
+void Simulation<Dim>::enable_contact(const ContactOptions& options) {
+  if (finalized_) throw std::logic_error("contact must be enabled before the simulation is finalized");
+  if (!(options.position_correction >= 0.0 && options.position_correction < 2.0))
+    throw std::invalid_argument("contact position correction must be in [0, 2) cell sizes");
+  if (!(options.min_mass_fraction >= 0.0 && options.min_mass_fraction < 0.5))
+    throw std::invalid_argument("contact min_mass_fraction must be in [0, 0.5)");
+  contact_ = true;
+  contact_opt_ = options;
+  pair_settings_.assign(1, options.default_pair);
+}
+
+template <int Dim>
+void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& settings) {
+  if (!contact_) throw std::logic_error("enable_contact() must come before set_contact_pair()");
+  const int n = static_cast<int>(materials_.size());
+  if (a < 0 || b < 0 || a >= n || b >= n || a == b) throw std::invalid_argument("contact pair needs two different materials");
+  if (pair_index_.size() != static_cast<std::size_t>(n * n)) pair_index_.assign(static_cast<std::size_t>(n * n), 0);
+  ContactPairSettings s = settings;
+  if (s.normal == NormalMethod::specified) {
+    const double len = s.normal_vector.head<Dim>().norm();
+    if (!(len > 0.0)) throw std::invalid_argument("a specified contact normal must be non-zero");
+    s.normal_vector /= len;
+  }
+  pair_settings_.push_back(s);
+  ContactPairSettings flipped = s;  // the same pair seen from b: the normal points from b to a
+  flipped.normal_vector = -s.normal_vector;
+  pair_settings_.push_back(flipped);
+  const int k = static_cast<int>(pair_settings_.size());
+  pair_index_[static_cast<std::size_t>(a * n + b)] = k - 2;
+  pair_index_[static_cast<std::size_t>(b * n + a)] = k - 1;
+}
+
+template <int Dim>
+const ContactPairSettings& Simulation<Dim>::contact_pair(int a, int b) const {
+  const std::size_t n = materials_.size();
+  if (pair_index_.size() != n * n) return pair_settings_.at(0);
+  return pair_settings_.at(static_cast<std::size_t>(pair_index_[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)]));
+}
+
+// Without contact: one field over the whole grid shared by every deformable material (slot = node),
+// rigid materials act through rigid_mask_. With contact: one field per material, laid out each step.
+template <int Dim>
+void Simulation<Dim>::init_fields() {
+  const std::size_t nm = materials_.size();
+  fields_.clear();
+  field_of_material_.assign(nm, -1);
+  if (!contact_) {
+    VelocityField<Dim> f;
+    f.extent = grid_.nodes_per_dim();
+    f.count = grid_.node_count();
+    f.index = NodeIndexer<Dim>{grid_.strides(), 0};
+    fields_.push_back(f);
+    for (std::size_t m = 0; m < nm; ++m)
+      if (!materials_[m].is_rigid()) field_of_material_[m] = 0;
+    slot_node_.resize(grid_.node_count());
+    for (std::size_t i = 0; i < slot_node_.size(); ++i) slot_node_[i] = static_cast<int>(i);
+    nodes_.resize(grid_.node_count(), false);
+  } else {
+    for (std::size_t m = 0; m < nm; ++m) {
+      VelocityField<Dim> f;
+      f.material = static_cast<int>(m);
+      f.rigid = materials_[m].is_rigid();
+      field_of_material_[m] = static_cast<int>(fields_.size());
+      fields_.push_back(f);
+    }
+    if (pair_index_.size() != nm * nm) pair_index_.assign(nm * nm, 0);
+    box_lo_.assign(nm, IVec<Dim>{});
+    box_hi_.assign(nm, IVec<Dim>{});
+    node_field_count_.assign(grid_.node_count(), 0);
+    pair_work_first_.assign(nm * nm, 0.0);
+    pair_work_second_.assign(nm * nm, 0.0);
+  }
+  work_first_.assign(grid_.node_count(), 0.0);
+  work_second_.assign(grid_.node_count(), 0.0);
+  field_velocity_.assign(fields_.size(), Vec<Dim>::Zero());
+}
+
+// Each material's field covers the box [lo, hi] of nodes its particles reach, stored contiguously:
+// slot = first + Σ (L_d − lo_d) stride_d. Storage only grows, so steady runs do not allocate.
+template <int Dim>
+void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi) {
+  std::size_t total = 0;
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    VelocityField<Dim>& F = fields_[f];
+    const std::size_t m = static_cast<std::size_t>(F.material);
+    F.first = total;
+    if (material_end_[m] == material_begin_[m]) {
+      F.count = 0;
+      F.extent = IVec<Dim>{};
+      continue;
+    }
+    F.lo = lo[m];
+    std::size_t count = 1;
+    int shift = static_cast<int>(total);
+    for (int d = 0; d < Dim; ++d) {
+      F.extent[d] = hi[m][d] - lo[m][d] + 1;
+      F.index.stride[d] = static_cast<int>(count);
+      shift -= F.lo[d] * F.index.stride[d];
+      count *= static_cast<std::size_t>(F.extent[d]);
+    }
+    F.index.shift = shift;
+    F.count = count;
+    total += count;
+  }
+  if (nodes_.mass.size() != total) {
+    nodes_.resize(total, true);
+    for (auto& t : thread_nodes_) t.resize(total, true);
+  }
+  slot_node_.resize(total);
+  const IVec<Dim>& gs = grid_.strides();
+  for (const VelocityField<Dim>& F : fields_) {
+    for (std::size_t s = 0; s < F.count; ++s) {
+      std::size_t r = s;
+      int node = 0;
+      for (int d = 0; d < Dim; ++d) {
+        const int local = static_cast<int>(r % static_cast<std::size_t>(F.extent[d]));
+        r /= static_cast<std::size_t>(F.extent[d]);
+        node += (F.lo[d] + local) * gs[d];
+      }
+      slot_node_[F.first + s] = node;
+    }
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
+  if (thread_nodes_.empty()) return;
+  const std::size_t n = nodes_.mass.size();
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const auto& b : thread_nodes_) {
+      if (mass) nodes_.mass[i] += b.mass[i];
+      if (momentum) nodes_.momentum[i] += b.momentum[i];
+      if (force) nodes_.force[i] += b.force[i];
+      if (contact_terms) {
+        nodes_.mass_position[i] += b.mass_position[i];
+        nodes_.domain[i] += b.domain[i];
+        nodes_.domain_gradient[i] += b.domain_gradient[i];
+      }
+    }
+  }
+}
+
+// Fixed components are zeroed; rigid nodes (single field) and rigid fields take m v_rigid, no force.
+template <int Dim>
+void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const {
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    const VelocityField<Dim>& F = fields_[f];
+    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
+    if (F.rigid) {
+      const Vec<Dim> v = field_velocity_[f];
+      for (long s = b; s < e; ++s) {
+        momentum[static_cast<std::size_t>(s)] = nodes_.mass[static_cast<std::size_t>(s)] * v;
+        if (force) (*force)[static_cast<std::size_t>(s)].setZero();
+      }
+      continue;
+    }
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (long ss = b; ss < e; ++ss) {
+      const std::size_t s = static_cast<std::size_t>(ss);
+      const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
+      if (rigid_mask_[i]) {
+        momentum[s] = nodes_.mass[s] * rigid_velocity_[i];
+        if (force) (*force)[s].setZero();
+      }
+      if (const std::uint8_t mask = fixed_mask_[i]) {
+        for (int d = 0; d < Dim; ++d)
+          if (mask & (1u << d)) {
+            momentum[s][d] = 0.0;
+            if (force) (*force)[s][d] = 0.0;
+          }
+      }
+    }
+  }
+}
+
+// v_i = p_i / m_i after the velocity boundary conditions on p_i; empty nodes get no velocity.
+template <int Dim>
+void Simulation<Dim>::velocity_from_momentum() {
+  apply_velocity_bc(nodes_.momentum, nullptr);
+  const double mmin = empty_node_mass_;
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
+    nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+}
+
+// p_i^{n+1} = p_i^n + f_i dt after boundary conditions on both; with contact, contact is resolved on
+// p^{n+1} with consistent forces (Nairn 2018 eq. 19); then v_i^{n+1} = p_i^{n+1}/m_i, a_i = f_i/m_i.
+template <int Dim>
+void Simulation<Dim>::update_grid(double dt) {
+  apply_velocity_bc(nodes_.momentum, &nodes_.force);
+  const double mmin = empty_node_mass_;
+  const std::size_t n = nodes_.mass.size();
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
+  if (contact_) resolve_contact(ContactPass::updated, dt);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = nodes_.mass[i];
+    if (m > mmin) {
+      nodes_.velocity[i] = nodes_.momentum[i] / m;
+      nodes_.acceleration[i] = nodes_.force[i] / m;
+    } else {
+      nodes_.velocity[i].setZero();
+      nodes_.acceleration[i].setZero();
+    }
+  }
+  // Rigid nodes keep the prescribed velocity (the force was zeroed consistently, so only the
+  // velocity needs resetting when the prescribed velocity changes).
+  if (!contact_) {
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      if (rigid_mask_[i] && nodes_.mass[i] > mmin) nodes_.velocity[i] = rigid_velocity_[i];
+  }
+  for (std::size_t f = 0; f < fields_.size(); ++f)
+    if (fields_[f].rigid)
+      for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) nodes_.velocity[s] = field_velocity_[f];
+}
+
+template <int Dim>
+void Simulation<Dim>::move_rigid_particles(double dt, double t) {
+  for (std::size_t m = 0; m < materials_.size(); ++m) {
+    if (!materials_[m].is_rigid()) continue;
+    const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
+    const Vec<Dim> dx = ((materials_[m].rigid_velocity_at(t + dt) + materials_[m].rigid_velocity_at(t)) * 0.5 * dt)
+                            .template head<Dim>();
+    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+      p_.velocity[k] = v;
+      p_.position[k] += dx;
+    }
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
+  long k = bad;
+  for (std::size_t j = 0; k < 0 && j < p_.size(); ++j)  // rigid particles are checked here
+    if (materials_[static_cast<std::size_t>(p_.material[j])].is_rigid() && !grid_.contains(p_.position[j]))
+      k = static_cast<long>(j);
+  if (k < 0) return;
+  const std::size_t u = static_cast<std::size_t>(k);
+  std::ostringstream msg;
+  msg.precision(6);
+  const bool finite = p_.velocity[u].allFinite() && p_.position[u].allFinite();
+  msg << "step " << step_ << ", t = " << time_ << " s: particle " << k << " of body '"
+      << bodies_[static_cast<std::size_t>(p_.body[u])].name << "' ";
+  if (!finite) {
+    msg << "has a non-finite velocity or position (the step blew up; try a smaller CFL factor)";
+  } else {
+    msg << "left the grid at (";
+    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << p_.position[u][d];
+    msg << ") m; grid spans (";
+    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << grid_.lo()[d];
+    msg << ") to (";
+    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << grid_.hi()[d];
+    msg << ") m";
+  }
+  throw SimulationError(msg.str(), step_, time_, k);
+}
+
+template struct NodalFields<2>;
+template struct NodalFields<3>;
+#define FRICTHERM_INSTANTIATE_FIELDS(D)                                                                       \
+  template void Simulation<D>::enable_contact(const ContactOptions&);                                         \
+  template void Simulation<D>::set_contact_pair(int, int, const ContactPairSettings&);                        \
+  template const ContactPairSettings& Simulation<D>::contact_pair(int, int) const;                            \
+  template void Simulation<D>::init_fields();                                                                 \
+  template void Simulation<D>::layout_fields(const std::vector<IVec<D>>&, const std::vector<IVec<D>>&);      \
+  template void Simulation<D>::reduce_thread_buffers(bool, bool, bool, bool);                                    \
+  template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*) const;           \
+  template void Simulation<D>::velocity_from_momentum();                                                      \
+  template void Simulation<D>::update_grid(double);                                                           \
+  template void Simulation<D>::move_rigid_particles(double, double);                                          \
+  template void Simulation<D>::check_particle(long, double) const;
+FRICTHERM_INSTANTIATE_FIELDS(2)
+FRICTHERM_INSTANTIATE_FIELDS(3)
+#undef FRICTHERM_INSTANTIATE_FIELDS
+
+}  // namespace frictherm::mechanics

@@ -1,0 +1,79 @@
+// Sliding block (Nairn, Bardenhagen & Smith 2018, figures 2, 3 and 5): the MPM block's mean velocity
+// and the total frictional work against the rigid-block solution (appendix eqs. 46–54).
+#include "sliding_block.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+using namespace frictherm;
+using namespace frictherm::verification;
+using mechanics::FrictionLaw;
+
+namespace {
+
+struct Comparison {
+  double velocity_error = 0.0;  // max |v_MPM − v_rigid| / v_max over the samples
+  double onset_error = 0.0;     // |t_onset,MPM − t_onset,rigid| / sliding time
+  double work_error = 0.0;      // |W_MPM − Q| / Q at tf
+  double work_order_gap = 0.0;  // |W2nd − W1st| / Q at tf
+};
+
+Comparison compare(const SlidingHistory& h, const RigidBlock& r, const char* name) {
+  using C = SlidingBlockConstants;
+  Comparison c;
+  const double tf = C::t_final(), ti = r.onset();
+  double onset = tf;
+  for (std::size_t k = 0; k < h.time.size(); ++k) {
+    c.velocity_error = std::max(c.velocity_error, std::fabs(h.velocity[k] - r.velocity(h.time[k])) / C::v_max);
+    if (onset == tf && h.velocity[k] > 0.01 * C::v_max) onset = h.time[k];
+  }
+  // Onset: where the rigid solution reaches 1 % of v_max, compared with the MPM crossing.
+  double rigid_onset = ti;
+  while (r.velocity(rigid_onset) < 0.01 * C::v_max) rigid_onset += 1e-7;
+  c.onset_error = std::fabs(onset - rigid_onset) / (tf - ti);
+  const double Q = r.friction_work(tf);
+  c.work_error = std::fabs(h.work_second.back() - Q) / Q;
+  c.work_order_gap = std::fabs(h.work_second.back() - h.work_first.back()) / Q;
+  std::printf("[sliding block %s] max |v − v_rigid|/v_max = %.4f, onset error %.4f of the sliding time, "
+              "friction work %.5g J (first order %.5g J) vs rigid %.5g J: error %.4f; final v %.3f m/s (rigid %.3f)\n",
+              name, c.velocity_error, c.onset_error, h.work_second.back(), h.work_first.back(), Q, c.work_error,
+              h.velocity.back(), r.velocity(tf));
+  return c;
+}
+
+}  // namespace
+
+TEST(SlidingBlock, RigidSolutionMatchesQuadrature) {
+  // Eqs. 50 and 53–54 against a trapezoid integration of dv/dt = α T + β − γ v and of (S_slide) v.
+  for (double k : {0.0, 0.5 / 31.6}) {
+    RigidBlock r = rigid_solution(0.3, 0.2, k, 0.05 * SlidingBlockConstants::normal_stress());
+    const double ti = r.onset(), tf = SlidingBlockConstants::t_final();
+    const int n = 200000;
+    const double dt = (tf - ti) / n;
+    double v = 0.0, q = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double T = i * dt;
+      auto acc = [&](double TT, double vv) { return r.alpha() * TT + r.beta() - r.gamma() * vv; };
+      const double k1 = acc(T, v), k2 = acc(T + 0.5 * dt, v + 0.5 * dt * k1), k3 = acc(T + 0.5 * dt, v + 0.5 * dt * k2),
+                   k4 = acc(T + dt, v + dt * k3);
+      const double v_new = v + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+      auto power = [&](double vv) { return r.l * r.b * ((r.mu_d + r.k * vv) * r.N + r.S_a) * vv; };
+      q += 0.5 * dt * (power(v) + power(v_new));
+      v = v_new;
+    }
+    EXPECT_NEAR(v, r.velocity(tf), 1e-9 * r.velocity(tf)) << "k = " << k;
+    // Trapezoid error ~ (tf − ti)^3/n^2 |P''|: far below 1e-8 relative here.
+    EXPECT_NEAR(q, r.friction_work(tf), 1e-8 * q) << "k = " << k;
+  }
+}
+
+TEST(SlidingBlock, CoulombMatchesRigidBlock) {
+  SlidingBlockSetup s;
+  s.law = FrictionLaw::coulomb(0.2);
+  const Comparison c = compare(run_sliding_block(s), rigid_solution(0.2, 0.2, 0.0, 0.0), "coulomb");
+  EXPECT_LT(c.velocity_error, 0.02);
+  EXPECT_LT(c.onset_error, 0.02);
+  EXPECT_LT(c.work_error, 0.03);
+}
