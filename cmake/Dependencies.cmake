@@ -4,6 +4,7 @@ find_package(SUNDIALS 6.4 REQUIRED COMPONENTS cvode arkode nvecserial
              sunlinsolklu sunlinsolpcg sunlinsolspgmr sunmatrixsparse)
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(nlohmann_json 3.10 REQUIRED)
+find_package(Boost 1.74 REQUIRED)  # header-only: Boost.Math root finders (mechanics friction laws)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
 if(FRICTHERM_BUILD_TESTS)
   find_package(GTest REQUIRED)
