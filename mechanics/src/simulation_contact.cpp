@@ -95,7 +95,9 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   const double d_n = dp_stick.dot(n);  // eq. 15
   const Vec<Dim> t_vec = dp_stick - d_n * n;
   const double d_t = t_vec.norm();
-  const double area = std::sqrt(2.0 * c.cell_volume * std::min(a.domain, b.domain)) / h_perp;  // eq. 11
+  // Eq. 11 with Ω_i = Σ_j Ω_{i,j}, the node's total extrapolated domain (a volume, so the 2D thickness
+  // is already in it).
+  const double area = std::sqrt(2.0 * (a.domain + b.domain) * std::min(a.domain, b.domain)) / h_perp;
   if (!(area > 0.0)) return out;
 
   if (!in_contact) {  // separated: only an adhesive interface with tensile strength may hold (eq. 25)

@@ -21,6 +21,7 @@ namespace frictherm::verification {
 struct SlidingBlockSetup {
   mechanics::FrictionLaw law = mechanics::FrictionLaw::coulomb(0.2);
   mechanics::NormalMethod normal = mechanics::NormalMethod::specified;
+  mechanics::SeparationMethod separation = mechanics::SeparationMethod::position;
   mechanics::ShapeKind shape = mechanics::ShapeKind::ugimp;
   double cell = 0.005;
   double cfl = 0.5;
@@ -128,6 +129,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     co.default_pair.law = s.law;
     co.default_pair.normal = s.normal;
     co.default_pair.normal_vector = Vec<3>(-sn, c, 0.0);  // from base to block
+    co.separation = s.separation;
     sim.enable_contact(co);
     ContactPairSettings pair = co.default_pair;
     sim.set_contact_pair(base, block_material, pair);

@@ -77,3 +77,31 @@ TEST(SlidingBlock, CoulombMatchesRigidBlock) {
   EXPECT_LT(c.onset_error, 0.02);
   EXPECT_LT(c.work_error, 0.03);
 }
+
+TEST(SlidingBlock, LinearVelocityDependenceMatchesRigidBlock) {
+  const double k = 0.5 / SlidingBlockConstants::v_max;  // k v_max = 0.5
+  SlidingBlockSetup s;
+  s.law = FrictionLaw::linear_velocity(0.2, k);
+  const Comparison c = compare(run_sliding_block(s), rigid_solution(0.2, 0.2, k, 0.0), "linear velocity");
+  EXPECT_LT(c.velocity_error, 0.02);
+  EXPECT_LT(c.onset_error, 0.02);
+  EXPECT_LT(c.work_error, 0.03);
+}
+
+TEST(SlidingBlock, AdhesionMatchesRigidBlock) {
+  // Unlike the Coulomb term, the adhesion term S_a A_c acts only at nodes in contact. At the paper's
+  // 5 mm cells the elastic block (three cells tall, preloaded to only 0.15 MPa) rocks on the base as
+  // it slides over the grid, parts of the interface open for a few steps, and the block loses about
+  // 8 % of its adhesion: we measured a velocity error of 2.5 % of v_max and a work error of 6 % there.
+  // Eq. 11 also overestimates the area of the two end nodes (√(3/8) h t instead of h t / 2), which
+  // delays the onset by about 2 % of the sliding time. Both vanish with resolution: at 2.5 mm cells
+  // the errors are 0.6 % and 1.6 %, so this case runs at 2.5 mm.
+  const double S_a = 0.3 * SlidingBlockConstants::normal_stress();
+  SlidingBlockSetup s;
+  s.cell = 0.0025;
+  s.law = FrictionLaw::adhesion(0.2, S_a);
+  const Comparison c = compare(run_sliding_block(s), rigid_solution(0.2, 0.2, 0.0, S_a), "adhesion");
+  EXPECT_LT(c.velocity_error, 0.02);
+  EXPECT_LT(c.onset_error, 0.02);
+  EXPECT_LT(c.work_error, 0.03);
+}
