@@ -29,6 +29,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -159,7 +160,41 @@ struct H5Output::Impl {
     Scoped& operator=(const Scoped&) = delete;
   };
 
+  // ---- extra append-only tables /<name>/<column> (hot spots, coupling), written with the series ----
+  struct Table {
+    Handle group;
+    std::vector<std::string> names;
+    std::vector<Handle> sets;
+    std::vector<double> pending;  // row-major rows not yet written
+    hsize_t written = 0;
+  };
+  std::map<std::string, Table> tables;
+
+  void write_table(const std::string& name, Table& t) {
+    const std::size_t cols = t.names.size();
+    if (cols == 0 || t.pending.empty()) return;
+    hsize_t rows = t.pending.size() / cols;
+    std::vector<double> column(rows);
+    const hsize_t total = t.written + rows;
+    for (std::size_t j = 0; j < cols; ++j) {
+      for (hsize_t r = 0; r < rows; ++r) column[r] = t.pending[r * cols + j];
+      const std::string where = "/" + name + "/" + t.names[j];
+      const hid_t ds = t.sets[j].get();
+      check(H5Dset_extent(ds, &total), io.file, "cannot extend " + where);
+      const Handle fs{check_id(H5Dget_space(ds), io.file, "cannot get the dataspace of " + where), H5Sclose};
+      check(H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, &t.written, nullptr, &rows, nullptr), io.file,
+            "cannot select rows of " + where);
+      const Handle ms = io.space(1, &rows);
+      check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, ms.get(), fs.get(), H5P_DEFAULT, column.data()), io.file,
+            "cannot write " + where);
+    }
+    t.written = total;
+    t.pending.clear();
+  }
+  // ---- end of extra tables ----
+
   void write_pending() {
+    for (auto& [name, table] : tables) write_table(name, table);  // extra tables
     const std::size_t cols = series_names.size();
     if (cols == 0 || pending.empty()) return;
     hsize_t rows = pending.size() / cols;
@@ -471,6 +506,70 @@ void H5Output::append_series(const std::vector<double>& row) {
   if (m.pending.size() >= m.options.series_batch_rows * row.size()) flush();
 }
 
+// ---- extra tables (declare_table / append_table_row) ----
+void H5Output::declare_table(const std::string& name, const std::vector<std::string>& columns) {
+  Impl& m = live();
+  check_name(name, "table");
+  if (name == "meta" || name == "snapshots" || name == "series" || name == "failure" || name == "xdmf" ||
+      m.tables.count(name) != 0)
+    throw std::logic_error("H5Output: table /" + name + " already exists or is reserved");
+  if (columns.empty()) throw std::invalid_argument("table /" + name + " needs at least one column");
+  std::set<std::string> seen;
+  std::size_t longest = 1;
+  for (const auto& n : columns) {
+    check_name(n, "table column");
+    if (!seen.insert(n).second) throw std::invalid_argument("table column '" + n + "' declared twice");
+    longest = std::max(longest, n.size());
+  }
+  const Quiet quiet;
+  const Impl::Scoped hold(m);
+  Impl::Table t;
+  t.group = m.io.group(m.file.get(), name, "/" + name);
+  std::string packed(columns.size() * longest, '\0');  // fixed-length, NUL-padded names
+  for (std::size_t i = 0; i < columns.size(); ++i) packed.replace(i * longest, columns[i].size(), columns[i]);
+  {
+    const Handle type = m.io.string_type(longest);
+    const hsize_t count = columns.size();
+    const Handle s = m.io.space(1, &count);
+    const Handle a{check_id(H5Acreate2(t.group.get(), "columns", type.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT),
+                            m.io.file, "cannot create /" + name + " attribute columns"),
+                   H5Aclose};
+    check(H5Awrite(a.get(), type.get(), packed.data()), m.io.file, "cannot write /" + name + " attribute columns");
+  }
+  const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1024;
+  const Handle space = m.io.space(1, &zero, &unlimited);
+  Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), m.io.file, "cannot create a property list"), H5Pclose};
+  check(H5Pset_chunk(dcpl.get(), 1, &chunk), m.io.file, "cannot set chunking");
+  for (const auto& n : columns)
+    t.sets.emplace_back(check_id(H5Dcreate2(t.group.get(), n.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                            dcpl.get(), H5P_DEFAULT),
+                                 m.io.file, "cannot create /" + name + "/" + n),
+                        H5Dclose);
+  t.names = columns;
+  m.tables.emplace(name, std::move(t));
+  m.flush_file();
+}
+
+void H5Output::append_table_row(const std::string& name, const std::vector<double>& row) {
+  Impl& m = live();
+  const auto it = m.tables.find(name);
+  if (it == m.tables.end()) throw std::logic_error("H5Output: append_table_row before declare_table(" + name + ")");
+  Impl::Table& t = it->second;
+  if (row.size() != t.names.size())
+    throw std::invalid_argument("table /" + name + " row has " + std::to_string(row.size()) + " values, " +
+                                std::to_string(t.names.size()) + " columns declared");
+  t.pending.insert(t.pending.end(), row.begin(), row.end());
+  if (t.pending.size() >= m.options.series_batch_rows * row.size()) flush();
+}
+
+std::size_t H5Output::table_rows(const std::string& name) const {
+  if (!impl_) return 0;
+  const auto it = impl_->tables.find(name);
+  if (it == impl_->tables.end() || it->second.names.empty()) return 0;
+  return it->second.written + it->second.pending.size() / it->second.names.size();
+}
+// ---- end of extra tables ----
+
 std::size_t H5Output::series_rows() const {
   if (!impl_) return 0;
   const Impl& m = *impl_;
@@ -492,6 +591,7 @@ void H5Output::close() {
   m.write_xdmf();
   const Quiet quiet;
   m.series_sets.clear();
+  m.tables.clear();
   m.series.reset();
   m.snapshots.reset();
   m.meta.reset();

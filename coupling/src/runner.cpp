@@ -1,6 +1,7 @@
 // The run loop: build the simulation, step to end_time landing on every snapshot time, write
 // snapshots and series, and keep the failing state when the simulation breaks down.
 #include "runner_detail.hpp"
+#include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
 #include <frictherm/mechanics/errors.hpp>
 
@@ -33,6 +34,7 @@ class Run {
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
     sim_ = build_simulation<Dim>(s_);
+    if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;
     if (threads > 0) omp_set_num_threads(threads);
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
@@ -40,13 +42,18 @@ class Run {
     H5Output out = open_output();
     out_ = &out;
     detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
-    out.declare_series(detail::series_names(Dim));
+    std::vector<std::string> series_columns = detail::series_names(Dim);
+    detail::append_contact_series_names<Dim>(series_columns, *sim_);
+    if (thermal_) thermal_->declare_output(out, series_columns);  // thermal hook: columns + /hotspots
+    out.declare_series(series_columns);
     series();
     snapshot();
     std::ostream& log = o_.log ? *o_.log : std::cerr;
     detail::ProgressLine progress(std::cerr, show_progress(o_), s_.end_time);
     try {
       loop(progress);
+      if (thermal_ && r_.status == RunResult::Status::completed)
+        thermal_->continuation(out, *sim_, s_.output.fields);  // thermal hook: thermal-only phase
     } catch (const mechanics::SimulationError& e) {
       progress.finish();
       out.begin_failure(e.step(), e.time(), e.what());
@@ -72,6 +79,7 @@ class Run {
     const char* status = r_.status == RunResult::Status::failed               ? "failed"
                          : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
                                                                                 : "completed";
+    if (thermal_) thermal_->write_metadata(out, *sim_);  // thermal hook: integrator statistics, energy books
     out.write_metadata("status", status);
     out.write_metadata("steps", static_cast<double>(r_.steps));
     out.write_metadata("final_time", r_.time);
@@ -112,6 +120,10 @@ class Run {
       }
       sim_->step(limit);
       const double t = sim_->time();
+      // Thermal hook; a window also closes at every snapshot time and at the end.
+      // TODO(lead): pass sim_->frictional_work(HeatingOrder) (order: thermal_->heating_order()) once
+      // Simulation::frictional_work lands; until then no frictional heat reaches the coupler.
+      if (thermal_) thermal_->after_step(*sim_, {}, t >= next_snap - eps);
       if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {
         series();
         if (series_dt > 0.0) next_series = (std::floor(t / series_dt + 1e-9) + 1.0) * series_dt;
@@ -129,7 +141,9 @@ class Run {
   }
 
   void series() {
-    out_->append_series(detail::series_row<Dim>(*sim_));
+    std::vector<double> row = detail::series_row<Dim>(*sim_);
+    if (thermal_) thermal_->extend_series_row(row, *out_, *sim_, sim_->time());  // thermal hook
+    out_->append_series(row);
     last_series_step_ = sim_->step_count();
   }
 
@@ -143,6 +157,7 @@ class Run {
   const Scene& s_;
   const RunOptions& o_;
   std::unique_ptr<mechanics::Simulation<Dim>> sim_;
+  std::unique_ptr<detail::ThermalRun<Dim>> thermal_;  // only for scenes with a `thermal` section
   H5Output* out_ = nullptr;
   RunResult r_;
   long last_series_step_ = -1;

@@ -13,6 +13,10 @@ namespace frictherm::coupling::detail {
 /// Series columns: time, step, dt, kinetic_energy, strain_energy, total_energy, external_work,
 /// momentum_x, momentum_y (, momentum_z).
 std::vector<std::string> series_names(int dim);
+/// With contact: cumulative frictional work (total and per listed pair, both orders), contact and
+/// sliding node counts and each body's mean velocity.
+template <int Dim>
+void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim);
 
 template <int Dim>
 std::vector<double> series_row(const mechanics::Simulation<Dim>& sim);

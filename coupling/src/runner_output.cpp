@@ -17,12 +17,47 @@ std::vector<std::string> series_names(int dim) {
 }
 
 template <int Dim>
+void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim) {
+  if (!sim.contact_enabled()) return;
+  const auto& mats = sim.materials();
+  for (const char* order : {"first", "second"}) {
+    names.push_back(std::string("friction_work_") + order);
+    for (const auto& [a, b] : sim.contact_pairs())
+      names.push_back(std::string("friction_work_") + order + "." + mats[static_cast<std::size_t>(a)].name + "." +
+                      mats[static_cast<std::size_t>(b)].name);
+  }
+  names.emplace_back("contact_nodes");
+  names.emplace_back("sliding_nodes");
+  const char* axes[3] = {"x", "y", "z"};
+  for (const auto& body : sim.bodies())
+    for (int d = 0; d < Dim; ++d) names.push_back(std::string("mean_velocity_") + axes[d] + "." + body.name);
+}
+
+template <int Dim>
 std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
   const double ke = sim.kinetic_energy(), se = sim.strain_energy();
   std::vector<double> row{sim.time(), static_cast<double>(sim.step_count()), sim.last_time_step(), ke, se,
                           ke + se,    sim.external_work()};
   const auto P = sim.linear_momentum();
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+  if (!sim.contact_enabled()) return row;
+  for (auto order : {mechanics::HeatingOrder::first, mechanics::HeatingOrder::second}) {
+    row.push_back(sim.cumulative_frictional_work(order));
+    for (const auto& [a, b] : sim.contact_pairs()) row.push_back(sim.cumulative_frictional_work(order, a, b));
+  }
+  row.push_back(static_cast<double>(sim.contact_stats().contact_nodes));
+  row.push_back(static_cast<double>(sim.contact_stats().sliding_nodes));
+  // Mass-weighted mean velocity of each body (what the sliding-block charts plot).
+  const auto& p = sim.particles();
+  std::vector<mechanics::Vec<Dim>> mv(sim.bodies().size(), mechanics::Vec<Dim>::Zero());
+  std::vector<double> m(sim.bodies().size(), 0.0);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const std::size_t b = static_cast<std::size_t>(p.body[k]);
+    mv[b] += p.mass[k] * p.velocity[k];
+    m[b] += p.mass[k];
+  }
+  for (std::size_t b = 0; b < mv.size(); ++b)
+    for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mv[b][d] / m[b] : 0.0);
   return row;
 }
 
@@ -119,6 +154,7 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
 }
 
 #define FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(D)                                                                \
+  template void append_contact_series_names<D>(std::vector<std::string>&, const mechanics::Simulation<D>&);      \
   template std::vector<double> series_row<D>(const mechanics::Simulation<D>&);                               \
   template void write_fields<D>(H5Output&, const mechanics::Simulation<D>&, const std::vector<std::string>&); \
   template void write_start_metadata<D>(H5Output&, const Scene&, const mechanics::Simulation<D>&, const RunOptions&);

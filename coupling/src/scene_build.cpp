@@ -54,6 +54,10 @@ std::unique_ptr<mechanics::Simulation<Dim>> build_simulation(const Scene& scene)
       throw SceneError("materials." + m.name + ": " + e.what());
     }
   }
+  if (scene.contact.enabled) {
+    sim->enable_contact(scene.contact.options);
+    for (const ContactPairSpec& p : scene.contact.pairs) sim->set_contact_pair(p.material_a, p.material_b, p.settings);
+  }
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& b = scene.bodies[i];
     const std::string path = "bodies[" + std::to_string(i) + "]";

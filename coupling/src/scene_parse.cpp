@@ -236,14 +236,9 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   apply_overrides(doc, overrides);
   const JsonReader root(doc, "");
   if (!doc.is_object()) root.expected("a JSON object at the top level of the scene");
-  for (const char* later : {"thermal", "coupling", "contact"})
-    if (doc.contains(later))
-      throw SceneError(std::string(later) + ": not supported by this version of frictherm (" FRICTHERM_VERSION
-                                            "); it handles single-field mechanics only. Remove the \"" +
-                       later + "\" section.");
   // Unknown top-level keys first, so a misspelt section is reported as such.
   for (const char* key : {"units", "description", "dimension", "analysis", "thickness", "grid", "materials",
-                          "bodies", "boundary", "loads", "solver", "run", "output"})
+                          "bodies", "boundary", "loads", "contact", "solver", "run", "output", "thermal", "coupling"})
     root.has(key);
   root.finish();
 
@@ -276,7 +271,9 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   detail::parse_boundary(root, s, ctx);
   detail::parse_loads(root, s, ctx);
   parse_solver(root, s);
+  s.contact = parse_contact_section(root, s.dimension, ctx.material_names);  // scene_contact.cpp
   parse_output(root, s);
+  s.thermal = parse_thermal_sections(root, s.dimension, s.materials, s.options.thickness);  // scene_thermal.cpp
   return s;
 }
 

@@ -61,6 +61,7 @@ void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& 
   const int k = static_cast<int>(pair_settings_.size());
   pair_index_[static_cast<std::size_t>(a * n + b)] = k - 2;
   pair_index_[static_cast<std::size_t>(b * n + a)] = k - 1;
+  explicit_pairs_.emplace_back(a, b);
 }
 
 template <int Dim>

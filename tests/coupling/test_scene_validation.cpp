@@ -128,12 +128,66 @@ TEST(SceneValidation, MissingImageFile) {
   EXPECT_THAT(scene_error(s), AllOf(StartsWith("bodies[0].shape.file: "), HasSubstr("no_such_image.pgm")));
 }
 
-TEST(SceneValidation, LaterSectionsAreNotSupportedYet) {
-  for (const char* key : {"thermal", "coupling", "contact"}) {
-    Json s = good_scene();
-    s[key] = Json::object();
-    EXPECT_THAT(scene_error(s), AllOf(StartsWith(std::string(key) + ": "), HasSubstr("not supported by this version")));
-  }
+namespace {
+Json contact_scene() {
+  Json s = good_scene();
+  s["materials"]["base"] = s["materials"]["steel"];
+  s["bodies"].push_back(Json::parse(R"({"name": "floor", "material": "base",
+      "shape": {"type": "rectangle", "lo": [0.0, 0.0], "hi": [0.2, 0.02]}})"));
+  s["contact"] = Json::parse(R"({"normal": "avg", "separation": "displacement", "law": "frictionless",
+      "pairs": [{"materials": ["base", "steel"], "normal": [0, 2],
+                 "law": {"type": "smooth_static_dynamic", "mu_static": 0.4, "mu_dynamic": 0.2, "v_half": 0.05}}]})");
+  return s;
+}
+}  // namespace
+
+TEST(SceneValidation, ContactSectionBuildsPerMaterialFields) {
+  const auto scene = parse_scene(contact_scene().dump());
+  ASSERT_TRUE(scene.contact.enabled);
+  ASSERT_EQ(scene.contact.pairs.size(), 1u);
+  const auto sim = frictherm::coupling::build_simulation<2>(scene);
+  ASSERT_TRUE(sim->contact_enabled());
+  EXPECT_EQ(sim->fields().size(), 2u);  // one velocity field per material
+  const int steel = 0, base = 1;  // materials are numbered in file order
+  const auto& ab = sim->contact_pair(base, steel);
+  EXPECT_EQ(ab.normal, frictherm::mechanics::NormalMethod::specified);
+  EXPECT_DOUBLE_EQ(ab.normal_vector[1], 1.0);  // normalised
+  EXPECT_DOUBLE_EQ(sim->contact_pair(steel, base).normal_vector[1], -1.0);  // seen from the other side
+  EXPECT_EQ(ab.law.kind(), frictherm::mechanics::FrictionKind::smooth_static_dynamic);
+  EXPECT_EQ(sim->contact_options().separation, frictherm::mechanics::SeparationMethod::displacement);
+  EXPECT_EQ(sim->contact_options().default_pair.normal, frictherm::mechanics::NormalMethod::average_volume_gradient);
+  EXPECT_EQ(sim->contact_options().default_pair.law.kind(), frictherm::mechanics::FrictionKind::frictionless);
+}
+
+TEST(SceneValidation, ContactMistakesNameTheKey) {
+  Json s = contact_scene();
+  s["contact"]["law"] = Json::parse(R"({"type": "coulomb", "mu": -0.1})");
+  EXPECT_THAT(scene_error(s), StartsWith("contact.law.mu: expected a number >= 0, got -0.1"));
+  s = contact_scene();
+  s["contact"]["law"] = Json::parse(R"({"type": "sticky"})");
+  EXPECT_THAT(scene_error(s), StartsWith("contact.law.type: expected one of"));
+  s = contact_scene();
+  s["contact"]["pairs"][0]["materials"] = Json::parse(R"(["base", "wood"])");
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("contact.pairs[0].materials[1]: unknown material 'wood'"),
+                                    HasSubstr("steel, base")));
+  s = contact_scene();
+  s["contact"]["normal"] = Json::parse("[0, 1]");
+  EXPECT_THAT(scene_error(s), StartsWith("contact.normal: expected \"mvg\" or \"avg\""));
+  s = contact_scene();
+  s["contact"]["pairs"][0]["normal"] = Json::parse("[0, 0]");
+  EXPECT_THAT(scene_error(s), StartsWith("contact.pairs[0].normal: expected a non-zero normal vector"));
+  s = contact_scene();
+  s["contact"]["pairs"][0]["law"] = Json::parse(R"({"type": "smooth_static_dynamic", "mu_static": 0.4, "mu_dynamic": 0.2, "v_half": 0})");
+  EXPECT_THAT(scene_error(s), StartsWith("contact.pairs[0].law.v_half: expected a number > 0"));
+  s = contact_scene();
+  s["contact"]["pairs"].push_back(Json::parse(R"({"materials": ["steel", "base"], "law": "stick"})"));
+  EXPECT_THAT(scene_error(s), StartsWith("contact.pairs[1].materials: this pair is already listed"));
+  s = contact_scene();
+  s["contact"]["law"] = Json::parse(R"({"type": "tabulated", "speeds": [0, 1], "mu": [0.3]})");
+  EXPECT_THAT(scene_error(s), StartsWith("contact.law.mu: expected 2 coefficients"));
+  s = contact_scene();
+  s["contact"]["separation"] = "gap";
+  EXPECT_THAT(scene_error(s), StartsWith("contact.separation: expected one of"));
 }
 
 TEST(SceneValidation, RequiredKeysAndChoices) {

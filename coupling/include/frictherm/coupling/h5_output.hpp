@@ -9,6 +9,7 @@
 //   /failure               the state a failed run stopped in (same shape), attr message
 //   /series/<column>       extendible 1-D doubles, /series/time first; attr columns on /series
 //                          lists the column names in declared order
+//   /<table>/<column>      extra tables of the same layout (declare_table), e.g. /hotspots
 //   /xdmf/polyvertex_<n>   int32 0..n-1, the Polyvertex connectivity the XDMF file points at
 // Beside RUN.h5 an XDMF file RUN.xdmf (ParaView: Xdmf3ReaderS) lists every ended snapshot.
 //
@@ -69,6 +70,12 @@ class H5Output {
   /// end_snapshot() and at flush().
   void append_series(const std::vector<double>& row);
   std::size_t series_rows() const;  // rows appended so far (written or buffered)
+
+  /// An extra append-only table /<name>/<column> laid out like /series (extendible 1-D doubles, attr
+  /// columns on the group), e.g. /hotspots. Rows are buffered and written with the series rows.
+  void declare_table(const std::string& name, const std::vector<std::string>& columns);
+  void append_table_row(const std::string& name, const std::vector<double>& row);
+  std::size_t table_rows(const std::string& name) const;  // appended so far
 
   /// Writes buffered series rows and flushes the file to the operating system.
   void flush();

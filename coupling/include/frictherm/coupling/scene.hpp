@@ -7,6 +7,8 @@
 // All validation happens while parsing and building, before any step runs; every error is one
 // SceneError whose message starts with the key path (e.g. `bodies[1].shape.radius: ...`).
 #include <frictherm/coupling/json_reader.hpp>
+#include <frictherm/coupling/scene_contact.hpp>
+#include <frictherm/coupling/scene_thermal.hpp>  // thermal + coupling sections
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/image.hpp>
 #include <frictherm/mechanics/loads.hpp>
@@ -102,6 +104,8 @@ struct Scene {
   long max_steps = 0;     // 0: no limit
   int threads = 0;        // 0: OpenMP's default
   OutputSpec output;
+  ContactSpec contact;       // `contact` section (scene_contact.hpp); one shared velocity field when absent
+  ThermalSceneSpec thermal;  // `thermal` and `coupling` sections (scene_thermal.hpp); disabled when absent
 };
 
 /// Reads and validates a scene file. Image files are looked up relative to the scene's folder.

@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace frictherm::mechanics {
@@ -123,6 +124,8 @@ class Simulation {
   const ContactOptions& contact_options() const { return contact_opt_; }
   const ContactPairSettings& contact_pair(int material_a, int material_b) const;
   const ContactStats& contact_stats() const { return contact_stats_; }
+  /// The pairs given settings with set_contact_pair, in call order.
+  const std::vector<std::pair<int, int>>& contact_pairs() const { return explicit_pairs_; }
   /// Frictional work of the last step per grid node (J), added once per contact node (eqs. 27, 34,
   /// 36, 40): what the coupling hands to the thermal solver. All zeros without contact.
   const std::vector<double>& frictional_work(HeatingOrder order) const {
@@ -184,6 +187,7 @@ class Simulation {
   ContactOptions contact_opt_;
   std::vector<ContactPairSettings> pair_settings_;  // [0] = default
   std::vector<int> pair_index_;                     // materials² -> pair_settings_ index
+  std::vector<std::pair<int, int>> explicit_pairs_;
   std::vector<std::pair<int, int>> contact_entries_;  // (node, slot) of multi-material nodes, by node
   std::vector<std::uint16_t> node_field_count_;
   std::vector<double> work_first_, work_second_;    // per grid node, last step

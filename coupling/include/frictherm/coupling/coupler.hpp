@@ -1,0 +1,134 @@
+#pragma once
+// One-way thermal coupling of MPM mechanics to a thermal integrator, window by window
+// (design §4; Nairn et al. 2018 §2.11, eqs. 37–38):
+//
+//   Coupler<2> c(grid, shape, options);
+//   c.start(particles, t0);
+//   each mechanics step: c.after_step(particles, nodal_work /* J by grid node */, t);
+//   c.close_window(particles, t_end);            // deliver what is pending
+//   c.continue_thermal(particles, t_end + more);  // optional thermal-only phase
+//
+// A window ends when its policy says so (every step, every n steps, adaptive) or when the caller
+// closes it. Then: M, T (eq. 38) and K are built from the particles as they are now; the work
+// accumulated over the window is delivered as the constant source W_i / Δt_window (exact:
+// ∫ q dt = W_i); the integrator advances the nodal temperatures over the window; the particles get
+// T_p += Σ_i S_ip ΔT_i; hot spots are updated. Σ_p m_p C_v,p ΔT_p = Σ_i M_i ΔT_i, which equals the
+// heat delivered when conduction conserves energy (adiabatic edges; exact for forward_euler and
+// the KLU-based integrators, to the solver tolerance for PCG).
+#include <frictherm/coupling/heat_handoff.hpp>
+#include <frictherm/coupling/hotspots.hpp>
+#include <frictherm/coupling/thermal_assembly.hpp>
+#include <frictherm/thermal/integrator.hpp>
+
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace frictherm::coupling {
+
+struct WindowPolicy {
+  enum class Kind { every_step, every_n_steps, adaptive };
+  Kind kind = Kind::every_step;
+  long steps = 1;  // every_n_steps: n
+  /// adaptive: close when the pending heat would raise some node by more than this (K), estimated
+  /// as W_i / M_i with M from the last assembly (the smallest unknown's M for nodes that were none).
+  double max_temperature_rise = 1.0;
+  double max_duration = std::numeric_limits<double>::infinity();  // adaptive: longest window (s)
+  long max_steps = 0;                                              // adaptive: most steps (0: no limit)
+};
+
+/// A grid face held at a fixed temperature: every thermal unknown on it is a Dirichlet node.
+struct FixedTemperatureFace {
+  int axis = 0;
+  bool upper = false;
+  double temperature = 293.15;  // K
+};
+
+struct CouplerOptions {
+  std::vector<ThermalProperties> materials;  // by material id
+  std::string integrator = "cvode_bdf";      // thermal::make_integrator name
+  thermal::IntegratorOptions integrator_options;
+  AssemblyOptions assembly;
+  WindowPolicy window;
+  HotSpotOptions hotspots;
+  std::vector<FixedTemperatureFace> fixed_faces;
+  double thickness = 1.0;  // 2D out-of-plane thickness (m), for hot-spot areas
+};
+
+/// Where the heat went (J). Without fixed faces nodal_energy_change equals heat_delivered up to the
+/// integrator's conservation error; with them the difference is the heat taken by the faces.
+struct EnergyBooks {
+  double work_received = 0.0;        // Σ nodal work handed to after_step
+  double heat_delivered = 0.0;       // Σ over closed windows of ∫ Σ_i q_i dt
+  double heat_relocated = 0.0;       // the part that sat on nodes that were not unknowns
+  double nodal_energy_change = 0.0;  // Σ over windows of Σ_i M_i ΔT_i (= Σ_p m_p C_v,p ΔT_p)
+  long windows = 0;                  // closed windows with mechanics
+  long continuation_intervals = 0;   // thermal-only intervals
+  long steps = 0;                    // mechanics steps seen
+  double min_window = std::numeric_limits<double>::infinity();  // s
+  double max_window = 0.0;                                      // s
+  double max_assembly_residual = 0.0;  // worst of M partition-of-unity and K·1 = 0 residuals
+};
+
+template <int Dim>
+class Coupler {
+ public:
+  /// Throws std::invalid_argument for a bad integrator name or options.
+  Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind shape, CouplerOptions options);
+
+  /// Records each particle's initial temperature and the initial energy, assembles once (for the
+  /// adaptive policy's estimate) and finds the initial hot spots. Throws std::invalid_argument if
+  /// no particle belongs to a conducting material.
+  void start(const mechanics::Particles<Dim>& particles, double time);
+  /// After a mechanics step that ended at `time`: adds its nodal work (J by grid node, empty for
+  /// none) and closes the window if the policy says so. Returns true when a window closed.
+  bool after_step(mechanics::Particles<Dim>& particles, const std::vector<double>& nodal_work, double time);
+  /// Closes the open window at `time` (a no-op when it has zero length). Returns true if it closed.
+  bool close_window(mechanics::Particles<Dim>& particles, double time);
+  /// Thermal-only phase (no pending work allowed): integrates the last assembled problem, without
+  /// sources, from the end of the last window or interval to `time`, and maps the change back.
+  void continue_thermal(mechanics::Particles<Dim>& particles, double time);
+
+  const EnergyBooks& books() const { return books_; }
+  double pending_heat() const { return pending_.total(); }
+  double window_start() const { return window_start_; }
+  long window_steps() const { return window_steps_; }
+  /// Σ_p m_p C_v,p (T_p − T_p(start)) (J).
+  double particle_energy_change(const mechanics::Particles<Dim>& particles) const;
+  const thermal::Integrator& integrator() const { return *integrator_; }
+  const HotSpotTracker& hotspots() const { return tracker_; }
+  /// The system of the last window (nullptr before the first assembly).
+  const NodalThermalSystem* system() const { return has_system_ ? &system_ : nullptr; }
+  const CouplerOptions& options() const { return opt_; }
+
+ private:
+  void assemble(const mechanics::Particles<Dim>& particles);
+  void advance_and_map(mechanics::Particles<Dim>& particles, double t0, double t1);
+  double mass_estimate(std::size_t node) const;
+
+  mechanics::Grid<Dim> grid_;
+  mechanics::ShapeKind shape_;
+  CouplerOptions opt_;
+  std::unique_ptr<thermal::Integrator> integrator_;
+  HeatAccumulator pending_;
+  HotSpotTracker tracker_;
+  NodalThermalSystem system_;
+  bool has_system_ = false;
+  std::optional<thermal::Problem> problem_;
+  Eigen::VectorXd nodal_temperature_;  // state at the end of the last window or interval
+  double min_unknown_mass_ = 0.0;
+  mutable std::unordered_map<std::size_t, double> nearest_mass_;  // mass_estimate of isolated nodes
+  double window_start_ = 0.0;
+  long window_steps_ = 0;
+  double max_rise_ = 0.0;               // adaptive estimate for the open window (K)
+  double initial_energy_ = 0.0;
+  EnergyBooks books_;
+};
+
+extern template class Coupler<2>;
+extern template class Coupler<3>;
+
+}  // namespace frictherm::coupling

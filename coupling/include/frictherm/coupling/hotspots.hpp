@@ -1,0 +1,88 @@
+#pragma once
+// Hot spots on particles (design §4, thermal-notes §3): particles above a temperature threshold,
+// clustered by adjacency, followed from one update (coupling window) to the next.
+//
+// * Hot particle: T_p > threshold (mode absolute) or T_p − T0_p > threshold (mode rise, T0_p the
+//   particle's temperature when set_reference was called). Only particles of conducting materials.
+// * Adjacent: centres closer than link_factor × the larger particle spacing of the two (spacing
+//   2 max_d l_p, l_p the particle half-widths; 1.5 links the diagonal neighbours of a lattice).
+//   Found with a cell list (cells of the link distance) and a union-find: O(N_hot).
+// * Identity: a cluster keeps the id of the previous hot spot it shares the most particles with;
+//   when several clusters claim the same id, the one sharing most keeps it and the others get new
+//   ids (a split); a merge keeps the id with the largest overlap (and its birth time). Birth time
+//   is the update time a hot spot was first seen; duration is the time since then.
+#include <frictherm/coupling/thermal_assembly.hpp>
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace frictherm::coupling {
+
+struct HotSpotOptions {
+  enum class Mode { absolute, rise };
+  Mode mode = Mode::rise;
+  double threshold = 100.0;       // K: temperature (absolute) or rise above T0_p (rise)
+  double link_factor = 1.5;       // adjacency distance in particle spacings
+  std::size_t min_particles = 1;  // smaller clusters are ignored
+};
+
+struct HotSpot {
+  long id = 0;
+  std::size_t particle_count = 0;
+  double peak_temperature = 0.0;     // K
+  double mean_temperature = 0.0;     // K, volume-weighted
+  double size = 0.0;                 // area (2D, m², volumes over the thickness) or volume (3D, m³)
+  double equivalent_diameter = 0.0;  // m: 2 sqrt(A/π) in 2D, (6 V/π)^(1/3) in 3D
+  std::array<double, 3> centroid{};  // volume-weighted (m)
+  std::vector<int> materials;        // material ids present, ascending
+  double excess_energy = 0.0;        // Σ_p m_p C_v,p (T_p − T0_p) (J)
+  double birth_time = 0.0;           // s
+  double duration = 0.0;             // s, time of the last update minus birth_time
+  std::vector<std::size_t> particles;  // particle indices, ascending
+};
+
+class HotSpotTracker {
+ public:
+  explicit HotSpotTracker(int dim = 2, HotSpotOptions options = {}, double thickness = 1.0);
+
+  /// Records T0_p (the reference of mode rise and of excess_energy).
+  template <int Dim>
+  void set_reference(const mechanics::Particles<Dim>& particles);
+  /// Finds the hot spots of the current state at `time` and matches them with the previous ones.
+  template <int Dim>
+  void update(const mechanics::Particles<Dim>& particles, const std::vector<ThermalProperties>& materials,
+              double time);
+
+  const HotSpotOptions& options() const { return opt_; }
+  /// The hot spots of the last update, ascending id.
+  const std::vector<HotSpot>& hot_spots() const { return current_; }
+  /// The one with the highest peak temperature; nullptr if there is none.
+  const HotSpot* hottest() const;
+  /// Ids handed out so far (every hot spot ever seen).
+  long ids_issued() const { return next_id_; }
+  /// Highest particle temperature at the last update (conducting materials; K).
+  double max_temperature() const { return max_temperature_; }
+  double last_time() const { return last_time_; }
+
+ private:
+  struct Candidate {
+    std::size_t index;
+    std::array<double, 3> x;
+    double spacing, temperature, volume, excess;
+    int material;
+  };
+  void cluster_and_match(std::vector<Candidate>& hot, double time);
+
+  int dim_;
+  HotSpotOptions opt_;
+  double thickness_;
+  std::vector<double> reference_;        // T0_p
+  std::vector<HotSpot> current_;
+  std::vector<long> owner_;              // particle -> id of its hot spot at the last update (-1)
+  long next_id_ = 0;
+  double max_temperature_ = 0.0;
+  double last_time_ = 0.0;
+};
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,191 @@
+// The coupling window: accumulate work, assemble (eq. 38), deliver, integrate, map back, track.
+#include <frictherm/coupling/coupler.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+
+namespace {
+
+// Partition of unity and zero row sums hold to round-off; anything larger is a bug, not physics.
+constexpr double kAssemblyTolerance = 1e-10;
+
+}  // namespace
+
+template <int Dim>
+Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind shape, CouplerOptions options)
+    : grid_(grid),
+      shape_(shape),
+      opt_(std::move(options)),
+      integrator_(thermal::make_integrator(opt_.integrator, opt_.integrator_options)),
+      pending_(grid.node_count()),
+      tracker_(Dim, opt_.hotspots, opt_.thickness) {
+  const WindowPolicy& w = opt_.window;
+  if (w.kind == WindowPolicy::Kind::every_n_steps && w.steps < 1)
+    throw std::invalid_argument("Coupler: every_n_steps needs steps >= 1");
+  if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
+    throw std::invalid_argument("Coupler: adaptive windows need max_temperature_rise > 0");
+  if (!(w.max_duration > 0.0)) throw std::invalid_argument("Coupler: max_duration must be > 0");
+  for (const FixedTemperatureFace& f : opt_.fixed_faces)
+    if (f.axis < 0 || f.axis >= Dim) throw std::invalid_argument("Coupler: fixed face axis out of range");
+}
+
+template <int Dim>
+void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
+  window_start_ = time;
+  window_steps_ = 0;
+  max_rise_ = 0.0;
+  pending_.clear();
+  books_ = EnergyBooks{};
+  initial_energy_ = particle_thermal_energy(p, opt_.materials);
+  assemble(p);
+  nodal_temperature_ = system_.temperature;
+  tracker_.set_reference(p);
+  tracker_.update(p, opt_.materials, time);
+}
+
+template <int Dim>
+void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
+  system_ = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly);
+  has_system_ = true;
+  const double residual = std::max(system_.mass_residual(), system_.row_sum_residual());
+  books_.max_assembly_residual = std::max(books_.max_assembly_residual, residual);
+  if (!(residual <= kAssemblyTolerance))
+    throw std::logic_error("thermal assembly: partition-of-unity / zero-row-sum residual " +
+                           std::to_string(residual) + " exceeds round-off");
+  min_unknown_mass_ = system_.mass.minCoeff();
+  nearest_mass_.clear();
+  problem_.emplace(system_.mass, system_.conductance);
+  for (const FixedTemperatureFace& f : opt_.fixed_faces) {
+    const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
+    for (std::size_t u = 0; u < system_.size(); ++u)
+      if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
+        problem_->set_dirichlet(static_cast<Eigen::Index>(u), f.temperature);
+  }
+}
+
+template <int Dim>
+double Coupler<Dim>::mass_estimate(std::size_t node) const {
+  const int u = system_.unknown[node];
+  if (u >= 0) return system_.mass[u];
+  // Not an unknown: its heat will go to the unknowns around it (distribute_heat), so their M counts.
+  const mechanics::IVec<Dim> li = grid_.node_lattice(static_cast<int>(node));
+  const auto& npd = grid_.nodes_per_dim();
+  double m = 0.0;
+  for (int c = 0; c < (Dim == 2 ? 9 : 27); ++c) {
+    int rem = c, j = 0;
+    bool inside = true;
+    for (int d = 0; d < Dim; ++d) {
+      const int l = li[static_cast<std::size_t>(d)] + rem % 3 - 1 + mechanics::Grid<Dim>::ghost;
+      rem /= 3;
+      inside = inside && l >= 0 && l < npd[static_cast<std::size_t>(d)];
+      j += l * grid_.strides()[d];
+    }
+    if (!inside) continue;
+    const int v = system_.unknown[static_cast<std::size_t>(j)];
+    if (v >= 0) m += system_.mass[v];
+  }
+  if (m > 0.0) return m;
+  // No unknown next to it: the nearest unknown takes the heat (distribute_heat). Rare; cached.
+  const auto hit = nearest_mass_.find(node);
+  if (hit != nearest_mass_.end()) return hit->second;
+  const mechanics::Vec<Dim> x = grid_.node_position(static_cast<int>(node));
+  double best = std::numeric_limits<double>::infinity();
+  m = min_unknown_mass_;
+  for (std::size_t v = 0; v < system_.size(); ++v) {
+    const double d2 = (grid_.node_position(system_.grid_node[v]) - x).squaredNorm();
+    if (d2 < best) {
+      best = d2;
+      m = system_.mass[static_cast<Eigen::Index>(v)];
+    }
+  }
+  nearest_mass_.emplace(node, m);
+  return m;
+}
+
+template <int Dim>
+bool Coupler<Dim>::after_step(mechanics::Particles<Dim>& p, const std::vector<double>& nodal_work, double time) {
+  ++books_.steps;
+  ++window_steps_;
+  const double before = pending_.total();
+  pending_.add(nodal_work);
+  books_.work_received += pending_.total() - before;
+  const WindowPolicy& w = opt_.window;
+  bool close = false;
+  switch (w.kind) {
+    case WindowPolicy::Kind::every_step: close = true; break;
+    case WindowPolicy::Kind::every_n_steps: close = window_steps_ >= w.steps; break;
+    case WindowPolicy::Kind::adaptive: {
+      const std::vector<double>& acc = pending_.work();
+      for (std::size_t i = 0; i < nodal_work.size(); ++i)
+        if (nodal_work[i] != 0.0) max_rise_ = std::max(max_rise_, std::fabs(acc[i]) / mass_estimate(i));
+      close = max_rise_ >= w.max_temperature_rise || time - window_start_ >= w.max_duration * (1.0 - 1e-12) ||
+              (w.max_steps > 0 && window_steps_ >= w.max_steps);
+      break;
+    }
+  }
+  return close ? close_window(p, time) : false;
+}
+
+template <int Dim>
+bool Coupler<Dim>::close_window(mechanics::Particles<Dim>& p, double time) {
+  const double dt = time - window_start_;
+  if (!(dt > 0.0)) return false;  // nothing to integrate; pending heat stays for the next window
+  assemble(p);
+  const HeatDistribution heat = distribute_heat(grid_, system_, pending_.work());
+  const Eigen::VectorXd q = heat.joules / dt;  // constant over the window: ∫ q dt = W (design §4)
+  problem_->set_source(q);
+  books_.heat_delivered += q.sum() * dt;
+  books_.heat_relocated += heat.relocated;
+  nodal_temperature_ = system_.temperature;
+  advance_and_map(p, window_start_, time);
+  pending_.clear();
+  ++books_.windows;
+  books_.min_window = std::min(books_.min_window, dt);
+  books_.max_window = std::max(books_.max_window, dt);
+  window_start_ = time;
+  window_steps_ = 0;
+  max_rise_ = 0.0;
+  tracker_.update(p, opt_.materials, time);
+  return true;
+}
+
+template <int Dim>
+void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
+  if (pending_.total() != 0.0)
+    throw std::logic_error("Coupler::continue_thermal: close the window with pending heat first");
+  if (!(time > window_start_)) return;
+  if (!has_system_) {
+    assemble(p);
+    nodal_temperature_ = system_.temperature;
+  }
+  problem_->clear_source();
+  advance_and_map(p, window_start_, time);
+  ++books_.continuation_intervals;
+  window_start_ = time;
+  window_steps_ = 0;
+  tracker_.update(p, opt_.materials, time);
+}
+
+template <int Dim>
+void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, double t1) {
+  const Eigen::VectorXd start = nodal_temperature_;
+  integrator_->advance(*problem_, nodal_temperature_, t0, t1);  // writes Dirichlet values first
+  const Eigen::VectorXd delta = nodal_temperature_ - start;
+  add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta);  // design §4
+  books_.nodal_energy_change += system_.mass.dot(delta);
+}
+
+template <int Dim>
+double Coupler<Dim>::particle_energy_change(const mechanics::Particles<Dim>& p) const {
+  return particle_thermal_energy(p, opt_.materials) - initial_energy_;
+}
+
+template class Coupler<2>;
+template class Coupler<3>;
+
+}  // namespace frictherm::coupling

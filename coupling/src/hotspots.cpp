@@ -1,0 +1,211 @@
+// Hot-spot detection (threshold + adjacency clustering with a cell list) and tracking by overlap.
+#include <frictherm/coupling/hotspots.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <tuple>
+
+namespace frictherm::coupling {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct UnionFind {
+  std::vector<std::size_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), std::size_t{0}); }
+  std::size_t find(std::size_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  void unite(std::size_t a, std::size_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+}  // namespace
+
+HotSpotTracker::HotSpotTracker(int dim, HotSpotOptions options, double thickness)
+    : dim_(dim), opt_(options), thickness_(thickness) {
+  if (dim != 2 && dim != 3) throw std::invalid_argument("HotSpotTracker: dim must be 2 or 3");
+  if (!(opt_.link_factor > 0.0)) throw std::invalid_argument("HotSpotTracker: link_factor must be > 0");
+  if (!(thickness > 0.0)) throw std::invalid_argument("HotSpotTracker: thickness must be > 0");
+}
+
+template <int Dim>
+void HotSpotTracker::set_reference(const mechanics::Particles<Dim>& p) {
+  reference_ = p.temperature;
+}
+
+template <int Dim>
+void HotSpotTracker::update(const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
+                            double time) {
+  if (Dim != dim_) throw std::logic_error("HotSpotTracker: particles of another dimension");
+  if (reference_.size() != p.size()) set_reference(p);
+  std::vector<Candidate> hot;
+  max_temperature_ = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const auto id = static_cast<std::size_t>(p.material[k]);
+    if (id >= materials.size() || !materials[id].conducts) continue;
+    const double T = p.temperature[k];
+    max_temperature_ = std::max(max_temperature_, T);
+    const double level = opt_.mode == HotSpotOptions::Mode::absolute ? T : T - reference_[k];
+    if (!(level > opt_.threshold)) continue;
+    Candidate c{};
+    c.index = k;
+    for (int d = 0; d < Dim; ++d) c.x[static_cast<std::size_t>(d)] = p.position[k][d];
+    c.spacing = 2.0 * p.half_size[k].maxCoeff();
+    c.temperature = T;
+    c.volume = p.volume[k];
+    c.excess = p.mass[k] * materials[id].heat_capacity * (T - reference_[k]);
+    c.material = p.material[k];
+    hot.push_back(c);
+  }
+  if (!std::isfinite(max_temperature_)) max_temperature_ = 0.0;
+  if (owner_.size() != p.size()) owner_.assign(p.size(), -1);
+  cluster_and_match(hot, time);
+}
+
+void HotSpotTracker::cluster_and_match(std::vector<Candidate>& hot, double time) {
+  last_time_ = time;
+  const std::size_t n = hot.size();
+  UnionFind uf(n);
+  if (n > 1) {
+    // Cell list with cells of the largest link distance: linked pairs are in neighbouring cells.
+    double cell = 0.0;
+    for (const Candidate& c : hot) cell = std::max(cell, opt_.link_factor * c.spacing);
+    std::array<double, 3> lo{};
+    for (int d = 0; d < dim_; ++d) {
+      lo[static_cast<std::size_t>(d)] = hot[0].x[static_cast<std::size_t>(d)];
+      for (const Candidate& c : hot) lo[static_cast<std::size_t>(d)] = std::min(lo[static_cast<std::size_t>(d)], c.x[static_cast<std::size_t>(d)]);
+    }
+    std::vector<std::array<std::int64_t, 3>> coord(n);
+    std::array<std::int64_t, 3> extent{1, 1, 1};
+    for (std::size_t k = 0; k < n; ++k)
+      for (int d = 0; d < dim_; ++d) {
+        const auto dd = static_cast<std::size_t>(d);
+        coord[k][dd] = static_cast<std::int64_t>(std::floor((hot[k].x[dd] - lo[dd]) / cell));
+        extent[dd] = std::max(extent[dd], coord[k][dd] + 2);
+      }
+    auto key_of = [&](const std::array<std::int64_t, 3>& c) { return (c[2] * extent[1] + c[1]) * extent[0] + c[0]; };
+    std::vector<std::pair<std::int64_t, std::size_t>> sorted(n);
+    for (std::size_t k = 0; k < n; ++k) sorted[k] = {key_of(coord[k]), k};
+    std::sort(sorted.begin(), sorted.end());
+    const int reach_z = dim_ == 3 ? 1 : 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      for (int dz = -reach_z; dz <= reach_z; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            std::array<std::int64_t, 3> c = {coord[a][0] + dx, coord[a][1] + dy, coord[a][2] + dz};
+            if (c[0] < 0 || c[1] < 0 || c[2] < 0) continue;
+            const std::int64_t key = key_of(c);
+            auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(key, std::size_t{0}));
+            for (; it != sorted.end() && it->first == key; ++it) {
+              const std::size_t b = it->second;
+              if (b <= a) continue;
+              double d2 = 0.0;
+              for (int d = 0; d < dim_; ++d) {
+                const double e = hot[a].x[static_cast<std::size_t>(d)] - hot[b].x[static_cast<std::size_t>(d)];
+                d2 += e * e;
+              }
+              const double link = opt_.link_factor * std::max(hot[a].spacing, hot[b].spacing);
+              if (d2 <= link * link) uf.unite(a, b);
+            }
+          }
+    }
+  }
+
+  // Clusters (roots in order of their smallest member) -> hot spots.
+  std::map<std::size_t, std::vector<std::size_t>> groups;
+  for (std::size_t k = 0; k < n; ++k) groups[uf.find(k)].push_back(k);
+  std::vector<HotSpot> found;
+  for (auto& [root, members] : groups) {
+    (void)root;
+    if (members.size() < opt_.min_particles) continue;
+    HotSpot h;
+    h.particle_count = members.size();
+    double vol = 0.0, tv = 0.0;
+    std::array<double, 3> xv{};
+    h.peak_temperature = -std::numeric_limits<double>::infinity();
+    for (std::size_t m : members) {
+      const Candidate& c = hot[m];
+      h.particles.push_back(c.index);
+      h.peak_temperature = std::max(h.peak_temperature, c.temperature);
+      vol += c.volume;
+      tv += c.temperature * c.volume;
+      for (int d = 0; d < dim_; ++d) xv[static_cast<std::size_t>(d)] += c.x[static_cast<std::size_t>(d)] * c.volume;
+      h.excess_energy += c.excess;
+      if (std::find(h.materials.begin(), h.materials.end(), c.material) == h.materials.end())
+        h.materials.push_back(c.material);
+    }
+    std::sort(h.particles.begin(), h.particles.end());
+    std::sort(h.materials.begin(), h.materials.end());
+    h.mean_temperature = vol > 0.0 ? tv / vol : h.peak_temperature;
+    for (int d = 0; d < dim_; ++d) h.centroid[static_cast<std::size_t>(d)] = vol > 0.0 ? xv[static_cast<std::size_t>(d)] / vol : 0.0;
+    h.size = dim_ == 2 ? vol / thickness_ : vol;
+    h.equivalent_diameter = dim_ == 2 ? 2.0 * std::sqrt(h.size / kPi) : std::cbrt(6.0 * h.size / kPi);
+    found.push_back(std::move(h));
+  }
+
+  // Overlap with the previous hot spots: (overlap, new index, old id), largest overlaps first.
+  std::map<long, const HotSpot*> previous;
+  for (const HotSpot& h : current_) previous[h.id] = &h;
+  std::vector<std::tuple<std::size_t, std::size_t, long>> pairs;
+  for (std::size_t f = 0; f < found.size(); ++f) {
+    std::map<long, std::size_t> overlap;
+    for (std::size_t k : found[f].particles)
+      if (k < owner_.size() && owner_[k] >= 0) ++overlap[owner_[k]];
+    for (const auto& [id, count] : overlap) pairs.emplace_back(count, f, id);
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) {
+    if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) > std::get<0>(b);
+    if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) < std::get<1>(b);
+    return std::get<2>(a) < std::get<2>(b);
+  });
+  std::vector<char> assigned(found.size(), 0);
+  std::map<long, char> claimed;
+  for (const auto& [count, f, id] : pairs) {
+    (void)count;
+    if (assigned[f] || claimed[id]) continue;
+    assigned[f] = 1;
+    claimed[id] = 1;
+    found[f].id = id;
+    found[f].birth_time = previous.at(id)->birth_time;
+  }
+  for (std::size_t f = 0; f < found.size(); ++f) {
+    if (assigned[f]) continue;
+    found[f].id = next_id_++;
+    found[f].birth_time = time;
+  }
+  for (HotSpot& h : found) h.duration = time - h.birth_time;
+  std::sort(found.begin(), found.end(), [](const HotSpot& a, const HotSpot& b) { return a.id < b.id; });
+
+  for (const HotSpot& h : current_)
+    for (std::size_t k : h.particles)
+      if (k < owner_.size()) owner_[k] = -1;
+  for (const HotSpot& h : found)
+    for (std::size_t k : h.particles)
+      if (k < owner_.size()) owner_[k] = h.id;
+  current_ = std::move(found);
+}
+
+const HotSpot* HotSpotTracker::hottest() const {
+  const HotSpot* best = nullptr;
+  for (const HotSpot& h : current_)
+    if (!best || h.peak_temperature > best->peak_temperature) best = &h;
+  return best;
+}
+
+template void HotSpotTracker::set_reference<2>(const mechanics::Particles<2>&);
+template void HotSpotTracker::set_reference<3>(const mechanics::Particles<3>&);
+template void HotSpotTracker::update<2>(const mechanics::Particles<2>&, const std::vector<ThermalProperties>&, double);
+template void HotSpotTracker::update<3>(const mechanics::Particles<3>&, const std::vector<ThermalProperties>&, double);
+
+}  // namespace frictherm::coupling

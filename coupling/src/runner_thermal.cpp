@@ -1,0 +1,150 @@
+// The thermal side of a run: coupler calls, series columns, /hotspots, metadata, continuation.
+#include "runner_thermal.hpp"
+
+#include <frictherm/mechanics/errors.hpp>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace frictherm::coupling::detail {
+
+namespace {
+
+const char* const kSeriesColumns[] = {"heat_delivered",         "thermal_energy_change",     "max_temperature",
+                                      "hotspot_count",          "hottest_hotspot_temperature", "hottest_hotspot_size",
+                                      "hottest_hotspot_diameter", "thermal_windows"};
+
+std::vector<std::string> hotspot_columns(int dim) {
+  std::vector<std::string> c{"time", "id", "particle_count", "peak_temperature", "mean_temperature", "size",
+                             "equivalent_diameter"};
+  const char* axes[3] = {"centroid_x", "centroid_y", "centroid_z"};
+  for (int d = 0; d < dim; ++d) c.emplace_back(axes[d]);
+  for (const char* n : {"birth_time", "duration", "excess_energy", "material_mask"}) c.emplace_back(n);
+  return c;
+}
+
+}  // namespace
+
+template <int Dim>
+ThermalRun<Dim>::ThermalRun(const Scene& scene, mechanics::Simulation<Dim>& sim)
+    : spec_(scene.thermal), coupler_(sim.grid(), sim.options().shape, scene.thermal.coupler) {
+  try {
+    coupler_.start(sim.particles(), sim.time());
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(std::string("thermal.materials: ") + e.what());
+  }
+}
+
+template <int Dim>
+void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& names) {
+  for (const char* c : kSeriesColumns) names.emplace_back(c);
+  out.declare_table("hotspots", hotspot_columns(Dim));
+}
+
+template <int Dim>
+void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
+                                        const mechanics::Simulation<Dim>& sim, double time) {
+  const EnergyBooks& b = coupler_.books();
+  const HotSpotTracker& hs = coupler_.hotspots();
+  const HotSpot* hot = hs.hottest();
+  const long windows = b.windows + b.continuation_intervals;
+  // thermal_energy_change: Σ_p m_p C_v,p (T_p − T_p(0)), which equals heat_delivered (design §4).
+  row.insert(row.end(), {b.heat_delivered, coupler_.particle_energy_change(sim.particles()), hs.max_temperature(),
+                         static_cast<double>(hs.hot_spots().size()), hot ? hot->peak_temperature : 0.0,
+                         hot ? hot->size : 0.0, hot ? hot->equivalent_diameter : 0.0, static_cast<double>(windows)});
+  if (windows == hotspot_windows_written_) return;
+  hotspot_windows_written_ = windows;
+  for (const HotSpot& h : hs.hot_spots()) {
+    std::vector<double> r{time, static_cast<double>(h.id), static_cast<double>(h.particle_count), h.peak_temperature,
+                          h.mean_temperature, h.size, h.equivalent_diameter};
+    for (int d = 0; d < Dim; ++d) r.push_back(h.centroid[static_cast<std::size_t>(d)]);
+    double mask = 0.0;  // bit m set: material id m present (exact in a double up to id 52)
+    for (int m : h.materials) mask += std::ldexp(1.0, m);
+    r.insert(r.end(), {h.birth_time, h.duration, h.excess_energy, mask});
+    out.append_table_row("hotspots", r);
+  }
+}
+
+template <int Dim>
+template <class F>
+void ThermalRun<Dim>::guarded(const mechanics::Simulation<Dim>& sim, double time, F&& f) {
+  try {
+    f();
+  } catch (const thermal::SolverError& e) {
+    throw mechanics::SimulationError(std::string("thermal solver failed: ") + e.what(), sim.step_count(), time, -1);
+  } catch (const thermal::StabilityError& e) {
+    throw mechanics::SimulationError(std::string("thermal integration unstable: ") + e.what(), sim.step_count(),
+                                     time, -1);
+  }
+}
+
+template <int Dim>
+void ThermalRun<Dim>::after_step(mechanics::Simulation<Dim>& sim, const std::vector<double>& nodal_work,
+                                 bool must_close) {
+  guarded(sim, sim.time(), [&] {
+    const bool closed = coupler_.after_step(sim.particles(), nodal_work, sim.time());
+    if (must_close && !closed) coupler_.close_window(sim.particles(), sim.time());
+  });
+}
+
+template <int Dim>
+void ThermalRun<Dim>::continuation(H5Output& out, mechanics::Simulation<Dim>& sim,
+                                   const std::vector<std::string>& fields) {
+  if (!(spec_.continuation_duration > 0.0)) return;
+  guarded(sim, sim.time(), [&] { coupler_.close_window(sim.particles(), sim.time()); });
+  const double t0 = sim.time();
+  const long n = spec_.continuation_intervals;
+  double t = t0;
+  for (long k = 1; k <= n; ++k) {
+    t = t0 + spec_.continuation_duration * static_cast<double>(k) / static_cast<double>(n);
+    guarded(sim, t, [&] { coupler_.continue_thermal(sim.particles(), t); });
+    std::vector<double> row = series_row<Dim>(sim);
+    row[0] = t;  // the mechanics columns stay at their final values
+    extend_series_row(row, out, sim, t);
+    out.append_series(row);
+  }
+  out.begin_snapshot(sim.step_count(), t);
+  write_fields<Dim>(out, sim, fields);
+  out.end_snapshot();
+}
+
+template <int Dim>
+void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const {
+  const CouplerOptions& o = coupler_.options();
+  const EnergyBooks& b = coupler_.books();
+  const thermal::IntegratorStats& st = coupler_.integrator().stats();
+  out.write_metadata("thermal_integrator", o.integrator);
+  out.write_metadata("thermal_rtol", o.integrator_options.rtol);
+  out.write_metadata("thermal_atol", o.integrator_options.atol);
+  out.write_metadata("thermal_window_policy", to_string(o.window.kind));
+  out.write_metadata("heating_order", to_string(spec_.heating_order));
+  const std::pair<const char*, double> values[] = {
+      {"thermal_steps", static_cast<double>(st.steps)},
+      {"thermal_rhs_evals", static_cast<double>(st.rhs_evals)},
+      {"thermal_jac_evals", static_cast<double>(st.jac_evals)},
+      {"thermal_nonlinear_iters", static_cast<double>(st.nonlinear_iters)},
+      {"thermal_linear_iters", static_cast<double>(st.linear_iters)},
+      {"thermal_error_test_failures", static_cast<double>(st.error_test_failures)},
+      {"thermal_convergence_failures", static_cast<double>(st.convergence_failures)},
+      {"thermal_reinits", static_cast<double>(st.reinits)},
+      {"thermal_wall_time", st.wall_seconds},
+      {"thermal_windows", static_cast<double>(b.windows)},
+      {"thermal_continuation_intervals", static_cast<double>(b.continuation_intervals)},
+      {"thermal_min_window", b.windows > 0 ? b.min_window : 0.0},
+      {"thermal_max_window", b.max_window},
+      {"work_received", b.work_received},
+      {"heat_delivered", b.heat_delivered},
+      {"heat_relocated", b.heat_relocated},
+      {"heat_pending", coupler_.pending_heat()},
+      {"nodal_energy_change", b.nodal_energy_change},
+      {"particle_energy_change", coupler_.particle_energy_change(sim.particles())},
+      {"max_assembly_residual", b.max_assembly_residual},
+      {"hotspots_seen", static_cast<double>(coupler_.hotspots().ids_issued())},
+  };
+  for (const auto& [key, value] : values) out.write_metadata(key, value);
+}
+
+template class ThermalRun<2>;
+template class ThermalRun<3>;
+
+}  // namespace frictherm::coupling::detail

@@ -1,0 +1,51 @@
+#pragma once
+// The thermal side of a run (scenes with a `thermal` section): owns the Coupler and writes its
+// series columns, the /hotspots table and the thermal metadata. The run loop (runner.cpp) calls it
+// at a handful of places; without a `thermal` section it is never created.
+#include "runner_detail.hpp"
+
+#include <frictherm/coupling/coupler.hpp>
+
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling::detail {
+
+template <int Dim>
+class ThermalRun {
+ public:
+  /// Starts the coupler on the initial state. Throws SceneError if no particle conducts heat.
+  ThermalRun(const Scene& scene, mechanics::Simulation<Dim>& sim);
+
+  /// Appends the thermal series columns to `names` and declares the /hotspots table.
+  void declare_output(H5Output& out, std::vector<std::string>& names);
+  /// Appends the thermal values to a series row; writes the hot spots to /hotspots when a window
+  /// closed since the last row.
+  void extend_series_row(std::vector<double>& row, H5Output& out, const mechanics::Simulation<Dim>& sim,
+                         double time);
+  /// After a mechanics step: hands its nodal work (J by grid node; empty for none) to the coupler
+  /// and closes the window when `must_close` (a snapshot time or the end). Thermal failures become
+  /// a mechanics::SimulationError so the run keeps its last good state.
+  void after_step(mechanics::Simulation<Dim>& sim, const std::vector<double>& nodal_work, bool must_close);
+  /// Thermal-only continuation after the mechanics (scene coupling.continuation): one series row per
+  /// interval and a final snapshot at its end time.
+  void continuation(H5Output& out, mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields);
+  /// Integrator statistics and energy books into /meta (thermal_*).
+  void write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const;
+
+  HeatingOrder heating_order() const { return spec_.heating_order; }
+  const Coupler<Dim>& coupler() const { return coupler_; }
+
+ private:
+  template <class F>
+  void guarded(const mechanics::Simulation<Dim>& sim, double time, F&& f);
+
+  ThermalSceneSpec spec_;
+  Coupler<Dim> coupler_;
+  long hotspot_windows_written_ = -1;  // windows + intervals at the last /hotspots write
+};
+
+extern template class ThermalRun<2>;
+extern template class ThermalRun<3>;
+
+}  // namespace frictherm::coupling::detail

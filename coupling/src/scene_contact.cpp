@@ -1,0 +1,136 @@
+// Scene section `contact`: friction laws, normals and contact detection per material pair.
+#include <frictherm/coupling/scene_contact.hpp>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace frictherm::coupling {
+
+namespace {
+
+/// Runs a FrictionLaw factory; its std::invalid_argument (which names the parameter) gets the key path.
+template <class F>
+mechanics::FrictionLaw checked(const JsonReader& at, F&& make) {
+  try {
+    return make();
+  } catch (const std::invalid_argument& e) {
+    at.fail(e.what());
+  }
+}
+
+/// "mvg", "avg" or a vector (a specified normal, from the pair's first material to its second).
+void parse_normal(const JsonReader& n, int dim, bool vector_allowed, mechanics::ContactPairSettings& s) {
+  if (n.is_string()) {
+    s.normal = mechanics::normal_method_from_string(n.as_choice({"mvg", "avg"}));
+    return;
+  }
+  if (!vector_allowed) n.expected("\"mvg\" or \"avg\" (a specified normal belongs to a pair in contact.pairs)");
+  if (!n.is_array()) n.expected("\"mvg\", \"avg\" or an array of " + std::to_string(dim) + " numbers (a specified normal)");
+  const std::vector<double> v = n.as_vector(static_cast<std::size_t>(dim));
+  double len2 = 0.0;
+  for (double x : v) len2 += x * x;
+  if (!(len2 > 0.0)) n.fail("expected a non-zero normal vector");
+  s.normal = mechanics::NormalMethod::specified;
+  s.normal_vector.setZero();
+  for (int d = 0; d < dim; ++d) s.normal_vector[d] = v[static_cast<std::size_t>(d)];
+}
+
+}  // namespace
+
+mechanics::FrictionLaw parse_friction_law(const JsonReader& law) {
+  using mechanics::FrictionLaw;
+  const std::vector<std::string> types{"stick", "frictionless", "coulomb", "linear_velocity", "adhesion",
+                                       "static_dynamic", "smooth_static_dynamic", "tabulated"};
+  if (law.is_string()) {
+    const std::string t = law.as_choice({"stick", "frictionless"});
+    return t == "stick" ? FrictionLaw::stick() : FrictionLaw::frictionless();
+  }
+  if (!law.is_object()) law.expected("a friction law: \"stick\", \"frictionless\" or an object with \"type\"");
+  const std::string type = law.at("type", "one of stick, frictionless, coulomb, linear_velocity, adhesion, "
+                                          "static_dynamic, smooth_static_dynamic, tabulated")
+                               .as_choice(types);
+  const Range mu_range = Range::non_negative();
+  FrictionLaw out;
+  if (type == "stick") {
+    out = FrictionLaw::stick();
+  } else if (type == "frictionless") {
+    out = FrictionLaw::frictionless();
+  } else if (type == "coulomb") {
+    const double mu = law.number("mu", mu_range);
+    out = checked(law, [&] { return FrictionLaw::coulomb(mu); });
+  } else if (type == "linear_velocity") {
+    const double mu = law.number("mu", mu_range), k = law.number("k", Range::non_negative());
+    out = checked(law, [&] { return FrictionLaw::linear_velocity(mu, k); });
+  } else if (type == "adhesion") {
+    const double mu = law.number("mu", mu_range), sa = law.number("shear_strength", Range::non_negative());
+    const double na = law.number("tensile_strength", std::numeric_limits<double>::infinity(), Range::positive());
+    out = checked(law, [&] { return FrictionLaw::adhesion(mu, sa, na); });
+  } else if (type == "static_dynamic" || type == "smooth_static_dynamic") {
+    const double ms = law.number("mu_static", mu_range), md = law.number("mu_dynamic", mu_range);
+    if (type == "static_dynamic") {
+      out = checked(law, [&] { return FrictionLaw::static_dynamic(ms, md); });
+    } else {
+      const double vh = law.number("v_half", Range::positive());
+      out = checked(law, [&] { return FrictionLaw::smooth_static_dynamic(ms, md, vh); });
+    }
+  } else {  // tabulated
+    const std::vector<double> speeds = law.at("speeds", "an array of sliding speeds (m/s), increasing").as_number_list(1, Range::non_negative());
+    const std::vector<double> mu = law.at("mu", "an array of friction coefficients, one per speed").as_number_list(1, mu_range);
+    if (mu.size() != speeds.size())
+      law.at("mu").fail("expected " + std::to_string(speeds.size()) + " coefficients (one per speed), got " +
+                        std::to_string(mu.size()));
+    out = checked(law, [&] { return FrictionLaw::tabulated(speeds, mu); });
+  }
+  law.finish();
+  return out;
+}
+
+ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::vector<std::string>& material_names) {
+  ContactSpec spec;
+  const auto c = root.find("contact");
+  if (!c) return spec;
+  if (!c->is_object()) c->expected("an object (see docs/contact.md)");
+  spec.enabled = true;
+  mechanics::ContactOptions& o = spec.options;
+  if (const auto n = c->find("normal")) parse_normal(*n, dim, false, o.default_pair);
+  if (const auto law = c->find("law")) o.default_pair.law = parse_friction_law(*law);
+  o.separation = mechanics::separation_method_from_string(
+      c->choice("separation", {"position", "displacement", "velocity_only"}, "position"));
+  o.position_correction = c->number("position_correction", 0.8, Range{0.0, 2.0, false, true});
+  o.min_mass_fraction = c->number("min_mass_fraction", 1e-6, Range{0.0, 0.5, false, true});
+  auto material_id = [&](const JsonReader& name) {
+    const std::string n = name.as_string();
+    const auto it = std::find(material_names.begin(), material_names.end(), n);
+    if (it == material_names.end()) {
+      std::string known;
+      for (const auto& m : material_names) known += (known.empty() ? "" : ", ") + m;
+      name.fail("unknown material '" + n + "' (defined: " + known + ")");
+    }
+    return static_cast<int>(it - material_names.begin());
+  };
+  if (const auto pairs = c->find("pairs")) {
+    for (const JsonReader& p : pairs->elements()) {
+      if (!p.is_object()) p.expected("an object with \"materials\": [a, b] and a \"law\"");
+      const JsonReader mats = p.at("materials", "an array of two material names");
+      const auto names = mats.elements();
+      if (names.size() != 2) mats.expected("an array of two material names");
+      ContactPairSpec ps;
+      ps.material_a = material_id(names[0]);
+      ps.material_b = material_id(names[1]);
+      if (ps.material_a == ps.material_b) mats.fail("expected two different materials");
+      for (const ContactPairSpec& q : spec.pairs)
+        if ((q.material_a == ps.material_a && q.material_b == ps.material_b) ||
+            (q.material_a == ps.material_b && q.material_b == ps.material_a))
+          mats.fail("this pair is already listed");
+      ps.settings = o.default_pair;
+      ps.settings.law = parse_friction_law(p.at("law", "a friction law"));
+      if (const auto n = p.find("normal")) parse_normal(*n, dim, true, ps.settings);
+      p.finish();
+      spec.pairs.push_back(ps);
+    }
+  }
+  c->finish();
+  return spec;
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,168 @@
+// Scene sections `thermal` and `coupling`: validated into a ThermalSceneSpec (docs/scenes.md).
+#include <frictherm/coupling/scene_thermal.hpp>
+
+#include "scene_detail.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+namespace frictherm::coupling {
+
+namespace {
+
+void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
+  CouplerOptions& c = spec.coupler;
+  thermal::IntegratorOptions& o = c.integrator_options;
+  c.integrator = t.choice("integrator", thermal::integrator_names(), "cvode_bdf");
+  o.rtol = t.number("rtol", o.rtol, Range::open(0.0, 1.0));
+  o.atol = t.number("atol", o.atol, Range::positive());
+  o.max_steps = t.integer("max_steps", o.max_steps, 1, std::numeric_limits<int>::max());
+  if (const auto ls = t.find("linear_solver")) {
+    std::vector<std::string> allowed;
+    if (c.integrator == "cvode_bdf" || c.integrator == "arkode_dirk") allowed = {"klu", "pcg"};
+    if (c.integrator == "cvode_adams") allowed = {"fixed_point", "klu", "pcg"};
+    if (allowed.empty()) ls->fail("not used by the explicit integrator " + c.integrator + " (remove it)");
+    o.linear_solver = ls->as_choice(allowed);
+  }
+  o.krylov_maxl = static_cast<int>(t.integer("krylov_maxl", o.krylov_maxl, 1, 100000));
+  o.reinit_every_window = t.find("reinit_every_window") ? t.at("reinit_every_window").as_bool() : false;
+  if (const auto fe = t.find("forward_euler")) {
+    if (c.integrator != "forward_euler") fe->fail("only for \"integrator\": \"forward_euler\"");
+    o.fe_stability_policy = fe->choice("stability", {"substep", "refuse", "unguarded"}, "substep");
+    o.fe_safety = fe->number("safety", o.fe_safety, Range::left_open(0.0, 1.0));
+    o.fe_max_dt = fe->number("max_dt", 0.0, Range::non_negative());
+    o.fe_limit_estimate = fe->choice("limit_estimate", {"gershgorin", "power"}, "gershgorin");
+    fe->finish();
+  }
+  try {
+    thermal::make_integrator(c.integrator, o);  // the thermal module's own checks, before any step
+  } catch (const std::invalid_argument& e) {
+    t.fail(e.what());
+  }
+}
+
+void parse_materials(const JsonReader& t, ThermalSceneSpec& spec, const std::vector<mechanics::Material>& mats) {
+  std::vector<std::string> names;
+  for (const auto& m : mats) names.push_back(m.name);
+  spec.coupler.materials.assign(mats.size(), ThermalProperties{});
+  const JsonReader table =
+      t.at("materials", "an object mapping material names to {\"heat_capacity\": J/(kg K), \"conductivity\": W/(m K)}");
+  for (const std::string& name : table.keys()) {
+    const JsonReader m = table.at(name);
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      std::string known;
+      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+      m.fail("no material of this name in \"materials\" (defined: " + known + ")");
+    }
+    if (!m.is_object()) m.expected("an object with heat_capacity and conductivity");
+    ThermalProperties& p = spec.coupler.materials[static_cast<std::size_t>(it - names.begin())];
+    p.conducts = true;
+    p.heat_capacity = m.number("heat_capacity", Range::positive());
+    p.conductivity = m.number("conductivity", Range::non_negative());
+    m.finish();
+  }
+  for (std::size_t i = 0; i < mats.size(); ++i)
+    if (!mats[i].is_rigid() && !spec.coupler.materials[i].conducts)
+      table.fail("missing material \"" + mats[i].name +
+                 "\" (every deformable material needs heat_capacity and conductivity; rigid ones may be left out)");
+}
+
+void parse_fixed_faces(const JsonReader& t, ThermalSceneSpec& spec, int dim) {
+  const auto list = t.find("fixed_temperature");
+  if (!list) return;
+  for (const JsonReader& e : list->elements()) {
+    if (!e.is_object()) e.expected("an object {\"face\": NAME, \"temperature\": K}");
+    FixedTemperatureFace f;
+    const std::string face = e.choice("face", face_names(dim));
+    detail::face_from_name(face, f.axis, f.upper);
+    f.temperature = e.number("temperature", Range::positive());
+    e.finish();
+    spec.coupler.fixed_faces.push_back(f);
+  }
+}
+
+void parse_window(const JsonReader& c, WindowPolicy& w) {
+  const auto win = c.find("window");
+  if (!win) return;
+  const std::vector<std::string> policies{"every_step", "every_n_steps", "adaptive"};
+  const std::string policy = win->is_string() ? win->as_choice(policies)
+                             : win->is_object()
+                                 ? win->choice("policy", policies)
+                                 : (win->expected("\"every_step\" or an object {\"policy\": ...}"), std::string());
+  if (policy == "every_step") {
+    w.kind = WindowPolicy::Kind::every_step;
+  } else if (policy == "every_n_steps") {
+    if (!win->is_object()) win->expected("an object {\"policy\": \"every_n_steps\", \"steps\": N}");
+    w.kind = WindowPolicy::Kind::every_n_steps;
+    w.steps = win->integer("steps", 1, std::numeric_limits<int>::max());
+  } else {
+    if (!win->is_object()) win->expected("an object {\"policy\": \"adaptive\", \"max_temperature_rise\": K, ...}");
+    w.kind = WindowPolicy::Kind::adaptive;
+    w.max_temperature_rise = win->number("max_temperature_rise", Range::positive());
+    w.max_duration = win->number("max_duration", w.max_duration, Range::positive());
+    w.max_steps = win->integer("max_steps", 0, 1, std::numeric_limits<int>::max());
+  }
+  if (win->is_object()) win->finish();
+}
+
+void parse_hotspots(const JsonReader& c, HotSpotOptions& h) {
+  const auto hs = c.find("hotspots");
+  if (!hs) return;
+  h.mode = hs->choice("mode", {"rise", "absolute"}, "rise") == "absolute" ? HotSpotOptions::Mode::absolute
+                                                                           : HotSpotOptions::Mode::rise;
+  h.threshold = hs->number("threshold", h.threshold,
+                           h.mode == HotSpotOptions::Mode::absolute ? Range::positive() : Range::non_negative());
+  h.link_factor = hs->number("link_factor", h.link_factor, Range::closed(1.0, 10.0));
+  h.min_particles = static_cast<std::size_t>(hs->integer("min_particles", 1, 1, std::numeric_limits<int>::max()));
+  hs->finish();
+}
+
+}  // namespace
+
+const char* to_string(HeatingOrder order) { return order == HeatingOrder::first ? "first" : "second"; }
+
+const char* to_string(WindowPolicy::Kind kind) {
+  switch (kind) {
+    case WindowPolicy::Kind::every_step: return "every_step";
+    case WindowPolicy::Kind::every_n_steps: return "every_n_steps";
+    case WindowPolicy::Kind::adaptive: return "adaptive";
+  }
+  return "?";
+}
+
+ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
+                                        const std::vector<mechanics::Material>& materials, double thickness) {
+  ThermalSceneSpec spec;
+  const auto t = root.find("thermal");
+  const auto c = root.find("coupling");
+  if (!t) {
+    if (c) c->fail("needs a \"thermal\" section (the thermal solver and the materials' heat capacity and conductivity)");
+    return spec;
+  }
+  if (!t->is_object()) t->expected("an object with at least \"materials\"");
+  spec.enabled = true;
+  spec.coupler.thickness = dimension == 2 ? thickness : 1.0;
+  parse_integrator(*t, spec);
+  spec.coupler.assembly.active_mass_fraction =
+      t->number("active_mass_fraction", spec.coupler.assembly.active_mass_fraction, Range::open(0.0, 1.0));
+  parse_materials(*t, spec, materials);
+  parse_fixed_faces(*t, spec, dimension);
+  t->finish();
+  if (!c) return spec;
+  if (!c->is_object()) c->expected("an object");
+  parse_window(*c, spec.coupler.window);
+  spec.heating_order = c->choice("heating_order", {"first", "second"}, "second") == "first" ? HeatingOrder::first
+                                                                                           : HeatingOrder::second;
+  if (const auto cont = c->find("continuation")) {
+    spec.continuation_duration = cont->number("duration", Range::positive());
+    spec.continuation_intervals = cont->integer("intervals", spec.continuation_intervals, 1, 10000000);
+    cont->finish();
+  }
+  parse_hotspots(*c, spec.coupler.hotspots);
+  c->finish();
+  return spec;
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,243 @@
+// Nodal thermal mass, temperature and conductance from particles (Nairn et al. 2018 eq. 38), and
+// the incremental particle update T_p += Σ_i S_ip ΔT_i (design §4).
+#include <frictherm/coupling/thermal_assembly.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+
+namespace {
+
+const ThermalProperties& props_of(const std::vector<ThermalProperties>& materials, int id) {
+  if (id < 0 || static_cast<std::size_t>(id) >= materials.size())
+    throw std::invalid_argument("thermal assembly: particle of material id " + std::to_string(id) + " but only " +
+                                std::to_string(materials.size()) + " materials have thermal properties");
+  return materials[static_cast<std::size_t>(id)];
+}
+
+/// One particle's nodes, weights S_ip and gradients G_ip, in the order the stencil visits them.
+template <int Dim, class Kernel>
+struct NodeList {
+  static constexpr int capacity = mechanics::Stencil<Dim, Kernel>::node_count;
+  int count = 0;
+  int node[capacity];
+  double S[capacity];
+  mechanics::Vec<Dim> G[capacity];
+
+  void fill(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, std::size_t k) {
+    mechanics::Stencil<Dim, Kernel> st;
+    st.evaluate(grid, p.position[k], p.half_size[k]);
+    count = 0;
+    st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
+      node[count] = i;
+      S[count] = w;
+      G[count] = g;
+      ++count;
+    });
+  }
+};
+
+template <int Dim, class Kernel>
+NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
+                                 const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt) {
+  using Nodes = NodeList<Dim, Kernel>;
+  const std::size_t n_nodes = grid.node_count();
+  NodalThermalSystem sys;
+  sys.grid_mass.assign(n_nodes, 0.0);
+  std::vector<double> mct(n_nodes, 0.0);
+  Nodes nl;
+
+  // Pass 1: M_i and M_i T_i (eq. 38).
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const ThermalProperties& m = props_of(materials, p.material[k]);
+    if (!m.conducts) continue;
+    const double mc = p.mass[k] * m.heat_capacity;
+    sys.particle_heat_capacity += mc;
+    nl.fill(grid, p, k);
+    for (int a = 0; a < nl.count; ++a) {
+      const auto i = static_cast<std::size_t>(nl.node[a]);
+      sys.grid_mass[i] += mc * nl.S[a];
+      mct[i] += mc * p.temperature[k] * nl.S[a];
+    }
+  }
+  if (!(sys.particle_heat_capacity > 0.0))
+    throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
+
+  // Unknowns: nodes carrying more than a tiny fraction of the largest nodal heat capacity.
+  sys.max_mass = *std::max_element(sys.grid_mass.begin(), sys.grid_mass.end());
+  const double threshold = opt.active_mass_fraction * sys.max_mass;
+  sys.unknown.assign(n_nodes, -1);
+  for (std::size_t i = 0; i < n_nodes; ++i) {
+    if (sys.grid_mass[i] > threshold && sys.grid_mass[i] > 0.0) {
+      sys.unknown[i] = static_cast<int>(sys.grid_node.size());
+      sys.grid_node.push_back(static_cast<int>(i));
+    } else {
+      sys.dropped_mass += sys.grid_mass[i];
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
+  sys.mass.resize(n);
+  sys.temperature.resize(n);
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const auto i = static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)]);
+    sys.mass[u] = sys.grid_mass[i];
+    sys.temperature[u] = mct[i] / sys.grid_mass[i];
+  }
+
+  // Pass 2: K_ij = Σ_p V_p k_p G'_ip·G'_jp, accumulated per unknown row in slots indexed by the lattice
+  // offset of j from i (each component in [-(K-1), K-1]).
+  constexpr int kw = 2 * Kernel::K - 1;
+  constexpr int slots = Dim == 2 ? kw * kw : kw * kw * kw;
+  std::vector<double> rows(static_cast<std::size_t>(n) * slots, 0.0);
+  mechanics::Vec<Dim> Gk[Nodes::capacity];
+  mechanics::IVec<Dim> lat[Nodes::capacity];
+  int row[Nodes::capacity];
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const ThermalProperties& m = props_of(materials, p.material[k]);
+    if (!m.conducts || !(m.conductivity > 0.0)) continue;
+    nl.fill(grid, p, k);
+    double s_kept = 0.0;
+    mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
+    int kept = 0;
+    for (int a = 0; a < nl.count; ++a) {
+      const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
+      if (u >= 0) {
+        s_kept += nl.S[a];
+        row[kept] = u;
+        Gk[kept] = nl.G[a];
+        lat[kept] = grid.node_lattice(nl.node[a]);
+        nl.S[kept] = nl.S[a];
+        ++kept;
+      } else {
+        g_dropped += nl.G[a];
+      }
+    }
+    if (kept == 0 || !(s_kept > 0.0)) continue;  // no heat capacity of its own reaches an unknown
+    if (kept < nl.count)
+      for (int a = 0; a < kept; ++a) Gk[a] += (nl.S[a] / s_kept) * g_dropped;  // lump dropped nodes
+    const double c = p.volume[k] * m.conductivity;
+    for (int a = 0; a < kept; ++a) {
+      double* r = &rows[static_cast<std::size_t>(row[a]) * slots];
+      for (int b = 0; b < kept; ++b) {
+        int slot = 0, scale = 1;
+        for (int d = 0; d < Dim; ++d) {
+          slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
+          scale *= kw;
+        }
+        r[slot] += c * Gk[a].dot(Gk[b]);
+      }
+    }
+  }
+
+  // CSR with the diagonal set to minus the off-diagonal row sum, so K·1 = 0 to the round-off of
+  // that sum (the products above give it only approximately, and exact zero row sums make the
+  // conduction part conserve Σ M_i T_i exactly).
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(static_cast<std::size_t>(n) * 9);
+  const auto& stride = grid.strides();
+  constexpr int centre = (slots - 1) / 2;
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const double* r = &rows[static_cast<std::size_t>(u) * slots];
+    const int node = sys.grid_node[static_cast<std::size_t>(u)];
+    double off_sum = 0.0;
+    for (int s = 0; s < slots; ++s) {
+      if (s == centre || r[s] == 0.0) continue;
+      int rem = s, j = node;
+      for (int d = 0; d < Dim; ++d) {
+        j += (rem % kw - (Kernel::K - 1)) * stride[d];
+        rem /= kw;
+      }
+      const int v = sys.unknown[static_cast<std::size_t>(j)];
+      trip.emplace_back(u, v, r[s]);
+      off_sum += r[s];
+    }
+    trip.emplace_back(u, u, -off_sum);
+  }
+  sys.conductance.resize(n, n);
+  sys.conductance.setFromTriplets(trip.begin(), trip.end());
+  return sys;
+}
+
+template <int Dim, class Kernel>
+void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
+                     const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
+                     const Eigen::VectorXd& delta) {
+  NodeList<Dim, Kernel> nl;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (!props_of(materials, p.material[k]).conducts) continue;
+    nl.fill(grid, p, k);
+    double dT = 0.0;
+    for (int a = 0; a < nl.count; ++a) {
+      const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
+      if (u >= 0) dT += nl.S[a] * delta[u];
+    }
+    p.temperature[k] += dT;
+  }
+}
+
+}  // namespace
+
+double NodalThermalSystem::mass_residual() const {
+  double total = 0.0;
+  for (double m : grid_mass) total += m;
+  return particle_heat_capacity > 0.0 ? std::fabs(total - particle_heat_capacity) / particle_heat_capacity : 0.0;
+}
+
+double NodalThermalSystem::row_sum_residual() const {
+  if (size() == 0) return 0.0;
+  const Eigen::VectorXd r = conductance * Eigen::VectorXd::Ones(static_cast<Eigen::Index>(size()));
+  const double kmax = conductance.diagonal().cwiseAbs().maxCoeff();
+  return kmax > 0.0 ? r.cwiseAbs().maxCoeff() / kmax : 0.0;
+}
+
+double NodalThermalSystem::energy(const Eigen::VectorXd& nodal_temperature) const {
+  return mass.dot(nodal_temperature);
+}
+
+template <int Dim>
+NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
+                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
+                                    const AssemblyOptions& options) {
+  return mechanics::dispatch_shape(shape, [&](auto kernel) {
+    return assemble_with<Dim, decltype(kernel)>(grid, particles, materials, options);
+  });
+}
+
+template <int Dim>
+void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
+                                   mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
+                                   const NodalThermalSystem& system, const Eigen::VectorXd& delta) {
+  if (delta.size() != static_cast<Eigen::Index>(system.size()))
+    throw std::invalid_argument("add_nodal_change_to_particles: " + std::to_string(delta.size()) +
+                                " nodal changes for " + std::to_string(system.size()) + " unknowns");
+  mechanics::dispatch_shape(shape, [&](auto kernel) {
+    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta);
+  });
+}
+
+template <int Dim>
+double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials) {
+  double e = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const ThermalProperties& m = props_of(materials, p.material[k]);
+    if (m.conducts) e += p.mass[k] * m.heat_capacity * p.temperature[k];
+  }
+  return e;
+}
+
+#define FRICTHERM_INSTANTIATE_ASSEMBLY(D)                                                                       \
+  template NodalThermalSystem assemble_thermal<D>(const mechanics::Grid<D>&, const mechanics::Particles<D>&,   \
+                                                  mechanics::ShapeKind, const std::vector<ThermalProperties>&, \
+                                                  const AssemblyOptions&);                                     \
+  template void add_nodal_change_to_particles<D>(const mechanics::Grid<D>&, mechanics::Particles<D>&,          \
+                                                 mechanics::ShapeKind, const std::vector<ThermalProperties>&,  \
+                                                 const NodalThermalSystem&, const Eigen::VectorXd&);           \
+  template double particle_thermal_energy<D>(const mechanics::Particles<D>&, const std::vector<ThermalProperties>&);
+FRICTHERM_INSTANTIATE_ASSEMBLY(2)
+FRICTHERM_INSTANTIATE_ASSEMBLY(3)
+#undef FRICTHERM_INSTANTIATE_ASSEMBLY
+
+}  // namespace frictherm::coupling

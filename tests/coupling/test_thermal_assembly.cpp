@@ -1,0 +1,228 @@
+// Thermal assembly from particles (Nairn et al. 2018 eq. 38), heat handoff and the incremental
+// particle update: conservation laws and exact properties of the discretisation.
+#include "thermal_test_support.hpp"
+
+#include <frictherm/coupling/heat_handoff.hpp>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace fc = frictherm::coupling;
+namespace fm = frictherm::mechanics;
+using fc::test::fill_box;
+using fc::test::make_grid;
+
+namespace {
+
+const fm::ShapeKind kShapes[] = {fm::ShapeKind::linear, fm::ShapeKind::ugimp, fm::ShapeKind::quadratic_bspline};
+
+// Two materials (an HMX-like grain in a binder-like block) and a rigid one without thermal properties.
+std::vector<fc::ThermalProperties> two_materials() {
+  return {{true, 1100.0, 0.45}, {true, 1500.0, 0.14}, {false, 0.0, 0.0}};
+}
+
+// 2D: a 6 x 4 mm block of material 1 with a 2 x 2 mm inclusion of material 0, on a 10 x 8 grid of
+// 1 mm cells (thickness 2 mm), temperatures varying in space; a rigid body of material 2 beside it.
+fm::Particles<2> block_2d(double thickness = 2e-3) {
+  fm::Particles<2> p;
+  auto T = [](const fm::Vec<2>& x) { return 300.0 + 1e4 * x[0] + 30.0 * std::sin(2e3 * x[1]); };
+  fill_box<2>(p, {2e-3, 2e-3}, {4e-3, 4e-3}, 1e-3, 2, 1900.0, 0, T, thickness);
+  fill_box<2>(p, {4e-3, 2e-3}, {8e-3, 6e-3}, 1e-3, 2, 1190.0, 1, T, thickness);
+  fill_box<2>(p, {2e-3, 4e-3}, {4e-3, 6e-3}, 1e-3, 2, 1190.0, 1, T, thickness);
+  fill_box<2>(p, {8e-3, 2e-3}, {9e-3, 6e-3}, 1e-3, 2, 7800.0, 2, T, thickness);
+  return p;
+}
+
+double total_heat_capacity(const fm::Particles<2>& p, const std::vector<fc::ThermalProperties>& m) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const auto& pr = m[static_cast<std::size_t>(p.material[k])];
+    if (pr.conducts) s += p.mass[k] * pr.heat_capacity;
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(ThermalAssembly, PartitionOfUnityAndZeroRowSums2D) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
+  const auto p = block_2d();
+  const auto mats = two_materials();
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    const fc::NodalThermalSystem s = fc::assemble_thermal(grid, p, shape, mats);
+    // Σ_i M_i = Σ_p m_p C_p: partition of unity, round-off of ~1e2 terms.
+    double sum = 0.0;
+    for (double m : s.grid_mass) sum += m;
+    EXPECT_NEAR(sum, total_heat_capacity(p, mats), 1e-13 * sum);
+    EXPECT_LT(s.mass_residual(), 1e-13);
+    EXPECT_EQ(s.dropped_mass, 0.0);  // the lattice fills whole cells: no tiny nodes
+    // K·1 = 0 and K = Kᵀ exactly (the same products in the same order).
+    EXPECT_LT(s.row_sum_residual(), 1e-13);
+    const Eigen::MatrixXd K = Eigen::MatrixXd(s.conductance);
+    EXPECT_EQ((K - K.transpose()).cwiseAbs().maxCoeff(), 0.0);
+    // Positive semi-definite: eigenvalues >= -round-off.
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K).eigenvalues();
+    EXPECT_GT(ev.minCoeff(), -1e-12 * ev.maxCoeff());
+    // Eq. 38: Σ M_i T_i = Σ m_p C_p T_p (partition of unity again).
+    EXPECT_NEAR(s.energy(s.temperature), fc::particle_thermal_energy(p, mats), 1e-13 * s.energy(s.temperature));
+    // Units: 2D volumes carry the thickness, so K is W/K: halving the thickness halves K and M.
+    const fc::NodalThermalSystem half = fc::assemble_thermal(grid, block_2d(1e-3), shape, mats);
+    EXPECT_NEAR(half.conductance.diagonal().sum(), 0.5 * s.conductance.diagonal().sum(),
+                1e-12 * s.conductance.diagonal().sum());
+    EXPECT_NEAR(half.mass.sum(), 0.5 * s.mass.sum(), 1e-12 * s.mass.sum());
+  }
+}
+
+TEST(ThermalAssembly, PartitionOfUnityAndZeroRowSums3D) {
+  const auto grid = make_grid<3>({0.0, 0.0, 0.0}, 1e-3, {6, 5, 5});
+  fm::Particles<3> p;
+  fill_box<3>(p, {1e-3, 1e-3, 1e-3}, {4e-3, 3e-3, 4e-3}, 1e-3, 2, 1900.0, 0,
+              [](const fm::Vec<3>& x) { return 300.0 + 1e4 * x[2]; });
+  const std::vector<fc::ThermalProperties> mats{{true, 1100.0, 0.45}};
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    const fc::NodalThermalSystem s = fc::assemble_thermal(grid, p, shape, mats);
+    EXPECT_LT(s.mass_residual(), 1e-13);
+    EXPECT_LT(s.row_sum_residual(), 1e-13);
+    const Eigen::MatrixXd K = Eigen::MatrixXd(s.conductance);
+    EXPECT_EQ((K - K.transpose()).cwiseAbs().maxCoeff(), 0.0);
+  }
+}
+
+// For shape functions that reproduce linear fields, Σ_j G_jp T_j = ∇T at every particle, so
+// (K T)_i = k ∇T · Σ_p V_p G_ip, which vanishes wherever node i's support lies inside the body
+// (Σ_p V_p G_ip is the particle quadrature of ∫∇S_i dV = 0; the regular lattice makes it exact).
+// For a quadratic field T = x² the same quadrature gives the discrete Laplacian's action
+// (K T)_i = −k ∇²T Σ_p V_p S_ip = −2 k Σ_p V_p S_ip on interior nodes.
+TEST(ThermalAssembly, LinearFieldIsInEquilibriumAndQuadraticFieldGivesLaplacian) {
+  const double h = 1e-3, k = 0.45;
+  const auto grid = make_grid<2>({0.0, 0.0}, h, {12, 12});
+  fm::Particles<2> p;
+  fill_box<2>(p, {1e-3, 1e-3}, {11e-3, 11e-3}, h, 2, 1900.0, 0, [](const fm::Vec<2>&) { return 300.0; });
+  const std::vector<fc::ThermalProperties> mats{{true, 1100.0, k}};
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    const fc::NodalThermalSystem s = fc::assemble_thermal(grid, p, shape, mats);
+    const auto n = static_cast<Eigen::Index>(s.size());
+    Eigen::VectorXd lin(n), quad(n), vs = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index u = 0; u < n; ++u) {
+      const fm::Vec<2> x = grid.node_position(s.grid_node[static_cast<std::size_t>(u)]);
+      lin[u] = 300.0 + 2e4 * x[0] - 7e3 * x[1];
+      quad[u] = 1e6 * x[0] * x[0];
+    }
+    // Σ_p V_p S_ip on the unknowns: M_i / (ρ C) for a single material.
+    vs = s.mass / (1900.0 * 1100.0);
+    const Eigen::VectorXd KT = s.conductance * lin, KQ = s.conductance * quad;
+    const double scale = s.conductance.diagonal().maxCoeff() * lin.cwiseAbs().maxCoeff();
+    int interior = 0;
+    double worst_lin = 0.0, worst_quad = 0.0;
+    for (Eigen::Index u = 0; u < n; ++u) {
+      const fm::Vec<2> x = grid.node_position(s.grid_node[static_cast<std::size_t>(u)]);
+      // Interior: two cells away from the body's edges (the widest support, 1.5 h, plus a particle).
+      if (x[0] < 3e-3 - 1e-9 || x[0] > 9e-3 + 1e-9 || x[1] < 3e-3 - 1e-9 || x[1] > 9e-3 + 1e-9) continue;
+      ++interior;
+      worst_lin = std::max(worst_lin, std::fabs(KT[u]) / scale);
+      worst_quad = std::max(worst_quad, std::fabs(KQ[u] + 2e6 * k * vs[u]) / (2e6 * k * vs[u]));
+    }
+    EXPECT_EQ(interior, 49);
+    EXPECT_LT(worst_lin, 1e-13) << "linear field not in equilibrium";
+    EXPECT_LT(worst_quad, 1e-10) << "quadratic field: not the Laplacian's action";
+    // Globally K T sums to zero for any T (zero column sums): no heat is created by conduction.
+    EXPECT_LT(std::fabs(KQ.sum()), 1e-12 * KQ.cwiseAbs().sum());
+    RecordProperty(std::string("quadratic_rel_error_") + fm::to_string(shape), std::to_string(worst_quad));
+  }
+}
+
+// Nodes whose heat capacity is below active_mass_fraction·max M are dropped; K keeps zero row sums
+// and stays PSD, and Σ M over the unknowns + the dropped mass is the particles' heat capacity.
+TEST(ThermalAssembly, TinyNodesAreDroppedWithoutBreakingConservation) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {8, 8});
+  fm::Particles<2> p;
+  fill_box<2>(p, {2e-3, 2e-3}, {6e-3, 6e-3}, 1e-3, 2, 1900.0, 0, [](const fm::Vec<2>&) { return 300.0; });
+  // One particle nudged just past a cell edge: with linear shape functions the far nodes get S ~ 1e-4.
+  p.position[0][0] -= 0.2501e-3;
+  const std::vector<fc::ThermalProperties> mats{{true, 1100.0, 0.45}};
+  fc::AssemblyOptions opt;
+  opt.active_mass_fraction = 1e-3;
+  const fc::NodalThermalSystem s = fc::assemble_thermal(grid, p, fm::ShapeKind::linear, mats, opt);
+  EXPECT_GT(s.dropped_mass, 0.0);
+  EXPECT_NEAR(s.mass.sum() + s.dropped_mass, total_heat_capacity(p, mats), 1e-13 * s.mass.sum());
+  EXPECT_LT(s.row_sum_residual(), 1e-13);
+  const Eigen::MatrixXd K = Eigen::MatrixXd(s.conductance);
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K).eigenvalues();
+  EXPECT_GT(ev.minCoeff(), -1e-12 * ev.maxCoeff());
+  for (std::size_t u = 0; u < s.size(); ++u) EXPECT_GT(s.mass[static_cast<Eigen::Index>(u)], 1e-3 * s.max_mass);
+}
+
+// Heat on nodes that are not unknowns (empty grid nodes, a rigid body's nodes) moves to unknowns
+// without loss; heat on unknowns stays where it is.
+TEST(HeatHandoff, HeatOnNodesWithoutUnknownsIsMovedWithoutLoss) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
+  const auto p = block_2d();
+  const auto mats = two_materials();
+  const fc::NodalThermalSystem s = fc::assemble_thermal(grid, p, fm::ShapeKind::ugimp, mats);
+  std::vector<double> work(grid.node_count(), 0.0);
+  const int on_body = grid.node_index({5, 4});               // an unknown
+  const int next_to = grid.node_index({1, 3});               // empty, beside the block's unknowns
+  const int far = grid.node_index({10, 8});                  // corner of the grid: no unknown near
+  const int ghost = grid.node_index({-1, -1});               // a ghost node
+  ASSERT_GE(s.unknown[static_cast<std::size_t>(on_body)], 0);
+  ASSERT_LT(s.unknown[static_cast<std::size_t>(next_to)], 0);
+  ASSERT_LT(s.unknown[static_cast<std::size_t>(far)], 0);
+  work[static_cast<std::size_t>(on_body)] = 1.25e-3;
+  work[static_cast<std::size_t>(next_to)] = 0.7;
+  work[static_cast<std::size_t>(far)] = 3.3e-2;
+  work[static_cast<std::size_t>(ghost)] = 1e-5;
+  const fc::HeatDistribution d = fc::distribute_heat(grid, s, work);
+  const double total = 1.25e-3 + 0.7 + 3.3e-2 + 1e-5;
+  EXPECT_NEAR(d.total, total, 1e-16 * total);
+  EXPECT_NEAR(d.joules.sum(), total, 1e-15 * total);
+  EXPECT_NEAR(d.relocated, total - 1.25e-3, 1e-15 * total);
+  EXPECT_EQ(d.joules[s.unknown[static_cast<std::size_t>(on_body)]], 1.25e-3);
+  // The far corner's heat went to a single nearest unknown: the block's corner node (9, 6)... or
+  // whichever unknown is nearest; it must be at most sqrt(1² + 2²) cells away.
+  EXPECT_TRUE((d.joules.array() >= 0.0).all());
+}
+
+// The accumulator sums energy, not rates, and forgets it when cleared.
+TEST(HeatHandoff, AccumulatorSumsEnergy) {
+  fc::HeatAccumulator acc(20);
+  std::vector<double> w(20, 0.0);
+  w[3] = 1.0;
+  w[7] = 0.25;
+  for (int k = 0; k < 10; ++k) acc.add(w);
+  acc.add(std::vector<double>{});  // no work this step
+  EXPECT_DOUBLE_EQ(acc.total(), 12.5);
+  EXPECT_DOUBLE_EQ(acc.work()[3], 10.0);
+  acc.clear();
+  EXPECT_EQ(acc.total(), 0.0);
+  EXPECT_EQ(acc.work()[3], 0.0);
+  EXPECT_THROW(acc.add(std::vector<double>(5, 1.0)), std::invalid_argument);
+  w[2] = std::nan("");
+  EXPECT_THROW(acc.add(w), std::invalid_argument);
+}
+
+// T_p += Σ_i S_ip ΔT_i conserves Σ m_p C_p T_p exactly: Σ_p m_p C_p ΔT_p = Σ_i M_i ΔT_i.
+TEST(IncrementalMapping, ParticleEnergyChangeEqualsNodalEnergyChange) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
+  const auto mats = two_materials();
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    auto p = block_2d();
+    const fc::NodalThermalSystem s = fc::assemble_thermal(grid, p, shape, mats);
+    Eigen::VectorXd dT(static_cast<Eigen::Index>(s.size()));
+    for (Eigen::Index u = 0; u < dT.size(); ++u) dT[u] = 5.0 * std::sin(0.7 * static_cast<double>(u)) + 2.0;
+    const double e0 = fc::particle_thermal_energy(p, mats);
+    const std::vector<double> rigid_before(p.temperature.end() - 8, p.temperature.end());
+    fc::add_nodal_change_to_particles(grid, p, shape, mats, s, dT);
+    const double de = fc::particle_thermal_energy(p, mats) - e0;
+    const double expected = s.mass.dot(dT);
+    // Round-off: e0 ~ 1e3 J carries ~1e-13 J of error, the change is ~4 J.
+    EXPECT_NEAR(de, expected, 1e-12 * e0);
+    // The rigid body (no thermal properties) keeps its temperatures.
+    EXPECT_EQ(std::vector<double>(p.temperature.end() - 8, p.temperature.end()), rigid_before);
+  }
+}
