@@ -1,0 +1,156 @@
+#!/usr/bin/python3
+"""Figures 3, 4 and 5 of Nairn, Bardenhagen & Smith (2018): the sliding block of
+examples/sliding_block.json run with several friction laws, MPM against the rigid-block solution
+(appendix eqs. 46-54).
+
+  sliding_block_figures.py [--frictherm PATH] [--out DIR] [--cell H]
+
+Runs `frictherm run` once per law (about a second each at the paper's 5 mm cells) and writes
+DIR/fig3_velocity.png, DIR/fig4_static_dynamic.png and DIR/fig5_friction_work.png, plus a line per
+run with the largest velocity error. Uses the Debian packages python3-h5py, python3-matplotlib and
+python3-numpy; runs headless.
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENE = os.path.join(HERE, "sliding_block.json")
+
+# The set-up of examples/sliding_block.json (SI).
+RHO, H, L, B = 1000.0, 0.015, 0.040, 0.001
+V_MAX, SLIDE = 31.6, 0.085
+T_SLIDE = 3.0 * SLIDE / V_MAX
+TF = T_SLIDE / 0.6
+T2 = 0.25 * TF
+TS = TF - T2
+N = 2.0 * V_MAX / T_SLIDE**2 * RHO * H * TS
+
+
+class RigidBlock:
+    """Appendix eqs. 46-54 (R = 1): S_slide = (mu_d + k v) N + S_a after S reaches mu_s N + S_a."""
+
+    def __init__(self, mu_s, mu_d, k=0.0, s_a=0.0):
+        self.mu_s, self.mu_d, self.k, self.s_a = mu_s, mu_d, k, s_a
+        self.onset = T2 + (mu_s + s_a / N) * TS           # eq. 47
+        self.alpha = N / (RHO * H * TS)                    # eq. 49
+        self.beta = (mu_s - mu_d) * N / (RHO * H)
+        self.gamma = k * N / (RHO * H)
+
+    def velocity(self, t):                                 # eq. 50
+        T = np.maximum(np.asarray(t) - self.onset, 0.0)
+        if self.k == 0.0:
+            return 0.5 * self.alpha * T**2 + self.beta * T
+        psi = self.alpha / self.gamma
+        phi = (self.beta - psi) / self.gamma               # eq. 51
+        return psi * T + phi * (1.0 - np.exp(-self.gamma * T))
+
+    def work(self, t):
+        """Eqs. 52-54; the first bracket of the printed eq. 54 swaps psi and phi (it is the integral of v)."""
+        T = np.maximum(np.asarray(t) - self.onset, 0.0)
+        c = self.mu_d * N + self.s_a
+        a, b, g = self.alpha, self.beta, self.gamma
+        if self.k == 0.0:
+            return L * B * c * (a * T**3 / 6.0 + 0.5 * b * T**2)      # eq. 53
+        psi, phi = a / g, (b - a / g) / g
+        e1, e2 = np.exp(-g * T), np.exp(-2.0 * g * T)
+        dist = 0.5 * psi * T**2 + phi * (T - (1.0 - e1) / g)
+        v2 = (psi**2 * T**3 / 3.0 + phi**2 * (T - (3.0 - 4.0 * e1 + e2) / (2.0 * g))
+              + psi * phi * (T**2 - 2.0 / g**2 * (1.0 - (1.0 + T * g) * e1)))
+        return L * B * (c * dist + self.k * N * v2)
+
+
+def run(frictherm, out_dir, name, law, cell):
+    out = os.path.join(out_dir, name + ".h5")
+    cmd = [frictherm, "run", SCENE, "-o", out, "--set", "contact.pairs[0].law=" + json.dumps(law)]
+    if cell:
+        cmd += ["--set", "grid.cell_size=%r" % cell]
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    with h5py.File(out, "r") as f:
+        s = f["series"]
+        return (np.array(s["time"]), np.array(s["mean_velocity_x.block"]),
+                np.array(s["friction_work_first"]), np.array(s["friction_work_second"]))
+
+
+def report(name, t, v, rigid):
+    err = np.max(np.abs(v - rigid.velocity(t))) / V_MAX
+    print("%-34s max |v - v_rigid| / v_max = %.4f" % (name, err))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--frictherm", default=os.path.join(HERE, "..", "build", "coupling", "frictherm"))
+    ap.add_argument("--out", default=os.path.join(HERE, "..", "results", "sliding_block"))
+    ap.add_argument("--cell", type=float, default=None, help="cell size (m); default the scene's 5 mm")
+    a = ap.parse_args()
+    if not os.access(a.frictherm, os.X_OK):
+        sys.exit("frictherm not found at %s (build first, or pass --frictherm)" % a.frictherm)
+    os.makedirs(a.out, exist_ok=True)
+    k = 0.5 / V_MAX
+
+    # Figures 3 and 5: three friction laws.
+    laws = [("Coulomb, mu = 0.2", {"type": "coulomb", "mu": 0.2}, RigidBlock(0.2, 0.2)),
+            ("mu = 0.2 + k v, k v_max = 0.5", {"type": "linear_velocity", "mu": 0.2, "k": k}, RigidBlock(0.2, 0.2, k)),
+            ("adhesion, S_a = 0.3 N", {"type": "adhesion", "mu": 0.2, "shear_strength": 0.3 * N},
+             RigidBlock(0.2, 0.2, 0.0, 0.3 * N))]
+    fig3, ax3 = plt.subplots(figsize=(6.4, 4.4))
+    fig5, ax5 = plt.subplots(figsize=(6.4, 4.4))
+    for i, (label, law, rigid) in enumerate(laws):
+        t, v, w1, w2 = run(a.frictherm, a.out, "law%d" % i, law, a.cell)
+        report(label, t, v, rigid)
+        ts = np.linspace(0.0, TF, 400)
+        c = "C%d" % i
+        ax3.plot(t * 1e3, v, c, label=label + " (MPM)")
+        ax3.plot(ts * 1e3, rigid.velocity(ts), c + ":", label=label + " (rigid)")
+        ax5.plot(t * 1e3, w2, c, label=label + " (MPM, 2nd order)")
+        ax5.plot(t * 1e3, w1, c + "--", lw=0.8, label=label + " (MPM, 1st order)")
+        ax5.plot(ts * 1e3, rigid.work(ts), c + ":", label=label + " (rigid)")
+    for ax, ylabel, fig, name in ((ax3, "mean block velocity (m/s)", fig3, "fig3_velocity.png"),
+                                  (ax5, "total friction work (J)", fig5, "fig5_friction_work.png")):
+        ax.set_xlabel("time (ms)")
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(a.out, name), dpi=130)
+
+    # Figure 4: static mu_s = 0.4 to dynamic mu_d = 0.2, smooth law (eq. 42) for several v_half,
+    # and the naive switch that starts sliding early.
+    fig4, ax4 = plt.subplots(figsize=(6.4, 4.4))
+    # Each is reported against the rigid solution it should approach: mu = 0.4 Coulomb for a large
+    # v_half, the static/dynamic solution for a small one (the naive law misses it: it slides early).
+    smooth = {"type": "smooth_static_dynamic", "mu_static": 0.4, "mu_dynamic": 0.2}
+    cases = [("v1/2 = 1000 m/s", dict(smooth, v_half=1000.0), RigidBlock(0.4, 0.4)),
+             ("v1/2 = 1 m/s", dict(smooth, v_half=1.0), RigidBlock(0.4, 0.2)),
+             ("v1/2 = 0.05 m/s", dict(smooth, v_half=0.05), RigidBlock(0.4, 0.2)),
+             ("naive static/dynamic", {"type": "static_dynamic", "mu_static": 0.4, "mu_dynamic": 0.2},
+              RigidBlock(0.4, 0.2))]
+    ts = np.linspace(0.0, TF, 400)
+    for i, (label, law, rigid) in enumerate(cases):
+        t, v, _, _ = run(a.frictherm, a.out, "static%d" % i, law, a.cell)
+        report(label, t, v, rigid)
+        ax4.plot(t * 1e3, v, "C%d" % i, label=label + " (MPM)")
+    for (ms, md), style in (((0.2, 0.2), "k:"), ((0.4, 0.2), "k--"), ((0.4, 0.4), "k-.")):
+        ax4.plot(ts * 1e3, RigidBlock(ms, md).velocity(ts), style, lw=1, label="rigid, mu_s = %g, mu_d = %g" % (ms, md))
+    ax4.set_xlabel("time (ms)")
+    ax4.set_ylabel("mean block velocity (m/s)")
+    ax4.legend(fontsize=7)
+    ax4.grid(alpha=0.3)
+    fig4.tight_layout()
+    fig4.savefig(os.path.join(a.out, "fig4_static_dynamic.png"), dpi=130)
+    print("wrote", ", ".join(os.path.join(a.out, n) for n in ("fig3_velocity.png", "fig4_static_dynamic.png",
+                                                                "fig5_friction_work.png")))
+
+
+if __name__ == "__main__":
+    main()
