@@ -30,6 +30,8 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
   if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
     throw std::invalid_argument("Coupler: adaptive windows need max_temperature_rise > 0");
   if (!(w.max_duration > 0.0)) throw std::invalid_argument("Coupler: max_duration must be > 0");
+  if (!(opt_.subgrid_relaxation_time > 0.0))
+    throw std::invalid_argument("Coupler: subgrid_relaxation_time must be > 0");
   for (const FixedTemperatureFace& f : opt_.fixed_faces)
     if (f.axis < 0 || f.axis >= Dim) throw std::invalid_argument("Coupler: fixed face axis out of range");
 }
@@ -176,7 +178,11 @@ void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, doub
   const Eigen::VectorXd start = nodal_temperature_;
   integrator_->advance(*problem_, nodal_temperature_, t0, t1);  // writes Dirichlet values first
   const Eigen::VectorXd delta = nodal_temperature_ - start;
-  add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta);  // design §4
+  const double beta = std::isfinite(opt_.subgrid_relaxation_time)
+                          ? -std::expm1(-(t1 - t0) / opt_.subgrid_relaxation_time)
+                          : 0.0;
+  add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta,
+                                &nodal_temperature_);  // design §4
   books_.nodal_energy_change += system_.mass.dot(delta);
 }
 

@@ -120,10 +120,10 @@ class Run {
       }
       sim_->step(limit);
       const double t = sim_->time();
-      // Thermal hook; a window also closes at every snapshot time and at the end.
-      // TODO(lead): pass sim_->frictional_work(HeatingOrder) (order: thermal_->heating_order()) once
-      // Simulation::frictional_work lands; until then no frictional heat reaches the coupler.
-      if (thermal_) thermal_->after_step(*sim_, {}, t >= next_snap - eps);
+      // Thermal hook: the step's nodal frictional work (J, eqs. 27/34/36) goes to the coupler; a
+      // window also closes at every snapshot time and at the end.
+      if (thermal_)
+        thermal_->after_step(*sim_, sim_->frictional_work(thermal_->heating_order()), t >= next_snap - eps);
       if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {
         series();
         if (series_dt > 0.0) next_series = (std::floor(t / series_dt + 1e-9) + 1.0) * series_dt;

@@ -121,8 +121,6 @@ void parse_hotspots(const JsonReader& c, HotSpotOptions& h) {
 
 }  // namespace
 
-const char* to_string(HeatingOrder order) { return order == HeatingOrder::first ? "first" : "second"; }
-
 const char* to_string(WindowPolicy::Kind kind) {
   switch (kind) {
     case WindowPolicy::Kind::every_step: return "every_step";
@@ -160,6 +158,8 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
     spec.continuation_intervals = cont->integer("intervals", spec.continuation_intervals, 1, 10000000);
     cont->finish();
   }
+  spec.coupler.subgrid_relaxation_time =
+      c->number("subgrid_relaxation_time", spec.coupler.subgrid_relaxation_time, Range::positive());
   parse_hotspots(*c, spec.coupler.hotspots);
   c->finish();
   return spec;

@@ -164,17 +164,23 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 template <int Dim, class Kernel>
 void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
                      const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
-                     const Eigen::VectorXd& delta) {
+                     const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
   NodeList<Dim, Kernel> nl;
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!props_of(materials, p.material[k]).conducts) continue;
     nl.fill(grid, p, k);
-    double dT = 0.0;
+    double dT = 0.0, pic = 0.0, s = 0.0;
     for (int a = 0; a < nl.count; ++a) {
       const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
-      if (u >= 0) dT += nl.S[a] * delta[u];
+      if (u < 0) continue;
+      dT += nl.S[a] * delta[u];  // design §4: the increment, not the nodal value
+      if (end) {
+        pic += nl.S[a] * (*end)[u];
+        s += nl.S[a];
+      }
     }
-    p.temperature[k] += dT;
+    const double flip = p.temperature[k] + dT;
+    p.temperature[k] = (end && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
   }
 }
 
@@ -209,12 +215,17 @@ NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mech
 template <int Dim>
 void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                   const NodalThermalSystem& system, const Eigen::VectorXd& delta) {
-  if (delta.size() != static_cast<Eigen::Index>(system.size()))
+                                   const NodalThermalSystem& system, const Eigen::VectorXd& delta,
+                                   double relaxation, const Eigen::VectorXd* end) {
+  const auto n = static_cast<Eigen::Index>(system.size());
+  if (delta.size() != n || (end && end->size() != n))
     throw std::invalid_argument("add_nodal_change_to_particles: " + std::to_string(delta.size()) +
-                                " nodal changes for " + std::to_string(system.size()) + " unknowns");
+                                " nodal values for " + std::to_string(system.size()) + " unknowns");
+  if (!(relaxation >= 0.0 && relaxation <= 1.0))
+    throw std::invalid_argument("add_nodal_change_to_particles: relaxation must be in [0, 1]");
+  const Eigen::VectorXd* pic = relaxation > 0.0 ? end : nullptr;
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta);
+    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, relaxation, pic);
   });
 }
 
@@ -234,7 +245,8 @@ double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::ve
                                                   const AssemblyOptions&);                                     \
   template void add_nodal_change_to_particles<D>(const mechanics::Grid<D>&, mechanics::Particles<D>&,          \
                                                  mechanics::ShapeKind, const std::vector<ThermalProperties>&,  \
-                                                 const NodalThermalSystem&, const Eigen::VectorXd&);           \
+                                                 const NodalThermalSystem&, const Eigen::VectorXd&, double,    \
+                                                 const Eigen::VectorXd*);                                      \
   template double particle_thermal_energy<D>(const mechanics::Particles<D>&, const std::vector<ThermalProperties>&);
 FRICTHERM_INSTANTIATE_ASSEMBLY(2)
 FRICTHERM_INSTANTIATE_ASSEMBLY(3)

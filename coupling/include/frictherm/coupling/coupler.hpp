@@ -56,6 +56,11 @@ struct CouplerOptions {
   HotSpotOptions hotspots;
   std::vector<FixedTemperatureFace> fixed_faces;
   double thickness = 1.0;  // 2D out-of-plane thickness (m), for hot-spot areas
+  /// Sub-grid relaxation time τ (s): each window blends β = 1 − exp(−Δt/τ) of the PIC value into the
+  /// incremental update (add_nodal_change_to_particles), so particle-scale structure the grid cannot
+  /// resolve decays as exp(−t/τ) whatever the window length. Infinite (default): pure incremental
+  /// update (design §4), which keeps such structure forever.
+  double subgrid_relaxation_time = std::numeric_limits<double>::infinity();
 };
 
 /// Where the heat went (J). Without fixed faces nodal_energy_change equals heat_delivered up to the

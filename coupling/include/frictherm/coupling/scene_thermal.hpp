@@ -12,6 +12,7 @@
 // Without a `thermal` section nothing thermal is computed; `coupling` needs `thermal`.
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/json_reader.hpp>
+#include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/material.hpp>
 
 #include <string>
@@ -19,9 +20,9 @@
 
 namespace frictherm::coupling {
 
-/// Frictional heating order of the mechanics (Nairn et al. 2018 eqs. 27 and 34/36); maps onto
-/// mechanics::HeatingOrder when the runner asks the simulation for its nodal work.
-enum class HeatingOrder { first, second };
+/// Frictional heating order (Nairn et al. 2018 eqs. 27 and 34/36): the order of the nodal work the
+/// runner takes from Simulation::frictional_work.
+using HeatingOrder = mechanics::HeatingOrder;
 
 struct ThermalSceneSpec {
   bool enabled = false;        // the scene has a `thermal` section
@@ -36,7 +37,6 @@ struct ThermalSceneSpec {
 ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
                                         const std::vector<mechanics::Material>& materials, double thickness);
 
-const char* to_string(HeatingOrder order);
 const char* to_string(WindowPolicy::Kind kind);
 
 }  // namespace frictherm::coupling

@@ -68,10 +68,16 @@ NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mech
 
 /// T_p += Σ_i S_ip ΔT_i for the particles of conducting materials (design §4); `delta` is on the
 /// unknowns of `system`, which must have been assembled from the same particle positions.
+///
+/// Optional sub-grid relaxation (`relaxation` β in [0, 1], `end` the nodal temperatures after the
+/// window): T_p ← (1 − β) (T_p + Σ_i S_ip ΔT_i) + β Σ_i S_ip T_i,end / Σ_i S_ip, a FLIP/PIC blend that
+/// damps particle-scale structure the grid cannot see (it never decays with β = 0). A uniform β keeps
+/// Σ_p m_p C_v,p T_p exact wherever every node of a particle is an unknown.
 template <int Dim>
 void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                   const NodalThermalSystem& system, const Eigen::VectorXd& delta);
+                                   const NodalThermalSystem& system, const Eigen::VectorXd& delta,
+                                   double relaxation = 0.0, const Eigen::VectorXd* end = nullptr);
 
 /// Σ_p m_p C_v,p T_p over the particles of conducting materials (J).
 template <int Dim>
@@ -86,10 +92,12 @@ extern template NodalThermalSystem assemble_thermal<3>(const mechanics::Grid<3>&
                                                        const AssemblyOptions&);
 extern template void add_nodal_change_to_particles<2>(const mechanics::Grid<2>&, mechanics::Particles<2>&,
                                                       mechanics::ShapeKind, const std::vector<ThermalProperties>&,
-                                                      const NodalThermalSystem&, const Eigen::VectorXd&);
+                                                      const NodalThermalSystem&, const Eigen::VectorXd&, double,
+                                                      const Eigen::VectorXd*);
 extern template void add_nodal_change_to_particles<3>(const mechanics::Grid<3>&, mechanics::Particles<3>&,
                                                       mechanics::ShapeKind, const std::vector<ThermalProperties>&,
-                                                      const NodalThermalSystem&, const Eigen::VectorXd&);
+                                                      const NodalThermalSystem&, const Eigen::VectorXd&, double,
+                                                      const Eigen::VectorXd*);
 extern template double particle_thermal_energy<2>(const mechanics::Particles<2>&,
                                                   const std::vector<ThermalProperties>&);
 extern template double particle_thermal_energy<3>(const mechanics::Particles<3>&,
