@@ -1,0 +1,87 @@
+#pragma once
+// The oscillating block of Nairn, Bardenhagen & Smith (2018), figure 6: a 40 × 15 mm block (1 mm
+// thick) on a 60 × 25 mm base fixed at its bottom, 2.5 mm cells, the material of figure 2
+// (E = 2500 MPa, ν = 0.33, ρ = 1 g/cm³). A normal stress is ramped slowly to 100 MPa over [0, t1];
+// then rigid blocks on the top 5/6 of both side edges move with v = v_max sin ω(t − t1) (eq. 44),
+// ω = 2 v_max/x_max, x_max = 0.1 mm, v_max = 0.01 % of the bar wave speed. Coulomb μ = 0.5 between
+// block and base. The paper's pushers "move the edges"; here they are rigid materials bonded to the
+// block (an adhesion law with strengths far above any stress: it sticks in compression and in
+// tension), so both sides follow the prescribed motion. One stick–slide–stick interval lasts until the
+// pushers stop at t1 + π/ω.
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <cmath>
+#include <memory>
+
+namespace frictherm::verification {
+
+struct OscillatingBlock {
+  static constexpr double l = 0.040, h = 0.015, b = 0.001, cell = 0.0025;
+  static constexpr double E = 2500e6, nu = 0.33, rho = 1000.0;
+  static constexpr double normal_stress = 100e6, mu = 0.5, x_max = 1e-4;
+  static constexpr double t1 = 0.25e-3;  // slow compared with the block's 8 µs wave transit
+  /// Bulk (P-wave, plane strain) speed: 1924 m/s, the paper's v in eq. 45.
+  static double wave_speed() {
+    const double lam = E * nu / ((1 + nu) * (1 - 2 * nu)), G = E / (2 * (1 + nu));
+    return std::sqrt((lam + 2 * G) / rho);
+  }
+  /// 0.01 % of the bar wave speed √(E/ρ): 0.158 m/s and a period 2π/ω = 1.987 ms, as in the paper.
+  static double v_max() { return 1e-4 * std::sqrt(E / rho); }
+  static double omega() { return 2.0 * v_max() / x_max; }
+  static double end_time() { return t1 + M_PI / omega(); }
+
+  static std::unique_ptr<mechanics::Simulation<2>> make(double cfl,
+                                                        mechanics::ShapeKind shape = mechanics::ShapeKind::ugimp) {
+    using namespace mechanics;
+    SimulationOptions o;
+    o.analysis = Analysis::plane_strain;
+    o.thickness = b;
+    o.shape = shape;
+    o.cfl = cfl;
+    auto sim = std::make_unique<Simulation<2>>(Grid<2>(Vec<2>(0, 0), Vec<2>(cell, cell), IVec<2>{24, 18}), o);
+    Material elastic;
+    elastic.density = rho, elastic.youngs_modulus = E, elastic.poisson_ratio = nu;
+    Material base_m = elastic, block_m = elastic, pusher_m;
+    base_m.name = "base", block_m.name = "block", pusher_m.name = "pusher";
+    pusher_m.kind = MaterialKind::rigid;
+    pusher_m.density = rho;
+    pusher_m.rigid_velocity = {TimeFunction::sinusoid(v_max(), omega(), t1, end_time()), TimeFunction::constant(0.0)};
+    const int base = sim->add_material(base_m), block = sim->add_material(block_m),
+              pusher = sim->add_material(pusher_m);
+    sim->add_body("base", *make_box<2>(Vec<2>(0, 0), Vec<2>(0.060, 0.025), base), 2, Vec<2>::Zero());
+    sim->add_body("block", *make_box<2>(Vec<2>(0.010, 0.025), Vec<2>(0.050, 0.040), block), 2, Vec<2>::Zero());
+    const double y0 = 0.025 + h / 6.0;  // top 5/6 of the side edges
+    sim->add_body("left pusher", *make_box<2>(Vec<2>(0.0075, y0), Vec<2>(0.010, 0.040), pusher), 2, Vec<2>::Zero());
+    sim->add_body("right pusher", *make_box<2>(Vec<2>(0.050, y0), Vec<2>(0.0525, 0.040), pusher), 2, Vec<2>::Zero());
+    sim->fix_face(FixedFace{1, false, {{true, true, true}}});
+    ContactOptions co;
+    co.default_pair.law = FrictionLaw::adhesion(0.0, 1e15, 1e15);  // pushers bonded to the block
+    co.default_pair.normal = NormalMethod::max_volume_gradient;
+    sim->enable_contact(co);
+    ContactPairSettings interface;
+    interface.law = FrictionLaw::coulomb(mu);
+    interface.normal = NormalMethod::specified;
+    interface.normal_vector = Vec<3>(0, 1, 0);  // from base to block
+    sim->set_contact_pair(base, block, interface);
+    EdgeTraction<2> top;
+    top.body = 1, top.axis = 1, top.upper = true, top.traction = Vec<2>(0, -normal_stress);
+    top.scale = TimeFunction::ramp(1.0, t1);
+    sim->add_edge_traction(top);
+    return sim;
+  }
+
+  struct Work {
+    double first = 0.0, second = 0.0;  // J, base–block pair
+    long steps = 0;
+  };
+
+  static Work run(double cfl, mechanics::ShapeKind shape = mechanics::ShapeKind::ugimp) {
+    auto sim = make(cfl, shape);
+    const double T = end_time();
+    while (sim->time() < T * (1 - 1e-12)) sim->step(T - sim->time());
+    return {sim->cumulative_frictional_work(mechanics::HeatingOrder::first, 0, 1),
+            sim->cumulative_frictional_work(mechanics::HeatingOrder::second, 0, 1), sim->step_count()};
+  }
+};
+
+}  // namespace frictherm::verification
