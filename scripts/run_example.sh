@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # README command 1: install the Debian packages, build, run the main example scene and draw it.
-#   scripts/run_example.sh [SCENE.json]     (default: examples/bar_vibration.json)
+#   scripts/run_example.sh [SCENE.json] [FIELD]  (default: examples/sliding_block_heating.json, temperature)
 # Leaves results/<scene>.h5 (+ .xdmf for ParaView) and results/<scene>_particles.png, _series.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scene=${1:-examples/bar_vibration.json}
+scene=${1:-examples/sliding_block_heating.json}
+field=${2:-temperature}
 name=$(basename "$scene" .json)
 scripts/install_deps.sh
 scripts/build.sh
 mkdir -p results
 ./build/coupling/frictherm run "$scene" -o "results/$name.h5"
-/usr/bin/python3 examples/plot_run.py "results/$name.h5" --field velocity_x -o "results/$name"
+/usr/bin/python3 examples/plot_run.py "results/$name.h5" --field "$field" -o "results/$name"
 echo "wrote results/$name.h5, results/$name.xdmf, results/${name}_particles.png, results/${name}_series.png"
