@@ -74,12 +74,24 @@ mechanics::Material parse_material(const JsonReader& m, const std::string& name,
   mat.kind = mechanics::material_kind_from_string(type.as_choice({"linear_elastic", "neo_hookean", "rigid"}));
   if (mat.is_rigid()) {
     mat.density = m.number("density", 1000.0, Range::positive());
+    if (const auto b = m.find("boundary")) mat.rigid_boundary = b->as_bool();
     const auto v = m.find("velocity");
     if (v) {
       const std::string what = "an array of " + std::to_string(s.dimension) +
-                               " time functions (numbers or {\"type\": ...} objects), one per dimension";
+                               " time functions (numbers or {\"type\": ...} objects), one per dimension" +
+                               (mat.rigid_boundary ? " or null for a free component" : "");
       if (!v->is_array() || v->json().size() != static_cast<std::size_t>(s.dimension)) v->expected(what);
-      for (const JsonReader& f : v->elements()) mat.rigid_velocity.push_back(parse_time_function(f));
+      std::size_t d = 0;
+      for (const JsonReader& f : v->elements()) {
+        if (f.json().is_null()) {
+          if (!mat.rigid_boundary) f.fail("a free (null) component needs \"boundary\": true on the material");
+          mat.rigid_controls[d] = false;
+          mat.rigid_velocity.push_back(mechanics::TimeFunction::constant(0.0));
+        } else {
+          mat.rigid_velocity.push_back(parse_time_function(f));
+        }
+        ++d;
+      }
     } else {
       mat.rigid_velocity.assign(static_cast<std::size_t>(s.dimension), mechanics::TimeFunction::constant(0.0));
     }

@@ -91,6 +91,7 @@ void Simulation<Dim>::init_fields() {
     nodes_.resize(grid_.node_count(), false);
   } else {
     for (std::size_t m = 0; m < nm; ++m) {
+      if (materials_[m].is_rigid() && materials_[m].rigid_boundary) continue;  // acts through rigid_mask_
       VelocityField<Dim> f;
       f.material = static_cast<int>(m);
       f.rigid = materials_[m].is_rigid();
@@ -175,9 +176,10 @@ void Simulation<Dim>::reduce_thread_buffers(bool mass, bool momentum, bool force
   }
 }
 
-// Fixed components are zeroed; rigid nodes (single field) and rigid fields take m v_rigid, no force.
+// Fixed components are zeroed; components driven by a rigid boundary material take its velocity; rigid
+// fields (contact) take m v_rigid and no force.
 template <int Dim>
-void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const {
+void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
@@ -193,9 +195,17 @@ void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::ve
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
       const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
-      if (rigid_mask_[i]) {
-        momentum[s] = nodes_.mass[s] * rigid_velocity_[i];
-        if (force) (*force)[s].setZero();
+      if (const std::uint8_t driven = rigid_mask_[i]) {
+        // Driven components end the step at the rigid velocity. In the momentum update the change is
+        // made a force, (m v_rigid − p)/dt, so that the particles' FLIP update receives it too.
+        for (int d = 0; d < Dim; ++d)
+          if (driven & (1u << d)) {
+            const double target = nodes_.mass[s] * rigid_velocity_[i][d];
+            if (force)
+              (*force)[s][d] = (target - momentum[s][d]) / dt;
+            else
+              momentum[s][d] = target;
+          }
       }
       if (const std::uint8_t mask = fixed_mask_[i]) {
         for (int d = 0; d < Dim; ++d)
@@ -211,7 +221,7 @@ void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::ve
 // v_i = p_i / m_i after the velocity boundary conditions on p_i; empty nodes get no velocity.
 template <int Dim>
 void Simulation<Dim>::velocity_from_momentum() {
-  apply_velocity_bc(nodes_.momentum, nullptr);
+  apply_velocity_bc(nodes_.momentum, nullptr, 0.0);
   const double mmin = empty_node_mass_;
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
@@ -222,7 +232,7 @@ void Simulation<Dim>::velocity_from_momentum() {
 // p^{n+1} with consistent forces (Nairn 2018 eq. 19); then v_i^{n+1} = p_i^{n+1}/m_i, a_i = f_i/m_i.
 template <int Dim>
 void Simulation<Dim>::update_grid(double dt) {
-  apply_velocity_bc(nodes_.momentum, &nodes_.force);
+  apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
 #pragma omp parallel for num_threads(threads_) schedule(static)
@@ -241,10 +251,12 @@ void Simulation<Dim>::update_grid(double dt) {
   }
   // Rigid nodes keep the prescribed velocity (the force was zeroed consistently, so only the
   // velocity needs resetting when the prescribed velocity changes).
-  if (!contact_) {
 #pragma omp parallel for num_threads(threads_) schedule(static)
-    for (std::size_t i = 0; i < n; ++i)
-      if (rigid_mask_[i] && nodes_.mass[i] > mmin) nodes_.velocity[i] = rigid_velocity_[i];
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
+    if (const std::uint8_t driven = rigid_mask_[i]; driven && nodes_.mass[s] > mmin)
+      for (int d = 0; d < Dim; ++d)
+        if (driven & (1u << d)) nodes_.velocity[s][d] = rigid_velocity_[i][d];
   }
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
@@ -301,7 +313,7 @@ template struct NodalFields<3>;
   template void Simulation<D>::init_fields();                                                                 \
   template void Simulation<D>::layout_fields(const std::vector<IVec<D>>&, const std::vector<IVec<D>>&);      \
   template void Simulation<D>::reduce_thread_buffers(bool, bool, bool, bool);                                    \
-  template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*) const;           \
+  template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::update_grid(double);                                                           \
   template void Simulation<D>::move_rigid_particles(double, double);                                          \

@@ -42,6 +42,8 @@ template <int Dim>
 int Simulation<Dim>::add_material(const Material& m) {
   if (finalized_) throw std::logic_error("materials must be added before the simulation is finalized");
   if (!(m.density > 0.0)) throw std::invalid_argument("material '" + m.name + "': density must be > 0");
+  if (m.is_rigid() && !m.rigid_boundary && !(m.rigid_controls[0] && m.rigid_controls[1] && m.rigid_controls[2]))
+    throw std::invalid_argument("material '" + m.name + "': only a boundary rigid material may leave velocity components free");
   if (!m.is_rigid()) {
     if (!(m.youngs_modulus > 0.0)) throw std::invalid_argument("material '" + m.name + "': E must be > 0");
     if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))

@@ -60,11 +60,10 @@ void Simulation<Dim>::step_with(double dt) {
   }
   const bool usf = opt_.scheme == UpdateScheme::usf;
   map_to_grid<Kernel>(dt, /*with_forces=*/!usf);
+  map_rigid_particles<Kernel>(t);
   if (contact_) {
     find_contact_nodes();
     resolve_contact(ContactPass::extrapolated, dt);
-  } else {
-    map_rigid_particles<Kernel>(t);
   }
   if (usf) {
     velocity_from_momentum();
@@ -203,21 +202,26 @@ void Simulation<Dim>::add_internal_forces() {
   reduce_thread_buffers(false, false, true, false);
 }
 
-// Without contact, nodes touched by a rigid material take its prescribed velocity (single field).
+// Rigid materials without a velocity field of their own (all of them without contact, boundary ones
+// with contact): every node they touch takes their prescribed velocity components.
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_rigid_particles(double t) {
   std::fill(rigid_mask_.begin(), rigid_mask_.end(), std::uint8_t{0});
   for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (!materials_[m].is_rigid()) continue;
+    if (!materials_[m].is_rigid() || field_of_material_[m] >= 0) continue;
     const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
+    std::uint8_t bits = 0;
+    for (int d = 0; d < Dim; ++d)
+      if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Stencil<Dim, Kernel> s;
       s.evaluate(grid_, p_.position[k], p_.half_size[k]);
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
         if (S > 0.0) {
-          rigid_mask_[static_cast<std::size_t>(i)] = 1;
-          rigid_velocity_[static_cast<std::size_t>(i)] = v;
+          rigid_mask_[static_cast<std::size_t>(i)] |= bits;
+          for (int d = 0; d < Dim; ++d)
+            if (bits & (1u << d)) rigid_velocity_[static_cast<std::size_t>(i)][d] = v[d];
         }
       });
     }

@@ -3,6 +3,7 @@
 #include <frictherm/mechanics/time_function.hpp>
 #include <frictherm/mechanics/types.hpp>
 
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -22,6 +23,13 @@ struct Material {
   double poisson_ratio = 0.0;    // nu
   /// Rigid materials: prescribed velocity, one function of time per component (m/s).
   std::vector<TimeFunction> rigid_velocity;
+  /// Rigid materials: which velocity components they prescribe (a component left free follows the
+  /// deformable material). Only a boundary rigid material may leave components free.
+  std::array<bool, 3> rigid_controls{{true, true, true}};
+  /// Rigid materials with contact enabled: false (default) meets the other materials through contact
+  /// laws; true acts as a velocity boundary condition on every node it touches, as it always does
+  /// without contact (NairnMPM's rigid BC particles).
+  bool rigid_boundary = false;
 
   bool is_rigid() const { return kind == MaterialKind::rigid; }
   double shear_modulus() const { return youngs_modulus / (2.0 * (1.0 + poisson_ratio)); }

@@ -161,7 +161,9 @@ class Simulation {
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
   void reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);
-  void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force) const;
+  /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
+  /// come) the forces are made consistent instead.
+  void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
   void update_grid(double dt);
   void velocity_from_momentum();
   enum class ContactPass { extrapolated, updated, remapped };
@@ -179,7 +181,7 @@ class Simulation {
   std::vector<std::size_t> material_begin_, material_end_;  // particle ranges after finalize()
   NodalFields<Dim> nodes_;
   std::vector<VelocityField<Dim>> fields_;
-  std::vector<int> field_of_material_;  // -1: rigid material without contact (handled by rigid_mask_)
+  std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
   std::vector<int> slot_node_;
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
@@ -195,7 +197,7 @@ class Simulation {
   ContactStats contact_stats_;
   std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1)
   std::vector<std::uint8_t> fixed_mask_;        // bit d set: velocity component d fixed to 0
-  std::vector<std::uint8_t> rigid_mask_;        // 1: node driven by a rigid material
+  std::vector<std::uint8_t> rigid_mask_;        // bit d set: velocity component d driven by a rigid material
   std::vector<Vec<Dim>> rigid_velocity_;
   std::vector<FixedFace> faces_;
   std::vector<PointLoad<Dim>> point_loads_;
