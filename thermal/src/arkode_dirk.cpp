@@ -2,7 +2,6 @@
 
 #include <arkode/arkode_arkstep.h>
 #include <sunlinsol/sunlinsol_klu.h>
-#include <sunlinsol/sunlinsol_pcg.h>
 
 namespace frictherm::thermal::detail {
 
@@ -35,14 +34,15 @@ void ArkodeDirk::create(double t0) {
     check(ARKStepSetLinearSolver(mem, ls_.get(), a_.get()), "ARKStepSetLinearSolver");
     check(ARKStepSetJacFn(mem, &OdeSystem::jac), "ARKStepSetJacFn");
   } else {
-    ls_ = LinSolPtr(SUNLinSol_PCG(y_.get(), SUN_PREC_LEFT, opt_.krylov_maxl, ctx));
-    check_ptr(ls_.get(), "SUNLinSol_PCG", name_);
+    ls_ = make_krylov_solver(sys_, y_.get(), opt_.krylov_maxl, ctx, name_);
     check(ARKStepSetLinearSolver(mem, ls_.get(), nullptr), "ARKStepSetLinearSolver");
     check(ARKStepSetJacTimes(mem, nullptr, &OdeSystem::jtimes), "ARKStepSetJacTimes");
-    check(ARKStepSetPreconditioner(mem, nullptr, &OdeSystem::psolve), "ARKStepSetPreconditioner");
+    check(ARKStepSetPreconditioner(mem, sys_.has_reaction() ? &OdeSystem::psetup : nullptr, &OdeSystem::psolve),
+          "ARKStepSetPreconditioner");
   }
-  // f_i is linear in y with a constant Jacobian: one Newton iteration per stage.
-  check(ARKStepSetLinear(mem, 0), "ARKStepSetLinear");
+  // Without a reaction f_i is linear in y with a constant Jacobian: one Newton iteration per
+  // stage. The Arrhenius term is nonlinear: full Newton then.
+  if (!sys_.has_reaction()) check(ARKStepSetLinear(mem, 0), "ARKStepSetLinear");
 }
 
 void ArkodeDirk::reinit(double t0) {

@@ -3,7 +3,6 @@
 #include <cvode/cvode.h>
 #include <cvode/cvode_ls.h>
 #include <sunlinsol/sunlinsol_klu.h>
-#include <sunlinsol/sunlinsol_pcg.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 namespace frictherm::thermal::detail {
@@ -39,11 +38,12 @@ void CvodeIntegrator::create(double t0) {
       check(CVodeSetJacFn(mem, &OdeSystem::jac), "CVodeSetJacFn");
       break;
     case LinearSolverKind::Pcg:  // CG on the SPD form, exact J·v, Jacobi preconditioner
-      ls_ = LinSolPtr(SUNLinSol_PCG(y_.get(), SUN_PREC_LEFT, opt_.krylov_maxl, ctx));
-      check_ptr(ls_.get(), "SUNLinSol_PCG", name_);
+      // (GMRES when a consuming reaction makes the Newton matrix non-symmetric; ode_system.hpp)
+      ls_ = make_krylov_solver(sys_, y_.get(), opt_.krylov_maxl, ctx, name_);
       check(CVodeSetLinearSolver(mem, ls_.get(), nullptr), "CVodeSetLinearSolver");
       check(CVodeSetJacTimes(mem, nullptr, &OdeSystem::jtimes), "CVodeSetJacTimes");
-      check(CVodeSetPreconditioner(mem, nullptr, &OdeSystem::psolve), "CVodeSetPreconditioner");
+      check(CVodeSetPreconditioner(mem, sys_.has_reaction() ? &OdeSystem::psetup : nullptr, &OdeSystem::psolve),
+            "CVodeSetPreconditioner");
       break;
     case LinearSolverKind::FixedPoint:  // functional iteration (non-stiff Adams)
       nls_ = NonlinSolPtr(SUNNonlinSol_FixedPoint(y_.get(), 0, ctx));

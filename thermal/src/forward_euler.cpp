@@ -5,14 +5,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace frictherm::thermal::detail {
 
 ForwardEuler::ForwardEuler(const IntegratorOptions& options) : opt_(options) {}
 
-void ForwardEuler::advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1) {
+void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0,
+                                double t1) {
   const auto start = std::chrono::steady_clock::now();
   problem.check_state(T);
   if (!(std::isfinite(t0) && std::isfinite(t1) && t1 >= t0)) {
@@ -30,6 +33,11 @@ void ForwardEuler::advance(const Problem& problem, Eigen::VectorXd& T, double t0
   }
   const double dt_limit = cached_dt_limit_;
   const double h_stable = opt_.fe_safety * dt_limit;
+  if (problem.has_reaction()) {
+    advance_reacting(problem, T, progress, t0, t1, dt_limit);
+    stats_.wall_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return;
+  }
 
   // Steps requested by the caller: one per window unless fe_max_dt caps the step.
   long n = 1;
@@ -75,6 +83,90 @@ void ForwardEuler::advance(const Problem& problem, Eigen::VectorXd& T, double t0
     throw StabilityError(os.str(), h, dt_limit);
   }
   T = std::move(work);
+}
+
+void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress,
+                                    double t0, double t1, double dt_limit) {
+  // Explicit Euler for conduction and sources; the reaction is advanced over each sub-step
+  // at the sub-step's start temperature with its exact solution for frozen T,
+  //   λ⁺ = 1 − (1 − λ) e^{−h k(T)},   released heat Q (λ⁺ − λ)
+  // (zero-order: Q h k(T)), so λ stays in [0, 1] and Σ M T − Σ Q λ changes only by the
+  // transport heat. The remaining explicit constraint is the self-heating rate
+  // a_i = Q_i (1 − λ_i) k'(T_i)/M_i, which with conduction gives sub-steps
+  // h ≤ fe_safety·2/(λ_cond + max_i a_i) (the growing mode resolved to a factor e² per step).
+  const Reaction& rx = problem.reaction();
+  const bool consume = problem.reaction_consumes();
+  const Index n = problem.size();
+  const Eigen::VectorXd& m = problem.mass();
+  std::vector<Index> nodes;
+  for (Index i = 0; i < n; ++i) {
+    if (rx.heat[i] > 0.0 && !problem.is_dirichlet(i)) nodes.push_back(i);
+  }
+  const double lam_cond = std::isfinite(dt_limit) ? 2.0 / dt_limit : 0.0;
+  Eigen::VectorXd work = T;
+  Eigen::VectorXd lam = progress != nullptr ? *progress : Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd w(n), rate(static_cast<Index>(nodes.size()));
+  double t = t0;
+  long steps = 0;
+  double h = 0.0, h_lim = 0.0;
+  bool last = false;
+  while (!last) {
+    double smax = 0.0;
+    for (std::size_t r = 0; r < nodes.size(); ++r) {
+      const Index i = nodes[r];
+      rate[static_cast<Index>(r)] = rx.rate_constant(work[i]);
+      const double a = rx.heat[i] * (1.0 - lam[i]) * rx.rate_constant_derivative(work[i]) / m[i];
+      smax = std::max(smax, a);
+    }
+    const double bound = lam_cond + smax;
+    h_lim = bound > 0.0 ? opt_.fe_safety * 2.0 / bound : std::numeric_limits<double>::infinity();
+    h = t1 - t;
+    if (opt_.fe_max_dt > 0.0) h = std::min(h, opt_.fe_max_dt);
+    if (opt_.fe_stability_policy == "substep") {
+      h = std::min(h, h_lim);
+    } else if (opt_.fe_stability_policy == "refuse" && h > h_lim) {
+      std::ostringstream os;
+      os << "forward_euler: step " << h << " s exceeds the conduction + reaction stability limit "
+         << h_lim << " s at t = " << t << " s; refusing (fe_stability_policy \"refuse\"). Use "
+         << "\"substep\" or an implicit integrator such as cvode_bdf";
+      throw StabilityError(os.str(), h, h_lim / opt_.fe_safety);
+    }
+    last = h >= t1 - t;
+    if (last) h = t1 - t;
+    problem.transport_heat_rate(t + 0.5 * h, work, w);  // source at the sub-step midpoint
+    w *= h;                                                // transport heat [J]
+    for (std::size_t r = 0; r < nodes.size(); ++r) {
+      const Index i = nodes[r];
+      const double k = rate[static_cast<Index>(r)];
+      const double burnt = consume ? (1.0 - lam[i]) * -std::expm1(-h * k) : h * k;  // Δλ
+      w[i] += rx.heat[i] * burnt;
+      if (consume) lam[i] += burnt;
+    }
+    work.array() += w.array() / m.array();
+    t = last ? t1 : t + h;
+    ++steps;
+    if (!last && steps >= opt_.max_steps) {
+      stats_.steps += steps;
+      stats_.rhs_evals += steps;
+      std::ostringstream os;
+      os << "forward_euler: max_steps = " << opt_.max_steps << " sub-steps reached at t = " << t
+         << " s in the window [" << t0 << ", " << t1 << "] s: the reaction limits the step to " << h_lim
+         << " s. Raise IntegratorOptions::max_steps or use an implicit integrator such as cvode_bdf";
+      throw StabilityError(os.str(), h, h_lim / opt_.fe_safety);
+    }
+  }
+  stats_.steps += steps;
+  stats_.rhs_evals += steps;
+  if (!work.allFinite() || !lam.allFinite()) {
+    std::ostringstream os;
+    os << "forward_euler: temperatures became non-finite (last step " << h << " s, limit " << h_lim
+       << " s, policy \"" << opt_.fe_stability_policy << "\")";
+    throw StabilityError(os.str(), h, h_lim);
+  }
+  T = std::move(work);
+  if (progress != nullptr && consume) {
+    for (Index i : nodes) (*progress)[i] = std::min(lam[i], 1.0);  // ≤ 1 up to round-off
+  }
 }
 
 }  // namespace frictherm::thermal::detail

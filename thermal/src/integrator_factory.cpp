@@ -37,6 +37,21 @@ IntegratorStats& IntegratorStats::operator-=(const IntegratorStats& o) {
   return *this;
 }
 
+void Integrator::advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1) {
+  if (problem.reaction_consumes()) {
+    throw std::invalid_argument(name() +
+                                ": the problem's reaction consumes its reactant; pass the reaction "
+                                "progress: advance(problem, T, progress, t0, t1)");
+  }
+  advance_impl(problem, T, nullptr, t0, t1);
+}
+
+void Integrator::advance(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress, double t0,
+                         double t1) {
+  problem.check_progress(progress);
+  advance_impl(problem, T, &progress, t0, t1);
+}
+
 const std::vector<std::string>& integrator_names() {
   static const std::vector<std::string> names{"forward_euler", "cvode_bdf", "cvode_adams", "arkode_erk",
                                               "arkode_dirk"};
@@ -51,6 +66,7 @@ void check_options(const std::string& name, const IntegratorOptions& o) {
   };
   if (!(std::isfinite(o.rtol) && o.rtol > 0.0)) bad("rtol must be finite and > 0");
   if (!(std::isfinite(o.atol) && o.atol > 0.0)) bad("atol must be finite and > 0 (K)");
+  if (!(std::isfinite(o.progress_atol) && o.progress_atol > 0.0)) bad("progress_atol must be finite and > 0");
   if (o.max_steps <= 0) bad("max_steps must be > 0");
   if (o.krylov_maxl <= 0) bad("krylov_maxl must be > 0");
   if (!(o.fe_safety > 0.0 && o.fe_safety <= 1.0)) bad("fe_safety must be in (0, 1]");

@@ -3,13 +3,21 @@
 #include <nvector/nvector_serial.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
-#include <vector>
+#include <algorithm>
 
 namespace frictherm::thermal::detail {
 namespace {
 
 Eigen::Map<Eigen::VectorXd> view(N_Vector v) {
   return {N_VGetArrayPointer(v), static_cast<Index>(N_VGetLength(v))};
+}
+
+// Position of entry (row, col) in a compressed row-major matrix (it must exist).
+Index find_entry(const SparseMatrix& a, Index row, Index col) {
+  const auto* begin = a.innerIndexPtr() + a.outerIndexPtr()[row];
+  const auto* end = a.innerIndexPtr() + a.outerIndexPtr()[row + 1];
+  const auto* it = std::lower_bound(begin, end, static_cast<SparseMatrix::StorageIndex>(col));
+  return static_cast<Index>(it - a.innerIndexPtr());
 }
 
 }  // namespace
@@ -23,12 +31,26 @@ void OdeSystem::build(const Problem& problem, bool symmetric) {
   fscale_ = s_.cwiseQuotient(m);  // 1/M (plain) or M^{-1/2} (symmetric)
   for (Index d : problem.dirichlet_nodes()) fscale_[d] = 0.0;
 
+  rx_node_.clear();
+  consume_ = problem.reaction_consumes();
+  if (problem.has_reaction()) {
+    for (Index i = 0; i < n; ++i) {
+      if (problem.reaction().heat[i] > 0.0 && !problem.is_dirichlet(i)) rx_node_.push_back(i);
+    }
+  }
+  const Index nr = reacting();
+  rx_q_.resize(nr);
+  for (Index r = 0; r < nr; ++r) rx_q_[r] = problem.reaction().heat[rx_node_[static_cast<std::size_t>(r)]];
+  frozen_ = Eigen::VectorXd::Zero(nr);
+  const Index ns = state_size();
+
   // J_ij = −fscale_i (K_ij + δ_ij hA_i) / s_j over free i, j; explicit (maybe zero) diagonal
-  // for every row so that I − γJ never needs a new sparsity pattern.
+  // for every row so that I − γJ never needs a new sparsity pattern; explicit zeros on the
+  // reaction's T–λ entries.
   const SparseMatrix& k = problem.conductance();
   const Eigen::VectorXd& ha = problem.convection_coefficients();
   std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(static_cast<std::size_t>(k.nonZeros() + n));
+  trip.reserve(static_cast<std::size_t>(k.nonZeros() + n + 3 * nr));
   for (Index i = 0; i < n; ++i) {
     const bool free_row = !problem.is_dirichlet(i);
     trip.emplace_back(i, i, free_row ? -fscale_[i] * ha[i] / s_[i] : 0.0);
@@ -38,22 +60,71 @@ void OdeSystem::build(const Problem& problem, bool symmetric) {
       trip.emplace_back(i, it.col(), -fscale_[i] * it.value() / s_[it.col()]);
     }
   }
-  jac_.resize(n, n);
+  if (consume_) {
+    for (Index r = 0; r < nr; ++r) {
+      const Index i = rx_node_[static_cast<std::size_t>(r)];
+      trip.emplace_back(i, n + r, 0.0);
+      trip.emplace_back(n + r, i, 0.0);
+      trip.emplace_back(n + r, n + r, 0.0);
+    }
+  }
+  jac_.resize(ns, ns);
   jac_.setFromTriplets(trip.begin(), trip.end());
   jac_.makeCompressed();
   jdiag_ = jac_.diagonal();
+  const auto nrs = static_cast<std::size_t>(nr);
+  pos_tt_.assign(nrs, 0);
+  pos_tl_.assign(consume_ ? nrs : 0, 0);
+  pos_lt_.assign(consume_ ? nrs : 0, 0);
+  pos_ll_.assign(consume_ ? nrs : 0, 0);
+  for (std::size_t r = 0; r < nrs; ++r) {
+    const Index i = rx_node_[r];
+    pos_tt_[r] = find_entry(jac_, i, i);
+    if (!consume_) continue;
+    const Index l = n + static_cast<Index>(r);
+    pos_tl_[r] = find_entry(jac_, i, l);
+    pos_lt_[r] = find_entry(jac_, l, i);
+    pos_ll_[r] = find_entry(jac_, l, l);
+  }
+  d_tt_ = d_tl_ = d_lt_ = d_ll_ = Eigen::VectorXd::Zero(nr);
+  cache_valid_ = false;
   t_work_.resize(n);
   w_work_.resize(n);
 }
 
-void OdeSystem::to_y(const Eigen::VectorXd& T, N_Vector y) const { view(y) = s_.cwiseProduct(T); }
+void OdeSystem::to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y) {
+  auto yv = view(y);
+  const Index n = nodes();
+  yv.head(n) = s_.cwiseProduct(T);
+  for (Index r = 0; r < reacting(); ++r) {
+    const double lam = progress != nullptr ? (*progress)[rx_node_[static_cast<std::size_t>(r)]] : 0.0;
+    if (consume_) {
+      yv[n + r] = lam;
+    } else {
+      frozen_[r] = lam;
+    }
+  }
+  cache_valid_ = false;
+}
 
-void OdeSystem::to_T(N_Vector y, Eigen::VectorXd& T) const { T = view(y).cwiseQuotient(s_); }
+void OdeSystem::to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const {
+  const auto yv = view(y);
+  const Index n = nodes();
+  T = yv.head(n).cwiseQuotient(s_);
+  if (progress == nullptr || !consume_) return;
+  for (Index r = 0; r < reacting(); ++r) {
+    (*progress)[rx_node_[static_cast<std::size_t>(r)]] = std::clamp(yv[n + r], 0.0, 1.0);
+  }
+}
 
-void OdeSystem::fill_abstol(double atol, N_Vector out) const { view(out) = atol * s_; }
+void OdeSystem::fill_abstol(double atol, double progress_atol, N_Vector out) const {
+  auto v = view(out);
+  v.head(nodes()) = atol * s_;
+  v.tail(state_size() - nodes()).setConstant(progress_atol);
+}
 
 MatrixPtr OdeSystem::make_jacobian_matrix(SUNContext ctx) const {
-  SUNMatrix a = SUNSparseMatrix(static_cast<sunindextype>(size()), static_cast<sunindextype>(size()),
+  SUNMatrix a = SUNSparseMatrix(static_cast<sunindextype>(state_size()), static_cast<sunindextype>(state_size()),
                                 static_cast<sunindextype>(jac_.nonZeros()), CSR_MAT, ctx);
   check_ptr(a, "SUNSparseMatrix", "thermal");
   return MatrixPtr(a);
@@ -62,19 +133,61 @@ MatrixPtr OdeSystem::make_jacobian_matrix(SUNContext ctx) const {
 int OdeSystem::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* self = static_cast<OdeSystem*>(user_data);
   try {
-    self->t_work_ = view(y).cwiseQuotient(self->s_);
-    self->problem_->heat_rate(t, self->t_work_, self->w_work_);
-    view(ydot) = self->fscale_.cwiseProduct(self->w_work_);
+    const Index n = self->nodes();
+    const auto yv = view(y);
+    auto out = view(ydot);
+    self->t_work_ = yv.head(n).cwiseQuotient(self->s_);
+    self->problem_->transport_heat_rate(t, self->t_work_, self->w_work_);
+    const Reaction& rx = self->problem_->reaction();
+    for (Index r = 0; r < self->reacting(); ++r) {
+      const Index i = self->rx_node_[static_cast<std::size_t>(r)];
+      const double remaining = 1.0 - (self->consume_ ? yv[n + r] : self->frozen_[r]);
+      const double rate = remaining * rx.rate_constant(self->t_work_[i]);  // (1 − λ) k(T)
+      self->w_work_[i] += self->rx_q_[r] * rate;
+      if (self->consume_) out[n + r] = rate;
+    }
+    out.head(n) = self->fscale_.cwiseProduct(self->w_work_);
     return 0;
   } catch (...) {
     return -1;  // unrecoverable: SUNDIALS reports *_RHSFUNC_FAIL
   }
 }
 
-int OdeSystem::jac(sunrealtype, N_Vector, N_Vector, SUNMatrix J, void* user_data, N_Vector, N_Vector,
+void OdeSystem::reaction_blocks(N_Vector y) {
+  const Index n = nodes();
+  const Index nr = reacting();
+  const auto yv = view(y);
+  const Index nkey = consume_ ? 2 * nr : nr;
+  if (cache_valid_ && cache_key_.size() == nkey) {
+    bool same = true;
+    for (Index r = 0; r < nr && same; ++r) {
+      same = cache_key_[r] == yv[rx_node_[static_cast<std::size_t>(r)]] && (!consume_ || cache_key_[nr + r] == yv[n + r]);
+    }
+    if (same) return;
+  }
+  cache_key_.resize(nkey);
+  const Reaction& rx = problem_->reaction();
+  for (Index r = 0; r < nr; ++r) {
+    const Index i = rx_node_[static_cast<std::size_t>(r)];
+    const double temp = yv[i] / s_[i];
+    const double lam = consume_ ? yv[n + r] : frozen_[r];
+    const double k = rx.rate_constant(temp);
+    const double dk = rx.rate_constant_derivative(temp);
+    const double c = fscale_[i] * rx_q_[r];
+    d_tt_[r] = c * (1.0 - lam) * dk / s_[i];
+    d_tl_[r] = -c * k;
+    d_lt_[r] = (1.0 - lam) * dk / s_[i];
+    d_ll_[r] = -k;
+    cache_key_[r] = yv[i];
+    if (consume_) cache_key_[nr + r] = yv[n + r];
+  }
+  cache_valid_ = true;
+}
+
+int OdeSystem::jac(sunrealtype, N_Vector y, N_Vector, SUNMatrix J, void* user_data, N_Vector, N_Vector,
                    N_Vector) {
-  const auto* self = static_cast<const OdeSystem*>(user_data);
-  const SparseMatrix& a = self->jac_;  // constant: copy the precomputed CSR arrays
+  auto* self = static_cast<OdeSystem*>(user_data);
+  const SparseMatrix& a = self->jac_;  // constant part: copy the precomputed CSR arrays
   const auto nnz = static_cast<sunindextype>(a.nonZeros());
   if (SUNSparseMatrix_NNZ(J) < nnz && SUNSparseMatrix_Reallocate(J, nnz) != 0) return -1;
   sunindextype* ptr = SUNSparseMatrix_IndexPointers(J);
@@ -85,13 +198,43 @@ int OdeSystem::jac(sunrealtype, N_Vector, N_Vector, SUNMatrix J, void* user_data
     idx[e] = static_cast<sunindextype>(a.innerIndexPtr()[e]);
     val[e] = a.valuePtr()[e];
   }
+  if (!self->has_reaction()) return 0;
+  self->reaction_blocks(y);  // the reaction's 2×2 blocks at y
+  for (std::size_t r = 0; r < self->rx_node_.size(); ++r) {
+    const auto ri = static_cast<Index>(r);
+    val[self->pos_tt_[r]] += self->d_tt_[ri];
+    if (!self->consume_) continue;
+    val[self->pos_tl_[r]] = self->d_tl_[ri];
+    val[self->pos_lt_[r]] = self->d_lt_[ri];
+    val[self->pos_ll_[r]] = self->d_ll_[ri];
+  }
   return 0;
 }
 
-int OdeSystem::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector, N_Vector, void* user_data,
+int OdeSystem::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector y, N_Vector, void* user_data,
                       N_Vector) {
-  const auto* self = static_cast<const OdeSystem*>(user_data);
-  view(jv).noalias() = self->jac_ * view(v);  // exact stencil apply
+  auto* self = static_cast<OdeSystem*>(user_data);
+  auto out = view(jv);
+  const auto in = view(v);
+  out.noalias() = self->jac_ * in;  // exact stencil apply
+  if (!self->has_reaction()) return 0;
+  self->reaction_blocks(y);  // exact J·v at the current iterate
+  const Index n = self->nodes();
+  for (Index r = 0; r < self->reacting(); ++r) {
+    const Index i = self->rx_node_[static_cast<std::size_t>(r)];
+    out[i] += self->d_tt_[r] * in[i];
+    if (!self->consume_) continue;
+    out[i] += self->d_tl_[r] * in[n + r];
+    out[n + r] = self->d_lt_[r] * in[i] + self->d_ll_[r] * in[n + r];
+  }
+  return 0;
+}
+
+int OdeSystem::psetup(sunrealtype, N_Vector y, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype,
+                      void* user_data) {
+  auto* self = static_cast<OdeSystem*>(user_data);
+  self->reaction_blocks(y);
+  *jcur = SUNTRUE;
   return 0;
 }
 
@@ -99,7 +242,29 @@ int OdeSystem::psolve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, s
                       sunrealtype, int, void* user_data) {
   const auto* self = static_cast<const OdeSystem*>(user_data);
   // P = diag(I − γJ) = 1 + γ·diag(M^{-1/2}K_eff M^{-1/2}) > 0 (Jacobi, thermal-notes §1)
-  view(z) = view(r).array() / (1.0 - gamma * self->jdiag_.array());
+  auto zv = view(z);
+  const auto rv = view(r);
+  zv = rv.array() / (1.0 - gamma * self->jdiag_.array());
+  if (!self->has_reaction()) return 0;
+  // Reacting nodes: exact inverse of the 2×2 block of I − γJ (1×1 when zero-order). A
+  // non-positive pivot means the step is too long for the self-heating: recoverable failure.
+  const Index n = self->nodes();
+  for (Index q = 0; q < self->reacting(); ++q) {
+    const Index i = self->rx_node_[static_cast<std::size_t>(q)];
+    const double a11 = 1.0 - gamma * (self->jdiag_[i] + self->d_tt_[q]);
+    if (!self->consume_) {
+      if (!(a11 > 0.0)) return 1;
+      zv[i] = rv[i] / a11;
+      continue;
+    }
+    const double a12 = -gamma * self->d_tl_[q];
+    const double a21 = -gamma * self->d_lt_[q];
+    const double a22 = 1.0 - gamma * self->d_ll_[q];
+    const double det = a11 * a22 - a12 * a21;
+    if (!(det > 0.0) || !(a22 > 0.0)) return 1;
+    zv[i] = (a22 * rv[i] - a12 * rv[n + q]) / det;
+    zv[n + q] = (a11 * rv[n + q] - a21 * rv[i]) / det;
+  }
   return 0;
 }
 

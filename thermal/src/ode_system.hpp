@@ -5,6 +5,16 @@
 //              needed by PCG; absolute tolerances scale as √M_i·atol).
 // Dirichlet rows and columns of J are dropped: their f is 0 and their Newton correction is
 // 0, so the dropped columns never act, and J stays symmetric in the symmetric form.
+//
+// Reaction (reaction.hpp), on the free nodes i with Q_i > 0 ("reacting nodes", r = 0..R−1):
+//   f_T,i += c_i Q_i (1 − λ_r) k(T_i),   c_i = fscale_i (1/M_i or M_i^{-1/2});
+//   consuming: the state grows to y = [s ⊙ T; λ_0 … λ_{R−1}] (N + R unknowns) with
+//   f_λ,r = (1 − λ_r) k(T_i); zero-order: λ is a fixed parameter of the window.
+// The reaction adds a 2×2 block per reacting node to J (T = y/s):
+//   ∂f_T,i/∂y_i += c_i Q_i (1 − λ_r) k'(T_i)/s_i    ∂f_T,i/∂λ_r = −c_i Q_i k(T_i)
+//   ∂f_λ,r/∂y_i  = (1 − λ_r) k'(T_i)/s_i            ∂f_λ,r/∂λ_r = −k(T_i)
+// so J is no longer constant. With consumption it is not symmetric (∂f_T/∂λ < 0 < ∂f_λ/∂T,
+// so no diagonal scaling symmetrises it): Krylov then uses GMRES.
 // Internal header; callbacks take this object as user_data.
 #pragma once
 
@@ -13,6 +23,8 @@
 
 #include <sundials/sundials_types.h>
 
+#include <vector>
+
 namespace frictherm::thermal::detail {
 
 class OdeSystem {
@@ -20,13 +32,21 @@ class OdeSystem {
   void build(const Problem& problem, bool symmetric);
   // Rebinds to the caller's Problem object for this window (same revision as built).
   void bind(const Problem& problem) { problem_ = &problem; }
-  Index size() const { return s_.size(); }
+  Index nodes() const { return s_.size(); }
+  Index state_size() const { return s_.size() + (consume_ ? reacting() : 0); }
+  Index reacting() const { return static_cast<Index>(rx_node_.size()); }
   bool symmetric() const { return symmetric_; }
+  bool has_reaction() const { return !rx_node_.empty(); }
+  // The Newton matrix is non-symmetric (consuming reaction): Krylov must be GMRES.
+  bool nonsymmetric() const { return consume_ && has_reaction(); }
 
-  void to_y(const Eigen::VectorXd& T, N_Vector y) const;
-  void to_T(N_Vector y, Eigen::VectorXd& T) const;
-  void fill_abstol(double atol, N_Vector out) const;
-  const SparseMatrix& jacobian() const { return jac_; }
+  // Window state. progress may be null (λ = 0). For a zero-order reaction λ is copied as the
+  // window's fixed parameter; for a consuming one it enters y.
+  void to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y);
+  // T from y; progress (if given and consuming) updated on reacting nodes, clamped to [0, 1].
+  void to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const;
+  void fill_abstol(double atol, double progress_atol, N_Vector out) const;
+  const SparseMatrix& jacobian() const { return jac_; }  // constant part (reaction entries 0)
   MatrixPtr make_jacobian_matrix(SUNContext ctx) const;  // CSR SUNSparseMatrix with J's pattern
 
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data);
@@ -34,17 +54,31 @@ class OdeSystem {
                  N_Vector tmp2, N_Vector tmp3);
   static int jtimes(N_Vector v, N_Vector jv, sunrealtype t, N_Vector y, N_Vector fy, void* user_data,
                     N_Vector tmp);
-  // Jacobi preconditioner z = diag(I − γJ)⁻¹ r.
+  // Reaction only: evaluates the reaction blocks at y for psolve.
+  static int psetup(sunrealtype t, N_Vector y, N_Vector fy, sunbooleantype jok, sunbooleantype* jcur,
+                    sunrealtype gamma, void* user_data);
+  // Jacobi preconditioner z = diag(I − γJ)⁻¹ r (2×2 blocks on reacting nodes when consuming).
   static int psolve(sunrealtype t, N_Vector y, N_Vector fy, N_Vector r, N_Vector z, sunrealtype gamma,
                     sunrealtype delta, int lr, void* user_data);
 
  private:
+  // Reaction Jacobian entries at y into d_tt_ … d_ll_ (cached on the reacting entries of y).
+  void reaction_blocks(N_Vector y);
+
   const Problem* problem_ = nullptr;
   bool symmetric_ = false;
+  bool consume_ = false;
   Eigen::VectorXd s_;       // y = s ⊙ T
   Eigen::VectorXd fscale_;  // f = fscale ⊙ w (w the nodal heat rate), 0 on Dirichlet rows
-  Eigen::VectorXd jdiag_;   // diag(J)
-  SparseMatrix jac_;
+  Eigen::VectorXd jdiag_;   // diag of the constant part of J
+  SparseMatrix jac_;        // constant part of J, with explicit zeros on the reaction entries
+  std::vector<Index> rx_node_;  // node of reacting unknown r
+  Eigen::VectorXd rx_q_;        // Q of reacting node r
+  Eigen::VectorXd frozen_;      // zero-order: λ_r for this window
+  std::vector<Index> pos_tt_, pos_tl_, pos_lt_, pos_ll_;  // CSR positions of the reaction entries
+  Eigen::VectorXd d_tt_, d_tl_, d_lt_, d_ll_;
+  Eigen::VectorXd cache_key_;  // reacting entries of y the blocks were computed at
+  bool cache_valid_ = false;
   mutable Eigen::VectorXd t_work_, w_work_;
 };
 

@@ -175,8 +175,73 @@ void Problem::clear_boundaries() {
   touch();
 }
 
-void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
-                        Eigen::Ref<Eigen::VectorXd> w) const {
+void Problem::set_reaction(Reaction reaction) {
+  if (reaction.heat.size() != size()) {
+    std::ostringstream os;
+    os << "set_reaction: size mismatch, heat Q has " << reaction.heat.size() << " entries for " << size()
+       << " nodes";
+    fail(os.str());
+  }
+  for (Index i = 0; i < size(); ++i) {
+    if (!std::isfinite(reaction.heat[i]) || reaction.heat[i] < 0.0) {
+      std::ostringstream os;
+      os << "set_reaction: heat of reaction Q[" << i << "] = " << reaction.heat[i] << " J must be finite and >= 0";
+      fail(os.str());
+    }
+  }
+  if (!(std::isfinite(reaction.prefactor) && reaction.prefactor > 0.0)) {
+    fail("set_reaction: prefactor Z must be finite and > 0 (1/s)");
+  }
+  if (!(std::isfinite(reaction.activation_temperature) && reaction.activation_temperature > 0.0)) {
+    fail("set_reaction: activation temperature E_a/R must be finite and > 0 (K)");
+  }
+  reaction_ = std::move(reaction);
+  has_reaction_ = true;
+  touch();
+}
+
+void Problem::clear_reaction() {
+  reaction_ = Reaction{};
+  has_reaction_ = false;
+  touch();
+}
+
+void Problem::reaction_power(const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                             const Eigen::Ref<const Eigen::VectorXd>& progress,
+                             Eigen::Ref<Eigen::VectorXd> p) const {
+  p.setZero();
+  if (!has_reaction_) return;
+  const bool fresh = progress.size() == 0;
+  for (Index i = 0; i < size(); ++i) {
+    const double q = reaction_.heat[i];
+    if (q == 0.0 || fixed_[static_cast<std::size_t>(i)]) continue;
+    const double remaining = fresh ? 1.0 : 1.0 - progress[i];
+    p[i] = q * remaining * reaction_.rate_constant(temperature[i]);
+  }
+}
+
+double Problem::released_heat(const Eigen::VectorXd& progress) const {
+  if (!has_reaction_) return 0.0;
+  return reaction_.heat.dot(progress);
+}
+
+void Problem::check_progress(const Eigen::VectorXd& progress) const {
+  if (progress.size() != size()) {
+    std::ostringstream os;
+    os << "size mismatch: reaction progress has " << progress.size() << " entries for " << size() << " nodes";
+    fail(os.str());
+  }
+  for (Index i = 0; i < size(); ++i) {
+    if (!(progress[i] >= 0.0 && progress[i] <= 1.0)) {  // also rejects NaN
+      std::ostringstream os;
+      os << "reaction progress[" << i << "] = " << progress[i] << " must be in [0, 1]";
+      fail(os.str());
+    }
+  }
+}
+
+void Problem::transport_heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                                  Eigen::Ref<Eigen::VectorXd> w) const {
   // w = −K T + q(t) + f + hA ⊙ (T_inf − T)   (eq. 37 right-hand side plus boundaries)
   w.noalias() = -(k_ * temperature);
   w += flux_ + ha_tinf_ - ha_.cwiseProduct(temperature);
@@ -189,6 +254,24 @@ void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& tempe
     }
   }
   for (Index d : dirichlet_nodes_) w[d] = 0.0;
+}
+
+void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                        const Eigen::Ref<const Eigen::VectorXd>& progress, Eigen::Ref<Eigen::VectorXd> w) const {
+  transport_heat_rate(t, temperature, w);
+  if (!has_reaction_) return;
+  const bool fresh = progress.size() == 0;
+  for (Index i = 0; i < size(); ++i) {
+    const double q = reaction_.heat[i];
+    if (q == 0.0 || fixed_[static_cast<std::size_t>(i)]) continue;
+    const double remaining = fresh ? 1.0 : 1.0 - progress[i];
+    w[i] += q * remaining * reaction_.rate_constant(temperature[i]);
+  }
+}
+
+void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                        Eigen::Ref<Eigen::VectorXd> w) const {
+  heat_rate(t, temperature, Eigen::VectorXd(), w);
 }
 
 void Problem::rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,

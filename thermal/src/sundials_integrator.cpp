@@ -1,11 +1,25 @@
 #include "sundials_integrator.hpp"
 
+#include <sunlinsol/sunlinsol_pcg.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
+
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 namespace frictherm::thermal::detail {
+
+LinSolPtr make_krylov_solver(const OdeSystem& sys, N_Vector y, int maxl, SUNContext ctx, const std::string& who) {
+  if (sys.nonsymmetric()) {
+    LinSolPtr ls(SUNLinSol_SPGMR(y, SUN_PREC_LEFT, maxl, ctx));
+    check_ptr(ls.get(), "SUNLinSol_SPGMR", who);
+    return ls;
+  }
+  LinSolPtr ls(SUNLinSol_PCG(y, SUN_PREC_LEFT, maxl, ctx));
+  check_ptr(ls.get(), "SUNLinSol_PCG", who);
+  return ls;
+}
 
 LinearSolverKind parse_linear_solver(const std::string& integrator, const std::string& value) {
   const bool implicit = integrator == "cvode_bdf" || integrator == "arkode_dirk";
@@ -51,7 +65,8 @@ void SundialsIntegrator::on_reset_stats() {
   reinits_ = 0;
 }
 
-void SundialsIntegrator::advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1) {
+void SundialsIntegrator::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress,
+                                      double t0, double t1) {
   const auto start = std::chrono::steady_clock::now();
   problem.check_state(T);
   if (!(std::isfinite(t0) && std::isfinite(t1) && t1 >= t0)) {
@@ -62,17 +77,20 @@ void SundialsIntegrator::advance(const Problem& problem, Eigen::VectorXd& T, dou
   problem.apply_dirichlet(T);
   if (t1 == t0) return;
 
-  const bool same_problem = built_ && problem.revision() == revision_ && problem.size() == sys_.size();
+  const bool same_problem = built_ && problem.revision() == revision_ && problem.size() == sys_.nodes();
+  // The progress (λ = 0 without one) is part of the state (consuming) or of the RHS (zero-order).
+  const Eigen::VectorXd progress_now = progress != nullptr ? *progress : Eigen::VectorXd::Zero(problem.size());
   if (!same_problem) {
     if (built_) absorb_counters();
     built_ = false;
     release();
     if (!ctx_) ctx_ = make_context();
     sys_.build(problem, lin_ == LinearSolverKind::Pcg);
-    y_ = make_vector(static_cast<long>(problem.size()), ctx_.get());
-    abstol_ = make_vector(static_cast<long>(problem.size()), ctx_.get());
-    sys_.fill_abstol(opt_.atol, abstol_.get());  // abstol_i = s_i·atol (√M_i·atol for PCG)
-    sys_.to_y(T, y_.get());
+    y_ = make_vector(static_cast<long>(sys_.state_size()), ctx_.get());
+    abstol_ = make_vector(static_cast<long>(sys_.state_size()), ctx_.get());
+    // abstol_i = s_i·atol (√M_i·atol for PCG) on T, progress_atol on λ
+    sys_.fill_abstol(opt_.atol, opt_.progress_atol, abstol_.get());
+    sys_.to_y(T, progress, y_.get());
     sink_.last_message.clear();
     create(t0);
     built_ = true;
@@ -81,10 +99,11 @@ void SundialsIntegrator::advance(const Problem& problem, Eigen::VectorXd& T, dou
     ++reinits_;
   } else {
     sys_.bind(problem);
-    const bool continues = !opt_.reinit_every_window && t0 == t_last_ && T == t_state_last_;
+    const bool continues = !opt_.reinit_every_window && t0 == t_last_ && T == t_state_last_ &&
+                           progress_now.size() == progress_last_.size() && progress_now == progress_last_;
     if (!continues) {
       absorb_counters();
-      sys_.to_y(T, y_.get());
+      sys_.to_y(T, progress, y_.get());
       sink_.last_message.clear();
       reinit(t0);
       offset_ = counters();
@@ -109,10 +128,11 @@ void SundialsIntegrator::advance(const Problem& problem, Eigen::VectorXd& T, dou
     check(flag, c.c_str());
   }
   Eigen::VectorXd out;
-  sys_.to_T(y_.get(), out);
+  sys_.to_T(y_.get(), out, progress);
   problem.apply_dirichlet(out);  // exact fixed values (y/s round trip)
   T = std::move(out);
   t_state_last_ = T;
+  progress_last_ = progress != nullptr ? *progress : Eigen::VectorXd::Zero(problem.size());
   t_last_ = t1;
 }
 

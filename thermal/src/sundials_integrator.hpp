@@ -1,8 +1,9 @@
 // Shared window logic of the SUNDIALS-backed integrators (thermal-notes §1). Internal header.
 //
-// Each advance(problem, T, t0, t1) is one window. The solver is
+// Each advance(problem, T, [progress,] t0, t1) is one window. The solver is
 //  * rebuilt when the problem's M, K or boundaries changed (new Jacobian and pattern),
-//  * re-initialised (history cleared) when T was changed outside, t0 is not the previous t1,
+//  * re-initialised (history cleared) when T (or the reaction progress) was changed outside,
+//    t0 is not the previous t1,
 //    or options.reinit_every_window is set,
 //  * otherwise continued with its history (source changes between windows are then handled
 //    by error control, which the notes found cheaper unless the jumps are large).
@@ -21,16 +22,20 @@ namespace frictherm::thermal::detail {
 
 enum class LinearSolverKind { Klu, Pcg, FixedPoint, None };
 
+// The Krylov solver for linear_solver "pcg": PCG, or SPGMR when sys.nonsymmetric().
+LinSolPtr make_krylov_solver(const OdeSystem& sys, N_Vector y, int maxl, SUNContext ctx, const std::string& who);
+
 // Parses options.linear_solver for the named integrator (see IntegratorOptions).
 LinearSolverKind parse_linear_solver(const std::string& integrator, const std::string& value);
 
 class SundialsIntegrator : public Integrator {
  public:
   SundialsIntegrator(std::string name, const IntegratorOptions& options, LinearSolverKind lin);
-  void advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1) final;
   std::string name() const override { return name_; }
 
  protected:
+  void advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0,
+                    double t1) final;
   virtual void release() = 0;                  // free solver memory and solvers
   virtual void create(double t0) = 0;          // y_ holds the initial state
   virtual void reinit(double t0) = 0;          // y_ holds the new state
@@ -59,7 +64,7 @@ class SundialsIntegrator : public Integrator {
   bool built_ = false;
   std::uint64_t revision_ = 0;
   double t_last_ = std::numeric_limits<double>::quiet_NaN();
-  Eigen::VectorXd t_state_last_;
+  Eigen::VectorXd t_state_last_, progress_last_;
   IntegratorStats base_, offset_;
   double wall_ = 0.0;
   long reinits_ = 0;

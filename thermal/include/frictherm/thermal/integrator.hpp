@@ -29,14 +29,19 @@ struct IntegratorStats {
 struct IntegratorOptions {
   double rtol = 1e-6;   // relative tolerance (SUNDIALS integrators)
   double atol = 1e-6;   // absolute tolerance [K]
+  double progress_atol = 1e-6;  // absolute tolerance on the reaction progress λ (dimensionless)
   long max_steps = 10000;  // per advance() call (CVODE mxstep; ARKODE mxsteps)
   // Linear solver for implicit methods: "klu" (sparse direct, exact Jacobian −M⁻¹K) or "pcg"
   // (preconditioned CG on the symmetric form y = M^{1/2}T, Jacobi preconditioner,
   // thermal-notes §1). cvode_adams also accepts "fixed_point" (its default: no linear solver).
+  // With a consuming reaction the Newton matrix is not symmetric (the T–λ coupling), so "pcg"
+  // then runs GMRES (SPGMR) with the same exact J·v and a 2×2 block-Jacobi preconditioner.
   // Empty means the integrator's default (klu for cvode_bdf and arkode_dirk).
   std::string linear_solver;
   int krylov_maxl = 100;   // PCG maximum iterations (SUNDIALS default 5 is too small)
-  // forward_euler stability handling: "substep" (take equal sub-steps h ≤ fe_safety·dt_limit),
+  // forward_euler stability handling: "substep" (take equal sub-steps h ≤ fe_safety·dt_limit;
+  // with a reaction, adaptive sub-steps h ≤ fe_safety·2/(λ_cond + max_i(k_i + a_i)), where
+  // k_i is the rate constant and a_i the self-heating rate Q_i(1−λ_i)k'(T_i)/M_i),
   // "refuse" (throw StabilityError if the step would exceed fe_safety·dt_limit) or
   // "unguarded" (no check; exists only to demonstrate the instability).
   std::string fe_stability_policy = "substep";
@@ -86,14 +91,24 @@ class Integrator {
   // Integrates problem from t0 to t1 (t1 ≥ t0), updating T in place. Dirichlet values are
   // written into T first. The problem's source is evaluated at absolute time t.
   // Throws std::invalid_argument for bad input, SolverError / StabilityError on failure
-  // (T is then left unchanged).
-  virtual void advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1) = 0;
+  // (T is then left unchanged). A zero-order reaction (consume = false) is evaluated at
+  // λ = 0; a consuming reaction needs the overload with the progress (else invalid_argument).
+  void advance(const Problem& problem, Eigen::VectorXd& T, double t0, double t1);
+  // Same with the reaction progress λ (size() entries in [0, 1]), updated in place when the
+  // reaction consumes (clamped to [0, 1] on return; the clamp is at the solver-tolerance
+  // level) and held fixed for a zero-order reaction. λ of Dirichlet nodes and nodes with
+  // Q_i = 0 never changes. Without a reaction, progress is checked and left unchanged.
+  void advance(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress, double t0,
+               double t1);
   virtual std::string name() const = 0;
 
   const IntegratorStats& stats() const { return stats_; }
   void reset_stats() { stats_ = IntegratorStats{}; on_reset_stats(); }
 
  protected:
+  // progress is null for the 4-argument advance (then the reaction, if any, is zero-order).
+  virtual void advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress,
+                            double t0, double t1) = 0;
   virtual void on_reset_stats() {}
   IntegratorStats stats_;
 };

@@ -4,9 +4,12 @@
 //
 // with M the diagonal (lumped) heat capacity [J/K], K the symmetric conductance matrix [W/K],
 // q(t) nodal sources [W] (constant, or linear in time over a window), f prescribed nodal heat
-// inputs [W] (flux boundaries) and hA ⊙ (T_inf − T) convective exchange [W].
+// inputs [W] (flux boundaries) and hA ⊙ (T_inf − T) convective exchange [W]. An optional
+// Arrhenius reaction adds Q_i (1 − λ_i) Z exp(−Θ/T_i) with a per-node progress λ (reaction.hpp).
 // The module knows nothing about where M and K come from (MPM, FD or FE grids).
 #pragma once
+
+#include "frictherm/thermal/reaction.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -56,11 +59,37 @@ class Problem {
   const Eigen::VectorXd& flux() const { return flux_; }
   const Eigen::VectorXd& convection_coefficients() const { return ha_; }
 
+  // ---- reaction (reaction.hpp) ----
+  // Throws std::invalid_argument unless heat has size() finite entries ≥ 0 and Z, Θ are
+  // finite and > 0. Dirichlet nodes and nodes with Q_i = 0 never react.
+  void set_reaction(Reaction reaction);
+  void clear_reaction();
+  bool has_reaction() const { return has_reaction_; }
+  // True when the reaction depletes its reactant, so integrators need the progress λ.
+  bool reaction_consumes() const { return has_reaction_ && reaction_.consume; }
+  const Reaction& reaction() const { return reaction_; }  // empty heat without a reaction
+  // p_i = Q_i (1 − λ_i) Z exp(−Θ/T_i) [W]; zero on Dirichlet nodes and without a reaction.
+  // An empty progress means λ = 0 (fresh material).
+  void reaction_power(const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                      const Eigen::Ref<const Eigen::VectorXd>& progress, Eigen::Ref<Eigen::VectorXd> p) const;
+  // Σ_i Q_i λ_i [J]: heat released so far (0 without a reaction).
+  double released_heat(const Eigen::VectorXd& progress) const;
+  // Throws std::invalid_argument unless progress has size() finite entries in [0, 1].
+  void check_progress(const Eigen::VectorXd& progress) const;
+
   // ---- evaluation ----
-  // Nodal heat rate w = −K T + q(t) + f + hA ⊙ (T_inf − T) [W]; zero on Dirichlet nodes.
+  // Nodal heat rate without the reaction, −K T + q(t) + f + hA ⊙ (T_inf − T) [W]; zero on
+  // Dirichlet nodes.
+  void transport_heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                           Eigen::Ref<Eigen::VectorXd> w) const;
+  // Full nodal heat rate w = transport + reaction power at progress λ [W] (empty progress:
+  // λ = 0); zero on Dirichlet nodes.
+  void heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                 const Eigen::Ref<const Eigen::VectorXd>& progress, Eigen::Ref<Eigen::VectorXd> w) const;
+  // Same with λ = 0 (fresh material; identical to transport_heat_rate without a reaction).
   void heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
                  Eigen::Ref<Eigen::VectorXd> w) const;
-  // dT/dt = M⁻¹ w.
+  // dT/dt = M⁻¹ w (λ = 0).
   void rhs(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
            Eigen::Ref<Eigen::VectorXd> dTdt) const;
   // Σ over free nodes of q(t) + f + hA ⊙ (T_inf − T) [W]: the power entering through sources
@@ -73,7 +102,7 @@ class Problem {
   // Throws std::invalid_argument unless T has size() finite entries.
   void check_state(const Eigen::VectorXd& temperature) const;
 
-  // Changes whenever M, K or a boundary changes (not when sources change); integrators use it
+  // Changes whenever M, K, a boundary or the reaction changes (not when sources change); integrators use it
   // to know when to rebuild Jacobians. Unique across all Problem objects.
   std::uint64_t revision() const { return revision_; }
 
@@ -91,6 +120,8 @@ class Problem {
   std::vector<Index> dirichlet_nodes_;
   Eigen::VectorXd fixed_value_;
   Eigen::VectorXd flux_, ha_, ha_tinf_;
+  bool has_reaction_ = false;
+  Reaction reaction_;
   std::uint64_t revision_ = 0;
 };
 

@@ -3,4 +3,5 @@
 
 #include "frictherm/thermal/integrator.hpp"
 #include "frictherm/thermal/problem.hpp"
+#include "frictherm/thermal/reaction.hpp"
 #include "frictherm/thermal/stability.hpp"
