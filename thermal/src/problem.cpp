@@ -210,13 +210,20 @@ void Problem::reaction_power(const Eigen::Ref<const Eigen::VectorXd>& temperatur
                              const Eigen::Ref<const Eigen::VectorXd>& progress,
                              Eigen::Ref<Eigen::VectorXd> p) const {
   p.setZero();
+  add_reaction_power(temperature, progress, p);
+}
+
+// Q_i (1 − λ_i) Z exp(−Θ/T_i) added to p on reacting, non-Dirichlet nodes (λ = 0 when progress is empty).
+void Problem::add_reaction_power(const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                                 const Eigen::Ref<const Eigen::VectorXd>& progress,
+                                 Eigen::Ref<Eigen::VectorXd> p) const {
   if (!has_reaction_) return;
   const bool fresh = progress.size() == 0;
   for (Index i = 0; i < size(); ++i) {
     const double q = reaction_.heat[i];
     if (q == 0.0 || fixed_[static_cast<std::size_t>(i)]) continue;
     const double remaining = fresh ? 1.0 : 1.0 - progress[i];
-    p[i] = q * remaining * reaction_.rate_constant(temperature[i]);
+    p[i] += q * remaining * reaction_.rate_constant(temperature[i]);
   }
 }
 
@@ -259,14 +266,7 @@ void Problem::transport_heat_rate(double t, const Eigen::Ref<const Eigen::Vector
 void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,
                         const Eigen::Ref<const Eigen::VectorXd>& progress, Eigen::Ref<Eigen::VectorXd> w) const {
   transport_heat_rate(t, temperature, w);
-  if (!has_reaction_) return;
-  const bool fresh = progress.size() == 0;
-  for (Index i = 0; i < size(); ++i) {
-    const double q = reaction_.heat[i];
-    if (q == 0.0 || fixed_[static_cast<std::size_t>(i)]) continue;
-    const double remaining = fresh ? 1.0 : 1.0 - progress[i];
-    w[i] += q * remaining * reaction_.rate_constant(temperature[i]);
-  }
+  add_reaction_power(temperature, progress, w);
 }
 
 void Problem::heat_rate(double t, const Eigen::Ref<const Eigen::VectorXd>& temperature,

@@ -107,6 +107,8 @@ class Problem {
   std::uint64_t revision() const { return revision_; }
 
  private:
+  void add_reaction_power(const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                          const Eigen::Ref<const Eigen::VectorXd>& progress, Eigen::Ref<Eigen::VectorXd> p) const;
   void check_node(Index node, const char* what) const;
   void check_source_vector(const Eigen::VectorXd& q, const char* what) const;
   void touch();
