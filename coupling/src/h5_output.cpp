@@ -160,6 +160,42 @@ struct H5Output::Impl {
     Scoped& operator=(const Scoped&) = delete;
   };
 
+  // /<name> with a `columns` attribute and one extendible 1-D double dataset per column (series, tables).
+  void create_columns(const std::string& name, const std::vector<std::string>& columns, const char* what,
+                      Handle& group_out, std::vector<Handle>& sets) {
+    std::set<std::string> seen;
+    std::size_t longest = 1;
+    for (const auto& n : columns) {
+      check_name(n, what);
+      if (!seen.insert(n).second) throw std::invalid_argument(std::string(what) + " '" + n + "' declared twice");
+      longest = std::max(longest, n.size());
+    }
+    const Quiet quiet;
+    const Scoped hold_cache(*this);
+    group_out = io.group(file.get(), name, "/" + name);
+    std::string packed(columns.size() * longest, '\0');  // fixed-length, NUL-padded names
+    for (std::size_t i = 0; i < columns.size(); ++i) packed.replace(i * longest, columns[i].size(), columns[i]);
+    {
+      const Handle type = io.string_type(longest);
+      const hsize_t n_columns = columns.size();
+      const Handle s = io.space(1, &n_columns);
+      const Handle a{check_id(H5Acreate2(group_out.get(), "columns", type.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT),
+                              io.file, "cannot create /" + name + " attribute columns"),
+                     H5Aclose};
+      check(H5Awrite(a.get(), type.get(), packed.data()), io.file, "cannot write /" + name + " attribute columns");
+    }
+    const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1024;
+    const Handle space = io.space(1, &zero, &unlimited);
+    Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), io.file, "cannot create a property list"), H5Pclose};
+    check(H5Pset_chunk(dcpl.get(), 1, &chunk), io.file, "cannot set chunking");
+    for (const auto& n : columns)
+      sets.emplace_back(check_id(H5Dcreate2(group_out.get(), n.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                            dcpl.get(), H5P_DEFAULT),
+                                 io.file, "cannot create /" + name + "/" + n),
+                        H5Dclose);
+    flush_file();
+  }
+
   // ---- extra append-only tables /<name>/<column> (hot spots, coupling), written with the series ----
   struct Table {
     Handle group;
@@ -460,39 +496,8 @@ void H5Output::declare_series(const std::vector<std::string>& names) {
   if (names.empty() || names.front() != "time") {
     throw std::invalid_argument("series columns must start with \"time\"");
   }
-  std::set<std::string> seen;
-  std::size_t longest = 1;
-  for (const auto& n : names) {
-    check_name(n, "series column");
-    if (!seen.insert(n).second) throw std::invalid_argument("series column '" + n + "' declared twice");
-    longest = std::max(longest, n.size());
-  }
-  const Quiet quiet;
-  const Impl::Scoped hold(m);
-  m.series = m.io.group(m.file.get(), "series", "/series");
-  std::string packed(names.size() * longest, '\0');  // fixed-length, NUL-padded names
-  for (std::size_t i = 0; i < names.size(); ++i) packed.replace(i * longest, names[i].size(), names[i]);
-  {
-    const Handle t = m.io.string_type(longest);
-    const hsize_t count = names.size();
-    const Handle s = m.io.space(1, &count);
-    const Handle a{check_id(H5Acreate2(m.series.get(), "columns", t.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT),
-                            m.io.file, "cannot create /series attribute columns"),
-                   H5Aclose};
-    check(H5Awrite(a.get(), t.get(), packed.data()), m.io.file, "cannot write /series attribute columns");
-  }
-  const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1024;
-  const Handle space = m.io.space(1, &zero, &unlimited);
-  Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), m.io.file, "cannot create a property list"), H5Pclose};
-  check(H5Pset_chunk(dcpl.get(), 1, &chunk), m.io.file, "cannot set chunking");
-  for (const auto& n : names) {
-    m.series_sets.emplace_back(check_id(H5Dcreate2(m.series.get(), n.c_str(), H5T_IEEE_F64LE, space.get(),
-                                                   H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
-                                        m.io.file, "cannot create /series/" + n),
-                               H5Dclose);
-  }
+  m.create_columns("series", names, "series column", m.series, m.series_sets);
   m.series_names = names;
-  m.flush_file();
 }
 
 void H5Output::append_series(const std::vector<double>& row) {
@@ -514,40 +519,10 @@ void H5Output::declare_table(const std::string& name, const std::vector<std::str
       m.tables.count(name) != 0)
     throw std::logic_error("H5Output: table /" + name + " already exists or is reserved");
   if (columns.empty()) throw std::invalid_argument("table /" + name + " needs at least one column");
-  std::set<std::string> seen;
-  std::size_t longest = 1;
-  for (const auto& n : columns) {
-    check_name(n, "table column");
-    if (!seen.insert(n).second) throw std::invalid_argument("table column '" + n + "' declared twice");
-    longest = std::max(longest, n.size());
-  }
-  const Quiet quiet;
-  const Impl::Scoped hold(m);
   Impl::Table t;
-  t.group = m.io.group(m.file.get(), name, "/" + name);
-  std::string packed(columns.size() * longest, '\0');  // fixed-length, NUL-padded names
-  for (std::size_t i = 0; i < columns.size(); ++i) packed.replace(i * longest, columns[i].size(), columns[i]);
-  {
-    const Handle type = m.io.string_type(longest);
-    const hsize_t count = columns.size();
-    const Handle s = m.io.space(1, &count);
-    const Handle a{check_id(H5Acreate2(t.group.get(), "columns", type.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT),
-                            m.io.file, "cannot create /" + name + " attribute columns"),
-                   H5Aclose};
-    check(H5Awrite(a.get(), type.get(), packed.data()), m.io.file, "cannot write /" + name + " attribute columns");
-  }
-  const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1024;
-  const Handle space = m.io.space(1, &zero, &unlimited);
-  Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), m.io.file, "cannot create a property list"), H5Pclose};
-  check(H5Pset_chunk(dcpl.get(), 1, &chunk), m.io.file, "cannot set chunking");
-  for (const auto& n : columns)
-    t.sets.emplace_back(check_id(H5Dcreate2(t.group.get(), n.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
-                                            dcpl.get(), H5P_DEFAULT),
-                                 m.io.file, "cannot create /" + name + "/" + n),
-                        H5Dclose);
+  m.create_columns(name, columns, "table column", t.group, t.sets);
   t.names = columns;
   m.tables.emplace(name, std::move(t));
-  m.flush_file();
 }
 
 void H5Output::append_table_row(const std::string& name, const std::vector<double>& row) {
