@@ -2,6 +2,8 @@
 // Bodies and loads live in scene_bodies.cpp and scene_loads.cpp.
 #include "scene_detail.hpp"
 
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -70,8 +72,30 @@ void parse_grid(const JsonReader& root, Scene& s) {
 mechanics::Material parse_material(const JsonReader& m, const std::string& name, const Scene& s) {
   mechanics::Material mat;
   mat.name = name;
-  const JsonReader type = m.at("type", "\"linear_elastic\", \"neo_hookean\" or \"rigid\"");
-  mat.kind = mechanics::material_kind_from_string(type.as_choice({"linear_elastic", "neo_hookean", "rigid"}));
+  const JsonReader type = m.at("type", "\"linear_elastic\", \"neo_hookean\", \"mie_gruneisen\" or \"rigid\"");
+  mat.kind = mechanics::material_kind_from_string(
+      type.as_choice({"linear_elastic", "neo_hookean", "mie_gruneisen", "rigid"}));
+  if (mat.kind == mechanics::MaterialKind::mie_gruneisen) {
+    if (s.options.analysis == mechanics::Analysis::plane_stress)
+      type.fail("mie_gruneisen needs \"analysis\": \"plane_strain\" or a 3D scene (an equation of state has no "
+                "plane-stress form)");
+    mechanics::MieGruneisenParams& g = mat.mie_gruneisen;
+    mat.density = g.density = m.number("density", Range::positive());
+    g.C0 = m.number("C0", Range::positive());
+    g.S1 = m.number("S1");
+    g.S2 = m.number("S2", 0.0, Range::any());
+    g.gamma0 = m.number("gamma0", Range::non_negative());
+    g.shear_modulus = m.number("shear_modulus", Range::non_negative());
+    g.yield_stress = m.number("yield_stress", std::numeric_limits<double>::infinity(), Range::positive());
+    g.hardening_modulus = m.number("hardening_modulus", 0.0, Range::non_negative());
+    try {
+      mechanics::validate(g, s.options.analysis, m.path());
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(e.what());
+    }
+    m.finish();
+    return mat;
+  }
   if (mat.is_rigid()) {
     mat.density = m.number("density", 1000.0, Range::positive());
     if (const auto b = m.find("boundary")) mat.rigid_boundary = b->as_bool();

@@ -27,7 +27,9 @@ MaterialKind material_kind_from_string(const std::string& name) {
   if (name == "linear_elastic") return MaterialKind::linear_elastic;
   if (name == "neo_hookean") return MaterialKind::neo_hookean;
   if (name == "rigid") return MaterialKind::rigid;
-  throw std::invalid_argument("unknown material type '" + name + "' (expected linear_elastic, neo_hookean or rigid)");
+  if (name == "mie_gruneisen") return MaterialKind::mie_gruneisen;
+  throw std::invalid_argument("unknown material type '" + name +
+                              "' (expected linear_elastic, neo_hookean, mie_gruneisen or rigid)");
 }
 
 const char* to_string(MaterialKind kind) {
@@ -35,6 +37,7 @@ const char* to_string(MaterialKind kind) {
     case MaterialKind::linear_elastic: return "linear_elastic";
     case MaterialKind::neo_hookean: return "neo_hookean";
     case MaterialKind::rigid: return "rigid";
+    case MaterialKind::mie_gruneisen: return "mie_gruneisen";
   }
   return "?";
 }

@@ -16,6 +16,8 @@ void Particles<Dim>::reserve(std::size_t n) {
   stress_zz.reserve(n);
   temperature.reserve(n);
   plastic_strain.reserve(n);
+  internal_energy.reserve(n);
+  plastic_work.reserve(n);
   material.reserve(n);
   body.reserve(n);
 }
@@ -35,6 +37,8 @@ void Particles<Dim>::add(const Vec<Dim>& x, const Vec<Dim>& lp, double m, double
   stress_zz.push_back(0.0);
   temperature.push_back(temperature_K);
   plastic_strain.push_back(0.0);
+  internal_energy.push_back(0.0);
+  plastic_work.push_back(0.0);
   material.push_back(material_id);
   body.push_back(body_id);
 }
@@ -63,6 +67,8 @@ void Particles<Dim>::permute(const std::vector<std::size_t>& order) {
   permute_field(stress_zz, order);
   permute_field(temperature, order);
   permute_field(plastic_strain, order);
+  permute_field(internal_energy, order);
+  permute_field(plastic_work, order);
   permute_field(material, order);
   permute_field(body, order);
 }

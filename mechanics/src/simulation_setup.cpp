@@ -1,4 +1,5 @@
 // Simulation set-up: materials, bodies filled with particles, boundary conditions and loads.
+#include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <algorithm>
@@ -44,6 +45,13 @@ int Simulation<Dim>::add_material(const Material& m) {
   if (!(m.density > 0.0)) throw std::invalid_argument("material '" + m.name + "': density must be > 0");
   if (m.is_rigid() && !m.rigid_boundary && !(m.rigid_controls[0] && m.rigid_controls[1] && m.rigid_controls[2]))
     throw std::invalid_argument("material '" + m.name + "': only a boundary rigid material may leave velocity components free");
+  if (m.kind == MaterialKind::mie_gruneisen) {
+    Material mg = m;
+    mg.mie_gruneisen.density = m.density;
+    validate(mg.mie_gruneisen, opt_.analysis, "material '" + m.name + "'");  // names the parameter
+    materials_.push_back(mg);
+    return static_cast<int>(materials_.size()) - 1;
+  }
   if (!m.is_rigid()) {
     if (!(m.youngs_modulus > 0.0)) throw std::invalid_argument("material '" + m.name + "': E must be > 0");
     if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
@@ -231,13 +239,16 @@ double Simulation<Dim>::stable_time_step() const {
     const Material& mat = materials_[m];
     const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
     if (mat.is_rigid()) continue;
-    const double c0 = mat.p_wave_speed(opt_.analysis);
-    const bool nh = mat.kind == MaterialKind::neo_hookean;
+    const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
+    const double c0 = mg ? 0.0 : mat.p_wave_speed(opt_.analysis);
     double local = 0.0;
 #pragma omp parallel for num_threads(threads_) reduction(max : local) schedule(static)
     for (std::size_t k = b; k < e; ++k) {
       if (!finalized_ && p_.material[k] != static_cast<int>(m)) continue;
-      const double c = nh ? mat.wave_speed(opt_.analysis, p_.volume[k] / p_.initial_volume[k]) : c0;
+      const double J = p_.volume[k] / p_.initial_volume[k];
+      const double c = mg   ? mie_gruneisen_wave_speed(mat.mie_gruneisen, J, p_.internal_energy[k])
+                       : nh ? mat.wave_speed(opt_.analysis, J)
+                            : c0;
       local = std::max(local, c + p_.velocity[k].norm());
     }
     cmax = std::max(cmax, local);

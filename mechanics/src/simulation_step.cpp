@@ -4,6 +4,7 @@
 // scatters into the slots of its material's velocity field (field_of_material_), so the same loops
 // serve the shared single field and the per-material fields of multimaterial contact.
 #include <frictherm/mechanics/errors.hpp>
+#include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <omp.h>
@@ -316,18 +317,35 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
     if (mat.is_rigid() || f < 0) continue;
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
-    const bool nh = mat.kind == MaterialKind::neo_hookean;
-#pragma omp parallel for num_threads(threads_) schedule(static)
+    const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
+    long beyond = -1;  // a particle compressed past the Hugoniot's limit
+#pragma omp parallel for num_threads(threads_) schedule(static) reduction(max : beyond)
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
       st[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });
       Mat<Dim>& F = p_.deformation_gradient[k];
       F = (Mat<Dim>::Identity() + dt * L) * F;
       p_.volume[k] = F.determinant() * p_.initial_volume[k];
-      if (nh)
+      if (mg) {
+        double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+        if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, p_.stress[k],
+                                      p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k],
+                                      wp) != MieGruneisenStatus::ok)
+          beyond = std::max(beyond, static_cast<long>(k));
+        p_.plastic_work[k] += wp * p_.volume[k];
+      } else if (nh) {
         neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
-      else
+      } else {
         linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
+      }
+    }
+    if (beyond >= 0) {
+      std::ostringstream msg;
+      msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '" << mat.name
+          << "' is compressed past the limit of its Hugoniot (J = "
+          << p_.volume[static_cast<std::size_t>(beyond)] / p_.initial_volume[static_cast<std::size_t>(beyond)]
+          << "; try a smaller CFL factor)";
+      throw SimulationError(msg.str(), step_, time_, beyond);
     }
   }
 }

@@ -232,3 +232,21 @@ TEST(SceneValidation, BodyWithoutParticlesIsNamedWhenBuilt) {
   s["bodies"].push_back(copy);
   EXPECT_THAT(scene_error(s), AllOf(StartsWith("bodies[1]: "), HasSubstr("no particles")));
 }
+
+TEST(SceneValidation, MieGruneisenMaterial) {
+  Json s = good_scene();
+  s["materials"]["steel"] = Json::parse(R"({"type": "mie_gruneisen", "density": 1891, "C0": 3070, "S1": 1.79,
+      "gamma0": 0.7, "shear_modulus": 4.81e9, "yield_stress": 2.6e8})");
+  const auto scene = parse_scene(s.dump());
+  const auto& g = scene.materials.at(0).mie_gruneisen;
+  EXPECT_EQ(scene.materials.at(0).kind, frictherm::mechanics::MaterialKind::mie_gruneisen);
+  EXPECT_DOUBLE_EQ(g.density, 1891.0);
+  EXPECT_DOUBLE_EQ(g.S2, 0.0);
+  EXPECT_DOUBLE_EQ(g.yield_stress, 2.6e8);
+  EXPECT_NO_THROW(frictherm::coupling::build_simulation<2>(scene));
+  s["materials"]["steel"]["S1"] = 12.0;  // Hugoniot singular before 10 % compression
+  EXPECT_THAT(scene_error(s), StartsWith("materials.steel.S1: expected S1, S2 whose Hugoniot stays finite"));
+  s["materials"]["steel"]["S1"] = 1.79;
+  s["analysis"] = "plane_stress";
+  EXPECT_THAT(scene_error(s), StartsWith("materials.steel.type: mie_gruneisen needs"));
+}

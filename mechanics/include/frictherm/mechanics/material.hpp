@@ -1,5 +1,6 @@
 #pragma once
 // Material parameters and the constitutive updates (inline: they run inside particle loops).
+#include <frictherm/mechanics/mie_gruneisen_params.hpp>
 #include <frictherm/mechanics/time_function.hpp>
 #include <frictherm/mechanics/types.hpp>
 
@@ -10,7 +11,7 @@
 
 namespace frictherm::mechanics {
 
-enum class MaterialKind { linear_elastic, neo_hookean, rigid };
+enum class MaterialKind { linear_elastic, neo_hookean, rigid, mie_gruneisen };
 
 MaterialKind material_kind_from_string(const std::string& name);  // throws std::invalid_argument
 const char* to_string(MaterialKind kind);
@@ -21,6 +22,8 @@ struct Material {
   double density = 0.0;          // rho0 (kg/m^3)
   double youngs_modulus = 0.0;   // E (Pa)
   double poisson_ratio = 0.0;    // nu
+  /// mie_gruneisen: equation of state, shear modulus and yield (density is kept equal to `density`).
+  MieGruneisenParams mie_gruneisen;
   /// Rigid materials: prescribed velocity, one function of time per component (m/s).
   std::vector<TimeFunction> rigid_velocity;
   /// Rigid materials: which velocity components they prescribe (a component left free follows the

@@ -24,6 +24,8 @@ struct Particles {
   std::vector<double> stress_zz;           // out-of-plane Cauchy stress in 2D (plane strain), 0 in 3D
   std::vector<double> temperature;         // T_p (K)
   std::vector<double> plastic_strain;      // equivalent plastic strain (0 for elastic materials)
+  std::vector<double> internal_energy;     // specific internal energy e (J/kg) of equation-of-state materials
+  std::vector<double> plastic_work;        // plastic work done on the particle since the start (J)
   std::vector<std::int32_t> material;      // material id
   std::vector<std::int32_t> body;          // body id
 
@@ -37,7 +39,7 @@ struct Particles {
   void permute(const std::vector<std::size_t>& order);
   /// Bytes of particle storage per particle (all fields).
   static constexpr std::size_t bytes_per_particle() {
-    return sizeof(Vec<Dim>) * 4 + sizeof(double) * 6 + sizeof(Mat<Dim>) * 2 + sizeof(std::int32_t) * 2;
+    return sizeof(Vec<Dim>) * 4 + sizeof(double) * 8 + sizeof(Mat<Dim>) * 2 + sizeof(std::int32_t) * 2;
   }
 };
 
