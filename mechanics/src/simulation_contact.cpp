@@ -140,11 +140,12 @@ void Simulation<Dim>::find_contact_nodes() {
   for (std::size_t s = 0; s < total; ++s)
     if (nodes_.mass[s] > mmin) ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
   contact_entries_.clear();
-  for (std::size_t s = 0; s < total; ++s) {
-    const int node = slot_node_[s];
-    if (nodes_.mass[s] > mmin && node_field_count_[static_cast<std::size_t>(node)] >= 2)
-      contact_entries_.emplace_back(node, static_cast<int>(s));
-  }
+  for (std::size_t f = 0; f < fields_.size(); ++f)
+    for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) {
+      const int node = slot_node_[s];
+      if (nodes_.mass[s] > mmin && node_field_count_[static_cast<std::size_t>(node)] >= 2)
+        contact_entries_.push_back({node, static_cast<int>(s), static_cast<int>(f)});
+    }
   std::sort(contact_entries_.begin(), contact_entries_.end());
 }
 
@@ -153,21 +154,15 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const bool heat = pass == ContactPass::updated;
   const bool forces = pass == ContactPass::updated;
   const std::size_t nm = materials_.size();
-  // Field of a slot: fields are contiguous and in material order.
-  auto field_of_slot = [&](int slot) {
-    std::size_t f = 0;
-    while (fields_[f].first + fields_[f].count <= static_cast<std::size_t>(slot)) ++f;
-    return f;
-  };
   Vec<Dim> h = grid_.cell_size();
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
   PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, cell_volume, dt, heat};
   if (heat) contact_stats_ = ContactStats{};
 
-  std::vector<ContactSide<Dim>> sides;
-  std::vector<int> slots, mats;
-  std::vector<Vec<Dim>> dps;
-  sides.reserve(8), slots.reserve(8), mats.reserve(8), dps.reserve(8);
+  // Per-node scratch, reused from call to call (no allocation per step once grown).
+  thread_local std::vector<ContactSide<Dim>> sides;
+  thread_local std::vector<int> slots, mats;
+  thread_local std::vector<Vec<Dim>> dps;
   auto apply = [&](int slot, const Vec<Dim>& dp) {
     nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
     if (forces) nodes_.force[static_cast<std::size_t>(slot)] += dp / dt;  // eq. 19
@@ -182,21 +177,21 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   };
 
   for (std::size_t e = 0; e < contact_entries_.size();) {
-    const int node = contact_entries_[e].first;
+    const int node = contact_entries_[e].node;
     std::size_t end = e;
-    while (end < contact_entries_.size() && contact_entries_[end].first == node) ++end;
+    while (end < contact_entries_.size() && contact_entries_[end].node == node) ++end;
     // Gather the materials at this node; slivers below min_mass_fraction take no part.
     sides.clear(), slots.clear(), mats.clear();
     double node_mass = 0.0;
-    for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].second)];
+    for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].slot)];
     for (std::size_t q = e; q < end; ++q) {
-      const int slot = contact_entries_[q].second;
+      const int slot = contact_entries_[q].slot;
       const std::size_t su = static_cast<std::size_t>(slot);
       if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
         if (heat) ++contact_stats_.guarded;
         continue;
       }
-      const std::size_t f = field_of_slot(slot);
+      const std::size_t f = static_cast<std::size_t>(contact_entries_[q].field);
       ContactSide<Dim> sd;
       sd.mass = nodes_.mass[su];
       sd.momentum = nodes_.momentum[su];

@@ -190,7 +190,11 @@ class Simulation {
   std::vector<ContactPairSettings> pair_settings_;  // [0] = default
   std::vector<int> pair_index_;                     // materials² -> pair_settings_ index
   std::vector<std::pair<int, int>> explicit_pairs_;
-  std::vector<std::pair<int, int>> contact_entries_;  // (node, slot) of multi-material nodes, by node
+  struct ContactEntry {  // one field with mass at a multi-material node
+    int node, slot, field;
+    bool operator<(const ContactEntry& o) const { return node != o.node ? node < o.node : slot < o.slot; }
+  };
+  std::vector<ContactEntry> contact_entries_;  // sorted by node; within a node in material order
   std::vector<std::uint16_t> node_field_count_;
   std::vector<double> work_first_, work_second_;    // per grid node, last step
   std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
