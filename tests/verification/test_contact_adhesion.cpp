@@ -9,6 +9,8 @@
 // Optionally a shear load, spread over the bottom particle row only (so it makes no overturning
 // moment that would tilt the normal traction), ramps with it: S(t) = r N(t).
 // Criterion: release when N = 1/√(r²/S_a² + 1/N_a²).
+#include "test_materials.hpp"
+
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <gtest/gtest.h>
@@ -36,19 +38,11 @@ PullOff pull(const FrictionLaw& law, double N_max, double r) {
   SimulationOptions o;
   o.thickness = kB;
   Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(kCell, kCell), IVec<2>{32, 20}), o);
-  Material base_m;
-  base_m.name = "base";
-  base_m.kind = MaterialKind::rigid;
-  base_m.density = 1000.0;
-  base_m.rigid_velocity = {TimeFunction::constant(0.0), TimeFunction::constant(0.0)};
-  Material block_m;
-  block_m.name = "block";
-  block_m.density = 1000.0;
-  block_m.youngs_modulus = 2500e6;
+  const Material base_m = frictherm::verification::rigid_at_rest("base");
   // ν = 0: with ν = 0.33 the bonded block's lateral contraction concentrates the traction at the
   // interface's ends (we measured 13.5 % above the mean at the end nodes, 2.5 % below it inside) and
   // the interface peels from its ends at N = 0.83 N_a: a real effect, but not the criterion's.
-  block_m.poisson_ratio = 0.0;
+  const Material block_m = frictherm::verification::elastic_material("block", 1000.0, 2500e6, 0.0);
   const int base = sim.add_material(base_m), block = sim.add_material(block_m);
   const double x0 = 0.0125;
   sim.add_body("base", *make_box<2>(Vec<2>(0.005, 0.0), Vec<2>(0.075, kY0), base), 2, Vec<2>::Zero());

@@ -32,6 +32,8 @@
 //     recovers the rigid-body result, and it is what the paper used for its angled surfaces.
 // The turned-geometry case is therefore tested with the specified normal only; the gradient-normal
 // failure on particle staircases is a known limitation (docs/contact.md), not asserted here.
+#include "test_materials.hpp"
+
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <gtest/gtest.h>
@@ -68,16 +70,8 @@ double measured_acceleration(const Incline& c, double* final_velocity) {
   const Vec<2> lo(-0.010, c.turned ? -0.080 : -0.010), span(c.turned ? 0.150 : 0.160, c.turned ? 0.130 : 0.060);
   const IVec<2> cells{static_cast<int>(std::lround(span[0] / c.cell)), static_cast<int>(std::lround(span[1] / c.cell))};
   Simulation<2> sim(Grid<2>(lo, Vec<2>(c.cell, c.cell), cells), o);
-  Material base_m;
-  base_m.name = "incline";
-  base_m.kind = MaterialKind::rigid;
-  base_m.density = 1000.0;
-  base_m.rigid_velocity = {TimeFunction::constant(0.0), TimeFunction::constant(0.0)};
-  Material block_m;
-  block_m.name = "block";
-  block_m.density = 1000.0;
-  block_m.youngs_modulus = 2500e6;
-  block_m.poisson_ratio = 0.33;
+  const Material base_m = frictherm::verification::rigid_at_rest("incline");
+  const Material block_m = frictherm::verification::elastic_material("block", 1000.0, 2500e6, 0.33);
   const int base = sim.add_material(base_m), block = sim.add_material(block_m);
   auto quad = [&](double s0, double h0, double s1, double h1, int mat) {
     return make_polygon<2>({at(s0, h0), at(s1, h0), at(s1, h1), at(s0, h1)}, 0.0, 0.0, mat);
