@@ -1,5 +1,8 @@
 // MPM throughput: particle-steps per second and bytes per particle for elastic blocks in 2D and 3D,
-// each shape function, on 1 and 2 threads. Prints a table; asserts nothing.
+// each shape function, on 1 and 2 threads. Prints a table; asserts nothing. The extended B-spline
+// (EBS) line also gives its cost relative to the quadratic B-spline: the per-step rebuild of the
+// basis and the flattened weights (the block's faces cut their knot spans in half, so every face has
+// degenerate nodes).
 //   bench_mpm [--quick] [--steps N]
 #include <frictherm/mechanics/simulation.hpp>
 
@@ -17,13 +20,15 @@ namespace {
 
 template <int Dim>
 std::size_t stencil_bytes(ShapeKind s) {
+  if (s == ShapeKind::extended_bspline)  // flattened entries: slot, N^e, ∇N^e, 3^Dim per particle + offset
+    return (Dim == 2 ? 9 : 27) * (sizeof(std::int32_t) + sizeof(double) + sizeof(Vec<Dim>)) + sizeof(std::size_t);
   return dispatch_shape(s, [](auto k) { return sizeof(Stencil<Dim, decltype(k)>); });
 }
 
 // A block of `target` particles (2 per cell per direction) in a grid with a one-cell margin,
 // moving and vibrating so that stresses are non-trivial. Returns particle-steps per second.
 template <int Dim>
-void run_case(long target, ShapeKind shape, int threads, int steps) {
+double run_case(long target, ShapeKind shape, int threads, int steps, double quadratic_rate = 0.0) {
   omp_set_num_threads(threads);
   const int ppc = 2;
   const long cells_total = target / static_cast<long>(std::pow(ppc, Dim));
@@ -53,10 +58,17 @@ void run_case(long target, ShapeKind shape, int threads, int steps) {
   const std::size_t nodes = sim.grid().node_count();
   const std::size_t node_bytes = nodes * (sizeof(double) + 4 * sizeof(Vec<Dim>)) * static_cast<std::size_t>(threads);
   const std::size_t bytes = Particles<Dim>::bytes_per_particle() + stencil_bytes<Dim>(shape) + node_bytes / p.size();
-  std::printf("%dD  %-18s %8zu particles  %d thread%s  %7.2f M particle-steps/s  (%5.2f M per thread)  %4zu B/particle\n",
+  std::printf("%dD  %-18s %8zu particles  %d thread%s  %7.2f M particle-steps/s  (%5.2f M per thread)  %4zu B/particle",
               Dim, to_string(shape), p.size(), threads, threads > 1 ? "s" : " ", rate / 1e6, rate / 1e6 / threads,
               bytes);
+  if (shape == ShapeKind::extended_bspline && quadratic_rate > 0.0) {
+    const auto& B = sim.extended_bases()[0];
+    std::printf("  cost %.2fx quadratic_bspline (%d degenerate nodes, %d extended cells)", quadratic_rate / rate,
+                B.degenerate_count(), B.extended_cell_count());
+  }
+  std::printf("\n");
   std::fflush(stdout);
+  return rate;
 }
 
 }  // namespace
@@ -77,10 +89,19 @@ int main(int argc, char** argv) {
   for (long target : {10000L, 100000L}) {
     if (quick && target > 10000L) break;
     const int nsteps = steps > 0 ? steps : static_cast<int>(std::max(20L, 4000000L / target));
-    for (ShapeKind s : {ShapeKind::linear, ShapeKind::ugimp, ShapeKind::quadratic_bspline})
-      for (int t = 1; t <= max_threads; ++t) run_case<2>(target, s, t, nsteps);
-    for (ShapeKind s : {ShapeKind::linear, ShapeKind::ugimp, ShapeKind::quadratic_bspline})
-      for (int t = 1; t <= max_threads; ++t) run_case<3>(target, s, t, std::max(10, nsteps / 3));
+    const ShapeKind shapes[] = {ShapeKind::linear, ShapeKind::ugimp, ShapeKind::quadratic_bspline,
+                                ShapeKind::extended_bspline};
+    double quadratic[2][3] = {};  // [dim 2/3][threads]
+    for (ShapeKind s : shapes)
+      for (int t = 1; t <= max_threads; ++t) {
+        const double r = run_case<2>(target, s, t, nsteps, quadratic[0][t]);
+        if (s == ShapeKind::quadratic_bspline) quadratic[0][t] = r;
+      }
+    for (ShapeKind s : shapes)
+      for (int t = 1; t <= max_threads; ++t) {
+        const double r = run_case<3>(target, s, t, std::max(10, nsteps / 3), quadratic[1][t]);
+        if (s == ShapeKind::quadratic_bspline) quadratic[1][t] = r;
+      }
   }
   return 0;
 }

@@ -63,6 +63,30 @@ void EbsBasis<Dim>::rebuild(const Grid<Dim>& grid, const std::vector<Vec<Dim>>& 
 }
 
 template <int Dim>
+void EbsBasis<Dim>::rebuild(const Grid<Dim>& grid, const std::vector<Vec<Dim>>& position,
+                            const std::vector<double>& volume,
+                            const std::vector<std::pair<std::size_t, std::size_t>>& ranges) {
+  std::size_t n = 0;
+  for (const auto& r : ranges) {
+    if (r.second < r.first || r.second > position.size() || r.second > volume.size())
+      throw std::out_of_range("EbsBasis::rebuild: particle range outside the particle arrays");
+    n += r.second - r.first;
+  }
+  // rebuild_impl visits i = 0 .. n-1 in order, twice: follow the ranges with a cursor.
+  std::size_t range = 0, start = 0;  // local index of the first particle of ranges[range]
+  rebuild_impl(grid, n, [&](std::size_t i, double& V) -> const Vec<Dim>& {
+    if (i < start) range = 0, start = 0;  // second pass: restart
+    while (i >= start + (ranges[range].second - ranges[range].first)) {
+      start += ranges[range].second - ranges[range].first;
+      ++range;
+    }
+    const std::size_t p = ranges[range].first + (i - start);
+    V = volume[p];
+    return position[p];
+  });
+}
+
+template <int Dim>
 template <class Get>
 void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) {
   if (!(opt_.occupation >= 0.0) || !std::isfinite(opt_.occupation))
@@ -70,6 +94,8 @@ void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) 
   if (!(opt_.out_of_plane > 0.0) || !std::isfinite(opt_.out_of_plane))
     throw std::invalid_argument("EBS out_of_plane (thickness / cross-section) must be finite and > 0");
   if (opt_.search_radius < 0) throw std::invalid_argument("EBS search_radius must be >= 0");
+  if (kept_ && kept_->size() != grid.node_count())
+    throw std::invalid_argument("EbsBasis::rebuild: the kept-node mask must have one entry per grid node");
   const IVec<Dim>& cells = grid.cells();
 
   // Pass 1: the cell (knot span) of each particle, the body's bounding box of cells.
@@ -183,7 +209,9 @@ void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) 
     }
     int best = INT_MAX;
     IVec<Dim> Q{};
+    const bool kept = kept_ && (*kept_)[static_cast<std::size_t>(grid_.node_index(J))];
     for (const Offset& o : offsets_) {
+      if (kept) break;  // a node with a velocity condition keeps its own B-spline
       IVec<Dim> c;
       for (int d = 0; d < Dim; ++d) c[d] = J[d] + o.off[d];
       if (in_region(c) && cell_[static_cast<std::size_t>(local(c))] == EbsCell::interior) {
@@ -192,7 +220,7 @@ void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) 
         break;
       }
     }
-    if (best == INT_MAX) {  // no interior cell near: keep the plain B-spline (docs/ebs.md)
+    if (best == INT_MAX) {  // kept, or no interior cell near: the plain B-spline (docs/ebs.md)
       node_[kJ] = EbsNode::stable;
       ++stable_count_;
       ++promoted_count_;

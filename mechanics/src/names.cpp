@@ -11,7 +11,9 @@ ShapeKind shape_kind_from_string(const std::string& name) {
   if (name == "linear") return ShapeKind::linear;
   if (name == "ugimp") return ShapeKind::ugimp;
   if (name == "quadratic_bspline") return ShapeKind::quadratic_bspline;
-  throw std::invalid_argument("unknown shape function '" + name + "' (expected linear, ugimp or quadratic_bspline)");
+  if (name == "extended_bspline" || name == "ebs") return ShapeKind::extended_bspline;
+  throw std::invalid_argument("unknown shape function '" + name +
+                              "' (expected linear, ugimp, quadratic_bspline or extended_bspline)");
 }
 
 const char* to_string(ShapeKind kind) {
@@ -19,6 +21,7 @@ const char* to_string(ShapeKind kind) {
     case ShapeKind::linear: return "linear";
     case ShapeKind::ugimp: return "ugimp";
     case ShapeKind::quadratic_bspline: return "quadratic_bspline";
+    case ShapeKind::extended_bspline: return "extended_bspline";
   }
   return "?";
 }

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace frictherm::mechanics {
@@ -67,6 +68,11 @@ class EbsBasis {
 
   const EbsOptions& options() const { return opt_; }
   void set_options(const EbsOptions& opt) { opt_ = opt; }
+  /// Nodes (grid flat index) with a non-zero entry in `mask` are never degenerate: they keep their
+  /// own B-spline (counted in promoted_count), so that a velocity condition on them (a fixed face,
+  /// a rigid boundary) still acts on the body. nullptr: none. The mask must outlive the rebuilds and
+  /// have grid.node_count() entries.
+  void set_kept_nodes(const std::vector<std::uint8_t>* mask) { kept_ = mask; }
 
   /// Rebuild from particles begin..end-1 of the body (positions x_p, current volumes Ω_p).
   /// Throws std::out_of_range if a particle lies outside [lo - h/2, hi + h/2), std::invalid_argument
@@ -76,6 +82,10 @@ class EbsBasis {
   /// Same, for the particles listed in `particles` (bodies not stored contiguously).
   void rebuild(const Grid<Dim>& grid, const std::vector<Vec<Dim>>& position, const std::vector<double>& volume,
                const std::vector<std::size_t>& particles);
+  /// Same, for the particles of several index ranges [first, second) (a body made of several
+  /// materials, e.g. the shared velocity field of the MPM step without contact).
+  void rebuild(const Grid<Dim>& grid, const std::vector<Vec<Dim>>& position, const std::vector<double>& volume,
+               const std::vector<std::pair<std::size_t, std::size_t>>& ranges);
 
   /// Extended basis at x. The basis lives on the cells holding the body's particles; a point in any
   /// other cell (or outside the grid) gets an empty stencil.
@@ -103,14 +113,25 @@ class EbsBasis {
 
   int stable_count() const { return stable_count_; }
   int degenerate_count() const { return degenerate_count_; }
-  /// Nodes that would be degenerate but have no interior cell within search_radius: kept as
-  /// stable (plain B-spline there), e.g. bodies thinner than about 3 cells.
+  /// Nodes that would be degenerate but are kept (set_kept_nodes) or have no interior cell within
+  /// search_radius: stable with their plain B-spline, e.g. bodies thinner than about 3 cells.
   int promoted_count() const { return promoted_count_; }
   /// Cells holding particles whose block has a degenerate node (the cells where EBS differs from OBS).
   int extended_cell_count() const { return extended_cells_; }
   /// Largest number of entries of any point's stencil (27 in 3D, 9 in 2D, 3 in 1D if nothing is extended).
   int max_stencil_size() const { return max_stencil_; }
   const Grid<Dim>& grid() const { return grid_; }
+  /// Box of every node whose support meets a cell holding the body's particles, in lattice
+  /// coordinates counted from the first ghost node (as NodeIndexer and Stencil::first_node): the
+  /// nodes of the plain B-spline stencils of the body's particles. Every node with a non-zero N^e
+  /// lies in it (each is stable, so its support holds an interior cell, which holds particles).
+  /// hi < lo for a body without particles.
+  void node_box(IVec<Dim>& lo, IVec<Dim>& hi) const {
+    for (int d = 0; d < Dim; ++d) {
+      lo[d] = org_[d] + Grid<Dim>::ghost;
+      hi[d] = org_[d] + ext_[d] - 1 + Grid<Dim>::ghost;
+    }
+  }
 
  private:
   friend struct EbsStencil<Dim>;
@@ -131,6 +152,7 @@ class EbsBasis {
   void dilate();
 
   EbsOptions opt_;
+  const std::vector<std::uint8_t>* kept_ = nullptr;
   Grid<Dim> grid_;
   // Region: node lattice box org_ .. org_+ext_-1 = the body's bounding box of cells grown by one
   // node (every node whose support meets it); everything outside is exterior / inactive / empty.

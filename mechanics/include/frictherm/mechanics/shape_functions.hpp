@@ -2,16 +2,21 @@
 // Shape functions as tensor products of 1D kernels, evaluated per particle into a compact stencil
 // (base node + 1D weights and derivatives per direction). Particle loops are templated on the kernel,
 // so the choice costs no virtual call: `dispatch_shape(kind, f)` calls f(Kernel{}) once per pass.
+// The extended B-spline (EBS, docs/ebs.md) is built per body and per step by the MPM step itself;
+// its per-particle weights are stored flattened (PrecomputedStencils) and read by the same loops.
 #include <frictherm/mechanics/grid.hpp>
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <utility>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace frictherm::mechanics {
 
-enum class ShapeKind { linear, ugimp, quadratic_bspline };
+enum class ShapeKind { linear, ugimp, quadratic_bspline, extended_bspline };
 
 ShapeKind shape_kind_from_string(const std::string& name);  // throws std::invalid_argument
 const char* to_string(ShapeKind kind);
@@ -100,6 +105,11 @@ struct QuadraticBSplineKernel {
   }
 };
 
+/// Tag of the extended B-spline in the MPM step's particle loops. Its 1D kernel is the quadratic
+/// B-spline: where no per-body extension applies (rigid boundary particles marking nodes) it
+/// evaluates as the plain quadratic B-spline.
+struct ExtendedBSplineKernel : QuadraticBSplineKernel {};
+
 /// Tensor-product stencil of one particle: Dim sets of 1D weights.
 template <int Dim, class Kernel>
 struct Stencil {
@@ -159,13 +169,50 @@ struct Stencil {
   }
 };
 
+/// One particle's entries of PrecomputedStencils: same for_each call shape as Stencil. The slots
+/// were computed with the particle's own velocity field, so the indexer argument is not used.
+template <int Dim>
+struct PrecomputedStencil {
+  const std::int32_t* slot;
+  const double* S;
+  const Vec<Dim>* G;
+  std::size_t begin, end;
+
+  template <class F>
+  void for_each(const NodeIndexer<Dim>& /*ix*/, F&& f) const {
+    for (std::size_t e = begin; e < end; ++e) f(static_cast<int>(slot[e]), S[e], G[e]);
+  }
+  std::size_t size() const { return end - begin; }
+};
+
+/// Shape function values of every particle for one step, flattened (CSR): particle k owns entries
+/// begin[k] .. begin[k+1]-1, each a nodal slot of its velocity field with S_ip and G_ip. Filled
+/// once per step; the arrays keep their capacity, so steady runs do not allocate.
+template <int Dim>
+struct PrecomputedStencils {
+  std::vector<std::size_t> begin{0};
+  std::vector<std::int32_t> slot;
+  std::vector<double> S;
+  std::vector<Vec<Dim>> G;
+
+  std::size_t particles() const { return begin.size() - 1; }
+  std::size_t entries() const { return begin.back(); }
+  PrecomputedStencil<Dim> operator[](std::size_t k) const {
+    return {slot.data(), S.data(), G.data(), begin[k], begin[k + 1]};
+  }
+};
+
 /// Calls f(Kernel{}) with the kernel type named by kind: the one runtime switch per pass.
+/// extended_bspline gives its underlying QuadraticBSplineKernel: code outside the MPM step (the
+/// thermal assembly, the heat hand-off) uses the plain quadratic B-spline; Simulation::step builds
+/// the extension itself (docs/ebs.md).
 template <class F>
 decltype(auto) dispatch_shape(ShapeKind kind, F&& f) {
   switch (kind) {
     case ShapeKind::linear: return f(LinearKernel{});
     case ShapeKind::ugimp: return f(UGIMPKernel{});
-    case ShapeKind::quadratic_bspline: return f(QuadraticBSplineKernel{});
+    case ShapeKind::quadratic_bspline:
+    case ShapeKind::extended_bspline: return f(QuadraticBSplineKernel{});
   }
   throw std::logic_error("unknown shape function kind");
 }
