@@ -3,6 +3,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <ctime>
 #include <sstream>
 
@@ -31,6 +32,16 @@ void append_contact_series_names(std::vector<std::string>& names, const mechanic
   const char* axes[3] = {"x", "y", "z"};
   for (const auto& body : sim.bodies())
     for (int d = 0; d < Dim; ++d) names.push_back(std::string("mean_velocity_") + axes[d] + "." + body.name);
+  // Penalty contact (docs/penalty_contact.md): the springs' energy, and per pair (master.slave) the
+  // normal force, active contacts, deepest gap and the summed length of the penetrated master segments.
+  if (!sim.penalty_contact()) return;
+  names.emplace_back("penalty_energy");
+  for (const auto& pp : sim.penalty_pairs()) {
+    const std::string pair =
+        mats[static_cast<std::size_t>(pp.master_material)].name + "." + mats[static_cast<std::size_t>(pp.slave_material)].name;
+    for (const char* what : {"penalty_force.", "penalty_contacts.", "penalty_min_gap.", "penalty_contact_length."})
+      names.push_back(what + pair);
+  }
 }
 
 template <int Dim>
@@ -58,6 +69,28 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
   }
   for (std::size_t b = 0; b < mv.size(); ++b)
     for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mv[b][d] / m[b] : 0.0);
+  const mechanics::PenaltyContact<Dim>* pc = sim.penalty_contact();
+  if (!pc) return row;
+  row.push_back(pc->stored_energy());
+  const auto& bp = sim.boundary_points();
+  std::vector<int> segments;
+  for (std::size_t k = 0; k < pc->pair_count(); ++k) {
+    double gap = 0.0;
+    segments.clear();
+    for (const auto& c : pc->contacts())
+      if (c.pair == static_cast<int>(k)) {
+        gap = std::min(gap, c.gap);
+        segments.push_back(c.segment);
+      }
+    std::sort(segments.begin(), segments.end());
+    segments.erase(std::unique(segments.begin(), segments.end()), segments.end());
+    double length = 0.0;  // Kakouris 2024 §4.3.1: the contact length is the sum of the penetrated master segments
+    for (int sgm : segments) length += bp.segment_length(static_cast<std::size_t>(sgm));
+    row.push_back(pc->books(k).normal_force);
+    row.push_back(static_cast<double>(pc->books(k).active));
+    row.push_back(gap);
+    row.push_back(length);
+  }
   return row;
 }
 

@@ -1,4 +1,5 @@
-// Scene section `contact`: friction laws, normals and contact detection per material pair.
+// Scene section `contact`: friction laws, normals and contact detection per material pair, and the
+// contact method (multimaterial or penalty on boundary points) with its penalty settings.
 #include <frictherm/coupling/scene_contact.hpp>
 
 #include <algorithm>
@@ -33,6 +34,30 @@ void parse_normal(const JsonReader& n, int dim, bool vector_allowed, mechanics::
   s.normal = mechanics::NormalMethod::specified;
   s.normal_vector.setZero();
   for (int d = 0; d < dim; ++d) s.normal_vector[d] = v[static_cast<std::size_t>(d)];
+}
+
+/// "penalty": {"normal": ε_N | "normal_factor": f, "tangential": ε_T, "tangential_law": ...,
+/// "search_radius": m, "paper_terms": bool} (Kakouris 2024; docs/penalty_contact.md).
+void parse_penalty(const JsonReader& p, mechanics::PenaltySettings& s) {
+  if (!p.is_object()) p.expected("an object with \"normal\" or \"normal_factor\", \"tangential\", \"tangential_law\", \"search_radius\"");
+  if (p.has("normal") && p.has("normal_factor"))
+    p.at("normal_factor").fail("give either \"normal\" (N/m^3) or \"normal_factor\" (multiple of E/h), not both");
+  if (const auto n = p.find("normal")) s.normal_penalty = n->as_number(Range::positive()), s.normal_factor = 1.0;
+  if (const auto f = p.find("normal_factor")) s.normal_factor = f->as_number(Range::positive()), s.normal_penalty = 0.0;
+  s.tangential_penalty = p.number("tangential", s.tangential_penalty, Range::non_negative());
+  s.law = mechanics::tangential_law_from_string(
+      p.choice("tangential_law", {"return_mapping", "incremental"}, mechanics::to_string(s.law)));
+  s.search_radius = p.number("search_radius", s.search_radius, Range::non_negative());
+  if (const auto t = p.find("paper_terms")) s.paper_correction_terms = t->as_bool();
+  p.finish();
+}
+
+/// Penalty contact takes a coulomb or frictionless law (Kakouris 2024 eq. 32).
+void check_penalty_law(const mechanics::ContactPairSettings& s, const JsonReader& at) {
+  if (s.method != mechanics::ContactMethod::penalty) return;
+  const auto k = s.law.kind();
+  if (k != mechanics::FrictionKind::coulomb && k != mechanics::FrictionKind::frictionless)
+    at.fail("penalty contact takes a \"coulomb\" or \"frictionless\" law, got " + s.law.describe());
 }
 
 }  // namespace
@@ -92,8 +117,19 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
   if (!c->is_object()) c->expected("an object (see docs/contact.md)");
   spec.enabled = true;
   mechanics::ContactOptions& o = spec.options;
+  o.default_pair.method =
+      mechanics::contact_method_from_string(c->choice("method", {"multimaterial", "penalty"}, "multimaterial"));
+  if (o.default_pair.method == mechanics::ContactMethod::penalty && dim != 2)
+    c->at("method").fail("penalty contact is 2D only (expected \"multimaterial\" in 3D)");
+  if (const auto pen = c->find("penalty")) parse_penalty(*pen, o.default_pair.penalty);
+  o.boundary_spacing = c->number("boundary_spacing", 0.0, Range::non_negative());
   if (const auto n = c->find("normal")) parse_normal(*n, dim, false, o.default_pair);
-  if (const auto law = c->find("law")) o.default_pair.law = parse_friction_law(*law);
+  if (const auto law = c->find("law")) {
+    o.default_pair.law = parse_friction_law(*law);
+    check_penalty_law(o.default_pair, *law);
+  } else if (o.default_pair.method == mechanics::ContactMethod::penalty) {
+    o.default_pair.law = mechanics::FrictionLaw::frictionless();  // the default "stick" has no penalty form
+  }
   o.separation = mechanics::separation_method_from_string(
       c->choice("separation", {"position", "displacement", "velocity_only"}, "position"));
   o.position_correction = c->number("position_correction", 0.8, Range{0.0, 2.0, false, true});
@@ -123,8 +159,21 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
             (q.material_a == ps.material_b && q.material_b == ps.material_a))
           mats.fail("this pair is already listed");
       ps.settings = o.default_pair;
-      ps.settings.law = parse_friction_law(p.at("law", "a friction law"));
+      if (const auto m = p.find("method")) {
+        ps.settings.method = mechanics::contact_method_from_string(m->as_choice({"multimaterial", "penalty"}));
+        if (ps.settings.method == mechanics::ContactMethod::penalty && dim != 2)
+          m->fail("penalty contact is 2D only (expected \"multimaterial\" in 3D)");
+      }
+      const JsonReader law = p.at("law", "a friction law");
+      ps.settings.law = parse_friction_law(law);
+      check_penalty_law(ps.settings, law);
       if (const auto n = p.find("normal")) parse_normal(*n, dim, true, ps.settings);
+      if (const auto pen = p.find("penalty")) parse_penalty(*pen, ps.settings.penalty);
+      if (const auto m = p.find("master")) {
+        const int id = material_id(*m);
+        if (id != ps.material_a && id != ps.material_b) m->fail("expected one of the pair's two materials");
+        ps.settings.penalty.master = id;
+      }
       p.finish();
       spec.pairs.push_back(ps);
     }

@@ -1,3 +1,4 @@
+#include <frictherm/mechanics/boundary_points.hpp>
 #include <frictherm/mechanics/geometry.hpp>
 
 #include <cmath>
@@ -21,6 +22,10 @@ class Box final : public Region<Dim> {
   }
   Vec<Dim> box_lo() const override { return lo_; }
   Vec<Dim> box_hi() const override { return hi_; }
+  std::vector<std::vector<Vec<2>>> boundary_loops(double spacing) const override {
+    if constexpr (Dim != 2) return {};
+    else return {sample_rectangle_boundary(lo_, hi_, spacing)};
+  }
 
  private:
   Vec<Dim> lo_, hi_;
@@ -48,6 +53,10 @@ class Ellipse final : public Region<Dim> {
   }
   Vec<Dim> box_lo() const override { return c_ - Vec<Dim>::Constant(a_.maxCoeff()); }
   Vec<Dim> box_hi() const override { return c_ + Vec<Dim>::Constant(a_.maxCoeff()); }
+  std::vector<std::vector<Vec<2>>> boundary_loops(double spacing) const override {
+    if constexpr (Dim != 2) return {};
+    else return {sample_ellipse_boundary(c_, a_, std::atan2(sin_, cos_), spacing)};
+  }
 
  private:
   Vec<Dim> c_, a_;
@@ -67,6 +76,11 @@ class Annulus final : public Region<Dim> {
   }
   Vec<Dim> box_lo() const override { return c_ - Vec<Dim>::Constant(ro_); }
   Vec<Dim> box_hi() const override { return c_ + Vec<Dim>::Constant(ro_); }
+  std::vector<std::vector<Vec<2>>> boundary_loops(double spacing) const override {
+    if constexpr (Dim != 2) return {};
+    else if (ri_ > 0.0) return sample_annulus_boundary(c_, ri_, ro_, spacing);
+    else return {sample_ellipse_boundary(c_, Vec<2>(ro_, ro_), 0.0, spacing)};
+  }
 
  private:
   Vec<Dim> c_;
@@ -134,6 +148,12 @@ class Polygon final : public Extruded<Dim> {
   }
   Vec<2> planar_lo() const override { return lo_; }
   Vec<2> planar_hi() const override { return hi_; }
+
+ public:
+  std::vector<std::vector<Vec<2>>> boundary_loops(double spacing) const override {
+    if constexpr (Dim != 2) return {};
+    else return {sample_polygon_boundary(v_, spacing)};
+  }
 
  private:
   std::vector<Vec<2>> v_;

@@ -134,6 +134,10 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
 // node the slots come in material order because fields are laid out in material order.
 template <int Dim>
 void Simulation<Dim>::find_contact_nodes() {
+  if (!any_multimaterial_) {  // every present pair uses penalty contact
+    contact_entries_.clear();
+    return;
+  }
   std::fill(node_field_count_.begin(), node_field_count_.end(), std::uint16_t{0});
   const double mmin = empty_node_mass_;
   const std::size_t total = nodes_.mass.size();
@@ -218,7 +222,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       // Two materials: a is the deformable one when the other is rigid.
       std::size_t ia = 0, ib = 1;
       if (sides[0].rigid) std::swap(ia, ib);
-      if (!sides[ia].rigid) {
+      if (!sides[ia].rigid && contact_pair(mats[ia], mats[ib]).method == ContactMethod::multimaterial) {
         ctx.settings = &contact_pair(mats[ia], mats[ib]);
         const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
         if (r.changed) {
@@ -247,7 +251,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
         std::size_t dominant = count;
         double rigid_weight = -1.0;
         for (std::size_t j = 0; j < count; ++j) {
-          if (j == a) continue;
+          if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
           rest.add(sides[j]);
           if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
           if (sides[j].rigid && sides[j].mass > rigid_weight) {  // a rigid neighbour dominates the lump
@@ -257,6 +261,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
             rest.rigid_acceleration = sides[j].rigid_acceleration;
           }
         }
+        if (dominant == count) continue;  // all its partners here use penalty contact
         ctx.settings = &contact_pair(mats[a], mats[dominant]);
         const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
         if (r.changed) dps[a] = r.dp;

@@ -3,6 +3,7 @@
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
+#include <cmath>
 #include <sstream>
 
 namespace frictherm::mechanics {
@@ -37,6 +38,9 @@ void Simulation<Dim>::enable_contact(const ContactOptions& options) {
     throw std::invalid_argument("contact position correction must be in [0, 2) cell sizes");
   if (!(options.min_mass_fraction >= 0.0 && options.min_mass_fraction < 0.5))
     throw std::invalid_argument("contact min_mass_fraction must be in [0, 0.5)");
+  if (!(options.boundary_spacing >= 0.0) || !std::isfinite(options.boundary_spacing))
+    throw std::invalid_argument("contact boundary_spacing must be finite and >= 0 (0: half the cell size)");
+  check_penalty_settings(options.default_pair, -1, -1);
   contact_ = true;
   contact_opt_ = options;
   pair_settings_.assign(1, options.default_pair);
@@ -49,7 +53,8 @@ void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& 
   if (a < 0 || b < 0 || a >= n || b >= n || a == b) throw std::invalid_argument("contact pair needs two different materials");
   if (pair_index_.size() != static_cast<std::size_t>(n * n)) pair_index_.assign(static_cast<std::size_t>(n * n), 0);
   ContactPairSettings s = settings;
-  if (s.normal == NormalMethod::specified) {
+  check_penalty_settings(s, a, b);
+  if (s.method == ContactMethod::multimaterial && s.normal == NormalMethod::specified) {
     const double len = s.normal_vector.head<Dim>().norm();
     if (!(len > 0.0)) throw std::invalid_argument("a specified contact normal must be non-zero");
     s.normal_vector /= len;
@@ -108,6 +113,7 @@ void Simulation<Dim>::init_fields() {
   work_first_.assign(grid_.node_count(), 0.0);
   work_second_.assign(grid_.node_count(), 0.0);
   field_velocity_.assign(fields_.size(), Vec<Dim>::Zero());
+  if (contact_) setup_penalty();
 }
 
 // Each material's field covers the box [lo, hi] of nodes its particles reach, stored contiguously:

@@ -33,6 +33,8 @@ Simulation<Dim>::Simulation(const Grid<Dim>& grid, const SimulationOptions& opti
     throw std::invalid_argument("a 2D simulation needs analysis plane_strain or plane_stress");
   if (!(opt_.cfl > 0.0 && opt_.cfl <= 1.0)) throw std::invalid_argument("CFL factor must be in (0, 1]");
   if (Dim == 2 && !(opt_.thickness > 0.0)) throw std::invalid_argument("thickness must be > 0");
+  if (!(opt_.ebs_occupation >= 0.0) || !std::isfinite(opt_.ebs_occupation))
+    throw std::invalid_argument("extended B-spline occupation parameter C_c must be finite and >= 0");
   nodes_.resize(grid_.node_count());
   fixed_mask_.assign(grid_.node_count(), 0);
   rigid_mask_.assign(grid_.node_count(), 0);
@@ -127,6 +129,17 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
     throw std::invalid_argument(msg.str());
   }
   bodies_.push_back(BodyInfo{name, count});
+  // Penalty contact: the region's boundary, sampled now (the region is not kept), and the body's
+  // single material (−1 for several, e.g. an image).
+  int body_mat = p_.material[before];
+  for (std::size_t k = before; k < p_.size(); ++k)
+    if (p_.material[k] != body_mat) body_mat = -1;
+  const double spacing = contact_opt_.boundary_spacing > 0.0 ? contact_opt_.boundary_spacing : 0.5 * grid_.min_cell_size();
+  body_loops_.push_back(Dim == 2 ? region.boundary_loops(spacing) : std::vector<std::vector<Vec<2>>>{});
+  body_loop_spacing_.push_back(spacing);
+  body_material_.push_back(body_mat);
+  body_half_size_.push_back(lp);
+  body_velocity_.push_back(velocity);
   return body_id;
 }
 
@@ -255,6 +268,7 @@ double Simulation<Dim>::stable_time_step() const {
   }
   for (const Material& mat : materials_)  // rigid bodies move material through the grid too
     if (mat.is_rigid()) cmax = std::max(cmax, mat.rigid_velocity_at(time_).norm());
+  cmax *= penalty_wave_factor();
   if (cmax <= 0.0) return opt_.max_time_step;
   return std::min(opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step);
 }

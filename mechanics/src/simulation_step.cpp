@@ -2,7 +2,9 @@
 // update. Particle loops are templated on the shape-function kernel (static dispatch) and threaded
 // with OpenMP; scatters go to per-thread nodal buffers that are summed afterwards. Every particle
 // scatters into the slots of its material's velocity field (field_of_material_), so the same loops
-// serve the shared single field and the per-material fields of multimaterial contact.
+// serve the shared single field and the per-material fields of multimaterial contact. With the
+// extended B-spline the weights are precomputed per step (simulation_ebs.cpp) and the same loops
+// read them.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/simulation.hpp>
@@ -16,11 +18,17 @@
 
 namespace frictherm::mechanics {
 
+namespace {
+template <class Kernel>
+constexpr bool is_extended = std::is_same_v<Kernel, ExtendedBSplineKernel>;
+}  // namespace
+
 template <int Dim>
 template <class Kernel>
-std::vector<Stencil<Dim, Kernel>>& Simulation<Dim>::stencils() {
+auto& Simulation<Dim>::stencils() {
   if constexpr (std::is_same_v<Kernel, LinearKernel>) return st_linear_;
   else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return st_ugimp_;
+  else if constexpr (is_extended<Kernel>) return st_extended_;
   else return st_quadratic_;
 }
 
@@ -33,7 +41,10 @@ double Simulation<Dim>::step(double dt_limit) {
     msg << "step " << step_ << ", t = " << time_ << " s: time step " << dt << " s is not positive and finite";
     throw SimulationError(msg.str(), step_, time_, -1);
   }
-  dispatch_shape(opt_.shape, [&](auto kernel) { step_with<decltype(kernel)>(dt); });
+  if (opt_.shape == ShapeKind::extended_bspline)
+    step_with<ExtendedBSplineKernel>(dt);
+  else
+    dispatch_shape(opt_.shape, [&](auto kernel) { step_with<decltype(kernel)>(dt); });
   last_dt_ = dt;
   return dt;
 }
@@ -49,19 +60,23 @@ void Simulation<Dim>::step_with(double dt) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
     for (auto& t : thread_nodes_) t.resize(nodes_.mass.size(), contact_);
   }
-  stencils<Kernel>().resize(p_.size());
   const double t = time_;
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
       field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
+  map_rigid_particles<Kernel>(t);  // nodes driven by rigid boundary materials (EBS keeps them)
+  if constexpr (is_extended<Kernel>) {
+    prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
+  } else {
+    stencils<Kernel>().resize(p_.size());
+    if (contact_) evaluate_stencils<Kernel>();  // also lays out the per-material boxes of nodes
+  }
   if (contact_) {
-    evaluate_stencils<Kernel>();  // also lays out the per-material boxes of nodes
     std::fill(work_first_.begin(), work_first_.end(), 0.0);
     std::fill(work_second_.begin(), work_second_.end(), 0.0);
   }
   const bool usf = opt_.scheme == UpdateScheme::usf;
   map_to_grid<Kernel>(dt, /*with_forces=*/!usf);
-  map_rigid_particles<Kernel>(t);
   if (contact_) {
     find_contact_nodes();
     resolve_contact(ContactPass::extrapolated, dt);
@@ -70,16 +85,20 @@ void Simulation<Dim>::step_with(double dt) {
     velocity_from_momentum();
     update_stress<Kernel>(nodes_.velocity, dt);
     add_internal_forces<Kernel>();
+    move_boundary_points(dt, t);  // penalty: the points move with the velocity the stress update used
   }
   map_external_loads<Kernel>(t);
-  update_grid(dt);
+  apply_penalty_forces();  // penalty pairs: point forces into the nodal forces (Kakouris 2024 eq. 36)
+  update_grid(dt);         // velocity conditions act on the penalty forces too
   const long bad = update_particles<Kernel>(dt);
+  if (opt_.scheme == UpdateScheme::usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
   move_rigid_particles(dt, t);
   time_ += dt;
   ++step_;
   check_particle(bad, dt);
   if (opt_.scheme == UpdateScheme::musl) {
     remap_momentum<Kernel>(dt);
+    move_boundary_points(dt, t);  // MUSL: with the remapped velocity, as the stress update
     update_stress<Kernel>(nodes_.velocity, dt);
   } else if (opt_.scheme == UpdateScheme::usl) {
     update_stress<Kernel>(nodes_.velocity, dt);
@@ -134,8 +153,8 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
       if (!contact_) {
 #pragma omp for schedule(static) nowait
         for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-          Stencil<Dim, Kernel>& s = st[k];
-          s.evaluate(grid_, p_.position[k], p_.half_size[k]);
+          if constexpr (!is_extended<Kernel>) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+          const auto& s = st[k];  // EBS: a view of the precomputed entries
           const double mp = p_.mass[k];
           const Vec<Dim> mv = mp * p_.velocity[k];
           const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];

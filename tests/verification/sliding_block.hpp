@@ -28,6 +28,7 @@ struct SlidingBlockSetup {
   double angle = 0.0;    // radians; rotated variant only
   bool rotated = false;
   bool single_material = false;  // block and base one material (no contact): benchmark baseline
+  mechanics::ContactMethod method = mechanics::ContactMethod::multimaterial;  // or penalty (base = master)
   /// Rotated variant: scale both loads by the block's particle mass over ρ l h b, so the load per
   /// unit mass is the exact block's even when the turned lattice fills the block with a few
   /// particles more or fewer (at 45° and 5 mm cells it holds 92 particles instead of 96).
@@ -145,6 +146,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     co.default_pair.normal = s.normal;
     co.default_pair.normal_vector = Vec<3>(-sn, c, 0.0);  // from base to block
     co.separation = s.separation;
+    co.default_pair.method = s.method;
     sim.enable_contact(co);
     ContactPairSettings pair = co.default_pair;
     sim.set_contact_pair(base, block_material, pair);

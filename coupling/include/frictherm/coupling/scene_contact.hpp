@@ -7,6 +7,14 @@
 //               "pairs": [{"materials": ["base", "block"], "normal": [0, 1],
 //                          "law": {"type": "adhesion", "mu": 0.2, "shear_strength": 4.4e4}}]}
 //
+// Penalty contact on boundary points (Kakouris 2024, 2D; docs/penalty_contact.md) for all pairs or
+// per pair, with the same laws (coulomb or frictionless), so a scene switches method by one key:
+//
+//   "contact": {"method": "penalty", "boundary_spacing": 0.0025,
+//               "penalty": {"normal_factor": 1.0, "tangential_law": "return_mapping"},
+//               "pairs": [{"materials": ["base", "block"], "law": {"type": "coulomb", "mu": 0.2},
+//                          "master": "base", "penalty": {"normal": 5e11}}]}
+//
 // Without a `contact` section all deformable materials share one velocity field.
 #include <frictherm/coupling/json_reader.hpp>
 #include <frictherm/mechanics/contact.hpp>

@@ -10,6 +10,10 @@
 // extrapolation, after the momentum update (with forces kept consistent, eq. 19, and frictional
 // work of first and second order, eqs. 27 and 29–36) and, for MUSL, after the momentum remap.
 //
+// A pair may instead use penalty contact on boundary material points (Kakouris et al. 2024, method
+// = penalty; penalty_contact.hpp, docs/penalty_contact.md): its materials then meet only through
+// penalty forces, and the node-based resolution above skips them.
+//
 // Sign convention: the normal n̂ points from material a to material b, so the materials approach
 // when (v_b − v_a)·n̂ < 0 and the separation is δ = (x̄_b − x̄_a)·n̂ − 0.8 h⊥ (positions) or
 // (Δx̄_b − Δx̄_a)·n̂ (displacements); the paper prints these with the opposite orientation.
@@ -23,19 +27,41 @@ namespace frictherm::mechanics {
 enum class NormalMethod { max_volume_gradient, average_volume_gradient, specified };
 enum class SeparationMethod { position, displacement, velocity_only };
 enum class HeatingOrder { first, second };
+enum class ContactMethod { multimaterial, penalty };
+/// Penalty contact, tangential law: return mapping with a tangential spring (default) or Kakouris
+/// 2024 eq. 32 as printed (increment only). See penalty_contact.hpp.
+enum class TangentialLaw { return_mapping, incremental };
 
 NormalMethod normal_method_from_string(const std::string& name);          // "mvg", "avg"
 SeparationMethod separation_method_from_string(const std::string& name);  // "position", "displacement", "velocity_only"
 HeatingOrder heating_order_from_string(const std::string& name);          // "first", "second"
+ContactMethod contact_method_from_string(const std::string& name);        // "multimaterial", "penalty"
+TangentialLaw tangential_law_from_string(const std::string& name);        // "return_mapping", "incremental"
 const char* to_string(NormalMethod m);
 const char* to_string(SeparationMethod m);
 const char* to_string(HeatingOrder o);
+const char* to_string(ContactMethod m);
+const char* to_string(TangentialLaw law);
+
+/// Penalty contact settings of a pair (method == penalty; Kakouris 2024 §3.5–3.6). The friction
+/// coefficient is the pair's law: coulomb (μ) or frictionless (μ = 0).
+struct PenaltySettings {
+  double normal_penalty = 0.0;      // ε_N (N/m³); 0: normal_factor × E/Δh (eq. 40), E the smaller finite modulus
+  double normal_factor = 1.0;       // multiple of E/Δh when normal_penalty is 0
+  double tangential_penalty = 0.0;  // ε_T (N/m³); 0: equal to ε_N (eq. 40)
+  TangentialLaw law = TangentialLaw::return_mapping;
+  double search_radius = 0.0;       // distance check (m); 0: the smallest cell size Δh
+  int master = -1;                  // material id of the master; -1: the rigid, else stiffer, else heavier body
+  bool paper_correction_terms = false;  // the (g/l) P and (Δg_T/l) Q terms of eqs. 51–52
+};
 
 /// How one pair of materials interacts.
 struct ContactPairSettings {
   FrictionLaw law = FrictionLaw::stick();
   NormalMethod normal = NormalMethod::max_volume_gradient;
   Vec<3> normal_vector = Vec<3>::UnitY();  // specified normal, from the pair's first material to its second
+  ContactMethod method = ContactMethod::multimaterial;
+  PenaltySettings penalty;                 // method == penalty
 };
 
 struct ContactOptions {
@@ -46,6 +72,9 @@ struct ContactOptions {
   /// contact there: its field is a numerical sliver, and its reduced mass would make the contact
   /// and heating terms ill-conditioned.
   double min_mass_fraction = 1e-6;
+  /// Penalty contact: spacing of the boundary points sampled on each body's region (m); 0: half
+  /// the smallest cell size. Used when a body is added, so set it before add_body().
+  double boundary_spacing = 0.0;
 };
 
 }  // namespace frictherm::mechanics

@@ -16,6 +16,10 @@ class Region {
   virtual int material_at(const Vec<Dim>& x) const = 0;
   virtual Vec<Dim> box_lo() const = 0;  // axis-aligned bounding box
   virtual Vec<Dim> box_hi() const = 0;
+  /// 2D: the region's boundary as closed loops sampled with points at most `spacing` apart, material
+  /// on the left (outer loops counter-clockwise, holes clockwise), for penalty contact
+  /// (boundary_points.hpp). Empty when the region has none (images, 3D).
+  virtual std::vector<std::vector<Vec<2>>> boundary_loops(double /*spacing*/) const { return {}; }
 };
 
 /// Rectangle (2D) or box (3D) [lo, hi].

@@ -11,16 +11,27 @@
 //          removes the small-mass-node noise of USL while keeping its energy behaviour).
 // Time step: dt = C * min(h) / max_p (c_p + |v_p|), with C the CFL factor and c_p the particle's
 // dilatational wave speed (Nairn 2018 eq. 45 with the particle speed added).
+// Shape functions: linear, uGIMP, quadratic B-spline, or the extended B-spline (Kakouris 2024 §3.3),
+// rebuilt at the start of every step per velocity field (each body's field with contact, the shared
+// field of all deformable particles without) and used for every transfer of the step (docs/ebs.md).
+// Contact pairs may instead use penalty contact on boundary material points (ContactMethod::penalty,
+// Kakouris 2024; docs/penalty_contact.md): the boundary loops of each body come from its region,
+// the penalty forces join the nodal forces before the momentum update, the points move with their
+// field's new grid velocity, and the frictional heat goes to frictional_work() like the
+// multimaterial heat.
 #include <frictherm/mechanics/contact.hpp>
+#include <frictherm/mechanics/ebs.hpp>
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/loads.hpp>
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/particles.hpp>
+#include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +46,7 @@ struct SimulationOptions {
   Analysis analysis = Analysis::plane_strain;  // 2D: plane_strain or plane_stress; 3D: three_d
   double thickness = 1.0;                      // 2D out-of-plane thickness (m)
   ShapeKind shape = ShapeKind::ugimp;
+  double ebs_occupation = 0.75;                // extended_bspline: C_c, a cell is interior if φ_c > C_c (Kakouris 2024 eq. 20)
   UpdateScheme scheme = UpdateScheme::musl;
   double cfl = 0.5;                            // C in (0, 1]
   double max_time_step = std::numeric_limits<double>::infinity();
@@ -75,6 +87,13 @@ struct ContactStats {
   long multi_nodes = 0;       // of which with three or more (lumped virtual material, eqs. 39–40)
   long sliding_nodes = 0;     // node-pairs sliding in the momentum-update pass
   long guarded = 0;           // materials left out because their mass fraction was below min_mass_fraction
+  long penalty_contacts = 0;  // penalty contact: active slave point – master segment contacts
+  long penalty_sliding = 0;   // of which sliding
+};
+
+/// A material pair in penalty contact: master and slave materials, index into penalty_contact()'s pairs.
+struct PenaltyPairInfo {
+  int master_material = -1, slave_material = -1;
 };
 
 struct BodyInfo {
@@ -96,10 +115,15 @@ class Simulation {
   void fix_face(const FixedFace& face);
   void add_point_load(const PointLoad<Dim>& load);
   void add_edge_traction(const EdgeTraction<Dim>& load);
-  /// Turns on multimaterial contact (one velocity field per material); before finalize().
+  /// Turns on contact (one velocity field per material); before finalize(), and before add_body()
+  /// when the penalty boundary spacing is set.
   void enable_contact(const ContactOptions& options);
   /// Settings of one material pair (order matters only for a specified normal: from a to b).
+  /// Penalty pairs (2D only) take a coulomb or frictionless law.
   void set_contact_pair(int material_a, int material_b, const ContactPairSettings& settings);
+  /// Replaces the boundary loops of a body (penalty contact; material on the left of each loop),
+  /// e.g. for an image body, whose region has none. Before finalize().
+  void set_body_boundary(int body, const std::vector<std::vector<Vec<2>>>& loops);
   /// Groups particles by material and resolves loads; called by the first step if not before.
   void finalize();
 
@@ -126,6 +150,14 @@ class Simulation {
   const ContactStats& contact_stats() const { return contact_stats_; }
   /// The pairs given settings with set_contact_pair, in call order.
   const std::vector<std::pair<int, int>>& contact_pairs() const { return explicit_pairs_; }
+  /// Penalty contact (after finalize()): nullptr without penalty pairs; pair k of it is
+  /// penalty_pairs()[k]. Its books hold the last step's forces and the heat per pair.
+  const PenaltyContact<Dim>* penalty_contact() const { return penalty_ ? &*penalty_ : nullptr; }
+  const std::vector<PenaltyPairInfo>& penalty_pairs() const { return penalty_pairs_; }
+  /// Boundary material points of the bodies in penalty pairs (field = velocity field index). The
+  /// mutable access is for set-up (e.g. shifting a body with its particles before the first step).
+  const BoundaryPoints<Dim>& boundary_points() const { return boundary_; }
+  BoundaryPoints<Dim>& boundary_points() { return boundary_; }
   /// Frictional work of the last step per grid node (J), added once per contact node (eqs. 27, 34,
   /// 36, 40): what the coupling hands to the thermal solver. All zeros without contact.
   const std::vector<double>& frictional_work(HeatingOrder order) const {
@@ -136,6 +168,9 @@ class Simulation {
   double cumulative_frictional_work(HeatingOrder order, int material_a, int material_b) const;
   const std::vector<Material>& materials() const { return materials_; }
   const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  /// extended_bspline: the extended basis of each velocity field (fields()[f]) as rebuilt at the
+  /// start of the last step (classification, counts); empty for the other shape functions.
+  const std::vector<EbsBasis<Dim>>& extended_bases() const { return ebs_; }
   double time() const { return time_; }
   long step_count() const { return step_; }
   double last_time_step() const { return last_dt_; }
@@ -155,8 +190,9 @@ class Simulation {
   template <class Kernel> void remap_momentum(double dt);
   template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
   template <class Kernel> long update_particles(double dt);
-  template <class Kernel> std::vector<Stencil<Dim, Kernel>>& stencils();
+  template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
   template <class Kernel> void evaluate_stencils();
+  void prepare_extended_stencils();  // EBS: rebuild per field, lay out the fields, flatten the weights
   template <class Kernel> void map_rigid_fields();
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
@@ -170,6 +206,11 @@ class Simulation {
   void find_contact_nodes();
   void resolve_contact(ContactPass pass, double dt);
   void move_rigid_particles(double dt, double t);
+  void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
+  void setup_penalty();                          // finalize(): penalty pairs and boundary points
+  void apply_penalty_forces();                   // step: detection, forces into nodes_.force, heat
+  void move_boundary_points(double dt, double t);  // step: with the new nodal momenta
+  double penalty_wave_factor() const;            // time step: √(ε/(E/Δh)) when a penalty is stiffer than eq. 40
   void check_particle(long bad, double dt) const;
   void resolve_loads();
 
@@ -199,6 +240,21 @@ class Simulation {
   std::vector<double> work_first_, work_second_;    // per grid node, last step
   std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
   ContactStats contact_stats_;
+  bool any_multimaterial_ = true;               // some present material pair uses multimaterial contact
+  // Penalty contact: per body its boundary loops (from its region, or set_body_boundary), the spacing
+  // they were sampled with (−1: given by the user), its material (−1: several) and particle half-size.
+  std::vector<std::vector<std::vector<Vec<2>>>> body_loops_;
+  std::vector<double> body_loop_spacing_;
+  std::vector<int> body_material_;
+  std::vector<Vec<Dim>> body_half_size_, body_velocity_;
+  BoundaryPoints<Dim> boundary_;
+  std::optional<PenaltyContact<Dim>> penalty_;
+  std::vector<PenaltyPairInfo> penalty_pairs_;
+  std::vector<FieldNodes<Dim>> penalty_fields_;  // the fields' node boxes, refreshed each step
+  std::vector<double> penalty_reference_mass_;   // per field: its mean particle mass (sliver test)
+  // A boundary point leaves out a node of its field holding less than 0.25 S m_p (a sliver of the
+  // body beside its edge, see simulation_penalty.cpp).
+  static constexpr double penalty_sliver_ = 0.25;
   std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1)
   std::vector<std::uint8_t> fixed_mask_;        // bit d set: velocity component d fixed to 0
   std::vector<std::uint8_t> rigid_mask_;        // bit d set: velocity component d driven by a rigid material
@@ -218,6 +274,10 @@ class Simulation {
   std::vector<Stencil<Dim, LinearKernel>> st_linear_;
   std::vector<Stencil<Dim, UGIMPKernel>> st_ugimp_;
   std::vector<Stencil<Dim, QuadraticBSplineKernel>> st_quadratic_;
+  PrecomputedStencils<Dim> st_extended_;   // EBS: N^e, ∇N^e of every particle, this step
+  std::vector<EbsBasis<Dim>> ebs_;         // EBS: one per velocity field
+  std::vector<std::pair<std::size_t, std::size_t>> ebs_ranges_;  // rebuild scratch: a field's particle ranges
+  std::vector<std::uint8_t> ebs_kept_;     // EBS: nodes never made degenerate (velocity conditions)
   bool finalized_ = false;
   double time_ = 0.0;
   long step_ = 0;

@@ -1,0 +1,359 @@
+// Penalty contact on boundary material points inside the MPM step (Kakouris, Chatzis &
+// Triantafyllou 2024 §3.4–3.7, Algorithms 1 and 3; docs/penalty_contact.md). Per step, after the
+// particle-to-grid transfer and before the momentum update:
+//   detection and penalty forces at the boundary points' step-start positions (K·27–34), each point
+//   force added to its own field's nodal force through the point's own weights (K·36), and the
+//   frictional heat to the grid nodes through the same weights (frictional_work(), both orders);
+// the points move with their field's nodal velocity (PIC), rigid fields' points with the rigid body,
+// and the velocity is the one the step's stress update uses (USL: v^{n+1} after the momentum update;
+// MUSL: the remapped v^{n+1}; USF: the step-start velocity, before the forces). The gap then measures
+// the overlap of the bodies as their strains see it: moving the points with the pre-remap v^{n+1}
+// under MUSL made the penalty spring and the bodies' elasticity two springs integrated with different
+// velocities, a non-conservative loop that grew slowly at any time step (see move_boundary_points).
+// The weights: S_I, the step's shape function at the point (with extended B-splines the body's
+// extended basis N^e wherever it is defined, i.e. in a cell holding the body's particles, else the
+// plain B-spline; degenerate nodes carry no mass and drop out), renormalised over the nodes of the
+// point's field that hold material: m_I > 0.25 S_I m_p, m_p the body's mean particle mass. The same
+// weights scatter the force and heat and gather the velocity, so the penalty spring does no spurious
+// work. The sliver test keeps the point off nodes just outside the body's edge that hold a tail of
+// its particles' shape functions only: such a node would take a share S of the force over its tiny
+// mass and the point would follow its velocity. Measured without it: the sliding block with uGIMP
+// blew up in 19 steps (a node of 7e-18 kg with S = 0.06), and with the quadratic B-spline a bar
+// impact lost 16 % of its energy (the paper's "severe errors at the contact point" with OBS); with
+// it both are right (tests/verification/test_penalty_*). EBS never needs it: its degenerate nodes
+// have no mass. Weighting by nodal mass instead (S_I m_I / Σ S m) is just as stable but moves the
+// contact force into the body: the stacked bars' contact rows then lost the whole contact stress.
+#include <frictherm/mechanics/errors.hpp>
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace frictherm::mechanics {
+
+namespace {
+
+/// Slot of grid node `node` in a field's box, or −1 outside it.
+template <int Dim>
+int slot_of(const Grid<Dim>& grid, const FieldNodes<Dim>& F, int node) {
+  const IVec<Dim> L = grid.node_lattice(node);
+  int slot = F.index.shift;
+  for (int d = 0; d < Dim; ++d) {
+    const int l = L[d] + Grid<Dim>::ghost;
+    if (l < F.lo[d] || l >= F.lo[d] + F.extent[d]) return -1;
+    slot += l * F.index.stride[d];
+  }
+  return slot;
+}
+
+/// The boundary points' weights in the step: GridWeights (the step's kernel, renormalised over the
+/// nodes where the field has mass), or with EBS the field's extended basis where it is defined.
+template <int Dim>
+struct StepWeights {
+  GridWeights<Dim> plain;
+  const std::vector<EbsBasis<Dim>>* ebs = nullptr;
+
+  template <class Visit>
+  void operator()(int field, const Vec<Dim>& x, const Vec<Dim>& half_size, Visit&& visit) const {
+    if (ebs && try_extended(field, x, visit)) return;
+    plain(field, x, half_size, visit);
+  }
+
+ private:
+  static constexpr int kMax = 64;  // largest stencil taken from the extended basis (2D: 9 plain, ~16 extended)
+
+  template <class Visit>
+  bool try_extended(int field, const Vec<Dim>& x, Visit& visit) const {
+    EbsStencil<Dim> s;
+    (*ebs)[static_cast<std::size_t>(field)].evaluate(x, s);
+    if (s.table == EbsStencil<Dim>::empty || s.size() > kMax) return false;
+    const FieldNodes<Dim>& F = plain.fields[static_cast<std::size_t>(field)];
+    int slot[kMax], node[kMax];
+    double S[kMax];
+    int m = 0;
+    double sum = 0.0;
+    s.for_each([&](int nd, double w, const Vec<Dim>&) {
+      if (w == 0.0) return;
+      const int sl = slot_of(*plain.grid, F, nd);
+      if (sl < 0 || !plain.keeps(field, static_cast<std::size_t>(sl), w)) return;
+      slot[m] = sl, node[m] = nd, S[m] = w;
+      sum += w;
+      ++m;
+    });
+    // N^e sums to one over the stable nodes, which all have mass; a sum far from one means the point
+    // sits where the extension does not describe the field (fall back to the plain spline).
+    if (m == 0 || !(sum > 0.5)) return false;
+    const double inv = 1.0 / sum;
+    for (int a = 0; a < m; ++a) visit(slot[a], node[a], S[a] * inv);
+    return true;
+  }
+};
+
+double modulus_for_penalty(const Material& m) {
+  if (m.is_rigid()) return std::numeric_limits<double>::infinity();
+  return m.youngs_modulus;  // mie_gruneisen: 0 unless given, then the partner's E (or set the penalty)
+}
+
+}  // namespace
+
+template <int Dim>
+void Simulation<Dim>::check_penalty_settings(const ContactPairSettings& s, int a, int b) const {
+  if (s.method != ContactMethod::penalty) return;
+  const std::string what = a < 0 ? std::string("default contact pair") :
+                                   "contact pair (" + materials_[static_cast<std::size_t>(a)].name + ", " +
+                                       materials_[static_cast<std::size_t>(b)].name + ")";
+  const auto bad = [&](const std::string& m) { throw std::invalid_argument(what + ": penalty contact " + m); };
+  if (Dim != 2) bad("is 2D only (boundary segments; 3D surfaces are not implemented)");
+  if (s.law.kind() != FrictionKind::coulomb && s.law.kind() != FrictionKind::frictionless)
+    bad("takes a coulomb or frictionless law (Kakouris 2024 eq. 32), got " + s.law.describe());
+  const PenaltySettings& p = s.penalty;
+  if (!(p.normal_penalty >= 0.0) || !std::isfinite(p.normal_penalty)) bad("normal penalty must be finite and >= 0 (0: E/h)");
+  if (!(p.normal_factor > 0.0) || !std::isfinite(p.normal_factor)) bad("normal penalty factor must be finite and > 0");
+  if (!(p.tangential_penalty >= 0.0) || !std::isfinite(p.tangential_penalty))
+    bad("tangential penalty must be finite and >= 0 (0: the normal penalty)");
+  if (!(p.search_radius >= 0.0) || !std::isfinite(p.search_radius)) bad("search radius must be finite and >= 0");
+  if (a < 0 && p.master >= 0) bad("master belongs to a listed pair, not the default");
+  if (a >= 0 && p.master >= 0 && p.master != a && p.master != b) bad("master must be one of the pair's two materials");
+}
+
+template <int Dim>
+void Simulation<Dim>::set_body_boundary(int body, const std::vector<std::vector<Vec<2>>>& loops) {
+  if (finalized_) throw std::logic_error("body boundaries must be set before the simulation is finalized");
+  if (body < 0 || body >= static_cast<int>(bodies_.size())) throw std::invalid_argument("set_body_boundary: no such body");
+  for (const auto& l : loops)
+    if (l.size() < 3) throw std::invalid_argument("body '" + bodies_[static_cast<std::size_t>(body)].name + "': a boundary loop needs at least 3 points");
+  body_loops_[static_cast<std::size_t>(body)] = loops;
+  body_loop_spacing_[static_cast<std::size_t>(body)] = -1.0;  // given, not sampled
+}
+
+// Pairs of present materials that use penalty contact, their master/slave choice and penalties, and
+// the boundary points of every body in such a pair.
+template <int Dim>
+void Simulation<Dim>::setup_penalty() {
+  penalty_.reset();
+  penalty_pairs_.clear();
+  boundary_ = BoundaryPoints<Dim>{};
+  const std::size_t nm = materials_.size();
+  std::vector<double> mass(nm, 0.0);
+  for (std::size_t k = 0; k < p_.size(); ++k) mass[static_cast<std::size_t>(p_.material[k])] += p_.mass[k];
+  const auto present = [&](std::size_t m) { return field_of_material_[m] >= 0 && material_end_[m] > material_begin_[m]; };
+  any_multimaterial_ = false;
+  std::vector<std::uint8_t> in_penalty(nm, 0);
+  std::vector<PenaltyPairSettings> settings;
+  const double h = grid_.min_cell_size();
+  for (std::size_t a = 0; a < nm; ++a)
+    for (std::size_t b = a + 1; b < nm; ++b) {
+      if (!present(a) || !present(b) || (materials_[a].is_rigid() && materials_[b].is_rigid())) continue;
+      const ContactPairSettings& s = contact_pair(static_cast<int>(a), static_cast<int>(b));
+      if (s.method != ContactMethod::penalty) {
+        any_multimaterial_ = true;
+        continue;
+      }
+      check_penalty_settings(s, static_cast<int>(a), static_cast<int>(b));
+      // Master: as set; else the rigid one, else the stiffer, else the heavier, else the first.
+      const Material &A = materials_[a], &B = materials_[b];
+      int master = s.penalty.master;
+      if (master < 0) {
+        const double Ea = modulus_for_penalty(A), Eb = modulus_for_penalty(B);
+        if (Ea != Eb) master = Ea > Eb ? static_cast<int>(a) : static_cast<int>(b);
+        else master = mass[b] > mass[a] ? static_cast<int>(b) : static_cast<int>(a);
+      }
+      const int slave = master == static_cast<int>(a) ? static_cast<int>(b) : static_cast<int>(a);
+      PenaltyPairSettings ps;
+      ps.master = field_of_material_[static_cast<std::size_t>(master)];
+      ps.slave = field_of_material_[static_cast<std::size_t>(slave)];
+      ps.mu = s.law.kind() == FrictionKind::coulomb ? s.law.mu() : 0.0;
+      ps.normal_penalty = s.penalty.normal_penalty;
+      if (ps.normal_penalty == 0.0) {
+        try {
+          ps.normal_penalty = s.penalty.normal_factor * default_penalty(modulus_for_penalty(A), modulus_for_penalty(B), h);
+        } catch (const std::invalid_argument&) {
+          throw std::invalid_argument("contact pair (" + A.name + ", " + B.name +
+                                      "): neither material has a finite Young's modulus > 0; set the normal penalty");
+        }
+      }
+      ps.tangential_penalty = s.penalty.tangential_penalty;
+      ps.law = s.penalty.law;
+      ps.search_radius = s.penalty.search_radius;
+      ps.paper_correction_terms = s.penalty.paper_correction_terms;
+      settings.push_back(ps);
+      penalty_pairs_.push_back(PenaltyPairInfo{master, slave});
+      in_penalty[a] = in_penalty[b] = 1;
+    }
+  if (settings.empty()) return;
+  penalty_reference_mass_.assign(fields_.size(), 0.0);
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    const auto m = static_cast<std::size_t>(fields_[f].material);
+    const std::size_t n = material_end_[m] - material_begin_[m];
+    if (n > 0) penalty_reference_mass_[f] = mass[m] / static_cast<double>(n);
+  }
+  penalty_.emplace(grid_, PenaltyOptions{Dim == 2 ? opt_.thickness : 1.0});
+  for (const PenaltyPairSettings& ps : settings) penalty_->add_pair(ps);
+
+  const double spacing = contact_opt_.boundary_spacing > 0.0 ? contact_opt_.boundary_spacing : 0.5 * h;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const int m = body_material_[i];
+    const std::string& name = bodies_[i].name;
+    if (m < 0) {
+      bool any = false;  // a body of several materials: does one of them use penalty contact?
+      for (std::size_t k = 0; k < p_.size() && !any; ++k)
+        if (p_.body[k] == static_cast<int>(i) && in_penalty[static_cast<std::size_t>(p_.material[k])]) any = true;
+      if (any)
+        throw std::invalid_argument("body '" + name + "' has several materials; penalty contact needs one material per body");
+      continue;
+    }
+    if (!in_penalty[static_cast<std::size_t>(m)]) continue;
+    if (body_loops_[i].empty())
+      throw std::invalid_argument("body '" + name + "': penalty contact needs its boundary, and its shape gives none "
+                                  "(images; set one with set_body_boundary)");
+    if (body_loop_spacing_[i] >= 0.0 && std::fabs(body_loop_spacing_[i] - spacing) > 1e-12 * spacing)
+      throw std::logic_error("body '" + name + "': the contact boundary spacing changed after the body was added "
+                             "(enable_contact must come before add_body)");
+    try {
+      boundary_.add_loops(field_of_material_[static_cast<std::size_t>(m)], body_loops_[i], body_half_size_[i], body_velocity_[i]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("body '" + name + "': " + e.what());
+    }
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::apply_penalty_forces() {
+  if (!penalty_) return;
+  penalty_fields_.resize(fields_.size());
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    penalty_fields_[f].lo = fields_[f].lo;
+    penalty_fields_[f].extent = fields_[f].extent;
+    penalty_fields_[f].index = fields_[f].index;
+  }
+  StepWeights<Dim> w;
+  w.plain.grid = &grid_;
+  w.plain.shape = opt_.shape;
+  w.plain.fields.swap(penalty_fields_);  // borrowed for the step, returned below (no allocation)
+  w.plain.slot_mass = &nodes_.mass;
+  w.plain.min_mass = empty_node_mass_;
+  w.plain.reference_mass = &penalty_reference_mass_;
+  w.plain.sliver = penalty_sliver_;
+  if (opt_.shape == ShapeKind::extended_bspline) w.ebs = &ebs_;
+  // Step 1 (K·27): a slave point is a candidate if its stencil reaches a node where the master has mass.
+  const auto master_has_mass = [&](int field, int node) {
+    const int s = slot_of(grid_, w.plain.fields[static_cast<std::size_t>(field)], node);
+    return s >= 0 && nodes_.mass[static_cast<std::size_t>(s)] > empty_node_mass_;
+  };
+  PenaltyContact<Dim>& pc = *penalty_;
+  pc.compute(boundary_, [&](int k, int i) {
+    return touches_field(boundary_, i, w, pc.pair(static_cast<std::size_t>(k)).master, master_has_mass);
+  });
+  pc.scatter_forces(boundary_, w, nodes_.force);  // K·36; rigid fields drop theirs in update_grid
+  pc.scatter_heat(boundary_, w, work_first_);     // penalty heat has no first/second-order split
+  pc.scatter_heat(boundary_, w, work_second_);
+  for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
+    const auto a = static_cast<std::size_t>(std::min(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
+    const auto b = static_cast<std::size_t>(std::max(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
+    pair_work_first_[a * materials_.size() + b] += pc.books(k).heat_step;
+    pair_work_second_[a * materials_.size() + b] += pc.books(k).heat_step;
+  }
+  penalty_fields_.swap(w.plain.fields);
+}
+
+// With the weights of the step's start (those the forces go out with): a rigid field's points move as
+// its particles do; the others with v_b = Σ_I w_I v_I, x_b += Δt v_b, where v_I is the nodal velocity
+// the stress update of the step uses (simulation_step.cpp calls this at that point of the step):
+//   USL  v^{n+1} = (p^n + Δt f)/m after the momentum update;
+//   MUSL the remapped v̂^{n+1} = Σ_p S_Ip m_p v_p^{n+1} / m_I (after the remap);
+//   USF  the step-start v̂^n (after the stress update, before the penalty forces).
+// Why (docs/penalty_contact.md, "Stability"): the contact is a penalty spring in series with the
+// bodies' elasticity. With MUSL the strains follow v̂ but the points followed v^{n+1}; per step the
+// gap then moves with Δt B·M⁻¹f while the bodies keep only Δt B·M⁻¹ M_C M⁻¹ f of it (M_C the
+// consistent mass), and the loop is not conservative. The stacked bars with EBS at C = 0.5 blew up at
+// three of six grid offsets that way (growth per step ∝ Δt², so C = 0.1 only delayed it); moved with
+// v̂ all six hold the contact stress to 0.2 % (tests/verification/test_penalty_stability.cpp).
+template <int Dim>
+void Simulation<Dim>::move_boundary_points(double dt, double t) {
+  if (!penalty_) return;
+  penalty_fields_.resize(fields_.size());  // USF moves the points before apply_penalty_forces
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    penalty_fields_[f].lo = fields_[f].lo;
+    penalty_fields_[f].extent = fields_[f].extent;
+    penalty_fields_[f].index = fields_[f].index;
+  }
+  StepWeights<Dim> w;
+  w.plain.grid = &grid_;
+  w.plain.shape = opt_.shape;
+  w.plain.fields.swap(penalty_fields_);
+  w.plain.slot_mass = &nodes_.mass;
+  w.plain.min_mass = empty_node_mass_;
+  w.plain.reference_mass = &penalty_reference_mass_;
+  w.plain.sliver = penalty_sliver_;
+  if (opt_.shape == ShapeKind::extended_bspline) w.ebs = &ebs_;
+  BoundaryPoints<Dim>& bp = boundary_;
+  for (std::size_t i = 0; i < bp.size(); ++i) {
+    const auto f = static_cast<std::size_t>(bp.field[i]);
+    Vec<Dim> v = Vec<Dim>::Zero();
+    if (fields_[f].rigid) {
+      const Material& m = materials_[static_cast<std::size_t>(fields_[f].material)];
+      v = (0.5 * (m.rigid_velocity_at(t) + m.rigid_velocity_at(t + dt))).template head<Dim>();
+    } else {
+      w(bp.field[i], bp.position[i], bp.half_size[i],
+        [&](int slot, int, double S) { v += S * nodes_.velocity[static_cast<std::size_t>(slot)]; });
+    }
+    bp.velocity[i] = v;
+  }
+  for (std::size_t i = 0; i < bp.size(); ++i) bp.position[i] += dt * bp.velocity[i];
+  penalty_fields_.swap(w.plain.fields);
+  // Boundary points may lie on the grid's edge (a body against a fixed face): allow the ghost layer.
+  const Vec<Dim> lo = grid_.lo() - grid_.cell_size(), hi = grid_.hi() + grid_.cell_size();
+  for (std::size_t i = 0; i < bp.size(); ++i)
+    if (!bp.position[i].allFinite() || (bp.position[i].array() < lo.array()).any() ||
+        (bp.position[i].array() > hi.array()).any()) {
+      const int m = fields_[static_cast<std::size_t>(bp.field[i])].material;
+      std::ostringstream msg;
+      msg << "step " << step_ << ", t = " << time_ << " s: boundary point " << i << " of material '"
+          << materials_[static_cast<std::size_t>(m)].name << "' "
+          << (bp.position[i].allFinite() ? "left the grid" : "has a non-finite position")
+          << " (penalty contact; the step blew up: try a smaller CFL factor or penalty)";
+      throw SimulationError(msg.str(), step_, time_, -1);
+    }
+  contact_stats_.penalty_contacts = contact_stats_.penalty_sliding = 0;
+  for (std::size_t k = 0; k < penalty_->pair_count(); ++k) {
+    contact_stats_.penalty_contacts += penalty_->books(k).active;
+    contact_stats_.penalty_sliding += penalty_->books(k).sliding;
+  }
+}
+
+// The penalty spring of a boundary point (stiffness ε A_s against a tributary mass ~ ρ A_s Δh) rings
+// at √(ε/(ρ Δh)); with ε = E/Δh (K·40) that is c/Δh, inside the CFL limit. A stiffer penalty raises
+// the frequency by √(ε/(E/Δh)), and the time step shrinks by the same factor.
+template <int Dim>
+double Simulation<Dim>::penalty_wave_factor() const {
+  if (!penalty_) return 1.0;
+  double factor = 1.0;
+  const double h = grid_.min_cell_size();
+  for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
+    const PenaltyPairSettings& s = penalty_->pair(k);
+    double E = std::numeric_limits<double>::infinity();
+    for (int m : {penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material}) {
+      const double Em = modulus_for_penalty(materials_[static_cast<std::size_t>(m)]);
+      if (Em > 0.0) E = std::min(E, Em);
+    }
+    if (!std::isfinite(E)) continue;
+    factor = std::max(factor, std::sqrt(std::max(s.normal_penalty, s.tangential_penalty) / (E / h)));
+  }
+  return factor;
+}
+
+#define FRICTHERM_INSTANTIATE_PENALTY(D)                                                              \
+  template void Simulation<D>::check_penalty_settings(const ContactPairSettings&, int, int) const;    \
+  template void Simulation<D>::set_body_boundary(int, const std::vector<std::vector<Vec<2>>>&);       \
+  template void Simulation<D>::setup_penalty();                                                       \
+  template void Simulation<D>::apply_penalty_forces();                                                \
+  template void Simulation<D>::move_boundary_points(double, double);                                  \
+  template double Simulation<D>::penalty_wave_factor() const;
+FRICTHERM_INSTANTIATE_PENALTY(2)
+FRICTHERM_INSTANTIATE_PENALTY(3)
+#undef FRICTHERM_INSTANTIATE_PENALTY
+
+}  // namespace frictherm::mechanics
