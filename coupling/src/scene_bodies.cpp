@@ -1,5 +1,6 @@
 // Scene parsing: bodies and their shapes (rectangle/box, disk/sphere, ellipse/ellipsoid, annulus,
-// polygon, image), with the check that every body lies inside the grid.
+// polygon, image; ellipse_packing in scene_packing.cpp, grains as materials in scene_grains.cpp), with
+// the check that every body lies inside the grid.
 #include "scene_detail.hpp"
 
 #include <algorithm>
@@ -8,15 +9,7 @@
 
 namespace frictherm::coupling::detail {
 
-namespace {
-
-std::string join_names(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "\"" : ", \"") + n + "\"";
-  return out.empty() ? "none" : out;
-}
-
-/// z_range [z0, z1]: required for planar shapes in 3D, not allowed in 2D.
+// z_range [z0, z1]: required for planar shapes in 3D, not allowed in 2D.
 void read_z_range(const JsonReader& shape, int dim, ShapeSpec& out) {
   if (dim == 2) {
     if (const auto z = shape.find("z_range")) z->fail("only for 3D scenes (2D shapes are planar)");
@@ -27,6 +20,14 @@ void read_z_range(const JsonReader& shape, int dim, ShapeSpec& out) {
   if (!(v[1] > v[0])) z.expected("[z0, z1] with z1 > z0");
   out.z_lo = v[0];
   out.z_hi = v[1];
+}
+
+namespace {
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "\"" : ", \"") + n + "\"";
+  return out.empty() ? "none" : out;
 }
 
 void parse_box(const JsonReader& shape, int dim, ShapeSpec& out) {
@@ -99,14 +100,14 @@ void parse_polygon(const JsonReader& shape, int dim, ShapeSpec& out) {
     }
 }
 
-void parse_image(const JsonReader& shape, const ParseContext& ctx, ShapeSpec& out) {
+void parse_image(const JsonReader& shape, Scene& s, ParseContext& ctx, ShapeSpec& out) {
   out.type = ShapeType::image;
-  const JsonReader file = shape.at("file", "the path of a PGM image, relative to the scene file");
+  const JsonReader file = shape.at("file", "the path of a PGM or BMP image, relative to the scene file");
   const std::string rel = file.as_string();
   if (rel.empty()) file.expected("a file name");
   out.image_file = (rel[0] == '/' || ctx.base_dir.empty()) ? rel : ctx.base_dir + "/" + rel;
   try {
-    out.image = mechanics::read_pgm(out.image_file);
+    out.image = mechanics::read_grey_image(out.image_file);
   } catch (const std::exception& e) {
     file.fail(e.what());
   }
@@ -114,6 +115,7 @@ void parse_image(const JsonReader& shape, const ParseContext& ctx, ShapeSpec& ou
   out.origin = {origin[0], origin[1]};
   out.pixel_size = shape.number("pixel_size", Range::positive());
   const JsonReader levels = shape.at("levels", "an array of {\"range\": [g0, g1], \"material\": NAME}");
+  std::vector<LevelSplit> splits;
   for (const JsonReader& l : levels.elements(1)) {
     const JsonReader range = l.at("range", "[g0, g1], grey levels");
     if (!range.is_array() || range.json().size() != 2) range.expected("[g0, g1], two grey levels");
@@ -122,26 +124,43 @@ void parse_image(const JsonReader& shape, const ParseContext& ctx, ShapeSpec& ou
     level.min_level = static_cast<int>(g[0].as_integer(0, out.image.max_value));
     level.max_level = static_cast<int>(g[1].as_integer(level.min_level, out.image.max_value));
     level.material = ctx.material_id(l.at("material", "a material name"));
+    if (const auto split = l.find("split")) {  // each connected grain / each grey level its own material
+      LevelSplit sp{out.levels.size(), split->as_choice({"grains", "grey_levels"}) == "grey_levels",
+                    mechanics::Connectivity::eight, l};
+      if (const auto c = l.find("connectivity")) {
+        if (sp.by_grey_level) c->fail("only for \"split\": \"grains\"");
+        const long v = c->as_integer(4, 8);
+        if (v != 4 && v != 8) c->expected("4 or 8 (neighbours sharing an edge, or an edge or a corner)");
+        sp.connectivity = v == 4 ? mechanics::Connectivity::four : mechanics::Connectivity::eight;
+      }
+      if (s.materials[static_cast<std::size_t>(level.material)].is_rigid())
+        split->fail("grains of a rigid material cannot be split (expected a deformable material)");
+      splits.push_back(sp);
+    } else if (const auto c = l.find("connectivity")) {
+      c->fail("only with \"split\": \"grains\"");
+    }
     l.finish();
     out.levels.push_back(level);
   }
   read_z_range(shape, ctx.dim, out);
+  if (!splits.empty()) split_image_levels(splits, s, ctx, out);
   out.box_lo = {out.origin[0], out.origin[1], out.z_lo};
   out.box_hi = {out.origin[0] + out.image.width * out.pixel_size, out.origin[1] + out.image.height * out.pixel_size,
                 out.z_hi};
 }
 
-ShapeSpec parse_shape(const JsonReader& shape, const ParseContext& ctx) {
+ShapeSpec parse_shape(const JsonReader& shape, Scene& s, ParseContext& ctx) {
   const std::string type =
       shape.at("type", "the shape's type").as_choice({"rectangle", "box", "disk", "sphere", "ellipse", "ellipsoid",
-                                                      "annulus", "polygon", "image"});
+                                                      "annulus", "polygon", "image", "ellipse_packing"});
   ShapeSpec out;
   if (type == "rectangle" || type == "box") parse_box(shape, ctx.dim, out);
   else if (type == "disk" || type == "sphere") parse_ellipse(shape, ctx.dim, /*round=*/true, out);
   else if (type == "ellipse" || type == "ellipsoid") parse_ellipse(shape, ctx.dim, /*round=*/false, out);
   else if (type == "annulus") parse_annulus(shape, ctx.dim, out);
   else if (type == "polygon") parse_polygon(shape, ctx.dim, out);
-  else parse_image(shape, ctx, out);
+  else if (type == "image") parse_image(shape, s, ctx, out);
+  else parse_ellipse_packing(shape, s, ctx, out);  // scene_packing.cpp
   shape.finish();
   return out;
 }
@@ -173,11 +192,11 @@ void parse_bodies(const JsonReader& root, Scene& s, ParseContext& ctx) {
       (name ? *name : b).fail("the name \"" + body.name + "\" is already used by bodies[" +
                               std::to_string(same - ctx.body_names.begin()) + "]");
     const JsonReader shape = b.at("shape", "an object with the body's shape");
-    body.shape = parse_shape(shape, ctx);
+    body.shape = parse_shape(shape, s, ctx);
     const bool image = body.shape.type == ShapeType::image;
     if (image) {
       if (const auto m = b.find("material"))
-        m->fail("not allowed for an image body (the shape's levels choose the materials)");
+        m->fail("not allowed for an image body or an ellipse_packing body (the shape chooses the materials)");
     } else {
       body.material = ctx.material_id(b.at("material", "the name of a material"));
     }

@@ -29,6 +29,9 @@ std::unique_ptr<mechanics::Region<Dim>> make_region(const ShapeSpec& s, int mate
       return mechanics::make_polygon<Dim>(v, s.z_lo, s.z_hi, material);
     }
     case ShapeType::image:
+      if (s.pixel_materials.width > 0)  // a material per pixel (grains split into materials, ellipse_packing)
+        return mechanics::make_pixel_region<Dim>(s.pixel_materials, mechanics::Vec<2>(s.origin[0], s.origin[1]),
+                                                 s.pixel_size, s.z_lo, s.z_hi);
       return mechanics::make_image_region<Dim>(s.image, mechanics::Vec<2>(s.origin[0], s.origin[1]), s.pixel_size,
                                                s.levels, s.z_lo, s.z_hi);
   }
@@ -69,7 +72,11 @@ std::unique_ptr<mechanics::Simulation<Dim>> build_simulation(const Scene& scene)
     }
   }
   for (const auto& f : scene.fixed_faces) sim->fix_face(f);
-  sim->finalize();
+  try {
+    sim->finalize();  // sets up penalty contact: its pairs and the bodies' boundary points
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(std::string("contact: ") + e.what());
+  }
   // Loads are added one by one after finalize() so that a load selecting no particle is named.
   for (std::size_t i = 0; i < scene.point_loads.size(); ++i) {
     const PointLoadSpec& p = scene.point_loads[i];

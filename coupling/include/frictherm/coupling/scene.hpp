@@ -13,6 +13,7 @@
 #include <frictherm/mechanics/image.hpp>
 #include <frictherm/mechanics/loads.hpp>
 #include <frictherm/mechanics/material.hpp>
+#include <frictherm/mechanics/microstructure.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/time_function.hpp>
 
@@ -42,6 +43,12 @@ struct ShapeSpec {
   std::array<double, 2> origin{};                  // image: lower-left corner (m)
   double pixel_size = 0.0;                         // image (m)
   std::vector<mechanics::GreyLevelMaterial> levels;  // image: grey ranges -> material ids
+  mechanics::PixelMaterials pixel_materials;        // image: material per pixel when set (width > 0), e.g.
+                                                    // every grain its own material (scene_grains.cpp)
+  bool generated = false;                           // image made by "ellipse_packing" (scene_packing.cpp)
+  std::string write_image;                          // generated: where a run writes it ("": beside the output)
+  std::size_t grain_count = 0;                      // generated: grains placed
+  double target_fraction = 0.0, fraction = 0.0;     // generated: asked and achieved grain area fraction
   SceneVec box_lo{}, box_hi{};                     // tight bounding box (checked against the grid)
 };
 
