@@ -23,7 +23,9 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
       opt_(std::move(options)),
       integrator_(thermal::make_integrator(opt_.integrator, opt_.integrator_options)),
       pending_(grid.node_count()),
-      tracker_(Dim, opt_.hotspots, opt_.thickness) {
+      plastic_(opt_.plastic),
+      tracker_(Dim, opt_.hotspots, opt_.thickness),
+      fates_(opt_.fates) {
   const WindowPolicy& w = opt_.window;
   if (w.kind == WindowPolicy::Kind::every_n_steps && w.steps < 1)
     throw std::invalid_argument("Coupler: every_n_steps needs steps >= 1");
@@ -34,6 +36,13 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
     throw std::invalid_argument("Coupler: subgrid_relaxation_time must be > 0");
   for (const FixedTemperatureFace& f : opt_.fixed_faces)
     if (f.axis < 0 || f.axis >= Dim) throw std::invalid_argument("Coupler: fixed face axis out of range");
+  if (opt_.reaction.enabled) {
+    const thermal::ArrheniusKinetics& k = opt_.reaction.kinetics;
+    if (!(k.prefactor > 0.0 && k.activation_temperature > 0.0 && k.specific_heat_of_reaction >= 0.0) ||
+        !std::isfinite(k.prefactor) || !std::isfinite(k.activation_temperature) ||
+        !std::isfinite(k.specific_heat_of_reaction))
+      throw std::invalid_argument("Coupler: reaction kinetics need finite Z > 0, Θ > 0 and q >= 0");
+  }
 }
 
 template <int Dim>
@@ -42,8 +51,12 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
   window_steps_ = 0;
   max_rise_ = 0.0;
   pending_.clear();
+  pending_plastic_ = 0.0;
   books_ = EnergyBooks{};
   initial_energy_ = particle_thermal_energy(p, opt_.materials);
+  if (opt_.plastic.enabled) plastic_.start(p);
+  if (opt_.reaction.enabled) particle_progress_.assign(p.size(), 0.0);  // fresh material
+  fates_ = HotSpotFates(opt_.fates);
   assemble(p);
   nodal_temperature_ = system_.temperature;
   tracker_.set_reference(p);
@@ -67,6 +80,14 @@ void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
     for (std::size_t u = 0; u < system_.size(); ++u)
       if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
         problem_->set_dirichlet(static_cast<Eigen::Index>(u), f.temperature);
+  }
+  if (opt_.reaction.enabled) {
+    // Reacting mass and progress gathered from the particles; Q_i = q m_i (heat_sources.hpp).
+    NodalReaction r = gather_reaction(grid_, p, shape_, opt_.reaction, system_, particle_progress_);
+    problem_->set_reaction(thermal::make_reaction(opt_.reaction.kinetics, r.reacting_mass));
+    nodal_progress_ = r.progress;
+    nodal_progress_ref_ = std::move(r.progress);
+    particle_progress_ref_ = particle_progress_;
   }
 }
 
@@ -116,6 +137,13 @@ bool Coupler<Dim>::after_step(mechanics::Particles<Dim>& p, const std::vector<do
   const double before = pending_.total();
   pending_.add(nodal_work);
   books_.work_received += pending_.total() - before;
+  if (opt_.plastic.enabled) {
+    double dw = 0.0;
+    const double heat = plastic_.collect(grid_, p, shape_, pending_, dw);  // β Δw_p S_ip on the nodes
+    pending_plastic_ += heat;
+    books_.plastic_heat_received += heat;
+    books_.plastic_work_received += dw;
+  }
   const WindowPolicy& w = opt_.window;
   bool close = false;
   switch (w.kind) {
@@ -125,6 +153,9 @@ bool Coupler<Dim>::after_step(mechanics::Particles<Dim>& p, const std::vector<do
       const std::vector<double>& acc = pending_.work();
       for (std::size_t i = 0; i < nodal_work.size(); ++i)
         if (nodal_work[i] != 0.0) max_rise_ = std::max(max_rise_, std::fabs(acc[i]) / mass_estimate(i));
+      if (pending_plastic_ != 0.0)  // plastic heat can sit on any node: scan them all
+        for (std::size_t i = 0; i < acc.size(); ++i)
+          if (acc[i] != 0.0) max_rise_ = std::max(max_rise_, std::fabs(acc[i]) / mass_estimate(i));
       close = max_rise_ >= w.max_temperature_rise || time - window_start_ >= w.max_duration * (1.0 - 1e-12) ||
               (w.max_steps > 0 && window_steps_ >= w.max_steps);
       break;
@@ -142,10 +173,12 @@ bool Coupler<Dim>::close_window(mechanics::Particles<Dim>& p, double time) {
   const Eigen::VectorXd q = heat.joules / dt;  // constant over the window: ∫ q dt = W (design §4)
   problem_->set_source(q);
   books_.heat_delivered += q.sum() * dt;
+  books_.plastic_heat_delivered += pending_plastic_;
   books_.heat_relocated += heat.relocated;
   nodal_temperature_ = system_.temperature;
   advance_and_map(p, window_start_, time);
   pending_.clear();
+  pending_plastic_ = 0.0;
   ++books_.windows;
   books_.min_window = std::min(books_.min_window, dt);
   books_.max_window = std::max(books_.max_window, dt);
@@ -166,17 +199,27 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
     nodal_temperature_ = system_.temperature;
   }
   problem_->clear_source();
+  if (!fates_.started()) fates_.begin(tracker_, window_start_);  // the hot spots at the end of loading
   advance_and_map(p, window_start_, time);
   ++books_.continuation_intervals;
   window_start_ = time;
   window_steps_ = 0;
   tracker_.update(p, opt_.materials, time);
+  fates_.update(p, particle_progress_, tracker_, time);
 }
 
 template <int Dim>
 void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, double t1) {
   const Eigen::VectorXd start = nodal_temperature_;
-  integrator_->advance(*problem_, nodal_temperature_, t0, t1);  // writes Dirichlet values first
+  if (opt_.reaction.enabled) {
+    const double released0 = problem_->released_heat(nodal_progress_);
+    integrator_->advance(*problem_, nodal_temperature_, nodal_progress_, t0, t1);  // T and λ
+    books_.reaction_heat_released += problem_->released_heat(nodal_progress_) - released0;
+    scatter_progress(grid_, p, shape_, opt_.reaction, system_, nodal_progress_ref_, nodal_progress_,
+                     particle_progress_ref_, particle_progress_);
+  } else {
+    integrator_->advance(*problem_, nodal_temperature_, t0, t1);  // writes Dirichlet values first
+  }
   const Eigen::VectorXd delta = nodal_temperature_ - start;
   const double beta = std::isfinite(opt_.subgrid_relaxation_time)
                           ? -std::expm1(-(t1 - t0) / opt_.subgrid_relaxation_time)
@@ -184,6 +227,14 @@ void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, doub
   add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta,
                                 &nodal_temperature_);  // design §4
   books_.nodal_energy_change += system_.mass.dot(delta);
+}
+
+template <int Dim>
+double Coupler<Dim>::particle_reaction_heat(const mechanics::Particles<Dim>& p) const {
+  double m = 0.0;
+  for (std::size_t k = 0; k < particle_progress_.size() && k < p.size(); ++k)
+    if (opt_.reaction.reacts(p.material[k])) m += p.mass[k] * particle_progress_[k];
+  return opt_.reaction.kinetics.specific_heat_of_reaction * m;
 }
 
 template <int Dim>

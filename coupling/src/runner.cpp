@@ -3,6 +3,7 @@
 #include "runner_detail.hpp"
 #include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
+#include <frictherm/coupling/microstructure.hpp>
 #include <frictherm/mechanics/errors.hpp>
 
 #include <omp.h>
@@ -41,6 +42,7 @@ class Run {
     r_.particles = sim_->particles().size();
     H5Output out = open_output();
     out_ = &out;
+    write_microstructure_images(out);  // generated bodies (ellipse_packing): the image beside the output
     detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
     std::vector<std::string> series_columns = detail::series_names(Dim);
     detail::append_contact_series_names<Dim>(series_columns, *sim_);
@@ -90,6 +92,18 @@ class Run {
   }
 
  private:
+  void write_microstructure_images(H5Output& out) const {
+    std::vector<std::string> written;
+    try {
+      written = write_generated_images(s_, r_.output);
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+    std::string list;
+    for (const auto& w : written) list += (list.empty() ? "" : "; ") + w;
+    if (!list.empty()) out.write_metadata("microstructure_images", list);
+  }
+
   H5Output open_output() const {
     try {
       return H5Output(r_.output, Dim);
@@ -150,6 +164,7 @@ class Run {
   void snapshot() {
     out_->begin_snapshot(sim_->step_count(), sim_->time());
     detail::write_fields<Dim>(*out_, *sim_, s_.output.fields);
+    if (thermal_) thermal_->write_fields(*out_);  // thermal hook: reaction_progress
     out_->end_snapshot();
     last_snapshot_step_ = sim_->step_count();
   }

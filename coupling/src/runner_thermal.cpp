@@ -3,7 +3,10 @@
 
 #include <frictherm/mechanics/errors.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <stdexcept>
 
 namespace frictherm::coupling::detail {
@@ -23,6 +26,10 @@ std::vector<std::string> hotspot_columns(int dim) {
   return c;
 }
 
+const char* const kFateColumns[] = {"id",           "fate",          "particle_count",      "start_time",
+                                    "initial_peak_temperature", "final_peak_temperature", "max_peak_temperature",
+                                    "max_reaction_progress",    "decision_time", "runaway_time", "time_to_runaway"};
+
 }  // namespace
 
 template <int Dim>
@@ -38,7 +45,12 @@ ThermalRun<Dim>::ThermalRun(const Scene& scene, mechanics::Simulation<Dim>& sim)
 template <int Dim>
 void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& names) {
   for (const char* c : kSeriesColumns) names.emplace_back(c);
+  const CouplerOptions& o = coupler_.options();
+  if (o.plastic.enabled) names.insert(names.end(), {"plastic_work", "plastic_heat"});
+  if (o.reaction.enabled) names.insert(names.end(), {"reaction_heat", "max_reaction_progress"});
   out.declare_table("hotspots", hotspot_columns(Dim));
+  if (spec_.continuation_duration > 0.0)
+    out.declare_table("hotspot_fates", std::vector<std::string>(std::begin(kFateColumns), std::end(kFateColumns)));
 }
 
 template <int Dim>
@@ -52,6 +64,12 @@ void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
   row.insert(row.end(), {b.heat_delivered, coupler_.particle_energy_change(sim.particles()), hs.max_temperature(),
                          static_cast<double>(hs.hot_spots().size()), hot ? hot->peak_temperature : 0.0,
                          hot ? hot->size : 0.0, hot ? hot->equivalent_diameter : 0.0, static_cast<double>(windows)});
+  const CouplerOptions& o = coupler_.options();
+  if (o.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
+  if (o.reaction.enabled) {
+    const std::vector<double>& lam = coupler_.reaction_progress();
+    row.insert(row.end(), {b.reaction_heat_released, lam.empty() ? 0.0 : *std::max_element(lam.begin(), lam.end())});
+  }
   if (windows == hotspot_windows_written_) return;
   hotspot_windows_written_ = windows;
   for (const HotSpot& h : hs.hot_spots()) {
@@ -102,10 +120,29 @@ void ThermalRun<Dim>::continuation(H5Output& out, mechanics::Simulation<Dim>& si
     row[0] = t;  // the mechanics columns stay at their final values
     extend_series_row(row, out, sim, t);
     out.append_series(row);
+    const HotSpotFates& f = coupler_.fates();
+    if (spec_.stop_when_decided && !f.records().empty() && f.all_decided()) break;
+  }
+  coupler_.finish_continuation();
+  for (const HotSpotFateRecord& r : coupler_.fates().records()) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.append_table_row("hotspot_fates",
+                         {static_cast<double>(r.id), static_cast<double>(r.fate), static_cast<double>(r.particles.size()),
+                          r.start_time, r.initial_peak_temperature, r.peak_temperature, r.max_peak_temperature,
+                          r.max_progress, r.decision_time, r.runaway_time,
+                          r.fate == HotSpotFate::runaway ? r.runaway_time - r.start_time : nan});
   }
   out.begin_snapshot(sim.step_count(), t);
-  write_fields<Dim>(out, sim, fields);
+  detail::write_fields<Dim>(out, sim, fields);
+  write_fields(out);
   out.end_snapshot();
+}
+
+template <int Dim>
+void ThermalRun<Dim>::write_fields(H5Output& out) const {
+  const std::vector<double>& lam = coupler_.reaction_progress();
+  if (coupler_.options().reaction.enabled && !lam.empty())
+    out.snapshot_field("reaction_progress", lam.data(), lam.size(), 1);
 }
 
 template <int Dim>
@@ -134,6 +171,11 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"thermal_max_window", b.max_window},
       {"work_received", b.work_received},
       {"heat_delivered", b.heat_delivered},
+      {"plastic_work_received", b.plastic_work_received},
+      {"plastic_heat_received", b.plastic_heat_received},
+      {"plastic_heat_delivered", b.plastic_heat_delivered},
+      {"reaction_heat_released", b.reaction_heat_released},
+      {"particle_reaction_heat", coupler_.particle_reaction_heat(sim.particles())},
       {"heat_relocated", b.heat_relocated},
       {"heat_pending", coupler_.pending_heat()},
       {"nodal_energy_change", b.nodal_energy_change},
@@ -142,6 +184,13 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"hotspots_seen", static_cast<double>(coupler_.hotspots().ids_issued())},
   };
   for (const auto& [key, value] : values) out.write_metadata(key, value);
+  out.write_metadata("plastic_heating", o.plastic.enabled ? "on" : "off");
+  if (o.reaction.enabled) {
+    out.write_metadata("reaction_kinetics", o.reaction.kinetics_name);
+    out.write_metadata("reaction_prefactor", o.reaction.kinetics.prefactor);
+    out.write_metadata("reaction_activation_temperature", o.reaction.kinetics.activation_temperature);
+    out.write_metadata("reaction_heat_of_reaction", o.reaction.kinetics.specific_heat_of_reaction);
+  }
 }
 
 template class ThermalRun<2>;

@@ -30,6 +30,8 @@ class ThermalRun {
   /// Thermal-only continuation after the mechanics (scene coupling.continuation): one series row per
   /// interval and a final snapshot at its end time.
   void continuation(H5Output& out, mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields);
+  /// Particle fields of the thermal side into the open snapshot (reaction_progress with a reaction).
+  void write_fields(H5Output& out) const;
   /// Integrator statistics and energy books into /meta (thermal_*).
   void write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const;
 

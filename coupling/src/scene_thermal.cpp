@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace frictherm::coupling {
@@ -42,10 +43,14 @@ void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
   }
 }
 
-void parse_materials(const JsonReader& t, ThermalSceneSpec& spec, const std::vector<mechanics::Material>& mats) {
+constexpr double kDefaultTaylorQuinney = 0.9;  // the classical fraction for metals; docs/scenes.md
+
+void parse_materials(const JsonReader& t, ThermalSceneSpec& spec, const std::vector<mechanics::Material>& mats,
+                     std::optional<JsonReader>& taylor_quinney_key) {
   std::vector<std::string> names;
   for (const auto& m : mats) names.push_back(m.name);
   spec.coupler.materials.assign(mats.size(), ThermalProperties{});
+  spec.coupler.plastic.taylor_quinney.assign(mats.size(), 0.0);
   const JsonReader table =
       t.at("materials", "an object mapping material names to {\"heat_capacity\": J/(kg K), \"conductivity\": W/(m K)}");
   for (const std::string& name : table.keys()) {
@@ -61,12 +66,49 @@ void parse_materials(const JsonReader& t, ThermalSceneSpec& spec, const std::vec
     p.conducts = true;
     p.heat_capacity = m.number("heat_capacity", Range::positive());
     p.conductivity = m.number("conductivity", Range::non_negative());
+    if (const auto tq = m.find("taylor_quinney"); tq && !taylor_quinney_key) taylor_quinney_key = tq;
+    spec.coupler.plastic.taylor_quinney[static_cast<std::size_t>(it - names.begin())] =
+        m.number("taylor_quinney", kDefaultTaylorQuinney, Range::closed(0.0, 1.0));
     m.finish();
   }
   for (std::size_t i = 0; i < mats.size(); ++i)
     if (!mats[i].is_rigid() && !spec.coupler.materials[i].conducts)
       table.fail("missing material \"" + mats[i].name +
                  "\" (every deformable material needs heat_capacity and conductivity; rigid ones may be left out)");
+}
+
+void parse_reaction(const JsonReader& t, ThermalSceneSpec& spec, const std::vector<mechanics::Material>& mats) {
+  const auto r = t.find("reaction");
+  if (!r) return;
+  if (!r->is_object()) r->expected("an object {\"kinetics\": ..., \"materials\": [names]}");
+  ReactionOptions& rx = spec.coupler.reaction;
+  rx.enabled = true;
+  const JsonReader k = r->at("kinetics", "\"hmx_rogers1975\" or {\"prefactor\", \"activation_energy\", \"heat_of_reaction\"}");
+  if (k.is_string()) {
+    rx.kinetics_name = k.as_choice({"hmx_rogers1975"});
+    rx.kinetics = thermal::hmx_kinetics_rogers1975();
+  } else if (k.is_object()) {
+    rx.kinetics_name = "explicit";
+    rx.kinetics.prefactor = k.number("prefactor", Range::positive());
+    rx.kinetics.activation_temperature = k.number("activation_energy", Range::positive()) / thermal::kGasConstant;
+    rx.kinetics.specific_heat_of_reaction = k.number("heat_of_reaction", Range::non_negative());
+    k.finish();
+  } else {
+    k.expected("\"hmx_rogers1975\" or an object {\"prefactor\": 1/s, \"activation_energy\": J/mol, "
+               "\"heat_of_reaction\": J/kg}");
+  }
+  rx.reacting.assign(mats.size(), 0);
+  const JsonReader list = r->at("materials", "an array of the names of the materials that react");
+  for (const JsonReader& e : list.elements(1)) {
+    const std::string name = e.as_string();
+    std::size_t id = 0;
+    while (id < mats.size() && mats[id].name != name) ++id;
+    if (id == mats.size()) e.fail("no material of this name in \"materials\"");
+    if (!spec.coupler.materials[id].conducts)
+      e.fail("material \"" + name + "\" has no thermal properties (list it in thermal.materials)");
+    rx.reacting[id] = 1;
+  }
+  r->finish();
 }
 
 void parse_fixed_faces(const JsonReader& t, ThermalSceneSpec& spec, int dim) {
@@ -107,7 +149,7 @@ void parse_window(const JsonReader& c, WindowPolicy& w) {
   if (win->is_object()) win->finish();
 }
 
-void parse_hotspots(const JsonReader& c, HotSpotOptions& h) {
+void parse_hotspots(const JsonReader& c, HotSpotOptions& h, HotSpotFateOptions& f) {
   const auto hs = c.find("hotspots");
   if (!hs) return;
   h.mode = hs->choice("mode", {"rise", "absolute"}, "rise") == "absolute" ? HotSpotOptions::Mode::absolute
@@ -116,6 +158,8 @@ void parse_hotspots(const JsonReader& c, HotSpotOptions& h) {
                            h.mode == HotSpotOptions::Mode::absolute ? Range::positive() : Range::non_negative());
   h.link_factor = hs->number("link_factor", h.link_factor, Range::closed(1.0, 10.0));
   h.min_particles = static_cast<std::size_t>(hs->integer("min_particles", 1, 1, std::numeric_limits<int>::max()));
+  f.runaway_progress = hs->number("runaway_progress", f.runaway_progress, Range::left_open(0.0, 1.0));
+  f.runaway_temperature = hs->number("runaway_temperature", f.runaway_temperature, Range::positive());
   hs->finish();
 }
 
@@ -145,9 +189,15 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   parse_integrator(*t, spec);
   spec.coupler.assembly.active_mass_fraction =
       t->number("active_mass_fraction", spec.coupler.assembly.active_mass_fraction, Range::open(0.0, 1.0));
-  parse_materials(*t, spec, materials);
+  std::optional<JsonReader> taylor_quinney_key;
+  parse_materials(*t, spec, materials, taylor_quinney_key);
+  parse_reaction(*t, spec, materials);
   parse_fixed_faces(*t, spec, dimension);
   t->finish();
+  if (c && !c->is_object()) c->expected("an object");
+  spec.coupler.plastic.enabled = c && c->find("plastic_heating") && c->at("plastic_heating").as_bool();
+  if (taylor_quinney_key && !spec.coupler.plastic.enabled)
+    taylor_quinney_key->fail("only used with \"coupling\": {\"plastic_heating\": true}");
   if (!c) return spec;
   if (!c->is_object()) c->expected("an object");
   parse_window(*c, spec.coupler.window);
@@ -156,11 +206,12 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   if (const auto cont = c->find("continuation")) {
     spec.continuation_duration = cont->number("duration", Range::positive());
     spec.continuation_intervals = cont->integer("intervals", spec.continuation_intervals, 1, 10000000);
+    spec.stop_when_decided = cont->find("stop_when_decided") && cont->at("stop_when_decided").as_bool();
     cont->finish();
   }
   spec.coupler.subgrid_relaxation_time =
       c->number("subgrid_relaxation_time", spec.coupler.subgrid_relaxation_time, Range::positive());
-  parse_hotspots(*c, spec.coupler.hotspots);
+  parse_hotspots(*c, spec.coupler.hotspots, spec.coupler.fates);
   c->finish();
   return spec;
 }

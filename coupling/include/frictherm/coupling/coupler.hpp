@@ -15,7 +15,15 @@
 // T_p += Σ_i S_ip ΔT_i; hot spots are updated. Σ_p m_p C_v,p ΔT_p = Σ_i M_i ΔT_i, which equals the
 // heat delivered when conduction conserves energy (adiabatic edges; exact for forward_euler and
 // the KLU-based integrators, to the solver tolerance for PCG).
+//
+// Optional sources (issue 5, heat_sources.hpp): plastic work times a Taylor–Quinney fraction joins
+// the frictional work in the window's pending heat (separate books); an Arrhenius reaction
+// (thermal::Reaction) on the nodes of reacting materials, with the progress λ kept on the particles
+// and gathered at every assembly. Books: Σ_i M_i ΔT_i = frictional + plastic heat delivered +
+// reaction heat released (adiabatic edges; to the solver tolerance with a reaction).
 #include <frictherm/coupling/heat_handoff.hpp>
+#include <frictherm/coupling/heat_sources.hpp>
+#include <frictherm/coupling/hotspot_fates.hpp>
 #include <frictherm/coupling/hotspots.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/thermal/integrator.hpp>
@@ -61,15 +69,23 @@ struct CouplerOptions {
   /// resolve decays as exp(−t/τ) whatever the window length. Infinite (default): pure incremental
   /// update (design §4), which keeps such structure forever.
   double subgrid_relaxation_time = std::numeric_limits<double>::infinity();
+  PlasticHeatingOptions plastic;  // plastic work as a heat source (off by default)
+  ReactionOptions reaction;       // Arrhenius reaction heat (off by default)
+  HotSpotFateOptions fates;       // runaway criteria of the continuation
 };
 
 /// Where the heat went (J). Without fixed faces nodal_energy_change equals heat_delivered up to the
 /// integrator's conservation error; with them the difference is the heat taken by the faces.
 struct EnergyBooks {
-  double work_received = 0.0;        // Σ nodal work handed to after_step
-  double heat_delivered = 0.0;       // Σ over closed windows of ∫ Σ_i q_i dt
+  double work_received = 0.0;        // Σ nodal (frictional) work handed to after_step
+  double plastic_work_received = 0.0;  // Σ_p Δw_p of the materials with a Taylor–Quinney fraction
+  double plastic_heat_received = 0.0;  // Σ_p β Δw_p added to the pending heat
+  double heat_delivered = 0.0;       // Σ over closed windows of ∫ Σ_i q_i dt (frictional + plastic)
+  double plastic_heat_delivered = 0.0;  // the plastic part of heat_delivered
+  double reaction_heat_released = 0.0;  // Σ over windows and intervals of Σ_i Q_i Δλ_i
   double heat_relocated = 0.0;       // the part that sat on nodes that were not unknowns
   double nodal_energy_change = 0.0;  // Σ over windows of Σ_i M_i ΔT_i (= Σ_p m_p C_v,p ΔT_p)
+                                     // = heat_delivered + reaction_heat_released (adiabatic)
   long windows = 0;                  // closed windows with mechanics
   long continuation_intervals = 0;   // thermal-only intervals
   long steps = 0;                    // mechanics steps seen
@@ -94,8 +110,11 @@ class Coupler {
   /// Closes the open window at `time` (a no-op when it has zero length). Returns true if it closed.
   bool close_window(mechanics::Particles<Dim>& particles, double time);
   /// Thermal-only phase (no pending work allowed): integrates the last assembled problem, without
-  /// sources, from the end of the last window or interval to `time`, and maps the change back.
+  /// sources, from the end of the last window or interval to `time`, and maps the change back. The
+  /// first call starts following the fates of the hot spots alive then (hotspot_fates.hpp).
   void continue_thermal(mechanics::Particles<Dim>& particles, double time);
+  /// End of the continuation: settles the fates of undecided hot spots (HotSpotFates::finish).
+  void finish_continuation() { fates_.finish(); }
 
   const EnergyBooks& books() const { return books_; }
   double pending_heat() const { return pending_.total(); }
@@ -105,6 +124,11 @@ class Coupler {
   double particle_energy_change(const mechanics::Particles<Dim>& particles) const;
   const thermal::Integrator& integrator() const { return *integrator_; }
   const HotSpotTracker& hotspots() const { return tracker_; }
+  const HotSpotFates& fates() const { return fates_; }
+  /// Reaction progress λ_p of every particle (0 for non-reacting ones); empty without a reaction.
+  const std::vector<double>& reaction_progress() const { return particle_progress_; }
+  /// q Σ_p m_p λ_p over reacting particles (J): the reaction heat the particles carry.
+  double particle_reaction_heat(const mechanics::Particles<Dim>& particles) const;
   /// The system of the last window (nullptr before the first assembly).
   const NodalThermalSystem* system() const { return has_system_ ? &system_ : nullptr; }
   const CouplerOptions& options() const { return opt_; }
@@ -119,7 +143,14 @@ class Coupler {
   CouplerOptions opt_;
   std::unique_ptr<thermal::Integrator> integrator_;
   HeatAccumulator pending_;
+  double pending_plastic_ = 0.0;  // plastic part of pending_ (J)
+  PlasticHeatSource<Dim> plastic_;
   HotSpotTracker tracker_;
+  HotSpotFates fates_;
+  std::vector<double> particle_progress_;       // λ_p (reaction only)
+  std::vector<double> particle_progress_ref_;   // λ_p at the last assembly
+  Eigen::VectorXd nodal_progress_;              // λ_i on the unknowns, current
+  Eigen::VectorXd nodal_progress_ref_;          // λ_i gathered at the last assembly
   NodalThermalSystem system_;
   bool has_system_ = false;
   std::optional<thermal::Problem> problem_;

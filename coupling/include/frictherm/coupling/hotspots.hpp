@@ -64,6 +64,14 @@ class HotSpotTracker {
   /// Highest particle temperature at the last update (conducting materials; K).
   double max_temperature() const { return max_temperature_; }
   double last_time() const { return last_time_; }
+  /// Whether particle k at `temperature` counts as hot (threshold and mode; the reference is the one of
+  /// set_reference, none counting as 0 K).
+  bool is_hot(std::size_t k, double temperature) const {
+    const double level = opt_.mode == HotSpotOptions::Mode::absolute
+                             ? temperature
+                             : temperature - (k < reference_.size() ? reference_[k] : 0.0);
+    return level > opt_.threshold;
+  }
 
  private:
   struct Candidate {

@@ -3,11 +3,13 @@
 //
 //   "thermal":  {"integrator": "cvode_bdf", "rtol": 1e-6, "atol": 1e-3,
 //                "materials": {"hmx": {"heat_capacity": 1500, "conductivity": 0.45}},
-//                "fixed_temperature": [{"face": "x_min", "temperature": 300}]}
+//                "fixed_temperature": [{"face": "x_min", "temperature": 300}],
+//                "reaction": {"kinetics": "hmx_rogers1975", "materials": ["hmx"]}}
 //   "coupling": {"window": {"policy": "adaptive", "max_temperature_rise": 0.5},
 //                "heating_order": "second",
 //                "continuation": {"duration": 1e-3, "intervals": 100},
-//                "hotspots": {"mode": "rise", "threshold": 100}}
+//                "hotspots": {"mode": "rise", "threshold": 100},
+//                "plastic_heating": true}
 //
 // Without a `thermal` section nothing thermal is computed; `coupling` needs `thermal`.
 #include <frictherm/coupling/coupler.hpp>
@@ -30,6 +32,7 @@ struct ThermalSceneSpec {
   HeatingOrder heating_order = HeatingOrder::second;
   double continuation_duration = 0.0;  // s of thermal-only integration after the mechanics ends
   long continuation_intervals = 100;   // series rows (windows) over the continuation
+  bool stop_when_decided = false;      // end the continuation once every hot spot has a fate
 };
 
 /// Reads `thermal` and `coupling` from the scene root (both optional). `materials` are the scene's

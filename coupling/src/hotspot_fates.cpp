@@ -1,0 +1,88 @@
+// Hot-spot fates in the thermal-only continuation: dying by conduction or running away (hotspot_fates.hpp).
+#include <frictherm/coupling/hotspot_fates.hpp>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace frictherm::coupling {
+
+const char* to_string(HotSpotFate fate) {
+  switch (fate) {
+    case HotSpotFate::undecided: return "undecided";
+    case HotSpotFate::dying: return "dying";
+    case HotSpotFate::runaway: return "runaway";
+  }
+  return "?";
+}
+
+HotSpotFates::HotSpotFates(HotSpotFateOptions options) : opt_(options) {
+  if (!(opt_.runaway_progress > 0.0 && opt_.runaway_progress <= 1.0))
+    throw std::invalid_argument("HotSpotFates: runaway_progress must be in (0, 1]");
+  if (!(opt_.runaway_temperature > 0.0))
+    throw std::invalid_argument("HotSpotFates: runaway_temperature must be > 0");
+}
+
+void HotSpotFates::begin(const HotSpotTracker& tracker, double time) {
+  records_.clear();
+  started_ = true;
+  last_time_ = time;
+  for (const HotSpot& h : tracker.hot_spots()) {
+    HotSpotFateRecord r;
+    r.id = h.id;
+    r.particles = h.particles;
+    r.start_time = time;
+    r.initial_peak_temperature = r.peak_temperature = r.max_peak_temperature = r.previous_peak_temperature =
+        h.peak_temperature;
+    records_.push_back(std::move(r));
+  }
+}
+
+template <int Dim>
+void HotSpotFates::update(const mechanics::Particles<Dim>& p, const std::vector<double>& progress,
+                          const HotSpotTracker& tracker, double time) {
+  last_time_ = time;
+  for (HotSpotFateRecord& r : records_) {
+    double peak = 0.0, lam = 0.0;
+    bool hot = false;
+    for (std::size_t k : r.particles) {
+      if (k >= p.size()) continue;
+      const double T = p.temperature[k];
+      peak = std::max(peak, T);
+      if (k < progress.size()) lam = std::max(lam, progress[k]);
+      hot = hot || tracker.is_hot(k, T);
+    }
+    r.previous_peak_temperature = r.peak_temperature;
+    r.peak_temperature = peak;
+    r.max_peak_temperature = std::max(r.max_peak_temperature, peak);
+    r.max_progress = lam;
+    if (r.fate != HotSpotFate::undecided) continue;
+    if (lam >= opt_.runaway_progress || peak >= opt_.runaway_temperature) {
+      r.fate = HotSpotFate::runaway;
+      r.decision_time = r.runaway_time = time;
+    } else if (!hot) {
+      r.fate = HotSpotFate::dying;  // conduction took every particle of the spot below the threshold
+      r.decision_time = time;
+    }
+  }
+}
+
+void HotSpotFates::finish() {
+  for (HotSpotFateRecord& r : records_)
+    if (r.fate == HotSpotFate::undecided && r.peak_temperature < r.initial_peak_temperature &&
+        r.peak_temperature < r.previous_peak_temperature) {
+      r.fate = HotSpotFate::dying;  // still above the threshold, but cooling
+      r.decision_time = last_time_;
+    }
+}
+
+bool HotSpotFates::all_decided() const {
+  return std::all_of(records_.begin(), records_.end(),
+                     [](const HotSpotFateRecord& r) { return r.fate != HotSpotFate::undecided; });
+}
+
+template void HotSpotFates::update<2>(const mechanics::Particles<2>&, const std::vector<double>&, const HotSpotTracker&,
+                                      double);
+template void HotSpotFates::update<3>(const mechanics::Particles<3>&, const std::vector<double>&, const HotSpotTracker&,
+                                      double);
+
+}  // namespace frictherm::coupling
