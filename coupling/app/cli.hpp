@@ -45,14 +45,23 @@ ParsedArgs parse_args(const std::string& command, const std::vector<std::string>
 /// Exactly one positional argument named `what` (e.g. "SCENE").
 const std::string& single_positional(const std::string& command, const ParsedArgs& a, const std::string& what);
 
+/// The repeatable --set KEY=VALUE option every scene-reading command takes.
+extern const OptionSpec kSetOption;
+/// An integer in [1, 1024] given to `option`; UsageError otherwise.
+int positive_int(const std::string& command, const std::string& option, const std::string& text);
+
+int ensemble_command(const std::vector<std::string>& args, const std::string& command_line);
 int run_command(const std::vector<std::string>& args, const std::string& command_line);
 int validate_command(const std::vector<std::string>& args);
 int export_csv_command(const std::vector<std::string>& args);
+int microstructure_command(const std::vector<std::string>& args);  // cli_microstructure.cpp
 
 /// Help texts (printed to stdout by --help).
 extern const char* const kProgramHelp;
 extern const char* const kRunHelp;
 extern const char* const kValidateHelp;
 extern const char* const kExportCsvHelp;
+extern const char* const kMicrostructureHelp;
+extern const char* const kEnsembleHelp;
 
 }  // namespace frictherm::cli

@@ -11,9 +11,9 @@
 
 namespace frictherm::cli {
 
-namespace {
-
 const OptionSpec kSetOption{{"-s", "--set"}, true, "set", true};
+
+namespace {
 
 /// Loads a scene with the --set overrides; a problem becomes "frictherm: SCENE: message" and exit
 /// code 2 (returned as false).
@@ -30,6 +30,8 @@ bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene) 
   }
 }
 
+}  // namespace
+
 int positive_int(const std::string& command, const std::string& option, const std::string& text) {
   std::size_t used = 0;
   long v = 0;
@@ -42,8 +44,6 @@ int positive_int(const std::string& command, const std::string& option, const st
     throw UsageError(command, "option '" + option + "' expects an integer in [1, 1024], got '" + text + "'");
   return static_cast<int>(v);
 }
-
-}  // namespace
 
 int run_command(const std::vector<std::string>& args, const std::string& command_line) {
   const ParsedArgs a = parse_args("run", args,

@@ -1,4 +1,4 @@
-// frictherm: the command-line program (run, validate, export-csv).
+// frictherm: the command-line program (run, validate, export-csv, ensemble).
 #include "cli.hpp"
 
 #include <exception>
@@ -19,6 +19,8 @@ const char* help_of(const std::string& command) {
   if (command == "run") return frictherm::cli::kRunHelp;
   if (command == "validate") return frictherm::cli::kValidateHelp;
   if (command == "export-csv") return frictherm::cli::kExportCsvHelp;
+  if (command == "microstructure") return frictherm::cli::kMicrostructureHelp;
+  if (command == "ensemble") return frictherm::cli::kEnsembleHelp;
   return nullptr;
 }
 
@@ -48,6 +50,8 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
   if (cmd == "run") return run_command(rest, command_line);
   if (cmd == "validate") return validate_command(rest);
   if (cmd == "export-csv") return export_csv_command(rest);
+  if (cmd == "microstructure") return microstructure_command(rest);
+  if (cmd == "ensemble") return ensemble_command(rest, command_line);
   throw UsageError("", (cmd[0] == '-' ? "unknown option '" : "unknown command '") + cmd + "'");
 }
 

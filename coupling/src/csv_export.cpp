@@ -44,26 +44,28 @@ void put_number(std::ostream& out, double value) {
 
 }  // namespace
 
-SeriesTable read_series(const std::string& h5_path) {
+SeriesTable read_series(const std::string& h5_path) { return read_table(h5_path, "series"); }
+
+SeriesTable read_table(const std::string& h5_path, const std::string& group) {
   const Quiet quiet;
   SeriesTable table;
+  const std::string at = "/" + group;
   const Handle f{check_id(H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), h5_path, "cannot open the file"),
                  H5Fclose};
-  if (H5Lexists(f.get(), "series", H5P_DEFAULT) <= 0) return table;
-  const Handle g{check_id(H5Gopen2(f.get(), "series", H5P_DEFAULT), h5_path, "cannot open /series"), H5Gclose};
+  if (H5Lexists(f.get(), group.c_str(), H5P_DEFAULT) <= 0) return table;
+  const Handle g{check_id(H5Gopen2(f.get(), group.c_str(), H5P_DEFAULT), h5_path, "cannot open " + at), H5Gclose};
   if (H5Aexists(g.get(), "columns") > 0) {
-    const Handle a{check_id(H5Aopen(g.get(), "columns", H5P_DEFAULT), h5_path, "cannot open /series attribute columns"),
-                   H5Aclose};
-    const Handle t{check_id(H5Aget_type(a.get()), h5_path, "cannot read the type of /series attribute columns"),
-                   H5Tclose};
-    const Handle s{check_id(H5Aget_space(a.get()), h5_path, "cannot read /series attribute columns"), H5Sclose};
+    const std::string attr = at + " attribute columns";
+    const Handle a{check_id(H5Aopen(g.get(), "columns", H5P_DEFAULT), h5_path, "cannot open " + attr), H5Aclose};
+    const Handle t{check_id(H5Aget_type(a.get()), h5_path, "cannot read the type of " + attr), H5Tclose};
+    const Handle s{check_id(H5Aget_space(a.get()), h5_path, "cannot read " + attr), H5Sclose};
     const std::size_t size = H5Tget_size(t.get());
     const hssize_t count = H5Sget_simple_extent_npoints(s.get());
     if (H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) > 0 || size == 0 || count < 0) {
-      fail(h5_path, "/series attribute columns is not a fixed-length string array");
+      fail(h5_path, attr + " is not a fixed-length string array");
     }
     std::string packed(size * static_cast<std::size_t>(count), '\0');
-    check(H5Aread(a.get(), t.get(), packed.data()), h5_path, "cannot read /series attribute columns");
+    check(H5Aread(a.get(), t.get(), packed.data()), h5_path, "cannot read " + attr);
     for (hssize_t i = 0; i < count; ++i) {
       std::string name = packed.substr(static_cast<std::size_t>(i) * size, size);
       name.resize(std::min(name.size(), name.find('\0')));
@@ -77,12 +79,12 @@ SeriesTable read_series(const std::string& h5_path) {
                        return 0;
                      },
                      &table.names),
-          h5_path, "cannot list /series");
+          h5_path, "cannot list " + at);
     std::stable_partition(table.names.begin(), table.names.end(), [](const std::string& n) { return n == "time"; });
   }
   std::size_t rows = std::numeric_limits<std::size_t>::max();
   for (const auto& name : table.names) {
-    const std::string where = "/series/" + name;
+    const std::string where = at + "/" + name;
     const Handle d{check_id(H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT), h5_path, "cannot open " + where), H5Dclose};
     const Handle s{check_id(H5Dget_space(d.get()), h5_path, "cannot read the shape of " + where), H5Sclose};
     const hssize_t n = H5Sget_simple_extent_npoints(s.get());

@@ -147,8 +147,12 @@ void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
 void parse_solver(const JsonReader& root, Scene& s) {
   const auto solver = root.find("solver");
   if (!solver) return;
-  s.options.shape = mechanics::shape_kind_from_string(
-      solver->choice("shape_function", {"linear", "ugimp", "quadratic_bspline"}, "ugimp"));
+  s.options.shape = mechanics::shape_kind_from_string(solver->choice(
+      "shape_function", {"linear", "ugimp", "quadratic_bspline", "extended_bspline", "ebs"}, "ugimp"));
+  if (s.options.shape == mechanics::ShapeKind::extended_bspline)  // C_c, Kakouris 2024 eq. 20
+    s.options.ebs_occupation = solver->number("ebs_occupation", s.options.ebs_occupation, Range::closed(0.0, 1.0));
+  else if (const auto c = solver->find("ebs_occupation"))
+    c->fail("only with \"shape_function\": \"extended_bspline\"");
   s.options.scheme = mechanics::update_scheme_from_string(solver->choice("scheme", {"usf", "usl", "musl"}, "musl"));
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
@@ -234,7 +238,12 @@ void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
       value = o.value;  // a bare word: a string
     }
     try {
-      doc[pointer_of(o.path)] = value;
+      const Json::json_pointer ptr = pointer_of(o.path);
+      if (value.is_null() && doc.contains(ptr) && doc.at(ptr.parent_pointer()).is_object()) {
+        doc.at(ptr.parent_pointer()).erase(ptr.back());  // KEY=null removes an object key
+      } else {
+        doc[ptr] = value;
+      }
     } catch (const Json::exception&) {
       throw SceneError("--set " + o.path + ": cannot set this key (a part of its path is not an object or array)");
     }
@@ -302,14 +311,20 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   ctx.base_dir = base_dir;
   parse_grid(root, s);
   parse_materials(root, s, ctx);
+  ctx.declared_materials = s.materials.size();  // image bodies may add one material per grain after these
   parse_run(root, s);  // before bodies and output: defaults depend on end_time
   detail::parse_bodies(root, s, ctx);
   detail::parse_boundary(root, s, ctx);
   detail::parse_loads(root, s, ctx);
   parse_solver(root, s);
   s.contact = parse_contact_section(root, s.dimension, ctx.material_names);  // scene_contact.cpp
+  detail::expand_grain_contact_pairs(s, ctx);  // scene_grains.cpp: pairs of a grain template -> its grains
   parse_output(root, s);
-  s.thermal = parse_thermal_sections(root, s.dimension, s.materials, s.options.thickness);  // scene_thermal.cpp
+  // Thermal properties are given per declared material; grain materials take their template's.
+  const std::vector<mechanics::Material> declared(s.materials.begin(),
+                                                  s.materials.begin() + static_cast<long>(ctx.declared_materials));
+  s.thermal = parse_thermal_sections(root, s.dimension, declared, s.options.thickness);  // scene_thermal.cpp
+  detail::extend_grain_thermal(s, ctx);
   return s;
 }
 

@@ -1,6 +1,8 @@
 // The human-readable summary `frictherm validate` prints.
 #include "scene_detail.hpp"
 
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+
 #include <cmath>
 #include <iomanip>
 #include <ostream>
@@ -48,20 +50,46 @@ void describe(const Scene& s, std::ostream& out) {
                 << " update, CFL " << g(s.options.cfl);
   if (std::isfinite(s.options.max_time_step)) out << ", max time step " << g(s.options.max_time_step) << " s";
   out << '\n';
+  // Grain copies ("hmx#1", "hmx#2", ...) of one template are listed as one line.
+  auto grain_template = [&s](std::size_t m) {
+    const std::string& n = s.materials[m].name;
+    const std::size_t hash = n.rfind('#');
+    return hash == std::string::npos ? std::string() : n.substr(0, hash);
+  };
   for (std::size_t m = 0; m < s.materials.size(); ++m) {
     const auto& mat = s.materials[m];
-    row(m == 0 ? "materials" : "") << m << " " << mat.name << ": " << mechanics::to_string(mat.kind) << ", density "
-                                   << g(mat.density) << " kg/m^3";
-    if (!mat.is_rigid())
+    const std::string tmpl = grain_template(m);
+    std::size_t last = m;
+    while (!tmpl.empty() && last + 1 < s.materials.size() && grain_template(last + 1) == tmpl) ++last;
+    auto& line = row(m == 0 ? "materials" : "");
+    if (last > m)
+      line << m << "-" << last << " " << mat.name << " ... " << s.materials[last].name << ": " << last - m + 1
+           << " grains of " << tmpl << ", ";
+    else
+      line << m << " " << mat.name << ": ";
+    out << mechanics::to_string(mat.kind) << ", density " << g(mat.density) << " kg/m^3";
+    if (mat.kind == mechanics::MaterialKind::mie_gruneisen) {
+      const auto& mg = mat.mie_gruneisen;
+      out << ", C0 " << g(mg.C0) << " m/s, S1 " << g(mg.S1) << ", gamma0 " << g(mg.gamma0) << ", G " << g(mg.shear_modulus)
+          << " Pa";
+      if (mg.yield_stress > 0.0 && std::isfinite(mg.yield_stress)) out << ", yield " << g(mg.yield_stress) << " Pa";
+      out << ", wave speed " << g(mechanics::mie_gruneisen_wave_speed(mg, 1.0, 0.0)) << " m/s";
+    } else if (!mat.is_rigid()) {
       out << ", E " << g(mat.youngs_modulus) << " Pa, nu " << g(mat.poisson_ratio) << ", wave speed "
           << g(mat.p_wave_speed(s.options.analysis)) << " m/s";
+    }
     out << '\n';
+    m = last;
   }
   for (std::size_t b = 0; b < sim->bodies().size(); ++b) {
     const BodySpec& spec = s.bodies[b];
     row(b == 0 ? "bodies" : "") << b << " " << spec.name << ": " << shape_name(spec.shape.type, Dim) << ", "
                                 << (spec.material >= 0 ? s.materials[static_cast<std::size_t>(spec.material)].name
-                                                       : std::string("materials by grey level"))
+                                    : spec.shape.generated
+                                        ? "ellipse packing of " + std::to_string(spec.shape.grain_count) +
+                                              " grains, area fraction " + g(spec.shape.fraction)
+                                    : spec.shape.pixel_materials.width > 0 ? std::string("a material per grain")
+                                                                           : std::string("materials by grey level"))
                                 << ", " << sim->bodies()[b].particle_count << " particles\n";
   }
   row("particles") << p.size() << " (" << s.bodies.front().particles_per_cell << " per cell per direction)\n";

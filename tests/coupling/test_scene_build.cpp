@@ -278,3 +278,12 @@ TEST(SceneOverrides, SetValuesBeforeValidation) {
   EXPECT_THROW(parse_scene(good_scene().dump(), "<test>", ".", "scene", {fc::parse_override("bodies[x]=1")}),
                fc::SceneError);
 }
+
+TEST(SceneOverrides, NullRemovesAKey) {
+  // The default CFL factor comes back when the scene's value is removed.
+  const fc::Scene base = parse_scene(good_scene().dump(), "<test>", ".", "scene", {fc::parse_override("solver.cfl=0.25")});
+  ASSERT_DOUBLE_EQ(base.options.cfl, 0.25);
+  const fc::Scene s = parse_scene(good_scene().dump(), "<test>", ".", "scene",
+                                  {fc::parse_override("solver.cfl=0.25"), fc::parse_override("solver.cfl=null")});
+  EXPECT_DOUBLE_EQ(s.options.cfl, frictherm::mechanics::SimulationOptions{}.cfl);
+}

@@ -20,6 +20,8 @@ struct SeriesTable {
 /// first). Columns of unequal length are cut to the shortest. Throws std::runtime_error naming the
 /// file and object on any HDF5 failure.
 SeriesTable read_series(const std::string& h5_path);
+/// The same for any column group written like /series (e.g. "hotspots"); empty when absent.
+SeriesTable read_table(const std::string& h5_path, const std::string& group);
 
 /// Header line of column names, then one line per row. Numbers are written in the shortest form
 /// that reads back to the same double ("nan", "inf", "-inf" for non-finite values). Names holding
