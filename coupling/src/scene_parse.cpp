@@ -239,8 +239,8 @@ void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
     }
     try {
       const Json::json_pointer ptr = pointer_of(o.path);
-      if (value.is_null() && doc.contains(ptr) && doc.at(ptr.parent_pointer()).is_object()) {
-        doc.at(ptr.parent_pointer()).erase(ptr.back());  // KEY=null removes an object key
+      if (value.is_null()) {  // KEY=null removes an object key (nothing to do when it is absent)
+        if (doc.contains(ptr) && doc.at(ptr.parent_pointer()).is_object()) doc.at(ptr.parent_pointer()).erase(ptr.back());
       } else {
         doc[ptr] = value;
       }

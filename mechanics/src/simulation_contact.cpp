@@ -3,6 +3,8 @@
 // frictional work. Sign convention in contact.hpp: n̂ points from material a to material b.
 #include <frictherm/mechanics/simulation.hpp>
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -160,128 +162,156 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const std::size_t nm = materials_.size();
   Vec<Dim> h = grid_.cell_size();
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
-  PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, cell_volume, dt, heat};
   if (heat) contact_stats_ = ContactStats{};
 
-  // Per-node scratch, reused from call to call (no allocation per step once grown).
-  thread_local std::vector<ContactSide<Dim>> sides;
-  thread_local std::vector<int> slots, mats;
-  thread_local std::vector<Vec<Dim>> dps;
-  auto apply = [&](int slot, const Vec<Dim>& dp) {
-    nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
-    if (forces) nodes_.force[static_cast<std::size_t>(slot)] += dp / dt;  // eq. 19
-  };
-  auto add_work = [&](int node, int ma, int mb, double w1, double w2) {
-    if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
-    work_first_[static_cast<std::size_t>(node)] += w1;
-    work_second_[static_cast<std::size_t>(node)] += w2;
-    const std::size_t k = static_cast<std::size_t>(std::min(ma, mb)) * nm + static_cast<std::size_t>(std::max(ma, mb));
-    pair_work_first_[k] += w1;
-    pair_work_second_[k] += w2;
-  };
+  // Node groups of contact_entries_ (one per contact node): each group reads and writes only its own
+  // node's slots and work entries, so groups run in parallel. Stats and pair books go to per-thread
+  // accumulators, summed in thread order afterwards (deterministic for a given thread count).
+  contact_groups_.clear();
+  for (std::size_t e = 0; e < contact_entries_.size(); ++e)
+    if (e == 0 || contact_entries_[e].node != contact_entries_[e - 1].node) contact_groups_.push_back(e);
+  contact_groups_.push_back(contact_entries_.size());
+  const long groups = static_cast<long>(contact_groups_.size()) - 1;
+  const int threads = groups >= 256 ? threads_ : 1;
+  contact_thread_work_.resize(static_cast<std::size_t>(threads));
+  for (auto& t : contact_thread_work_) {
+    t.stats = ContactStats{};
+    if (heat) t.pair_first.assign(nm * nm, 0.0), t.pair_second.assign(nm * nm, 0.0);
+  }
 
-  for (std::size_t e = 0; e < contact_entries_.size();) {
-    const int node = contact_entries_[e].node;
-    std::size_t end = e;
-    while (end < contact_entries_.size() && contact_entries_[end].node == node) ++end;
-    // Gather the materials at this node; slivers below min_mass_fraction take no part.
-    sides.clear(), slots.clear(), mats.clear();
-    double node_mass = 0.0;
-    for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].slot)];
-    for (std::size_t q = e; q < end; ++q) {
-      const int slot = contact_entries_[q].slot;
-      const std::size_t su = static_cast<std::size_t>(slot);
-      if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
-        if (heat) ++contact_stats_.guarded;
-        continue;
-      }
-      const std::size_t f = static_cast<std::size_t>(contact_entries_[q].field);
-      ContactSide<Dim> sd;
-      sd.mass = nodes_.mass[su];
-      sd.momentum = nodes_.momentum[su];
-      sd.force = nodes_.force[su];
-      sd.mass_position = nodes_.mass_position[su];
-      sd.domain = nodes_.domain[su];
-      sd.domain_gradient = nodes_.domain_gradient[su];
-      sd.rigid = fields_[f].rigid;
-      if (sd.rigid) {
-        const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
-        sd.rigid_velocity = field_velocity_[f];
-        sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
-      }
-      sides.push_back(sd);
-      slots.push_back(slot);
-      mats.push_back(fields_[f].material);
-    }
-    const std::size_t count = sides.size();
-    if (heat) {
-      ++contact_stats_.contact_nodes;
-      if (count > 2) ++contact_stats_.multi_nodes;
-    }
-    if (count == 2) {
-      // Two materials: a is the deformable one when the other is rigid.
-      std::size_t ia = 0, ib = 1;
-      if (sides[0].rigid) std::swap(ia, ib);
-      if (!sides[ia].rigid && contact_pair(mats[ia], mats[ib]).method == ContactMethod::multimaterial) {
-        ctx.settings = &contact_pair(mats[ia], mats[ib]);
-        const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
-        if (r.changed) {
-          apply(slots[ia], r.dp);
-          if (!sides[ib].rigid) apply(slots[ib], Vec<Dim>(-r.dp));
+#pragma omp parallel num_threads(threads)
+  {
+    ContactThreadWork& acc = contact_thread_work_[static_cast<std::size_t>(omp_get_thread_num())];
+    PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, cell_volume, dt, heat};
+    // Per-node scratch, reused from call to call (no allocation per step once grown).
+    thread_local std::vector<ContactSide<Dim>> sides;
+    thread_local std::vector<int> slots, mats;
+    thread_local std::vector<Vec<Dim>> dps;
+    auto apply = [&](int slot, const Vec<Dim>& dp) {
+      nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
+      if (forces) nodes_.force[static_cast<std::size_t>(slot)] += dp / dt;  // eq. 19
+    };
+    auto add_work = [&](int node, int ma, int mb, double w1, double w2) {
+      if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
+      work_first_[static_cast<std::size_t>(node)] += w1;
+      work_second_[static_cast<std::size_t>(node)] += w2;
+      const std::size_t k = static_cast<std::size_t>(std::min(ma, mb)) * nm + static_cast<std::size_t>(std::max(ma, mb));
+      acc.pair_first[k] += w1;
+      acc.pair_second[k] += w2;
+    };
+    ContactStats& stats = acc.stats;
+
+#pragma omp for schedule(static)
+    for (long g = 0; g < groups; ++g) {
+      const std::size_t e = contact_groups_[static_cast<std::size_t>(g)];
+      const std::size_t end = contact_groups_[static_cast<std::size_t>(g) + 1];
+      const int node = contact_entries_[e].node;
+      // Gather the materials at this node; slivers below min_mass_fraction take no part.
+      sides.clear(), slots.clear(), mats.clear();
+      double node_mass = 0.0;
+      for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].slot)];
+      for (std::size_t q = e; q < end; ++q) {
+        const int slot = contact_entries_[q].slot;
+        const std::size_t su = static_cast<std::size_t>(slot);
+        if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
+          if (heat) ++stats.guarded;
+          continue;
         }
-        if (r.sliding && heat) {
-          ++contact_stats_.sliding_nodes;
-          add_work(node, mats[ia], mats[ib], r.work_first, r.work_second);
+        const std::size_t f = static_cast<std::size_t>(contact_entries_[q].field);
+        ContactSide<Dim> sd;
+        sd.mass = nodes_.mass[su];
+        sd.momentum = nodes_.momentum[su];
+        sd.force = nodes_.force[su];
+        sd.mass_position = nodes_.mass_position[su];
+        sd.domain = nodes_.domain[su];
+        sd.domain_gradient = nodes_.domain_gradient[su];
+        sd.rigid = fields_[f].rigid;
+        if (sd.rigid) {
+          const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
+          sd.rigid_velocity = field_velocity_[f];
+          sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
         }
+        sides.push_back(sd);
+        slots.push_back(slot);
+        mats.push_back(fields_[f].material);
       }
-    } else if (count > 2) {
-      // Three or more: each material against the others lumped into one virtual material; its
-      // change is applied to it alone, frictional work summed with eq. 40 (1/m_red = Σ_j 1/m_j, eq. 39).
-      bool any_rigid = false;
-      double inv_mred = 0.0, total = 0.0;
-      for (const auto& sd : sides) {
-        any_rigid = any_rigid || sd.rigid;
-        if (!sd.rigid) inv_mred += 1.0 / sd.mass, total += sd.mass;
+      const std::size_t count = sides.size();
+      if (heat) {
+        ++stats.contact_nodes;
+        if (count > 2) ++stats.multi_nodes;
       }
-      const double m_red_node = 1.0 / inv_mred;
-      dps.assign(count, Vec<Dim>::Zero());
-      for (std::size_t a = 0; a < count; ++a) {
-        if (sides[a].rigid) continue;
-        ContactSide<Dim> rest;
-        std::size_t dominant = count;
-        double rigid_weight = -1.0;
-        for (std::size_t j = 0; j < count; ++j) {
-          if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
-          rest.add(sides[j]);
-          if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
-          if (sides[j].rigid && sides[j].mass > rigid_weight) {  // a rigid neighbour dominates the lump
-            rigid_weight = sides[j].mass;
-            rest.rigid = true;
-            rest.rigid_velocity = sides[j].rigid_velocity;
-            rest.rigid_acceleration = sides[j].rigid_acceleration;
+      if (count == 2) {
+        // Two materials: a is the deformable one when the other is rigid.
+        std::size_t ia = 0, ib = 1;
+        if (sides[0].rigid) std::swap(ia, ib);
+        if (!sides[ia].rigid && contact_pair(mats[ia], mats[ib]).method == ContactMethod::multimaterial) {
+          ctx.settings = &contact_pair(mats[ia], mats[ib]);
+          const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
+          if (r.changed) {
+            apply(slots[ia], r.dp);
+            if (!sides[ib].rigid) apply(slots[ib], Vec<Dim>(-r.dp));
+          }
+          if (r.sliding && heat) {
+            ++stats.sliding_nodes;
+            add_work(node, mats[ia], mats[ib], r.work_first, r.work_second);
           }
         }
-        if (dominant == count) continue;  // all its partners here use penalty contact
-        ctx.settings = &contact_pair(mats[a], mats[dominant]);
-        const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
-        if (r.changed) dps[a] = r.dp;
-        if (r.sliding && heat) {
-          ++contact_stats_.sliding_nodes;
-          const double w = m_red_node / sides[a].mass;  // eq. 40
-          add_work(node, mats[a], mats[dominant], w * r.work_first, w * r.work_second);
+      } else if (count > 2) {
+        // Three or more: each material against the others lumped into one virtual material; its
+        // change is applied to it alone, frictional work summed with eq. 40 (1/m_red = Σ_j 1/m_j, eq. 39).
+        bool any_rigid = false;
+        double inv_mred = 0.0, total = 0.0;
+        for (const auto& sd : sides) {
+          any_rigid = any_rigid || sd.rigid;
+          if (!sd.rigid) inv_mred += 1.0 / sd.mass, total += sd.mass;
         }
+        const double m_red_node = 1.0 / inv_mred;
+        dps.assign(count, Vec<Dim>::Zero());
+        for (std::size_t a = 0; a < count; ++a) {
+          if (sides[a].rigid) continue;
+          ContactSide<Dim> rest;
+          std::size_t dominant = count;
+          double rigid_weight = -1.0;
+          for (std::size_t j = 0; j < count; ++j) {
+            if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
+            rest.add(sides[j]);
+            if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
+            if (sides[j].rigid && sides[j].mass > rigid_weight) {  // a rigid neighbour dominates the lump
+              rigid_weight = sides[j].mass;
+              rest.rigid = true;
+              rest.rigid_velocity = sides[j].rigid_velocity;
+              rest.rigid_acceleration = sides[j].rigid_acceleration;
+            }
+          }
+          if (dominant == count) continue;  // all its partners here use penalty contact
+          ctx.settings = &contact_pair(mats[a], mats[dominant]);
+          const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
+          if (r.changed) dps[a] = r.dp;
+          if (r.sliding && heat) {
+            ++stats.sliding_nodes;
+            const double w = m_red_node / sides[a].mass;  // eq. 40
+            add_work(node, mats[a], mats[dominant], w * r.work_first, w * r.work_second);
+          }
+        }
+        if (!any_rigid) {
+          // The lumped changes need not cancel; removing their mass-weighted mean keeps the node's total
+          // momentum exact without changing any relative velocity (an addition to the paper's §2.12).
+          Vec<Dim> residual = Vec<Dim>::Zero();
+          for (const auto& d : dps) residual += d;
+          for (std::size_t a = 0; a < count; ++a) dps[a] -= (sides[a].mass / total) * residual;
+        }
+        for (std::size_t a = 0; a < count; ++a)
+          if (!sides[a].rigid) apply(slots[a], dps[a]);
       }
-      if (!any_rigid) {
-        // The lumped changes need not cancel; removing their mass-weighted mean keeps the node's total
-        // momentum exact without changing any relative velocity (an addition to the paper's §2.12).
-        Vec<Dim> residual = Vec<Dim>::Zero();
-        for (const auto& d : dps) residual += d;
-        for (std::size_t a = 0; a < count; ++a) dps[a] -= (sides[a].mass / total) * residual;
-      }
-      for (std::size_t a = 0; a < count; ++a)
-        if (!sides[a].rigid) apply(slots[a], dps[a]);
     }
-    e = end;
+  }
+  for (const auto& t : contact_thread_work_) {
+    if (!heat) continue;
+    contact_stats_.contact_nodes += t.stats.contact_nodes;
+    contact_stats_.multi_nodes += t.stats.multi_nodes;
+    contact_stats_.sliding_nodes += t.stats.sliding_nodes;
+    contact_stats_.guarded += t.stats.guarded;
+    for (std::size_t k = 0; k < nm * nm; ++k) pair_work_first_[k] += t.pair_first[k], pair_work_second_[k] += t.pair_second[k];
   }
 }
 

@@ -74,21 +74,22 @@ TEST(SceneMicrostructure, ExampleHasOneMaterialPerGrainPlusBinderAndWalls) {
   EXPECT_LE(grains, 20u);
   // Achieved fraction within the default tolerance (half the largest possible grain: π/8 · 20² · 0.9 / 60² = 0.039).
   EXPECT_NEAR(shape.fraction, 0.5, 0.04);
-  // Declared: hmx (the grain template, left without particles), binder, wall, piston; then hmx#1..n.
-  ASSERT_EQ(s.materials.size(), 4 + grains);
-  for (std::size_t k = 1; k <= grains; ++k) EXPECT_EQ(s.materials[3 + k].name, "hmx#" + std::to_string(k));
+  // Declared: hmx (the grain template, left without particles), binder, side_wall, bottom_wall,
+  // piston; then hmx#1..n.
+  ASSERT_EQ(s.materials.size(), 5 + grains);
+  for (std::size_t k = 1; k <= grains; ++k) EXPECT_EQ(s.materials[4 + k].name, "hmx#" + std::to_string(k));
   const auto sim = fc::build_simulation<2>(s);
   std::set<int> used(sim->particles().material.begin(), sim->particles().material.end());
-  EXPECT_EQ(used.size(), grains + 1 /*binder*/ + 2 /*wall, piston*/);
+  EXPECT_EQ(used.size(), grains + 1 /*binder*/ + 3 /*side and bottom walls, piston*/);
   EXPECT_EQ(used.count(material_index(s, "hmx")), 0u);
   // One particle per pixel (2 x 2 um particles, 2 um pixels): grain particles = grain pixels.
   std::size_t grain_pixels = 0, grain_particles = 0;
   for (auto g : shape.image.pixels) grain_pixels += g > 0;
-  for (int m : sim->particles().material) grain_particles += m >= 4;
+  for (int m : sim->particles().material) grain_particles += m >= 5;
   EXPECT_EQ(grain_particles, grain_pixels);
   // Every pair meets through the default law: Coulomb mu = 0.3 (grain-grain, grain-binder, grain-wall).
   const int g1 = material_index(s, "hmx#1"), g2 = material_index(s, "hmx#2");
-  for (int other : {g2, material_index(s, "binder"), material_index(s, "wall"), material_index(s, "piston")})
+  for (int other : {g2, material_index(s, "binder"), material_index(s, "side_wall"), material_index(s, "piston")})
     EXPECT_EQ(sim->contact_pair(g1, other).law.describe(), "coulomb(mu=0.3)");
   // Thermal properties: grains take hmx's (table 1: 950 J/(kg K), 0.45 W/(m K)).
   ASSERT_EQ(s.thermal.coupler.materials.size(), s.materials.size());

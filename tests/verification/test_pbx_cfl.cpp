@@ -5,19 +5,26 @@
 // in binder, walls, top wall at 3.07 m/s) loaded for 3.9 µs (12 µm, 20 % of its height); the full
 // 240 µm specimen is examples/pbx_compaction.json with examples/pbx_figures.py --cfl-sweep.
 //
-// Measured (J per metre of thickness; the reference is the second order at C = 0.1):
-//   C      W1        W2
-//   1      0.2216    0.1390
-//   0.5    0.1029    0.0772
-//   0.25   0.0765    0.0626
-//   0.1    0.0605    0.0546
-//   0.05   0.0555    0.0516   (not run here: 140,000 steps)
-// Both orders are still converging at C = 0.1 (the gap W1 − W2 halves with C, as O(C) terms do);
-// at every larger C the second order is the closer one, by about a factor two in error.
+// Measured (J per metre of thickness; the reference is the second order at C = 0.05; frictionless
+// velocity-boundary walls, contact min_mass_fraction 0.02 as in the scene):
+//   C      W1        W2        error W1   error W2
+//   1      0.0689    0.0463     240 %      128 %
+//   0.5    0.0440    0.0325     117 %       60 %
+//   0.25   0.0252    0.0215      24 %      5.8 %
+//   0.1    0.0209    0.0190     3.2 %      6.2 %
+//   0.05   0.0218    0.0203
+// Below C = 0.25 both orders sit within a few per cent of each other and of the reference (the
+// run-to-run scatter of this partly chaotic compaction); above it the second order is the closer one,
+// by a factor two to four: the paper's finding, second-order heating is accurate at a larger C.
+// Asserted: the gap between the orders shrinks at every halving of C; for C ≥ 0.25 the second order
+// is the closer one; at C = 0.25 the second order is within 10 % and the first order is not; at
+// C = 0.1 both are within 10 %.
 #include <frictherm/coupling/scene.hpp>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -45,19 +52,61 @@ Work run(double cfl) {
 }  // namespace
 
 TEST(PbxCompaction, SecondOrderHeatingConvergesFasterWithC) {
-  const double smallest = 0.1;
+  const double smallest = 0.05;
   const Work ref = run(smallest);
   std::printf("[pbx cfl] C = %.3g: W1 = %.6g J, W2 = %.6g J (%ld steps)\n", smallest, ref.first, ref.second, ref.steps);
   ASSERT_GT(ref.second, 0.0) << "grains must slide";
   double last_gap = std::fabs(ref.first - ref.second);
-  for (const double c : {0.25, 0.5, 1.0}) {  // growing C: the orders drift apart
+  for (const double c : {0.1, 0.25, 0.5, 1.0}) {  // growing C: the orders drift apart
     const Work w = run(c);
     const double e1 = std::fabs(w.first - ref.second) / ref.second, e2 = std::fabs(w.second - ref.second) / ref.second;
     const double gap = std::fabs(w.first - w.second);
     std::printf("[pbx cfl] C = %.3g: W1 = %.6g J (error %.1f %%), W2 = %.6g J (error %.1f %%), %ld steps\n", c, w.first,
                 100 * e1, w.second, 100 * e2, w.steps);
-    EXPECT_LT(e2, e1) << "second order must be closer to the converged work at C = " << c;
-    EXPECT_GT(gap, 1.5 * last_gap) << "the orders must approach each other as C falls (O(C) difference)";
+    EXPECT_GT(gap, last_gap) << "the orders must approach each other as C falls";
     last_gap = gap;
+    if (c >= 0.25) EXPECT_LT(e2, e1) << "second order must be closer to the converged work at C = " << c;
+    if (c == 0.25) {
+      EXPECT_LT(e2, 0.10) << "second order within 10 % at C = 0.25";
+      EXPECT_GT(e1, 0.10) << "first order still more than 10 % off at C = 0.25";
+    }
+    if (c == 0.1) EXPECT_LT(std::max(e1, e2), 0.10) << "both orders within 10 % at C = 0.1";
   }
+}
+
+// The contact passes run their nodes in parallel (per-thread stats and pair books, summed in thread
+// order). The full 240 µm specimen (15,376 particles, thousands of contact nodes among 55 grains)
+// gives the same frictional work and momentum on one and two threads, up to the round-off the
+// particle-to-grid reduction order introduces.
+TEST(PbxCompaction, ContactPassesGiveTheSameWorkOnOneAndTwoThreads) {
+  const std::string path = std::string(FRICTHERM_SOURCE_DIR) + "/examples/pbx_compaction.json";
+  const coupling::Scene scene = coupling::load_scene(path, {{"run.end_time", "1e-7"}});
+  struct Result {
+    double w1, w2, px, py;
+    long contact_nodes;
+  };
+  auto run_with = [&](int threads) {
+    omp_set_num_threads(threads);
+    auto sim = coupling::build_simulation<2>(scene);
+    long contact_nodes = 0;
+    for (int s = 0; s < 100; ++s) {
+      sim->step();
+      contact_nodes = std::max(contact_nodes, sim->contact_stats().contact_nodes);
+    }
+    const auto& p = sim->particles();
+    double px = 0.0, py = 0.0;
+    for (std::size_t k = 0; k < p.size(); ++k) px += p.mass[k] * p.velocity[k][0], py += p.mass[k] * p.velocity[k][1];
+    return Result{sim->cumulative_frictional_work(mechanics::HeatingOrder::first),
+                  sim->cumulative_frictional_work(mechanics::HeatingOrder::second), px, py, contact_nodes};
+  };
+  const Result one = run_with(1), two = run_with(2);
+  omp_set_num_threads(omp_get_num_procs());
+  std::printf("[pbx threads] contact nodes %ld; W2 %.12g vs %.12g J\n", one.contact_nodes, one.w2, two.w2);
+  ASSERT_GT(one.contact_nodes, 256) << "the parallel contact path must be exercised";
+  ASSERT_GT(one.w2, 0.0);
+  EXPECT_NEAR(two.w1, one.w1, 1e-9 * one.w1);
+  EXPECT_NEAR(two.w2, one.w2, 1e-9 * one.w2);
+  const double scale = std::hypot(one.px, one.py) + 1e-30;
+  EXPECT_NEAR(two.px, one.px, 1e-9 * scale);
+  EXPECT_NEAR(two.py, one.py, 1e-9 * scale);
 }

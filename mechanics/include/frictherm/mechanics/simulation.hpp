@@ -236,6 +236,12 @@ class Simulation {
     bool operator<(const ContactEntry& o) const { return node != o.node ? node < o.node : slot < o.slot; }
   };
   std::vector<ContactEntry> contact_entries_;  // sorted by node; within a node in material order
+  std::vector<std::size_t> contact_groups_;     // start of each node's entries, then the end
+  struct ContactThreadWork {                    // per-thread contact stats and pair books of one pass
+    ContactStats stats;
+    std::vector<double> pair_first, pair_second;
+  };
+  std::vector<ContactThreadWork> contact_thread_work_;
   std::vector<std::uint16_t> node_field_count_;
   std::vector<double> work_first_, work_second_;    // per grid node, last step
   std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
