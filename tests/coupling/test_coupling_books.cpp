@@ -1,5 +1,6 @@
 // Verification (issue 4): energy books of a whole run with frictional heating — the sliding-block
 // example with a thermal section, through the runner, for every window policy.
+#include "h5_test_support.hpp"
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
@@ -20,21 +21,7 @@ using fc::Json;
 
 namespace {
 
-std::vector<double> read_doubles(const std::string& file, const std::string& path) {
-  std::vector<double> out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return out;
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  if (d >= 0) {
-    const hid_t sp = H5Dget_space(d);
-    out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)));
-    if (!out.empty()) H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
-    H5Sclose(sp);
-    H5Dclose(d);
-  }
-  H5Fclose(f);
-  return out;
-}
+using frictherm::test::read_doubles;
 
 }  // namespace
 

@@ -4,6 +4,7 @@
 // checked against the adiabatic explosion time computed here by quadrature, which conduction can
 // only lengthen; the small one must cool below the hot-spot threshold first. CVODE BDF and forward
 // Euler must agree, and their step counts are printed.
+#include "h5_test_support.hpp"
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/thermal/reaction.hpp>
@@ -79,21 +80,7 @@ Json ignition_scene(const std::string& integrator) {
   return s;
 }
 
-std::vector<double> read_doubles(const std::string& file, const std::string& path) {
-  std::vector<double> out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return out;
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  if (d >= 0) {
-    const hid_t sp = H5Dget_space(d);
-    out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)));
-    if (!out.empty()) H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
-    H5Sclose(sp);
-    H5Dclose(d);
-  }
-  H5Fclose(f);
-  return out;
-}
+using frictherm::test::read_doubles;
 double meta(const std::string& file, const std::string& key) { return read_doubles(file, "/meta/" + key).at(0); }
 
 // Adiabatic first-order explosion: C dT/dt = q (1 − λ) k(T), dλ/dt = (1 − λ) k(T), so T = T_h + (q/C) λ

@@ -1,6 +1,7 @@
 // Plastic heating (issue 5): the plastic work of a Mie-Grüneisen/J2 body times a Taylor–Quinney
 // fraction is handed to the thermal side with the particles' shape weights, in its own books; with
 // friction too, frictional + plastic heat = heat delivered = Σ_p m_p C_v ΔT_p (adiabatic edges).
+#include "h5_test_support.hpp"
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
@@ -54,21 +55,7 @@ Json impact_scene(bool friction, double beta) {
 
 double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
 
-std::vector<double> read_doubles(const std::string& file, const std::string& path) {
-  std::vector<double> out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return out;
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  if (d >= 0) {
-    const hid_t sp = H5Dget_space(d);
-    out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)));
-    if (!out.empty()) H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
-    H5Sclose(sp);
-    H5Dclose(d);
-  }
-  H5Fclose(f);
-  return out;
-}
+using frictherm::test::read_doubles;
 
 }  // namespace
 
