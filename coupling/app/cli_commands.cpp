@@ -84,6 +84,12 @@ int run_command(const std::vector<std::string>& args, const std::string& command
   if (!opt.quiet) {
     std::printf("wrote %s: %zu snapshots, %zu series rows; %ld steps to t = %g s in %.2f s (%zu particles)\n",
                 r.output.c_str(), r.snapshots, r.series_rows, r.steps, r.time, r.wall_time, r.particles);
+    if (r.wall_time > 0.0 && r.steps > 0) {
+      std::printf("%.3g particle-steps/s; wall time by phase:", static_cast<double>(r.particles) * r.steps / r.wall_time);
+      for (const auto& [name, seconds] : r.phase_seconds)
+        if (seconds > 0.0005 * r.wall_time) std::printf(" %s %.1f%%", name.c_str(), 100.0 * seconds / r.wall_time);
+      std::printf("\n");
+    }
   }
   return kOk;
 }

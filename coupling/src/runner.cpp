@@ -54,8 +54,11 @@ class Run {
     detail::ProgressLine progress(std::cerr, show_progress(o_), s_.end_time);
     try {
       loop(progress);
-      if (thermal_ && r_.status == RunResult::Status::completed)
+      if (thermal_ && r_.status == RunResult::Status::completed) {
+        const Clock::time_point c0 = Clock::now();
         thermal_->continuation(out, *sim_, s_.output.fields);  // thermal hook: thermal-only phase
+        continuation_seconds_ = seconds_since(c0);
+      }
     } catch (const mechanics::SimulationError& e) {
       progress.finish();
       out.begin_failure(e.step(), e.time(), e.what());
@@ -76,6 +79,7 @@ class Run {
     r_.steps = sim_->step_count();
     r_.time = sim_->time();
     r_.wall_time = seconds_since(t0);
+    record_phase_seconds(out);
     r_.snapshots = out.snapshot_count();
     r_.series_rows = out.series_rows();
     const char* status = r_.status == RunResult::Status::failed               ? "failed"
@@ -92,6 +96,27 @@ class Run {
   }
 
  private:
+  // RunResult::phase_seconds, also written to /meta as time_<phase>.
+  void record_phase_seconds(H5Output& out) {
+    const mechanics::StepPhaseTimes& m = sim_->phase_times();
+    auto& ph = r_.phase_seconds;
+    ph = {{"time_step", m.time_step},
+          {"shape_functions", m.shape_functions},
+          {"particle_to_grid", m.particle_to_grid},
+          {"contact", m.contact},
+          {"grid_update", m.grid_update},
+          {"grid_to_particle", m.grid_to_particle},
+          {"stress_update", m.stress_update},
+          {"heating", coupling_seconds_ - loading_solve_seconds_},
+          {"thermal_solve", loading_solve_seconds_},
+          {"continuation", continuation_seconds_},
+          {"output", output_seconds_}};
+    double accounted = 0.0;
+    for (const auto& p : ph) accounted += p.second;
+    ph.emplace_back("other", r_.wall_time - accounted);
+    for (const auto& [name, seconds] : ph) out.write_metadata("time_" + name, seconds);
+  }
+
   void write_microstructure_images(H5Output& out) const {
     std::vector<std::string> written;
     try {
@@ -136,8 +161,13 @@ class Run {
       const double t = sim_->time();
       // Thermal hook: the step's nodal frictional work (J, eqs. 27/34/36) goes to the coupler; a
       // window also closes at every snapshot time and at the end.
-      if (thermal_)
+      if (thermal_) {
+        const Clock::time_point c0 = Clock::now();
+        const double solve0 = thermal_->solve_seconds();
         thermal_->after_step(*sim_, sim_->frictional_work(thermal_->heating_order()), t >= next_snap - eps);
+        coupling_seconds_ += seconds_since(c0);
+        loading_solve_seconds_ += thermal_->solve_seconds() - solve0;
+      }
       if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {
         series();
         if (series_dt > 0.0) next_series = (std::floor(t / series_dt + 1e-9) + 1.0) * series_dt;
@@ -155,18 +185,22 @@ class Run {
   }
 
   void series() {
+    const Clock::time_point c0 = Clock::now();
     std::vector<double> row = detail::series_row<Dim>(*sim_);
     if (thermal_) thermal_->extend_series_row(row, *out_, *sim_, sim_->time());  // thermal hook
     out_->append_series(row);
     last_series_step_ = sim_->step_count();
+    output_seconds_ += seconds_since(c0);
   }
 
   void snapshot() {
+    const Clock::time_point c0 = Clock::now();
     out_->begin_snapshot(sim_->step_count(), sim_->time());
     detail::write_fields<Dim>(*out_, *sim_, s_.output.fields);
     if (thermal_) thermal_->write_fields(*out_);  // thermal hook: reaction_progress
     out_->end_snapshot();
     last_snapshot_step_ = sim_->step_count();
+    output_seconds_ += seconds_since(c0);
   }
 
   const Scene& s_;
@@ -177,6 +211,10 @@ class Run {
   RunResult r_;
   long last_series_step_ = -1;
   long last_snapshot_step_ = -1;
+  double coupling_seconds_ = 0.0;       // in thermal_->after_step (heating and solve)
+  double loading_solve_seconds_ = 0.0;  // of which inside the integrator
+  double continuation_seconds_ = 0.0;
+  double output_seconds_ = 0.0;         // series rows and snapshots
 };
 
 }  // namespace

@@ -37,6 +37,8 @@ class ThermalRun {
 
   HeatingOrder heating_order() const { return spec_.heating_order; }
   const Coupler<Dim>& coupler() const { return coupler_; }
+  /// Wall time spent inside the thermal integrator so far (s).
+  double solve_seconds() const { return coupler_.integrator().stats().wall_seconds; }
 
  private:
   template <class F>

@@ -132,7 +132,7 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
 
 }  // namespace
 
-// Lists (node, slot) for every node where two or more fields have mass, sorted by node; within a
+// Lists (node, slot) for every node where two or more fields have mass, grouped by node; within a
 // node the slots come in material order because fields are laid out in material order.
 template <int Dim>
 void Simulation<Dim>::find_contact_nodes() {
@@ -140,23 +140,39 @@ void Simulation<Dim>::find_contact_nodes() {
     contact_entries_.clear();
     return;
   }
-  std::fill(node_field_count_.begin(), node_field_count_.end(), std::uint16_t{0});
+  // Counting sort by node, O(slots) (no pass over the whole grid and no comparison sort): count the
+  // fields with mass at each node, give each node with two or more a run of entries in order of first
+  // appearance, fill the runs in field order. The counts and cursors are reset slot by slot.
   const double mmin = empty_node_mass_;
   const std::size_t total = nodes_.mass.size();
+  for (std::size_t s = 0; s < total; ++s) {
+    const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
+    node_field_count_[node] = 0;
+    node_entry_cursor_[node] = -1;
+  }
   for (std::size_t s = 0; s < total; ++s)
     if (nodes_.mass[s] > mmin) ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
-  contact_entries_.clear();
+  int entries = 0;
+  for (std::size_t s = 0; s < total; ++s) {
+    const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
+    if (nodes_.mass[s] > mmin && node_field_count_[node] >= 2 && node_entry_cursor_[node] < 0) {
+      node_entry_cursor_[node] = entries;
+      entries += node_field_count_[node];
+    }
+  }
+  contact_entries_.resize(static_cast<std::size_t>(entries));
   for (std::size_t f = 0; f < fields_.size(); ++f)
     for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) {
       const int node = slot_node_[s];
       if (nodes_.mass[s] > mmin && node_field_count_[static_cast<std::size_t>(node)] >= 2)
-        contact_entries_.push_back({node, static_cast<int>(s), static_cast<int>(f)});
+        contact_entries_[static_cast<std::size_t>(node_entry_cursor_[static_cast<std::size_t>(node)]++)] = {
+            node, static_cast<int>(s), static_cast<int>(f)};
     }
-  std::sort(contact_entries_.begin(), contact_entries_.end());
 }
 
 template <int Dim>
 void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
+  const NestedPhase timed(phase_times_.contact, nested_phase_);  // called inside other phases
   const bool heat = pass == ContactPass::updated;
   const bool forces = pass == ContactPass::updated;
   const std::size_t nm = materials_.size();

@@ -107,6 +107,7 @@ void Simulation<Dim>::init_fields() {
     box_lo_.assign(nm, IVec<Dim>{});
     box_hi_.assign(nm, IVec<Dim>{});
     node_field_count_.assign(grid_.node_count(), 0);
+    node_entry_cursor_.assign(grid_.node_count(), -1);
     pair_work_first_.assign(nm * nm, 0.0);
     pair_work_second_.assign(nm * nm, 0.0);
   }
@@ -188,16 +189,21 @@ template <int Dim>
 void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
-    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
-    if (F.rigid) {
-      const Vec<Dim> v = field_velocity_[f];
-      for (long s = b; s < e; ++s) {
-        momentum[static_cast<std::size_t>(s)] = nodes_.mass[static_cast<std::size_t>(s)] * v;
-        if (force) (*force)[static_cast<std::size_t>(s)].setZero();
-      }
-      continue;
+    if (!F.rigid) continue;
+    const Vec<Dim> v = field_velocity_[f];
+    for (std::size_t s = F.first; s < F.first + F.count; ++s) {
+      momentum[s] = nodes_.mass[s] * v;
+      if (force) (*force)[s].setZero();
     }
-#pragma omp parallel for num_threads(threads_) schedule(static)
+  }
+  // One parallel region over the deformable fields (one per grain in a PBX: a region each would
+  // cost more than their few hundred slots).
+#pragma omp parallel num_threads(threads_)
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    const VelocityField<Dim>& F = fields_[f];
+    if (F.rigid) continue;
+    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
+#pragma omp for schedule(static) nowait
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
       const std::size_t i = static_cast<std::size_t>(slot_node_[s]);

@@ -35,7 +35,10 @@ auto& Simulation<Dim>::stencils() {
 template <int Dim>
 double Simulation<Dim>::step(double dt_limit) {
   finalize();
+  lap_ = PhaseLap{};
+  nested_phase_ = 0.0;
   const double dt = std::min(stable_time_step(), dt_limit);
+  lap_.to(phase_times_.time_step);
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     std::ostringstream msg;
     msg << "step " << step_ << ", t = " << time_ << " s: time step " << dt << " s is not positive and finite";
@@ -60,6 +63,7 @@ void Simulation<Dim>::step_with(double dt) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
     for (auto& t : thread_nodes_) t.resize(nodes_.mass.size(), contact_);
   }
+  StepPhaseTimes& pt = phase_times_;
   const double t = time_;
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
@@ -75,33 +79,51 @@ void Simulation<Dim>::step_with(double dt) {
     std::fill(work_first_.begin(), work_first_.end(), 0.0);
     std::fill(work_second_.begin(), work_second_.end(), 0.0);
   }
+  lap_.to(pt.shape_functions);
   const bool usf = opt_.scheme == UpdateScheme::usf;
   map_to_grid<Kernel>(dt, /*with_forces=*/!usf);
+  lap_.to(pt.particle_to_grid);
   if (contact_) {
     find_contact_nodes();
     resolve_contact(ContactPass::extrapolated, dt);
+    lap_.to(pt.contact, nested_phase_);
   }
   if (usf) {
     velocity_from_momentum();
+    lap_.to(pt.grid_update);
     update_stress<Kernel>(nodes_.velocity, dt);
+    lap_.to(pt.stress_update);
     add_internal_forces<Kernel>();
+    lap_.to(pt.particle_to_grid);
     move_boundary_points(dt, t);  // penalty: the points move with the velocity the stress update used
+    lap_.to(pt.contact, nested_phase_);
   }
   map_external_loads<Kernel>(t);
+  lap_.to(pt.particle_to_grid);
   apply_penalty_forces();  // penalty pairs: point forces into the nodal forces (Kakouris 2024 eq. 36)
+  lap_.to(pt.contact, nested_phase_);
   update_grid(dt);         // velocity conditions act on the penalty forces too
+  lap_.to(pt.grid_update, nested_phase_);  // less its contact pass (resolve_contact times itself)
   const long bad = update_particles<Kernel>(dt);
   if (opt_.scheme == UpdateScheme::usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
   move_rigid_particles(dt, t);
+  lap_.to(pt.grid_to_particle);
   time_ += dt;
   ++step_;
   check_particle(bad, dt);
   if (opt_.scheme == UpdateScheme::musl) {
-    remap_momentum<Kernel>(dt);
+    remap_momentum<Kernel>();
+    lap_.to(pt.particle_to_grid);
+    if (contact_) resolve_contact(ContactPass::remapped, dt);
+    lap_.to(pt.contact, nested_phase_);
+    velocity_from_momentum();
     move_boundary_points(dt, t);  // MUSL: with the remapped velocity, as the stress update
+    lap_.to(pt.grid_update);
     update_stress<Kernel>(nodes_.velocity, dt);
+    lap_.to(pt.stress_update);
   } else if (opt_.scheme == UpdateScheme::usl) {
     update_stress<Kernel>(nodes_.velocity, dt);
+    lap_.to(pt.stress_update);
   }
 }
 
@@ -110,20 +132,34 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::evaluate_stencils() {
   auto& st = stencils<Kernel>();
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    int lo[Dim], hi[Dim];
-    for (int d = 0; d < Dim; ++d) lo[d] = INT_MAX, hi[d] = INT_MIN;
-    const std::size_t b = material_begin_[m], e = material_end_[m];
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(min : lo[:Dim]) reduction(max : hi[:Dim])
-    for (std::size_t k = b; k < e; ++k) {
-      st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
-      const IVec<Dim> f = st[k].first_node();
-      for (int d = 0; d < Dim; ++d) {
-        lo[d] = std::min(lo[d], f[d]);
-        hi[d] = std::max(hi[d], f[d] + Kernel::K - 1);
+  const std::size_t nm = materials_.size();
+  for (std::size_t m = 0; m < nm; ++m) box_lo_[m].fill(INT_MAX), box_hi_[m].fill(INT_MIN);
+  // One parallel region for all materials (a grain is a few hundred particles: a region per
+  // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
+#pragma omp parallel num_threads(threads_)
+  {
+    thread_local std::vector<IVec<Dim>> lo, hi;
+    IVec<Dim> none_lo, none_hi;
+    none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
+    lo.assign(nm, none_lo);
+    hi.assign(nm, none_hi);
+    for (std::size_t m = 0; m < nm; ++m) {
+#pragma omp for schedule(static) nowait
+      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+        st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+        const IVec<Dim> f = st[k].first_node();
+        for (int d = 0; d < Dim; ++d) {
+          lo[m][d] = std::min(lo[m][d], f[d]);
+          hi[m][d] = std::max(hi[m][d], f[d] + Kernel::K - 1);
+        }
       }
     }
-    for (int d = 0; d < Dim; ++d) box_lo_[m][d] = lo[d], box_hi_[m][d] = hi[d];
+#pragma omp critical(frictherm_stencil_boxes)
+    for (std::size_t m = 0; m < nm; ++m)
+      for (int d = 0; d < Dim; ++d) {
+        box_lo_[m][d] = std::min(box_lo_[m][d], lo[m][d]);
+        box_hi_[m][d] = std::max(box_hi_[m][d], hi[m][d]);
+      }
   }
   layout_fields(box_lo_, box_hi_);
 }
@@ -270,12 +306,13 @@ long Simulation<Dim>::update_particles(double dt) {
   long bad = std::numeric_limits<long>::max();  // min-reduction identity
   double work = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
+#pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const int f = field_of_material_[m];
     if (f < 0 || materials_[m].is_rigid()) continue;
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
     const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(min : bad) reduction(+ : work)
+#pragma omp for schedule(static) nowait
     for (long kk = b; kk < e; ++kk) {
       const std::size_t k = static_cast<std::size_t>(kk);
       Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
@@ -296,11 +333,11 @@ long Simulation<Dim>::update_particles(double dt) {
   return bad == std::numeric_limits<long>::max() ? -1 : bad;
 }
 
-// MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p; with
-// contact, contact is resolved again on the remapped momenta.
+// MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p (step_with
+// then resolves contact again on the remapped momenta).
 template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::remap_momentum(double dt) {
+void Simulation<Dim>::remap_momentum() {
   auto& st = stencils<Kernel>();
 #pragma omp parallel num_threads(threads_)
   {
@@ -320,8 +357,6 @@ void Simulation<Dim>::remap_momentum(double dt) {
     }
   }
   reduce_thread_buffers(false, true, false, false);
-  if (contact_) resolve_contact(ContactPass::remapped, dt);
-  velocity_from_momentum();
 }
 
 // Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
@@ -330,6 +365,8 @@ template <class Kernel>
 void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   auto& st = stencils<Kernel>();
   const Analysis an = opt_.analysis;
+  long beyond = -1;  // a particle compressed past the Hugoniot's limit
+#pragma omp parallel num_threads(threads_) reduction(max : beyond)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const Material& mat = materials_[m];
     const int f = field_of_material_[m];
@@ -337,8 +374,7 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
     const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
-    long beyond = -1;  // a particle compressed past the Hugoniot's limit
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(max : beyond)
+#pragma omp for schedule(static) nowait
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
       st[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });
@@ -358,14 +394,15 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
         linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
       }
     }
-    if (beyond >= 0) {
-      std::ostringstream msg;
-      msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '" << mat.name
-          << "' is compressed past the limit of its Hugoniot (J = "
-          << p_.volume[static_cast<std::size_t>(beyond)] / p_.initial_volume[static_cast<std::size_t>(beyond)]
-          << "; try a smaller CFL factor)";
-      throw SimulationError(msg.str(), step_, time_, beyond);
-    }
+  }
+  if (beyond >= 0) {
+    const std::size_t k = static_cast<std::size_t>(beyond);
+    std::ostringstream msg;
+    msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '"
+        << materials_[static_cast<std::size_t>(p_.material[k])].name
+        << "' is compressed past the limit of its Hugoniot (J = " << p_.volume[k] / p_.initial_volume[k]
+        << "; try a smaller CFL factor)";
+    throw SimulationError(msg.str(), step_, time_, beyond);
   }
 }
 

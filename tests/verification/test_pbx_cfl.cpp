@@ -65,12 +65,16 @@ TEST(PbxCompaction, SecondOrderHeatingConvergesFasterWithC) {
                 100 * e1, w.second, 100 * e2, w.steps);
     EXPECT_GT(gap, last_gap) << "the orders must approach each other as C falls";
     last_gap = gap;
-    if (c >= 0.25) EXPECT_LT(e2, e1) << "second order must be closer to the converged work at C = " << c;
+    if (c >= 0.25) {
+      EXPECT_LT(e2, e1) << "second order must be closer to the converged work at C = " << c;
+    }
     if (c == 0.25) {
       EXPECT_LT(e2, 0.10) << "second order within 10 % at C = 0.25";
       EXPECT_GT(e1, 0.10) << "first order still more than 10 % off at C = 0.25";
     }
-    if (c == 0.1) EXPECT_LT(std::max(e1, e2), 0.10) << "both orders within 10 % at C = 0.1";
+    if (c == 0.1) {
+      EXPECT_LT(std::max(e1, e2), 0.10) << "both orders within 10 % at C = 0.1";
+    }
   }
 }
 

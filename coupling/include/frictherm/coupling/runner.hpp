@@ -13,6 +13,8 @@
 #include <iosfwd>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace frictherm::coupling {
 
@@ -43,6 +45,12 @@ struct RunResult {
   std::size_t series_rows = 0;
   std::size_t particles = 0;
   std::string message;       // the SimulationError's message when failed
+  /// Wall time (s) by phase, in this order: the mechanics step's phases (time_step, shape_functions,
+  /// particle_to_grid, contact, grid_update, grid_to_particle, stress_update), heating (the coupler
+  /// outside the integrator: work accumulated, heat mapped, temperatures back, hot spots),
+  /// thermal_solve (the integrator during loading), continuation (thermal-only phase), output
+  /// (series and snapshots) and other (the rest of wall_time: set-up, progress, metadata).
+  std::vector<std::pair<std::string, double>> phase_seconds;
   int exit_code() const { return status == Status::failed ? 1 : 0; }
 };
 

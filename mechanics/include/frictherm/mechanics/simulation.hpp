@@ -28,6 +28,7 @@
 #include <frictherm/mechanics/particles.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/step_timing.hpp>
 
 #include <cstdint>
 #include <limits>
@@ -174,6 +175,8 @@ class Simulation {
   double time() const { return time_; }
   long step_count() const { return step_; }
   double last_time_step() const { return last_dt_; }
+  /// Wall time spent in each phase of step() since the start.
+  const StepPhaseTimes& phase_times() const { return phase_times_; }
 
   double kinetic_energy() const;  // of deformable particles (J)
   double strain_energy() const;   // J
@@ -187,7 +190,7 @@ class Simulation {
   template <class Kernel> void add_internal_forces();
   template <class Kernel> void map_rigid_particles(double t);
   template <class Kernel> void map_external_loads(double t);
-  template <class Kernel> void remap_momentum(double dt);
+  template <class Kernel> void remap_momentum();
   template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
   template <class Kernel> long update_particles(double dt);
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
@@ -233,16 +236,16 @@ class Simulation {
   std::vector<std::pair<int, int>> explicit_pairs_;
   struct ContactEntry {  // one field with mass at a multi-material node
     int node, slot, field;
-    bool operator<(const ContactEntry& o) const { return node != o.node ? node < o.node : slot < o.slot; }
   };
-  std::vector<ContactEntry> contact_entries_;  // sorted by node; within a node in material order
+  std::vector<ContactEntry> contact_entries_;  // grouped by node; within a node in material order
   std::vector<std::size_t> contact_groups_;     // start of each node's entries, then the end
   struct ContactThreadWork {                    // per-thread contact stats and pair books of one pass
     ContactStats stats;
     std::vector<double> pair_first, pair_second;
   };
   std::vector<ContactThreadWork> contact_thread_work_;
-  std::vector<std::uint16_t> node_field_count_;
+  std::vector<std::uint16_t> node_field_count_;  // per grid node: fields with mass (find_contact_nodes)
+  std::vector<int> node_entry_cursor_;           // per grid node: next entry of its run, −1: none
   std::vector<double> work_first_, work_second_;    // per grid node, last step
   std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
   ContactStats contact_stats_;
@@ -290,6 +293,9 @@ class Simulation {
   double last_dt_ = 0.0;
   double external_work_ = 0.0;
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
+  StepPhaseTimes phase_times_;
+  PhaseLap lap_;  // step(): phase boundaries
+  double nested_phase_ = 0.0;  // contact time inside the phase the lap is in
   int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves
 };
 

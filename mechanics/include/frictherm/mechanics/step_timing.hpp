@@ -1,0 +1,62 @@
+#pragma once
+// Wall time of each phase of the MPM step, summed over a run: where a benchmark's time goes.
+// One clock read per phase boundary (~20 ns), about ten per step.
+#include <chrono>
+
+namespace frictherm::mechanics {
+
+struct StepPhaseTimes {
+  double time_step = 0.0;         // s: stable time step (CFL over the particles)
+  double shape_functions = 0.0;   // s: stencils, EBS rebuild, field layout, rigid-driven nodes
+  double particle_to_grid = 0.0;  // s: mass, momentum, forces, MUSL remap, external loads
+  double contact = 0.0;           // s: contact nodes, multimaterial passes (with the frictional work), penalty
+  double grid_update = 0.0;       // s: momentum update, velocity conditions, nodal velocities
+  double grid_to_particle = 0.0;  // s: particle velocities and positions, rigid bodies
+  double stress_update = 0.0;     // s: velocity gradient, deformation gradient, constitutive update
+  double total() const {
+    return time_step + shape_functions + particle_to_grid + contact + grid_update + grid_to_particle + stress_update;
+  }
+};
+
+/// Adds its lifetime to `phase` and to `nested` (a phase timed inside another: the outer lap
+/// subtracts `nested` so that no time is counted twice).
+class NestedPhase {
+ public:
+  NestedPhase(double& phase, double& nested) : phase_(phase), nested_(nested), start_(Clock::now()) {}
+  ~NestedPhase() {
+    const double d = std::chrono::duration<double>(Clock::now() - start_).count();
+    phase_ += d;
+    nested_ += d;
+  }
+  NestedPhase(const NestedPhase&) = delete;
+  NestedPhase& operator=(const NestedPhase&) = delete;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  double& phase_;
+  double& nested_;
+  Clock::time_point start_;
+};
+
+/// A lap clock: to(acc) adds the time since the last lap (or construction) to acc.
+class PhaseLap {
+ public:
+  PhaseLap() : last_(Clock::now()) {}
+  void to(double& accumulator) {
+    const Clock::time_point now = Clock::now();
+    accumulator += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+  /// As to(), less the time `nested` phases took meanwhile (then reset).
+  void to(double& accumulator, double& nested) {
+    to(accumulator);
+    accumulator -= nested;
+    nested = 0.0;
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point last_;
+};
+
+}  // namespace frictherm::mechanics
