@@ -98,9 +98,18 @@ void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) 
     throw std::invalid_argument("EbsBasis::rebuild: the kept-node mask must have one entry per grid node");
   const IVec<Dim>& cells = grid.cells();
 
-  // Pass 1: the cell (knot span) of each particle, the body's bounding box of cells.
-  auto cell_of = [&](const Vec<Dim>& x, std::size_t i) {
-    IVec<Dim> c;
+  // Pass 1: validate every particle; the cells its domain overlaps, the body's bounding box of them.
+  // The domain of particle p is the cell's shape scaled to the particle's current volume, side
+  // h_d (Ω_p/Ω_c)^(1/Dim) centred on x_p (the uGIMP domain with the current volume), clipped to the
+  // grid's cells. Counting each particle whole in the cell that holds its position (eq. 19 read
+  // literally) quantises φ_c in steps of 1/(particles per cell): with 2 × 2 particles per cell, a
+  // cell inside a body reads φ_c = 0.5 whenever a column of particles sits on one of its faces, turns
+  // "boundary" at C_c = 0.5, and the extension (3, -3, 1) then takes the mass of a full cell off a
+  // stable node (docs/ebs.md, "Volume fraction").
+  const double measure = grid.cell_volume() * (Dim < 3 ? opt_.out_of_plane : 1.0);
+  auto domain_of = [&](const Vec<Dim>& x, double V, std::size_t i, Vec<Dim>& lower, Vec<Dim>& upper, IVec<Dim>& klo,
+                       IVec<Dim>& khi) {
+    const double a = 0.5 * std::pow(V / measure, 1.0 / Dim);  // half side, in cells
     for (int d = 0; d < Dim; ++d) {
       const double s = (x[d] - grid.lo()[d]) * grid.inverse_cell_size()[d];  // as QuadraticBSplineKernel
       if (!(s >= -0.5 && s < cells[d] + 0.5)) {
@@ -108,27 +117,31 @@ void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) 
         msg << "EbsBasis::rebuild: particle " << i << " at " << x.transpose() << " is outside the grid";
         throw std::out_of_range(msg.str());
       }
-      c[d] = static_cast<int>(std::floor(s + 0.5));
+      lower[d] = std::max(s - a, -0.5);
+      upper[d] = std::min(s + a, cells[d] + 0.5);
+      klo[d] = static_cast<int>(std::floor(lower[d] + 0.5));          // cells k with k + 1/2 > lower
+      khi[d] = std::min(static_cast<int>(std::ceil(upper[d] + 0.5)) - 1, cells[d]);  // k - 1/2 < upper
     }
-    return c;
   };
   IVec<Dim> cmin, cmax;
   cmin.fill(INT_MAX);
   cmax.fill(INT_MIN);
-  particle_cell_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     double V = 0.0;
-    const IVec<Dim> c = particle_cell_[i] = cell_of(get(i, V), i);
+    const Vec<Dim>& x = get(i, V);
     if (!(V > 0.0) || !std::isfinite(V)) throw std::invalid_argument("EbsBasis::rebuild: particle volume must be finite and > 0");
+    Vec<Dim> lower, upper;
+    IVec<Dim> klo, khi;
+    domain_of(x, V, i, lower, upper, klo, khi);
     for (int d = 0; d < Dim; ++d) {
-      cmin[d] = std::min(cmin[d], c[d]);
-      cmax[d] = std::max(cmax[d], c[d]);
+      cmin[d] = std::min(cmin[d], klo[d]);
+      cmax[d] = std::max(cmax[d], khi[d]);
     }
   }
 
   // Input is valid: from here on the object describes this body on this grid.
   grid_ = grid;
-  cell_measure_ = grid.cell_volume() * (Dim < 3 ? opt_.out_of_plane : 1.0);
+  cell_measure_ = measure;
 
   // Region = bounding box + 1: every node whose support meets a cell of the box.
   std::size_t total = 1;
@@ -160,11 +173,24 @@ void EbsBasis<Dim>::rebuild_impl(const Grid<Dim>& grid, std::size_t n, Get get) 
   stable_count_ = degenerate_count_ = promoted_count_ = max_stencil_ = extended_cells_ = 0;
   if (n == 0) return;
 
-  // Pass 2: Σ Ω_p per cell (Kakouris 2024 eq. 19 numerator).
+  // Pass 2: the material volume in each cell (Kakouris 2024 eq. 19 numerator), Σ_p Ω_p |D_p ∩ c| / |D_p|
+  // over the particles' domains D_p. For domains that tile the body this is the body's volume in the
+  // cell, whatever the particles' positions.
   for (std::size_t i = 0; i < n; ++i) {
     double V = 0.0;
-    get(i, V);
-    volume_[static_cast<std::size_t>(local(particle_cell_[i]))] += V;
+    const Vec<Dim>& x = get(i, V);
+    Vec<Dim> lower, upper;
+    IVec<Dim> klo, khi;
+    domain_of(x, V, i, lower, upper, klo, khi);
+    for_box<Dim>(klo, khi, [&](const IVec<Dim>& c) {
+      double f = measure;  // Ω_p / |D_p| with |D_p| in cells^Dim is Ω_c
+      for (int d = 0; d < Dim; ++d) {
+        const double overlap = std::min(upper[d], c[d] + 0.5) - std::max(lower[d], c[d] - 0.5);
+        if (overlap <= 1e-12) return;  // a domain ending on a face: round-off, not material
+        f *= overlap;
+      }
+      volume_[static_cast<std::size_t>(local(c))] += f;
+    });
   }
 
   // Cells: interior if φ_c > C_c, boundary if 0 < φ_c <= C_c, exterior if φ_c = 0 (eq. 20).

@@ -92,6 +92,37 @@ struct StepWeights {
   }
 };
 
+/// The step's weights over the fields' current node boxes, for apply_penalty_forces and
+/// move_boundary_points. The boxes are copied into `home` (kept between steps, so nothing is
+/// allocated) and lent to the weights; the destructor gives them back.
+template <int Dim>
+struct LentStepWeights {
+  StepWeights<Dim> w;
+  std::vector<FieldNodes<Dim>>& boxes;
+  LentStepWeights(std::vector<FieldNodes<Dim>>& home, const Grid<Dim>& grid, ShapeKind shape,
+                  const std::vector<VelocityField<Dim>>& fields, const std::vector<double>& slot_mass, double min_mass,
+                  const std::vector<double>& reference_mass, double sliver, const std::vector<EbsBasis<Dim>>& ebs)
+      : boxes(home) {
+    home.resize(fields.size());
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      home[f].lo = fields[f].lo;
+      home[f].extent = fields[f].extent;
+      home[f].index = fields[f].index;
+    }
+    w.plain.grid = &grid;
+    w.plain.shape = shape;
+    w.plain.fields.swap(home);
+    w.plain.slot_mass = &slot_mass;
+    w.plain.min_mass = min_mass;
+    w.plain.reference_mass = &reference_mass;
+    w.plain.sliver = sliver;
+    if (shape == ShapeKind::extended_bspline) w.ebs = &ebs;
+  }
+  LentStepWeights(const LentStepWeights&) = delete;
+  LentStepWeights& operator=(const LentStepWeights&) = delete;
+  ~LentStepWeights() { boxes.swap(w.plain.fields); }
+};
+
 double modulus_for_penalty(const Material& m) {
   if (m.is_rigid()) return std::numeric_limits<double>::infinity();
   return m.youngs_modulus;  // mie_gruneisen: 0 unless given, then the partner's E (or set the penalty)
@@ -223,21 +254,9 @@ void Simulation<Dim>::setup_penalty() {
 template <int Dim>
 void Simulation<Dim>::apply_penalty_forces() {
   if (!penalty_) return;
-  penalty_fields_.resize(fields_.size());
-  for (std::size_t f = 0; f < fields_.size(); ++f) {
-    penalty_fields_[f].lo = fields_[f].lo;
-    penalty_fields_[f].extent = fields_[f].extent;
-    penalty_fields_[f].index = fields_[f].index;
-  }
-  StepWeights<Dim> w;
-  w.plain.grid = &grid_;
-  w.plain.shape = opt_.shape;
-  w.plain.fields.swap(penalty_fields_);  // borrowed for the step, returned below (no allocation)
-  w.plain.slot_mass = &nodes_.mass;
-  w.plain.min_mass = empty_node_mass_;
-  w.plain.reference_mass = &penalty_reference_mass_;
-  w.plain.sliver = penalty_sliver_;
-  if (opt_.shape == ShapeKind::extended_bspline) w.ebs = &ebs_;
+  LentStepWeights<Dim> lent(penalty_fields_, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
+                            penalty_reference_mass_, penalty_sliver_, ebs_);
+  const StepWeights<Dim>& w = lent.w;
   // Step 1 (K·27): a slave point is a candidate if its stencil reaches a node where the master has mass.
   const auto master_has_mass = [&](int field, int node) {
     const int s = slot_of(grid_, w.plain.fields[static_cast<std::size_t>(field)], node);
@@ -250,13 +269,13 @@ void Simulation<Dim>::apply_penalty_forces() {
   pc.scatter_forces(boundary_, w, nodes_.force);  // K·36; rigid fields drop theirs in update_grid
   pc.scatter_heat(boundary_, w, work_first_);     // penalty heat has no first/second-order split
   pc.scatter_heat(boundary_, w, work_second_);
+  pc.update_frequency_bound(boundary_, w, nodes_.mass, empty_node_mass_);  // for the next time step
   for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
     const auto a = static_cast<std::size_t>(std::min(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
     const auto b = static_cast<std::size_t>(std::max(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
     pair_work_first_[a * materials_.size() + b] += pc.books(k).heat_step;
     pair_work_second_[a * materials_.size() + b] += pc.books(k).heat_step;
   }
-  penalty_fields_.swap(w.plain.fields);
 }
 
 // With the weights of the step's start (those the forces go out with): a rigid field's points move as
@@ -274,21 +293,9 @@ void Simulation<Dim>::apply_penalty_forces() {
 template <int Dim>
 void Simulation<Dim>::move_boundary_points(double dt, double t) {
   if (!penalty_) return;
-  penalty_fields_.resize(fields_.size());  // USF moves the points before apply_penalty_forces
-  for (std::size_t f = 0; f < fields_.size(); ++f) {
-    penalty_fields_[f].lo = fields_[f].lo;
-    penalty_fields_[f].extent = fields_[f].extent;
-    penalty_fields_[f].index = fields_[f].index;
-  }
-  StepWeights<Dim> w;
-  w.plain.grid = &grid_;
-  w.plain.shape = opt_.shape;
-  w.plain.fields.swap(penalty_fields_);
-  w.plain.slot_mass = &nodes_.mass;
-  w.plain.min_mass = empty_node_mass_;
-  w.plain.reference_mass = &penalty_reference_mass_;
-  w.plain.sliver = penalty_sliver_;
-  if (opt_.shape == ShapeKind::extended_bspline) w.ebs = &ebs_;
+  LentStepWeights<Dim> lent(penalty_fields_, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
+                            penalty_reference_mass_, penalty_sliver_, ebs_);  // USF: before apply_penalty_forces
+  const StepWeights<Dim>& w = lent.w;
   BoundaryPoints<Dim>& bp = boundary_;
   for (std::size_t i = 0; i < bp.size(); ++i) {
     const auto f = static_cast<std::size_t>(bp.field[i]);
@@ -303,7 +310,6 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
     bp.velocity[i] = v;
   }
   for (std::size_t i = 0; i < bp.size(); ++i) bp.position[i] += dt * bp.velocity[i];
-  penalty_fields_.swap(w.plain.fields);
   // Boundary points may lie on the grid's edge (a body against a fixed face): allow the ghost layer.
   const Vec<Dim> lo = grid_.lo() - grid_.cell_size(), hi = grid_.hi() + grid_.cell_size();
   for (std::size_t i = 0; i < bp.size(); ++i)
@@ -345,13 +351,30 @@ double Simulation<Dim>::penalty_wave_factor() const {
   return factor;
 }
 
+// Time-step guard (docs/penalty_contact.md, "Stability"): forward Euler on the bodies plus the
+// penalty springs is stable while Δt ≤ 2/√(ω_el² + ω_p²), ω_el = 2 c/Δh the elastic bound behind the
+// CFL condition (c = `wave_speed`, the largest wave plus particle speed) and ω_p² the Gershgorin bound
+// of the last step's springs on the last step's nodal masses (PenaltyContact::update_frequency_bound,
+// from apply_penalty_forces). ε above E/Δh is already in penalty_wave_factor; this catches light
+// nodes carrying a point's force (a stable EBS node whose support barely holds material, a node the
+// sliver test keeps) that the CFL condition does not see. Infinite without contacts.
+template <int Dim>
+double Simulation<Dim>::penalty_time_step_limit(double wave_speed) const {
+  if (!penalty_) return std::numeric_limits<double>::infinity();
+  const double wp2 = penalty_->frequency_bound_squared();
+  if (!(wp2 > 0.0)) return std::numeric_limits<double>::infinity();
+  const double wel = 2.0 * wave_speed / grid_.min_cell_size();
+  return 2.0 / std::sqrt(wel * wel + wp2);
+}
+
 #define FRICTHERM_INSTANTIATE_PENALTY(D)                                                              \
   template void Simulation<D>::check_penalty_settings(const ContactPairSettings&, int, int) const;    \
   template void Simulation<D>::set_body_boundary(int, const std::vector<std::vector<Vec<2>>>&);       \
   template void Simulation<D>::setup_penalty();                                                       \
   template void Simulation<D>::apply_penalty_forces();                                                \
   template void Simulation<D>::move_boundary_points(double, double);                                  \
-  template double Simulation<D>::penalty_wave_factor() const;
+  template double Simulation<D>::penalty_wave_factor() const;                                         \
+  template double Simulation<D>::penalty_time_step_limit(double) const;
 FRICTHERM_INSTANTIATE_PENALTY(2)
 FRICTHERM_INSTANTIATE_PENALTY(3)
 #undef FRICTHERM_INSTANTIATE_PENALTY

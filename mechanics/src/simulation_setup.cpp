@@ -268,9 +268,10 @@ double Simulation<Dim>::stable_time_step() const {
   }
   for (const Material& mat : materials_)  // rigid bodies move material through the grid too
     if (mat.is_rigid()) cmax = std::max(cmax, mat.rigid_velocity_at(time_).norm());
+  const double dt_penalty = penalty_time_step_limit(cmax);  // light nodes under contacts (simulation_penalty.cpp)
   cmax *= penalty_wave_factor();
   if (cmax <= 0.0) return opt_.max_time_step;
-  return std::min(opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step);
+  return std::min({opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step, dt_penalty});
 }
 
 template <int Dim>

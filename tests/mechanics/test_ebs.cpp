@@ -408,6 +408,60 @@ TEST(Ebs, RebuildIsStateless) {
   EXPECT_EQ(static_cast<int>(active), reused.stable_count() + reused.degenerate_count());
 }
 
+// φ_c (eq. 19) is the body's volume in the cell, whatever the particles' positions: a rectangle of
+// 2 × 2 particles per cell, stretched 2 % along x and compressed along y to J = 0.99 and shifted by
+// fractions of a cell, so that columns of particles cross the cells' faces. Counting each particle
+// whole in the cell of its position gave 1, 2 or 3 columns per cell, φ = 0.495 / 0.99 / 1.485 for
+// cells full of material, and at C_c = 0.5 such a cell turned "boundary": its nodes became
+// degenerate inside the body and the extension (3, -3, 1) cancelled the lumped mass of the stable
+// node two cells in (the Neo-Hookean rings of tests/verification/test_penalty_rings.cpp blew up so).
+// Bounds: volume conservation to round-off (1e-12, sums of ~1e3 terms); a full cell holds 0.99 of
+// its volume, and the square particle domains (side 0.4975 h) on the 0.51 h × 0.485 h lattice leave
+// gaps and overlaps of 0.0125 h, which move φ by at most ±0.025 per direction: |φ − 0.99| < 0.06
+// (whole particles: ≥ 0.49 off). Lumped masses Σ_p N^e_I(x_p) Ω_p > 0 at every stable node.
+TEST(Ebs, VolumeFractionIsTheCoveredVolume) {
+  const Grid<2> g = grid2();
+  const double t = 0.01, lx = 1.02, ly = 0.99 / 1.02;
+  const auto ref = fill<2>(g, 2, t, [](const Vec<2>& x) { return x[0] > 0.3 && x[0] < 0.9 && x[1] > 0.4 && x[1] < 1.2; });
+  const Vec<2> X0(0.3, 0.4);
+  for (double shift : {0.0, 0.013, 0.027, 0.041, 0.062, 0.083}) {
+    Body<2> b;
+    for (std::size_t k = 0; k < ref.x.size(); ++k) {
+      const Vec<2> d = ref.x[k] - X0;
+      b.x.push_back(X0 + Vec<2>(lx * d[0] + shift, ly * d[1] + 0.5 * shift));
+      b.V.push_back(0.99 * ref.V[k]);
+    }
+    const double xlo = X0[0] + shift, xhi = X0[0] + 0.6 * lx + shift;  // the deformed rectangle
+    const double ylo = X0[1] + 0.5 * shift, yhi = X0[1] + 0.8 * ly + 0.5 * shift;
+    for (double Cc : {0.5, 0.75}) {
+      SCOPED_TRACE(testing::Message() << "shift " << shift << ", C_c = " << Cc);
+      EbsOptions opt;
+      opt.occupation = Cc;
+      opt.out_of_plane = t;
+      EbsBasis<2> ebs(opt);
+      ebs.rebuild(g, b.x, b.V, 0, b.x.size());
+      double total = 0.0, body = 0.0;
+      for (double V : b.V) body += V;
+      int full = 0;
+      for (int n = 0; n < static_cast<int>(g.node_count()); ++n) {
+        total += ebs.volume_fraction(n) * g.cell_volume() * t;
+        const Vec<2> c = g.node_position(n);  // cell n = [c − h/2, c + h/2]
+        if (c[0] - 0.05 > xlo && c[0] + 0.05 < xhi && c[1] - 0.05 > ylo && c[1] + 0.05 < yhi) {
+          ++full;
+          EXPECT_NEAR(ebs.volume_fraction(n), 0.99, 0.06) << "cell " << n;
+          EXPECT_EQ(ebs.cell_state(n), EbsCell::interior) << "cell " << n;
+        }
+      }
+      EXPECT_GE(full, 20);
+      EXPECT_NEAR(total, body, 1e-12 * body);
+      std::map<int, double> mass;
+      for (std::size_t k = 0; k < b.x.size(); ++k)
+        for (const auto& en : entries(ebs.evaluate(b.x[k]))) mass[en.node] += en.S * b.V[k];
+      for (const auto& [n, m] : mass) EXPECT_GT(m, 0.0) << "lumped mass of stable node " << n;
+    }
+  }
+}
+
 // Eq. 22 on a nodal field: extrapolating the quadratic's B-spline coefficients from the stable
 // nodes gives the exact coefficients at the degenerate nodes (degree-2 Lagrange is exact on Q2).
 TEST(Ebs, ExtrapolateNodalField) {

@@ -11,11 +11,13 @@
 //    its bottom row, gravity ramped over 50 periods, stress averaged over 4 more) with EBS at C = 0.5
 //    instead of the paper's 0.1.
 // 2. Nairn's sliding block (sliding_block.hpp; Coulomb μ = 0.2, base the master) with EBS and
-//    penalty contact at C = 0.5 through the load ramps, up to the onset of sliding. (The sliding phase
-//    with EBS at C = 0.5 still blows up at 10.5 ms, from another cause: docs/penalty_contact.md.)
+//    penalty contact at C = 0.5 through the load ramps, up to the onset of sliding (the sliding phase:
+//    test_penalty_sliding_block).
+// 3. The time-step guard's bound of the penalty frequency (PenaltyContact::update_frequency_bound)
+//    against the exact largest eigenvalue of the springs on the nodal masses.
 #include "sliding_block.hpp"
+#include "stacked_bars.hpp"
 
-#include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <gtest/gtest.h>
@@ -23,7 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <map>
 #include <vector>
 
 using namespace frictherm;
@@ -32,9 +34,6 @@ using namespace frictherm::verification;
 
 namespace {
 
-constexpr double kH = 0.1, kBar = 0.3, kE = 50.5e9, kRho = 2783.0, kG = 9.81, kWidth = 0.4;
-constexpr double kStack = 2 * kBar, kContactStress = kRho * kG * kBar;
-
 struct StackResult {
   double force = 0.0;  // mean penalty normal force / (ρ g h_top A)
   double rows = 0.0;   // largest |σ̄ − σ_an| / (ρ g h_top) of the particle rows beside the contact
@@ -42,83 +41,10 @@ struct StackResult {
 };
 
 StackResult stacked_bars(double offset, double cfl) {
-  SimulationOptions o;
-  o.analysis = Analysis::plane_stress;
-  o.shape = ShapeKind::extended_bspline;
-  o.scheme = UpdateScheme::musl;
-  o.ebs_occupation = 0.75;
-  o.cfl = cfl;
-  Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(kH, kH), IVec<2>{8, 11}), o);
-  Material m;
-  m.density = kRho;
-  m.youngs_modulus = kE;
-  m.poisson_ratio = 0.0;
-  m.name = "bottom";
-  const int bottom = sim.add_material(m);
-  m.name = "top";
-  const int top = sim.add_material(m);
-  ContactOptions co;
-  co.default_pair.method = ContactMethod::penalty;
-  co.default_pair.law = FrictionLaw::frictionless();
-  sim.enable_contact(co);
-  ContactPairSettings pair = co.default_pair;
-  pair.penalty.master = bottom;
-  sim.set_contact_pair(bottom, top, pair);
-  const double x0 = 2 * kH, y0 = 0.2;
-  sim.add_body("bottom", *make_box<2>(Vec<2>(x0, y0), Vec<2>(x0 + kWidth, y0 + kBar), bottom), 4, Vec<2>::Zero());
-  sim.add_body("top", *make_box<2>(Vec<2>(x0, y0 + kBar), Vec<2>(x0 + kWidth, y0 + kStack), top), 4, Vec<2>::Zero());
-  const double c = std::sqrt(kE / kRho), T = 4.0 * kStack / c, t_ramp = 50 * T, t_end = t_ramp + 4 * T;
-  const TimeFunction ramp = TimeFunction::ramp(1.0, t_ramp);
-  EdgeTraction<2> support;
-  support.body = 0;
-  support.axis = 1;
-  support.upper = false;
-  support.traction = Vec<2>(0.0, kRho * kG * kStack);
-  support.scale = ramp;
-  sim.add_edge_traction(support);
-  sim.finalize();
-  auto& p = sim.particles();
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    p.position[k][1] += offset;
-    p.initial_position[k][1] += offset;
-  }
-  auto& bp = sim.boundary_points();
-  for (std::size_t i = 0; i < bp.size(); ++i) {
-    bp.position[i][1] += offset;
-    bp.reference_position[i][1] += offset;
-  }
-  const double top_y = y0 + kStack + offset, contact_y = y0 + kBar + offset;
-  std::vector<double> mean(p.size(), 0.0);
-  double t_mean = 0.0, force = 0.0;
-  StackResult r;
-  try {
-    while (sim.time() < t_end) {
-      const double t = sim.time();
-      sim.options().gravity = Vec<3>(0.0, -kG * ramp(t), 0.0);
-      const double dt = sim.step(t < t_ramp ? t_ramp - t : t_end - t);
-      if (sim.time() > t_ramp) {
-        for (std::size_t k = 0; k < p.size(); ++k) mean[k] += p.stress[k](1, 1) * dt;
-        force += sim.penalty_contact()->books(0).normal_force * dt;
-        t_mean += dt;
-      }
-    }
-  } catch (const SimulationError& e) {
-    std::printf("[stacked bars EBS C = %.2f offset %.3f m] blew up: %s\n", cfl, offset, e.what());
-    r.force = r.rows = r.l1 = std::numeric_limits<double>::infinity();
-    return r;
-  }
-  double num = 0.0, row_m = 0.0, row_s = 0.0;
-  int nm = 0, ns = 0;
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const double y = p.initial_position[k][1];
-    const double err = mean[k] / t_mean + kRho * kG * (top_y - y);
-    num += std::fabs(err) * p.volume[k];
-    if (y < contact_y && y > contact_y - kH / 4) row_m += err, ++nm;
-    if (y > contact_y && y < contact_y + kH / 4) row_s += err, ++ns;
-  }
-  r.force = force / t_mean / (kContactStress * kWidth);
-  r.rows = std::max(std::fabs(row_m / nm), std::fabs(row_s / ns)) / kContactStress;
-  r.l1 = num / (kRho * kG * kStack * kWidth * kStack);
+  const StackedBarsResult b = run_stacked_bars(ShapeKind::extended_bspline, offset, cfl);
+  if (!b.failure.empty())
+    std::printf("[stacked bars EBS C = %.2f offset %.3f m] blew up: %s\n", cfl, offset, b.failure.c_str());
+  StackResult r{b.force, std::max(b.master_top, b.slave_bottom), b.l1};
   std::printf("[stacked bars EBS C = %.2f offset %.3f m] penalty force %.5f of the top bar's weight, contact rows "
               "%.4f of rho g h_top, L1 (eq. 42) %.2e\n",
               cfl, offset, r.force, r.rows, r.l1);
@@ -174,4 +100,77 @@ TEST(PenaltyStability, EbsSlidingBlockRestsQuietlyAtCfl05) {
               fewest, vy, ke);
   EXPECT_EQ(fewest, 17);
   EXPECT_LT(vy, 2e-3);
+}
+
+// A block pressed 1e-4 m into a base (21 slave points on 0.1 m, segments 5 mm; ε_N = 1e11 N/m³, A_s =
+// 5e-6 m²), each boundary point its own "node" of mass 1 + (index mod 3) kg (weights S = 1): the
+// springs' stiffness on the normal velocities is K = Σ_c k_c b_c b_cᵀ with b_c = (+1 slave, −(1−β),
+// −β ends). Asserted: the bound is at least the largest eigenvalue of M⁻¹K (power iteration, converged
+// to 1e-9; a Gershgorin bound cannot be below it) and at most twice it here (measured 1.50×); a single contact on a segment's middle (β = 0.5) gives
+// exactly k (1·2/m_s) or k (0.5·2/m_end), the larger. Round-off: 1e-12 relative.
+TEST(PenaltyStability, FrequencyBoundDominatesTheSpringsEigenvalue) {
+  const Grid<2> grid(Vec<2>(0, 0), Vec<2>(0.01, 0.01), IVec<2>{40, 30});
+  const double eps = 1e11;
+  auto bound_and_exact = [&](const BoundaryPoints<2>& bp, double& exact) {
+    PenaltyContact<2> pc(grid, PenaltyOptions{1e-3});
+    PenaltyPairSettings ps;
+    ps.master = 0;
+    ps.slave = 1;
+    ps.normal_penalty = eps;
+    pc.add_pair(ps);
+    pc.compute(bp);
+    std::vector<double> mass(bp.size());
+    for (std::size_t i = 0; i < bp.size(); ++i) mass[i] = 1.0 + static_cast<double>(i % 3);
+    const auto own_node = [&](int, const Vec<2>& x, const Vec<2>&, auto&& visit) {
+      visit(static_cast<int>(&x - bp.position.data()), 0, 1.0);  // the point's index as its slot
+    };
+    const double bound = pc.update_frequency_bound(bp, own_node, mass, 0.0);
+    std::vector<std::map<int, double>> rows;  // b_c per contact
+    std::vector<double> k;
+    for (const auto& r : pc.contacts()) {
+      std::map<int, double> b;
+      b[r.slave] += 1.0;
+      b[r.segment] -= 1.0 - r.beta;
+      b[bp.next[static_cast<std::size_t>(r.segment)]] -= r.beta;
+      rows.push_back(b);
+      k.push_back(eps * r.area);
+    }
+    std::vector<double> v(bp.size()), w(bp.size());  // not the translation, a zero mode (Σ b = 0)
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::sin(1.0 + 0.7 * static_cast<double>(i));
+    exact = 0.0;
+    for (int it = 0; it < 5000; ++it) {  // power iteration on M⁻¹K (similar to a symmetric matrix)
+      std::fill(w.begin(), w.end(), 0.0);
+      for (std::size_t c = 0; c < rows.size(); ++c) {
+        double g = 0.0;
+        for (const auto& [I, b] : rows[c]) g += b * v[static_cast<std::size_t>(I)];
+        for (const auto& [I, b] : rows[c]) w[static_cast<std::size_t>(I)] += k[c] * b * g / mass[static_cast<std::size_t>(I)];
+      }
+      double n = 0.0;
+      for (double x : w) n = std::max(n, std::fabs(x));
+      const double prev = exact;
+      exact = n;
+      for (std::size_t i = 0; i < v.size(); ++i) v[i] = w[i] / n;
+      if (it > 100 && std::fabs(exact - prev) < 1e-12 * exact) break;
+    }
+    return bound;
+  };
+  BoundaryPoints<2> bp;
+  bp.add_loop(0, sample_rectangle_boundary(Vec<2>(0.05, 0.05), Vec<2>(0.35, 0.15), 0.005), Vec<2>::Constant(0.0025));
+  bp.add_loop(1, sample_rectangle_boundary(Vec<2>(0.1, 0.1499), Vec<2>(0.2, 0.1999), 0.005), Vec<2>::Constant(0.0025));
+  double exact = 0.0;
+  const double bound = bound_and_exact(bp, exact);
+  std::printf("[frequency bound] pressed block: Gershgorin %.6e 1/s^2, largest eigenvalue %.6e (ratio %.3f)\n", bound,
+              exact, bound / exact);
+  EXPECT_GE(bound, exact * (1 - 1e-9));
+  EXPECT_LT(bound, 2.0 * exact);
+
+  BoundaryPoints<2> one;  // one slave point over the middle of a master segment
+  one.add_loop(0, {Vec<2>(0.105, 0.05), Vec<2>(0.11, 0.10), Vec<2>(0.10, 0.10)}, Vec<2>::Constant(0.0025));
+  one.add_loop(1, {Vec<2>(0.105, 0.0999), Vec<2>(0.2, 0.2), Vec<2>(0.0, 0.2)}, Vec<2>::Constant(0.0025));
+  const double b1 = bound_and_exact(one, exact);
+  ASSERT_EQ(one.size(), 6u);
+  double expected = 0.0;
+  for (int i : {1, 2}) expected = std::max(expected, 0.5 * 2.0 / (1.0 + i % 3));  // segment 1's ends
+  expected = std::max(expected, 1.0 * 2.0 / (1.0 + 3 % 3));                       // the slave point, index 3
+  EXPECT_NEAR(b1, expected * eps * one.tributary_length(3) * 1e-3, 1e-12 * b1);
 }

@@ -187,7 +187,6 @@ class EbsBasis {
     int d2;
   };
   std::vector<Offset> offsets_;           // search offsets of Q_J by increasing distance
-  std::vector<IVec<Dim>> particle_cell_;  // rebuild scratch
   double cell_measure_ = 1.0;  // Ω_c
   int stable_count_ = 0, degenerate_count_ = 0, promoted_count_ = 0, max_stencil_ = 0, extended_cells_ = 0;
 };

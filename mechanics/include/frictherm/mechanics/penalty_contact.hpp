@@ -23,6 +23,8 @@
 #include <frictherm/mechanics/boundary_points.hpp>
 #include <frictherm/mechanics/contact.hpp>  // TangentialLaw
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -159,6 +161,54 @@ class PenaltyContact {
       weights(points.field[i], points.position[i], points.half_size[i],
               [&](int slot, int, double S) { nodal_force[static_cast<std::size_t>(slot)] += S * force_[i]; });
   }
+  /// Gershgorin bound of the squared frequency of the penalty springs of the last compute() on the
+  /// grid (docs/penalty_contact.md, "Stability"), stored for frequency_bound_squared():
+  /// ω_p² ≤ max_I Σ_c k_c |B_cI| ‖B_c‖₁ / m_I. B_c maps nodal velocities to contact c's gap rate: the
+  /// weights S_I of the slave point, −(1−β) S_I and −β S_I of the segment's ends, summed per node;
+  /// k_c = A_s ε_N, or A_s max(ε_N, ε_T) while a return-mapping contact sticks on its tangential
+  /// spring (the two springs are orthogonal, so the larger bounds the pair). m_I = slot_mass; nodes
+  /// at or below min_mass get no velocity and are skipped. Same weights as scatter_forces.
+  template <class Weights>
+  double update_frequency_bound(const BoundaryPoints<Dim>& points, const Weights& weights,
+                                const std::vector<double>& slot_mass, double min_mass) {
+    node_load_.clear();
+    for (const PenaltyContactRecord& r : records_) {
+      const PenaltyPairSettings& P = pairs_[static_cast<std::size_t>(r.pair)];
+      const bool spring = !r.vertex && !r.sliding && P.mu > 0.0 && P.law == TangentialLaw::return_mapping;
+      const double k = r.area * (spring ? std::max(P.normal_penalty, P.tangential_penalty) : P.normal_penalty);
+      row_.clear();
+      const int ends[3] = {r.slave, r.segment, points.next[static_cast<std::size_t>(r.segment)]};
+      const double scale[3] = {1.0, -(1.0 - r.beta), -r.beta};
+      for (int e = 0; e < 3; ++e)
+        if (scale[e] != 0.0)
+          weights(points.field[static_cast<std::size_t>(ends[e])], points.position[static_cast<std::size_t>(ends[e])],
+                  points.half_size[static_cast<std::size_t>(ends[e])],
+                  [&](int slot, int, double S) { row_.emplace_back(slot, scale[e] * S); });
+      std::sort(row_.begin(), row_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      std::size_t m = 0;  // merge the two ends' entries on shared nodes
+      for (std::size_t q = 0; q < row_.size(); ++q) {
+        if (m > 0 && row_[m - 1].first == row_[q].first) row_[m - 1].second += row_[q].second;
+        else row_[m++] = row_[q];
+      }
+      row_.resize(m);
+      double norm1 = 0.0;
+      for (const auto& e : row_) norm1 += std::fabs(e.second);
+      for (const auto& e : row_) node_load_.emplace_back(e.first, k * std::fabs(e.second) * norm1);
+    }
+    std::sort(node_load_.begin(), node_load_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    frequency_bound2_ = 0.0;
+    for (std::size_t q = 0; q < node_load_.size();) {
+      const int slot = node_load_[q].first;
+      double load = 0.0;
+      for (; q < node_load_.size() && node_load_[q].first == slot; ++q) load += node_load_[q].second;
+      const double mI = slot_mass[static_cast<std::size_t>(slot)];
+      if (mI > min_mass) frequency_bound2_ = std::max(frequency_bound2_, load / mI);
+    }
+    return frequency_bound2_;
+  }
+  /// The bound of the last update_frequency_bound() (1/s²); 0 before any, or without contacts.
+  double frequency_bound_squared() const { return frequency_bound2_; }
+
   /// Adds each point's heat to grid nodes (J per grid node), same weights.
   template <class Weights>
   void scatter_heat(const BoundaryPoints<Dim>& points, const Weights& weights, std::vector<double>& nodal_heat) const {
@@ -195,6 +245,8 @@ class PenaltyContact {
   double bin_size_ = 1.0;
   double stored_energy_ = 0.0;
   std::uint64_t stamp_ = 0;
+  std::vector<std::pair<int, double>> row_, node_load_;  // update_frequency_bound scratch: (slot, value)
+  double frequency_bound2_ = 0.0;
 };
 
 /// Step 1 helper (K §3.5, eq. 27): true if any node of point i's own stencil (via `weights`) is one

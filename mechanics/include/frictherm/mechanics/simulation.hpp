@@ -214,6 +214,7 @@ class Simulation {
   void apply_penalty_forces();                   // step: detection, forces into nodes_.force, heat
   void move_boundary_points(double dt, double t);  // step: with the new nodal momenta
   double penalty_wave_factor() const;            // time step: √(ε/(E/Δh)) when a penalty is stiffer than eq. 40
+  double penalty_time_step_limit(double wave_speed) const;  // time step: the last step's penalty springs
   void check_particle(long bad, double dt) const;
   void resolve_loads();
 
