@@ -57,32 +57,38 @@ struct LinearKernel {
 /// characteristic function of half-width lp <= h/2, which stays at its initial size (K = 3).
 struct UGIMPKernel {
   static constexpr int K = 3;
-  static double weight(double d, double h, double lp, double& grad) {
+  /// S(d) and dS/dd for a particle of half-width lp at distance d from the node; inv_h = 1/h,
+  /// inv_hlp = 1/(h lp) (one division per particle and axis instead of one per branch).
+  static double weight(double d, double h, double lp, double inv_h, double inv_hlp, double& grad) {
     const double a = std::fabs(d);
     const double sgn = d < 0.0 ? -1.0 : 1.0;
     if (a < lp) {
-      grad = -d / (h * lp);
-      return 1.0 - (d * d + lp * lp) / (2.0 * h * lp);
+      grad = -d * inv_hlp;
+      return 1.0 - 0.5 * (d * d + lp * lp) * inv_hlp;
     }
     if (a < h - lp) {
-      grad = -sgn / h;
-      return 1.0 - a / h;
+      grad = -sgn * inv_h;
+      return 1.0 - a * inv_h;
     }
     if (a < h + lp) {
       const double r = h + lp - a;
-      grad = -sgn * r / (2.0 * h * lp);
-      return r * r / (4.0 * h * lp);
+      grad = -0.5 * sgn * r * inv_hlp;
+      return 0.25 * r * r * inv_hlp;
     }
     grad = 0.0;
     return 0.0;
+  }
+  static double weight(double d, double h, double lp, double& grad) {
+    return weight(d, h, lp, 1.0 / h, 1.0 / (h * lp), grad);
   }
   static void eval(double x, double lo, double h, double inv_h, double lp, Weights1D<K>& out) {
     const double s = (x - lo) * inv_h;
     const int j = static_cast<int>(std::floor(s));
     out.base = (s - j < 0.5) ? j - 1 : j;
+    const double inv_hlp = inv_h / lp;
     for (int a = 0; a < K; ++a) {
       const double d = x - (lo + h * (out.base + a));
-      out.w[a] = weight(d, h, lp, out.dw[a]);
+      out.w[a] = weight(d, h, lp, inv_h, inv_hlp, out.dw[a]);
     }
   }
 };
