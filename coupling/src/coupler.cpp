@@ -81,7 +81,7 @@ void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
       if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
         problem_->set_dirichlet(static_cast<Eigen::Index>(u), f.temperature);
   }
-  if (opt_.reaction.enabled) {
+  if (reaction_active()) {
     // Reacting mass and progress gathered from the particles; Q_i = q m_i (heat_sources.hpp).
     NodalReaction r = gather_reaction(grid_, p, shape_, opt_.reaction, system_, particle_progress_);
     problem_->set_reaction(thermal::make_reaction(opt_.reaction.kinetics, r.reacting_mass));
@@ -194,7 +194,9 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
   if (pending_.total() != 0.0)
     throw std::logic_error("Coupler::continue_thermal: close the window with pending heat first");
   if (!(time > window_start_)) return;
-  if (!has_system_) {
+  const bool reaction_starts = opt_.reaction.enabled && !continuing_;
+  continuing_ = true;
+  if (!has_system_ || reaction_starts) {  // a reaction held back during loading joins the problem now
     assemble(p);
     nodal_temperature_ = system_.temperature;
   }
@@ -211,7 +213,7 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
 template <int Dim>
 void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, double t1) {
   const Eigen::VectorXd start = nodal_temperature_;
-  if (opt_.reaction.enabled) {
+  if (reaction_active()) {
     const double released0 = problem_->released_heat(nodal_progress_);
     integrator_->advance(*problem_, nodal_temperature_, nodal_progress_, t0, t1);  // T and λ
     books_.reaction_heat_released += problem_->released_heat(nodal_progress_) - released0;

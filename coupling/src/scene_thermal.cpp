@@ -108,6 +108,7 @@ void parse_reaction(const JsonReader& t, ThermalSceneSpec& spec, const std::vect
       e.fail("material \"" + name + "\" has no thermal properties (list it in thermal.materials)");
     rx.reacting[id] = 1;
   }
+  if (const auto d = r->find("during_loading")) rx.during_loading = d->as_bool();
   r->finish();
 }
 

@@ -248,22 +248,28 @@ template <int Dim>
 double Simulation<Dim>::stable_time_step() const {
   double cmax = 0.0;
   const std::size_t n = p_.size();
-  // One parallel region for all materials (grains are small: see evaluate_stencils).
+  if (finalized_ && wave_speed_ready_ && wave_speed_.size() == n) {
+    // The wave speeds of the last stress update (rigid particles: −∞; the rigid loop below counts them).
+#pragma omp parallel for num_threads(threads_) schedule(static) reduction(max : cmax)
+    for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speed_[k] + p_.velocity[k].norm());
+  } else {
+    // One parallel region for all materials (grains are small: see evaluate_stencils).
 #pragma omp parallel num_threads(threads_) reduction(max : cmax)
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    const Material& mat = materials_[m];
-    const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
-    if (mat.is_rigid()) continue;
-    const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
-    const double c0 = mg ? 0.0 : mat.p_wave_speed(opt_.analysis);
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+      const Material& mat = materials_[m];
+      const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
+      if (mat.is_rigid()) continue;
+      const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
+      const double c0 = mg ? 0.0 : mat.p_wave_speed(opt_.analysis);
 #pragma omp for schedule(static) nowait
-    for (std::size_t k = b; k < e; ++k) {
-      if (!finalized_ && p_.material[k] != static_cast<int>(m)) continue;
-      const double J = p_.volume[k] / p_.initial_volume[k];
-      const double c = mg   ? mie_gruneisen_wave_speed(mat.mie_gruneisen, J, p_.internal_energy[k])
-                       : nh ? mat.wave_speed(opt_.analysis, J)
-                            : c0;
-      cmax = std::max(cmax, c + p_.velocity[k].norm());
+      for (std::size_t k = b; k < e; ++k) {
+        if (!finalized_ && p_.material[k] != static_cast<int>(m)) continue;
+        const double J = p_.volume[k] / p_.initial_volume[k];
+        const double c = mg   ? mie_gruneisen_wave_speed(mat.mie_gruneisen, J, p_.internal_energy[k])
+                         : nh ? mat.wave_speed(opt_.analysis, J)
+                              : c0;
+        cmax = std::max(cmax, c + p_.velocity[k].norm());
+      }
     }
   }
   for (const Material& mat : materials_)  // rigid bodies move material through the grid too

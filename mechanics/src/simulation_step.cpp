@@ -365,6 +365,8 @@ template <class Kernel>
 void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   auto& st = stencils<Kernel>();
   const Analysis an = opt_.analysis;
+  if (wave_speed_.size() != p_.size())
+    wave_speed_.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
   long beyond = -1;  // a particle compressed past the Hugoniot's limit
 #pragma omp parallel num_threads(threads_) reduction(max : beyond)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
@@ -374,6 +376,7 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
     const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
+    const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
 #pragma omp for schedule(static) nowait
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
@@ -384,14 +387,16 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
       if (mg) {
         double wp = 0.0;  // plastic work per unit current volume (J/m^3)
         if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, p_.stress[k],
-                                      p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k],
-                                      wp) != MieGruneisenStatus::ok)
+                                      p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k], wp,
+                                      &wave_speed_[k]) != MieGruneisenStatus::ok)
           beyond = std::max(beyond, static_cast<long>(k));
         p_.plastic_work[k] += wp * p_.volume[k];
       } else if (nh) {
         neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
+        wave_speed_[k] = mat.wave_speed(an, p_.volume[k] / p_.initial_volume[k]);
       } else {
         linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
+        wave_speed_[k] = c0;
       }
     }
   }
@@ -404,6 +409,7 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
         << "; try a smaller CFL factor)";
     throw SimulationError(msg.str(), step_, time_, beyond);
   }
+  wave_speed_ready_ = true;
 }
 
 #define FRICTHERM_INSTANTIATE_STEP(D) template double Simulation<D>::step(double);

@@ -47,6 +47,7 @@ void ArkodeDirk::create(double t0) {
 
 void ArkodeDirk::reinit(double t0) {
   check(ARKStepReInit(mem_.get(), nullptr, &OdeSystem::rhs, t0, y_.get()), "ARKStepReInit");
+  check(ARKStepSVtolerances(mem_.get(), opt_.rtol, abstol_.get()), "ARKStepSVtolerances");  // abstol_ may be new
 }
 
 int ArkodeDirk::evolve(double t1) {

@@ -19,6 +19,7 @@ void ArkodeErk::create(double t0) {
 
 void ArkodeErk::reinit(double t0) {
   check(ERKStepReInit(mem_.get(), &OdeSystem::rhs, t0, y_.get()), "ERKStepReInit");
+  check(ERKStepSVtolerances(mem_.get(), opt_.rtol, abstol_.get()), "ERKStepSVtolerances");  // abstol_ may be new
 }
 
 int ArkodeErk::evolve(double t1) {

@@ -55,7 +55,10 @@ void CvodeIntegrator::create(double t0) {
   }
 }
 
-void CvodeIntegrator::reinit(double t0) { check(CVodeReInit(mem_.get(), t0, y_.get()), "CVodeReInit"); }
+void CvodeIntegrator::reinit(double t0) {
+  check(CVodeReInit(mem_.get(), t0, y_.get()), "CVodeReInit");
+  check(CVodeSVtolerances(mem_.get(), opt_.rtol, abstol_.get()), "CVodeSVtolerances");  // abstol_ may be new
+}
 
 int CvodeIntegrator::evolve(double t1) {
   // 6.4.1: tstop stays set after tout == tstop and ReInit keeps it, so set it every window.

@@ -80,7 +80,26 @@ void SundialsIntegrator::advance_impl(const Problem& problem, Eigen::VectorXd& T
   const bool same_problem = built_ && problem.revision() == revision_ && problem.size() == sys_.nodes();
   // The progress (λ = 0 without one) is part of the state (consuming) or of the RHS (zero-order).
   const Eigen::VectorXd progress_now = progress != nullptr ? *progress : Eigen::VectorXd::Zero(problem.size());
-  if (!same_problem) {
+  bool renewed = false;  // a changed problem of the same shape: new M, K in the kept solver memory
+  if (!same_problem && built_ && lin_ != LinearSolverKind::Klu && problem.size() == sys_.nodes()) {
+    const Index old_size = sys_.state_size();
+    const bool old_reaction = sys_.has_reaction(), old_nonsymmetric = sys_.nonsymmetric();
+    sys_.build(problem, lin_ == LinearSolverKind::Pcg);
+    if (sys_.state_size() == old_size && sys_.has_reaction() == old_reaction &&
+        sys_.nonsymmetric() == old_nonsymmetric) {
+      // The solver set-up depends only on these (KLU's matrix has the old pattern: rebuilt below).
+      absorb_counters();
+      sys_.fill_abstol(opt_.atol, opt_.progress_atol, abstol_.get());
+      sys_.to_y(T, progress, y_.get());
+      sink_.last_message.clear();
+      reinit(t0);  // history cleared: M and K changed under it
+      revision_ = problem.revision();
+      offset_ = counters();
+      ++reinits_;
+      renewed = true;
+    }
+  }
+  if (!same_problem && !renewed) {
     if (built_) absorb_counters();
     built_ = false;
     release();
@@ -97,7 +116,7 @@ void SundialsIntegrator::advance_impl(const Problem& problem, Eigen::VectorXd& T
     revision_ = problem.revision();
     offset_ = counters();
     ++reinits_;
-  } else {
+  } else if (!renewed) {
     sys_.bind(problem);
     const bool continues = !opt_.reinit_every_window && t0 == t_last_ && T == t_state_last_ &&
                            progress_now.size() == progress_last_.size() && progress_now == progress_last_;

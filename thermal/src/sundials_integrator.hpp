@@ -1,7 +1,11 @@
 // Shared window logic of the SUNDIALS-backed integrators (thermal-notes §1). Internal header.
 //
 // Each advance(problem, T, [progress,] t0, t1) is one window. The solver is
-//  * rebuilt when the problem's M, K or boundaries changed (new Jacobian and pattern),
+//  * rebuilt when the problem's M, K or boundaries changed and KLU holds their pattern, or the
+//    state size (reacting nodes) or the reaction's presence changed,
+//  * re-initialised in its kept memory with the new M, K when only their values changed (PCG,
+//    fixed point, explicit: what a coupler's per-window re-assembly does; no CVodeCreate, no
+//    new solvers or vectors),
 //  * re-initialised (history cleared) when T (or the reaction progress) was changed outside,
 //    t0 is not the previous t1,
 //    or options.reinit_every_window is set,

@@ -153,6 +153,9 @@ class Coupler {
   Eigen::VectorXd nodal_progress_ref_;          // λ_i gathered at the last assembly
   NodalThermalSystem system_;
   bool has_system_ = false;
+  bool continuing_ = false;  // continue_thermal has been called
+  /// The Arrhenius heat is part of the problem: enabled, and during loading or in the continuation.
+  bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }
   std::optional<thermal::Problem> problem_;
   Eigen::VectorXd nodal_temperature_;  // state at the end of the last window or interval
   double min_unknown_mass_ = 0.0;

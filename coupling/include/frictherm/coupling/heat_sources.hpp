@@ -32,6 +32,7 @@ struct PlasticHeatingOptions {
 
 struct ReactionOptions {
   bool enabled = false;
+  bool during_loading = true;           // false: the reaction starts with the thermal-only continuation
   thermal::ArrheniusKinetics kinetics;  // Z, Θ = E_a/R, q (J/kg)
   std::string kinetics_name;            // for the metadata ("hmx_rogers1975" or "explicit")
   std::vector<char> reacting;           // by material id: 1 if its particles react

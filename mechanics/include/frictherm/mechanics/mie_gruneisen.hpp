@@ -161,13 +161,15 @@ enum class MieGruneisenStatus { ok, beyond_hugoniot_limit };
 ///   energy            specific internal energy e (J/kg): trapezoidal pressure work −½(p_n + p_{n+1}) ΔJ/ρ0
 ///                     plus the plastic work (J/ρ0) σ:Δε_p, solved in closed form since p is linear in e;
 ///                     elastic shear energy is stored, not added to e,
-/// and returns in plastic_work the step's σ:Δε_p per unit current volume (J/m^3).
+/// and returns in plastic_work the step's σ:Δε_p per unit current volume (J/m^3) and, if asked, in
+/// wave_speed the dilatational wave speed of the new state (as mie_gruneisen_wave_speed, for the CFL step).
 /// J_old = J / det(I + dt L). If J is at or beyond the Hugoniot limit (J <= mie_gruneisen_min_J, or
 /// J <= 0) nothing is changed and beyond_hugoniot_limit is returned.
 template <int Dim>
 inline MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& L, double dt, double J, const MieGruneisenParams& m,
                                                Mat<Dim>& sigma, double& sigma_zz, double& plastic_strain,
-                                               double& energy, double& plastic_work) {
+                                               double& energy, double& plastic_work,
+                                               double* wave_speed = nullptr) {
   plastic_work = 0.0;
   if (!(J > mie_gruneisen_min_J(m))) return MieGruneisenStatus::beyond_hugoniot_limit;  // also J <= 0, NaN
   const double J_old = J / (Mat<Dim>::Identity() + dt * L).determinant();
@@ -186,6 +188,11 @@ inline MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& L, double dt, dou
   energy = (energy - 0.5 * (p_old + f) * dJ / m.density + inc.plastic_work * J / m.density) /
            (1.0 + 0.5 * m.gamma0 * dJ);
   const double p = f + m.gamma0 * m.density * energy;
+  if (wave_speed) {  // as mie_gruneisen_wave_speed(m, J, energy), from the parts computed here
+    const double c2 = J * J / m.density * (df + m.gamma0 * p);
+    const double c = c2 > 0.0 ? std::sqrt(c2) : 0.0;
+    *wave_speed = std::sqrt(c * c + 4.0 / 3.0 * m.shear_modulus * J / m.density);
+  }
   sigma = s;
   sigma.diagonal().array() -= p;
   sigma_zz = Dim == 2 ? s_zz - p : 0.0;

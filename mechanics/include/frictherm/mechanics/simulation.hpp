@@ -294,6 +294,10 @@ class Simulation {
   double last_dt_ = 0.0;
   double external_work_ = 0.0;
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
+  // Per particle: the dilatational wave speed of its state (J, e change only in the stress update,
+  // which refreshes it); −∞ for rigid particles. stable_time_step adds |v_p| to it.
+  std::vector<double> wave_speed_;
+  bool wave_speed_ready_ = false;  // set by the first stress update
   StepPhaseTimes phase_times_;
   PhaseLap lap_;  // step(): phase boundaries
   double nested_phase_ = 0.0;  // contact time inside the phase the lap is in
