@@ -156,6 +156,7 @@ void parse_solver(const JsonReader& root, Scene& s) {
   s.options.scheme = mechanics::update_scheme_from_string(solver->choice("scheme", {"usf", "usl", "musl"}, "musl"));
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
+  if (const auto t = solver->find("pic_relaxation_time")) s.options.pic_relaxation_time = t->as_number(Range::positive());
   solver->finish();
 }
 

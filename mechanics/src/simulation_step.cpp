@@ -297,7 +297,9 @@ void Simulation<Dim>::map_external_loads(double t) {
   }
 }
 
-// Grid-to-particle (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1}. Returns the first
+// Grid-to-particle (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1}; with a PIC relaxation time
+// τ, v_p ← (1 − α) v_p + α Σ S_ip v_i^{n+1}, α = 1 − e^(−dt/τ), which damps the particle velocity modes
+// the grid cannot see at a rate independent of the time step. Returns the first
 // particle with a non-finite state or outside the grid, or -1.
 template <int Dim>
 template <class Kernel>
@@ -306,6 +308,7 @@ long Simulation<Dim>::update_particles(double dt) {
   long bad = std::numeric_limits<long>::max();  // min-reduction identity
   double work = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
+  const double pic = std::isfinite(opt_.pic_relaxation_time) ? -std::expm1(-dt / opt_.pic_relaxation_time) : 0.0;
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const int f = field_of_material_[m];
@@ -323,6 +326,7 @@ long Simulation<Dim>::update_particles(double dt) {
       const Vec<Dim> v_mid = p_.velocity[k] + 0.5 * dt * a;
       work += p_.mass[k] * g.dot(v_mid) * dt;
       p_.velocity[k] += dt * a;
+      if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
       p_.position[k] += dt * v;
       const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
       if (!ok) bad = std::min(bad, kk);

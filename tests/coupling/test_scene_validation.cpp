@@ -3,6 +3,8 @@
 
 #include <gmock/gmock.h>
 
+#include <cmath>
+
 using frictherm::coupling::Json;
 using frictherm::coupling::parse_scene;
 using frictherm::coupling::test::good_scene;
@@ -94,6 +96,15 @@ TEST(SceneValidation, CflFactorMustBeInZeroOne) {
   Json s = good_scene();
   s["solver"] = {{"cfl", 1.0}};
   EXPECT_NO_THROW(parse_scene(s.dump()));
+}
+
+TEST(SceneValidation, PicRelaxationTimeMustBePositive) {
+  Json s = good_scene();
+  s["solver"] = {{"pic_relaxation_time", 0.0}};
+  EXPECT_THAT(scene_error(s), StartsWith("solver.pic_relaxation_time: expected a number > 0"));
+  s["solver"] = {{"pic_relaxation_time", 3e-8}};
+  EXPECT_DOUBLE_EQ(parse_scene(s.dump()).options.pic_relaxation_time, 3e-8);
+  EXPECT_TRUE(std::isinf(parse_scene(good_scene().dump()).options.pic_relaxation_time));  // pure FLIP
 }
 
 TEST(SceneValidation, VectorLengthMustMatchDimension) {

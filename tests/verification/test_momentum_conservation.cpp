@@ -16,7 +16,8 @@ using namespace frictherm::mechanics;
 namespace {
 
 template <int Dim>
-std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int ppc = 2) {
+std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int ppc = 2,
+                                               double pic_relaxation_time = INFINITY) {
   const double h = Dim == 2 ? 0.05 : 0.1;
   const int n = Dim == 2 ? 40 : 20;
   IVec<Dim> cells;
@@ -24,6 +25,7 @@ std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shap
   SimulationOptions o;
   o.shape = shape;
   o.scheme = scheme;
+  o.pic_relaxation_time = pic_relaxation_time;
   auto owned = std::make_unique<Simulation<Dim>>(Grid<Dim>(Vec<Dim>::Zero(), Vec<Dim>::Constant(h), cells), o);
   Simulation<Dim>& sim = *owned;
   Material m;
@@ -46,10 +48,10 @@ std::unique_ptr<Simulation<Dim>> spinning_disk(MaterialKind kind, ShapeKind shap
 }
 
 template <int Dim>
-void spin_and_check(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int threads) {
+void spin_and_check(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int threads, double pic_relaxation_time = INFINITY) {
   omp_set_num_threads(threads);
   // The simulation threads only above ~2000 particles per thread: 4 per cell per direction then.
-  auto owned = spinning_disk<Dim>(kind, shape, scheme, threads > 1 ? 4 : 2);
+  auto owned = spinning_disk<Dim>(kind, shape, scheme, threads > 1 ? 4 : 2, pic_relaxation_time);
   Simulation<Dim>& sim = *owned;
   const auto& p = sim.particles();
   const Vec<Dim> P0 = sim.linear_momentum();
@@ -61,8 +63,8 @@ void spin_and_check(MaterialKind kind, ShapeKind shape, UpdateScheme scheme, int
     worst = std::max(worst, (sim.linear_momentum() - P0).norm() / scale);
   }
   omp_set_num_threads(1);
-  std::printf("[momentum %dD %s %s %s, %d threads] max |P - P0| / sum m|v| over 1000 steps = %.2e\n", Dim,
-              to_string(kind), to_string(shape), to_string(scheme), threads, worst);
+  std::printf("[momentum %dD %s %s %s, %d threads, PIC time %g s] max |P - P0| / sum m|v| over 1000 steps = %.2e\n",
+              Dim, to_string(kind), to_string(shape), to_string(scheme), threads, pic_relaxation_time, worst);
   // Worst case round-off: each step sums N particle terms (relative error <= N eps), 1000 steps add
   // linearly: 1000 N eps. The observed drift is orders of magnitude below (errors partly cancel).
   EXPECT_LT(worst, 1000.0 * p.size() * 1.1e-16);
@@ -95,4 +97,31 @@ TEST(MomentumConservation, NeoHookean2DTwoThreads) {
 }
 TEST(MomentumConservation, NeoHookean3D) {
   spin_and_check<3>(MaterialKind::neo_hookean, ShapeKind::ugimp, UpdateScheme::musl, 1);
+}
+
+// The FLIP/PIC blend keeps momentum: Σ_p m_p Σ_i S_ip v_i = Σ_i m_i v_i, the grid's momentum, which the
+// FLIP update also hands back. Same bound as pure FLIP; τ = 1 ms, about 3 steps (α ≈ 0.25 per step).
+TEST(MomentumConservation, FlipPicBlend) {
+  for (UpdateScheme u : {UpdateScheme::usl, UpdateScheme::musl})
+    spin_and_check<2>(MaterialKind::linear_elastic, ShapeKind::ugimp, u, 1, 1e-3);
+}
+
+// A body in uniform translation stays in it under any blend (PIC reproduces a uniform field:
+// Σ_i S_ip = 1), to round-off; here nearly pure PIC (τ a tenth of a step).
+TEST(MomentumConservation, PicBlendKeepsUniformTranslation) {
+  SimulationOptions o;
+  o.pic_relaxation_time = 1e-7;  // Δt ≈ 0.5 · 0.05 m / 79 m/s = 3e-4 s
+  Simulation<2> sim(Grid<2>(Vec<2>::Zero(), Vec<2>::Constant(0.05), IVec<2>{40, 40}), o);
+  Material m;
+  m.name = "rubber", m.kind = MaterialKind::linear_elastic, m.density = 1100.0, m.youngs_modulus = 5e6,
+  m.poisson_ratio = 0.4;
+  const int mat = sim.add_material(m);
+  const Vec<2> v0(0.7, -0.4);
+  sim.add_body("block", *make_box<2>(Vec<2>(0.5, 0.5), Vec<2>(1.2, 1.0), mat), 2, v0);
+  for (int s = 0; s < 200; ++s) sim.step();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < sim.particles().size(); ++k)
+    worst = std::max(worst, (sim.particles().velocity[k] - v0).norm() / v0.norm());
+  std::printf("[PIC translation] max |v_p - v0| / |v0| after 200 steps = %.2e\n", worst);
+  EXPECT_LT(worst, 1e-12);
 }

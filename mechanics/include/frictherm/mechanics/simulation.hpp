@@ -50,6 +50,9 @@ struct SimulationOptions {
   double ebs_occupation = 0.75;                // extended_bspline: C_c, a cell is interior if φ_c > C_c (Kakouris 2024 eq. 20)
   UpdateScheme scheme = UpdateScheme::musl;
   double cfl = 0.5;                            // C in (0, 1]
+  // FLIP/PIC blend v_p ← (1 − α) v_p^FLIP + α Σ S_ip v_i with α = 1 − e^(−Δt/τ): the particle velocity
+  // modes the grid cannot see decay as e^(−t/τ) whatever the time step (∞: pure FLIP).
+  double pic_relaxation_time = std::numeric_limits<double>::infinity();
   double max_time_step = std::numeric_limits<double>::infinity();
   Vec<3> gravity = Vec<3>::Zero();             // body force per unit mass (m/s^2)
 };
