@@ -64,14 +64,6 @@ struct Args {
   long klu_max_nodes = 20000;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 Args parse(int argc, char** argv) {
   Args a;
   for (int i = 1; i < argc; ++i) {
@@ -82,7 +74,7 @@ Args parse(int argc, char** argv) {
     }
     if (i + 1 >= argc) throw std::invalid_argument("missing value after " + key);
     const std::string v = argv[++i];
-    if (key == "--grids") a.grids = split(v);
+    if (key == "--grids") a.grids = thermal_grids::split_list(v);
     else if (key == "--n2") a.n2 = std::stoi(v);
     else if (key == "--n3") a.n3 = std::stoi(v);
     else if (key == "--h") a.h = std::stod(v);
@@ -90,7 +82,7 @@ Args parse(int argc, char** argv) {
     else if (key == "--c") a.wave_speed = std::stod(v);
     else if (key == "--windows") {
       a.windows.clear();
-      for (const auto& w : split(v)) a.windows.push_back(std::stod(w));
+      for (const auto& w : thermal_grids::split_list(v)) a.windows.push_back(std::stod(w));
       std::sort(a.windows.begin(), a.windows.end());
     } else if (key == "--count") a.count = std::stoi(v);
     else if (key == "--count-last") a.count_last = std::stoi(v);
@@ -98,7 +90,7 @@ Args parse(int argc, char** argv) {
     else if (key == "--atol") a.atol = std::stod(v);
     else if (key == "--fe-safety") a.fe_safety = std::stod(v);
     else if (key == "--mode") a.mode = v;
-    else if (key == "--integrators") a.integrators = split(v);
+    else if (key == "--integrators") a.integrators = thermal_grids::split_list(v);
     else if (key == "--crossover-max") a.crossover_max = std::stod(v);
     else if (key == "--klu-max-nodes") a.klu_max_nodes = std::stol(v);
     else throw std::invalid_argument("unknown option " + key);

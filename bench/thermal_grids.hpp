@@ -12,11 +12,22 @@
 
 #include <Eigen/Core>
 
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace thermal_grids {
 
 namespace ft = frictherm::thermal;
+
+/// "a,b,,c" -> {"a", "b", "c"} (command-line lists of the thermal benchmarks).
+inline std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
 
 struct Material {
   double rho_c = 1.0;  // volumetric heat capacity ρc [J/(m³K)]

@@ -52,17 +52,9 @@ struct Args {
                                        "cvode_adams",   "arkode_erk",    "arkode_dirk/klu"};
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 std::vector<double> numbers(const std::string& s) {
   std::vector<double> out;
-  for (const auto& x : split(s)) out.push_back(std::stod(x));
+  for (const auto& x : thermal_grids::split_list(s)) out.push_back(std::stod(x));
   return out;
 }
 
@@ -76,7 +68,7 @@ Args parse(int argc, char** argv) {
     else if (key == "--windows") a.windows = numbers(v);
     else if (key == "--rtols") a.rtols = numbers(v);
     else if (key == "--fe-safety") a.fe_safety = numbers(v);
-    else if (key == "--integrators") a.integrators = split(v);
+    else if (key == "--integrators") a.integrators = thermal_grids::split_list(v);
     else throw std::invalid_argument("unknown option " + key);
   }
   return a;

@@ -1,5 +1,6 @@
 // Scene sections `thermal` and `coupling`: parsing, validation messages, and a whole run through
 // the runner (conduction between two blocks at different temperatures, continuation, /hotspots).
+#include "h5_test_support.hpp"
 #include "test_scene_support.hpp"
 
 #include <frictherm/coupling/csv_export.hpp>
@@ -156,22 +157,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<double> read_doubles(const std::string& file, const std::string& path) {
-  std::vector<double> out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return out;
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  if (d >= 0) {
-    const hid_t sp = H5Dget_space(d);
-    const auto n = static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp));
-    out.resize(n);
-    if (n > 0) H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
-    H5Sclose(sp);
-    H5Dclose(d);
-  }
-  H5Fclose(f);
-  return out;
-}
+using frictherm::test::read_doubles;
 
 std::string read_string(const std::string& file, const std::string& path) {
   std::string out;
