@@ -61,6 +61,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
   if (a.has("output")) opt.output = a.options.at("output");
   opt.quiet = a.has("quiet");
   opt.command_line = command_line;
+  opt.handle_signals = true;
   coupling::Scene scene;
   if (!load(path, a, scene)) return kUsage;
   coupling::RunResult r;
@@ -80,6 +81,12 @@ int run_command(const std::vector<std::string>& args, const std::string& command
     std::cerr << "frictherm: simulation failed: " << r.message << ". Kept in " << r.output << ": " << r.snapshots
               << " snapshots written before the failure, the failing state under /failure and the time series.\n";
     return kSimulationFailed;
+  }
+  if (r.status == coupling::RunResult::Status::interrupted) {
+    std::cerr << "frictherm: " << r.message << ". Kept in " << r.output << ": " << r.snapshots
+              << " snapshots (the last one at the interruption), " << r.series_rows
+              << " series rows; /meta/status = interrupted.\n";
+    return r.exit_code();
   }
   if (!opt.quiet) {
     std::printf("wrote %s: %zu snapshots, %zu series rows; %ld steps to t = %g s in %.2f s (%zu particles)\n",

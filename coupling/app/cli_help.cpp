@@ -40,7 +40,10 @@ const char* const kRunHelp =
     "A progress line (step, simulated time, steps/s, ETA) is shown when stderr is a terminal.\n"
     "If the simulation breaks down (non-finite values, a particle leaving the grid) the run stops,\n"
     "the failing state is written to /failure, every earlier snapshot stays readable, and the exit\n"
-    "code is 1.\n";
+    "code is 1. SIGINT (Ctrl-C) or SIGTERM ends the run after the current step: the series and a last\n"
+    "snapshot are written, /meta/status is `interrupted`, and the exit code is 128 + the signal\n"
+    "(130 for SIGINT, 143 for SIGTERM); a second signal ends the program at once. Series rows reach\n"
+    "the file at least every 2 s of wall time.\n";
 
 const char* const kValidateHelp =
     "usage: frictherm validate SCENE [--set KEY=VALUE ...]\n"

@@ -1,6 +1,7 @@
 // The run loop: build the simulation, step to end_time landing on every snapshot time, write
 // snapshots and series, and keep the failing state when the simulation breaks down.
 #include "runner_detail.hpp"
+#include "run_signals.hpp"
 #include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
 #include <frictherm/coupling/microstructure.hpp>
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 
 namespace frictherm::coupling {
@@ -34,6 +36,7 @@ class Run {
 
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
+    const detail::InterruptGuard interrupt_guard(o_.handle_signals);  // before the file exists
     sim_ = build_simulation<Dim>(s_);
     if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;
@@ -52,12 +55,14 @@ class Run {
     snapshot();
     std::ostream& log = o_.log ? *o_.log : std::cerr;
     detail::ProgressLine progress(std::cerr, show_progress(o_), s_.end_time);
+    last_flush_ = Clock::now();
     try {
       loop(progress);
       if (thermal_ && r_.status == RunResult::Status::completed) {
         const Clock::time_point c0 = Clock::now();
         thermal_->continuation(out, *sim_, s_.output.fields);  // thermal hook: thermal-only phase
         continuation_seconds_ = seconds_since(c0);
+        if (detail::interrupt_signal() != 0) interrupted();
       }
     } catch (const mechanics::SimulationError& e) {
       progress.finish();
@@ -73,6 +78,11 @@ class Run {
       if (last_series_step_ != sim_->step_count()) series();
       if (last_snapshot_step_ != sim_->step_count()) snapshot();
     }
+    if (r_.status == RunResult::Status::interrupted) {
+      r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " +
+                   std::to_string(sim_->step_count()) + ", t = " + format_number(sim_->time()) + " s";
+      out.write_metadata("interruption", r_.message);
+    }
     if (r_.status == RunResult::Status::stopped_at_max_steps && !o_.quiet)
       log << "frictherm: note: stopped at run.max_steps = " << s_.max_steps << " (t = " << sim_->time()
           << " s of end_time " << s_.end_time << " s)\n";
@@ -82,8 +92,9 @@ class Run {
     record_phase_seconds(out);
     r_.snapshots = out.snapshot_count();
     r_.series_rows = out.series_rows();
-    const char* status = r_.status == RunResult::Status::failed               ? "failed"
+    const char* status = r_.status == RunResult::Status::failed                 ? "failed"
                          : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
+                         : r_.status == RunResult::Status::interrupted          ? "interrupted"
                                                                                 : "completed";
     if (thermal_) thermal_->write_metadata(out, *sim_);  // thermal hook: integrator statistics, energy books
     out.write_metadata("status", status);
@@ -181,7 +192,19 @@ class Run {
         }
       }
       progress.update(sim_->step_count(), t);
+      if (detail::interrupt_signal() != 0) return interrupted();
     }
+  }
+
+  void interrupted() {
+    r_.status = RunResult::Status::interrupted;
+    r_.signal = detail::interrupt_signal();
+  }
+
+  static std::string format_number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
   }
 
   void series() {
@@ -190,6 +213,10 @@ class Run {
     if (thermal_) thermal_->extend_series_row(row, *out_, *sim_, sim_->time());  // thermal hook
     out_->append_series(row);
     last_series_step_ = sim_->step_count();
+    if (seconds_since(last_flush_) >= o_.flush_interval) {  // a killed run loses at most flush_interval
+      out_->flush();
+      last_flush_ = Clock::now();
+    }
     output_seconds_ += seconds_since(c0);
   }
 
@@ -215,6 +242,7 @@ class Run {
   double loading_solve_seconds_ = 0.0;  // of which inside the integrator
   double continuation_seconds_ = 0.0;
   double output_seconds_ = 0.0;         // series rows and snapshots
+  Clock::time_point last_flush_ = Clock::now();  // series rows written and file flushed
 };
 
 }  // namespace

@@ -1,6 +1,8 @@
 // The thermal side of a run: coupler calls, series columns, /hotspots, metadata, continuation.
 #include "runner_thermal.hpp"
 
+#include "run_signals.hpp"
+
 #include <frictherm/mechanics/errors.hpp>
 
 #include <algorithm>
@@ -122,6 +124,7 @@ void ThermalRun<Dim>::continuation(H5Output& out, mechanics::Simulation<Dim>& si
     out.append_series(row);
     const HotSpotFates& f = coupler_.fates();
     if (spec_.stop_when_decided && !f.records().empty() && f.all_decided()) break;
+    if (interrupt_signal() != 0) break;  // SIGINT/SIGTERM: end with this interval's state (run_signals.hpp)
   }
   coupler_.finish_continuation();
   for (const HotSpotFateRecord& r : coupler_.fates().records()) {

@@ -32,10 +32,17 @@ struct RunOptions {
   Progress progress = Progress::automatic;  // automatic: only when stderr is a terminal
   std::string command_line;  // stored in the metadata
   std::ostream* log = nullptr;  // notes (e.g. "stopped at max_steps"); nullptr: std::cerr
+  /// Catch SIGINT/SIGTERM during the run: the first one ends the run after the current step (or
+  /// continuation interval) with its series, a final snapshot and status `interrupted`; a second
+  /// one ends the process at once. Off by default (a library should not take over signals); the
+  /// frictherm program turns it on.
+  bool handle_signals = false;
+  /// Buffered series rows are written and the file flushed at least this often (wall seconds).
+  double flush_interval = 2.0;
 };
 
 struct RunResult {
-  enum class Status { completed, stopped_at_max_steps, failed };
+  enum class Status { completed, stopped_at_max_steps, failed, interrupted };
   Status status = Status::completed;
   std::string output;        // the HDF5 file written
   long steps = 0;
@@ -45,13 +52,18 @@ struct RunResult {
   std::size_t series_rows = 0;
   std::size_t particles = 0;
   std::string message;       // the SimulationError's message when failed
+  int signal = 0;            // interrupted: the signal that stopped the run (SIGINT, SIGTERM)
   /// Wall time (s) by phase, in this order: the mechanics step's phases (time_step, shape_functions,
   /// particle_to_grid, contact, grid_update, grid_to_particle, stress_update), heating (the coupler
   /// outside the integrator: work accumulated, heat mapped, temperatures back, hot spots),
   /// thermal_solve (the integrator during loading), continuation (thermal-only phase), output
   /// (series and snapshots) and other (the rest of wall_time: set-up, progress, metadata).
   std::vector<std::pair<std::string, double>> phase_seconds;
-  int exit_code() const { return status == Status::failed ? 1 : 0; }
+  /// 0 completed (or stopped at max_steps), 1 failed, 128 + signal when interrupted (130: SIGINT).
+  int exit_code() const {
+    if (status == Status::interrupted) return 128 + signal;
+    return status == Status::failed ? 1 : 0;
+  }
 };
 
 /// Runs a validated scene. Throws SceneError if the simulation cannot be built (e.g. a body with no

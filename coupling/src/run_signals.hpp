@@ -1,0 +1,26 @@
+#pragma once
+// SIGINT / SIGTERM during a run: the first one asks the run loop to stop after the current step
+// (flush, status `interrupted`, exit code 128 + signal); the handlers are then reset to the
+// default, so a second signal ends the process at once (the file keeps what its last flush held).
+namespace frictherm::coupling::detail {
+
+/// Installs the handlers for its lifetime when `enabled` (the library never does so unasked:
+/// RunOptions::handle_signals), and restores the previous ones after.
+class InterruptGuard {
+ public:
+  explicit InterruptGuard(bool enabled);
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  bool enabled_;
+};
+
+/// The signal received since the guard was installed (SIGINT, SIGTERM), or 0.
+int interrupt_signal();
+
+/// "SIGINT" / "SIGTERM" / "signal N".
+const char* signal_name(int signal);
+
+}  // namespace frictherm::coupling::detail

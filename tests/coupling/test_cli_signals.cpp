@@ -1,0 +1,135 @@
+// SIGINT / SIGTERM end a run cleanly: the program finishes the current step, writes the series and a
+// last snapshot, sets /meta/status to "interrupted", says so, and exits with 128 + the signal.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A small block at rest for a very long simulated time: ~1e7 steps, far more than the test waits.
+const char* const kLongScene = R"({
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "block", "material": "soft", "velocity": [0, 0],
+              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+  "run": {"end_time": 1000.0, "threads": 1},
+  "output": {"snapshot_count": 3, "series_interval": 1e-4}
+})";
+
+std::string read_string(hid_t file, const char* path) {
+  const hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
+  if (d < 0) return {};
+  const hid_t t = H5Dget_type(d);
+  std::vector<char> buf(H5Tget_size(t) + 1, '\0');
+  H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data());
+  H5Tclose(t);
+  H5Dclose(d);
+  return std::string(buf.data());
+}
+
+double read_double(hid_t file, const char* path) {
+  double v = -1.0;
+  const hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
+  if (d < 0) return v;
+  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &v);
+  H5Dclose(d);
+  return v;
+}
+
+hsize_t series_length(hid_t file) {
+  const hid_t d = H5Dopen2(file, "/series/time", H5P_DEFAULT);
+  if (d < 0) return 0;
+  const hid_t sp = H5Dget_space(d);
+  hsize_t n = 0;
+  H5Sget_simple_extent_dims(sp, &n, nullptr);
+  H5Sclose(sp);
+  H5Dclose(d);
+  return n;
+}
+
+struct Interrupted {
+  int exit_code = -1;
+  std::string stderr_text;
+};
+
+// Starts `frictherm run`, waits until it has written series rows for a while, sends `signal`.
+Interrupted run_and_signal(const fs::path& dir, int signal) {
+  const std::string scene = (dir / "long.json").string(), out = (dir / "long.h5").string();
+  const std::string err = (dir / "stderr.txt").string();
+  std::ofstream(scene) << kLongScene;
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen(err.c_str(), "w", stderr);
+    execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // The handlers are installed before the output file is created; wait for the file, then a while.
+  for (int i = 0; i < 200 && !fs::exists(out); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  kill(pid, signal);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  Interrupted r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err);
+  r.stderr_text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return r;
+}
+
+class Signals : public ::testing::TestWithParam<int> {};
+
+TEST_P(Signals, RunStopsCleanlyWithStatusInterruptedAndReadableFile) {
+  const int signal = GetParam();
+  const fs::path dir = fs::temp_directory_path() / ("frictherm_signals_" + std::to_string(signal) + "_" +
+                                                     std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Interrupted r = run_and_signal(dir, signal);
+  EXPECT_EQ(r.exit_code, 128 + signal) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find(signal == SIGINT ? "interrupted by SIGINT" : "interrupted by SIGTERM"),
+            std::string::npos)
+      << r.stderr_text;
+
+  const hid_t f = H5Fopen((dir / "long.h5").string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << "the interrupted run's file must open";
+  EXPECT_EQ(read_string(f, "/meta/status"), "interrupted");
+  const double steps = read_double(f, "/meta/steps");
+  EXPECT_GT(steps, 10.0) << "the run was stopped before it stepped";
+  EXPECT_GT(series_length(f), 1u);
+  // The last snapshot holds the state at the interruption: its step is the run's last step.
+  const hid_t g = H5Gopen2(f, "/snapshots", H5P_DEFAULT);
+  ASSERT_GE(g, 0);
+  H5G_info_t info;
+  H5Gget_info(g, &info);
+  ASSERT_GE(info.nlinks, 2u);  // t = 0 and the interruption
+  char name[16];
+  std::snprintf(name, sizeof name, "%06llu", static_cast<unsigned long long>(info.nlinks - 1));
+  const hid_t last = H5Gopen2(g, name, H5P_DEFAULT);
+  ASSERT_GE(last, 0);
+  std::int64_t step = -1;
+  const hid_t a = H5Aopen(last, "step", H5P_DEFAULT);
+  H5Aread(a, H5T_NATIVE_INT64, &step);
+  H5Aclose(a);
+  EXPECT_EQ(static_cast<double>(step), steps);
+  H5Gclose(last);
+  H5Gclose(g);
+  H5Fclose(f);
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(IntAndTerm, Signals, ::testing::Values(SIGINT, SIGTERM));
+
+}  // namespace
