@@ -157,6 +157,12 @@ void parse_solver(const JsonReader& root, Scene& s) {
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
   if (const auto t = solver->find("pic_relaxation_time")) s.options.pic_relaxation_time = t->as_number(Range::positive());
+  if (const auto d = solver->find("damping")) {  // mass-proportional damping over [0, until)
+    if (!d->is_object()) d->expected("an object {\"rate\": c (1/s), \"until\": t (s)}");
+    s.options.damping_rate = d->number("rate", Range::positive());
+    s.options.damping_until = d->number("until", Range::positive());
+    d->finish();
+  }
   solver->finish();
 }
 

@@ -244,9 +244,16 @@ void Simulation<Dim>::velocity_from_momentum() {
 // p^{n+1} with consistent forces (Nairn 2018 eq. 19); then v_i^{n+1} = p_i^{n+1}/m_i, a_i = f_i/m_i.
 template <int Dim>
 void Simulation<Dim>::update_grid(double dt) {
-  apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
+  if (opt_.damping_rate > 0.0 && time_ < opt_.damping_until) {
+    // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
+    // (explicit: stable for c dt < 2; the scene checks c dt_max < 1).
+    const double c = opt_.damping_rate;
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (std::size_t i = 0; i < n; ++i) nodes_.force[i] -= c * nodes_.momentum[i];
+  }
+  apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
   if (contact_) resolve_contact(ContactPass::updated, dt);

@@ -276,8 +276,12 @@ double Simulation<Dim>::stable_time_step() const {
     if (mat.is_rigid()) cmax = std::max(cmax, mat.rigid_velocity_at(time_).norm());
   const double dt_penalty = penalty_time_step_limit(cmax);  // light nodes under contacts (simulation_penalty.cpp)
   cmax *= penalty_wave_factor();
-  if (cmax <= 0.0) return opt_.max_time_step;
-  return std::min({opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step, dt_penalty});
+  // Explicit damping −c p_i: c dt ≤ 0.5 while it acts (stable up to 2, accurate well below 1).
+  const double dt_damping = opt_.damping_rate > 0.0 && time_ < opt_.damping_until
+                                ? 0.5 / opt_.damping_rate
+                                : std::numeric_limits<double>::infinity();
+  if (cmax <= 0.0) return std::min(opt_.max_time_step, dt_damping);
+  return std::min({opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step, dt_penalty, dt_damping});
 }
 
 template <int Dim>

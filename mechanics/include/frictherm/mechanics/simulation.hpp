@@ -53,6 +53,11 @@ struct SimulationOptions {
   // FLIP/PIC blend v_p ← (1 − α) v_p^FLIP + α Σ S_ip v_i with α = 1 − e^(−Δt/τ): the particle velocity
   // modes the grid cannot see decay as e^(−t/τ) whatever the time step (∞: pure FLIP).
   double pic_relaxation_time = std::numeric_limits<double>::infinity();
+  // Mass-proportional (Rayleigh) damping f_i −= c p_i at every node while t < damping_until: a
+  // quasi-static preload (dynamic relaxation) that leaves the body at rest instead of ringing. It
+  // damps every mode the grid carries, unlike the PIC blend. 0: none.
+  double damping_rate = 0.0;   // c (1/s)
+  double damping_until = 0.0;  // s
   double max_time_step = std::numeric_limits<double>::infinity();
   Vec<3> gravity = Vec<3>::Zero();             // body force per unit mass (m/s^2)
 };
