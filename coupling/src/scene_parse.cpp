@@ -157,6 +157,18 @@ void parse_solver(const JsonReader& root, Scene& s) {
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
   if (const auto t = solver->find("pic_relaxation_time")) s.options.pic_relaxation_time = t->as_number(Range::positive());
+  if (const auto u = solver->find("particle_update")) {  // FLIP, XPIC(m) or FMPM(k): transfer.hpp
+    if (u->is_string()) {
+      s.options.particle_update = mechanics::particle_update_from_string(u->as_choice({"flip", "xpic", "fmpm"}));
+    } else {
+      if (!u->is_object()) u->expected("\"flip\" or an object {\"type\": \"xpic\" or \"fmpm\", \"order\": 1..50}");
+      s.options.particle_update = mechanics::particle_update_from_string(u->choice("type", {"flip", "xpic", "fmpm"}, "flip"));
+      s.options.transfer_order = static_cast<int>(u->integer("order", 2, 1, 50));
+      u->finish();
+    }
+    if (s.options.particle_update != mechanics::ParticleUpdate::flip && std::isfinite(s.options.pic_relaxation_time))
+      u->fail("XPIC and FMPM filter the particle velocities themselves; remove solver.pic_relaxation_time");
+  }
   if (const auto d = solver->find("damping")) {  // mass-proportional damping over [0, until)
     if (!d->is_object()) d->expected("an object {\"rate\": c (1/s), \"until\": t (s)}");
     s.options.damping_rate = d->number("rate", Range::positive());

@@ -2,6 +2,7 @@
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/transfer.hpp>
 
 #include <stdexcept>
 
@@ -83,5 +84,21 @@ HeatingOrder heating_order_from_string(const std::string& name) {
 }
 
 const char* to_string(HeatingOrder o) { return o == HeatingOrder::first ? "first" : "second"; }
+
+ParticleUpdate particle_update_from_string(const std::string& name) {
+  if (name == "flip") return ParticleUpdate::flip;
+  if (name == "xpic") return ParticleUpdate::xpic;
+  if (name == "fmpm") return ParticleUpdate::fmpm;
+  throw std::invalid_argument("unknown particle update '" + name + "' (expected \"flip\", \"xpic\" or \"fmpm\")");
+}
+
+const char* to_string(ParticleUpdate u) {
+  switch (u) {
+    case ParticleUpdate::flip: return "flip";
+    case ParticleUpdate::xpic: return "xpic";
+    case ParticleUpdate::fmpm: return "fmpm";
+  }
+  return "?";
+}
 
 }  // namespace frictherm::mechanics

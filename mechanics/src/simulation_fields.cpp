@@ -246,6 +246,12 @@ template <int Dim>
 void Simulation<Dim>::update_grid(double dt) {
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
+  if (opt_.particle_update == ParticleUpdate::xpic) {  // XPIC filters v^n, the velocity p^n/m updated here
+    transfer_.start.resize(n);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+  }
   if (opt_.damping_rate > 0.0 && time_ < opt_.damping_until) {
     // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
     // (explicit: stable for c dt < 2; the scene checks c dt_max < 1).

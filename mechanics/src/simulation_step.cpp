@@ -104,6 +104,7 @@ void Simulation<Dim>::step_with(double dt) {
   lap_.to(pt.contact, nested_phase_);
   update_grid(dt);         // velocity conditions act on the penalty forces too
   lap_.to(pt.grid_update, nested_phase_);  // less its contact pass (resolve_contact times itself)
+  if (opt_.particle_update != ParticleUpdate::flip) filter_grid_velocity(stencils<Kernel>());  // XPIC/FMPM
   const long bad = update_particles<Kernel>(dt);
   if (opt_.scheme == UpdateScheme::usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
   move_rigid_particles(dt, t);
@@ -309,6 +310,8 @@ long Simulation<Dim>::update_particles(double dt) {
   double work = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const double pic = std::isfinite(opt_.pic_relaxation_time) ? -std::expm1(-dt / opt_.pic_relaxation_time) : 0.0;
+  const ParticleUpdate update = opt_.particle_update;
+  const std::vector<Vec<Dim>>& filtered = transfer_.filtered;  // v* of XPIC/FMPM (transfer.hpp)
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const int f = field_of_material_[m];
@@ -318,15 +321,31 @@ long Simulation<Dim>::update_particles(double dt) {
 #pragma omp for schedule(static) nowait
     for (long kk = b; kk < e; ++kk) {
       const std::size_t k = static_cast<std::size_t>(kk);
-      Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
-      st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-        a += S * nodes_.acceleration[i];
-        v += S * nodes_.velocity[i];
-      });
-      const Vec<Dim> v_mid = p_.velocity[k] + 0.5 * dt * a;
-      work += p_.mass[k] * g.dot(v_mid) * dt;
-      p_.velocity[k] += dt * a;
-      if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
+      Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
+      if (update == ParticleUpdate::flip) {
+        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+          a += S * nodes_.acceleration[i];
+          v += S * nodes_.velocity[i];
+        });
+      } else {
+        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+          a += S * nodes_.acceleration[i];
+          v += S * nodes_.velocity[i];
+          vf += S * filtered[static_cast<std::size_t>(i)];
+        });
+      }
+      const Vec<Dim> v_old = p_.velocity[k];
+      if (update == ParticleUpdate::flip) {
+        work += p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt;
+        p_.velocity[k] += dt * a;
+        if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
+      } else if (update == ParticleUpdate::xpic) {
+        p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
+      } else {
+        p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
+        v = vf;
+      }
+      if (update != ParticleUpdate::flip) work += p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt;
       p_.position[k] += dt * v;
       const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
       if (!ok) bad = std::min(bad, kk);

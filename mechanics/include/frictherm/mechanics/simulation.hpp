@@ -29,6 +29,7 @@
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
+#include <frictherm/mechanics/transfer.hpp>
 
 #include <cstdint>
 #include <limits>
@@ -53,6 +54,10 @@ struct SimulationOptions {
   // FLIP/PIC blend v_p ← (1 − α) v_p^FLIP + α Σ S_ip v_i with α = 1 − e^(−Δt/τ): the particle velocity
   // modes the grid cannot see decay as e^(−t/τ) whatever the time step (∞: pure FLIP).
   double pic_relaxation_time = std::numeric_limits<double>::infinity();
+  // Grid-to-particle transfer (transfer.hpp): FLIP (with the PIC blend above), XPIC(m) or FMPM(k);
+  // transfer_order is m or k (≥ 1; XPIC(1) and FMPM(1) are PIC).
+  ParticleUpdate particle_update = ParticleUpdate::flip;
+  int transfer_order = 1;
   // Mass-proportional (Rayleigh) damping f_i −= c p_i at every node while t < damping_until: a
   // quasi-static preload (dynamic relaxation) that leaves the body at rest instead of ringing. It
   // damps every mode the grid carries, unlike the PIC blend. 0: none.
@@ -212,6 +217,9 @@ class Simulation {
   /// come) the forces are made consistent instead.
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
   void update_grid(double dt);
+  /// XPIC/FMPM (transfer.hpp): transfer_.filtered = Σ_{j<order} (I − S⁺S)^j w0 per deformable field,
+  /// w0 = transfer_.start (XPIC) or nodes_.velocity (FMPM); simulation_transfer.cpp.
+  template <class Stencils> void filter_grid_velocity(const Stencils& st);
   void velocity_from_momentum();
   enum class ContactPass { extrapolated, updated, remapped };
   void find_contact_nodes();
@@ -274,6 +282,13 @@ class Simulation {
   // body beside its edge, see simulation_penalty.cpp).
   static constexpr double penalty_sliver_ = 0.25;
   std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1)
+  struct TransferScratch {  // XPIC/FMPM, per slot
+    std::vector<Vec<Dim>> start;     // XPIC: lumped v^n at the momentum update
+    std::vector<Vec<Dim>> filtered;  // v* (the series' sum)
+    std::vector<Vec<Dim>> term;      // (I − S⁺S)^j w0
+    std::vector<Vec<Dim>> round_trip;  // S⁺S term
+    std::vector<std::vector<Vec<Dim>>> thread_acc;  // per-thread scatter buffers (threads 1..n-1)
+  } transfer_;
   std::vector<std::uint8_t> fixed_mask_;        // bit d set: velocity component d fixed to 0
   std::vector<std::uint8_t> rigid_mask_;        // bit d set: velocity component d driven by a rigid material
   std::vector<Vec<Dim>> rigid_velocity_;

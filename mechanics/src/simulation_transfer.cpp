@@ -1,0 +1,73 @@
+// XPIC(m) and FMPM(k) grid velocity filters (transfer.hpp): the truncated Neumann series
+// v* = Σ_{j=0}^{order−1} (I − S⁺S)^j w0 on each deformable velocity field, one grid → particle → grid
+// round trip per term. Hammerquist & Nairn 2017 (XPIC), Nairn & Hammerquist 2021 (FMPM).
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <omp.h>
+
+namespace frictherm::mechanics {
+
+template <int Dim>
+template <class Stencils>
+void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
+  TransferScratch& X = transfer_;
+  const std::size_t n = nodes_.mass.size();
+  const std::vector<Vec<Dim>>& w0 = opt_.particle_update == ParticleUpdate::xpic ? X.start : nodes_.velocity;
+  X.filtered.assign(w0.begin(), w0.end());  // j = 0
+  if (opt_.transfer_order <= 1) return;
+  X.term.assign(w0.begin(), w0.end());
+  X.round_trip.resize(n);
+  if (X.thread_acc.size() != static_cast<std::size_t>(threads_ - 1)) X.thread_acc.resize(static_cast<std::size_t>(threads_ - 1));
+  for (auto& b : X.thread_acc) b.resize(n);
+  const double mmin = empty_node_mass_;
+  for (int j = 1; j < opt_.transfer_order; ++j) {
+    // round_trip_i = (S⁺ S term)_i = Σ_p S_ip m_p (Σ_k S_kp term_k) / m_i
+#pragma omp parallel num_threads(threads_)
+    {
+      const int tid = omp_get_thread_num();
+      std::vector<Vec<Dim>>& acc = tid == 0 ? X.round_trip : X.thread_acc[static_cast<std::size_t>(tid - 1)];
+      std::fill(acc.begin(), acc.end(), Vec<Dim>::Zero());
+      for (std::size_t m = 0; m < materials_.size(); ++m) {
+        const int f = field_of_material_[m];
+        if (f < 0 || materials_[m].is_rigid()) continue;
+        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+#pragma omp for schedule(static) nowait
+        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+          Vec<Dim> u = Vec<Dim>::Zero();
+          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { u += S * X.term[static_cast<std::size_t>(i)]; });
+          const Vec<Dim> mu = p_.mass[k] * u;
+          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc[static_cast<std::size_t>(i)] += S * mu; });
+        }
+      }
+    }
+    // term ← term − S⁺S term; zero at velocity conditions (v* keeps w0 there); filtered += term.
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (std::size_t s = 0; s < n; ++s) {
+      Vec<Dim> rt = X.round_trip[s];
+      for (const auto& b : X.thread_acc) rt += b[s];
+      const double ms = nodes_.mass[s];
+      Vec<Dim> next = ms > mmin ? Vec<Dim>(X.term[s] - rt / ms) : Vec<Dim>(Vec<Dim>::Zero());
+      const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
+      if (const std::uint8_t bc = static_cast<std::uint8_t>(fixed_mask_[node] | rigid_mask_[node]))
+        for (int d = 0; d < Dim; ++d)
+          if (bc & (1u << d)) next[d] = 0.0;
+      X.term[s] = next;
+      X.filtered[s] += next;
+    }
+  }
+  // Rigid fields keep their prescribed velocity.
+  for (const VelocityField<Dim>& F : fields_)
+    if (F.rigid)
+      for (std::size_t s = F.first; s < F.first + F.count; ++s) X.filtered[s] = w0[s];
+}
+
+#define FRICTHERM_INSTANTIATE_TRANSFER(D)                                                            \
+  template void Simulation<D>::filter_grid_velocity(const std::vector<Stencil<D, LinearKernel>>&);   \
+  template void Simulation<D>::filter_grid_velocity(const std::vector<Stencil<D, UGIMPKernel>>&);    \
+  template void Simulation<D>::filter_grid_velocity(const std::vector<Stencil<D, QuadraticBSplineKernel>>&); \
+  template void Simulation<D>::filter_grid_velocity(const PrecomputedStencils<D>&);
+FRICTHERM_INSTANTIATE_TRANSFER(2)
+FRICTHERM_INSTANTIATE_TRANSFER(3)
+#undef FRICTHERM_INSTANTIATE_TRANSFER
+
+}  // namespace frictherm::mechanics
