@@ -92,6 +92,8 @@ struct TwoBodyCase {
   FrictionLaw law;
   NormalMethod normal;
   SeparationMethod separation;
+  ParticleUpdate update = ParticleUpdate::flip;  // XPIC/FMPM filter each field: momentum kept per field
+  int order = 1;
 };
 
 TEST(ContactConservation, TwoFreeBodiesObliqueFrictionalImpact) {
@@ -108,10 +110,16 @@ TEST(ContactConservation, TwoFreeBodiesObliqueFrictionalImpact) {
       {"user law, MVG, velocity only",
        FrictionLaw::user([](double N, double, double v) { return (0.3 - 0.1 * v / (1.0 + v)) * N; }, "falling mu"),
        NormalMethod::max_volume_gradient, SeparationMethod::velocity_only},
+      {"coulomb, MVG, positions, XPIC(3)", FrictionLaw::coulomb(0.3), NormalMethod::max_volume_gradient,
+       SeparationMethod::position, ParticleUpdate::xpic, 3},
+      {"coulomb, MVG, displacements, FMPM(3)", FrictionLaw::coulomb(0.3), NormalMethod::max_volume_gradient,
+       SeparationMethod::displacement, ParticleUpdate::fmpm, 3},
   };
   for (const TwoBodyCase& k : cases) {
     SimulationOptions o;
     o.thickness = 0.001;
+    o.particle_update = k.update;
+    o.transfer_order = k.order;
     Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.005, 0.005), IVec<2>{50, 30}), o);
     const int a = sim.add_material(elastic("a")), b = sim.add_material(elastic("b", 2e8, 0.25));
     const double R = 0.02;
