@@ -65,14 +65,14 @@ void check_penalty_law(const mechanics::ContactPairSettings& s, const JsonReader
 mechanics::FrictionLaw parse_friction_law(const JsonReader& law) {
   using mechanics::FrictionLaw;
   const std::vector<std::string> types{"stick", "frictionless", "coulomb", "linear_velocity", "adhesion",
-                                       "static_dynamic", "smooth_static_dynamic", "tabulated"};
+                                       "static_dynamic", "smooth_static_dynamic", "composite", "tabulated"};
   if (law.is_string()) {
     const std::string t = law.as_choice({"stick", "frictionless"});
     return t == "stick" ? FrictionLaw::stick() : FrictionLaw::frictionless();
   }
   if (!law.is_object()) law.expected("a friction law: \"stick\", \"frictionless\" or an object with \"type\"");
   const std::string type = law.at("type", "one of stick, frictionless, coulomb, linear_velocity, adhesion, "
-                                          "static_dynamic, smooth_static_dynamic, tabulated")
+                                          "static_dynamic, smooth_static_dynamic, composite, tabulated")
                                .as_choice(types);
   const Range mu_range = Range::non_negative();
   FrictionLaw out;
@@ -98,6 +98,16 @@ mechanics::FrictionLaw parse_friction_law(const JsonReader& law) {
       const double vh = law.number("v_half", Range::positive());
       out = checked(law, [&] { return FrictionLaw::smooth_static_dynamic(ms, md, vh); });
     }
+  } else if (type == "composite") {  // eq 21 with every term: S = N (mu(v) + k v) + S_a
+    const double ms = law.number("mu_static", mu_range);
+    const double md = law.number("mu_dynamic", ms, mu_range);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double vh = law.number("v_half", inf, Range::positive());
+    if (md != ms && std::isinf(vh)) law.at("v_half", "the transition speed v_half (m/s, > 0): required when mu_dynamic differs from mu_static");
+    const double k = law.number("k", 0.0, Range::non_negative());
+    const double sa = law.number("shear_strength", 0.0, Range::non_negative());
+    const double na = law.number("tensile_strength", inf, Range::positive());
+    out = checked(law, [&] { return FrictionLaw::composite(ms, md, vh, k, sa, na); });
   } else {  // tabulated
     const std::vector<double> speeds = law.at("speeds", "an array of sliding speeds (m/s), increasing").as_number_list(1, Range::non_negative());
     const std::vector<double> mu = law.at("mu", "an array of friction coefficients, one per speed").as_number_list(1, mu_range);

@@ -130,6 +130,21 @@ FrictionLaw FrictionLaw::smooth_static_dynamic(double mu_static, double mu_dynam
   return f;
 }
 
+FrictionLaw FrictionLaw::composite(double mu_static, double mu_dynamic, double v_half, double k, double shear_strength,
+                                   double tensile_strength) {
+  require_coefficient("composite", "mu_static", mu_static);
+  require_coefficient("composite", "mu_dynamic", mu_dynamic);
+  require_coefficient("composite", "k", k);
+  require_coefficient("composite", "shear_strength", shear_strength);
+  if (!(v_half > 0.0)) bad("composite", "v_half", "> 0 (+inf: no static to dynamic transition)", v_half);
+  if (!(tensile_strength > 0.0)) bad("composite", "tensile_strength", "> 0 (+inf for none)", tensile_strength);
+  FrictionLaw f;
+  f.kind_ = FrictionKind::composite;
+  f.mu_ = mu_static, f.mu_d_ = mu_dynamic, f.v_half_ = v_half, f.k_ = k;
+  f.shear_strength_ = shear_strength, f.tensile_strength_ = tensile_strength;
+  return f;
+}
+
 FrictionLaw FrictionLaw::user(SlidingTraction S, std::string name) {
   if (!S) throw std::invalid_argument("user friction law '" + name + "': S must be a callable, got an empty function");
   FrictionLaw f;
@@ -204,6 +219,19 @@ FrictionOutcome FrictionLaw::in_contact(const ContactImpulse& c) const {
       const double half_b = h + mu_d_ * n_star;  // (D* + mu_d N*)/2 > 0
       return {false, n_star * ((mu_ * k_star + mu_d_ * d_t) / (half_b + root_disc))};
     }
+    case FrictionKind::composite: {
+      // Eq 21 with S = N (μ(v) + k v) + S_a, μ(v) = (μ_s v½ + μ_d v)/(v½ + v) (eq 42), in impulse form:
+      // h(v) = N* (μ(v) + k v) + S_a A_c dt; stick while d_t ≤ h(0) = μ_s N* + S_a A_c dt.
+      const double a_dt = std::isfinite(c.area * c.dt) ? std::max(0.0, c.area * c.dt) : 0.0;
+      const double adhesion = shear_strength_ * a_dt;
+      if (d_t <= mu_ * n_star + adhesion) return {};
+      if (!(m > 0.0 && std::isfinite(m))) return {};
+      auto h = [&](double v) {
+        const double mu = std::isinf(v_half_) ? mu_ : (mu_ * v_half_ + mu_d_ * v) / (v_half_ + v);
+        return n_star * (mu + k_ * v) + adhesion;
+      };
+      return {false, solve_sliding_impulse([&](double s) { return h((d_t - s) / m); }, d_t)};
+    }
     case FrictionKind::user: {
       const Custom& u = *custom_;
       if (!u.S) {  // tabulated: s = mu(v) N*, independent of A_c
@@ -233,7 +261,8 @@ FrictionOutcome FrictionLaw::in_contact(const ContactImpulse& c) const {
 }
 
 bool FrictionLaw::holds_when_separated(double sliding_traction, double normal_traction) const {
-  if (kind_ != FrictionKind::adhesion || !std::isfinite(tensile_strength_)) return false;
+  if ((kind_ != FrictionKind::adhesion && kind_ != FrictionKind::composite) || !std::isfinite(tensile_strength_))
+    return false;
   if (!(std::isfinite(sliding_traction) && std::isfinite(normal_traction))) return false;
   // Eq. 25: the bond breaks when (S_stick/S_a)² + (N/N_a)² > 1; with S_a = 0 any shear breaks it.
   double shear_term = 0.0;
@@ -246,7 +275,8 @@ bool FrictionLaw::holds_when_separated(double sliding_traction, double normal_tr
 }
 
 bool FrictionLaw::needs_area() const {
-  return kind_ == FrictionKind::adhesion || (kind_ == FrictionKind::user && custom_->S);
+  return kind_ == FrictionKind::adhesion || (kind_ == FrictionKind::composite && shear_strength_ > 0.0) ||
+         (kind_ == FrictionKind::user && custom_->S);
 }
 
 std::string FrictionLaw::describe() const {
@@ -261,6 +291,10 @@ std::string FrictionLaw::describe() const {
     case FrictionKind::static_dynamic: return "static_dynamic(mu_static=" + num(mu_) + ", mu_dynamic=" + num(mu_d_) + ")";
     case FrictionKind::smooth_static_dynamic:
       return "smooth_static_dynamic(mu_static=" + num(mu_) + ", mu_dynamic=" + num(mu_d_) + ", v_half=" + num(v_half_) + " m/s)";
+    case FrictionKind::composite:
+      return "composite(mu_static=" + num(mu_) + ", mu_dynamic=" + num(mu_d_) + ", v_half=" + num(v_half_) +
+             " m/s, k=" + num(k_) + " s/m, shear_strength=" + num(shear_strength_) +
+             " Pa, tensile_strength=" + num(tensile_strength_) + " Pa)";
     case FrictionKind::user: {
       if (custom_->S) return "user(" + custom_->name + ")";
       std::string s = "tabulated(speeds=[", m = "], mu=[";
@@ -283,7 +317,7 @@ FrictionKind friction_kind_from_string(const std::string& name) {
       {"adhesion", FrictionKind::adhesion},
       {"static_dynamic", FrictionKind::static_dynamic},
       {"smooth_static_dynamic", FrictionKind::smooth_static_dynamic},
-      {"tabulated", FrictionKind::user}};
+      {"composite", FrictionKind::composite}, {"tabulated", FrictionKind::user}};
   std::string valid;
   for (const auto& [n, k] : names) {
     if (name == n) return k;
@@ -301,6 +335,7 @@ const char* to_string(FrictionKind kind) {
     case FrictionKind::adhesion: return "adhesion";
     case FrictionKind::static_dynamic: return "static_dynamic";
     case FrictionKind::smooth_static_dynamic: return "smooth_static_dynamic";
+    case FrictionKind::composite: return "composite";
     case FrictionKind::user: return "user";
   }
   return "?";

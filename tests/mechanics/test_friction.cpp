@@ -183,6 +183,32 @@ TEST(Friction, SmoothLawLimits) {
   EXPECT_NEAR(s_tiny, mu_d * kNstar, (mu_s - mu_d) * tiny / v_min * kNstar + 1e-14 * s_tiny);
 }
 
+// The composite law (eq 21 with every term) reproduces each closed-form law it contains, and with all
+// terms at once satisfies eq 21 at its final sliding speed.
+TEST(Friction, CompositeReproducesItsPartsAndSolvesEq21) {
+  for (double d_t : {6e-8, 3e-7, 1e-5}) {
+    auto same = [&](const FrictionLaw& composite, const FrictionLaw& closed) {
+      const FrictionOutcome a = composite.in_contact(node(d_t)), b = closed.in_contact(node(d_t));
+      ASSERT_EQ(a.stick, b.stick) << composite.describe();
+      EXPECT_NEAR(a.slide_impulse, b.slide_impulse, kSolverTol * b.slide_impulse) << composite.describe() << " d_t " << d_t;
+    };
+    same(FrictionLaw::composite(0.3, 0.3, kInf, 0.0, 0.0), FrictionLaw::coulomb(0.3));
+    same(FrictionLaw::composite(0.2, 0.2, kInf, 0.05, 0.0), FrictionLaw::linear_velocity(0.2, 0.05));
+    same(FrictionLaw::composite(0.2, 0.2, kInf, 0.0, 1e3), FrictionLaw::adhesion(0.2, 1e3));
+    same(FrictionLaw::composite(0.4, 0.2, 0.05, 0.0, 0.0), FrictionLaw::smooth_static_dynamic(0.4, 0.2, 0.05));
+    const double k = 0.02, S_a = 500.0;
+    const SlidingTraction S = [=](double N, double, double v) { return (smooth_mu(0.35, 0.2, 0.05, v) + k * v) * N + S_a; };
+    expect_law_at_final_speed(FrictionLaw::composite(0.35, 0.2, 0.05, k, S_a), S, node(d_t));
+  }
+  // Tensile strength: separated surfaces hold inside the ellipse of eq 25, as the adhesion law.
+  const FrictionLaw c = FrictionLaw::composite(0.3, 0.2, 0.05, 0.0, 2.0, 4.0);
+  EXPECT_TRUE(c.holds_when_separated(1.0, 2.0));
+  EXPECT_FALSE(c.holds_when_separated(2.0, 2.0));
+  EXPECT_FALSE(FrictionLaw::composite(0.3, 0.2, 0.05, 0.0, 2.0).holds_when_separated(1.0, 1.0));
+  EXPECT_THROW(FrictionLaw::composite(0.3, 0.2, 0.0, 0.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(FrictionLaw::composite(0.3, 0.2, 0.05, -1.0, 0.0), std::invalid_argument);
+}
+
 TEST(Friction, UserLawRootFinder) {
   // Nonlinear in speed and area-dependent: S = (0.25 + 0.15 exp(−v/0.03)) N + 2e5 √(A_c/1e-6 m²) Pa.
   const SlidingTraction S = [](double N, double A, double v) {

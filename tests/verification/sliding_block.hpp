@@ -34,6 +34,7 @@ struct SlidingBlockSetup {
   /// particles more or fewer (at 45° and 5 mm cells it holds 92 particles instead of 96).
   bool mass_scaled_loads = false;
   int ppc = 2;
+  double R = 1.0;  // tangential load R N (paper variant)
 };
 
 struct SlidingBlockConstants {
@@ -50,10 +51,10 @@ struct SlidingBlockConstants {
 };
 
 /// Rigid-block solution of a sliding-block set-up with the given friction parameters.
-inline RigidBlock rigid_solution(double mu_s, double mu_d, double k, double S_a) {
+inline RigidBlock rigid_solution(double mu_s, double mu_d, double k, double S_a, double R = 1.0) {
   using C = SlidingBlockConstants;
   RigidBlock r;
-  r.rho = C::rho, r.h = C::h, r.l = C::l, r.b = C::b, r.N = C::normal_stress(), r.R = 1.0;
+  r.rho = C::rho, r.h = C::h, r.l = C::l, r.b = C::b, r.N = C::normal_stress(), r.R = R;
   r.t2 = 0.25 * C::t_final();
   r.ts = C::t_final() - r.t2;
   r.mu_s = mu_s, r.mu_d = mu_d, r.k = k, r.S_a = S_a;
@@ -126,7 +127,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     top.body = blk, top.axis = 1, top.upper = true, top.traction = Vec<2>(0, -N), top.scale = normal_ramp;
     sim.add_edge_traction(top);
     EdgeTraction<2> side;  // F_t = R N l b spread over the left edge (height h)
-    side.body = blk, side.axis = 0, side.upper = false, side.traction = Vec<2>(N * C::l / C::h, 0);
+    side.body = blk, side.axis = 0, side.upper = false, side.traction = Vec<2>(s.R * N * C::l / C::h, 0);
     side.scale = tangential_ramp;
     sim.add_edge_traction(side);
   } else {
@@ -137,7 +138,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     normal.force = -F * rot(0, 1), normal.scale = normal_ramp;
     sim.add_point_load(normal);
     PointLoad<2> tangential = normal;
-    tangential.force = F * rot(1, 0), tangential.scale = tangential_ramp;
+    tangential.force = s.R * F * rot(1, 0), tangential.scale = tangential_ramp;
     sim.add_point_load(tangential);
   }
   if (!s.single_material) {

@@ -28,7 +28,7 @@ struct FrictionOutcome {
   double slide_impulse = 0.0;   // S_slide A_c dt ≥ 0 when sliding (eq 17): Δp'_a = d_n n̂ + slide_impulse t̂
 };
 
-enum class FrictionKind { stick, frictionless, coulomb, linear_velocity, adhesion, static_dynamic, smooth_static_dynamic, user };
+enum class FrictionKind { stick, frictionless, coulomb, linear_velocity, adhesion, static_dynamic, smooth_static_dynamic, composite, user };
 
 /// Sliding traction S (Pa) as a function of normal traction N (Pa), contact area A_c (m^2) and final sliding speed |Δv'| (m/s).
 using SlidingTraction = std::function<double(double normal_traction, double area, double sliding_speed)>;
@@ -50,6 +50,13 @@ class FrictionLaw {
                               double tensile_strength = std::numeric_limits<double>::infinity());  // eqs 24-25
   static FrictionLaw static_dynamic(double mu_static, double mu_dynamic);  // naive law of §2.8 (known to start sliding early)
   static FrictionLaw smooth_static_dynamic(double mu_static, double mu_dynamic, double v_half);   // eqs 42-43
+  /// The generalized law of eq 21 with every term at once: S = N [μ(v) + k v] + S_a, μ(v) the smooth
+  /// static → dynamic coefficient of eq 42 (μ_s at v = 0, → μ_d as v ≫ v½; v½ = +inf keeps μ_s), k ≥ 0
+  /// (s/m) the velocity coefficient of eq 22, S_a the adhesion of eq 24 and N_a its tensile strength
+  /// (eq 25, +inf for none). Sticks while d_t ≤ (μ_s N + S_a) A_c dt; the sliding impulse is the root
+  /// of eq 21 (bracketed, TOMS 748).
+  static FrictionLaw composite(double mu_static, double mu_dynamic, double v_half, double k, double shear_strength,
+                               double tensile_strength = std::numeric_limits<double>::infinity());
   static FrictionLaw user(SlidingTraction S, std::string name = "user");   // generic law, solved by a bracketed root finder on eq 21
   /// mu(|Δv'|) piecewise linear through (speeds[i], mu[i]), held constant outside; a user law with
   /// S = mu(v) N (kind() == user). S A_c dt = mu(v) N* does not involve A_c, so needs_area() is false.
@@ -67,7 +74,7 @@ class FrictionLaw {
 
   // Parameters (0 when the law has none of that name).
   double mu() const { return mu_; }             // coulomb, adhesion; mu0 of linear_velocity; mu_s of the static laws
-  double mu_dynamic() const { return mu_d_; }   // static_dynamic, smooth_static_dynamic
+  double mu_dynamic() const { return mu_d_; }   // static_dynamic, smooth_static_dynamic, composite
   double velocity_coefficient() const { return k_; }  // k of linear_velocity (s/m)
   double v_half() const { return v_half_; }     // smooth_static_dynamic (m/s)
   double shear_strength() const { return shear_strength_; }      // S_a of adhesion (Pa)
