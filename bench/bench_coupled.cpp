@@ -11,6 +11,7 @@
 // --quick: 5 mm only, 2 ms. The default end times are 10 ms at 5 mm and 1 ms at 1 mm.
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
+#include <frictherm/coupling/thread_policy.hpp>
 
 #include <csignal>
 #include <cstdio>
@@ -73,7 +74,7 @@ std::string twin_scene(double h, double end_time, Mode mode, const std::string& 
 
 struct Figures {
   double wall = 0, cpu = 0, rate_wall = 0, rate_cpu = 0;
-  double heating_share = 0;
+  double heating_share = 0, heating_per_step = 0;
 };
 
 Figures run_case(double h, double end_time, Mode mode, int threads, const std::string& scratch) {
@@ -94,10 +95,11 @@ Figures run_case(double h, double end_time, Mode mode, int threads, const std::s
   for (const auto& [phase, sec] : r.phase_seconds)
     if (phase == "heating" || phase == "thermal_solve") heating += sec;
   f.heating_share = heating / f.wall;
+  f.heating_per_step = r.steps > 0 ? heating / static_cast<double>(r.steps) : 0.0;
   std::printf("  %4.1f mm  %-18s %d thr%s  %6zu particles %6ld steps  wall %7.3f s  cpu %7.3f s  "
-              "%6.2f M p-steps/s  %6.2f M p-steps/cpu-s  heating+solve %4.1f %%\n",
+              "%6.2f M p-steps/s  %6.2f M p-steps/cpu-s  heating+solve %4.1f %% (%5.1f us/step)\n",
               h * 1e3, name(mode), threads, threads > 1 ? "s" : " ", r.particles, r.steps, f.wall, f.cpu,
-              f.rate_wall / 1e6, f.rate_cpu / 1e6, 100 * f.heating_share);
+              f.rate_wall / 1e6, f.rate_cpu / 1e6, 100 * f.heating_share, 1e6 * f.heating_per_step);
   std::fflush(stdout);
   if (r.status == RunResult::Status::failed) std::printf("  FAILED: %s\n", r.message.c_str());
   return f;
@@ -127,6 +129,7 @@ void stop_busy(pid_t pid) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  frictherm::coupling::ensure_passive_wait(argv);  // as frictherm run does; OMP_WAIT_POLICY=active to compare
   std::vector<double> cells = {0.005, 0.001};
   double end5 = 0.010, end1 = 0.001;
   std::string scratch = "/tmp";

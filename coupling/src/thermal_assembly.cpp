@@ -40,6 +40,47 @@ struct NodeList {
   }
 };
 
+/// The node lists of one assembly, kept (per dimension and kernel, per thread) so that pass 2 and the
+/// map back to the particles after the integration do not evaluate the stencils again. An entry is
+/// reused only for the same grid and a particle at the same position with the same half-size, so the
+/// weights are the ones a fresh evaluation gives, bit for bit.
+template <int Dim, class Kernel>
+struct StencilCache {
+  const mechanics::Grid<Dim>* grid = nullptr;
+  mechanics::Vec<Dim> lo, h;
+  mechanics::IVec<Dim> cells;
+  std::vector<NodeList<Dim, Kernel>> lists;
+  std::vector<mechanics::Vec<Dim>> position, half_size;
+
+  static StencilCache& local() {
+    thread_local StencilCache cache;
+    return cache;
+  }
+  void reset(const mechanics::Grid<Dim>& g, std::size_t n) {
+    grid = &g;
+    lo = g.lo();
+    h = g.cell_size();
+    cells = g.cells();
+    lists.resize(n);
+    position.resize(n);
+    half_size.resize(n);
+  }
+  const NodeList<Dim, Kernel>& fill(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p, std::size_t k) {
+    lists[k].fill(g, p, k);
+    position[k] = p.position[k];
+    half_size[k] = p.half_size[k];
+    return lists[k];
+  }
+  /// The cached list of particle k if it is still exact, else nullptr.
+  const NodeList<Dim, Kernel>* find(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p,
+                                    std::size_t k) const {
+    if (grid != &g || lo != g.lo() || h != g.cell_size() || cells != g.cells()) return nullptr;
+    if (k >= lists.size() || lists[k].count == 0) return nullptr;
+    if (position[k] != p.position[k] || half_size[k] != p.half_size[k]) return nullptr;
+    return &lists[k];
+  }
+};
+
 template <int Dim, class Kernel>
 NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                                  const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt) {
@@ -48,7 +89,9 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   NodalThermalSystem sys;
   sys.grid_mass.assign(n_nodes, 0.0);
   std::vector<double> mct(n_nodes, 0.0);
-  Nodes nl;
+  StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
+  cache.reset(grid, p.size());
+  for (auto& l : cache.lists) l.count = 0;  // entries of non-conducting particles stay invalid
 
   // Pass 1: M_i and M_i T_i (eq. 38).
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -56,7 +99,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    nl.fill(grid, p, k);
+    const Nodes& nl = cache.fill(grid, p, k);
     for (int a = 0; a < nl.count; ++a) {
       const auto i = static_cast<std::size_t>(nl.node[a]);
       sys.grid_mass[i] += mc * nl.S[a];
@@ -98,7 +141,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   for (std::size_t k = 0; k < p.size(); ++k) {
     const ThermalProperties& m = props_of(materials, p.material[k]);
     if (!m.conducts || !(m.conductivity > 0.0)) continue;
-    nl.fill(grid, p, k);
+    Nodes nl = cache.lists[k];  // filled by pass 1 (a copy: the lumping below reorders S)
     double s_kept = 0.0;
     mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
     int kept = 0;
@@ -119,15 +162,20 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     if (kept < nl.count)
       for (int a = 0; a < kept; ++a) Gk[a] += (nl.S[a] / s_kept) * g_dropped;  // lump dropped nodes
     const double c = p.volume[k] * m.conductivity;
+    // K is symmetric: each product once, into row a at the offset of b and into row b at the mirrored
+    // offset (slots - 1 - slot). Every (row, slot) entry still gets the same single term per particle,
+    // in particle order, so the sums are bit-identical to the full double loop.
     for (int a = 0; a < kept; ++a) {
       double* r = &rows[static_cast<std::size_t>(row[a]) * slots];
-      for (int b = 0; b < kept; ++b) {
+      for (int b = a; b < kept; ++b) {
         int slot = 0, scale = 1;
         for (int d = 0; d < Dim; ++d) {
           slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
           scale *= kw;
         }
-        r[slot] += c * Gk[a].dot(Gk[b]);
+        const double kab = c * Gk[a].dot(Gk[b]);
+        r[slot] += kab;
+        if (b != a) rows[static_cast<std::size_t>(row[b]) * slots + static_cast<std::size_t>(slots - 1 - slot)] += kab;
       }
     }
   }
@@ -165,10 +213,13 @@ template <int Dim, class Kernel>
 void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
                      const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
                      const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
-  NodeList<Dim, Kernel> nl;
+  NodeList<Dim, Kernel> fresh;
+  const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!props_of(materials, p.material[k]).conducts) continue;
-    nl.fill(grid, p, k);
+    const NodeList<Dim, Kernel>* cached = cache.find(grid, p, k);  // the assembly's, when still exact
+    if (!cached) fresh.fill(grid, p, k);
+    const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;
     double dT = 0.0, pic = 0.0, s = 0.0;
     for (int a = 0; a < nl.count; ++a) {
       const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
