@@ -40,12 +40,18 @@ const char* name(Mode m) {
   return m == Mode::mechanics ? "mechanics only" : m == Mode::every_step ? "window every step" : "adaptive window";
 }
 
+std::string num(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.17g", x);
+  return b;
+}
+
 // The twin scene as JSON. dt is pinned (cfl 1 with max_time_step below the CFL limit): 1.2989663 us at
 // 5 mm, scaled with the cell size at 1 mm.
 std::string twin_scene(double h, double end_time, Mode mode, const std::string& output) {
   const double dt = 1.2989663e-6 * h / 0.005;
   std::string s = R"({"units": "SI", "dimension": 2, "analysis": "plane_strain", "thickness": 0.001,
-    "grid": {"lo": [0.0, 0.0], "hi": [0.150, 0.045], "cell_size": )" + std::to_string(h) + R"(},
+    "grid": {"lo": [0.0, 0.0], "hi": [0.150, 0.045], "cell_size": )" + num(h) + R"(},
     "materials": {
       "base": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 2.5e9, "poisson_ratio": 0.33},
       "block": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 2.5e9, "poisson_ratio": 0.33}},
@@ -57,9 +63,9 @@ std::string twin_scene(double h, double end_time, Mode mode, const std::string& 
     "loads": {"gravity": [0, -9806.65]},
     "contact": {"normal": "avg",
       "pairs": [{"materials": ["base", "block"], "law": {"type": "coulomb", "mu": 0.2}}]},
-    "solver": {"shape_function": "ugimp", "cfl": 1.0, "max_time_step": )" + std::to_string(dt) + R"(},
-    "run": {"end_time": )" + std::to_string(end_time) + R"(},
-    "output": {"file": ")" + output + R"(", "snapshot_count": 1, "series_interval": )" + std::to_string(end_time / 100) +
+    "solver": {"shape_function": "ugimp", "cfl": 1.0, "max_time_step": )" + num(dt) + R"(},
+    "run": {"end_time": )" + num(end_time) + R"(},
+    "output": {"file": ")" + output + R"(", "snapshot_count": 1, "series_interval": )" + num(end_time / 100) +
                   R"(})";
   if (mode != Mode::mechanics) {
     s += R"(, "thermal": {"integrator": "forward_euler",
@@ -78,7 +84,7 @@ struct Figures {
 };
 
 Figures run_case(double h, double end_time, Mode mode, int threads, const std::string& scratch) {
-  const std::string out = scratch + "/bench_coupled.h5";
+  const std::string out = scratch + "/bench_coupled_" + std::to_string(getpid()) + ".h5";
   const Scene scene = parse_scene(twin_scene(h, end_time, mode, out), "bench_coupled twin");
   RunOptions opt;
   opt.threads = threads;

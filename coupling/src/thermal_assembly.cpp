@@ -88,7 +88,8 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   const std::size_t n_nodes = grid.node_count();
   NodalThermalSystem sys;
   sys.grid_mass.assign(n_nodes, 0.0);
-  std::vector<double> mct(n_nodes, 0.0);
+  thread_local std::vector<double> mct;
+  mct.assign(n_nodes, 0.0);
   StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
   cache.reset(grid, p.size());
   for (auto& l : cache.lists) l.count = 0;  // entries of non-conducting particles stay invalid
@@ -134,7 +135,8 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   // offset of j from i (each component in [-(K-1), K-1]).
   constexpr int kw = 2 * Kernel::K - 1;
   constexpr int slots = Dim == 2 ? kw * kw : kw * kw * kw;
-  std::vector<double> rows(static_cast<std::size_t>(n) * slots, 0.0);
+  thread_local std::vector<double> rows;  // kept between windows: no fresh pages every window
+  rows.assign(static_cast<std::size_t>(n) * slots, 0.0);
   mechanics::Vec<Dim> Gk[Nodes::capacity];
   mechanics::IVec<Dim> lat[Nodes::capacity];
   int row[Nodes::capacity];
@@ -182,15 +184,21 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 
   // CSR with the diagonal set to minus the off-diagonal row sum, so K·1 = 0 to the round-off of
   // that sum (the products above give it only approximately, and exact zero row sums make the
-  // conduction part conserve Σ M_i T_i exactly).
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(static_cast<std::size_t>(n) * 9);
+  // conduction part conserve Σ M_i T_i exactly). Rows are written in place (Eigen's sorted
+  // startVec/insertBack fill): no triplet list, no temporary column-major copy.
   const auto& stride = grid.strides();
   constexpr int centre = (slots - 1) / 2;
+  std::size_t nnz = 0;
+  for (double v : rows) nnz += v != 0.0;
+  sys.conductance.resize(n, n);
+  sys.conductance.reserve(static_cast<Eigen::Index>(nnz) + n);
+  int col[slots];
+  double val[slots];
   for (Eigen::Index u = 0; u < n; ++u) {
     const double* r = &rows[static_cast<std::size_t>(u) * slots];
     const int node = sys.grid_node[static_cast<std::size_t>(u)];
     double off_sum = 0.0;
+    int count = 0;
     for (int s = 0; s < slots; ++s) {
       if (s == centre || r[s] == 0.0) continue;
       int rem = s, j = node;
@@ -198,14 +206,21 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         j += (rem % kw - (Kernel::K - 1)) * stride[d];
         rem /= kw;
       }
-      const int v = sys.unknown[static_cast<std::size_t>(j)];
-      trip.emplace_back(u, v, r[s]);
+      col[count] = sys.unknown[static_cast<std::size_t>(j)];
+      val[count++] = r[s];
       off_sum += r[s];
     }
-    trip.emplace_back(u, u, -off_sum);
+    col[count] = static_cast<int>(u);
+    val[count++] = -off_sum;
+    for (int a = 1; a < count; ++a)  // ascending columns (the lattice order gives them nearly sorted)
+      for (int b = a; b > 0 && col[b - 1] > col[b]; --b) {
+        std::swap(col[b - 1], col[b]);
+        std::swap(val[b - 1], val[b]);
+      }
+    sys.conductance.startVec(u);
+    for (int a = 0; a < count; ++a) sys.conductance.insertBack(u, col[a]) = val[a];
   }
-  sys.conductance.resize(n, n);
-  sys.conductance.setFromTriplets(trip.begin(), trip.end());
+  sys.conductance.finalize();
   return sys;
 }
 
