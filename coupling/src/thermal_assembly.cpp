@@ -137,9 +137,28 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   constexpr int slots = Dim == 2 ? kw * kw : kw * kw * kw;
   thread_local std::vector<double> rows;  // kept between windows: no fresh pages every window
   rows.assign(static_cast<std::size_t>(n) * slots, 0.0);
+  // The slot of node j in row i from the flat index difference j - i through a table (no
+  // node_lattice divisions per particle); the lattice is decoded instead if two offsets share a
+  // difference (fewer than kw nodes along an axis).
+  const auto& stride = grid.strides();
+  int reach = 0;
+  for (int d = 0; d < Dim; ++d) reach += (Kernel::K - 1) * stride[d];
+  thread_local std::vector<int> slot_of;
+  slot_of.assign(static_cast<std::size_t>(2 * reach + 1), -1);
+  bool use_table = true;
+  for (int sl = 0; sl < slots; ++sl) {
+    int rem = sl, diff = 0;
+    for (int d = 0; d < Dim; ++d) {
+      diff += (rem % kw - (Kernel::K - 1)) * stride[d];
+      rem /= kw;
+    }
+    int& e = slot_of[static_cast<std::size_t>(diff + reach)];
+    use_table = use_table && e < 0;
+    e = sl;
+  }
   mechanics::Vec<Dim> Gk[Nodes::capacity];
   mechanics::IVec<Dim> lat[Nodes::capacity];
-  int row[Nodes::capacity];
+  int row[Nodes::capacity], gnode[Nodes::capacity];
   for (std::size_t k = 0; k < p.size(); ++k) {
     const ThermalProperties& m = props_of(materials, p.material[k]);
     if (!m.conducts || !(m.conductivity > 0.0)) continue;
@@ -153,7 +172,8 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         s_kept += nl.S[a];
         row[kept] = u;
         Gk[kept] = nl.G[a];
-        lat[kept] = grid.node_lattice(nl.node[a]);
+        gnode[kept] = nl.node[a];
+        if (!use_table) lat[kept] = grid.node_lattice(nl.node[a]);
         nl.S[kept] = nl.S[a];
         ++kept;
       } else {
@@ -170,10 +190,12 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     for (int a = 0; a < kept; ++a) {
       double* r = &rows[static_cast<std::size_t>(row[a]) * slots];
       for (int b = a; b < kept; ++b) {
-        int slot = 0, scale = 1;
-        for (int d = 0; d < Dim; ++d) {
-          slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
-          scale *= kw;
+        int slot = 0;
+        if (use_table) {
+          slot = slot_of[static_cast<std::size_t>(gnode[b] - gnode[a] + reach)];
+        } else {
+          for (int d = 0, scale = 1; d < Dim; ++d, scale *= kw)
+            slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
         }
         const double kab = c * Gk[a].dot(Gk[b]);
         r[slot] += kab;
@@ -186,7 +208,6 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   // that sum (the products above give it only approximately, and exact zero row sums make the
   // conduction part conserve Σ M_i T_i exactly). Rows are written in place (Eigen's sorted
   // startVec/insertBack fill): no triplet list, no temporary column-major copy.
-  const auto& stride = grid.strides();
   constexpr int centre = (slots - 1) / 2;
   std::size_t nnz = 0;
   for (double v : rows) nnz += v != 0.0;
@@ -210,15 +231,24 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
       val[count++] = r[s];
       off_sum += r[s];
     }
-    col[count] = static_cast<int>(u);
-    val[count++] = -off_sum;
-    for (int a = 1; a < count; ++a)  // ascending columns (the lattice order gives them nearly sorted)
+    // Ascending columns: the slot order is the lattice order, in which unknown numbers increase
+    // (they follow the flat node index) unless an axis has fewer than kw nodes; then sort. The
+    // diagonal goes where its column falls.
+    for (int a = 1; a < count; ++a)
       for (int b = a; b > 0 && col[b - 1] > col[b]; --b) {
         std::swap(col[b - 1], col[b]);
         std::swap(val[b - 1], val[b]);
       }
     sys.conductance.startVec(u);
-    for (int a = 0; a < count; ++a) sys.conductance.insertBack(u, col[a]) = val[a];
+    bool diagonal = false;
+    for (int a = 0; a < count; ++a) {
+      if (!diagonal && col[a] > u) {
+        sys.conductance.insertBack(u, u) = -off_sum;
+        diagonal = true;
+      }
+      sys.conductance.insertBack(u, col[a]) = val[a];
+    }
+    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum;
   }
   sys.conductance.finalize();
   return sys;
