@@ -1,6 +1,8 @@
 // frictherm: the command-line program (run, validate, export-csv, ensemble).
 #include "cli.hpp"
 
+#include <frictherm/coupling/thread_policy.hpp>
+
 #include <exception>
 #include <iostream>
 #include <string>
@@ -58,6 +60,9 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifndef FRICTHERM_WITH_MPI  // under MPI the launcher owns the process: set OMP_WAIT_POLICY yourself
+  frictherm::coupling::ensure_passive_wait(argv);  // threads sleep at barriers (docs/coupling.md)
+#endif
   std::vector<std::string> words(argv + 1, argv + argc);
   std::string command_line;
   for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + quote_arg(argv[i]);

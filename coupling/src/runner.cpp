@@ -5,6 +5,7 @@
 #include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
 #include <frictherm/coupling/microstructure.hpp>
+#include <frictherm/coupling/thread_policy.hpp>
 #include <frictherm/mechanics/errors.hpp>
 
 #include <omp.h>
@@ -40,7 +41,8 @@ class Run {
     sim_ = build_simulation<Dim>(s_);
     if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;
-    if (threads > 0) omp_set_num_threads(threads);
+    // No count given: not more threads than idle cores or than the particles pay for (thread_policy.hpp).
+    omp_set_num_threads(threads > 0 ? threads : default_thread_count(sim_->particles().size()));
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
     r_.particles = sim_->particles().size();
     H5Output out = open_output();

@@ -40,6 +40,47 @@ struct NodeList {
   }
 };
 
+/// The node lists of one assembly, kept (per dimension and kernel, per thread) so that pass 2 and the
+/// map back to the particles after the integration do not evaluate the stencils again. An entry is
+/// reused only for the same grid and a particle at the same position with the same half-size, so the
+/// weights are the ones a fresh evaluation gives, bit for bit.
+template <int Dim, class Kernel>
+struct StencilCache {
+  const mechanics::Grid<Dim>* grid = nullptr;
+  mechanics::Vec<Dim> lo, h;
+  mechanics::IVec<Dim> cells;
+  std::vector<NodeList<Dim, Kernel>> lists;
+  std::vector<mechanics::Vec<Dim>> position, half_size;
+
+  static StencilCache& local() {
+    thread_local StencilCache cache;
+    return cache;
+  }
+  void reset(const mechanics::Grid<Dim>& g, std::size_t n) {
+    grid = &g;
+    lo = g.lo();
+    h = g.cell_size();
+    cells = g.cells();
+    lists.resize(n);
+    position.resize(n);
+    half_size.resize(n);
+  }
+  const NodeList<Dim, Kernel>& fill(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p, std::size_t k) {
+    lists[k].fill(g, p, k);
+    position[k] = p.position[k];
+    half_size[k] = p.half_size[k];
+    return lists[k];
+  }
+  /// The cached list of particle k if it is still exact, else nullptr.
+  const NodeList<Dim, Kernel>* find(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p,
+                                    std::size_t k) const {
+    if (grid != &g || lo != g.lo() || h != g.cell_size() || cells != g.cells()) return nullptr;
+    if (k >= lists.size() || lists[k].count == 0) return nullptr;
+    if (position[k] != p.position[k] || half_size[k] != p.half_size[k]) return nullptr;
+    return &lists[k];
+  }
+};
+
 template <int Dim, class Kernel>
 NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                                  const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt) {
@@ -47,8 +88,11 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   const std::size_t n_nodes = grid.node_count();
   NodalThermalSystem sys;
   sys.grid_mass.assign(n_nodes, 0.0);
-  std::vector<double> mct(n_nodes, 0.0);
-  Nodes nl;
+  thread_local std::vector<double> mct;
+  mct.assign(n_nodes, 0.0);
+  StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
+  cache.reset(grid, p.size());
+  for (auto& l : cache.lists) l.count = 0;  // entries of non-conducting particles stay invalid
 
   // Pass 1: M_i and M_i T_i (eq. 38).
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -56,7 +100,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    nl.fill(grid, p, k);
+    const Nodes& nl = cache.fill(grid, p, k);
     for (int a = 0; a < nl.count; ++a) {
       const auto i = static_cast<std::size_t>(nl.node[a]);
       sys.grid_mass[i] += mc * nl.S[a];
@@ -91,14 +135,34 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   // offset of j from i (each component in [-(K-1), K-1]).
   constexpr int kw = 2 * Kernel::K - 1;
   constexpr int slots = Dim == 2 ? kw * kw : kw * kw * kw;
-  std::vector<double> rows(static_cast<std::size_t>(n) * slots, 0.0);
+  thread_local std::vector<double> rows;  // kept between windows: no fresh pages every window
+  rows.assign(static_cast<std::size_t>(n) * slots, 0.0);
+  // The slot of node j in row i from the flat index difference j - i through a table (no
+  // node_lattice divisions per particle); the lattice is decoded instead if two offsets share a
+  // difference (fewer than kw nodes along an axis).
+  const auto& stride = grid.strides();
+  int reach = 0;
+  for (int d = 0; d < Dim; ++d) reach += (Kernel::K - 1) * stride[d];
+  thread_local std::vector<int> slot_of;
+  slot_of.assign(static_cast<std::size_t>(2 * reach + 1), -1);
+  bool use_table = true;
+  for (int sl = 0; sl < slots; ++sl) {
+    int rem = sl, diff = 0;
+    for (int d = 0; d < Dim; ++d) {
+      diff += (rem % kw - (Kernel::K - 1)) * stride[d];
+      rem /= kw;
+    }
+    int& e = slot_of[static_cast<std::size_t>(diff + reach)];
+    use_table = use_table && e < 0;
+    e = sl;
+  }
   mechanics::Vec<Dim> Gk[Nodes::capacity];
   mechanics::IVec<Dim> lat[Nodes::capacity];
-  int row[Nodes::capacity];
+  int row[Nodes::capacity], gnode[Nodes::capacity];
   for (std::size_t k = 0; k < p.size(); ++k) {
     const ThermalProperties& m = props_of(materials, p.material[k]);
     if (!m.conducts || !(m.conductivity > 0.0)) continue;
-    nl.fill(grid, p, k);
+    Nodes nl = cache.lists[k];  // filled by pass 1 (a copy: the lumping below reorders S)
     double s_kept = 0.0;
     mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
     int kept = 0;
@@ -108,7 +172,8 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         s_kept += nl.S[a];
         row[kept] = u;
         Gk[kept] = nl.G[a];
-        lat[kept] = grid.node_lattice(nl.node[a]);
+        gnode[kept] = nl.node[a];
+        if (!use_table) lat[kept] = grid.node_lattice(nl.node[a]);
         nl.S[kept] = nl.S[a];
         ++kept;
       } else {
@@ -119,30 +184,42 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     if (kept < nl.count)
       for (int a = 0; a < kept; ++a) Gk[a] += (nl.S[a] / s_kept) * g_dropped;  // lump dropped nodes
     const double c = p.volume[k] * m.conductivity;
+    // K is symmetric: each product once, into row a at the offset of b and into row b at the mirrored
+    // offset (slots - 1 - slot). Every (row, slot) entry still gets the same single term per particle,
+    // in particle order, so the sums are bit-identical to the full double loop.
     for (int a = 0; a < kept; ++a) {
       double* r = &rows[static_cast<std::size_t>(row[a]) * slots];
-      for (int b = 0; b < kept; ++b) {
-        int slot = 0, scale = 1;
-        for (int d = 0; d < Dim; ++d) {
-          slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
-          scale *= kw;
+      for (int b = a; b < kept; ++b) {
+        int slot = 0;
+        if (use_table) {
+          slot = slot_of[static_cast<std::size_t>(gnode[b] - gnode[a] + reach)];
+        } else {
+          for (int d = 0, scale = 1; d < Dim; ++d, scale *= kw)
+            slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
         }
-        r[slot] += c * Gk[a].dot(Gk[b]);
+        const double kab = c * Gk[a].dot(Gk[b]);
+        r[slot] += kab;
+        if (b != a) rows[static_cast<std::size_t>(row[b]) * slots + static_cast<std::size_t>(slots - 1 - slot)] += kab;
       }
     }
   }
 
   // CSR with the diagonal set to minus the off-diagonal row sum, so K·1 = 0 to the round-off of
   // that sum (the products above give it only approximately, and exact zero row sums make the
-  // conduction part conserve Σ M_i T_i exactly).
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(static_cast<std::size_t>(n) * 9);
-  const auto& stride = grid.strides();
+  // conduction part conserve Σ M_i T_i exactly). Rows are written in place (Eigen's sorted
+  // startVec/insertBack fill): no triplet list, no temporary column-major copy.
   constexpr int centre = (slots - 1) / 2;
+  std::size_t nnz = 0;
+  for (double v : rows) nnz += v != 0.0;
+  sys.conductance.resize(n, n);
+  sys.conductance.reserve(static_cast<Eigen::Index>(nnz) + n);
+  int col[slots];
+  double val[slots];
   for (Eigen::Index u = 0; u < n; ++u) {
     const double* r = &rows[static_cast<std::size_t>(u) * slots];
     const int node = sys.grid_node[static_cast<std::size_t>(u)];
     double off_sum = 0.0;
+    int count = 0;
     for (int s = 0; s < slots; ++s) {
       if (s == centre || r[s] == 0.0) continue;
       int rem = s, j = node;
@@ -150,14 +227,30 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         j += (rem % kw - (Kernel::K - 1)) * stride[d];
         rem /= kw;
       }
-      const int v = sys.unknown[static_cast<std::size_t>(j)];
-      trip.emplace_back(u, v, r[s]);
+      col[count] = sys.unknown[static_cast<std::size_t>(j)];
+      val[count++] = r[s];
       off_sum += r[s];
     }
-    trip.emplace_back(u, u, -off_sum);
+    // Ascending columns: the slot order is the lattice order, in which unknown numbers increase
+    // (they follow the flat node index) unless an axis has fewer than kw nodes; then sort. The
+    // diagonal goes where its column falls.
+    for (int a = 1; a < count; ++a)
+      for (int b = a; b > 0 && col[b - 1] > col[b]; --b) {
+        std::swap(col[b - 1], col[b]);
+        std::swap(val[b - 1], val[b]);
+      }
+    sys.conductance.startVec(u);
+    bool diagonal = false;
+    for (int a = 0; a < count; ++a) {
+      if (!diagonal && col[a] > u) {
+        sys.conductance.insertBack(u, u) = -off_sum;
+        diagonal = true;
+      }
+      sys.conductance.insertBack(u, col[a]) = val[a];
+    }
+    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum;
   }
-  sys.conductance.resize(n, n);
-  sys.conductance.setFromTriplets(trip.begin(), trip.end());
+  sys.conductance.finalize();
   return sys;
 }
 
@@ -165,10 +258,13 @@ template <int Dim, class Kernel>
 void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
                      const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
                      const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
-  NodeList<Dim, Kernel> nl;
+  NodeList<Dim, Kernel> fresh;
+  const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!props_of(materials, p.material[k]).conducts) continue;
-    nl.fill(grid, p, k);
+    const NodeList<Dim, Kernel>* cached = cache.find(grid, p, k);  // the assembly's, when still exact
+    if (!cached) fresh.fill(grid, p, k);
+    const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;
     double dT = 0.0, pic = 0.0, s = 0.0;
     for (int a = 0; a < nl.count; ++a) {
       const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];

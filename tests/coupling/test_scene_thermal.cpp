@@ -89,7 +89,8 @@ TEST(SceneThermal, DefaultsAndAbsence) {
   const fc::ThermalSceneSpec t = fc::parse_scene(s.dump()).thermal;
   EXPECT_TRUE(t.enabled);
   EXPECT_EQ(t.coupler.integrator, "cvode_bdf");
-  EXPECT_EQ(t.coupler.window.kind, fc::WindowPolicy::Kind::every_step);
+  EXPECT_EQ(t.coupler.window.kind, fc::WindowPolicy::Kind::adaptive);  // issue 13: adaptive by default
+  EXPECT_EQ(t.coupler.window.max_temperature_rise, 0.1);
   EXPECT_EQ(t.heating_order, fc::HeatingOrder::second);
   EXPECT_EQ(t.continuation_duration, 0.0);
   EXPECT_EQ(t.coupler.hotspots.mode, fc::HotSpotOptions::Mode::rise);
@@ -149,8 +150,12 @@ TEST(SceneThermal, ErrorsNameTheKeyPath) {
   s["coupling"]["window"] = Json::parse(R"({"policy": "every_n_steps"})");
   EXPECT_THAT(scene_error(s), StartsWith("coupling.window.steps: required key missing"));
   s = thermal_scene();
-  s["coupling"]["window"] = "adaptive";
-  EXPECT_THAT(scene_error(s), StartsWith("coupling.window: expected an object {\"policy\": \"adaptive\""));
+  s["coupling"]["window"] = "adaptive";  // the default rise
+  EXPECT_EQ(fc::parse_scene(s.dump()).thermal.coupler.window.kind, fc::WindowPolicy::Kind::adaptive);
+  EXPECT_EQ(fc::parse_scene(s.dump()).thermal.coupler.window.max_temperature_rise, 0.1);
+  s["coupling"]["window"] = Json::parse(R"({"policy": "adaptive", "max_duration": 1e-5})");
+  EXPECT_EQ(fc::parse_scene(s.dump()).thermal.coupler.window.max_temperature_rise, 0.1);
+  EXPECT_EQ(fc::parse_scene(s.dump()).thermal.coupler.window.max_duration, 1e-5);
 }
 
 namespace {
