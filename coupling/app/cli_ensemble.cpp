@@ -2,6 +2,8 @@
 // program is built with MPI and started by mpirun, serially otherwise (coupling/ensemble.hpp).
 #include "cli.hpp"
 
+#include <cmath>
+#include <string>
 #include <frictherm/coupling/ensemble.hpp>
 
 #include <cstdio>
@@ -117,9 +119,11 @@ int ensemble_command(const std::vector<std::string>& args, const std::string& /*
       const coupling::EnsembleSummary s = coupling::aggregate_members(path, o, all);
       if (!o.quiet)
         std::printf("wrote %s: %d members (%d completed, %d processes), %ld hot spots (%.2f ± %.2f per member), "
-                    "%ld ran away, %ld died, critical fraction %.3f\n",
+                    "%ld ran away, %ld died, critical fraction %s\n",
                     o.output.c_str(), s.members, s.completed, o.ranks, s.hotspots_total, s.hotspots_per_member_mean,
-                    s.hotspots_per_member_std, s.runaway, s.dying, s.critical_fraction);
+                    s.hotspots_per_member_std, s.runaway, s.dying,
+                    std::isnan(s.critical_fraction) ? "undefined (no decided hot spot)"
+                                                    : std::to_string(s.critical_fraction).substr(0, 5).c_str());
       if (s.completed < s.members) code = kSimulationFailed;
     }
   } catch (const std::invalid_argument& e) {

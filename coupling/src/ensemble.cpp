@@ -206,7 +206,8 @@ EnsembleSummary aggregate_members(const std::string& scene_path, const EnsembleO
     s.hotspots_per_member_mean = mean;
     s.hotspots_per_member_std = counts.size() > 1 ? std::sqrt(var / static_cast<double>(counts.size() - 1)) : 0.0;
   }
-  s.critical_fraction = (s.runaway + s.dying) > 0 ? static_cast<double>(s.runaway) / static_cast<double>(s.runaway + s.dying) : 0.0;
+  s.critical_fraction = (s.runaway + s.dying) > 0 ? static_cast<double>(s.runaway) / static_cast<double>(s.runaway + s.dying)
+                                                  : std::numeric_limits<double>::quiet_NaN();  // no decided spot: undefined
 
   std::vector<std::vector<double>> h(9);
   for (const auto& x : s.hotspots) {

@@ -61,11 +61,14 @@ void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
   const EnergyBooks& b = coupler_.books();
   const HotSpotTracker& hs = coupler_.hotspots();
   const HotSpot* hot = hs.hottest();
+  // No hot spot: the hottest_hotspot_* columns are NaN (undefined), not 0 (issue 14 item 6).
+  const double kNoHotSpot = std::numeric_limits<double>::quiet_NaN();
   const long windows = b.windows + b.continuation_intervals;
   // thermal_energy_change: Σ_p m_p C_v,p (T_p − T_p(0)), which equals heat_delivered (design §4).
   row.insert(row.end(), {b.heat_delivered, coupler_.particle_energy_change(sim.particles()), hs.max_temperature(),
-                         static_cast<double>(hs.hot_spots().size()), hot ? hot->peak_temperature : 0.0,
-                         hot ? hot->size : 0.0, hot ? hot->equivalent_diameter : 0.0, static_cast<double>(windows)});
+                         static_cast<double>(hs.hot_spots().size()), hot ? hot->peak_temperature : kNoHotSpot,
+                         hot ? hot->size : kNoHotSpot, hot ? hot->equivalent_diameter : kNoHotSpot,
+                         static_cast<double>(windows)});
   const CouplerOptions& o = coupler_.options();
   if (o.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
   if (o.reaction.enabled) {

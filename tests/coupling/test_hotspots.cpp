@@ -91,7 +91,7 @@ TEST(HotSpots, DiagonalNeighboursLinkButAGapOfOneParticleSeparates) {
   opt.mode = fc::HotSpotOptions::Mode::absolute;
   opt.threshold = 400.0;
   fc::HotSpotTracker tr(2, opt, kThick);
-  // A diagonal chain (distance √2 spacings < 1.5): one hot spot.
+  // A diagonal chain (distance √2 spacings < link_factor): one hot spot.
   for (int i = 0; i < 5; ++i) p.temperature[particle_at(p, {(2.25 + 0.5 * i) * 1e-3, (2.25 + 0.5 * i) * 1e-3})] = 500.0;
   tr.update(p, kMats, 0.0);
   EXPECT_EQ(tr.hot_spots().size(), 1u);
@@ -222,4 +222,34 @@ TEST(HotSpots, CellListMatchesAllPairsClustering) {
   std::size_t total = 0;
   for (const fc::HotSpot& h : tr.hot_spots()) total += h.particle_count;
   EXPECT_EQ(total, hot.size());
+}
+
+// Issue 14 item 8: in 3D the corner-diagonal neighbour is √3 = 1.73 spacings away; the default
+// link_factor must join it, and a one-particle gap (2 spacings) must still separate.
+TEST(HotSpots, CornerDiagonalNeighboursLinkIn3D) {
+  fm::Particles<3> p;
+  auto T = [](const fm::Vec<3>&) { return 300.0; };
+  fill_box<3>(p, {0.0, 0.0, 0.0}, {4e-3, 4e-3, 4e-3}, 1e-3, 2, 1900.0, 0, T);
+  auto at = [&](const fm::Vec<3>& x) {
+    for (std::size_t k = 0; k < p.size(); ++k)
+      if ((p.position[k] - x).norm() < 1e-9) return k;
+    ADD_FAILURE() << "no particle at " << x.transpose();
+    return std::size_t{0};
+  };
+  fc::HotSpotOptions opt;
+  opt.mode = fc::HotSpotOptions::Mode::absolute;
+  opt.threshold = 400.0;
+  opt.min_particles = 1;
+  fc::HotSpotTracker tr(3, opt, 1.0);
+  // A body-diagonal chain of 4 particles, each √3 spacings from the next: one hot spot of 4.
+  for (int i = 0; i < 4; ++i) p.temperature[at(fm::Vec<3>::Constant((1.25 + 0.5 * i) * 1e-3))] = 500.0;
+  tr.update(p, {{true, 1100.0, 0.45}}, 0.0);
+  ASSERT_EQ(tr.hot_spots().size(), 1u);
+  EXPECT_EQ(tr.hot_spots()[0].particles.size(), 4u);
+  // Two particles two spacings apart along x: separate.
+  for (auto& t : p.temperature) t = 300.0;
+  p.temperature[at({1.25e-3, 1.25e-3, 1.25e-3})] = 500.0;
+  p.temperature[at({2.25e-3, 1.25e-3, 1.25e-3})] = 500.0;
+  tr.update(p, {{true, 1100.0, 0.45}}, 1.0);
+  EXPECT_EQ(tr.hot_spots().size(), 2u);
 }

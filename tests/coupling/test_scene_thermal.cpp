@@ -230,6 +230,10 @@ TEST(SceneThermalRun, ConductionBetweenBlocksThroughTheRunner) {
   EXPECT_EQ(count.front(), 1.0);  // the hot block is one hot spot at t = 0
   EXPECT_LT(tmax.back(), 350.0 + 0.01);
   EXPECT_EQ(count.back(), 0.0);
+  // Issue 14 item 6: with no hot spot the hottest_hotspot_* columns are undefined (NaN), with one they hold its peak.
+  EXPECT_EQ(column("hottest_hotspot_temperature").front(), 400.0);
+  for (const char* c : {"hottest_hotspot_temperature", "hottest_hotspot_size", "hottest_hotspot_diameter"})
+    EXPECT_TRUE(std::isnan(column(c).back())) << c;
   for (std::size_t k = 1; k < tmax.size(); ++k) EXPECT_LE(tmax[k], tmax[k - 1] + 1e-6);  // maximum principle (to atol)
   // Windows of 10 steps, one cut short at the snapshot at t = 1 ms, then 10 continuation intervals.
   EXPECT_GE(windows.back(), static_cast<double>((r.steps + 9) / 10 + 10));

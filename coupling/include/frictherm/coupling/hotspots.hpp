@@ -23,7 +23,8 @@ struct HotSpotOptions {
   enum class Mode { absolute, rise };
   Mode mode = Mode::rise;
   double threshold = 100.0;       // K: temperature (absolute) or rise above T0_p (rise)
-  double link_factor = 1.5;       // adjacency distance in particle spacings
+  double link_factor = 1.8;       // adjacency distance in particle spacings: > √3 (3D corner
+                                  // diagonal), < 2 (a one-particle gap separates)
   std::size_t min_particles = 1;  // smaller clusters are ignored
 };
 
