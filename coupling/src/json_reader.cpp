@@ -80,10 +80,18 @@ long JsonReader::as_integer(long min, long max) const {
   else if (max != std::numeric_limits<long>::max())
     what += " <= " + std::to_string(max);
   if (!value_->is_number()) expected(what);
+  // Compare in the integer domain: 2^63 written as a float equals double(LONG_MAX) after rounding,
+  // so a float is first bounded by the exact powers of two before any cast (a cast out of range is UB).
+  if (value_->is_number_unsigned()) {
+    const auto u = value_->get<unsigned long long>();
+    if (u > static_cast<unsigned long long>(std::numeric_limits<long>::max())) expected(what);
+  }
   const double x = value_->get<double>();
-  if (!std::isfinite(x) || std::floor(x) != x || x < static_cast<double>(min) || x > static_cast<double>(max))
-    expected(what);
-  return value_->is_number_float() ? static_cast<long>(x) : value_->get<long>();
+  constexpr double two63 = 9223372036854775808.0;  // 2^63, exact in double
+  if (!std::isfinite(x) || std::floor(x) != x || x < -two63 || x >= two63) expected(what);
+  const long v = value_->is_number_float() ? static_cast<long>(x) : value_->get<long>();
+  if (v < min || v > max) expected(what);
+  return v;
 }
 
 std::string JsonReader::as_string() const {
@@ -248,6 +256,12 @@ Json parse_json_text(const std::string& text) {
     std::ostringstream msg;
     msg << "malformed JSON at line " << line << ", column " << column << ": " << detail;
     throw SceneError(msg.str());
+  } catch (const Json::exception& e) {
+    // e.g. out_of_range.406 "number overflow" for 1e999: nlohmann gives no position here.
+    std::string detail = e.what();
+    const std::size_t close = detail.find("] ");
+    if (close != std::string::npos) detail = detail.substr(close + 2);
+    throw SceneError("malformed JSON: " + detail);
   }
 }
 
