@@ -1,3 +1,5 @@
+#include <set>
+#include <vector>
 #include <frictherm/coupling/json_reader.hpp>
 
 #include <algorithm>
@@ -236,7 +238,17 @@ void JsonReader::finish() const {
 
 Json parse_json_text(const std::string& text) {
   try {
-    return Json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    // Duplicate keys refused (nlohmann keeps the last silently): one key set per open object.
+    std::vector<std::set<std::string>> keys;
+    const Json::parser_callback_t no_duplicates = [&keys](int, Json::parse_event_t event, Json& parsed) {
+      if (event == Json::parse_event_t::object_start) keys.emplace_back();
+      else if (event == Json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+      else if (event == Json::parse_event_t::key && !keys.empty() && parsed.is_string() &&
+               !keys.back().insert(parsed.get<std::string>()).second)
+        throw SceneError("duplicate key '" + parsed.get<std::string>() + "' in one JSON object");
+      return true;
+    };
+    return Json::parse(text, no_duplicates, /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const Json::parse_error& e) {
     // Line and column of the byte where parsing stopped (e.byte is 1-based).
     const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
