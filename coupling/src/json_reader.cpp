@@ -1,3 +1,5 @@
+#include <set>
+#include <vector>
 #include <frictherm/coupling/json_reader.hpp>
 
 #include <algorithm>
@@ -80,10 +82,18 @@ long JsonReader::as_integer(long min, long max) const {
   else if (max != std::numeric_limits<long>::max())
     what += " <= " + std::to_string(max);
   if (!value_->is_number()) expected(what);
+  // Compare in the integer domain: 2^63 written as a float equals double(LONG_MAX) after rounding,
+  // so a float is first bounded by the exact powers of two before any cast (a cast out of range is UB).
+  if (value_->is_number_unsigned()) {
+    const auto u = value_->get<unsigned long long>();
+    if (u > static_cast<unsigned long long>(std::numeric_limits<long>::max())) expected(what);
+  }
   const double x = value_->get<double>();
-  if (!std::isfinite(x) || std::floor(x) != x || x < static_cast<double>(min) || x > static_cast<double>(max))
-    expected(what);
-  return value_->is_number_float() ? static_cast<long>(x) : value_->get<long>();
+  constexpr double two63 = 9223372036854775808.0;  // 2^63, exact in double
+  if (!std::isfinite(x) || std::floor(x) != x || x < -two63 || x >= two63) expected(what);
+  const long v = value_->is_number_float() ? static_cast<long>(x) : value_->get<long>();
+  if (v < min || v > max) expected(what);
+  return v;
 }
 
 std::string JsonReader::as_string() const {
@@ -228,7 +238,17 @@ void JsonReader::finish() const {
 
 Json parse_json_text(const std::string& text) {
   try {
-    return Json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    // Duplicate keys refused (nlohmann keeps the last silently): one key set per open object.
+    std::vector<std::set<std::string>> keys;
+    const Json::parser_callback_t no_duplicates = [&keys](int, Json::parse_event_t event, Json& parsed) {
+      if (event == Json::parse_event_t::object_start) keys.emplace_back();
+      else if (event == Json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+      else if (event == Json::parse_event_t::key && !keys.empty() && parsed.is_string() &&
+               !keys.back().insert(parsed.get<std::string>()).second)
+        throw SceneError("duplicate key '" + parsed.get<std::string>() + "' in one JSON object");
+      return true;
+    };
+    return Json::parse(text, no_duplicates, /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const Json::parse_error& e) {
     // Line and column of the byte where parsing stopped (e.byte is 1-based).
     const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
@@ -248,6 +268,12 @@ Json parse_json_text(const std::string& text) {
     std::ostringstream msg;
     msg << "malformed JSON at line " << line << ", column " << column << ": " << detail;
     throw SceneError(msg.str());
+  } catch (const Json::exception& e) {
+    // e.g. out_of_range.406 "number overflow" for 1e999: nlohmann gives no position here.
+    std::string detail = e.what();
+    const std::size_t close = detail.find("] ");
+    if (close != std::string::npos) detail = detail.substr(close + 2);
+    throw SceneError("malformed JSON: " + detail);
   }
 }
 

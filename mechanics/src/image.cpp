@@ -64,11 +64,26 @@ GreyImage read_pgm(const std::string& path) {
   if (img.width <= 0 || img.height <= 0 || img.max_value <= 0 || img.max_value > 65535)
     throw std::runtime_error("PGM file '" + path + "': bad width, height or maximum grey value");
   const std::size_t n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
+  // Header checked against the file size before the pixel buffer is sized: a P5 pixel takes 1 or 2
+  // bytes, a P2 pixel at least one digit plus a separator (the last one none).
+  const std::streamoff here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff left = in.tellg() - here;
+  in.seekg(here);
+  const double need = magic[1] == '2' ? 2.0 * static_cast<double>(n) - 1.0
+                                      : static_cast<double>(n) * (img.max_value > 255 ? 2.0 : 1.0);
+  if (here < 0 || static_cast<double>(left) < need)
+    throw std::runtime_error("PGM file '" + path + "': header claims " + std::to_string(img.width) + "x" +
+                             std::to_string(img.height) + " pixels but the file holds only " +
+                             std::to_string(static_cast<long long>(left)) + " bytes after the header");
   img.pixels.resize(n);
   if (magic[1] == '2') {
     for (std::size_t k = 0; k < n; ++k) {
       int v;
       if (!(in >> v)) throw std::runtime_error("PGM file '" + path + "': fewer pixels than width*height");
+      if (v < 0 || v > img.max_value)
+        throw std::runtime_error("PGM file '" + path + "': pixel " + std::to_string(k) + " has value " +
+                                 std::to_string(v) + ", outside [0, " + std::to_string(img.max_value) + "]");
       img.pixels[k] = static_cast<std::uint16_t>(v);
     }
   } else {

@@ -261,3 +261,17 @@ TEST(SceneValidation, MieGruneisenMaterial) {
   s["analysis"] = "plane_stress";
   EXPECT_THAT(scene_error(s), StartsWith("materials.steel.type: mie_gruneisen needs"));
 }
+
+// Issue 15 class 3: numbers outside what the reader can hold are scene errors, never UB or a raw
+// nlohmann exception; duplicate keys are refused instead of last-wins.
+TEST(SceneValidation, NumbersOutOfRangeAndDuplicateKeysAreRefused) {
+  EXPECT_THAT(scene_error(std::string("{\"dimension\": 1e999}")), HasSubstr("number overflow"));
+  Json s = good_scene();
+  s["dimension"] = 9223372036854775808.0;  // 2^63 as a float: rounds to double(LONG_MAX)
+  EXPECT_THAT(scene_error(s), StartsWith("dimension: expected an integer in [2, 3]"));
+  s["dimension"] = 18446744073709551615ULL;  // unsigned, above LONG_MAX
+  EXPECT_THAT(scene_error(s), StartsWith("dimension: expected an integer in [2, 3]"));
+  const std::string text = good_scene().dump();
+  const std::string twice = "{\"dimension\": 2, " + text.substr(1);
+  EXPECT_THAT(scene_error(twice), HasSubstr("duplicate key 'dimension'"));
+}

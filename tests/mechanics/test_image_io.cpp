@@ -196,3 +196,16 @@ TEST(Labelling, PixelRegionGivesEachPixelItsMaterial) {
   EXPECT_EQ(prism->material_at(Vec<3>(1.5, 1.5, 0.25)), b);
   EXPECT_EQ(prism->material_at(Vec<3>(1.5, 1.5, 0.75)), -1);
 }
+
+// Issue 15: a header larger than the file is refused before the pixel buffer is sized (a 1e10-pixel
+// claim would allocate 10 GB), and a P2 value outside [0, maxval] is refused instead of wrapping.
+TEST(ImageIO, PgmHeaderCheckedAgainstFileSizeAndPixelRange) {
+  const std::string path = temp("bomb.pgm");
+  { std::ofstream f(path, std::ios::binary); f << "P5\n100000 100000\n255\n12345678"; }
+  EXPECT_NE(error_of(path).find("header claims 100000x100000 pixels"), std::string::npos) << error_of(path);
+  { std::ofstream f(path, std::ios::binary); f << "P2\n2 1\n255\n10 300\n"; }
+  EXPECT_NE(error_of(path).find("value 300, outside [0, 255]"), std::string::npos) << error_of(path);
+  { std::ofstream f(path, std::ios::binary); f << "P2\n2 1\n255\n10 -1\n"; }
+  EXPECT_NE(error_of(path).find("value -1, outside [0, 255]"), std::string::npos) << error_of(path);
+  std::remove(path.c_str());
+}
