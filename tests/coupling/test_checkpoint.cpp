@@ -1,0 +1,130 @@
+// Mechanics checkpoints (coupling/src/checkpoint.cpp, issue 17): a run restored from a checkpoint
+// into a simulation rebuilt from the same set-up continues bit-for-bit (positions, velocities,
+// stresses, frictional work, time); a write killed before its rename leaves the previous checkpoint
+// usable; a checkpoint refuses to restore into a different set-up.
+#include "../verification/sliding_block.hpp"
+
+#include <frictherm/coupling/checkpoint.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+namespace {
+
+using namespace frictherm;
+using namespace frictherm::verification;
+using C = SlidingBlockConstants;
+using mechanics::HeatingOrder;
+
+std::string temp_file(const std::string& name) {
+  return ::testing::TempDir() + "frictherm_checkpoint_" + name + ".h5";
+}
+
+void step_to(mechanics::Simulation<2>& sim, double t) {
+  while (sim.time() < t * (1 - 1e-12)) sim.step(t - sim.time());
+}
+
+// Exact equality: the restored run must repeat the same floating-point operations.
+void expect_identical(const mechanics::Simulation<2>& a, const mechanics::Simulation<2>& b) {
+  ASSERT_EQ(a.particles().size(), b.particles().size());
+  EXPECT_EQ(a.step_count(), b.step_count());
+  EXPECT_EQ(a.time(), b.time());
+  long differ = 0;
+  for (std::size_t k = 0; k < a.particles().size(); ++k) {
+    differ += a.particles().position[k] != b.particles().position[k];
+    differ += a.particles().velocity[k] != b.particles().velocity[k];
+    differ += a.particles().stress[k] != b.particles().stress[k];
+  }
+  EXPECT_EQ(differ, 0);
+  for (HeatingOrder o : {HeatingOrder::first, HeatingOrder::second})
+    EXPECT_EQ(a.cumulative_frictional_work(o), b.cumulative_frictional_work(o));
+  EXPECT_EQ(a.external_work(), b.external_work());
+}
+
+// The block slides from t ≈ 0.25 tf on; the checkpoint is taken while it slides, the comparison
+// 0.15 tf (about a thousand steps) later.
+void check_resume(const SlidingBlockSetup& s, const std::string& name) {
+  const double tf = C::t_final(), t_checkpoint = 0.45 * tf, t_end = 0.6 * tf;
+  const std::string path = temp_file(name);
+  int block = 0;
+  auto uninterrupted = make_sliding_block(s, block);
+  step_to(uninterrupted, t_checkpoint);
+  const double W_checkpoint = uninterrupted.cumulative_frictional_work(HeatingOrder::second);
+  ASSERT_GT(W_checkpoint, 0.0) << "the block must already slide at the checkpoint";
+  coupling::write_mechanics_checkpoint(path, uninterrupted, "{\"scene\": \"" + name + "\"}");
+  step_to(uninterrupted, t_end);
+  ASSERT_GT(uninterrupted.cumulative_frictional_work(HeatingOrder::second), 1.5 * W_checkpoint);
+
+  auto resumed = make_sliding_block(s, block);
+  coupling::read_mechanics_checkpoint(path, resumed);
+  EXPECT_EQ(resumed.cumulative_frictional_work(HeatingOrder::second), W_checkpoint);
+  EXPECT_EQ(coupling::checkpoint_scene_text(path), "{\"scene\": \"" + name + "\"}");
+  step_to(resumed, t_end);
+  expect_identical(uninterrupted, resumed);
+  std::remove(path.c_str());
+}
+
+TEST(Checkpoint, ResumedSlidingBlockEqualsUninterruptedBitForBit) {
+  SlidingBlockSetup s;  // the paper's set-up: deformable base fixed at its bottom, edge tractions
+  check_resume(s, "paper");
+}
+
+TEST(Checkpoint, ResumedRotatedBlockOnRigidBaseEqualsUninterrupted) {
+  SlidingBlockSetup s;  // rigid base, loads on the particles, lattice not aligned with the grid
+  s.rotated = true;
+  s.angle = 0.3;
+  s.law = mechanics::FrictionLaw::coulomb(0.2);
+  check_resume(s, "rotated");
+}
+
+TEST(Checkpoint, KilledWriteKeepsThePreviousCheckpoint) {
+  const std::string path = temp_file("killed");
+  SlidingBlockSetup s;
+  int block = 0;
+  auto sim = make_sliding_block(s, block);
+  step_to(sim, 0.3 * C::t_final());
+  coupling::write_mechanics_checkpoint(path, sim);
+  const long steps = sim.step_count();
+  // A write killed before its rename leaves a partial "<path>.tmp" beside the checkpoint.
+  { std::ofstream(path + ".tmp") << "partial HDF5 bytes"; }
+  auto restored = make_sliding_block(s, block);
+  coupling::read_mechanics_checkpoint(path, restored);
+  EXPECT_EQ(restored.step_count(), steps);
+  EXPECT_EQ(restored.time(), sim.time());
+  // The next write replaces the partial temporary and then the checkpoint.
+  sim.step();
+  coupling::write_mechanics_checkpoint(path, sim);
+  coupling::read_mechanics_checkpoint(path, restored);
+  EXPECT_EQ(restored.step_count(), steps + 1);
+  std::remove(path.c_str());
+}
+
+TEST(Checkpoint, RefusesADifferentSetUp) {
+  const std::string path = temp_file("mismatch");
+  SlidingBlockSetup s;
+  int block = 0;
+  auto sim = make_sliding_block(s, block);
+  coupling::write_mechanics_checkpoint(path, sim);
+  s.cell = 0.0025;  // four times the particles
+  auto other = make_sliding_block(s, block);
+  try {
+    coupling::read_mechanics_checkpoint(path, other);
+    ADD_FAILURE() << "restored a checkpoint into a different set-up";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("particles/position"), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
+}
+
+TEST(Checkpoint, RefusesPenaltyContact) {
+  SlidingBlockSetup s;
+  s.method = mechanics::ContactMethod::penalty;
+  int block = 0;
+  auto sim = make_sliding_block(s, block);
+  EXPECT_THROW(coupling::write_mechanics_checkpoint(temp_file("penalty"), sim), std::invalid_argument);
+}
+
+}  // namespace
