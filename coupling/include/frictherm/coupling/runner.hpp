@@ -39,6 +39,9 @@ struct RunOptions {
   bool handle_signals = false;
   /// Buffered series rows are written and the file flushed at least this often (wall seconds).
   double flush_interval = 2.0;
+  /// Wall seconds between checkpoints ("<output>.checkpoint", checkpoint.hpp); 0: only the scene's
+  /// run.checkpoint_interval. With either, a checkpoint is also written at the end and on SIGINT/SIGTERM.
+  double checkpoint_wall_interval = 0.0;
 };
 
 struct RunResult {
