@@ -46,6 +46,11 @@ class Run {
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
     r_.particles = sim_->particles().size();
     check_checkpoints();
+    if (!o_.resume_checkpoint.empty()) {
+      if (s_.thermal.enabled)
+        throw SceneError("thermal: resuming runs with a thermal section is not supported yet (expected no thermal section)");
+      read_mechanics_checkpoint(o_.resume_checkpoint, *sim_);
+    }
     H5Output out = open_output();
     out_ = &out;
     write_microstructure_images(out);  // generated bodies (ellipse_packing): the image beside the output
@@ -157,9 +162,13 @@ class Run {
     const double eps = 1e-10 * T;
     const double snap_dt = s_.output.snapshot_interval;
     const double series_dt = s_.output.series_interval;
-    long snap_k = 1;
-    double next_snap = std::min(snap_dt, T);
-    double next_series = series_dt;
+    // The next output times after the current one (t = 0, or a resumed checkpoint's time).
+    const double t0 = sim_->time();
+    long snap_k = static_cast<long>(std::floor(t0 / snap_dt + 1e-9)) + 1;
+    double next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
+    double next_series = series_dt > 0.0 ? (std::floor(t0 / series_dt + 1e-9) + 1.0) * series_dt : 0.0;
+    if (s_.checkpoint_interval > 0.0)
+      next_checkpoint_ = (std::floor(t0 / s_.checkpoint_interval + 1e-9) + 1.0) * s_.checkpoint_interval;
     while (sim_->time() < T - eps) {
       if (s_.max_steps > 0 && sim_->step_count() >= s_.max_steps) {
         r_.status = RunResult::Status::stopped_at_max_steps;

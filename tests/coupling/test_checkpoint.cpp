@@ -164,3 +164,40 @@ TEST(Checkpoint, RunnerWritesTheFinalStateAtTheEnd) {
   std::remove(o.output.c_str());
   std::remove(cp.c_str());
 }
+
+// examples/sliding_block.json (multimaterial Coulomb contact) run three ways on one thread:
+// uninterrupted; stopped after 3000 steps with a
+// checkpoint (the block already slides then: asserted); and resumed from that checkpoint to the end. The resumed run's final state and
+// frictional work equal the uninterrupted run's bit-for-bit.
+TEST(Checkpoint, ResumedRunEqualsUninterruptedRun) {
+  const std::string file = std::string(FRICTHERM_SOURCE_DIR) + "/examples/sliding_block.json";
+  auto run = [&](long max_steps, const std::string& name, const std::string& resume) {
+    const coupling::Scene scene = coupling::load_scene(
+        file, {{"run.max_steps", std::to_string(max_steps)}, {"run.threads", "1"}});
+    coupling::RunOptions o;
+    o.output = temp_file(name);
+    o.quiet = true;
+    o.checkpoint_wall_interval = 1e9;  // checkpoints on: one at the end
+    o.resume_checkpoint = resume;
+    const coupling::RunResult r = coupling::run_scene(scene, o);
+    auto sim = coupling::build_simulation<2>(scene);
+    coupling::read_mechanics_checkpoint(coupling::checkpoint_path(o.output), *sim);
+    EXPECT_EQ(sim->step_count(), r.steps);
+    return std::make_pair(r, std::move(sim));
+  };
+  const long never = 1L << 40;
+  auto [r_full, full] = run(never, "full", "");
+  ASSERT_EQ(r_full.status, coupling::RunResult::Status::completed);
+  auto [r_stop, stopped] = run(3000, "stopped", "");
+  ASSERT_EQ(r_stop.status, coupling::RunResult::Status::stopped_at_max_steps);
+  ASSERT_GT(stopped->cumulative_frictional_work(HeatingOrder::second), 0.0) << "the block must slide before the stop";
+  auto [r_resumed, resumed] = run(never, "resumed", coupling::checkpoint_path(temp_file("stopped")));
+  ASSERT_EQ(r_resumed.status, coupling::RunResult::Status::completed);
+  EXPECT_GT(resumed->cumulative_frictional_work(HeatingOrder::second),
+            2.0 * stopped->cumulative_frictional_work(HeatingOrder::second));
+  expect_identical(*full, *resumed);
+  for (const char* name : {"full", "stopped", "resumed"}) {
+    std::remove(temp_file(name).c_str());
+    std::remove(coupling::checkpoint_path(temp_file(name)).c_str());
+  }
+}
