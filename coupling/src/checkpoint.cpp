@@ -152,13 +152,10 @@ Handle open_checkpoint(const std::string& path, int dimension) {
   return f;
 }
 
-}  // namespace
-
-std::string checkpoint_path(const std::string& result_path) { return result_path + ".checkpoint"; }
 
 template <int Dim>
-void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
-                                const std::string& scene_text) {
+void write_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const std::string& scene_text,
+                      const std::string& source, const std::string& overrides) {
   sim.finalize();  // penalty contact is set up here
   const std::string why = sim.checkpoint_refusal();
   if (!why.empty()) throw std::invalid_argument("cannot checkpoint this run: " + why);
@@ -171,6 +168,8 @@ void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<D
     write_int_attribute(f.get(), tmp, "format", kFormat);
     write_int_attribute(f.get(), tmp, "dimension", Dim);
     write_array(f.get(), tmp, "scene", H5T_NATIVE_CHAR, scene_text.data(), scene_text.size(), 1);
+    write_array(f.get(), tmp, "scene_source", H5T_NATIVE_CHAR, source.data(), source.size(), 1);
+    write_array(f.get(), tmp, "scene_overrides", H5T_NATIVE_CHAR, overrides.data(), overrides.size(), 1);
     const Handle g{check_id(H5Gcreate2(f.get(), "mechanics", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp, "group"),
                    H5Gclose};
     sim.visit_state(Writer{g.get(), tmp});
@@ -179,6 +178,33 @@ void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<D
   // POSIX rename replaces `path` atomically: a reader sees the old or the new checkpoint, never half.
   if (std::rename(tmp.c_str(), path.c_str()) != 0)
     throw std::runtime_error("checkpoint '" + path + "': cannot rename '" + tmp + "' over it");
+}
+
+std::string read_text(const std::string& path, const char* name) {
+  const h5detail::Quiet quiet;
+  const Handle f = open_checkpoint(path, 0);
+  hsize_t n = 0;
+  const Handle d = open_array(f.get(), path, name, 1, n);
+  std::string text(n, '\0');
+  if (n > 0) check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), path, std::string("cannot read ") + name);
+  return text;
+}
+
+}  // namespace
+
+std::string checkpoint_path(const std::string& result_path) { return result_path + ".checkpoint"; }
+
+template <int Dim>
+void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
+                                const std::string& scene_text) {
+  write_checkpoint(path, sim, scene_text, "", "");
+}
+
+template <int Dim>
+void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const Scene& scene) {
+  std::string overrides;  // one "path=value" per line
+  for (const SceneOverride& o : scene.overrides) overrides += o.path + "=" + o.value + "\n";
+  write_checkpoint(path, sim, scene.text, scene.source, overrides);
 }
 
 template <int Dim>
@@ -190,18 +216,29 @@ void read_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Di
   sim.visit_state(Reader{g.get(), path, sim.particles().size()});
 }
 
-std::string checkpoint_scene_text(const std::string& path) {
-  const h5detail::Quiet quiet;
-  const Handle f = open_checkpoint(path, 0);
-  hsize_t n = 0;
-  const Handle d = open_array(f.get(), path, "scene", 1, n);
-  std::string text(n, '\0');
-  if (n > 0) check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), path, "cannot read /scene");
-  return text;
+std::string checkpoint_scene_text(const std::string& path) { return read_text(path, "scene"); }
+
+Scene checkpoint_scene(const std::string& path) {
+  const std::string text = read_text(path, "scene"), source = read_text(path, "scene_source");
+  std::vector<SceneOverride> overrides;
+  const std::string lines = read_text(path, "scene_overrides");
+  for (std::size_t a = 0, b; a < lines.size(); a = b + 1) {
+    b = lines.find('\n', a);
+    if (b == std::string::npos) b = lines.size();
+    if (b > a) overrides.push_back(parse_override(lines.substr(a, b - a)));
+  }
+  const std::size_t slash = source.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : source.substr(0, slash));
+  std::string name = slash == std::string::npos ? source : source.substr(slash + 1);
+  if (const std::size_t dot = name.find_last_of('.'); dot != std::string::npos && dot > 0) name = name.substr(0, dot);
+  if (name.empty()) name = "scene";
+  return parse_scene(text, source.empty() ? "<string>" : source, dir, name, overrides);
 }
 
 template void write_mechanics_checkpoint<2>(const std::string&, mechanics::Simulation<2>&, const std::string&);
 template void write_mechanics_checkpoint<3>(const std::string&, mechanics::Simulation<3>&, const std::string&);
+template void write_mechanics_checkpoint<2>(const std::string&, mechanics::Simulation<2>&, const Scene&);
+template void write_mechanics_checkpoint<3>(const std::string&, mechanics::Simulation<3>&, const Scene&);
 template void read_mechanics_checkpoint<2>(const std::string&, mechanics::Simulation<2>&);
 template void read_mechanics_checkpoint<3>(const std::string&, mechanics::Simulation<3>&);
 

@@ -230,7 +230,7 @@ class Run {
 
   void checkpoint() {
     const Clock::time_point c0 = Clock::now();
-    write_mechanics_checkpoint(checkpoint_path(r_.output), *sim_, s_.text);
+    write_mechanics_checkpoint(checkpoint_path(r_.output), *sim_, s_);
     last_checkpoint_ = Clock::now();
     output_seconds_ += seconds_since(c0);
   }

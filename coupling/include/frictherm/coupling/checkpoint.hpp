@@ -4,6 +4,7 @@
 // "<path>.tmp" first and is renamed over the previous checkpoint only once complete, so a kill
 // during a write keeps the previous checkpoint whole. A simulation rebuilt from the same scene and
 // restored with read_mechanics_checkpoint steps on bit-for-bit (docs/checkpoints.md).
+#include <frictherm/coupling/scene.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <string>
@@ -25,7 +26,15 @@ void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<D
 template <int Dim>
 void read_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim);
 
+/// As above, storing the scene's text, source path and --set overrides (for checkpoint_scene).
+template <int Dim>
+void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const Scene& scene);
+
 /// The scene text stored in a checkpoint ("" if none was given).
 std::string checkpoint_scene_text(const std::string& path);
+
+/// The scene a checkpoint was written from: its text parsed again with the stored overrides, image
+/// paths relative to the stored source's folder. Throws SceneError if the text does not parse.
+Scene checkpoint_scene(const std::string& path);
 
 }  // namespace frictherm::coupling
