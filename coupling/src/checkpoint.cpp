@@ -59,7 +59,9 @@ void write_array(hid_t group, const std::string& file, const std::string& name, 
   const Handle space{check_id(H5Screate_simple(components == 1 ? 1 : 2, dims, nullptr), file, "dataspace"), H5Sclose};
   const Handle lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), file, "property list"), H5Pclose};
   check(H5Pset_create_intermediate_group(lcpl.get(), 1), file, "property list");
-  const Handle d{check_id(H5Dcreate2(group, name.c_str(), file_type(type), space.get(), lcpl.get(), H5P_DEFAULT,
+  const Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), file, "property list"), H5Pclose};
+  check(H5Pset_obj_track_times(dcpl.get(), 0), file, "property list");  // equal states give equal files
+  const Handle d{check_id(H5Dcreate2(group, name.c_str(), file_type(type), space.get(), lcpl.get(), dcpl.get(),
                                      H5P_DEFAULT),
                           file, "cannot create '" + name + "'"),
                  H5Dclose};
