@@ -12,6 +12,7 @@ const char* const kProgramHelp =
     "commands:\n"
     "  run SCENE [-o OUT.h5] [--threads N] [--quiet] [--set KEY=VALUE ...]\n"
     "                                                  run a scene, write an HDF5 file (+ XDMF)\n"
+    "  resume RUN.h5 [-o OUT.h5]                       continue a run from RUN.h5.checkpoint\n"
     "  validate SCENE [--set KEY=VALUE ...]            check a scene and print a summary\n"
     "  export-csv RUN.h5 [-o OUT.csv]                  print the time series of a run as CSV\n"
     "  microstructure SCENE [-o IMAGE.pgm]             write the grain image of an ellipse_packing body\n"

@@ -19,6 +19,7 @@ std::string quote_arg(const std::string& a) {
 
 const char* help_of(const std::string& command) {
   if (command == "run") return frictherm::cli::kRunHelp;
+  if (command == "resume") return frictherm::cli::kResumeHelp;
   if (command == "validate") return frictherm::cli::kValidateHelp;
   if (command == "export-csv") return frictherm::cli::kExportCsvHelp;
   if (command == "microstructure") return frictherm::cli::kMicrostructureHelp;
@@ -50,6 +51,7 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
     return kOk;
   }
   if (cmd == "run") return run_command(rest, command_line);
+  if (cmd == "resume") return resume_command(rest, command_line);
   if (cmd == "validate") return validate_command(rest);
   if (cmd == "export-csv") return export_csv_command(rest);
   if (cmd == "microstructure") return microstructure_command(rest);

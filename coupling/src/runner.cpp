@@ -4,6 +4,7 @@
 #include "run_signals.hpp"
 #include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
+#include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/microstructure.hpp>
 #include <frictherm/coupling/thread_policy.hpp>
 #include <frictherm/mechanics/errors.hpp>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 
 namespace frictherm::coupling {
 
@@ -45,6 +47,12 @@ class Run {
     omp_set_num_threads(threads > 0 ? threads : default_thread_count(sim_->particles().size()));
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
     r_.particles = sim_->particles().size();
+    check_checkpoints();
+    if (!o_.resume_checkpoint.empty()) {
+      if (s_.thermal.enabled)
+        throw SceneError("thermal: resuming runs with a thermal section is not supported yet (expected no thermal section)");
+      read_mechanics_checkpoint(o_.resume_checkpoint, *sim_);
+    }
     H5Output out = open_output();
     out_ = &out;
     write_microstructure_images(out);  // generated bodies (ellipse_packing): the image beside the output
@@ -79,6 +87,7 @@ class Run {
     if (r_.status != RunResult::Status::failed) {
       if (last_series_step_ != sim_->step_count()) series();
       if (last_snapshot_step_ != sim_->step_count()) snapshot();
+      if (checkpoints_) checkpoint();  // at the end, and on SIGINT/SIGTERM
     }
     if (r_.status == RunResult::Status::interrupted) {
       r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " +
@@ -155,9 +164,13 @@ class Run {
     const double eps = 1e-10 * T;
     const double snap_dt = s_.output.snapshot_interval;
     const double series_dt = s_.output.series_interval;
-    long snap_k = 1;
-    double next_snap = std::min(snap_dt, T);
-    double next_series = series_dt;
+    // The next output times after the current one (t = 0, or a resumed checkpoint's time).
+    const double t0 = sim_->time();
+    long snap_k = static_cast<long>(std::floor(t0 / snap_dt + 1e-9)) + 1;
+    double next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
+    double next_series = series_dt > 0.0 ? (std::floor(t0 / series_dt + 1e-9) + 1.0) * series_dt : 0.0;
+    if (s_.checkpoint_interval > 0.0)
+      next_checkpoint_ = (std::floor(t0 / s_.checkpoint_interval + 1e-9) + 1.0) * s_.checkpoint_interval;
     while (sim_->time() < T - eps) {
       if (s_.max_steps > 0 && sim_->step_count() >= s_.max_steps) {
         r_.status = RunResult::Status::stopped_at_max_steps;
@@ -193,9 +206,35 @@ class Run {
           if (next_snap > t + eps || next_snap >= T) break;
         }
       }
+      if (checkpoints_ && (t >= next_checkpoint_ - eps || (o_.checkpoint_wall_interval > 0.0 &&
+                                                            seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval))) {
+        checkpoint();
+        if (s_.checkpoint_interval > 0.0)
+          next_checkpoint_ = (std::floor(t / s_.checkpoint_interval + 1e-9) + 1.0) * s_.checkpoint_interval;
+      }
       progress.update(sim_->step_count(), t);
       if (detail::interrupt_signal() != 0) return interrupted();
     }
+  }
+
+  // Checkpoints hold the mechanics state only (checkpoint.hpp): refused for thermal scenes and for
+  // penalty contact rather than written incomplete.
+  void check_checkpoints() {
+    checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
+    if (!checkpoints_) return;
+    const std::string key = s_.checkpoint_interval > 0.0 ? "run.checkpoint_interval" : "the checkpoint option";
+    if (s_.thermal.enabled)
+      throw SceneError(key + ": checkpoints of runs with a thermal section are not supported yet (expected no checkpoint interval)");
+    const std::string why = sim_->checkpoint_refusal();
+    if (!why.empty()) throw SceneError(key + ": " + why + " (expected no checkpoint interval)");
+    next_checkpoint_ = s_.checkpoint_interval > 0.0 ? s_.checkpoint_interval : std::numeric_limits<double>::infinity();
+  }
+
+  void checkpoint() {
+    const Clock::time_point c0 = Clock::now();
+    write_mechanics_checkpoint(checkpoint_path(r_.output), *sim_, s_);
+    last_checkpoint_ = Clock::now();
+    output_seconds_ += seconds_since(c0);
   }
 
   void interrupted() {
@@ -245,6 +284,9 @@ class Run {
   double continuation_seconds_ = 0.0;
   double output_seconds_ = 0.0;         // series rows and snapshots
   Clock::time_point last_flush_ = Clock::now();  // series rows written and file flushed
+  bool checkpoints_ = false;
+  double next_checkpoint_ = 0.0;                      // simulated time of the next checkpoint
+  Clock::time_point last_checkpoint_ = Clock::now();  // wall clock of the last checkpoint
 };
 
 }  // namespace

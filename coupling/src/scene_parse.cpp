@@ -183,6 +183,7 @@ void parse_run(const JsonReader& root, Scene& s) {
   s.end_time = run.number("end_time", Range::positive());
   s.max_steps = run.integer("max_steps", 0, 1, std::numeric_limits<long>::max());
   s.threads = static_cast<int>(run.integer("threads", 0, 1, 1024));
+  if (run.has("checkpoint_interval")) s.checkpoint_interval = run.number("checkpoint_interval", Range::positive());
   run.finish();
 }
 

@@ -39,6 +39,14 @@ struct RunOptions {
   bool handle_signals = false;
   /// Buffered series rows are written and the file flushed at least this often (wall seconds).
   double flush_interval = 2.0;
+  /// Wall seconds between checkpoints ("<output>.checkpoint", checkpoint.hpp); 0: only the scene's
+  /// run.checkpoint_interval. With either, a checkpoint is also written at the end and on SIGINT/SIGTERM.
+  double checkpoint_wall_interval = 0.0;
+  /// A checkpoint (checkpoint.hpp) to start from instead of t = 0: the simulation is built from the
+  /// scene, the checkpoint's state restored, and the run continues to end_time landing on the same
+  /// snapshot, series and checkpoint times as an uninterrupted run; the output file starts at the
+  /// checkpoint's state. Mechanics-only scenes.
+  std::string resume_checkpoint;
 };
 
 struct RunResult {

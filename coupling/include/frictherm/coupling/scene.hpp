@@ -110,6 +110,7 @@ struct Scene {
   double end_time = 0.0;  // s
   long max_steps = 0;     // 0: no limit
   int threads = 0;        // 0: OpenMP's default
+  double checkpoint_interval = 0.0;  // s of simulated time between checkpoints (checkpoint.hpp); 0: none
   OutputSpec output;
   ContactSpec contact;       // `contact` section (scene_contact.hpp); one shared velocity field when absent
   ThermalSceneSpec thermal;  // `thermal` and `coupling` sections (scene_thermal.hpp); disabled when absent

@@ -197,6 +197,46 @@ class Simulation {
   /// Work done by external loads and body force so far (J), accumulated each step.
   double external_work() const { return external_work_; }
 
+  // ---- checkpoint -------------------------------------------------------------------------
+  /// Why this simulation cannot be checkpointed (empty: it can). Penalty contact keeps slip
+  /// histories and boundary points that the state below does not hold.
+  std::string checkpoint_refusal() const {
+    return penalty_ ? "penalty contact keeps boundary-point and slip histories that checkpoints do not store" : "";
+  }
+  /// Calls v(name, member) for every member that changes while stepping and that the next step
+  /// reads: with these restored into a simulation built from the same set-up (after finalize()),
+  /// stepping continues bit-for-bit. Members are std::vector<T> (T double, int32 or a fixed-size
+  /// Eigen type) or double, long, bool. Everything else is rebuilt each step from these.
+  template <class Visitor> void visit_state(Visitor&& v) {
+    if (!finalized_) finalize();
+    v("particles/position", p_.position);
+    v("particles/initial_position", p_.initial_position);
+    v("particles/velocity", p_.velocity);
+    v("particles/half_size", p_.half_size);
+    v("particles/mass", p_.mass);
+    v("particles/initial_volume", p_.initial_volume);
+    v("particles/volume", p_.volume);
+    v("particles/deformation_gradient", p_.deformation_gradient);
+    v("particles/stress", p_.stress);
+    v("particles/stress_zz", p_.stress_zz);
+    v("particles/temperature", p_.temperature);
+    v("particles/plastic_strain", p_.plastic_strain);
+    v("particles/internal_energy", p_.internal_energy);
+    v("particles/plastic_work", p_.plastic_work);
+    v("particles/material", p_.material);
+    v("particles/body", p_.body);
+    v("time", time_);
+    v("step", step_);
+    v("last_dt", last_dt_);
+    v("external_work", external_work_);
+    v("work_first", work_first_);
+    v("work_second", work_second_);
+    v("pair_work_first", pair_work_first_);
+    v("pair_work_second", pair_work_second_);
+    v("wave_speed", wave_speed_);
+    v("wave_speed_ready", wave_speed_ready_);
+  }
+
  private:
   template <class Kernel> void step_with(double dt);
   template <class Kernel> void map_to_grid(double dt, bool with_forces);

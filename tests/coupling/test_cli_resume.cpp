@@ -1,0 +1,61 @@
+// `frictherm resume` (coupling/app/cli_resume.cpp): examples/sliding_block.json interrupted by SIGINT
+// while running on one thread and resumed ends in the same state as an uninterrupted run: the two
+// final checkpoints (every particle array, time, step count, work books) are byte-equal files.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+TEST(CliResume, InterruptedAndResumedRunEqualsUninterruptedRun) {
+  const fs::path dir = fs::temp_directory_path() / ("frictherm_resume_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = std::string(FRICTHERM_SOURCE_DIR) + "/examples/sliding_block.json";
+  const std::string part = (dir / "part.h5").string(), full = (dir / "full.h5").string();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen((dir / "stderr.txt").c_str(), "w", stderr);
+    execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", part.c_str(), "--quiet", "--set",
+          "run.threads=1", "--set", "run.checkpoint_interval=0.01", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  for (int i = 0; i < 200 && !fs::exists(part); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the run ended before the signal arrived";
+  ASSERT_EQ(WEXITSTATUS(status), 128 + SIGINT) << slurp(dir / "stderr.txt");
+  ASSERT_TRUE(fs::exists(part + ".checkpoint")) << "SIGINT must leave a checkpoint";
+
+  const std::string exe = FRICTHERM_EXE;
+  ASSERT_EQ(std::system((exe + " resume " + part + " -t 1 --quiet").c_str()), 0);
+  ASSERT_EQ(std::system((exe + " run " + scene + " -o " + full +
+                         " --quiet --set run.threads=1 --set run.checkpoint_interval=0.01").c_str()),
+            0);
+  const std::string resumed = slurp(dir / "part.resumed.h5.checkpoint"), uninterrupted = slurp(full + ".checkpoint");
+  ASSERT_FALSE(uninterrupted.empty());
+  EXPECT_TRUE(resumed == uninterrupted) << "the resumed run's final checkpoint differs from the uninterrupted run's";
+  EXPECT_FALSE(slurp(part + ".checkpoint") == uninterrupted) << "the interruption must come before the end";
+  fs::remove_all(dir);
+}
+
+}  // namespace
