@@ -141,8 +141,9 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
     o.default_pair.law = mechanics::FrictionLaw::frictionless();  // the default "stick" has no penalty form
   }
   o.separation = mechanics::separation_method_from_string(
-      c->choice("separation", {"position", "displacement", "velocity_only"}, "position"));
+      c->choice("separation", {"position", "displacement", "velocity_only", "extent"}, "position"));
   o.position_correction = c->number("position_correction", 0.8, Range{0.0, 2.0, false, true});
+  o.extent_tolerance = c->number("extent_tolerance", 0.0, Range{0.0, 1.0, false, false});
   o.min_mass_fraction = c->number("min_mass_fraction", 1e-6, Range{0.0, 0.5, false, true});
   auto material_id = [&](const JsonReader& name) {
     const std::string n = name.as_string();

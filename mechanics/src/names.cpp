@@ -65,7 +65,8 @@ SeparationMethod separation_method_from_string(const std::string& name) {
   if (name == "position") return SeparationMethod::position;
   if (name == "displacement") return SeparationMethod::displacement;
   if (name == "velocity_only") return SeparationMethod::velocity_only;
-  throw std::invalid_argument("unknown contact separation '" + name + "' (expected position, displacement or velocity_only)");
+  if (name == "extent") return SeparationMethod::extent;
+  throw std::invalid_argument("unknown contact separation '" + name + "' (expected position, displacement, velocity_only or extent)");
 }
 
 const char* to_string(SeparationMethod m) {
@@ -73,6 +74,7 @@ const char* to_string(SeparationMethod m) {
     case SeparationMethod::position: return "position";
     case SeparationMethod::displacement: return "displacement";
     case SeparationMethod::velocity_only: return "velocity_only";
+    case SeparationMethod::extent: return "extent";
   }
   return "?";
 }

@@ -3,6 +3,8 @@
 // frictional work. Sign convention in contact.hpp: n̂ points from material a to material b.
 #include <frictherm/mechanics/simulation.hpp>
 
+#include "contact_side.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -10,29 +12,6 @@
 
 namespace frictherm::mechanics {
 namespace {
-
-/// One material's (or a lumped virtual material's) nodal quantities at a contact node.
-template <int Dim>
-struct ContactSide {
-  double mass = 0.0;                  // m_{i,j}; for a rigid material only a presence weight
-  Vec<Dim> momentum = Vec<Dim>::Zero();
-  Vec<Dim> force = Vec<Dim>::Zero();
-  Vec<Dim> mass_position = Vec<Dim>::Zero();  // Σ S m x (or m Δx)
-  double domain = 0.0;                        // Ω_{i,j}
-  Vec<Dim> domain_gradient = Vec<Dim>::Zero();  // g_{i,j}
-  bool rigid = false;
-  Vec<Dim> rigid_velocity = Vec<Dim>::Zero();
-  Vec<Dim> rigid_acceleration = Vec<Dim>::Zero();
-
-  void add(const ContactSide& o) {
-    mass += o.mass;
-    momentum += o.momentum;
-    force += o.force;
-    mass_position += o.mass_position;
-    domain += o.domain;
-    domain_gradient += o.domain_gradient;
-  }
-};
 
 /// Result of one material pair at one node: the momentum change of material a and its friction work.
 template <int Dim>
@@ -48,6 +27,7 @@ struct PairContext {
   const ContactPairSettings* settings;
   SeparationMethod separation;
   double position_correction;
+  double extent_tolerance;
   double cell_volume;  // of the node's cell (2D: times thickness), m^3
   double dt;
   bool heat;           // the momentum-update pass: compute frictional work
@@ -60,18 +40,7 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   // Normal from a to b (eq. 7 and §2.3): specified, maximum or average volume gradient.
   Vec<Dim> n;
   const ContactPairSettings& s = *c.settings;
-  if (s.normal == NormalMethod::specified) {
-    n = s.normal_vector.template head<Dim>();
-  } else if (s.normal == NormalMethod::max_volume_gradient) {
-    const double ga = a.domain_gradient.norm(), gb = b.domain_gradient.norm();
-    if (!(std::max(ga, gb) > 0.0)) return out;
-    n = ga >= gb ? Vec<Dim>(a.domain_gradient / ga) : Vec<Dim>(-b.domain_gradient / gb);
-  } else {
-    n = (a.domain * a.domain_gradient - b.domain * b.domain_gradient) / (a.domain + b.domain);
-    const double len = n.norm();
-    if (!(len > 0.0)) return out;
-    n /= len;
-  }
+  if (!contact_normal(a, b, s, n)) return out;
   // Effective cell thickness across the interface, exact for rectangular cells: h⊥ = 1/|n ⊘ h|.
   const double h_perp = 1.0 / n.cwiseQuotient(h).norm();
 
@@ -83,6 +52,8 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n) - c.position_correction * h_perp;
   else if (c.separation == SeparationMethod::displacement)  // eqs. 9–10
     separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n);
+  else if (c.separation == SeparationMethod::extent)  // particle domains, contact_extents.cpp
+    separation = std::isnan(a.extent_gap) ? -1.0 : a.extent_gap - c.extent_tolerance * h_perp;
   const bool in_contact = approaching && separation < 0.0;
 
   // Stick momentum change and reduced mass (eqs. 12–14); a rigid b has v_c = v_b, m_red = m_a.
@@ -138,6 +109,7 @@ template <int Dim>
 void Simulation<Dim>::find_contact_nodes() {
   if (!any_multimaterial_) {  // every present pair uses penalty contact
     contact_entries_.clear();
+    contact_groups_.assign(1, 0);
     return;
   }
   // Counting sort by node, O(slots) (no pass over the whole grid and no comparison sort): count the
@@ -168,6 +140,11 @@ void Simulation<Dim>::find_contact_nodes() {
         contact_entries_[static_cast<std::size_t>(node_entry_cursor_[static_cast<std::size_t>(node)]++)] = {
             node, static_cast<int>(s), static_cast<int>(f)};
     }
+  // Node groups of contact_entries_: the start of each contact node's run, then the end.
+  contact_groups_.clear();
+  for (std::size_t e = 0; e < contact_entries_.size(); ++e)
+    if (e == 0 || contact_entries_[e].node != contact_entries_[e - 1].node) contact_groups_.push_back(e);
+  contact_groups_.push_back(contact_entries_.size());
 }
 
 template <int Dim>
@@ -180,13 +157,9 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
   if (heat) contact_stats_ = ContactStats{};
 
-  // Node groups of contact_entries_ (one per contact node): each group reads and writes only its own
+  // The node groups of contact_entries_ (find_contact_nodes): each group reads and writes only its own
   // node's slots and work entries, so groups run in parallel. Stats and pair books go to per-thread
   // accumulators, summed in thread order afterwards (deterministic for a given thread count).
-  contact_groups_.clear();
-  for (std::size_t e = 0; e < contact_entries_.size(); ++e)
-    if (e == 0 || contact_entries_[e].node != contact_entries_[e - 1].node) contact_groups_.push_back(e);
-  contact_groups_.push_back(contact_entries_.size());
   const long groups = static_cast<long>(contact_groups_.size()) - 1;
   const int threads = groups >= 256 ? threads_ : 1;
   contact_thread_work_.resize(static_cast<std::size_t>(threads));
@@ -198,10 +171,11 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
 #pragma omp parallel num_threads(threads)
   {
     ContactThreadWork& acc = contact_thread_work_[static_cast<std::size_t>(omp_get_thread_num())];
-    PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, cell_volume, dt, heat};
+    PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, contact_opt_.extent_tolerance,
+                    cell_volume, dt, heat};
     // Per-node scratch, reused from call to call (no allocation per step once grown).
     thread_local std::vector<ContactSide<Dim>> sides;
-    thread_local std::vector<int> slots, mats;
+    thread_local std::vector<int> slots, mats, entries;
     thread_local std::vector<Vec<Dim>> dps;
     auto apply = [&](int slot, const Vec<Dim>& dp) {
       nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
@@ -219,38 +193,9 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
 
 #pragma omp for schedule(static)
     for (long g = 0; g < groups; ++g) {
-      const std::size_t e = contact_groups_[static_cast<std::size_t>(g)];
-      const std::size_t end = contact_groups_[static_cast<std::size_t>(g) + 1];
-      const int node = contact_entries_[e].node;
-      // Gather the materials at this node; slivers below min_mass_fraction take no part.
-      sides.clear(), slots.clear(), mats.clear();
-      double node_mass = 0.0;
-      for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].slot)];
-      for (std::size_t q = e; q < end; ++q) {
-        const int slot = contact_entries_[q].slot;
-        const std::size_t su = static_cast<std::size_t>(slot);
-        if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
-          if (heat) ++stats.guarded;
-          continue;
-        }
-        const std::size_t f = static_cast<std::size_t>(contact_entries_[q].field);
-        ContactSide<Dim> sd;
-        sd.mass = nodes_.mass[su];
-        sd.momentum = nodes_.momentum[su];
-        sd.force = nodes_.force[su];
-        sd.mass_position = nodes_.mass_position[su];
-        sd.domain = nodes_.domain[su];
-        sd.domain_gradient = nodes_.domain_gradient[su];
-        sd.rigid = fields_[f].rigid;
-        if (sd.rigid) {
-          const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
-          sd.rigid_velocity = field_velocity_[f];
-          sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
-        }
-        sides.push_back(sd);
-        slots.push_back(slot);
-        mats.push_back(fields_[f].material);
-      }
+      const int node = contact_entries_[contact_groups_[static_cast<std::size_t>(g)]].node;
+      const int guarded = gather_contact_sides(static_cast<std::size_t>(g), dt, sides, slots, mats, entries);
+      if (heat) stats.guarded += guarded;
       const std::size_t count = sides.size();
       if (heat) {
         ++stats.contact_nodes;
@@ -286,19 +231,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
         for (std::size_t a = 0; a < count; ++a) {
           if (sides[a].rigid) continue;
           ContactSide<Dim> rest;
-          std::size_t dominant = count;
-          double rigid_weight = -1.0;
-          for (std::size_t j = 0; j < count; ++j) {
-            if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
-            rest.add(sides[j]);
-            if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
-            if (sides[j].rigid && sides[j].mass > rigid_weight) {  // a rigid neighbour dominates the lump
-              rigid_weight = sides[j].mass;
-              rest.rigid = true;
-              rest.rigid_velocity = sides[j].rigid_velocity;
-              rest.rigid_acceleration = sides[j].rigid_acceleration;
-            }
-          }
+          const std::size_t dominant = lump_partners(sides, mats, a, rest);
           if (dominant == count) continue;  // all its partners here use penalty contact
           ctx.settings = &contact_pair(mats[a], mats[dominant]);
           const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
@@ -331,6 +264,108 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   }
 }
 
+// The materials at contact node `group` above min_mass_fraction of the node's mass (slivers take no
+// part), with their slots, materials and entries; returns how many were left out.
+template <int Dim>
+int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides,
+                                          std::vector<int>& slots, std::vector<int>& mats, std::vector<int>& entries) const {
+  const std::size_t e = contact_groups_[group], end = contact_groups_[group + 1];
+  sides.clear(), slots.clear(), mats.clear(), entries.clear();
+  const bool extents = contact_opt_.separation == SeparationMethod::extent && entry_extent_own_.size() == contact_entries_.size();
+  double node_mass = 0.0;
+  for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].slot)];
+  int guarded = 0;
+  for (std::size_t q = e; q < end; ++q) {
+    const int slot = contact_entries_[q].slot;
+    const std::size_t su = static_cast<std::size_t>(slot);
+    if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
+      ++guarded;
+      continue;
+    }
+    const std::size_t f = static_cast<std::size_t>(contact_entries_[q].field);
+    ContactSide<Dim> sd;
+    sd.mass = nodes_.mass[su];
+    sd.momentum = nodes_.momentum[su];
+    sd.force = nodes_.force[su];
+    sd.mass_position = nodes_.mass_position[su];
+    sd.domain = nodes_.domain[su];
+    sd.domain_gradient = nodes_.domain_gradient[su];
+    sd.rigid = fields_[f].rigid;
+    if (sd.rigid) {
+      const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
+      sd.rigid_velocity = field_velocity_[f];
+      sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
+    }
+    if (extents) {  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
+      const double own = entry_extent_own_[q], other = entry_extent_other_[q];
+      if (std::isfinite(own) && std::isfinite(other)) sd.extent_gap = -(own + other);
+    }
+    sides.push_back(sd);
+    slots.push_back(slot);
+    mats.push_back(fields_[f].material);
+    entries.push_back(static_cast<int>(q));
+  }
+  return guarded;
+}
+
+// sides[a]'s multimaterial partners lumped into one virtual material (§2.12); a rigid partner
+// dominates the lump. Returns the heaviest partner, or sides.size() when every partner here uses
+// penalty contact.
+template <int Dim>
+std::size_t Simulation<Dim>::lump_partners(const std::vector<ContactSide<Dim>>& sides, const std::vector<int>& mats,
+                                           std::size_t a, ContactSide<Dim>& rest) const {
+  const std::size_t count = sides.size();
+  rest = ContactSide<Dim>{};
+  std::size_t dominant = count;
+  double rigid_weight = -1.0;
+  for (std::size_t j = 0; j < count; ++j) {
+    if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
+    rest.add(sides[j]);
+    if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
+    if (sides[j].rigid && sides[j].mass > rigid_weight) {
+      rigid_weight = sides[j].mass;
+      rest.rigid = true;
+      rest.rigid_velocity = sides[j].rigid_velocity;
+      rest.rigid_acceleration = sides[j].rigid_acceleration;
+    }
+  }
+  return dominant;
+}
+
+// Extent separation: per contact entry, the normal from its material to its partners, as
+// resolve_contact will compute it (two materials: the pair's normal; more: against the lump).
+template <int Dim>
+void Simulation<Dim>::compute_contact_normals() {
+  entry_normal_.assign(contact_entries_.size(), Vec<Dim>::Zero());
+  entry_extent_own_.clear();  // no gap while the normals are gathered
+  const long groups = static_cast<long>(contact_groups_.size()) - 1;
+  const int threads = groups >= 256 ? threads_ : 1;
+#pragma omp parallel num_threads(threads)
+  {
+    thread_local std::vector<ContactSide<Dim>> sides;
+    thread_local std::vector<int> slots, mats, entries;
+#pragma omp for schedule(static)
+    for (long g = 0; g < groups; ++g) {
+      gather_contact_sides(static_cast<std::size_t>(g), 1.0, sides, slots, mats, entries);
+      const std::size_t count = sides.size();
+      if (count < 2) continue;
+      for (std::size_t a = 0; a < count; ++a) {
+        Vec<Dim> n;
+        bool ok;
+        if (count == 2) {
+          const std::size_t b = 1 - a;
+          ok = contact_normal(sides[a], sides[b], contact_pair(mats[a], mats[b]), n);
+        } else {
+          ContactSide<Dim> rest;
+          const std::size_t dominant = lump_partners(sides, mats, a, rest);
+          ok = dominant < count && contact_normal(sides[a], rest, contact_pair(mats[a], mats[dominant]), n);
+        }
+        if (ok) entry_normal_[static_cast<std::size_t>(entries[a])] = n;
+      }
+    }
+  }
+}
+
 template <int Dim>
 double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order) const {
   const auto& w = order == HeatingOrder::first ? pair_work_first_ : pair_work_second_;
@@ -350,6 +385,11 @@ double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order, int a, in
 #define FRICTHERM_INSTANTIATE_CONTACT(D)                                              \
   template void Simulation<D>::find_contact_nodes();                                  \
   template void Simulation<D>::resolve_contact(ContactPass, double);                  \
+  template void Simulation<D>::compute_contact_normals();                             \
+  template int Simulation<D>::gather_contact_sides(std::size_t, double, std::vector<ContactSide<D>>&,      \
+                                                   std::vector<int>&, std::vector<int>&, std::vector<int>&) const; \
+  template std::size_t Simulation<D>::lump_partners(const std::vector<ContactSide<D>>&, const std::vector<int>&, \
+                                                    std::size_t, ContactSide<D>&) const;                      \
   template double Simulation<D>::cumulative_frictional_work(HeatingOrder) const;      \
   template double Simulation<D>::cumulative_frictional_work(HeatingOrder, int, int) const;
 FRICTHERM_INSTANTIATE_CONTACT(2)

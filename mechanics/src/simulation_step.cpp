@@ -85,6 +85,7 @@ void Simulation<Dim>::step_with(double dt) {
   lap_.to(pt.particle_to_grid);
   if (contact_) {
     find_contact_nodes();
+    if (contact_opt_.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
     resolve_contact(ContactPass::extrapolated, dt);
     lap_.to(pt.contact, nested_phase_);
   }

@@ -16,7 +16,8 @@
 //
 // Sign convention: the normal n̂ points from material a to material b, so the materials approach
 // when (v_b − v_a)·n̂ < 0 and the separation is δ = (x̄_b − x̄_a)·n̂ − 0.8 h⊥ (positions) or
-// (Δx̄_b − Δx̄_a)·n̂ (displacements); the paper prints these with the opposite orientation.
+// (Δx̄_b − Δx̄_a)·n̂ (displacements), or the gap between the particles' domains (extent, frictherm's
+// own test, contact_extents.cpp); the paper prints these with the opposite orientation.
 #include <frictherm/mechanics/friction.hpp>
 #include <frictherm/mechanics/types.hpp>
 
@@ -25,7 +26,7 @@
 namespace frictherm::mechanics {
 
 enum class NormalMethod { max_volume_gradient, average_volume_gradient, specified };
-enum class SeparationMethod { position, displacement, velocity_only };
+enum class SeparationMethod { position, displacement, velocity_only, extent };
 enum class HeatingOrder { first, second };
 enum class ContactMethod { multimaterial, penalty };
 /// Penalty contact, tangential law: return mapping with a tangential spring (default) or Kakouris
@@ -33,7 +34,7 @@ enum class ContactMethod { multimaterial, penalty };
 enum class TangentialLaw { return_mapping, incremental };
 
 NormalMethod normal_method_from_string(const std::string& name);          // "mvg", "avg"
-SeparationMethod separation_method_from_string(const std::string& name);  // "position", "displacement", "velocity_only"
+SeparationMethod separation_method_from_string(const std::string& name);  // "position", "displacement", "velocity_only", "extent"
 HeatingOrder heating_order_from_string(const std::string& name);          // "first", "second"
 ContactMethod contact_method_from_string(const std::string& name);        // "multimaterial", "penalty"
 TangentialLaw tangential_law_from_string(const std::string& name);        // "return_mapping", "incremental"
@@ -68,6 +69,9 @@ struct ContactOptions {
   ContactPairSettings default_pair;                   // pairs not set explicitly
   SeparationMethod separation = SeparationMethod::position;
   double position_correction = 0.8;                   // c in δ = (x̄_b − x̄_a)·n̂ − c h⊥ (eq. 8)
+  /// Extent separation (contact_extents.cpp): in contact while the gap between the particle domains
+  /// along n̂ is below this fraction of h⊥.
+  double extent_tolerance = 0.0;
   /// A material whose mass at a node is below this fraction of the node's mass takes no part in
   /// contact there: its field is a numerical sliver, and its reduced mass would make the contact
   /// and heating terms ill-conditioned.

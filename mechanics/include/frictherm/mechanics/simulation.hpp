@@ -116,6 +116,9 @@ struct BodyInfo {
 };
 
 template <int Dim>
+struct ContactSide;  // contact internals (mechanics/src/contact_side.hpp)
+
+template <int Dim>
 class Simulation {
  public:
   explicit Simulation(const Grid<Dim>& grid, const SimulationOptions& options = {});
@@ -264,6 +267,14 @@ class Simulation {
   enum class ContactPass { extrapolated, updated, remapped };
   void find_contact_nodes();
   void resolve_contact(ContactPass pass, double dt);
+  /// Contact node `group`'s materials above min_mass_fraction (with the extent gap when measured),
+  /// their slots, materials and contact entries; returns how many slivers were left out.
+  int gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides, std::vector<int>& slots,
+                           std::vector<int>& mats, std::vector<int>& entries) const;
+  std::size_t lump_partners(const std::vector<ContactSide<Dim>>& sides, const std::vector<int>& mats, std::size_t a,
+                            ContactSide<Dim>& rest) const;
+  void compute_contact_normals();                                // extent separation: entry_normal_
+  template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
   void setup_penalty();                          // finalize(): penalty pairs and boundary points
@@ -303,6 +314,11 @@ class Simulation {
   std::vector<ContactThreadWork> contact_thread_work_;
   std::vector<std::uint16_t> node_field_count_;  // per grid node: fields with mass (find_contact_nodes)
   std::vector<int> node_entry_cursor_;           // per grid node: next entry of its run, −1: none
+  // Extent separation, per contact entry: the normal from its material to its partners, and the
+  // largest extents of its own particle domains along it and of its partners' along its reverse.
+  std::vector<Vec<Dim>> entry_normal_;
+  std::vector<double> entry_extent_own_, entry_extent_other_;
+  std::vector<std::vector<double>> extent_thread_;  // per-thread maxima (threads 1..n-1), own then other
   std::vector<double> work_first_, work_second_;    // per grid node, last step
   std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
   ContactStats contact_stats_;

@@ -1,0 +1,88 @@
+// Extent separation (frictherm's contact detection; docs/contact.md, "Contact detection"): at each
+// contact node, the gap between two materials is measured from their particles' domains instead of
+// their nodal centres of mass (Nairn, Bardenhagen & Smith 2018 eq. 8). With n̂ the normal from
+// material a to its partners (eq. 7, as resolve_contact computes it),
+//   gap = min over the partners' particles of (x_p·n̂ − r_p)  −  max over a's particles of (x_p·n̂ + r_p),
+// r_p = Σ_d l_{p,d} |n̂_d| the half-extent of particle p's domain (half-sizes l_p) along n̂, over the
+// particles that give the node a weight. Touching flat surfaces have gap = 0 whatever their offset
+// from the grid lines, so a material that reaches a node only as a sliver of its edge row is still
+// seen in contact there, where the centre-of-mass test puts it ≈ 1.25 h away.
+#include <frictherm/mechanics/simulation.hpp>
+
+#include "contact_side.hpp"
+
+#include <omp.h>
+
+#include <cmath>
+#include <limits>
+
+namespace frictherm::mechanics {
+
+template <int Dim>
+template <class Stencils>
+void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
+  compute_contact_normals();
+  const std::size_t entries = contact_entries_.size();
+  constexpr double none = -std::numeric_limits<double>::infinity();
+  entry_extent_own_.assign(entries, none);
+  entry_extent_other_.assign(entries, none);
+  if (entries == 0) return;
+  if (static_cast<int>(extent_thread_.size()) < threads_ - 1) extent_thread_.resize(static_cast<std::size_t>(threads_ - 1));
+#pragma omp parallel num_threads(threads_)
+  {
+    const int tid = omp_get_thread_num();
+    double* own = entry_extent_own_.data();
+    double* other = entry_extent_other_.data();
+    if (tid > 0) {
+      std::vector<double>& buf = extent_thread_[static_cast<std::size_t>(tid - 1)];
+      buf.assign(2 * entries, none);
+      own = buf.data();
+      other = buf.data() + entries;
+    }
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+      const int f = field_of_material_[m];
+      if (f < 0) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+#pragma omp for schedule(static) nowait
+      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+        const Vec<Dim>& x = p_.position[k];
+        const Vec<Dim>& l = p_.half_size[k];
+        st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
+          if (!(S > 0.0)) return;
+          const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(slot)]);
+          const int c = node_field_count_[node];
+          if (c < 2) return;
+          const int begin = node_entry_cursor_[node] - c;  // the node's run (find_contact_nodes)
+          for (int q = begin; q < begin + c; ++q) {
+            const std::size_t qu = static_cast<std::size_t>(q);
+            const Vec<Dim>& n = entry_normal_[qu];
+            if (n.squaredNorm() == 0.0) continue;  // a sliver, or no normal
+            const double centre = x.dot(n), half = l.cwiseProduct(n).cwiseAbs().sum();
+            if (contact_entries_[qu].field == f)
+              own[qu] = std::max(own[qu], centre + half);
+            else
+              other[qu] = std::max(other[qu], half - centre);
+          }
+        });
+      }
+    }
+  }
+  for (int t = 0; t + 1 < threads_; ++t) {
+    const std::vector<double>& buf = extent_thread_[static_cast<std::size_t>(t)];
+    for (std::size_t q = 0; q < entries; ++q) {
+      entry_extent_own_[q] = std::max(entry_extent_own_[q], buf[q]);
+      entry_extent_other_[q] = std::max(entry_extent_other_[q], buf[entries + q]);
+    }
+  }
+}
+
+#define FRICTHERM_INSTANTIATE_EXTENTS(D)                                                             \
+  template void Simulation<D>::measure_contact_extents(const std::vector<Stencil<D, LinearKernel>>&); \
+  template void Simulation<D>::measure_contact_extents(const std::vector<Stencil<D, UGIMPKernel>>&);  \
+  template void Simulation<D>::measure_contact_extents(const std::vector<Stencil<D, QuadraticBSplineKernel>>&); \
+  template void Simulation<D>::measure_contact_extents(const PrecomputedStencils<D>&);
+FRICTHERM_INSTANTIATE_EXTENTS(2)
+FRICTHERM_INSTANTIATE_EXTENTS(3)
+#undef FRICTHERM_INSTANTIATE_EXTENTS
+
+}  // namespace frictherm::mechanics
