@@ -6,6 +6,8 @@ find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(Boost 1.74 REQUIRED)  # header-only: Boost.Math root finders (mechanics friction laws)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(MUPARSER REQUIRED muparser>=2.3)  # libmuparser-dev: friction laws written as expressions
 if(FRICTHERM_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
@@ -16,4 +18,13 @@ if(NOT TARGET frictherm_hdf5)
   target_include_directories(frictherm_hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
   target_link_libraries(frictherm_hdf5 INTERFACE ${HDF5_C_LIBRARIES})
   target_compile_definitions(frictherm_hdf5 INTERFACE ${HDF5_C_DEFINITIONS} ${HDF5_DEFINITIONS})
+endif()
+
+# muParser (pkg-config gives variables): one exported target with the full library path, linked
+# privately by mechanics, so consumers link it but never see its headers.
+if(NOT TARGET frictherm_muparser)
+  add_library(frictherm_muparser INTERFACE)
+  target_include_directories(frictherm_muparser SYSTEM INTERFACE ${MUPARSER_INCLUDE_DIRS})
+  target_link_libraries(frictherm_muparser INTERFACE ${MUPARSER_LINK_LIBRARIES})
+  target_compile_options(frictherm_muparser INTERFACE ${MUPARSER_CFLAGS_OTHER})
 endif()

@@ -2,7 +2,10 @@
 // contact method (multimaterial or penalty on boundary points) with its penalty settings.
 #include <frictherm/coupling/scene_contact.hpp>
 
+#include <frictherm/mechanics/friction_expression.hpp>
+
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 
 namespace frictherm::coupling {
@@ -16,6 +19,25 @@ mechanics::FrictionLaw checked(const JsonReader& at, F&& make) {
     return make();
   } catch (const std::invalid_argument& e) {
     at.fail(e.what());
+  }
+}
+
+/// {"type": "expression", "sliding_traction": "<S in N, A, v>", "constants": {"name": number, ...}}:
+/// muParser's refusals (syntax, unknown names, S < 0 or not finite at a sample point) get the key path.
+mechanics::FrictionLaw parse_expression_law(const JsonReader& law) {
+  const JsonReader text = law.at("sliding_traction", "an expression for the sliding traction S (Pa) in N (Pa), A (m^2), v (m/s)");
+  if (!text.is_string()) text.expected("a string: an expression in N (Pa), A (m^2), v (m/s), e.g. \"0.3*N\"");
+  std::map<std::string, double> constants;
+  if (const auto c = law.find("constants")) {
+    if (!c->is_object()) c->expected("an object of named numbers, e.g. {\"mu_s\": 0.35}");
+    for (const std::string& name : c->keys()) constants[name] = c->at(name).as_number();
+  }
+  try {
+    return mechanics::expression_friction_law(text.as_string(), constants);
+  } catch (const mechanics::FrictionExpressionError& e) {
+    const std::string& key = e.key();
+    if (key.rfind("constants.", 0) == 0) law.at("constants").at(key.substr(10)).fail(e.what());
+    text.fail(e.what());
   }
 }
 
@@ -65,14 +87,14 @@ void check_penalty_law(const mechanics::ContactPairSettings& s, const JsonReader
 mechanics::FrictionLaw parse_friction_law(const JsonReader& law) {
   using mechanics::FrictionLaw;
   const std::vector<std::string> types{"stick", "frictionless", "coulomb", "linear_velocity", "adhesion",
-                                       "static_dynamic", "smooth_static_dynamic", "composite", "tabulated"};
+                                       "static_dynamic", "smooth_static_dynamic", "composite", "tabulated", "expression"};
   if (law.is_string()) {
     const std::string t = law.as_choice({"stick", "frictionless"});
     return t == "stick" ? FrictionLaw::stick() : FrictionLaw::frictionless();
   }
   if (!law.is_object()) law.expected("a friction law: \"stick\", \"frictionless\" or an object with \"type\"");
   const std::string type = law.at("type", "one of stick, frictionless, coulomb, linear_velocity, adhesion, "
-                                          "static_dynamic, smooth_static_dynamic, composite, tabulated")
+                                          "static_dynamic, smooth_static_dynamic, composite, tabulated, expression")
                                .as_choice(types);
   const Range mu_range = Range::non_negative();
   FrictionLaw out;
@@ -108,6 +130,8 @@ mechanics::FrictionLaw parse_friction_law(const JsonReader& law) {
     const double sa = law.number("shear_strength", 0.0, Range::non_negative());
     const double na = law.number("tensile_strength", inf, Range::positive());
     out = checked(law, [&] { return FrictionLaw::composite(ms, md, vh, k, sa, na); });
+  } else if (type == "expression") {  // any S(N, A_c, |Δv'|) of eq 21, parsed by muParser
+    out = parse_expression_law(law);
   } else {  // tabulated
     const std::vector<double> speeds = law.at("speeds", "an array of sliding speeds (m/s), increasing").as_number_list(1, Range::non_negative());
     const std::vector<double> mu = law.at("mu", "an array of friction coefficients, one per speed").as_number_list(1, mu_range);

@@ -35,8 +35,9 @@ struct ContactSpec {
   std::vector<ContactPairSpec> pairs;
 };
 
-/// A friction law object: {"type": "coulomb", "mu": 0.2}, ... or the bare strings "stick" and
-/// "frictionless".
+/// A friction law object: {"type": "coulomb", "mu": 0.2}, ..., {"type": "expression",
+/// "sliding_traction": "mu_s*N + S_a", "constants": {"mu_s": 0.3, "S_a": 1e4}}, or the bare strings
+/// "stick" and "frictionless".
 mechanics::FrictionLaw parse_friction_law(const JsonReader& law);
 
 /// Reads the optional `contact` section; material names resolve against `material_names`.
