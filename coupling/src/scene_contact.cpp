@@ -167,8 +167,13 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
   o.separation = mechanics::separation_method_from_string(
       c->choice("separation", {"position", "displacement", "velocity_only", "extent"}, "position"));
   o.position_correction = c->number("position_correction", 0.8, Range{0.0, 2.0, false, true});
-  o.extent_tolerance = c->number("extent_tolerance", 0.0, Range{0.0, 1.0, false, false});
-  o.min_mass_fraction = c->number("min_mass_fraction", 1e-6, Range{0.0, 0.5, false, true});
+  // Extent detection handles slivers itself (normal contact only, see docs/contact.md), so by default
+  // it drops no material; the other detections drop slivers below 1e-6 of the node's mass.
+  const bool extent = o.separation == mechanics::SeparationMethod::extent;
+  if (extent) o.use_extent_detection();
+  o.extent_tolerance = c->number("extent_tolerance", o.extent_tolerance, Range{0.0, 1.0, false, false});
+  o.min_mass_fraction = c->number("min_mass_fraction", o.min_mass_fraction, Range{0.0, 0.5, false, true});
+  o.sliver_fraction = c->number("sliver_fraction", o.sliver_fraction, Range{0.0, 0.5, false, true});
   auto material_id = [&](const JsonReader& name) {
     const std::string n = name.as_string();
     const auto it = std::find(material_names.begin(), material_names.end(), n);

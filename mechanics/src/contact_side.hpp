@@ -25,6 +25,10 @@ struct ContactSide {
   /// Extent separation: the gap between this material's particle domains and its partners' along
   /// the normal from this material to them (m, < 0 where they overlap); NaN when not measured.
   double extent_gap = std::numeric_limits<double>::quiet_NaN();
+  /// Below ContactOptions::sliver_fraction of the node's mass: kept from interpenetrating, never
+  /// given friction (a sliver's contact area ~ its overlap but its mass ~ overlap², so any area-based
+  /// law would stick it and its shape-function gradient would strain its particles).
+  bool sliver = false;
 
   void add(const ContactSide& o) {
     mass += o.mass;

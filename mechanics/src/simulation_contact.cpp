@@ -81,6 +81,11 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     }
     return out;
   }
+  if (a.sliver || b.sliver) {  // normal change only: no friction, no heat (ContactSide::sliver)
+    out.changed = true;
+    out.dp = d_n * n;
+    return out;
+  }
   const FrictionOutcome f = s.law.in_contact(ContactImpulse{d_n, d_t, out.reduced_mass, area, c.dt});
   out.changed = true;
   if (f.stick || !(d_t > 0.0)) {
@@ -264,8 +269,8 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   }
 }
 
-// The materials at contact node `group` above min_mass_fraction of the node's mass (slivers take no
-// part), with their slots, materials and entries; returns how many were left out.
+// The materials at contact node `group` above min_mass_fraction of the node's mass (lighter ones take
+// no part; those under sliver_fraction are marked), with their slots, materials and entries; returns how many were left out.
 template <int Dim>
 int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides,
                                           std::vector<int>& slots, std::vector<int>& mats, std::vector<int>& entries) const {
@@ -291,6 +296,7 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
     sd.domain = nodes_.domain[su];
     sd.domain_gradient = nodes_.domain_gradient[su];
     sd.rigid = fields_[f].rigid;
+    sd.sliver = nodes_.mass[su] < contact_opt_.sliver_fraction * node_mass;
     if (sd.rigid) {
       const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
       sd.rigid_velocity = field_velocity_[f];
@@ -318,9 +324,11 @@ std::size_t Simulation<Dim>::lump_partners(const std::vector<ContactSide<Dim>>& 
   rest = ContactSide<Dim>{};
   std::size_t dominant = count;
   double rigid_weight = -1.0;
+  bool all_slivers = true;
   for (std::size_t j = 0; j < count; ++j) {
     if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
     rest.add(sides[j]);
+    all_slivers = all_slivers && sides[j].sliver;
     if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
     if (sides[j].rigid && sides[j].mass > rigid_weight) {
       rigid_weight = sides[j].mass;
@@ -329,6 +337,7 @@ std::size_t Simulation<Dim>::lump_partners(const std::vector<ContactSide<Dim>>& 
       rest.rigid_acceleration = sides[j].rigid_acceleration;
     }
   }
+  rest.sliver = dominant != count && all_slivers;
   return dominant;
 }
 

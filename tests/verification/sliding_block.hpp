@@ -147,6 +147,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     co.default_pair.normal = s.normal;
     co.default_pair.normal_vector = Vec<3>(-sn, c, 0.0);  // from base to block
     co.separation = s.separation;
+    if (s.separation == SeparationMethod::extent) co.use_extent_detection();
     co.default_pair.method = s.method;
     sim.enable_contact(co);
     ContactPairSettings pair = co.default_pair;

@@ -76,6 +76,19 @@ struct ContactOptions {
   /// contact there: its field is a numerical sliver, and its reduced mass would make the contact
   /// and heating terms ill-conditioned.
   double min_mass_fraction = 1e-6;
+  /// A material whose mass at a node is below this fraction of the node's mass (but above
+  /// min_mass_fraction) is a sliver there: contact stops it interpenetrating (normal change only)
+  /// but applies no friction and makes no heat. 0: none.
+  double sliver_fraction = 0.0;
+  /// Extent detection with its companions (the scene defaults for `"separation": "extent"`): no
+  /// material dropped, slivers below 1e-3 of the node's mass frictionless, gaps below 1 % of h⊥
+  /// not resolved (docs/contact.md, "Contact detection").
+  void use_extent_detection() {
+    separation = SeparationMethod::extent;
+    min_mass_fraction = 0.0;
+    sliver_fraction = 1e-3;
+    extent_tolerance = 0.01;
+  }
   /// Penalty contact: spacing of the boundary points sampled on each body's region (m); 0: half
   /// the smallest cell size. Used when a body is added, so set it before add_body().
   double boundary_spacing = 0.0;

@@ -1,0 +1,99 @@
+// Extent separation (contact_extents.cpp, docs/contact.md "Contact detection"): contact decided from the
+// gap between the particle domains along the normal, with slivers kept from interpenetrating but given
+// no friction. Checked on the sliding block of Nairn, Bardenhagen & Smith (2018), figure 2:
+//  * under the preload alone the block is in static equilibrium, so every particle row carries
+//    σ_yy = −N; with position separation the bottom rows do not (a sliver of the block's field at the
+//    node row below the interface falls below min_mass_fraction, is dropped, and its a = f/m strains
+//    the bottom row: tensile row 0, over-compressed row 1, worse at finer cells);
+//  * adhesion sliding against the rigid-block solution at two resolutions.
+#include "sliding_block.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+using namespace frictherm;
+using namespace frictherm::verification;
+using mechanics::FrictionLaw;
+using mechanics::SeparationMethod;
+
+namespace {
+
+// Mean σ_yy of the block's bottom particle row (k = 0) and the row above it (k = 1), 2 particles per cell.
+std::vector<double> bottom_row_stress(const mechanics::Simulation<2>& sim, int block, double cell) {
+  const auto& p = sim.particles();
+  double ymin = 1e300;
+  for (std::size_t q = 0; q < p.size(); ++q)
+    if (p.material[q] == block) ymin = std::min(ymin, p.position[q][1]);
+  std::vector<double> sum(2, 0.0), count(2, 0.0);
+  for (std::size_t q = 0; q < p.size(); ++q) {
+    if (p.material[q] != block) continue;
+    const double row = (p.position[q][1] - ymin) / (0.5 * cell);
+    for (int k = 0; k < 2; ++k)
+      if (std::fabs(row - k) < 0.25) sum[static_cast<std::size_t>(k)] += p.stress[q](1, 1), ++count[static_cast<std::size_t>(k)];
+  }
+  return {sum[0] / count[0], sum[1] / count[1]};
+}
+
+// Largest |σ_yy/N + 1| of the two bottom rows after the normal ramp (t1 = tf/4) and a further 0.3 ms.
+double preload_row_error(SeparationMethod separation, double cell) {
+  using C = SlidingBlockConstants;
+  SlidingBlockSetup s;
+  s.cell = cell;
+  s.separation = separation;
+  s.law = FrictionLaw::coulomb(0.2);
+  int block = 0;
+  mechanics::Simulation<2> sim = make_sliding_block(s, block);
+  const double t_end = 0.25 * C::t_final() + 3e-4;  // the tangential load starts at tf/4 from zero
+  while (sim.time() < t_end) sim.step(t_end - sim.time());
+  const std::vector<double> rows = bottom_row_stress(sim, block, cell);
+  const double N = C::normal_stress();
+  std::printf("[preload, %s, %.2f mm cells] bottom rows sigma_yy %.1f, %.1f kPa (applied -%.1f kPa)\n",
+              separation == SeparationMethod::extent ? "extent" : "position", cell * 1e3, rows[0] / 1e3,
+              rows[1] / 1e3, N / 1e3);
+  return std::max(std::fabs(rows[0] / N + 1.0), std::fabs(rows[1] / N + 1.0));
+}
+
+}  // namespace
+
+// Static equilibrium under the preload: the ramp (3.4 ms) is 300 times the block's wave transit time,
+// so the rows carry −N to within the small dynamic residue; 3 % allows for it. Two resolutions: the
+// sliver that breaks position separation shrinks with the cell while its damage grows.
+TEST(ExtentSeparation, PreloadedInterfaceRowsCarryTheAppliedPressure) {
+  for (double cell : {0.005, 0.0025}) EXPECT_LT(preload_row_error(SeparationMethod::extent, cell), 0.03) << cell;
+  // Position separation at 2.5 mm, for the record (measured: row 0 about −125 kPa, row 1 −168 kPa and
+  // drifting apart); not asserted, it documents why extent exists.
+  preload_row_error(SeparationMethod::position, 0.0025);
+}
+
+// Adhesion (μ = 0.2, S_a = 0.3 N, R = 1) with extent detection against the rigid block, errors relative to
+// its own v_max. Measured with the scene runner: 5.9 % / 1.5 % of v_max and −6.2 % / −1.5 % of the work at
+// 5 / 2.5 mm. At 1.25 mm the sliding block still lifts off (docs/contact.md, "Known limitations").
+TEST(ExtentSeparation, AdhesionBlockAtTwoResolutions) {
+  using C = SlidingBlockConstants;
+  const double S_a = 0.3 * C::normal_stress();
+  const RigidBlock r = rigid_solution(0.2, 0.2, 0.0, S_a);
+  const double tf = C::t_final(), v_max = r.velocity(tf), Q = r.friction_work(tf);
+  std::vector<double> velocity_error, work_error;
+  for (double cell : {0.005, 0.0025}) {
+    SlidingBlockSetup s;
+    s.cell = cell;
+    s.separation = SeparationMethod::extent;
+    s.law = FrictionLaw::adhesion(0.2, S_a);
+    const SlidingHistory h = run_sliding_block(s);
+    double e = 0.0;
+    for (std::size_t k = 0; k < h.time.size(); ++k) e = std::max(e, std::fabs(h.velocity[k] - r.velocity(h.time[k])) / v_max);
+    velocity_error.push_back(e);
+    work_error.push_back(std::fabs(h.work_second.back() - Q) / Q);
+    std::printf("[adhesion, extent, %.2f mm cells] max |v - v_rigid|/v_max %.4f (v_max %.2f m/s), work %.5g J vs %.5g J\n",
+                cell * 1e3, e, v_max, h.work_second.back(), Q);
+  }
+  EXPECT_LT(velocity_error[0], 0.08);
+  EXPECT_LT(velocity_error[1], 0.02);
+  EXPECT_LT(velocity_error[1], velocity_error[0]);
+  EXPECT_LT(work_error[1], 0.03);
+  EXPECT_LT(work_error[1], work_error[0]);
+}
+
