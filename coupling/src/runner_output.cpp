@@ -94,33 +94,44 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
   return row;
 }
 
+// Snapshot fields in the shapes VTK (ParaView's XDMF reader, Warp By Vector, Calculator) expects:
+// vectors are (n, 3) and the stress is the full 3x3 tensor (n, 9, row-major) in 2D as in 3D. In 2D the
+// z components of vectors are 0 and the stress's zz entry is the out-of-plane stress (stress_zz, 0 in
+// plane stress), its xz, yz, zx, zy entries 0. position keeps (n, Dim): it is the XDMF geometry (XY in
+// 2D), which VTK pads itself. docs/output.md describes every array.
 template <int Dim>
 void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields) {
   const auto& p = sim.particles();
   const std::size_t n = p.size();
   std::vector<double> buf;
   auto vectors = [&](const std::string& name, auto&& get) {
-    buf.resize(n * Dim);
+    buf.assign(n * 3, 0.0);
     for (std::size_t k = 0; k < n; ++k) {
       const mechanics::Vec<Dim> v = get(k);
-      for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = v[d];
+      for (int d = 0; d < Dim; ++d) buf[k * 3 + static_cast<std::size_t>(d)] = v[d];
     }
-    out.snapshot_field(name, buf.data(), n, Dim);
+    out.snapshot_field(name, buf.data(), n, 3);
   };
   auto scalars = [&](const std::string& name, const std::vector<double>& v) { out.snapshot_field(name, v.data(), n, 1); };
   for (const std::string& f : fields) {
     if (f == "position") {
-      vectors(f, [&](std::size_t k) { return p.position[k]; });
+      buf.resize(n * Dim);
+      for (std::size_t k = 0; k < n; ++k)
+        for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = p.position[k][d];
+      out.snapshot_field(f, buf.data(), n, Dim);
     } else if (f == "velocity") {
       vectors(f, [&](std::size_t k) { return p.velocity[k]; });
     } else if (f == "displacement") {
       vectors(f, [&](std::size_t k) { return mechanics::Vec<Dim>(p.position[k] - p.initial_position[k]); });
     } else if (f == "stress") {
-      buf.resize(n * Dim * Dim);
-      for (std::size_t k = 0; k < n; ++k)
+      buf.assign(n * 9, 0.0);
+      for (std::size_t k = 0; k < n; ++k) {
+        double* s = &buf[k * 9];
         for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j) buf[(k * Dim + static_cast<std::size_t>(i)) * Dim + static_cast<std::size_t>(j)] = p.stress[k](i, j);
-      out.snapshot_field(f, buf.data(), n, Dim * Dim);
+          for (int j = 0; j < Dim; ++j) s[3 * i + j] = p.stress[k](i, j);
+        if (Dim == 2 && k < p.stress_zz.size()) s[8] = p.stress_zz[k];
+      }
+      out.snapshot_field(f, buf.data(), n, 9);
     } else if (f == "stress_zz") {
       scalars(f, p.stress_zz);
     } else if (f == "mass") {
