@@ -8,6 +8,8 @@ find_package(Boost 1.74 REQUIRED)  # header-only: Boost.Math root finders (mecha
 find_package(OpenMP REQUIRED COMPONENTS CXX)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(MUPARSER REQUIRED muparser>=2.3)  # libmuparser-dev: friction laws written as expressions
+find_package(PNG REQUIRED)   # libpng-dev: PNG micrographs (mechanics/src/image_png_tiff.cpp)
+find_package(TIFF REQUIRED)  # libtiff-dev: TIFF micrographs
 if(FRICTHERM_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
@@ -27,4 +29,13 @@ if(NOT TARGET frictherm_muparser)
   target_include_directories(frictherm_muparser SYSTEM INTERFACE ${MUPARSER_INCLUDE_DIRS})
   target_link_libraries(frictherm_muparser INTERFACE ${MUPARSER_LINK_LIBRARIES})
   target_compile_options(frictherm_muparser INTERFACE ${MUPARSER_CFLAGS_OTHER})
+endif()
+
+# libpng and libtiff, like muParser: one exported target with full library paths, linked privately by
+# mechanics (consumers link them, never see their headers).
+if(NOT TARGET frictherm_images)
+  add_library(frictherm_images INTERFACE)
+  target_include_directories(frictherm_images SYSTEM INTERFACE ${PNG_INCLUDE_DIRS} ${TIFF_INCLUDE_DIRS})
+  target_link_libraries(frictherm_images INTERFACE ${PNG_LIBRARIES} ${TIFF_LIBRARIES})
+  target_compile_definitions(frictherm_images INTERFACE ${PNG_DEFINITIONS})
 endif()

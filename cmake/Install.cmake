@@ -2,7 +2,7 @@
 # another project can find_package(frictherm) and link frictherm::coupling.
 include(CMakePackageConfigHelpers)
 
-install(TARGETS frictherm_mechanics frictherm_thermal frictherm_coupling frictherm_hdf5 frictherm_muparser
+install(TARGETS frictherm_mechanics frictherm_thermal frictherm_coupling frictherm_hdf5 frictherm_muparser frictherm_images
         EXPORT frictherm-targets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

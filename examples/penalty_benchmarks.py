@@ -34,6 +34,14 @@ SHAPES = {"ebs": "extended_bspline", "obs": "quadratic_bspline"}
 COLORS = {"ebs": "tab:blue", "obs": "tab:red"}
 
 
+def in_plane_stress(stress):
+    """(n, 2, 2) in-plane Cauchy stress of a 2D snapshot: the file stores the 3x3 tensor (n, 9) since
+    format_version 2 (docs/output.md), (n, 4) before."""
+    stress = np.asarray(stress, dtype=float)
+    n = stress.shape[0]
+    return stress.reshape(n, 3, 3)[:, :2, :2] if stress.size == 9 * n else stress.reshape(n, 2, 2)
+
+
 def run(args, scene, tag, sets):
     """Runs frictherm on examples/<scene>.json with --set overrides; returns the output path."""
     out = os.path.join(args.out, f"{tag}.h5")
@@ -159,7 +167,7 @@ def half_disk(args):
             row = np.where((body == 0) & (d < 0.5 * h) & (np.abs(X0[:, 0]) < 2 * b) & (X0[:, 1] < 0.5 * R))[0]
             hold = [g for t, g in snaps if t >= 1.999e-4]  # the load is held from 200 us
             pos = np.mean([g["position"][row] for g in hold], axis=0)
-            syy = np.mean([g["stress"][row].reshape(-1, 2, 2)[:, 1, 1] for g in hold], axis=0)
+            syy = np.mean([in_plane_stress(g["stress"][row])[:, 1, 1] for g in hold], axis=0)
             an = hertz_sigma_zz(pos[:, 0], np.maximum(pos[:, 1], 0), b, p0)
             inside = np.abs(pos[:, 0]) <= 1.5 * b
             e = math.sqrt(np.mean((syy[inside] - an[inside]) ** 2)) / p0
@@ -188,7 +196,7 @@ def half_disk(args):
 
 # ---- Neo-Hookean rings (section 4.4) ----------------------------------------------------------------
 def von_mises(g):
-    s = g["stress"].reshape(-1, 2, 2)
+    s = in_plane_stress(g["stress"])
     szz = g["stress_zz"] if "stress_zz" in g else np.zeros(len(s))
     sxx, syy, sxy = s[:, 0, 0], s[:, 1, 1], s[:, 0, 1]
     return np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3 * sxy ** 2)
@@ -243,7 +251,7 @@ def granular(args):
         sets = {"grid.cell_size": h, "contact.boundary_spacing": 2 * math.pi * R / (n - 0.5)}
         path = run(args, "granular_waves", f"granular_{level}mm", sets)
         tt, g = snapshots(path)[-1]
-        s = g["stress"].reshape(-1, 2, 2)
+        s = in_plane_stress(g["stress"])
         d = np.sqrt(4 * s[:, 0, 1] ** 2 + (s[:, 0, 0] - s[:, 1, 1]) ** 2)  # eq. 50
         fringe = 1 - np.sin(kf * d) ** 2  # eq. 49
         disks = g["body"] > 0

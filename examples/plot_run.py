@@ -97,7 +97,9 @@ def stress_parts(g, dim):
     """Returns (3x3 stress per particle as an (n, 3, 3) array)."""
     s = np.asarray(g["stress"], dtype=float)
     n = s.shape[0]
-    full = np.zeros((n, 3, 3))
+    if s.size == 9 * n:  # format_version 2: the full 3x3 tensor (zz = stress_zz in 2D)
+        return s.reshape(n, 3, 3)
+    full = np.zeros((n, 3, 3))  # format_version 1 files: dim x dim, stress_zz apart
     full[:, :dim, :dim] = s.reshape(n, dim, dim)
     if dim == 2 and "stress_zz" in g:
         full[:, 2, 2] = np.asarray(g["stress_zz"], dtype=float).reshape(n)
@@ -135,8 +137,10 @@ def field_values(g, name, dim):
             index = int(suffix)
         elif len(suffix) == 1 and suffix in AXES[:dim]:
             index = AXES.index(suffix)
-        elif len(suffix) == 2 and all(c in AXES[:dim] for c in suffix) and comps == dim * dim:
-            index = AXES.index(suffix[0]) * dim + AXES.index(suffix[1])
+        elif len(suffix) == 2 and all(c in AXES for c in suffix) and comps in (9, dim * dim):
+            width = 3 if comps == 9 else dim  # 9: the 3x3 tensor of format_version 2, also in 2D
+            if all(AXES.index(c) < width for c in suffix):
+                index = AXES.index(suffix[0]) * width + AXES.index(suffix[1])
         if index is not None and index < comps:
             return (data[:, index] if data.ndim > 1 else data), name
     available = sorted(set(g.keys()) | {"speed", "von_mises", "pressure", "displacement_magnitude"})

@@ -2,6 +2,7 @@
 // The `frictherm` command-line program: subcommands and their argument handling.
 #include <map>
 #include <stdexcept>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,23 @@ int export_csv_command(const std::vector<std::string>& args);
 int microstructure_command(const std::vector<std::string>& args);  // cli_microstructure.cpp
 
 /// Help texts (printed to stdout by --help).
+/// What an MPI launcher told this process through its environment (cli_launcher.cpp).
+struct LauncherInfo {
+  bool launched = false;  // some launcher variable is set
+  long size = -1;         // process count announced (largest size variable), -1 if none
+  long rank = -1;         // this process's rank (largest rank variable), -1 if none
+  std::string evidence;   // e.g. "OMPI_COMM_WORLD_SIZE=2", for messages
+};
+LauncherInfo launcher_info();
+bool several_processes(const LauncherInfo& info);  // size > 1 or rank > 0
+/// kOk, or kUsage after a message (printed by rank 0 only) when started as several processes and
+/// `command` cannot share the work: any command without MPI, any command but ensemble with MPI.
+int refuse_under_launcher(const std::string& command);
+/// Process set-up before anything else (OpenMP wait policy in builds without MPI).
+void prepare_process(char** argv);
+/// `frictherm --version`: version, git commit, MPI, OpenMP, SUNDIALS, HDF5 and Eigen.
+void print_version(std::ostream& out);
+
 extern const char* const kProgramHelp;
 extern const char* const kRunHelp;
 extern const char* const kResumeHelp;

@@ -30,9 +30,6 @@ long non_negative_long(const std::string& option, const std::string& text) {
   return v;
 }
 
-/// MPI only when a launcher started us (a singleton MPI_Init is slow and refused as root in some
-/// containers): Open MPI sets OMPI_COMM_WORLD_SIZE, MPICH and others PMI_SIZE.
-bool launched_by_mpirun() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE"); }
 
 /// Sums each member's record fields over the processes (each member is run by exactly one).
 void gather_records(std::vector<coupling::MemberRecord>& all, const std::vector<coupling::MemberRecord>& mine,
@@ -79,6 +76,7 @@ int ensemble_command(const std::vector<std::string>& args, const std::string& /*
     return kOk;
   }
   const std::string& path = single_positional("ensemble", a, "SCENE");
+  const LauncherInfo launch = launcher_info();
   coupling::EnsembleOptions o;
   if (!a.has("seed-key")) throw UsageError("ensemble", "missing --seed-key KEY (the scene key that takes each seed)");
   o.seed_key = a.options.at("seed-key");
@@ -96,17 +94,28 @@ int ensemble_command(const std::vector<std::string>& args, const std::string& /*
     probe.push_back({o.seed_key, std::to_string(o.first_seed)});
     coupling::load_scene(path, probe);
   } catch (const coupling::SceneError& e) {
-    std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    // Every process finds the same error: only the first one (rank 0, or the only one) reports it.
+    if (launch.rank <= 0) std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
     return kUsage;
   }
 
   bool mpi = false;
 #ifdef FRICTHERM_WITH_MPI
-  if (launched_by_mpirun()) {
+  // MPI only when a launcher started us (a singleton MPI_Init is slow and refused as root in some
+  // containers; launcher_info in cli_launcher.cpp lists the variables looked at).
+  if (launch.launched) {
     MPI_Init(nullptr, nullptr);
     MPI_Comm_rank(MPI_COMM_WORLD, &o.rank);
     MPI_Comm_size(MPI_COMM_WORLD, &o.ranks);
     mpi = true;
+    if (launch.size > 1 && o.ranks != launch.size) {  // e.g. MPICH's mpiexec starting an Open MPI build
+      if (launch.rank <= 0)
+        std::cerr << "frictherm ensemble: the launcher started " << launch.size << " processes (" << launch.evidence
+                  << ") but MPI sees " << o.ranks << ": it is not the MPI this frictherm was built with, and "
+                  << "every process would run every member. Use that MPI's mpirun ('frictherm --version').\n";
+      MPI_Finalize();
+      return kUsage;
+    }
   }
 #endif
   int code = kOk;
@@ -126,8 +135,8 @@ int ensemble_command(const std::vector<std::string>& args, const std::string& /*
                                                     : std::to_string(s.critical_fraction).substr(0, 5).c_str());
       if (s.completed < s.members) code = kSimulationFailed;
     }
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "frictherm ensemble: " << e.what() << '\n';
+  } catch (const std::invalid_argument& e) {  // the same on every process: rank 0 reports it
+    if (o.rank == 0) std::cerr << "frictherm ensemble: " << e.what() << '\n';
     code = kUsage;
   } catch (const std::exception& e) {
     std::cerr << "frictherm ensemble: " << e.what() << '\n';

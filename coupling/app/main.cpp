@@ -1,8 +1,6 @@
 // frictherm: the command-line program (run, validate, export-csv, ensemble).
 #include "cli.hpp"
 
-#include <frictherm/coupling/thread_policy.hpp>
-
 #include <exception>
 #include <iostream>
 #include <string>
@@ -37,7 +35,7 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
     return kOk;
   }
   if (cmd == "--version" || cmd == "-V") {
-    std::cout << "frictherm " << FRICTHERM_VERSION << '\n';
+    print_version(std::cout);
     return kOk;
   }
   if (cmd == "help") {
@@ -49,6 +47,9 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
     if (!h || rest.size() > 1) throw UsageError("", "no help for '" + rest.back() + "'");
     std::cout << h;
     return kOk;
+  }
+  if (cmd == "run" || cmd == "resume" || cmd == "export-csv" || cmd == "microstructure" || cmd == "ensemble") {
+    if (const int refused = refuse_under_launcher(cmd); refused != kOk) return refused;
   }
   if (cmd == "run") return run_command(rest, command_line);
   if (cmd == "resume") return resume_command(rest, command_line);
@@ -62,9 +63,7 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
 }  // namespace
 
 int main(int argc, char** argv) {
-#ifndef FRICTHERM_WITH_MPI  // under MPI the launcher owns the process: set OMP_WAIT_POLICY yourself
-  frictherm::coupling::ensure_passive_wait(argv);  // threads sleep at barriers (docs/coupling.md)
-#endif
+  frictherm::cli::prepare_process(argv);
   std::vector<std::string> words(argv + 1, argv + argc);
   std::string command_line;
   for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + quote_arg(argv[i]);
@@ -72,6 +71,7 @@ int main(int argc, char** argv) {
     return dispatch(words, command_line);
   } catch (const frictherm::cli::UsageError& e) {
     const std::string who = e.command().empty() ? "frictherm" : "frictherm " + e.command();
+    if (frictherm::cli::launcher_info().rank > 0) return frictherm::cli::kUsage;  // rank 0 reports it
     std::cerr << who << ": " << e.what() << " (see '" << who << " --help')\n";
     return frictherm::cli::kUsage;
   } catch (const std::exception& e) {

@@ -416,7 +416,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.set_evictions(true);
   m.cache.set_initial_size = false;
 
-  const std::int32_t version = 1, d = dim;
+  const std::int32_t version = 2, d = dim;  // 2: vectors (n, 3) and stress (n, 9) in 2D too
   io.string_attribute(m.file.get(), "format", "frictherm-output", "/");
   io.attribute(m.file.get(), "format_version", H5T_STD_I32LE, H5T_NATIVE_INT32, &version, "/");
   io.attribute(m.file.get(), "dim", H5T_STD_I32LE, H5T_NATIVE_INT32, &d, "/");

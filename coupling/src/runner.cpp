@@ -58,6 +58,7 @@ class Run {
     write_microstructure_images(out);  // generated bodies (ellipse_packing): the image beside the output
     detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
     std::vector<std::string> series_columns = detail::series_names(Dim);
+    detail::append_body_series_names<Dim>(series_columns, *sim_);
     detail::append_contact_series_names<Dim>(series_columns, *sim_);
     if (thermal_) thermal_->declare_output(out, series_columns);  // thermal hook: columns + /hotspots
     out.declare_series(series_columns);
@@ -70,7 +71,7 @@ class Run {
       loop(progress);
       if (thermal_ && r_.status == RunResult::Status::completed) {
         const Clock::time_point c0 = Clock::now();
-        thermal_->continuation(out, *sim_, s_.output.fields);  // thermal hook: thermal-only phase
+        thermal_->continuation(out, *sim_, s_.output.fields, series_memory_);  // thermal hook: thermal-only phase
         continuation_seconds_ = seconds_since(c0);
         if (detail::interrupt_signal() != 0) interrupted();
       }
@@ -250,7 +251,7 @@ class Run {
 
   void series() {
     const Clock::time_point c0 = Clock::now();
-    std::vector<double> row = detail::series_row<Dim>(*sim_);
+    std::vector<double> row = detail::series_row<Dim>(*sim_, series_memory_, heating_order());
     if (thermal_) thermal_->extend_series_row(row, *out_, *sim_, sim_->time());  // thermal hook
     out_->append_series(row);
     last_series_step_ = sim_->step_count();
@@ -282,6 +283,11 @@ class Run {
   double coupling_seconds_ = 0.0;       // in thermal_->after_step (heating and solve)
   double loading_solve_seconds_ = 0.0;  // of which inside the integrator
   double continuation_seconds_ = 0.0;
+  detail::SeriesMemory series_memory_;  // the previous series row, for the contact_heat_rate columns
+  // The frictional work that becomes heat: the thermal section's heating order, else second order.
+  mechanics::HeatingOrder heating_order() const {
+    return thermal_ ? thermal_->heating_order() : mechanics::HeatingOrder::second;
+  }
   double output_seconds_ = 0.0;         // series rows and snapshots
   Clock::time_point last_flush_ = Clock::now();  // series rows written and file flushed
   bool checkpoints_ = false;

@@ -14,12 +14,28 @@ namespace frictherm::coupling::detail {
 /// momentum_x, momentum_y (, momentum_z).
 std::vector<std::string> series_names(int dim);
 /// With contact: cumulative frictional work (total and per listed pair, both orders), contact and
-/// sliding node counts and each body's mean velocity.
+/// sliding node counts, each body's mean velocity and the contact heat rate (total and per pair).
 template <int Dim>
 void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim);
 
+/// Every run: each body's mass-weighted mean temperature and mean displacement,
+/// mean_temperature.<body>, mean_displacement_x.<body>, _y (, _z).
 template <int Dim>
-std::vector<double> series_row(const mechanics::Simulation<Dim>& sim);
+void append_body_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim);
+
+/// What the rate columns remember from the previous series row.
+struct SeriesMemory {
+  double time = 0.0;
+  bool has_previous = false;
+  std::vector<double> work;  // cumulative frictional work: total, then per contact pair
+};
+
+/// One series row in the order of series_names + append_body_series_names +
+/// append_contact_series_names. contact_heat_rate(.pair) columns use the frictional work of `order`
+/// (the one handed to the thermal solver) and `memory` (updated here).
+template <int Dim>
+std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemory& memory,
+                               mechanics::HeatingOrder order);
 
 /// Writes the named per-particle fields of the current state into the open snapshot.
 template <int Dim>

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <ctime>
+#include <limits>
 #include <sstream>
 
 namespace frictherm::coupling::detail {
@@ -32,6 +33,10 @@ void append_contact_series_names(std::vector<std::string>& names, const mechanic
   const char* axes[3] = {"x", "y", "z"};
   for (const auto& body : sim.bodies())
     for (int d = 0; d < Dim; ++d) names.push_back(std::string("mean_velocity_") + axes[d] + "." + body.name);
+  names.emplace_back("contact_heat_rate");
+  for (const auto& [a, b] : sim.contact_pairs())
+    names.push_back("contact_heat_rate." + mats[static_cast<std::size_t>(a)].name + "." +
+                    mats[static_cast<std::size_t>(b)].name);
   // Penalty contact (docs/penalty_contact.md): the springs' energy, and per pair (master.slave) the
   // normal force, active contacts, deepest gap and the summed length of the penetrated master segments.
   if (!sim.penalty_contact()) return;
@@ -45,16 +50,67 @@ void append_contact_series_names(std::vector<std::string>& names, const mechanic
 }
 
 template <int Dim>
-std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
+void append_body_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim) {
+  const char* axes[3] = {"x", "y", "z"};
+  for (const auto& body : sim.bodies()) {
+    names.push_back("mean_temperature." + body.name);
+    for (int d = 0; d < Dim; ++d) names.push_back(std::string("mean_displacement_") + axes[d] + "." + body.name);
+  }
+}
+
+namespace {
+
+// Mass-weighted means over each body's particles: temperature (K) and displacement x - X (m).
+template <int Dim>
+void append_body_means(std::vector<double>& row, const mechanics::Simulation<Dim>& sim) {
+  const auto& p = sim.particles();
+  const std::size_t bodies = sim.bodies().size();
+  std::vector<double> m(bodies, 0.0), mT(bodies, 0.0);
+  std::vector<mechanics::Vec<Dim>> mu(bodies, mechanics::Vec<Dim>::Zero());
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const std::size_t b = static_cast<std::size_t>(p.body[k]);
+    m[b] += p.mass[k];
+    mT[b] += p.mass[k] * p.temperature[k];
+    mu[b] += p.mass[k] * (p.position[k] - p.initial_position[k]);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();  // a body without mass has no mean
+  for (std::size_t b = 0; b < bodies; ++b) {
+    row.push_back(m[b] > 0.0 ? mT[b] / m[b] : nan);
+    for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mu[b][d] / m[b] : nan);
+  }
+}
+
+// contact_heat_rate: the increase of the cumulative frictional work (of the order handed to the
+// thermal solver) since the previous series row over the time between them, W. The rates times the
+// row intervals add up to the frictional work exactly (a telescoping sum); 0 in the first row.
+template <int Dim>
+void append_heat_rates(std::vector<double>& row, const mechanics::Simulation<Dim>& sim, SeriesMemory& memory,
+                       mechanics::HeatingOrder order) {
+  std::vector<double> work{sim.cumulative_frictional_work(order)};
+  for (const auto& [a, b] : sim.contact_pairs()) work.push_back(sim.cumulative_frictional_work(order, a, b));
+  const double dt = sim.time() - memory.time;
+  for (std::size_t j = 0; j < work.size(); ++j)
+    row.push_back(memory.has_previous && dt > 0.0 ? (work[j] - memory.work[j]) / dt : 0.0);
+  memory.time = sim.time();
+  memory.has_previous = true;
+  memory.work = std::move(work);
+}
+
+}  // namespace
+
+template <int Dim>
+std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemory& memory,
+                               mechanics::HeatingOrder order) {
   const double ke = sim.kinetic_energy(), se = sim.strain_energy();
   std::vector<double> row{sim.time(), static_cast<double>(sim.step_count()), sim.last_time_step(), ke, se,
                           ke + se,    sim.external_work()};
   const auto P = sim.linear_momentum();
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+  append_body_means(row, sim);
   if (!sim.contact_enabled()) return row;
-  for (auto order : {mechanics::HeatingOrder::first, mechanics::HeatingOrder::second}) {
-    row.push_back(sim.cumulative_frictional_work(order));
-    for (const auto& [a, b] : sim.contact_pairs()) row.push_back(sim.cumulative_frictional_work(order, a, b));
+  for (auto each : {mechanics::HeatingOrder::first, mechanics::HeatingOrder::second}) {
+    row.push_back(sim.cumulative_frictional_work(each));
+    for (const auto& [a, b] : sim.contact_pairs()) row.push_back(sim.cumulative_frictional_work(each, a, b));
   }
   row.push_back(static_cast<double>(sim.contact_stats().contact_nodes));
   row.push_back(static_cast<double>(sim.contact_stats().sliding_nodes));
@@ -69,6 +125,7 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
   }
   for (std::size_t b = 0; b < mv.size(); ++b)
     for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mv[b][d] / m[b] : 0.0);
+  append_heat_rates(row, sim, memory, order);
   const mechanics::PenaltyContact<Dim>* pc = sim.penalty_contact();
   if (!pc) return row;
   row.push_back(pc->stored_energy());
@@ -94,33 +151,44 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim) {
   return row;
 }
 
+// Snapshot fields in the shapes VTK (ParaView's XDMF reader, Warp By Vector, Calculator) expects:
+// vectors are (n, 3) and the stress is the full 3x3 tensor (n, 9, row-major) in 2D as in 3D. In 2D the
+// z components of vectors are 0 and the stress's zz entry is the out-of-plane stress (stress_zz, 0 in
+// plane stress), its xz, yz, zx, zy entries 0. position keeps (n, Dim): it is the XDMF geometry (XY in
+// 2D), which VTK pads itself. docs/output.md describes every array.
 template <int Dim>
 void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields) {
   const auto& p = sim.particles();
   const std::size_t n = p.size();
   std::vector<double> buf;
   auto vectors = [&](const std::string& name, auto&& get) {
-    buf.resize(n * Dim);
+    buf.assign(n * 3, 0.0);
     for (std::size_t k = 0; k < n; ++k) {
       const mechanics::Vec<Dim> v = get(k);
-      for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = v[d];
+      for (int d = 0; d < Dim; ++d) buf[k * 3 + static_cast<std::size_t>(d)] = v[d];
     }
-    out.snapshot_field(name, buf.data(), n, Dim);
+    out.snapshot_field(name, buf.data(), n, 3);
   };
   auto scalars = [&](const std::string& name, const std::vector<double>& v) { out.snapshot_field(name, v.data(), n, 1); };
   for (const std::string& f : fields) {
     if (f == "position") {
-      vectors(f, [&](std::size_t k) { return p.position[k]; });
+      buf.resize(n * Dim);
+      for (std::size_t k = 0; k < n; ++k)
+        for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = p.position[k][d];
+      out.snapshot_field(f, buf.data(), n, Dim);
     } else if (f == "velocity") {
       vectors(f, [&](std::size_t k) { return p.velocity[k]; });
     } else if (f == "displacement") {
       vectors(f, [&](std::size_t k) { return mechanics::Vec<Dim>(p.position[k] - p.initial_position[k]); });
     } else if (f == "stress") {
-      buf.resize(n * Dim * Dim);
-      for (std::size_t k = 0; k < n; ++k)
+      buf.assign(n * 9, 0.0);
+      for (std::size_t k = 0; k < n; ++k) {
+        double* s = &buf[k * 9];
         for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j) buf[(k * Dim + static_cast<std::size_t>(i)) * Dim + static_cast<std::size_t>(j)] = p.stress[k](i, j);
-      out.snapshot_field(f, buf.data(), n, Dim * Dim);
+          for (int j = 0; j < Dim; ++j) s[3 * i + j] = p.stress[k](i, j);
+        if (Dim == 2 && k < p.stress_zz.size()) s[8] = p.stress_zz[k];
+      }
+      out.snapshot_field(f, buf.data(), n, 9);
     } else if (f == "stress_zz") {
       scalars(f, p.stress_zz);
     } else if (f == "mass") {
@@ -188,7 +256,8 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
 
 #define FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(D)                                                                \
   template void append_contact_series_names<D>(std::vector<std::string>&, const mechanics::Simulation<D>&);      \
-  template std::vector<double> series_row<D>(const mechanics::Simulation<D>&);                               \
+  template void append_body_series_names<D>(std::vector<std::string>&, const mechanics::Simulation<D>&);         \
+  template std::vector<double> series_row<D>(const mechanics::Simulation<D>&, SeriesMemory&, mechanics::HeatingOrder); \
   template void write_fields<D>(H5Output&, const mechanics::Simulation<D>&, const std::vector<std::string>&); \
   template void write_start_metadata<D>(H5Output&, const Scene&, const mechanics::Simulation<D>&, const RunOptions&);
 FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(2)

@@ -112,7 +112,7 @@ void ThermalRun<Dim>::after_step(mechanics::Simulation<Dim>& sim, const std::vec
 
 template <int Dim>
 void ThermalRun<Dim>::continuation(H5Output& out, mechanics::Simulation<Dim>& sim,
-                                   const std::vector<std::string>& fields) {
+                                   const std::vector<std::string>& fields, SeriesMemory& memory) {
   if (!(spec_.continuation_duration > 0.0)) return;
   guarded(sim, sim.time(), [&] { coupler_.close_window(sim.particles(), sim.time()); });
   const double t0 = sim.time();
@@ -121,7 +121,7 @@ void ThermalRun<Dim>::continuation(H5Output& out, mechanics::Simulation<Dim>& si
   for (long k = 1; k <= n; ++k) {
     t = t0 + spec_.continuation_duration * static_cast<double>(k) / static_cast<double>(n);
     guarded(sim, t, [&] { coupler_.continue_thermal(sim.particles(), t); });
-    std::vector<double> row = series_row<Dim>(sim);
+    std::vector<double> row = series_row<Dim>(sim, memory, spec_.heating_order);
     row[0] = t;  // the mechanics columns stay at their final values
     extend_series_row(row, out, sim, t);
     out.append_series(row);

@@ -29,7 +29,8 @@ class ThermalRun {
   void after_step(mechanics::Simulation<Dim>& sim, const std::vector<double>& nodal_work, bool must_close);
   /// Thermal-only continuation after the mechanics (scene coupling.continuation): one series row per
   /// interval and a final snapshot at its end time.
-  void continuation(H5Output& out, mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields);
+  void continuation(H5Output& out, mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields,
+                    SeriesMemory& memory);
   /// Particle fields of the thermal side into the open snapshot (reaction_progress with a reaction).
   void write_fields(H5Output& out) const;
   /// Integrator statistics and energy books into /meta (thermal_*).

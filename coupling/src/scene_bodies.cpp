@@ -102,7 +102,7 @@ void parse_polygon(const JsonReader& shape, int dim, ShapeSpec& out) {
 
 void parse_image(const JsonReader& shape, Scene& s, ParseContext& ctx, ShapeSpec& out) {
   out.type = ShapeType::image;
-  const JsonReader file = shape.at("file", "the path of a PGM or BMP image, relative to the scene file");
+  const JsonReader file = shape.at("file", "the path of a PGM, BMP, PNG or TIFF image, relative to the scene file");
   const std::string rel = file.as_string();
   if (rel.empty()) file.expected("a file name");
   out.image_file = (rel[0] == '/' || ctx.base_dir.empty()) ? rel : ctx.base_dir + "/" + rel;

@@ -48,12 +48,12 @@ std::string xml_escape(const std::string& text) {
   return out;
 }
 
-std::string xdmf_attribute_type(int components, int dim) {
+std::string xdmf_attribute_type(int components) {
   if (components == 1) return "Scalar";
-  if (components == dim) return "Vector";
-  if (components == 9 && dim == 3) return "Tensor";
-  if (components == 6 && dim == 3) return "Tensor6";
-  return "Matrix";  // e.g. the 2x2 in-plane stress in 2D
+  if (components == 3) return "Vector";
+  if (components == 9) return "Tensor";
+  if (components == 6) return "Tensor6";
+  return "Matrix";  // any other width: read as a plain multi-component array
 }
 
 std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name, int dim) {
@@ -85,7 +85,7 @@ std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name,
   for (const auto& f : grid.fields) {
     if (&f == position) continue;
     out += in3 + "<Attribute Name=\"" + xml_escape(f.name) + "\" AttributeType=\"" +
-           xdmf_attribute_type(f.components, dim) + "\" Center=\"Node\">\n";
+           xdmf_attribute_type(f.components) + "\" Center=\"Node\">\n";
     data_item(out, in4, dims_text(grid.points, f.components), f.integer, h5_file_name,
               grid.h5_group + "/" + f.name);
     out += in3 + "</Attribute>\n";

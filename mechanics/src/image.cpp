@@ -177,7 +177,10 @@ GreyImage read_grey_image(const std::string& path) {
   in.read(magic, 2);
   if (in && magic[0] == 'P' && (magic[1] == '2' || magic[1] == '5')) return read_pgm(path);
   if (in && magic[0] == 'B' && magic[1] == 'M') return read_bmp(path);
-  throw std::runtime_error("image file '" + path + "' is neither a PGM (magic P2 or P5) nor a BMP (magic BM)");
+  if (in && static_cast<unsigned char>(magic[0]) == 0x89 && magic[1] == 'P') return read_png(path);
+  if (in && ((magic[0] == 'I' && magic[1] == 'I') || (magic[0] == 'M' && magic[1] == 'M'))) return read_tiff(path);
+  throw std::runtime_error("image file '" + path +
+                           "' is none of PGM (magic P2 or P5), BMP (BM), PNG (\\x89PNG) or TIFF (II or MM)");
 }
 
 void write_pgm(const GreyImage& image, const std::string& path, const std::string& comment) {

@@ -136,11 +136,10 @@ struct Particles {
   std::vector<std::int32_t> material;
   Particles(std::size_t n, int dim, int k) {
     for (std::size_t p = 0; p < n; ++p) {
-      for (int c = 0; c < dim; ++c) {
-        position.push_back(0.01 * static_cast<double>(p % 10) + 0.001 * c + 0.1 * k);
-        velocity.push_back(std::sin(static_cast<double>(p + c + k)));
-      }
-      for (int c = 0; c < dim * dim; ++c) stress.push_back(1e6 * (p + 1) + c + k);
+      for (int c = 0; c < dim; ++c) position.push_back(0.01 * static_cast<double>(p % 10) + 0.001 * c + 0.1 * k);
+      // Vectors and tensors in the runner's shapes (3 and 9 components also in 2D, z padded with 0).
+      for (int c = 0; c < 3; ++c) velocity.push_back(c < dim ? std::sin(static_cast<double>(p + c + k)) : 0.0);
+      for (int c = 0; c < 9; ++c) stress.push_back(1e6 * (p + 1) + c + k);
       temperature.push_back(300.0 + static_cast<double>(p) + k);
       volume.push_back(1e-4);
       material.push_back(static_cast<std::int32_t>(p % 3));
@@ -148,8 +147,8 @@ struct Particles {
   }
   void write(H5Output& out, std::size_t n, int dim) const {
     out.snapshot_field("position", position.data(), n, dim);
-    out.snapshot_field("velocity", velocity.data(), n, dim);
-    out.snapshot_field("stress", stress.data(), n, dim * dim);
+    out.snapshot_field("velocity", velocity.data(), n, 3);
+    out.snapshot_field("stress", stress.data(), n, 9);
     out.snapshot_field("temperature", temperature.data(), n, 1);
     out.snapshot_field("volume", volume.data(), n, 1);
     out.snapshot_field("material", material.data(), n);
@@ -161,7 +160,8 @@ void expect_snapshot(hid_t f, const std::string& group, std::size_t n, int dim, 
   EXPECT_EQ(read_attr<std::int64_t>(f, group, "step", H5T_NATIVE_INT64), step);
   EXPECT_EQ(read_attr<double>(f, group, "time", H5T_NATIVE_DOUBLE), time);
   EXPECT_EQ(shape(f, group + "/position"), (std::vector<hsize_t>{n, hsize_t(dim)}));
-  EXPECT_EQ(shape(f, group + "/stress"), (std::vector<hsize_t>{n, hsize_t(dim * dim)}));
+  EXPECT_EQ(shape(f, group + "/velocity"), (std::vector<hsize_t>{n, 3}));
+  EXPECT_EQ(shape(f, group + "/stress"), (std::vector<hsize_t>{n, 9}));
   EXPECT_EQ(shape(f, group + "/temperature"), (std::vector<hsize_t>{n}));
   EXPECT_EQ(read_doubles(f, group + "/position"), ref.position);
   EXPECT_EQ(read_doubles(f, group + "/velocity"), ref.velocity);
@@ -318,10 +318,11 @@ TEST(Output, XdmfListsEverySnapshotAndField) {
   EXPECT_EQ(count_of(xml, "TopologyType=\"Polyvertex\" NumberOfElements=\"5\""), 4u);
   EXPECT_EQ(count_of(xml, "GeometryType=\"XY\""), 4u);
   EXPECT_EQ(count_of(xml, "<Attribute Name=\"velocity\" AttributeType=\"Vector\""), 4u);
-  EXPECT_EQ(count_of(xml, "<Attribute Name=\"stress\" AttributeType=\"Matrix\""), 4u);
+  EXPECT_EQ(count_of(xml, "<Attribute Name=\"stress\" AttributeType=\"Tensor\""), 4u);
   EXPECT_EQ(count_of(xml, "<Attribute Name=\"temperature\" AttributeType=\"Scalar\""), 4u);
   EXPECT_EQ(count_of(xml, "<Attribute Name=\"material\" AttributeType=\"Scalar\""), 4u);
-  EXPECT_EQ(count_of(xml, "<DataItem Dimensions=\"5 4\" NumberType=\"Float\""), 4u);
+  EXPECT_EQ(count_of(xml, "<DataItem Dimensions=\"5 9\" NumberType=\"Float\""), 4u);
+  EXPECT_EQ(count_of(xml, "<DataItem Dimensions=\"5 3\" NumberType=\"Float\""), 4u);
   EXPECT_EQ(count_of(xml, "NumberType=\"Int\" Precision=\"4\""), 8u);  // connectivity + material
   EXPECT_FALSE(fs::exists(out.xdmf_path() + ".tmp"));
   out.close();
@@ -336,12 +337,12 @@ TEST(Output, XdmfListsEverySnapshotAndField) {
 
 TEST(Output, XdmfAttributeTypes) {
   using frictherm::coupling::xdmf_attribute_type;
-  EXPECT_EQ(xdmf_attribute_type(1, 2), "Scalar");
-  EXPECT_EQ(xdmf_attribute_type(2, 2), "Vector");
-  EXPECT_EQ(xdmf_attribute_type(4, 2), "Matrix");
-  EXPECT_EQ(xdmf_attribute_type(3, 3), "Vector");
-  EXPECT_EQ(xdmf_attribute_type(9, 3), "Tensor");
-  EXPECT_EQ(xdmf_attribute_type(6, 3), "Tensor6");
+  EXPECT_EQ(xdmf_attribute_type(1), "Scalar");
+  EXPECT_EQ(xdmf_attribute_type(2), "Matrix");  // VTK's vector filters assert 3 components
+  EXPECT_EQ(xdmf_attribute_type(4), "Matrix");
+  EXPECT_EQ(xdmf_attribute_type(3), "Vector");
+  EXPECT_EQ(xdmf_attribute_type(9), "Tensor");
+  EXPECT_EQ(xdmf_attribute_type(6), "Tensor6");
   EXPECT_EQ(frictherm::coupling::xdmf_path_for("out/run.h5"), "out/run.xdmf");
   EXPECT_EQ(frictherm::coupling::xdmf_path_for("run"), "run.xdmf");
   EXPECT_EQ(frictherm::coupling::xml_escape("a<b&\"c\""), "a&lt;b&amp;&quot;c&quot;");

@@ -2,7 +2,7 @@
 // One HDF5 file per run, written so that a run that dies keeps what it already wrote.
 //
 // Layout (all datasets little-endian; names are the contract the plotting scripts rely on):
-//   /                      attrs: format = "frictherm-output", format_version = 1, dim
+//   /                      attrs: format = "frictherm-output", format_version = 2, dim
 //   /meta/<key>            scalar datasets: fixed-length UTF-8 strings or doubles
 //   /snapshots/000000 ...  one group per snapshot, attrs step (int64) and time (double);
 //                          datasets (n) for one component, (n, components) otherwise
@@ -50,8 +50,9 @@ class H5Output {
   /// Starts particle snapshot number snapshot_count(). Fields follow, then end_snapshot().
   void begin_snapshot(long step, double time);
   /// n rows x components doubles, row-major. Conventional names: position (n x dim, required for
-  /// the XDMF geometry), velocity, displacement (n x dim), stress (n x dim*dim), mass, volume,
-  /// temperature, ... Every field of one snapshot must have the same n.
+  /// the XDMF geometry), velocity, displacement (n x 3, z = 0 in 2D), stress (n x 9, the 3x3 tensor),
+  /// mass, volume, temperature, ... The XDMF file calls 3 components a Vector, 9 a Tensor, 6 a
+  /// Tensor6 (docs/output.md). Every field of one snapshot must have the same n.
   void snapshot_field(const std::string& name, const double* data, std::size_t n, int components);
   /// Integer per-particle field (material id, body id).
   void snapshot_field(const std::string& name, const std::int32_t* data, std::size_t n);

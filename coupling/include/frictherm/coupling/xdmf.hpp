@@ -26,8 +26,10 @@ struct XdmfGrid {
   std::vector<XdmfField> fields;  // must include "position" with `dim` components
 };
 
-/// "Scalar" (1), "Vector" (dim), in 3D "Tensor" (9) and "Tensor6" (6), otherwise "Matrix".
-std::string xdmf_attribute_type(int components, int dim);
+/// "Scalar" (1), "Vector" (3), "Tensor" (9), "Tensor6" (6), otherwise "Matrix". Only these widths are
+/// what VTK's filters take as vectors and tensors (Warp By Vector asserts 3 components), so 2D runs
+/// write vectors padded to 3 components and the stress as a 3x3 tensor (docs/output.md).
+std::string xdmf_attribute_type(int components);
 
 /// The XML of one grid (indented for the temporal collection). Throws std::invalid_argument when
 /// the grid has no position field of `dim` components or no points.

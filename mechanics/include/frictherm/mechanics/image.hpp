@@ -1,6 +1,7 @@
 #pragma once
-// Grey-scale images for image-defined microstructures: PGM (P2, P5) and uncompressed BMP (8-bit
-// palettised, 24-bit) readers, a PGM writer. Labelling of grains: microstructure.hpp.
+// Grey-scale images for image-defined microstructures: PGM (P2, P5), uncompressed BMP (8-bit
+// palettised, 24-bit), PNG (libpng) and TIFF (libtiff) readers, a PGM writer. Labelling of grains:
+// microstructure.hpp.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -24,7 +25,21 @@ GreyImage read_pgm(const std::string& path);
 /// compressed files are refused with std::runtime_error naming the file and what was found.
 GreyImage read_bmp(const std::string& path);
 
-/// Reads a PGM or BMP file, chosen by its first two bytes ("P2"/"P5" or "BM").
+/// Reads a PNG (libpng): grey, grey + alpha, RGB, RGBA or palette, 1 to 16 bits. Grey of 8 or fewer
+/// bits gives max_value 255 (1, 2 and 4 bit scaled up: 1 bit is 0 or 255), 16 bits max_value 65535;
+/// colour becomes grey by the BMP rule, round(0.299 R + 0.587 G + 0.114 B), per 8- or 16-bit sample;
+/// alpha and transparency are ignored. The header's size is checked against the file's before any
+/// allocation (deflate packs at most 1032:1). Throws std::runtime_error naming the file and the problem.
+GreyImage read_png(const std::string& path);
+
+/// Reads the first image of a TIFF (libtiff): 8 or 16 bit unsigned grey (min-is-black, or
+/// min-is-white, inverted) or RGB (grey by the BMP rule; extra samples such as alpha ignored), in
+/// strips with interleaved samples, any compression libtiff decodes. The header's size is checked
+/// against the file's before allocation (raw: 1:1, compressed: at most 4096:1). Throws
+/// std::runtime_error naming the file and the problem.
+GreyImage read_tiff(const std::string& path);
+
+/// Reads a PGM, BMP, PNG or TIFF file, chosen by its first two bytes ("P2"/"P5", "BM", "\x89P", "II"/"MM").
 GreyImage read_grey_image(const std::string& path);
 
 /// Writes `image` as binary PGM (P5; one byte per pixel when max_value <= 255, else two, big

@@ -1,0 +1,170 @@
+// MPI that cannot corrupt a study (issue 14): a frictherm built without MPI refuses to start as several
+// processes under a launcher (the launcher's variables are set by hand here), the MPI build refuses
+// every command but ensemble, --version names the build's features, and a real `mpirun -n 2` ensemble
+// writes the same aggregate as the serial one (skipped when mpirun is not installed).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "h5_test_support.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using frictherm::test::read_doubles;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result shell(const std::string& cmd) {
+  Result r;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
+
+// A small block moving slowly: a few dozen steps. The ensemble's seed key is the snapshot count, a
+// harmless integer that changes each member's steps (snapshot times shorten steps).
+const char* const kTinyScene = R"({
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
+              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+  "run": {"end_time": 2e-3, "threads": 1},
+  "output": {"snapshot_count": 4}
+})";
+
+class CliMpi : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("frictherm_mpi_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(path("tiny.json")) << kTinyScene;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+std::string serial_exe() { return std::string("'") + FRICTHERM_SERIAL_EXE + "'"; }
+std::string mpi_exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
+
+// mpirun of the MPI frictherm was built with, or "" when there is none (the test is then skipped).
+std::string mpirun() {
+  const Result which = shell("command -v mpirun");
+  if (which.code != 0 || which.output.empty()) return "";
+  std::string cmd = "mpirun --oversubscribe";  // 2 processes even on a 1-core machine
+  if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
+  return cmd;
+}
+
+}  // namespace
+
+TEST_F(CliMpi, SerialBuildRefusesEveryLauncherWithSeveralProcesses) {
+  const std::string scene = path("tiny.json");
+  for (const char* env : {"OMPI_COMM_WORLD_SIZE=2", "PMI_SIZE=4", "PMIX_SIZE=3", "MV2_COMM_WORLD_SIZE=2"}) {
+    const std::string out = path("run.h5");
+    const Result r = shell(std::string("env ") + env + " " + serial_exe() + " run '" + scene + "' -o '" + out + "'");
+    EXPECT_EQ(r.code, 2) << env << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(std::string("started by an MPI launcher as several processes (") + env + ")"));
+    EXPECT_THAT(r.output, HasSubstr("built without MPI"));
+    EXPECT_FALSE(fs::exists(out)) << env << ": nothing may be written";
+  }
+  // The ensemble, the command the issue saw corrupted, is refused too.
+  const Result e = shell("env OMPI_COMM_WORLD_SIZE=2 OMPI_COMM_WORLD_RANK=0 " + serial_exe() + " ensemble '" + scene +
+                         "' --seed-key output.snapshot_count -n 2 -o '" + path("ens.h5") + "'");
+  EXPECT_EQ(e.code, 2) << e.output;
+  EXPECT_THAT(e.output, HasSubstr("every member of 'ensemble'"));
+  EXPECT_FALSE(fs::exists(path("ens.h5")));
+  // Only rank 0 explains; a rank > 0 alone (PMIx gives no size) is enough to refuse.
+  const Result quiet = shell("env PMIX_RANK=1 " + serial_exe() + " run '" + scene + "' -o '" + path("q.h5") + "'");
+  EXPECT_EQ(quiet.code, 2);
+  EXPECT_EQ(quiet.output, "");
+}
+
+TEST_F(CliMpi, SingleProcessUnderALauncherRuns) {
+  const Result r = shell("env OMPI_COMM_WORLD_SIZE=1 OMPI_COMM_WORLD_RANK=0 " + serial_exe() + " run '" +
+                         path("tiny.json") + "' -o '" + path("one.h5") + "'");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path("one.h5")));
+}
+
+TEST_F(CliMpi, MpiBuildRefusesCommandsThatDoNotShareWork) {
+#ifndef FRICTHERM_TEST_MPI
+  GTEST_SKIP() << "frictherm was built without MPI";
+#endif
+  for (const char* cmd : {"run", "resume", "microstructure", "export-csv"}) {
+    const Result r = shell(std::string("env PMI_SIZE=2 PMI_RANK=0 ") + mpi_exe() + " " + cmd + " '" + path("tiny.json") + "'");
+    EXPECT_EQ(r.code, 2) << cmd << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(std::string("only 'frictherm ensemble' spreads its members over MPI processes; "
+                                                "every process would run '") + cmd + "'"));
+  }
+}
+
+TEST_F(CliMpi, VersionNamesTheBuildsFeatures) {
+  for (const std::string& exe : {serial_exe(), mpi_exe()}) {
+    const Result r = shell(exe + " --version");
+    EXPECT_EQ(r.code, 0);
+    EXPECT_THAT(r.output, HasSubstr("frictherm " FRICTHERM_VERSION "\n"));
+    for (const char* feature : {"  git commit: ", "  MPI: ", "  OpenMP: 20", "  SUNDIALS: 6.", "  HDF5: 1.", "  Eigen: 3."})
+      EXPECT_THAT(r.output, HasSubstr(feature)) << exe;
+  }
+  EXPECT_THAT(shell(serial_exe() + " --version").output, HasSubstr("  MPI: no"));
+#ifdef FRICTHERM_TEST_MPI
+  EXPECT_THAT(shell(mpi_exe() + " --version").output, HasSubstr("  MPI: yes, MPI 3."));
+#endif
+}
+
+TEST_F(CliMpi, MpirunEnsembleMatchesTheSerialOneAndReportsSceneErrorsOnce) {
+#ifndef FRICTHERM_TEST_MPI
+  GTEST_SKIP() << "frictherm was built without MPI";
+#endif
+  const std::string launcher = mpirun();
+  if (launcher.empty()) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
+  const std::string args = " ensemble '" + path("tiny.json") + "' --seed-key output.snapshot_count --first-seed 2 -n 3 --threads 1";
+  const Result serial = shell(mpi_exe() + args + " -o '" + path("serial.h5") + "'");
+  ASSERT_EQ(serial.code, 0) << serial.output;
+  const Result par = shell(launcher + " -n 2 " + mpi_exe() + args + " -o '" + path("par.h5") + "'");
+  ASSERT_EQ(par.code, 0) << par.output;
+  EXPECT_THAT(par.output, HasSubstr("3 members (3 completed, 2 processes)"));
+  EXPECT_EQ(count_of(par.output, "wrote "), 1u) << "only process 0 aggregates";
+  // Member k on process k mod 2, each member once: the aggregate equals the serial run's (the members
+  // are deterministic, so steps and simulated times agree exactly).
+  for (const char* column : {"seed", "status", "steps", "simulated_time", "hotspots"}) {
+    const std::string where = std::string("/members/") + column;
+    EXPECT_EQ(read_doubles(path("par.h5"), where), read_doubles(path("serial.h5"), where)) << column;
+  }
+  EXPECT_EQ(read_doubles(path("par.h5"), "/members/seed"), (std::vector<double>{2, 3, 4}));
+  for (int seed : {2, 3, 4}) EXPECT_TRUE(fs::exists(path("par_seed" + std::to_string(seed) + ".h5"))) << seed;
+
+  // A scene error: both processes find it, one reports it, the exit code is 2.
+  std::ofstream(path("bad.json")) << R"({"dimension": 2, "gird": {}})";
+  const Result bad = shell(launcher + " -n 2 " + mpi_exe() + " ensemble '" + path("bad.json") +
+                           "' --seed-key output.snapshot_count -n 2 -o '" + path("bad.h5") + "'");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_EQ(count_of(bad.output, "bad.json: "), 1u) << bad.output;
+}
