@@ -2,11 +2,13 @@
 // binder (the PBX specimen of Nairn, Bardenhagen & Smith 2018, section 3 and figure 8), generated
 // while parsing and then handled as an image body; and writing the image a run used.
 #include <frictherm/coupling/microstructure.hpp>
+#include <frictherm/coupling/output_files.hpp>
 #include <frictherm/mechanics/ellipse_packing.hpp>
 
 #include "scene_detail.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -170,12 +172,20 @@ std::string generated_image_path(const Scene& scene, std::size_t body, const std
 void write_generated_image(const Scene& scene, std::size_t body, const std::string& path) {
   const BodySpec& b = scene.bodies.at(body);
   if (!b.shape.generated) throw std::invalid_argument("body \"" + b.name + "\" has no generated image");
-  mechanics::write_pgm(b.shape.image, path,
+  // Written under a temporary name and renamed, so a reader never sees half an image.
+  const std::string temporary = temporary_path(path);
+  try {
+    mechanics::write_pgm(b.shape.image, temporary,
                        "frictherm ellipse_packing of body " + b.name + " in " + scene.source + ": " +
                            std::to_string(b.shape.grain_count) + " grains, fraction " + format_number(b.shape.fraction) +
                            " (target " + format_number(b.shape.target_fraction) + "), pixel " +
                            format_number(b.shape.pixel_size) + " m, lower-left corner (" +
                            format_number(b.shape.origin[0]) + ", " + format_number(b.shape.origin[1]) + ") m");
+    publish_file(temporary, path, true);
+  } catch (...) {
+    std::remove(temporary.c_str());
+    throw;
+  }
 }
 
 std::vector<std::string> write_generated_images(const Scene& scene, const std::string& output_file) {

@@ -202,6 +202,7 @@ void parse_output(const JsonReader& root, Scene& s) {
   if (has_interval) o.snapshot_interval = out->number("snapshot_interval", Range::positive());
   if (has_count) o.snapshot_interval = s.end_time / static_cast<double>(out->integer("snapshot_count", 1, 1000000));
   o.series_interval = out->number("series_interval", o.series_interval, Range::non_negative());
+  if (const auto w = out->find("overwrite")) o.overwrite = w->as_bool();
   if (const auto f = out->find("fields")) {
     const auto known = snapshot_field_names(s.dimension);
     std::vector<std::string> fields{"position"};  // the XDMF geometry: always written

@@ -82,6 +82,7 @@ struct OutputSpec {
   double snapshot_interval = 0.0;   // s (from snapshot_interval, or end_time / snapshot_count)
   double series_interval = 0.0;     // s; 0 writes a row every step
   std::vector<std::string> fields;  // snapshot fields, in the order they are written
+  bool overwrite = false;           // replace an existing output file (else refused; --force does the same)
 };
 
 /// A change applied to the scene's JSON before validation (`frictherm run --set solver.cfl=0.3`):
