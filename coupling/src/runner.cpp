@@ -208,8 +208,14 @@ class Run {
         const double stable = sim_->stable_time_step();
         if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
       }
+      const double t_before = sim_->time();
       sim_->step(limit);
       const double t = sim_->time();
+      if (!(t > t_before))  // a step too small for the clock (1e-300 s at t = 1): never loop without advancing
+        throw mechanics::SimulationError("step " + std::to_string(sim_->step_count()) + ", t = " + format_number(t) +
+                                             " s: the time step " + format_number(sim_->last_time_step()) +
+                                             " s no longer advances the time",
+                                         sim_->step_count(), t, -1);
       // Thermal hook: the step's nodal frictional work (J, eqs. 27/34/36) goes to the coupler; a
       // window also closes at every snapshot time and at the end.
       if (thermal_) {
@@ -225,11 +231,10 @@ class Run {
       }
       if (t >= next_snap - eps) {
         snapshot();
-        for (;;) {  // the next snapshot time after t
-          ++snap_k;
-          next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
-          if (next_snap > t + eps || next_snap >= T) break;
-        }
+        // The next snapshot time after t, in closed form (validation bounds end_time / snap_dt).
+        snap_k = std::max(snap_k + 1, static_cast<long>(std::floor((t + eps) / snap_dt)) + 1);
+        next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
+        if (next_snap <= t + eps && next_snap < T) next_snap = std::min(static_cast<double>(++snap_k) * snap_dt, T);
       }
       if (checkpoints_ && (t >= next_checkpoint_ - eps || (o_.checkpoint_wall_interval > 0.0 &&
                                                             seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval))) {
