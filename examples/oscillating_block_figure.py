@@ -45,7 +45,7 @@ T1 = pusher_start(SCENE)
 def run(frictherm, cfl, out_dir):
     out = os.path.join(out_dir, "oscillating_block_C%g.h5" % cfl)
     start = time.perf_counter()
-    subprocess.run([frictherm, "run", SCENE, "-o", out, "--quiet", "--threads", "1", "--set", "solver.cfl=%r" % cfl],
+    subprocess.run([frictherm, "run", SCENE, "-o", out, "--force", "--quiet", "--threads", "1", "--set", "solver.cfl=%r" % cfl],
                    check=True)
     wall = time.perf_counter() - start
     with h5py.File(out, "r") as f:

@@ -37,7 +37,7 @@ FATES = {0: "undecided", 1: "dying", 2: "runaway"}
 
 
 def run(a, out, extra):
-    cmd = [a.frictherm, "run", a.scene, "-o", out, "--quiet"]
+    cmd = [a.frictherm, "run", a.scene, "-o", out, "--force", "--quiet"]
     if a.threads:
         cmd += ["--threads", str(a.threads)]
     for s in a.set + extra:

@@ -48,7 +48,7 @@ def run(args, scene, tag, sets):
     if os.path.exists(out) and not args.rerun:
         print(f"reusing {out}")
         return out
-    cmd = [args.frictherm, "run", os.path.join(HERE, scene + ".json"), "-o", out, "--quiet"]
+    cmd = [args.frictherm, "run", os.path.join(HERE, scene + ".json"), "-o", out, "--force", "--quiet"]
     if args.threads:
         cmd += ["--threads", str(args.threads)]
     for key, value in sets.items():

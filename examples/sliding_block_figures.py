@@ -73,7 +73,7 @@ class RigidBlock:
 
 def run(frictherm, out_dir, name, law, cell):
     out = os.path.join(out_dir, name + ".h5")
-    cmd = [frictherm, "run", SCENE, "-o", out, "--set", "contact.pairs[0].law=" + json.dumps(law)]
+    cmd = [frictherm, "run", SCENE, "-o", out, "--force", "--set", "contact.pairs[0].law=" + json.dumps(law)]
     if cell:
         cmd += ["--set", "grid.cell_size=%r" % cell]
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)

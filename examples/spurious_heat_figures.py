@@ -75,7 +75,7 @@ def start_time(config):
 
 
 def run(frictherm, scene, out, sets):
-    cmd = [frictherm, "run", scene, "-o", out, "--quiet", "--threads", "1"]
+    cmd = [frictherm, "run", scene, "-o", out, "--force", "--quiet", "--threads", "1"]
     for s in sets:
         cmd += ["--set", s]
     if os.path.exists(out):

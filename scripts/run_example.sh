@@ -10,6 +10,6 @@ name=$(basename "$scene" .json)
 scripts/install_deps.sh
 scripts/build.sh
 mkdir -p results
-./build/coupling/frictherm run "$scene" -o "results/$name.h5"
+./build/coupling/frictherm run "$scene" -o "results/$name.h5" --force  # rerunning replaces the old result
 /usr/bin/python3 examples/plot_run.py "results/$name.h5" --field "$field" -o "results/$name"
 echo "wrote results/$name.h5, results/$name.xdmf, results/${name}_particles.png, results/${name}_series.png"

@@ -48,6 +48,8 @@ const std::string& single_positional(const std::string& command, const ParsedArg
 
 /// The repeatable --set KEY=VALUE option every scene-reading command takes.
 extern const OptionSpec kSetOption;
+/// The --force flag of the writing commands: replace an existing output file (never an input).
+extern const OptionSpec kForceOption;
 /// An integer in [1, 1024] given to `option`; UsageError otherwise.
 int positive_int(const std::string& command, const std::string& option, const std::string& text);
 

@@ -2,6 +2,7 @@
 #include "cli.hpp"
 
 #include <frictherm/coupling/csv_export.hpp>
+#include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
@@ -12,6 +13,7 @@
 namespace frictherm::cli {
 
 const OptionSpec kSetOption{{"-s", "--set"}, true, "set", true};
+const OptionSpec kForceOption{{"-f", "--force"}, false, "force"};
 
 namespace {
 
@@ -50,7 +52,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
                                   {{{"-o", "--output"}, true, "output"},
                                    {{"-t", "--threads"}, true, "threads"},
                                    {{"-q", "--quiet"}, false, "quiet"},
-                                   kSetOption});
+                                   kForceOption, kSetOption});
   if (a.help) {
     std::cout << kRunHelp;
     return kOk;
@@ -60,6 +62,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
   if (a.has("threads")) opt.threads = positive_int("run", "--threads", a.options.at("threads"));
   if (a.has("output")) opt.output = a.options.at("output");
   opt.quiet = a.has("quiet");
+  opt.overwrite = a.has("force");
   opt.command_line = command_line;
   opt.handle_signals = true;
   coupling::Scene scene;
@@ -122,7 +125,7 @@ int validate_command(const std::vector<std::string>& args) {
 }
 
 int export_csv_command(const std::vector<std::string>& args) {
-  const ParsedArgs a = parse_args("export-csv", args, {{{"-o", "--output"}, true, "output"}});
+  const ParsedArgs a = parse_args("export-csv", args, {{{"-o", "--output"}, true, "output"}, kForceOption});
   if (a.help) {
     std::cout << kExportCsvHelp;
     return kOk;
@@ -135,7 +138,9 @@ int export_csv_command(const std::vector<std::string>& args) {
   try {
     if (a.has("output")) {
       const std::string& out_path = a.options.at("output");
-      std::ofstream out(out_path);
+      coupling::check_output_path(out_path, {path}, a.has("force"), "--force");
+      const std::string live = coupling::temporary_path(out_path);  // renamed onto out_path when complete
+      std::ofstream out(live);
       if (!out) {
         std::cerr << "frictherm: cannot create '" << out_path << "'\n";
         return kUsage;
@@ -143,9 +148,11 @@ int export_csv_command(const std::vector<std::string>& args) {
       coupling::export_series_csv(path, out);
       out.close();
       if (!out) {
+        std::remove(live.c_str());
         std::cerr << "frictherm: cannot write '" << out_path << "'\n";
         return kUsage;
       }
+      coupling::publish_file(live, out_path, true);
     } else {
       coupling::export_series_csv(path, std::cout);
       std::cout.flush();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 #include <frictherm/coupling/ensemble.hpp>
+#include <frictherm/coupling/output_files.hpp>
 
 #include <cstdio>
 #include <cstdlib>
@@ -70,7 +71,7 @@ int ensemble_command(const std::vector<std::string>& args, const std::string& /*
                                    {{"--member-prefix"}, true, "member-prefix"},
                                    {{"-t", "--threads"}, true, "threads"},
                                    {{"-q", "--quiet"}, false, "quiet"},
-                                   kSetOption});
+                                   kForceOption, kSetOption});
   if (a.help) {
     std::cout << kEnsembleHelp;
     return kOk;
@@ -86,16 +87,26 @@ int ensemble_command(const std::vector<std::string>& args, const std::string& /*
   if (a.has("member-prefix")) o.member_prefix = a.options.at("member-prefix");
   if (a.has("threads")) o.threads = positive_int("ensemble", "--threads", a.options.at("threads"));
   o.quiet = a.has("quiet");
+  o.overwrite = a.has("force");
   try {
     if (a.lists.count("set"))
       for (const auto& s : a.lists.at("set")) o.overrides.push_back(coupling::parse_override(s));
-    coupling::load_scene(path, o.overrides);  // a scene error stops before any member runs
+    const coupling::Scene scene = coupling::load_scene(path, o.overrides);  // a scene error stops before any member runs
+    o.overwrite = o.overwrite || scene.output.overwrite;
+    // Existing results refused before any member runs (output_files.hpp).
+    const std::vector<std::string> inputs = coupling::scene_input_files(scene);
+    coupling::check_output_path(o.output, inputs, o.overwrite, "--force");
+    for (int k = 0; k < o.members; ++k)
+      coupling::check_output_path(coupling::member_file(o, o.first_seed + k), inputs, o.overwrite, "--force");
     std::vector<coupling::SceneOverride> probe = o.overrides;
     probe.push_back({o.seed_key, std::to_string(o.first_seed)});
     coupling::load_scene(path, probe);
   } catch (const coupling::SceneError& e) {
     // Every process finds the same error: only the first one (rank 0, or the only one) reports it.
     if (launch.rank <= 0) std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    return kUsage;
+  } catch (const coupling::OutputError& e) {
+    std::cerr << "frictherm ensemble: " << e.what() << '\n';
     return kUsage;
   }
 
@@ -169,6 +180,7 @@ const char* const kEnsembleHelp =
     "  -o, --output OUT.h5   aggregate file (default ensemble.h5)\n"
     "      --member-prefix P member files are P<seed>.h5\n"
     "  -t, --threads N       OpenMP threads per member\n"
+    "  -f, --force           replace existing member and aggregate files (else refused)\n"
     "  -q, --quiet           no progress lines and no summary\n"
     "  -s, --set KEY=VALUE   change a scene value for every member (repeatable)\n"
     "\n"

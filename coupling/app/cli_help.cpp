@@ -24,13 +24,16 @@ const char* const kProgramHelp =
     "Scene reference: docs/scenes.md\n";
 
 const char* const kRunHelp =
-    "usage: frictherm run SCENE [-o OUT.h5] [--threads N] [--quiet] [--set KEY=VALUE ...]\n"
+    "usage: frictherm run SCENE [-o OUT.h5] [--force] [--threads N] [--quiet] [--set KEY=VALUE ...]\n"
     "\n"
     "Validates SCENE, then runs it to run.end_time, writing particle snapshots, the time series and\n"
     "run metadata to one HDF5 file (and an XDMF file beside it for ParaView).\n"
     "\n"
     "options:\n"
     "  -o, --output OUT.h5   output file (default: the scene's output.file, else SCENE_NAME.h5)\n"
+    "  -f, --force           replace OUT.h5 if it exists (as output.overwrite: true does); without it\n"
+    "                        an existing OUT.h5 is refused (exit code 2). The scene and its images\n"
+    "                        are never written over.\n"
     "  -t, --threads N       OpenMP threads (default: the scene's run.threads, else all cores)\n"
     "  -q, --quiet           no progress line and no summary\n"
     "  -s, --set KEY=VALUE   change one scene value before validation (repeatable), e.g.\n"
@@ -44,7 +47,9 @@ const char* const kRunHelp =
     "code is 1. SIGINT (Ctrl-C) or SIGTERM ends the run after the current step: the series and a last\n"
     "snapshot are written, /meta/status is `interrupted`, and the exit code is 128 + the signal\n"
     "(130 for SIGINT, 143 for SIGTERM); a second signal ends the program at once. Series rows reach\n"
-    "the file at least every 2 s of wall time.\n";
+    "the file at least every 2 s of wall time.\n"
+    "While it runs the output is OUT.h5.<pid>.part (readable at any time); it is renamed to OUT.h5 when\n"
+    "the run ends (completed, failed or interrupted), so a second run writing OUT.h5 cannot destroy it.\n";
 
 const char* const kValidateHelp =
     "usage: frictherm validate SCENE [--set KEY=VALUE ...]\n"
@@ -56,13 +61,14 @@ const char* const kValidateHelp =
     "--set KEY=VALUE changes a value first, as for `frictherm run`.\n";
 
 const char* const kExportCsvHelp =
-    "usage: frictherm export-csv RUN.h5 [-o OUT.csv]\n"
+    "usage: frictherm export-csv RUN.h5 [-o OUT.csv] [--force]\n"
     "\n"
     "Writes the time series (/series) of a run as CSV: a header line of column names, then one\n"
     "line per row. Works on runs that failed part-way too.\n"
     "\n"
     "options:\n"
     "  -o, --output OUT.csv  output file (default: standard output)\n"
+    "  -f, --force           replace OUT.csv if it exists (else refused); never RUN.h5 itself\n"
     "  -h, --help            this help\n";
 
 }  // namespace frictherm::cli

@@ -3,6 +3,7 @@
 #include "cli.hpp"
 
 #include <frictherm/coupling/microstructure.hpp>
+#include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/scene.hpp>
 
 #include <iostream>
@@ -10,7 +11,7 @@
 namespace frictherm::cli {
 
 const char* const kMicrostructureHelp =
-    "usage: frictherm microstructure SCENE [-o IMAGE.pgm] [--body NAME] [--set KEY=VALUE ...]\n"
+    "usage: frictherm microstructure SCENE [-o IMAGE.pgm] [--force] [--body NAME] [--set KEY=VALUE ...]\n"
     "\n"
     "Generates the grains of SCENE's ellipse_packing bodies (as `run` would) and writes each body's\n"
     "image as PGM, without running anything: grey 0 binder, grains by label (or 255, as the shape's\n"
@@ -20,6 +21,7 @@ const char* const kMicrostructureHelp =
     "  -o, --output IMAGE.pgm  output image (default: the shape's write_image, else\n"
     "                          SCENE_NAME_BODY.pgm); needs one generated body or --body\n"
     "  -b, --body NAME         only this body\n"
+    "  -f, --force             replace an existing image (never the scene or its input images)\n"
     "  -s, --set KEY=VALUE     change one scene value first (repeatable), e.g. --set 'bodies[0].shape.seed=7'\n"
     "  -h, --help              this help\n";
 
@@ -27,7 +29,8 @@ int microstructure_command(const std::vector<std::string>& args) {
   const ParsedArgs a = parse_args("microstructure", args,
                                   {{{"-o", "--output"}, true, "output"},
                                    {{"-b", "--body"}, true, "body"},
-                                   {{"-s", "--set"}, true, "set", true}});
+                                   {{"-s", "--set"}, true, "set", true},
+                                   kForceOption});
   if (a.help) {
     std::cout << kMicrostructureHelp;
     return kOk;
@@ -58,6 +61,8 @@ int microstructure_command(const std::vector<std::string>& args) {
     const std::string out =
         a.has("output") ? a.options.at("output") : coupling::generated_image_path(scene, i, scene.output.file);
     try {
+      coupling::check_output_path(out, coupling::scene_input_files(scene), a.has("force") || scene.output.overwrite,
+                                  "--force");
       coupling::write_generated_image(scene, i, out);
     } catch (const std::exception& e) {
       std::cerr << "frictherm: " << e.what() << '\n';

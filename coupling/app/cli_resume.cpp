@@ -11,7 +11,7 @@
 namespace frictherm::cli {
 
 const char* const kResumeHelp =
-    "usage: frictherm resume RUN.h5 [-o OUT.h5] [--threads N] [--quiet]\n"
+    "usage: frictherm resume RUN.h5 [-o OUT.h5] [--force] [--threads N] [--quiet]\n"
     "\n"
     "Continues a run from its last checkpoint RUN.h5.checkpoint (written when the scene sets\n"
     "run.checkpoint_interval: at that interval, at the end and on SIGINT/SIGTERM). The scene is rebuilt\n"
@@ -21,6 +21,7 @@ const char* const kResumeHelp =
     "state; RUN.h5 is not changed. Mechanics-only scenes (no thermal section, no penalty contact).\n"
     "\n"
     "  -o, --output FILE     HDF5 file of the continuation (default RUN.resumed.h5)\n"
+    "  -f, --force           replace OUT.h5 if it exists (else refused)\n"
     "  -t, --threads N       OpenMP threads (1 thread repeats an interrupted 1-thread run bit-for-bit)\n"
     "  -q, --quiet           no progress line and no summary\n";
 
@@ -28,7 +29,8 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
   const ParsedArgs a = parse_args("resume", args,
                                   {{{"-o", "--output"}, true, "output"},
                                    {{"-t", "--threads"}, true, "threads"},
-                                   {{"-q", "--quiet"}, false, "quiet"}});
+                                   {{"-q", "--quiet"}, false, "quiet"},
+                                   kForceOption});
   if (a.help) {
     std::cout << kResumeHelp;
     return kOk;
@@ -40,6 +42,7 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
   if (stem.size() > 3 && stem.compare(stem.size() - 3, 3, ".h5") == 0) stem.resize(stem.size() - 3);
   opt.output = a.has("output") ? a.options.at("output") : stem + ".resumed.h5";
   opt.quiet = a.has("quiet");
+  opt.overwrite = a.has("force");
   opt.command_line = command_line;
   opt.handle_signals = true;
   opt.resume_checkpoint = coupling::checkpoint_path(run);
@@ -49,6 +52,9 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
     r = coupling::run_scene(scene, opt);
   } catch (const coupling::SceneError& e) {
     std::cerr << "frictherm: " << opt.resume_checkpoint << ": " << e.what() << '\n';
+    return kUsage;
+  } catch (const coupling::OutputError& e) {
+    std::cerr << "frictherm: " << e.what() << '\n';
     return kUsage;
   } catch (const std::exception& e) {
     std::cerr << "frictherm: resume of " << run << " failed: " << e.what() << '\n';

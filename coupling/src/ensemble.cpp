@@ -1,6 +1,7 @@
 // Ensembles of one scene over seeds, and the aggregation of their hot spots (ensemble.hpp).
 #include <frictherm/coupling/csv_export.hpp>
 #include <frictherm/coupling/ensemble.hpp>
+#include <frictherm/coupling/output_files.hpp>
 
 #include "h5_util.hpp"
 
@@ -49,6 +50,7 @@ std::vector<MemberRecord> run_members(const std::string& scene_path, const Ensem
     ro.output = r.file;
     ro.threads = o.threads;
     ro.quiet = o.quiet;
+    ro.overwrite = o.overwrite;
     ro.command_line = "ensemble member " + std::to_string(k) + " of " + scene_path + " with " + o.seed_key + "=" +
                       std::to_string(r.seed);
     try {
@@ -217,7 +219,10 @@ EnsembleSummary aggregate_members(const std::string& scene_path, const EnsembleO
     for (int j = 0; j < 9; ++j) h[static_cast<std::size_t>(j)].push_back(row[j]);
   }
   const h5detail::Quiet quiet;
-  const Handle file{check_id(H5Fcreate(o.output.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), o.output,
+  // Written under a temporary name and renamed when complete (output_files.hpp).
+  const std::string live = temporary_path(o.output);
+  {
+  const Handle file{check_id(H5Fcreate(live.c_str(), H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT), live,
                              "cannot create the file"),
                     H5Fclose};
   write_columns(file.get(), o.output, "members",
@@ -238,6 +243,8 @@ EnsembleSummary aggregate_members(const std::string& scene_path, const EnsembleO
   write_attribute(f, o.output, "members_with_runaway", s.members_with_runaway);
   write_attribute(f, o.output, "seed_key", o.seed_key);
   write_attribute(f, o.output, "scene", scene_path);
+  }
+  publish_file(live, o.output, o.overwrite);
   return s;
 }
 

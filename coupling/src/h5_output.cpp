@@ -19,6 +19,7 @@
 // * Not covered: a crash inside H5Fflush itself (HDF5 writes are not atomic) and power loss (no
 //   fsync; a killed process loses nothing the kernel already received).
 #include <frictherm/coupling/h5_output.hpp>
+#include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/xdmf.hpp>
 
 #include <hdf5.h>
@@ -110,7 +111,8 @@ std::string base_name(const std::string& path) {
 }  // namespace
 
 struct H5Output::Impl {
-  Io io;
+  Io io;                   // io.file: the file being written
+  std::string final_path;  // where close() puts it (io.file unless options.via_temporary)
   std::string xdmf_path;
   int dim = 2;
   H5OutputOptions options;
@@ -375,7 +377,7 @@ struct H5Output::Impl {
     write_xdmf();
   }
 
-  std::string io_name() const { return base_name(io.file); }
+  std::string io_name() const { return base_name(final_path); }
 
   void metadata(const std::string& key, hid_t type, const void* value, std::size_t bytes) {
     check_name(key, "metadata");
@@ -392,7 +394,8 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   if (dim != 2 && dim != 3) throw std::invalid_argument("H5Output: dim must be 2 or 3");
   if (options.series_batch_rows == 0) options.series_batch_rows = 1;
   Impl& m = *impl_;
-  m.io.file = path;
+  m.final_path = path;
+  m.io.file = options.via_temporary ? temporary_path(path) : path;
   m.xdmf_path = xdmf_path_for(path);
   m.dim = dim;
   m.options = options;
@@ -404,7 +407,8 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
         "cannot track creation order");
   Handle fapl{check_id(H5Pcreate(H5P_FILE_ACCESS), path, "cannot create a property list"), H5Pclose};
   check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST), path, "cannot set format bounds");
-  m.file = Handle{check_id(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), path, "cannot create the file"),
+  const unsigned mode = options.via_temporary ? H5F_ACC_EXCL : H5F_ACC_TRUNC;  // EXCL: never truncate another's file
+  m.file = Handle{check_id(H5Fcreate(m.io.file.c_str(), mode, fcpl.get(), fapl.get()), m.io.file, "cannot create the file"),
                   H5Fclose};
   m.cache.version = H5AC__CURR_CACHE_CONFIG_VERSION;
   check(H5Fget_mdc_config(m.file.get(), &m.cache), path, "cannot read the metadata cache configuration");
@@ -572,10 +576,12 @@ void H5Output::close() {
   m.meta.reset();
   m.file.reset();
   m.closed = true;
+  if (m.io.file != m.final_path) publish_file(m.io.file, m.final_path, m.options.replace_existing);
 }
 
 std::size_t H5Output::snapshot_count() const { return impl_ ? impl_->count : 0; }
-const std::string& H5Output::path() const { return impl_->io.file; }
+const std::string& H5Output::path() const { return impl_->final_path; }
+const std::string& H5Output::live_path() const { return impl_->io.file; }
 const std::string& H5Output::xdmf_path() const { return impl_->xdmf_path; }
 int H5Output::dim() const { return impl_->dim; }
 

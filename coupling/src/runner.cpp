@@ -6,6 +6,8 @@
 
 #include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/microstructure.hpp>
+#include <frictherm/coupling/output_files.hpp>
+#include <frictherm/coupling/xdmf.hpp>
 #include <frictherm/coupling/thread_policy.hpp>
 #include <frictherm/mechanics/errors.hpp>
 
@@ -40,12 +42,13 @@ class Run {
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
     const detail::InterruptGuard interrupt_guard(o_.handle_signals);  // before the file exists
+    r_.output = o_.output.empty() ? s_.output.file : o_.output;
+    check_output_files();  // before anything is built: refusals cost nothing
     sim_ = build_simulation<Dim>(s_);
     if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;
     // No count given: not more threads than idle cores or than the particles pay for (thread_policy.hpp).
     omp_set_num_threads(threads > 0 ? threads : default_thread_count(sim_->particles().size()));
-    r_.output = o_.output.empty() ? s_.output.file : o_.output;
     r_.particles = sim_->particles().size();
     check_checkpoints();
     if (!o_.resume_checkpoint.empty()) {
@@ -113,8 +116,12 @@ class Run {
     out.write_metadata("steps", static_cast<double>(r_.steps));
     out.write_metadata("final_time", r_.time);
     out.write_metadata("wall_time", r_.wall_time);
-    out.close();
     out_ = nullptr;
+    try {
+      out.close();  // renames "<output>.<pid>.part" onto the output
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
     return r_;
   }
 
@@ -152,9 +159,27 @@ class Run {
     if (!list.empty()) out.write_metadata("microstructure_images", list);
   }
 
+  bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
+
+  // The output, its XDMF file and generated images never land on a file this run reads; an existing
+  // output is replaced only when asked (RunOptions::overwrite, output.overwrite).
+  void check_output_files() const {
+    std::vector<std::string> inputs = scene_input_files(s_);
+    if (!o_.resume_checkpoint.empty()) inputs.push_back(o_.resume_checkpoint);
+    check_output_path(r_.output, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
+    check_output_path(xdmf_path_for(r_.output), inputs, true, "");
+    if (s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0)
+      check_output_path(checkpoint_path(r_.output), inputs, true, "");
+    for (std::size_t i = 0; i < s_.bodies.size(); ++i)
+      if (s_.bodies[i].shape.generated) check_output_path(generated_image_path(s_, i, r_.output), inputs, true, "");
+  }
+
   H5Output open_output() const {
     try {
-      return H5Output(r_.output, Dim);
+      H5OutputOptions options;
+      options.via_temporary = true;
+      options.replace_existing = overwrite();
+      return H5Output(r_.output, Dim, options);
     } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
@@ -184,8 +209,14 @@ class Run {
         const double stable = sim_->stable_time_step();
         if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
       }
+      const double t_before = sim_->time();
       sim_->step(limit);
       const double t = sim_->time();
+      if (!(t > t_before))  // a step too small for the clock (1e-300 s at t = 1): never loop without advancing
+        throw mechanics::SimulationError("step " + std::to_string(sim_->step_count()) + ", t = " + format_number(t) +
+                                             " s: the time step " + format_number(sim_->last_time_step()) +
+                                             " s no longer advances the time",
+                                         sim_->step_count(), t, -1);
       // Thermal hook: the step's nodal frictional work (J, eqs. 27/34/36) goes to the coupler; a
       // window also closes at every snapshot time and at the end.
       if (thermal_) {
@@ -201,11 +232,10 @@ class Run {
       }
       if (t >= next_snap - eps) {
         snapshot();
-        for (;;) {  // the next snapshot time after t
-          ++snap_k;
-          next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
-          if (next_snap > t + eps || next_snap >= T) break;
-        }
+        // The next snapshot time after t, in closed form (validation bounds end_time / snap_dt).
+        snap_k = std::max(snap_k + 1, static_cast<long>(std::floor((t + eps) / snap_dt)) + 1);
+        next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
+        if (next_snap <= t + eps && next_snap < T) next_snap = std::min(static_cast<double>(++snap_k) * snap_dt, T);
       }
       if (checkpoints_ && (t >= next_checkpoint_ - eps || (o_.checkpoint_wall_interval > 0.0 &&
                                                             seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval))) {

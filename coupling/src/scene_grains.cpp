@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <map>
 #include <set>
+#include <cstdint>
+#include <unordered_set>
 #include <stdexcept>
 
 namespace frictherm::coupling::detail {
@@ -16,6 +18,7 @@ namespace {
 
 // nm² per-pair tables in the mechanics (pair settings, pair work): 2000 materials ~ 80 MB.
 constexpr std::size_t kMaxMaterials = 2000;
+constexpr double kMaxContactPairs = 2e5;  // material pairs after grain expansion (each holds its own law)
 
 }  // namespace
 
@@ -84,22 +87,39 @@ void split_image_levels(const std::vector<LevelSplit>& splits, Scene& s, ParseCo
 
 void expand_grain_contact_pairs(Scene& s, const ParseContext& ctx) {
   if (!s.contact.enabled || ctx.grain_template.empty()) return;
-  auto members = [&](int m) {  // the template itself and its grains
+  // The template itself and its grains, gathered once (linear in the materials).
+  std::map<int, std::vector<int>> members;
+  for (std::size_t id = 0; id < ctx.grain_template.size(); ++id)
+    if (ctx.grain_template[id] >= 0) members[ctx.grain_template[id]].push_back(static_cast<int>(id));
+  auto members_of = [&](int m) {
     std::vector<int> out{m};
-    for (std::size_t id = 0; id < ctx.grain_template.size(); ++id)
-      if (ctx.grain_template[id] == m) out.push_back(static_cast<int>(id));
+    const auto it = members.find(m);
+    if (it != members.end()) out.insert(out.end(), it->second.begin(), it->second.end());
     return out;
   };
-  auto listed = [&](int a, int b) {
-    for (const ContactPairSpec& q : s.contact.pairs)
-      if ((q.material_a == a && q.material_b == b) || (q.material_a == b && q.material_b == a)) return true;
-    return false;
+  // Bounded before anything is generated: every listed pair expands to |A| x |B| pairs.
+  double total = 0.0;
+  for (std::size_t i = 0; i < s.contact.pairs.size(); ++i) {
+    const ContactPairSpec& p = s.contact.pairs[i];
+    const double n = static_cast<double>(members_of(p.material_a).size()) * static_cast<double>(members_of(p.material_b).size());
+    total += n;
+    if (total > kMaxContactPairs)
+      throw SceneError("contact.pairs[" + std::to_string(i) + "]: the grains of its materials make " + format_number(total) +
+                       " material pairs with the pairs before it; expected at most " + format_number(kMaxContactPairs) +
+                       " (fewer grains, or pair the binder with the grain template only where needed)");
+  }
+  // Explicit pairs win over expansions; a hash set of unordered pairs keeps the expansion linear.
+  auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32) |
+           static_cast<std::uint32_t>(std::max(a, b));
   };
-  const std::vector<ContactPairSpec> given = s.contact.pairs;  // explicit pairs win over expansions
+  std::unordered_set<std::uint64_t> listed;
+  for (const ContactPairSpec& q : s.contact.pairs) listed.insert(key(q.material_a, q.material_b));
+  const std::vector<ContactPairSpec> given = s.contact.pairs;
   for (const ContactPairSpec& p : given)
-    for (int a : members(p.material_a))
-      for (int b : members(p.material_b)) {
-        if (a == b || listed(a, b)) continue;
+    for (int a : members_of(p.material_a))
+      for (int b : members_of(p.material_b)) {
+        if (a == b || !listed.insert(key(a, b)).second) continue;
         ContactPairSpec e = p;
         e.material_a = a;
         e.material_b = b;

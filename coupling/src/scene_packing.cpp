@@ -2,11 +2,13 @@
 // binder (the PBX specimen of Nairn, Bardenhagen & Smith 2018, section 3 and figure 8), generated
 // while parsing and then handled as an image body; and writing the image a run used.
 #include <frictherm/coupling/microstructure.hpp>
+#include <frictherm/coupling/output_files.hpp>
 #include <frictherm/mechanics/ellipse_packing.hpp>
 
 #include "scene_detail.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -16,6 +18,9 @@ namespace frictherm::coupling {
 namespace detail {
 
 namespace {
+
+constexpr double kMaxPackedGrains = 1e6;              // grains of one packing
+constexpr std::size_t kMaxPackedGrainMaterials = 2000;  // with separate_grains (the scenes' material limit)
 
 /// major_axis: {"distribution": "uniform", "min", "max"} or {"distribution": "lognormal", "median",
 /// "sigma", "min", "max"} (m; the log-normal truncated to [min, max], default median e^{∓3 sigma}).
@@ -83,6 +88,16 @@ void parse_ellipse_packing(const JsonReader& shape, Scene& s, ParseContext& ctx,
   }
   if (size[0] / out.pixel_size * size[1] / out.pixel_size > 1e8)
     size_r.fail("expected at most 1e8 pixels of pixel_size");
+  // Inside the grid, checked before anything is generated (a rectangle far larger than the grid
+  // would otherwise be packed first).
+  for (int d = 0; d < 2; ++d) {
+    const double tol = 1e-9 * (s.grid_hi[d] - s.grid_lo[d]);
+    if (out.origin[d] < s.grid_lo[d] - tol || out.origin[d] + size[static_cast<std::size_t>(d)] > s.grid_hi[d] + tol)
+      size_r.fail("the packed rectangle [" + format_number(out.origin[0]) + ", " + format_number(out.origin[1]) + "] to [" +
+                  format_number(out.origin[0] + size[0]) + ", " + format_number(out.origin[1] + size[1]) +
+                  "] m is not inside the grid (" + format_number(s.grid_lo[0]) + ", " + format_number(s.grid_lo[1]) +
+                  ") to (" + format_number(s.grid_hi[0]) + ", " + format_number(s.grid_hi[1]) + ") m");
+  }
   mechanics::EllipsePackingOptions o;
   o.width = size[0];
   o.height = size[1];
@@ -107,13 +122,25 @@ void parse_ellipse_packing(const JsonReader& shape, Scene& s, ParseContext& ctx,
   if (!o.periodic && o.major_min + 2.0 * o.edge_gap > std::min(o.width, o.height))
     major.fail("the smallest grain (min + 2 edge_gap = " + format_number(o.major_min + 2.0 * o.edge_gap) +
                " m) does not fit in the rectangle");
+  const auto separate = shape.find("separate_grains");
+  const bool separate_grains = !separate || separate->as_bool();
+  {
+    // The fewest grains the target fraction can take (every grain as large as major_axis max and
+    // aspect_ratio allow), bounded before generation: packing time and memory grow with it.
+    const double largest_area = 0.25 * 3.14159265358979323846 * o.major_max * o.major_max * o.aspect_max;
+    const double fewest = std::floor(o.fraction * o.width * o.height / largest_area);
+    const double limit = separate_grains ? static_cast<double>(kMaxPackedGrainMaterials) : kMaxPackedGrains;
+    if (fewest > limit)
+      major.fail("the target fraction needs at least " + format_number(fewest) + " grains of at most " +
+                 format_number(o.major_max) + " m; expected at most " + format_number(limit) +
+                 (separate_grains ? " (one material per grain; set \"separate_grains\": false for more)" : "") +
+                 ": larger grains, a smaller rectangle or a smaller fraction");
+  }
   const JsonReader grain_r = shape.at("grain_material", "the material of the grains (a name in \"materials\")");
   const int grain = ctx.material_id(grain_r);
   if (s.materials[static_cast<std::size_t>(grain)].is_rigid()) grain_r.fail("expected a deformable material");
   const auto binder_r = shape.find("binder_material");
   const int binder = binder_r ? ctx.material_id(*binder_r) : -1;
-  const auto separate = shape.find("separate_grains");
-  const bool separate_grains = !separate || separate->as_bool();
   const bool labels_grey = shape.choice("image_grey", {"labels", "binary"}, "labels") == "labels";
   out.write_image = shape.string("write_image", "");
   read_z_range(shape, ctx.dim, out);
@@ -170,12 +197,20 @@ std::string generated_image_path(const Scene& scene, std::size_t body, const std
 void write_generated_image(const Scene& scene, std::size_t body, const std::string& path) {
   const BodySpec& b = scene.bodies.at(body);
   if (!b.shape.generated) throw std::invalid_argument("body \"" + b.name + "\" has no generated image");
-  mechanics::write_pgm(b.shape.image, path,
+  // Written under a temporary name and renamed, so a reader never sees half an image.
+  const std::string temporary = temporary_path(path);
+  try {
+    mechanics::write_pgm(b.shape.image, temporary,
                        "frictherm ellipse_packing of body " + b.name + " in " + scene.source + ": " +
                            std::to_string(b.shape.grain_count) + " grains, fraction " + format_number(b.shape.fraction) +
                            " (target " + format_number(b.shape.target_fraction) + "), pixel " +
                            format_number(b.shape.pixel_size) + " m, lower-left corner (" +
                            format_number(b.shape.origin[0]) + ", " + format_number(b.shape.origin[1]) + ") m");
+    publish_file(temporary, path, true);
+  } catch (...) {
+    std::remove(temporary.c_str());
+    throw;
+  }
 }
 
 std::vector<std::string> write_generated_images(const Scene& scene, const std::string& output_file) {

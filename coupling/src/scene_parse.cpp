@@ -184,6 +184,7 @@ void parse_run(const JsonReader& root, Scene& s) {
   s.max_steps = run.integer("max_steps", 0, 1, std::numeric_limits<long>::max());
   s.threads = static_cast<int>(run.integer("threads", 0, 1, 1024));
   if (run.has("checkpoint_interval")) s.checkpoint_interval = run.number("checkpoint_interval", Range::positive());
+  if (run.has("max_memory")) s.max_memory = run.number("max_memory", Range::positive());
   run.finish();
 }
 
@@ -202,6 +203,7 @@ void parse_output(const JsonReader& root, Scene& s) {
   if (has_interval) o.snapshot_interval = out->number("snapshot_interval", Range::positive());
   if (has_count) o.snapshot_interval = s.end_time / static_cast<double>(out->integer("snapshot_count", 1, 1000000));
   o.series_interval = out->number("series_interval", o.series_interval, Range::non_negative());
+  if (const auto w = out->find("overwrite")) o.overwrite = w->as_bool();
   if (const auto f = out->find("fields")) {
     const auto known = snapshot_field_names(s.dimension);
     std::vector<std::string> fields{"position"};  // the XDMF geometry: always written
@@ -249,6 +251,21 @@ Json::json_pointer pointer_of(const std::string& path) {
   return Json::json_pointer(p);
 }
 
+/// An array index in a --set path may append one element, not grow the array to any size
+/// (`bodies[200000000]=1` would allocate 2e8 nulls).
+void check_indices(const Json& doc, const Json::json_pointer& ptr, const std::string& path) {
+  if (ptr.empty()) return;
+  const Json::json_pointer parent = ptr.parent_pointer();
+  check_indices(doc, parent, path);
+  if (!doc.contains(parent) || !doc.at(parent).is_array()) return;
+  const std::string& token = ptr.back();
+  if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos) return;  // JSON refuses it
+  const std::size_t size = doc.at(parent).size();
+  if (token.size() > 9 || std::stoul(token) > size)
+    throw SceneError("--set " + path + ": index " + token + " is beyond the end of an array of " + std::to_string(size) +
+                     " elements (expected at most " + std::to_string(size) + ", which appends one)");
+}
+
 void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
   for (const SceneOverride& o : overrides) {
     Json value;
@@ -259,6 +276,7 @@ void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
     }
     try {
       const Json::json_pointer ptr = pointer_of(o.path);
+      check_indices(doc, ptr, o.path);
       if (value.is_null()) {  // KEY=null removes an object key (nothing to do when it is absent)
         if (doc.contains(ptr) && doc.at(ptr.parent_pointer()).is_object()) doc.at(ptr.parent_pointer()).erase(ptr.back());
       } else {
@@ -345,6 +363,8 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
                                                   s.materials.begin() + static_cast<long>(ctx.declared_materials));
   s.thermal = parse_thermal_sections(root, s.dimension, declared, s.options.thickness);  // scene_thermal.cpp
   detail::extend_grain_thermal(s, ctx);
+  s.cost = estimate_scene_cost(s);  // before any particle or grid array exists
+  check_scene_cost(s, s.cost);
   return s;
 }
 

@@ -106,6 +106,11 @@ void describe(const Scene& s, std::ostream& out) {
       out << " (more than max_steps " << s.max_steps << ": the run will stop early)";
     out << '\n';
   }
+  const SceneCost& c = s.cost;
+  row("estimate") << "at most " << g(c.particles) << " particles, " << g(c.grid_nodes) << " grid nodes, "
+                  << g(c.threads) << " thread(s): about " << g(std::round(c.memory_bytes / 1e6)) << " MB of memory (limit "
+                  << g(std::round(c.memory_limit / 1e6)) << " MB, " << c.memory_limit_source << "), "
+                  << g(c.steps) << " steps, " << g(std::round(c.output_bytes / 1e6)) << " MB of snapshots\n";
   const double snaps = std::ceil(s.end_time / s.output.snapshot_interval - 1e-9) + 1.0;
   row("output") << s.output.file << ": " << g(snaps) << " snapshots, series "
                 << (s.output.series_interval > 0.0 ? "every " + g(s.output.series_interval) + " s" : std::string("every step"))

@@ -1,5 +1,7 @@
 #include <frictherm/coupling/xdmf.hpp>
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
@@ -110,7 +112,8 @@ std::string xdmf_document(const std::vector<std::string>& grid_xml) {
 }
 
 void write_text_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = path + "." + std::to_string(static_cast<long>(::getpid())) + ".tmp";  // one per process:
+                                                                                                  // two writers never share it
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {

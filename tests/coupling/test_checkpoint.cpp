@@ -146,6 +146,7 @@ TEST(Checkpoint, RunnerWritesTheFinalStateAtTheEnd) {
   const coupling::Scene scene = coupling::parse_scene(scene_text);
   coupling::RunOptions o;
   o.output = temp_file("runner");
+  o.overwrite = true;  // a fixed name in the temporary folder: a rerun replaces it
   o.quiet = true;
   const coupling::RunResult r = coupling::run_scene(scene, o);
   ASSERT_EQ(r.status, coupling::RunResult::Status::completed);
@@ -176,6 +177,7 @@ TEST(Checkpoint, ResumedRunEqualsUninterruptedRun) {
         file, {{"run.max_steps", std::to_string(max_steps)}, {"run.threads", "1"}});
     coupling::RunOptions o;
     o.output = temp_file(name);
+    o.overwrite = true;  // a fixed name in the temporary folder: a rerun replaces it
     o.quiet = true;
     o.checkpoint_wall_interval = 1e9;  // checkpoints on: one at the end
     o.resume_checkpoint = resume;

@@ -36,7 +36,8 @@ TEST(CliResume, InterruptedAndResumedRunEqualsUninterruptedRun) {
           "run.threads=1", "--set", "run.checkpoint_interval=0.01", static_cast<char*>(nullptr));
     _exit(127);
   }
-  for (int i = 0; i < 200 && !fs::exists(part); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  const std::string live = part + "." + std::to_string(pid) + ".part";  // the output while it runs
+  for (int i = 0; i < 200 && !fs::exists(live); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   kill(pid, SIGINT);
   int status = 0;

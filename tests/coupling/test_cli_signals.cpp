@@ -76,8 +76,10 @@ Interrupted run_and_signal(const fs::path& dir, int signal) {
     execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
     _exit(127);
   }
-  // The handlers are installed before the output file is created; wait for the file, then a while.
-  for (int i = 0; i < 200 && !fs::exists(out); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  // The handlers are installed before the output file is created; wait for the file (written as
+  // "<out>.<pid>.part" until the run ends, output_files.hpp), then a while.
+  const std::string live = out + "." + std::to_string(pid) + ".part";
+  for (int i = 0; i < 200 && !fs::exists(live); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   kill(pid, signal);
   int status = 0;

@@ -52,6 +52,7 @@ TEST(SceneThermalRun, SlidingBlockEnergyBooksCloseForEveryWindowPolicy) {
     s["output"] = Json::parse(R"({"snapshot_count": 2})");
     fc::RunOptions opt;
     opt.output = (dir / "books.h5").string();
+    opt.overwrite = true;  // one file for the three window policies, read before the next run
     opt.quiet = true;
     const fc::RunResult r = fc::run_scene(fc::parse_scene(s.dump()), opt);
     ASSERT_EQ(r.status, fc::RunResult::Status::completed) << r.message;

@@ -39,6 +39,7 @@ struct EnsembleOptions {
   std::vector<SceneOverride> overrides;  // applied to every member before the seed
   int threads = 0;             // OpenMP threads per member (0: the scene's, else OpenMP's default)
   bool quiet = false;
+  bool overwrite = false;      // replace existing member and aggregate files (RunOptions::overwrite)
   int rank = 0, ranks = 1;     // this process's share
 };
 

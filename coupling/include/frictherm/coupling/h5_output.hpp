@@ -27,11 +27,19 @@ struct H5OutputOptions {
   std::size_t series_batch_rows = 64;
   /// Write RUN.xdmf beside RUN.h5 (rewritten after every ended snapshot).
   bool write_xdmf = true;
+  /// Write the file under a temporary name in the same folder ("<path>.<pid>.part", created
+  /// exclusively, never truncating another file) and rename it onto `path` in close() (issue 15:
+  /// a second run writing the same file cannot destroy the first one's). path() is the final name,
+  /// live_path() the file being written; the XDMF file refers to the final name.
+  bool via_temporary = false;
+  /// With via_temporary: close() may replace an existing `path`. When false and `path` appeared
+  /// meanwhile, close() keeps the result under live_path() and throws std::runtime_error saying so.
+  bool replace_existing = true;
 };
 
 class H5Output {
  public:
-  /// Creates or truncates `path`. dim is 2 or 3. Throws std::runtime_error naming the file when it
+  /// Creates or truncates `path` (or creates a temporary sibling, options.via_temporary). dim is 2 or 3. Throws std::runtime_error naming the file when it
   /// cannot be created (missing directory, no permission, ...).
   H5Output(const std::string& path, int dim, H5OutputOptions options = {});
   /// Calls close(); errors are reported on std::cerr, never thrown. An unfinished snapshot
@@ -84,7 +92,8 @@ class H5Output {
   void close();
 
   std::size_t snapshot_count() const;  // ended regular snapshots
-  const std::string& path() const;
+  const std::string& path() const;       // the final name
+  const std::string& live_path() const;  // the file being written (path() unless via_temporary)
   const std::string& xdmf_path() const;
   int dim() const;
 

@@ -26,6 +26,11 @@ class OutputError : public std::runtime_error {
 
 struct RunOptions {
   std::string output;        // HDF5 file; empty: the scene's output.file
+  /// Replace an existing output file (so does the scene's output.overwrite: true); otherwise an
+  /// existing one is refused before anything runs (OutputError). Files the run reads (the scene, its
+  /// images, the checkpoint resumed from) are never written, whatever this says. The file is written
+  /// as "<output>.<pid>.part" and renamed onto `output` at the end (output_files.hpp).
+  bool overwrite = false;
   int threads = 0;           // OpenMP threads; 0: the scene's run.threads, else OpenMP's default
   bool quiet = false;        // no progress line and no notes
   enum class Progress { automatic, always, never };

@@ -8,6 +8,7 @@
 // SceneError whose message starts with the key path (e.g. `bodies[1].shape.radius: ...`).
 #include <frictherm/coupling/json_reader.hpp>
 #include <frictherm/coupling/scene_contact.hpp>
+#include <frictherm/coupling/scene_cost.hpp>
 #include <frictherm/coupling/scene_thermal.hpp>  // thermal + coupling sections
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/image.hpp>
@@ -82,6 +83,7 @@ struct OutputSpec {
   double snapshot_interval = 0.0;   // s (from snapshot_interval, or end_time / snapshot_count)
   double series_interval = 0.0;     // s; 0 writes a row every step
   std::vector<std::string> fields;  // snapshot fields, in the order they are written
+  bool overwrite = false;           // replace an existing output file (else refused; --force does the same)
 };
 
 /// A change applied to the scene's JSON before validation (`frictherm run --set solver.cfl=0.3`):
@@ -111,6 +113,8 @@ struct Scene {
   long max_steps = 0;     // 0: no limit
   int threads = 0;        // 0: OpenMP's default
   double checkpoint_interval = 0.0;  // s of simulated time between checkpoints (checkpoint.hpp); 0: none
+  double max_memory = 0.0;  // run.max_memory (bytes); 0: a share of the machine's memory (scene_cost.hpp)
+  SceneCost cost;           // estimated while parsing, before anything large is built (scene_cost.hpp)
   OutputSpec output;
   ContactSpec contact;       // `contact` section (scene_contact.hpp); one shared velocity field when absent
   ThermalSceneSpec thermal;  // `thermal` and `coupling` sections (scene_thermal.hpp); disabled when absent

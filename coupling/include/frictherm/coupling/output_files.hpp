@@ -1,0 +1,36 @@
+#pragma once
+// Files a command writes, kept safe (issue 15): an output never lands on a file the run reads (the
+// scene, its images, a checkpoint being resumed), an existing result is replaced only when asked
+// (--force or the scene's output.overwrite: true), and a result is written under a temporary name
+// in the same folder and renamed onto its final name only when complete (docs/scenes.md, "Output
+// files"), so a second run writing the same file cannot destroy the first one's.
+#include <frictherm/coupling/runner.hpp>  // OutputError
+#include <frictherm/coupling/scene.hpp>
+
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling {
+
+/// Every file a scene reads: the scene file (unless the scene came from a string) and its images.
+std::vector<std::string> scene_input_files(const Scene& scene);
+
+/// True when both paths name the same existing file (same device and inode: symbolic and hard
+/// links and different spellings of one path count as the same file).
+bool same_file(const std::string& a, const std::string& b);
+
+/// Refuses (OutputError) to write `path` when it is one of `inputs`, when it is a folder, or when it
+/// exists and `overwrite` is false; `how_to_overwrite` is said in that last message (e.g. "--force").
+void check_output_path(const std::string& path, const std::vector<std::string>& inputs, bool overwrite,
+                       const std::string& how_to_overwrite);
+
+/// A name in the folder of `path` that no file has yet: "<path>.<pid>.part" (a counter is added if
+/// that exists).
+std::string temporary_path(const std::string& path);
+
+/// Renames the complete file `temporary` onto `path`. With `overwrite` false an existing `path` (one
+/// that appeared while the file was written, e.g. by a second run) is left alone and
+/// std::runtime_error says that the result stays under `temporary`.
+void publish_file(const std::string& temporary, const std::string& path, bool overwrite);
+
+}  // namespace frictherm::coupling

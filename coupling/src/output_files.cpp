@@ -1,0 +1,87 @@
+// Safe output files: inputs never overwritten, existing results only when asked, temporary names
+// renamed on success (output_files.hpp).
+#include <frictherm/coupling/output_files.hpp>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#ifdef __linux__
+#include <sys/syscall.h>
+#endif
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace frictherm::coupling {
+
+namespace {
+
+bool exists(const std::string& path) {
+  struct stat st {};
+  return ::lstat(path.c_str(), &st) == 0;
+}
+
+/// rename(2) that fails with EEXIST instead of replacing: renameat2(RENAME_NOREPLACE) where the kernel
+/// and file system have it, else link(2) + unlink(2) (link never replaces either).
+int rename_no_replace(const char* from, const char* to) {
+#if defined(__linux__) && defined(SYS_renameat2)
+  constexpr unsigned kNoReplace = 1u;  // RENAME_NOREPLACE
+  if (::syscall(SYS_renameat2, AT_FDCWD, from, AT_FDCWD, to, kNoReplace) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return -1;
+#endif
+  if (::link(from, to) != 0) return -1;
+  ::unlink(from);
+  return 0;
+}
+
+}  // namespace
+
+std::vector<std::string> scene_input_files(const Scene& scene) {
+  std::vector<std::string> files;
+  if (!scene.source.empty() && scene.source != "<string>") files.push_back(scene.source);
+  for (const BodySpec& b : scene.bodies)
+    if (!b.shape.image_file.empty()) files.push_back(b.shape.image_file);
+  return files;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa {}, sb {};
+  if (::stat(a.c_str(), &sa) != 0 || ::stat(b.c_str(), &sb) != 0) return false;
+  return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+void check_output_path(const std::string& path, const std::vector<std::string>& inputs, bool overwrite,
+                       const std::string& how_to_overwrite) {
+  for (const std::string& in : inputs)
+    if (same_file(path, in))
+      throw OutputError("refusing to write '" + path + "': it is an input of this run ('" + in +
+                        "'); choose another output file");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;  // nothing there (or a dangling link: created through it)
+  if (S_ISDIR(st.st_mode)) throw OutputError("cannot write '" + path + "': it is a folder");
+  if (!overwrite)
+    throw OutputError("'" + path + "' exists; refusing to replace an existing result (give " + how_to_overwrite +
+                      " to replace it, or choose another output file)");
+}
+
+std::string temporary_path(const std::string& path) {
+  const std::string stem = path + "." + std::to_string(static_cast<long>(::getpid()));
+  std::string candidate = stem + ".part";
+  for (int k = 1; exists(candidate); ++k) candidate = stem + "-" + std::to_string(k) + ".part";
+  return candidate;
+}
+
+void publish_file(const std::string& temporary, const std::string& path, bool overwrite) {
+  const int rc = overwrite ? std::rename(temporary.c_str(), path.c_str())
+                           : rename_no_replace(temporary.c_str(), path.c_str());
+  if (rc == 0) return;
+  const int err = errno;
+  if (err == EEXIST)
+    throw std::runtime_error("'" + path + "' was created by someone else while this run wrote its result; left it " +
+                             "alone: this run's result is in '" + temporary + "'");
+  throw std::runtime_error("cannot rename '" + temporary + "' to '" + path + "': " + std::strerror(err) +
+                           "; this run's result is in '" + temporary + "'");
+}
+
+}  // namespace frictherm::coupling

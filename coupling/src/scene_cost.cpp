@@ -1,0 +1,177 @@
+// Cost estimate of a scene before allocation (scene_cost.hpp).
+//
+// Memory model, fitted to the peak resident size of `frictherm run` (1 thread, 3 steps, /usr/bin/time)
+// on this code: 2D 4.0e6 and 1.6e7 grid nodes with a few particles: 439 and 1699 MB (~106 B/node);
+// 2D 6.4e5 and 2.56e6 particles on small grids: 257 and 894 MB (~350-395 B/particle); 3D 3.4e6
+// nodes: 531 MB (~154 B/node); 3D 1.38e7 particles: 6.8 GB (~490 B/particle). The constants below
+// round these up. Extra threads keep their own nodal scatter buffers (mass, momentum, force); a
+// thermal section adds its nodal system (an allowance, not fitted).
+#include <frictherm/coupling/scene.hpp>
+#include <frictherm/coupling/scene_cost.hpp>
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <thread>
+
+namespace frictherm::coupling {
+
+namespace {
+
+constexpr double kBaseBytes = 40e6;
+// A grid above kMaxEmptyGridNodes nodes with more than kMaxNodesPerParticle nodes per particle is
+// refused as mostly empty, unless run.max_memory is given (docs/scenes.md, "Cost limits").
+constexpr double kMaxEmptyGridNodes = 1e7;
+constexpr double kMaxNodesPerParticle = 100.0;
+double bytes_per_particle(int dim) { return dim == 2 ? 420.0 : 520.0; }
+double bytes_per_node(int dim) { return dim == 2 ? 115.0 : 165.0; }
+double thermal_bytes_per_node(int dim) { return dim == 2 ? 300.0 : 700.0; }
+
+std::string bytes_text(double b) {
+  if (b >= 1e9) return format_number(std::round(b / 1e8) / 10.0) + " GB";
+  return format_number(std::round(b / 1e5) / 10.0) + " MB";
+}
+
+}  // namespace
+
+double available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  double value = 0.0;
+  std::string unit;
+  while (in >> key >> value >> unit)
+    if (key == "MemAvailable:") return value * 1024.0;
+  return 0.0;
+}
+
+SceneCost estimate_scene_cost(const Scene& s) {
+  SceneCost c;
+  const int dim = s.dimension;
+  // Particles: every body's bounding box filled at particles_per_cell per direction (an upper bound;
+  // exact for boxes aligned with the cells).
+  for (const BodySpec& b : s.bodies) {
+    double n = 1.0;
+    for (int d = 0; d < dim; ++d) {
+      const double cells = std::max(0.0, (b.shape.box_hi[d] - b.shape.box_lo[d]) / s.cell_size[d]);
+      n *= (std::ceil(cells) + 1.0) * b.particles_per_cell;
+    }
+    c.particles += n;
+  }
+  c.grid_nodes = 1.0;
+  for (int d = 0; d < dim; ++d) c.grid_nodes *= static_cast<double>(s.cells[d]) + 1.0;
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const double wanted = s.threads > 0 ? s.threads : hw;
+  c.threads = static_cast<int>(std::max(1.0, std::min(wanted, std::floor(c.particles / 2000.0))));
+  c.memory_bytes = kBaseBytes + c.particles * bytes_per_particle(dim) + c.grid_nodes * bytes_per_node(dim) +
+                   (c.threads - 1) * c.grid_nodes * 8.0 * (1 + 2 * dim) +
+                   (s.thermal.enabled ? c.grid_nodes * thermal_bytes_per_node(dim) : 0.0);
+  if (s.max_memory > 0.0) {
+    c.memory_limit = s.max_memory;
+    c.memory_limit_source = "run.max_memory";
+  } else {
+    const double avail = available_memory_bytes();
+    c.memory_limit = avail > 0.0 ? kDefaultMemoryFraction * avail : 8.0 * 1024 * 1024 * 1024;
+    c.memory_limit_source = avail > 0.0 ? "75% of the machine's available memory" : "8 GiB (available memory unknown)";
+  }
+
+  // First time step, as Simulation::stable_time_step at t = 0: cfl h_min / (c + |v|), bounded by
+  // solver.max_time_step and damping.
+  double fastest_speed = 0.0, fastest_wave = 0.0;
+  std::string speed_key, wave_key;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    double v2 = 0.0;
+    for (int d = 0; d < dim; ++d) v2 += s.bodies[i].velocity[d] * s.bodies[i].velocity[d];
+    if (!(std::sqrt(v2) <= fastest_speed)) {
+      fastest_speed = std::sqrt(v2);
+      speed_key = "bodies[" + std::to_string(i) + "].velocity";
+    }
+  }
+  for (const mechanics::Material& m : s.materials) {
+    double w = 0.0;
+    if (m.is_rigid()) {
+      double v2 = 0.0;
+      for (const auto& f : m.rigid_velocity) v2 += f(0.0) * f(0.0);
+      w = std::sqrt(v2);
+    } else if (m.kind == mechanics::MaterialKind::mie_gruneisen) {
+      w = mechanics::mie_gruneisen_wave_speed(m.mie_gruneisen, 1.0, 0.0);
+    } else {
+      w = m.p_wave_speed(s.options.analysis);
+    }
+    if (!(w <= fastest_wave)) {
+      fastest_wave = w;
+      wave_key = "materials." + m.name;
+    }
+  }
+  c.wave_speed = fastest_wave + fastest_speed;
+  double h = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < dim; ++d) h = std::min(h, s.cell_size[d]);
+  c.time_step_key = fastest_speed > fastest_wave ? speed_key : wave_key;
+  if (std::isnan(c.wave_speed)) return c.time_step = c.wave_speed, c;  // refused by check_scene_cost
+  c.time_step = c.wave_speed > 0.0 ? s.options.cfl * h / c.wave_speed : std::numeric_limits<double>::infinity();
+  if (!(s.options.max_time_step >= c.time_step)) {
+    c.time_step = s.options.max_time_step;
+    c.time_step_key = "solver.max_time_step";
+  }
+  if (s.options.damping_rate > 0.0 && 0.5 / s.options.damping_rate < c.time_step) {
+    c.time_step = 0.5 / s.options.damping_rate;
+    c.time_step_key = "solver.damping.rate";
+  }
+
+  c.snapshots = std::ceil(s.end_time / s.output.snapshot_interval - 1e-9) + 1.0;
+  c.steps = std::max(std::ceil(s.end_time / c.time_step), c.snapshots - 1.0);
+  if (s.max_steps > 0) c.steps = std::min(c.steps, static_cast<double>(s.max_steps));
+  c.output_bytes = std::min(c.snapshots, c.steps + 1.0) * c.particles * 8.0 *
+                   static_cast<double>(3 * dim + dim * dim + 6);
+  return c;
+}
+
+void check_scene_cost(const Scene& s, const SceneCost& c) {
+  if (!(c.time_step > 0.0))  // 0 (an infinite wave speed or velocity) or NaN
+    throw SceneError(c.time_step_key + ": the first time step would be " + format_number(c.time_step) +
+                     " s (cfl x cell size / " + format_number(c.wave_speed) +
+                     " m/s); expected a positive, finite time step (check densities, moduli and velocities)");
+  if (c.snapshots > kMaxSnapshotCount)
+    throw SceneError(std::string("output (snapshot_interval or snapshot_count)") + ": the run would write " + format_number(c.snapshots) + " snapshots (end_time " +
+                     format_number(s.end_time) + " s / snapshot_interval " + format_number(s.output.snapshot_interval) +
+                     " s); expected at most " + format_number(kMaxSnapshotCount));
+  if (s.max_steps <= 0 && !(c.steps <= kMaxStepCount))
+    throw SceneError("run.end_time: the run would take about " + format_number(c.steps) + " steps of " +
+                     format_number(c.time_step) + " s (the first time step, set by " + c.time_step_key + ") to reach " +
+                     format_number(s.end_time) + " s; expected at most " + format_number(kMaxStepCount) +
+                     " steps: shorten run.end_time, or set run.max_steps to stop earlier");
+  // A mostly empty dense grid (the mechanics grid is dense: every node costs memory and time each
+  // step) is refused unless run.max_memory is given explicitly.
+  if (s.max_memory <= 0.0 && c.grid_nodes > kMaxEmptyGridNodes && c.grid_nodes > kMaxNodesPerParticle * c.particles)
+    throw SceneError("grid: " + format_number(c.grid_nodes) + " grid nodes for at most " + format_number(c.particles) +
+                     " particles (about " + bytes_text(c.grid_nodes * bytes_per_node(s.dimension)) +
+                     " of grid arrays, all visited every step); expected a grid around the bodies (at most " +
+                     format_number(kMaxNodesPerParticle) + " nodes per particle above " + format_number(kMaxEmptyGridNodes) +
+                     " nodes), or set run.max_memory (bytes) to accept it");
+  if (!(c.memory_bytes <= c.memory_limit)) {
+    // Blame the larger part: the particles (the body with most of them) or the grid.
+    std::string key = "grid";
+    const double particle_bytes = c.particles * bytes_per_particle(s.dimension);
+    if (particle_bytes > c.grid_nodes * bytes_per_node(s.dimension)) {
+      std::size_t worst = 0;
+      double most = -1.0;
+      for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+        double n = 1.0;
+        for (int d = 0; d < s.dimension; ++d)
+          n *= (std::ceil(std::max(0.0, (s.bodies[i].shape.box_hi[d] - s.bodies[i].shape.box_lo[d]) / s.cell_size[d])) + 1.0) *
+               s.bodies[i].particles_per_cell;
+        if (n > most) most = n, worst = i;
+      }
+      key = "bodies[" + std::to_string(worst) + "]";
+    }
+    throw SceneError(key + ": the scene needs about " + bytes_text(c.memory_bytes) + " of memory (" +
+                     format_number(c.particles) + " particles, " + format_number(c.grid_nodes) + " grid nodes, " +
+                     std::to_string(c.threads) + " threads); the limit is " + bytes_text(c.memory_limit) + " (" +
+                     c.memory_limit_source + "); expected fewer particles or grid cells, or a larger run.max_memory (bytes)");
+  }
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,210 @@
+// Files never lost (issue 15, output_files.hpp): an existing result is refused unless --force or
+// output.overwrite; the scene and other inputs are never written over; a result is written under a
+// temporary name and renamed when complete, so two runs writing one file both leave readable files.
+#include <frictherm/coupling/h5_output.hpp>
+
+#include "h5_test_support.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result frictherm(const std::string& args) {
+  const std::string cmd = std::string("'") + FRICTHERM_EXE + "' " + args + " 2>&1";
+  Result r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The run's /meta/status, or "" when the file does not open as HDF5.
+std::string status_of(const std::string& h5) {
+  const hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return "";
+  std::string s;
+  const hid_t d = H5Dopen2(f, "/meta/status", H5P_DEFAULT);
+  if (d >= 0) {
+    const hid_t t = H5Dget_type(d);
+    s.resize(H5Tget_size(t));
+    H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data());
+    s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
+    H5Tclose(t);
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return s;
+}
+
+class Files : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("frictherm_files_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  fs::path dir_;
+};
+
+const char* const kTinyScene = R"({
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
+              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+  "run": {"end_time": 2e-3, "threads": 1},
+  "output": {"snapshot_count": 4}
+})";
+
+TEST_F(Files, ExistingResultRefusedUnlessForcedOrOverwriteKey) {
+  const std::string scene = write("tiny.json", kTinyScene), out = path("run.h5");
+  ASSERT_EQ(frictherm("run " + scene + " -o " + out + " --quiet").code, 0);
+  const std::string first = slurp(out);
+  ASSERT_EQ(status_of(out), "completed");
+
+  const Result again = frictherm("run " + scene + " -o " + out + " --quiet");
+  EXPECT_EQ(again.code, 2) << again.output;
+  EXPECT_THAT(again.output, HasSubstr("exists"));
+  EXPECT_THAT(again.output, HasSubstr("--force"));
+  EXPECT_TRUE(slurp(out) == first) << "a refused run must not touch the existing result";
+
+  const Result forced = frictherm("run " + scene + " -o " + out + " --quiet --force");
+  EXPECT_EQ(forced.code, 0) << forced.output;
+  EXPECT_EQ(status_of(out), "completed");
+  const Result by_key = frictherm("run " + scene + " -o " + out + " --quiet --set output.overwrite=true");
+  EXPECT_EQ(by_key.code, 0) << by_key.output;
+  EXPECT_EQ(status_of(out), "completed");
+  // Nothing left behind under temporary names.
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_NE(e.path().extension(), ".part") << e.path();
+}
+
+TEST_F(Files, InputsAreNeverWrittenOverEvenWithForce) {
+  const std::string scene = write("tiny.json", kTinyScene);
+  for (const std::string force : {"", " --force"}) {
+    const Result r = frictherm("run " + scene + " -o " + scene + " --quiet" + force);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("input of this run"));
+    EXPECT_EQ(slurp(scene), kTinyScene);
+  }
+  // The same file under another spelling (a symbolic link) is the same input.
+  fs::create_symlink(scene, path("link.json"));
+  const Result via_link = frictherm("run " + scene + " -o " + path("link.json") + " --quiet --force");
+  EXPECT_EQ(via_link.code, 2) << via_link.output;
+  EXPECT_EQ(slurp(scene), kTinyScene);
+
+  // export-csv never writes over the run it reads.
+  ASSERT_EQ(frictherm("run " + scene + " -o " + path("run.h5") + " --quiet").code, 0);
+  const std::string run = slurp(path("run.h5"));
+  const Result csv = frictherm("export-csv " + path("run.h5") + " -o " + path("run.h5") + " --force");
+  EXPECT_EQ(csv.code, 2) << csv.output;
+  EXPECT_TRUE(slurp(path("run.h5")) == run);
+  EXPECT_EQ(status_of(path("run.h5")), "completed");
+  // An existing CSV is replaced only with --force.
+  ASSERT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv")).code, 0);
+  EXPECT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv")).code, 2);
+  EXPECT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv") + " --force").code, 0);
+}
+
+// Two runs started together on one output file: the first to finish publishes it; the second finds
+// the name taken and keeps its own result under its temporary name (exit code 2, saying where).
+// Both files are complete, readable results; nothing is truncated.
+TEST_F(Files, TwoWritersOfOneFileBothKeepReadableResults) {
+  std::string scene_text = kTinyScene;
+  scene_text.replace(scene_text.find("2e-3"), 4, "4e-2");  // ~0.5 s each: the two runs overlap
+  const std::string scene = write("tiny.json", scene_text), out = path("same.h5");
+  pid_t pids[2];
+  for (int k = 0; k < 2; ++k) {
+    pids[k] = fork();
+    if (pids[k] == 0) {
+      std::freopen(path("stderr" + std::to_string(k) + ".txt").c_str(), "w", stderr);
+      execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+  }
+  int codes[2];
+  for (int k = 0; k < 2; ++k) {
+    int status = 0;
+    waitpid(pids[k], &status, 0);
+    codes[k] = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  EXPECT_EQ(status_of(out), "completed");
+  int published = 0;
+  for (int k = 0; k < 2; ++k) {
+    const std::string live = out + "." + std::to_string(pids[k]) + ".part";
+    if (codes[k] == 0) {
+      ++published;
+      EXPECT_FALSE(fs::exists(live));
+    } else {
+      // Only possible when both ran at once: the later one keeps its result under its own name.
+      EXPECT_EQ(codes[k], 2) << slurp(path("stderr" + std::to_string(k) + ".txt"));
+      EXPECT_THAT(slurp(path("stderr" + std::to_string(k) + ".txt")), HasSubstr(live));
+      EXPECT_EQ(status_of(live), "completed");
+    }
+  }
+  EXPECT_GE(published, 1);
+}
+
+// The library level of the same: a file that appears under the final name while an H5Output writes
+// under its temporary name is left alone, and the output stays readable under the temporary name.
+TEST_F(Files, TemporaryOutputNeverReplacesAFileThatAppearedMeanwhile) {
+  using frictherm::coupling::H5Output;
+  using frictherm::coupling::H5OutputOptions;
+  const std::string out = path("r.h5");
+  H5OutputOptions o;
+  o.via_temporary = true;
+  o.replace_existing = false;
+  H5Output w(out, 2, o);
+  EXPECT_EQ(w.path(), out);
+  EXPECT_NE(w.live_path(), out);
+  EXPECT_EQ(fs::path(w.live_path()).parent_path(), dir_);
+  w.write_metadata("status", "completed");
+  write("r.h5", "someone else's result");
+  const std::string live = w.live_path();
+  EXPECT_THROW(w.close(), std::runtime_error);
+  EXPECT_EQ(slurp(out), "someone else's result");
+  EXPECT_EQ(status_of(live), "completed");
+
+  H5OutputOptions replace = o;
+  replace.replace_existing = true;
+  H5Output v(out, 2, replace);
+  v.write_metadata("status", "completed");
+  v.close();
+  EXPECT_EQ(status_of(out), "completed");
+  EXPECT_FALSE(fs::exists(v.live_path()));
+}
+
+}  // namespace

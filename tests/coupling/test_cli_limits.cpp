@@ -1,0 +1,104 @@
+// Resource bombs and endless runs refused by `frictherm validate` (issue 15 items 1-2, scene_cost.hpp):
+// each bad scene exits with code 2 within a second, with one message naming the key path and the
+// numbers, before anything large is allocated.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string output;
+  double seconds = 0.0;
+};
+
+Result validate(const std::string& scene, const std::string& sets) {
+  const std::string cmd = std::string("'") + FRICTHERM_EXE + "' validate '" + scene + "' " + sets + " 2>&1";
+  Result r;
+  const auto t0 = std::chrono::steady_clock::now();
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+const char* const kBase = R"({
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
+              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+  "run": {"end_time": 2e-3, "threads": 1},
+  "output": {"snapshot_count": 4}
+})";
+
+class Limits : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scene_ = (fs::temp_directory_path() / ("frictherm_limits_" + std::to_string(getpid()) + ".json")).string();
+    std::ofstream(scene_) << kBase;
+  }
+  void TearDown() override { fs::remove(scene_); }
+  // A refusal: exit code 2, one message starting with "frictherm: SCENE: KEY", within a second.
+  void expect_refused(const std::string& sets, const std::string& key, const std::string& detail) {
+    const Result r = validate(scene_, sets);
+    EXPECT_EQ(r.code, 2) << sets << "\n" << r.output;
+    EXPECT_THAT(r.output, StartsWith("frictherm: " + scene_ + ": " + key)) << sets;
+    EXPECT_THAT(r.output, HasSubstr(detail)) << sets;
+    EXPECT_LT(r.seconds, 1.0) << sets;
+  }
+  std::string scene_;
+};
+
+TEST_F(Limits, BaseSceneValidatesAndPrintsTheEstimate) {
+  const Result r = validate(scene_, "");
+  ASSERT_EQ(r.code, 0) << r.output;
+  // 4 x 3 cells of block at 2 x 2 particles per cell: 48 particles, the box bound counts (4+1) x (3+1) x 4 = 80.
+  EXPECT_THAT(r.output, HasSubstr("at most 80 particles, 66 grid nodes"));
+}
+
+TEST_F(Limits, ResourceBombsRefusedBeforeAllocation) {
+  // 7000 x 7000 cells at 10 x 10 particles per cell: ~4.8e9 particles, ~2 TB.
+  expect_refused("--set grid.hi=[7,7] --set grid.cell_size=0.001 --set 'bodies[0].shape.lo=[0,0]' "
+                 "--set 'bodies[0].shape.hi=[6.9,6.9]' --set 'bodies[0].particles_per_cell=10'",
+                 "bodies[0]: the scene needs about", "particles");
+  // An explicit memory limit below the (small) estimate.
+  expect_refused("--set run.max_memory=1e6", "bodies[0]", "the limit is 1 MB (run.max_memory)");
+  // 4.9e7-node grid for 48 particles: mostly empty, refused unless run.max_memory is given.
+  expect_refused("--set grid.hi=[70,70] --set grid.cell_size=0.01", "grid: 49014001 grid nodes", "nodes per particle");
+  // --set growing an array to 2e8 elements.
+  expect_refused("--set 'bodies[200000000]=1'", "--set bodies[200000000]", "beyond the end of an array of 1");
+}
+
+TEST_F(Limits, EndlessRunsRefusedWithTheirNumbers) {
+  expect_refused("--set output.snapshot_count=null --set output.snapshot_interval=1e-300", "output",
+                 "2e+297 snapshots");
+  expect_refused("--set output.snapshot_count=1000000", "output", "1000001 snapshots");
+  expect_refused("--set solver.max_time_step=1e-300", "run.end_time", "2e+297 steps of 1e-300 s");
+  expect_refused("--set run.end_time=1e300 --set 'bodies[0].velocity=[0,0]'", "run.end_time", "steps of");
+  // |v| overflows: the first time step would be 0, even with max_steps bounding the run.
+  expect_refused("--set 'bodies[0].velocity=[1e308,1e308]' --set run.max_steps=10", "bodies[0].velocity",
+                 "the first time step would be 0 s");
+  // With run.max_steps the same long run is bounded, so accepted.
+  EXPECT_EQ(validate(scene_, "--set solver.max_time_step=1e-300 --set run.max_steps=5").code, 0);
+}
+
+}  // namespace
