@@ -31,12 +31,13 @@ import subprocess
 import sys
 import time
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+import frictherm  # noqa: E402  (python/frictherm, the reader of run files)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 OSC = os.path.join(HERE, "oscillating_block.json")
@@ -86,9 +87,8 @@ def run(frictherm, scene, out, sets):
 
 
 def work_after(path, t1, column=PAIR):
-    with h5py.File(path, "r") as f:
-        t = f["series/time"][:]
-        w = f["series/" + column][:]
+    with frictherm.open(path) as r:
+        t, w = r.series["time"], r.series[column]
     return w[-1] - np.interp(t1, t, w)
 
 
@@ -177,8 +177,8 @@ def pbx_study(frictherm, out_dir):
                 out = os.path.join(out_dir, "pbx_%s_C%g_%d.h5" % (name.replace(" ", "_"), c, seed))
                 run(frictherm, PBX, out, sets + ["solver.cfl=%r" % c, "run.end_time=3.9e-6",
                                                  "bodies[0].shape.seed=%d" % seed])
-                with h5py.File(out, "r") as f:
-                    works.append(f["series/friction_work_second"][-1])
+                with frictherm.open(out) as r:
+                    works.append(r.series["friction_work_second"][-1])
             result[(name, c)] = np.array(works)
             w = result[(name, c)]
             print("PBX %-9s C = %-4g median %.4f J/m, min %.4f, max %.4f" % (name, c, np.median(w), w.min(), w.max()),

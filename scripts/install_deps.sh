@@ -2,7 +2,8 @@
 # Installs the Debian packages frictherm needs (Debian 12). Skips apt entirely when all are present.
 set -euo pipefail
 packages=(build-essential cmake pkg-config libeigen3-dev libsundials-dev libhdf5-dev libgtest-dev
-          nlohmann-json3-dev libboost-dev libmuparser-dev python3 python3-numpy python3-matplotlib python3-h5py)
+          nlohmann-json3-dev libboost-dev libmuparser-dev python3 python3-numpy python3-matplotlib python3-h5py
+          python3-pandas python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
