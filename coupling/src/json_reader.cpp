@@ -148,8 +148,18 @@ std::vector<JsonReader> JsonReader::elements(std::size_t min_size) const {
   return out;
 }
 
+namespace {
+JsonReader::KeyTableObserver& key_table_observer() {
+  static JsonReader::KeyTableObserver observer;
+  return observer;
+}
+}  // namespace
+
+void JsonReader::set_key_table_observer(KeyTableObserver observer) { key_table_observer() = std::move(observer); }
+
 std::vector<std::string> JsonReader::keys() const {
   require_object();
+  map_ = true;
   std::vector<std::string> out;
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     out.push_back(it.key());
@@ -175,7 +185,11 @@ bool JsonReader::has(const std::string& key) const {
 JsonReader JsonReader::at(const std::string& key, const std::string& what) const {
   if (!has(key)) {
     const std::string p = member_path(key);
-    throw SceneError(p + ": required key missing" + (what.empty() ? std::string() : " (expected " + what + ")"));
+    std::vector<std::string> present;  // a misspelt required key: name the key that is probably it
+    for (auto it = value_->begin(); it != value_->end(); ++it) present.push_back(it.key());
+    const std::string near = nearest_key(key, present);
+    throw SceneError(p + ": required key missing" + (what.empty() ? std::string() : " (expected " + what + ")") +
+                     (near.empty() ? std::string() : "; is '" + near + "' a misspelling of it?"));
   }
   return JsonReader(value_->at(key), member_path(key));
 }
@@ -226,14 +240,43 @@ std::vector<double> JsonReader::vector(const std::string& key, std::size_t n, co
 
 void JsonReader::finish() const {
   require_object();
+  if (key_table_observer()) key_table_observer()(path_, known_, map_);
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     if (std::find(known_.begin(), known_.end(), it.key()) != known_.end()) continue;
     std::string allowed;
     for (const std::string& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
+    const std::string near = nearest_key(it.key(), known_);
     throw SceneError(member_path(it.key()) + ": unknown key" +
                      (allowed.empty() ? std::string(" (no keys are allowed here)")
-                                      : " (allowed here: " + allowed + ")"));
+                                      : " (allowed here: " + allowed + ")") +
+                     (near.empty() ? std::string() : "; did you mean '" + near + "'?"));
   }
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);  // row[j]: distance of a[0, i) to b[0, j)
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string nearest_key(const std::string& typo, const std::vector<std::string>& allowed) {
+  const std::size_t limit = typo.size() <= 3 ? 1 : std::max<std::size_t>(2, typo.size() / 3);
+  std::string best;
+  std::size_t best_distance = limit + 1;
+  for (const std::string& k : allowed) {
+    const std::size_t d = edit_distance(typo, k);
+    if (d < best_distance && d < typo.size() && d < k.size()) best = k, best_distance = d;  // not a whole new word
+  }
+  return best;
 }
 
 Json parse_json_text(const std::string& text) {
