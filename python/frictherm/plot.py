@@ -103,6 +103,7 @@ def draw_hotspots(run, snap, png):
     fig = plt.figure(figsize=(7.5, 6), dpi=120)
     fig.figimage(img, 0, 0)
     ax, pad = _frame(fig, snap["position"].astype(float), particle_side(run, snap))
+    ax.set_zorder(1)  # above the figure image (figure images are drawn after axes of equal zorder)
     ax.patch.set_alpha(0.0)
     ax.set_axis_off()
     for x, y, d, i in zip(sel["centroid_x"], sel["centroid_y"], sel["equivalent_diameter"], sel["id"]):

@@ -167,8 +167,12 @@ def test_examples_read_through_the_package(run_file, ensemble_file, tmp_path):
     out = subprocess.run([sys.executable, os.path.join(EXAMPLES, "plot_run.py"), run_file, "--list"], env=env,
                          check=True, capture_output=True, text=True).stdout
     assert "status completed" in out and "hotspots (" in out
-    subprocess.run([sys.executable, os.path.join(EXAMPLES, "pbx_figures.py"), "--redraw", run_file, "--out",
-                    str(tmp_path)], env=env, check=True, capture_output=True)
+    redraw = subprocess.run([sys.executable, os.path.join(EXAMPLES, "pbx_figures.py"), "--redraw", run_file, "--out",
+                             str(tmp_path)], env=env, check=True, capture_output=True, text=True).stdout
+    with frictherm.open(run_file) as r:  # the hot spots circled: those of the window at the end of loading
+        at_end = int(np.count_nonzero(r.hotspots["time"] == r.hotspots["time"][np.argmin(
+            abs(r.hotspots["time"] - r.meta["end_time"]))]))
+    assert at_end >= 1 and f"{at_end} hot spots at the end of loading" in redraw
     for suffix in ("_temperature.png", "_hotspots.png", "_series.png"):
         png = tmp_path / ("run" + suffix)
         assert png.stat().st_size > 10000, png
