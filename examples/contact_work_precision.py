@@ -63,10 +63,10 @@ def sweep(full):
     return runs
 
 
-def run_one(frictherm, tmp, name, cell, cfl):
+def run_one(exe, tmp, name, cell, cfl):
     sets = dict((m[0], m[2]) for m in METHODS)[name]
     out = os.path.join(tmp, "run.h5")
-    cmd = [frictherm, "run", SCENE, "-o", out, "--threads", "1", "--quiet",
+    cmd = [exe, "run", SCENE, "-o", out, "--threads", "1", "--quiet",
            "--set", "grid.cell_size=%r" % cell, "--set", "solver.cfl=%r" % cfl]
     for s in sets:
         cmd += ["--set", s]

@@ -43,10 +43,10 @@ def pusher_start(scene):
 T1 = pusher_start(SCENE)
 
 
-def run(frictherm, cfl, out_dir):
+def run(exe, cfl, out_dir):
     out = os.path.join(out_dir, "oscillating_block_C%g.h5" % cfl)
     start = time.perf_counter()
-    subprocess.run([frictherm, "run", SCENE, "-o", out, "--quiet", "--threads", "1", "--set", "solver.cfl=%r" % cfl],
+    subprocess.run([exe, "run", SCENE, "-o", out, "--quiet", "--threads", "1", "--set", "solver.cfl=%r" % cfl],
                    check=True)
     wall = time.perf_counter() - start
     with frictherm.open(out) as r:

@@ -72,9 +72,9 @@ class RigidBlock:
         return L * B * (c * dist + self.k * N * v2)
 
 
-def run(frictherm, out_dir, name, law, cell):
+def run(exe, out_dir, name, law, cell):
     out = os.path.join(out_dir, name + ".h5")
-    cmd = [frictherm, "run", SCENE, "-o", out, "--set", "contact.pairs[0].law=" + json.dumps(law)]
+    cmd = [exe, "run", SCENE, "-o", out, "--set", "contact.pairs[0].law=" + json.dumps(law)]
     if cell:
         cmd += ["--set", "grid.cell_size=%r" % cell]
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
