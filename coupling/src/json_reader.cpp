@@ -1,6 +1,7 @@
 #include <set>
 #include <vector>
 #include <frictherm/coupling/json_reader.hpp>
+#include <frictherm/coupling/scene_value_observer.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -66,7 +67,20 @@ void JsonReader::expected(const std::string& what) const {
   fail("expected " + what + ", got " + describe_json(*value_));
 }
 
+namespace {
+SceneValueObserver& value_observer() {
+  static SceneValueObserver observer;
+  return observer;
+}
+void report(const std::string& path, const std::string& what, const std::vector<std::string>& choices = {}) {
+  if (value_observer()) value_observer()(path, what, choices);
+}
+}  // namespace
+
+void set_scene_value_observer(SceneValueObserver observer) { value_observer() = std::move(observer); }
+
 double JsonReader::as_number(const Range& range) const {
+  report(path_, range.describe());
   if (!value_->is_number()) expected(range.describe());
   const double x = value_->get<double>();
   if (!range.contains(x)) expected(range.describe());
@@ -81,6 +95,7 @@ long JsonReader::as_integer(long min, long max) const {
     what += " >= " + std::to_string(min);
   else if (max != std::numeric_limits<long>::max())
     what += " <= " + std::to_string(max);
+  report(path_, what);
   if (!value_->is_number()) expected(what);
   // Compare in the integer domain: 2^63 written as a float equals double(LONG_MAX) after rounding,
   // so a float is first bounded by the exact powers of two before any cast (a cast out of range is UB).
@@ -97,11 +112,13 @@ long JsonReader::as_integer(long min, long max) const {
 }
 
 std::string JsonReader::as_string() const {
+  report(path_, "a string");
   if (!value_->is_string()) expected("a string");
   return value_->get<std::string>();
 }
 
 bool JsonReader::as_bool() const {
+  report(path_, "true or false");
   if (!value_->is_boolean()) expected("true or false");
   return value_->get<bool>();
 }
@@ -110,6 +127,7 @@ std::string JsonReader::as_choice(const std::vector<std::string>& choices) const
   std::string what = choices.size() == 1 ? "\"" + choices[0] + "\"" : "one of ";
   if (choices.size() > 1)
     for (std::size_t k = 0; k < choices.size(); ++k) what += (k ? ", \"" : "\"") + choices[k] + "\"";
+  report(path_, what, choices);
   if (!value_->is_string()) expected(what);
   const std::string s = value_->get<std::string>();
   if (std::find(choices.begin(), choices.end(), s) == choices.end()) expected(what);
@@ -119,6 +137,7 @@ std::string JsonReader::as_choice(const std::vector<std::string>& choices) const
 std::vector<double> JsonReader::as_vector(std::size_t n, const Range& range) const {
   const std::string what =
       "an array of " + std::to_string(n) + (n == 1 ? " number" : " numbers") + " (one per dimension)";
+  report(path_, what + ", each " + range.describe());
   if (!value_->is_array() || value_->size() != n) expected(what);
   std::vector<double> out;
   out.reserve(n);
@@ -127,6 +146,8 @@ std::vector<double> JsonReader::as_vector(std::size_t n, const Range& range) con
 }
 
 std::vector<double> JsonReader::as_number_list(std::size_t min_size, const Range& range) const {
+  report(path_, "an array of " + (min_size > 0 ? "at least " + std::to_string(min_size) + " " : std::string()) +
+                    "numbers, each " + range.describe());
   if (!value_->is_array() || value_->size() < min_size)
     expected("an array of " + (min_size > 0 ? "at least " + std::to_string(min_size) + " " : std::string()) +
              "numbers");

@@ -30,14 +30,25 @@ struct KeyTable {
   bool constant = true;           // the same keys every time (else they depend on a variant, e.g. a shape's type)
   std::set<std::string> first;
   bool is_map = false;
+  std::vector<std::string> expected;  // what the validator expects of a value here (set_scene_value_observer)
+  std::vector<std::string> choices;   // the allowed strings of a choice
 };
+
+void add_unique(std::vector<std::string>& to, const std::string& x) {
+  if (std::find(to.begin(), to.end(), x) == to.end()) to.push_back(x);
+}
 
 // Key paths as patterns: bodies[3].shape -> bodies[].shape, materials.steel -> materials.* .
 std::map<std::string, KeyTable> record_key_tables(std::vector<std::string>& scenes) {
   std::vector<std::tuple<std::string, std::vector<std::string>, bool>> raw;
+  std::vector<std::tuple<std::string, std::string, std::vector<std::string>>> values;
   fc::JsonReader::set_key_table_observer(
       [&raw](const std::string& path, const std::vector<std::string>& keys, bool is_map) {
         raw.emplace_back(path, keys, is_map);
+      });
+  fc::set_scene_value_observer(
+      [&values](const std::string& path, const std::string& expected, const std::vector<std::string>& choices) {
+        values.emplace_back(path, expected, choices);
       });
   for (const auto& e : fs::directory_iterator(fs::path(FRICTHERM_SOURCE_DIR) / "examples"))
     if (e.path().extension() == ".json") scenes.push_back(e.path().string());
@@ -50,6 +61,7 @@ std::map<std::string, KeyTable> record_key_tables(std::vector<std::string>& scen
     }
   }
   fc::JsonReader::set_key_table_observer(nullptr);
+  fc::set_scene_value_observer(nullptr);
   const std::regex index(R"(\[[0-9]+\])");
   std::vector<std::string> maps;  // patterns of maps of user names
   auto pattern = [&](std::string p) {
@@ -76,8 +88,12 @@ std::map<std::string, KeyTable> record_key_tables(std::vector<std::string>& scen
     const std::set<std::string> now(keys.begin(), keys.end());
     if (fresh) t.first = now;
     else if (now != t.first) t.constant = false;
-    for (const auto& k : keys)
-      if (std::find(t.keys.begin(), t.keys.end(), k) == t.keys.end()) t.keys.push_back(k);
+    for (const auto& k : keys) add_unique(t.keys, k);
+  }
+  for (const auto& [path, expected, choices] : values) {  // leaves get an entry of their own
+    KeyTable& t = tables[pattern(path)];
+    add_unique(t.expected, expected);
+    for (const auto& c : choices) add_unique(t.choices, c);
   }
   return tables;
 }
@@ -91,8 +107,14 @@ fc::Json value_schema(const std::string& p, const std::map<std::string, KeyTable
   if (obj != tables.end() && obj->second.is_map) {
     s["type"] = "object";
     if (tables.count(p + ".*")) s["additionalProperties"] = value_schema(p + ".*", tables);
-  } else if (obj != tables.end()) {
+  } else if (obj != tables.end() && (!obj->second.keys.empty() || obj->second.expected.empty())) {
     s = object_schema(p, tables);
+  }
+  if (obj != tables.end() && !obj->second.expected.empty()) {  // annotations only: they never reject a value
+    std::string d;
+    for (const auto& e : obj->second.expected) d += (d.empty() ? "" : ", or ") + e;
+    s["description"] = "expected " + d;
+    if (!obj->second.choices.empty()) s["examples"] = obj->second.choices;
   }
   if (tables.count(p + "[]")) s["items"] = value_schema(p + "[]", tables);  // also an array of such objects
   return s;
@@ -159,6 +181,9 @@ TEST(SceneSchema, MatchesTheValidatorKeyTables) {
   for (const char* k : {"units", "dimension", "grid", "materials", "bodies", "contact", "thermal", "coupling", "solver",
                         "run", "output"})
     EXPECT_TRUE(stored["properties"].contains(k)) << k;
+  // What the validator expects of values shows as descriptions, a choice's strings as examples.
+  EXPECT_EQ(stored["properties"]["solver"]["properties"]["cfl"]["description"], "expected a number in (0, 1]");
+  EXPECT_TRUE(stored["properties"]["solver"]["properties"]["shape_function"]["examples"].size() >= 4u);
   // A map of user names: material definitions are checked under additionalProperties.
   EXPECT_TRUE(stored["properties"]["materials"]["additionalProperties"]["properties"].contains("density"));
   EXPECT_TRUE(stored["properties"]["bodies"]["items"]["properties"].contains("shape"));

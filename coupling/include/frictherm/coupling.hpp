@@ -30,6 +30,7 @@
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/coupling/scene_contact.hpp>
 #include <frictherm/coupling/scene_thermal.hpp>
+#include <frictherm/coupling/scene_value_observer.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/coupling/thread_policy.hpp>
 #include <frictherm/coupling/xdmf.hpp>
