@@ -14,7 +14,7 @@ Wall time is the run's (one thread). A run that blows up is listed and left off 
 Default sweep (about 3 minutes): every method at 5 and 2.5 mm with C = 0.5 and 0.25, and 1.25 mm at
 C = 0.5 for the uGIMP methods; --full adds 1.25 mm for every method and C = 0.125.
 --check exits 1 unless the facts measured when the chart was made still hold (see CHECKS).
-Uses the Debian packages python3-h5py, python3-matplotlib and python3-numpy; runs headless.
+Uses the Debian packages python3-h5py (through the frictherm package), python3-matplotlib and python3-numpy; runs headless.
 """
 import argparse
 import csv
@@ -24,15 +24,15 @@ import sys
 import tempfile
 import time
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+import frictherm  # noqa: E402  (python/frictherm, the reader of run files)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
 from sliding_block_figures import RigidBlock, TF, V_MAX  # noqa: E402
 
 SCENE = os.path.join(HERE, "sliding_block.json")
@@ -63,10 +63,10 @@ def sweep(full):
     return runs
 
 
-def run_one(frictherm, tmp, name, cell, cfl):
+def run_one(exe, tmp, name, cell, cfl):
     sets = dict((m[0], m[2]) for m in METHODS)[name]
     out = os.path.join(tmp, "run.h5")
-    cmd = [frictherm, "run", SCENE, "-o", out, "--force", "--threads", "1", "--quiet",
+    cmd = [exe, "run", SCENE, "-o", out, "--force", "--threads", "1", "--quiet",
            "--set", "grid.cell_size=%r" % cell, "--set", "solver.cfl=%r" % cfl]
     for s in sets:
         cmd += ["--set", s]
@@ -76,11 +76,9 @@ def run_one(frictherm, tmp, name, cell, cfl):
     if p.returncode != 0:
         return dict(method=name, cell=cell, cfl=cfl, wall=wall, ok=False, v_err=np.nan, w_err=np.nan,
                     note=p.stderr.strip().splitlines()[-1][:160] if p.stderr.strip() else "failed")
-    with h5py.File(out, "r") as f:
-        s = f["series"]
-        t = np.array(s["time"])
-        v = np.array(s["mean_velocity_x.block"])
-        w = np.array(s["friction_work_first"])
+    with frictherm.open(out) as r:
+        s = r.series
+        t, v, w = s["time"], s["mean_velocity_x.block"], s["friction_work_first"]
     rigid = RigidBlock(0.2, 0.2)
     sliding = t >= rigid.onset
     v_err = float(np.max(np.abs(v[sliding] - rigid.velocity(t[sliding]))) / V_MAX)

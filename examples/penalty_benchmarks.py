@@ -13,7 +13,7 @@ cell size, ...), keeps the HDF5 files under results/penalty/ and reuses them whe
 runs again). Options: --frictherm PATH, --threads N, --out DIR, --shapes ebs obs.
 Run times on this 2-core machine (defaults): hertz-disks ~3 min, half-disk ~5 min, rings ~2 min,
 granular ~1 min; the finest levels (R/40, 0.05 mm, 1.25 mm) take far longer.
-Uses python3-h5py, python3-matplotlib, python3-numpy; headless.
+Uses python3-h5py (through the frictherm package), python3-matplotlib, python3-numpy; headless.
 """
 import argparse
 import math
@@ -21,12 +21,13 @@ import os
 import subprocess
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+import frictherm  # noqa: E402  (python/frictherm, the reader of run files)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -67,17 +68,16 @@ def shape_sets(shape):
 
 
 def series(path):
-    with h5py.File(path, "r") as f:
-        return {k: np.asarray(f["series"][k]) for k in f["series"].keys()}
+    with frictherm.open(path) as r:
+        return r.series.as_dict()
 
 
 def snapshots(path):
     """[(time, {field: array})] in time order."""
     out = []
-    with h5py.File(path, "r") as f:
-        for name in f["snapshots"].keys():
-            g = f["snapshots"][name]
-            out.append((float(g.attrs["time"]), {k: np.asarray(g[k]) for k in g.keys()}))
+    with frictherm.open(path) as r:
+        for snap in r.snapshots:
+            out.append((snap.time, {k: snap[k] for k in snap.fields}))
     out.sort(key=lambda s: s[0])
     return out
 

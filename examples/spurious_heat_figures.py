@@ -31,12 +31,13 @@ import subprocess
 import sys
 import time
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+import frictherm  # noqa: E402  (python/frictherm, the reader of run files)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 OSC = os.path.join(HERE, "oscillating_block.json")
@@ -74,8 +75,8 @@ def start_time(config):
     return PAPER_T1 if config == "paper" else PUSH["start"]
 
 
-def run(frictherm, scene, out, sets):
-    cmd = [frictherm, "run", scene, "-o", out, "--force", "--quiet", "--threads", "1"]
+def run(exe, scene, out, sets):
+    cmd = [exe, "run", scene, "-o", out, "--force", "--quiet", "--threads", "1"]
     for s in sets:
         cmd += ["--set", s]
     if os.path.exists(out):
@@ -86,26 +87,25 @@ def run(frictherm, scene, out, sets):
 
 
 def work_after(path, t1, column=PAIR):
-    with h5py.File(path, "r") as f:
-        t = f["series/time"][:]
-        w = f["series/" + column][:]
+    with frictherm.open(path) as r:
+        t, w = r.series["time"], r.series[column]
     return w[-1] - np.interp(t1, t, w)
 
 
-def oscillating_study(frictherm, out_dir, cfls):
+def oscillating_study(exe, out_dir, cfls):
     rows = []  # (config, C, oscillating J, held J, pressed J or nan, wall s)
     for name, sets in CONFIGS.items():
         for c in cfls:
             base = sets + ["solver.cfl=%r" % c]
             tag = "%s_C%g" % (name.replace("(", "").replace(")", ""), c)
             osc = os.path.join(out_dir, "osc_%s.h5" % tag)
-            wall = run(frictherm, OSC, osc, base)
+            wall = run(exe, OSC, osc, base)
             held = os.path.join(out_dir, "held_%s.h5" % tag)
-            run(frictherm, OSC, held, base + ["materials.pusher.velocity[0].amplitude=0.0"])
+            run(exe, OSC, held, base + ["materials.pusher.velocity[0].amplitude=0.0"])
             pressed = float("nan")
             if name == "trusted":
                 pr = os.path.join(out_dir, "pressed_%s.h5" % tag)
-                run(frictherm, PRESSED, pr, ["solver.cfl=%r" % c])
+                run(exe, PRESSED, pr, ["solver.cfl=%r" % c])
                 pressed = work_after(pr, start_time(name))
             t1 = start_time(name)
             rows.append((name, c, work_after(osc, t1), work_after(held, t1), pressed, wall))
@@ -166,7 +166,7 @@ def plot_oscillating(rows, out_dir):
     fig.savefig(os.path.join(out_dir, "spurious_work_precision.png"), dpi=150)
 
 
-def pbx_study(frictherm, out_dir):
+def pbx_study(exe, out_dir):
     seeds = [2018, 1, 2, 3, 4]
     configs = {"FLIP": [], "PIC blend": ["solver.pic_relaxation_time=%r" % PBX_TAU]}
     result = {}
@@ -175,10 +175,10 @@ def pbx_study(frictherm, out_dir):
             works = []
             for seed in seeds:
                 out = os.path.join(out_dir, "pbx_%s_C%g_%d.h5" % (name.replace(" ", "_"), c, seed))
-                run(frictherm, PBX, out, sets + ["solver.cfl=%r" % c, "run.end_time=3.9e-6",
+                run(exe, PBX, out, sets + ["solver.cfl=%r" % c, "run.end_time=3.9e-6",
                                                  "bodies[0].shape.seed=%d" % seed])
-                with h5py.File(out, "r") as f:
-                    works.append(f["series/friction_work_second"][-1])
+                with frictherm.open(out) as r:
+                    works.append(r.series["friction_work_second"][-1])
             result[(name, c)] = np.array(works)
             w = result[(name, c)]
             print("PBX %-9s C = %-4g median %.4f J/m, min %.4f, max %.4f" % (name, c, np.median(w), w.min(), w.max()),

@@ -175,7 +175,7 @@ const char* const kEnsembleHelp =
     "\n"
     "options:\n"
     "  -k, --seed-key KEY    scene key path that takes each member's seed (required)\n"
-    "  -n, --members N       number of members (default 1)\n"
+    "  -n, --members N       number of members, 1 to 1024 (default 1)\n"
     "      --first-seed S    seed of the first member (default 1)\n"
     "  -o, --output OUT.h5   aggregate file (default ensemble.h5)\n"
     "      --member-prefix P member files are P<seed>.h5\n"

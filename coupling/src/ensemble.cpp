@@ -1,12 +1,14 @@
 // Ensembles of one scene over seeds, and the aggregation of their hot spots (ensemble.hpp).
-#include <frictherm/coupling/csv_export.hpp>
+#include <frictherm/coupling/results.hpp>
 #include <frictherm/coupling/ensemble.hpp>
 #include <frictherm/coupling/output_files.hpp>
+#include <frictherm/coupling/h5_output.hpp>
 
 #include "h5_util.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -106,12 +108,16 @@ void write_columns(hid_t file, const std::string& path, const std::string& group
     const hsize_t n = cols[j].size();
     const Handle s{check_id(H5Screate_simple(1, &n, nullptr), path, "dataspace"), H5Sclose};
     const std::string where = "/" + group + "/" + names[j];
-    const Handle d{check_id(H5Dcreate2(g.get(), names[j].c_str(), H5T_NATIVE_DOUBLE, s.get(), H5P_DEFAULT, H5P_DEFAULT,
-                                       H5P_DEFAULT),
+    const bool integer = H5Output::is_count_column(names[j]);  // seeds, ids, counts: int64 (format version 2)
+    const Handle d{check_id(H5Dcreate2(g.get(), names[j].c_str(), integer ? H5T_STD_I64LE : H5T_IEEE_F64LE, s.get(),
+                                       H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                             path, "cannot create " + where),
                    H5Dclose};
+    std::vector<double> values = cols[j];
+    if (integer)
+      for (double& v : values) v = std::nearbyint(v);
     if (n > 0)
-      check(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, cols[j].data()), path,
+      check(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), path,
             "cannot write " + where);
   }
 }
@@ -122,6 +128,31 @@ void write_attribute(hid_t file, const std::string& path, const std::string& nam
                           "cannot create attribute " + name),
                  H5Aclose};
   check(H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &value), path, "cannot write attribute " + name);
+}
+
+void write_attribute(hid_t file, const std::string& path, const std::string& name, std::int64_t value) {
+  const Handle s{check_id(H5Screate(H5S_SCALAR), path, "dataspace"), H5Sclose};
+  const Handle a{check_id(H5Acreate2(file, name.c_str(), H5T_STD_I64LE, s.get(), H5P_DEFAULT, H5P_DEFAULT), path,
+                          "cannot create attribute " + name),
+                 H5Aclose};
+  check(H5Awrite(a.get(), H5T_NATIVE_INT64, &value), path, "cannot write attribute " + name);
+}
+
+// The member files, in /members row order: a 1-D fixed-length UTF-8 string dataset /member_files.
+void write_strings(hid_t file, const std::string& path, const std::string& name, const std::vector<std::string>& values) {
+  std::size_t width = 1;
+  for (const auto& v : values) width = std::max(width, v.size());
+  std::string packed(width * values.size(), '\0');
+  for (std::size_t i = 0; i < values.size(); ++i) packed.replace(i * width, values[i].size(), values[i]);
+  const Handle type{check_id(H5Tcopy(H5T_C_S1), path, "string type"), H5Tclose};
+  check(H5Tset_size(type.get(), width), path, "string type");
+  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), path, "string type");
+  const hsize_t n = values.size();
+  const Handle s{check_id(H5Screate_simple(1, &n, nullptr), path, "dataspace"), H5Sclose};
+  const Handle d{check_id(H5Dcreate2(file, name.c_str(), type.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                          path, "cannot create /" + name),
+                 H5Dclose};
+  if (n > 0) check(H5Dwrite(d.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, packed.data()), path, "cannot write /" + name);
 }
 
 void write_attribute(hid_t file, const std::string& path, const std::string& name, const std::string& value) {
@@ -234,13 +265,18 @@ EnsembleSummary aggregate_members(const std::string& scene_path, const EnsembleO
                  "time_to_runaway"},
                 h);
   const hid_t f = file.get();
-  write_attribute(f, o.output, "members", s.members);
-  write_attribute(f, o.output, "completed", s.completed);
-  write_attribute(f, o.output, "hotspots_total", static_cast<double>(s.hotspots_total));
+  std::vector<std::string> files;
+  for (const MemberRecord& r : records) files.push_back(r.file);
+  write_strings(f, o.output, "member_files", files);
+  write_attribute(f, o.output, "format", std::string("frictherm-ensemble"));
+  write_attribute(f, o.output, "format_version", std::int64_t{2});
+  write_attribute(f, o.output, "members", std::int64_t{s.members});
+  write_attribute(f, o.output, "completed", std::int64_t{s.completed});
+  write_attribute(f, o.output, "hotspots_total", std::int64_t{s.hotspots_total});
   write_attribute(f, o.output, "hotspots_per_member_mean", s.hotspots_per_member_mean);
   write_attribute(f, o.output, "hotspots_per_member_std", s.hotspots_per_member_std);
   write_attribute(f, o.output, "critical_fraction", s.critical_fraction);
-  write_attribute(f, o.output, "members_with_runaway", s.members_with_runaway);
+  write_attribute(f, o.output, "members_with_runaway", std::int64_t{s.members_with_runaway});
   write_attribute(f, o.output, "seed_key", o.seed_key);
   write_attribute(f, o.output, "scene", scene_path);
   }

@@ -27,6 +27,7 @@
 #include "h5_util.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <limits>
@@ -191,7 +192,8 @@ struct H5Output::Impl {
     Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), io.file, "cannot create a property list"), H5Pclose};
     check(H5Pset_chunk(dcpl.get(), 1, &chunk), io.file, "cannot set chunking");
     for (const auto& n : columns)
-      sets.emplace_back(check_id(H5Dcreate2(group_out.get(), n.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+      sets.emplace_back(check_id(H5Dcreate2(group_out.get(), n.c_str(),
+                                            H5Output::is_count_column(n) ? H5T_STD_I64LE : H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                             dcpl.get(), H5P_DEFAULT),
                                  io.file, "cannot create /" + name + "/" + n),
                         H5Dclose);
@@ -216,6 +218,8 @@ struct H5Output::Impl {
     const hsize_t total = t.written + rows;
     for (std::size_t j = 0; j < cols; ++j) {
       for (hsize_t r = 0; r < rows; ++r) column[r] = t.pending[r * cols + j];
+      if (H5Output::is_count_column(t.names[j]))  // int64 on disk: round, do not truncate
+        for (double& v : column) v = std::nearbyint(v);
       const std::string where = "/" + name + "/" + t.names[j];
       const hid_t ds = t.sets[j].get();
       check(H5Dset_extent(ds, &total), io.file, "cannot extend " + where);
@@ -240,6 +244,8 @@ struct H5Output::Impl {
     const hsize_t total = series_written + rows;
     for (std::size_t j = 0; j < cols; ++j) {
       for (hsize_t r = 0; r < rows; ++r) column[r] = pending[r * cols + j];
+      if (H5Output::is_count_column(series_names[j]))  // int64 on disk: round, do not truncate
+        for (double& v : column) v = std::nearbyint(v);
       const std::string where = "/series/" + series_names[j];
       const hid_t ds = series_sets[j].get();
       check(H5Dset_extent(ds, &total), io.file, "cannot extend " + where);
@@ -420,7 +426,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.set_evictions(true);
   m.cache.set_initial_size = false;
 
-  const std::int32_t version = 2, d = dim;  // 2: vectors (n, 3) and stress (n, 9) in 2D too
+  const std::int32_t version = 2, d = dim;  // 2: vectors (n, 3) and stress (n, 9) in 2D too; steps, ids, counts int64
   io.string_attribute(m.file.get(), "format", "frictherm-output", "/");
   io.attribute(m.file.get(), "format_version", H5T_STD_I32LE, H5T_NATIVE_INT32, &version, "/");
   io.attribute(m.file.get(), "dim", H5T_STD_I32LE, H5T_NATIVE_INT32, &d, "/");
@@ -458,6 +464,23 @@ void H5Output::write_metadata(const std::string& key, double value) {
   Impl& m = live();
   const Quiet quiet;
   m.metadata(key, H5T_IEEE_F64LE, &value, sizeof value);
+}
+
+void H5Output::write_integer_metadata(const std::string& key, std::int64_t value) {
+  Impl& m = live();
+  const Quiet quiet;
+  m.metadata(key, H5T_NATIVE_INT64, &value, sizeof value);
+}
+
+bool H5Output::is_count_column(const std::string& name) {
+  static const std::set<std::string> exact{"step", "id", "fate", "seed", "status", "steps", "runaway", "dying",
+                                           "material_mask", "hotspots"};
+  auto ends_with = [&name](const std::string& tail) {
+    return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  if (name.rfind("penalty_contacts.", 0) == 0) return true;
+  if (name.find('.') != std::string::npos) return false;  // per-body or per-pair columns carry user names
+  return exact.count(name) > 0 || ends_with("_count") || ends_with("_nodes") || ends_with("_windows");
 }
 
 void H5Output::begin_snapshot(long step, double time) {

@@ -1,6 +1,7 @@
 #include <set>
 #include <vector>
 #include <frictherm/coupling/json_reader.hpp>
+#include <frictherm/coupling/scene_value_observer.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -66,7 +67,20 @@ void JsonReader::expected(const std::string& what) const {
   fail("expected " + what + ", got " + describe_json(*value_));
 }
 
+namespace {
+SceneValueObserver& value_observer() {
+  static SceneValueObserver observer;
+  return observer;
+}
+void report(const std::string& path, const std::string& what, const std::vector<std::string>& choices = {}) {
+  if (value_observer()) value_observer()(path, what, choices);
+}
+}  // namespace
+
+void set_scene_value_observer(SceneValueObserver observer) { value_observer() = std::move(observer); }
+
 double JsonReader::as_number(const Range& range) const {
+  report(path_, range.describe());
   if (!value_->is_number()) expected(range.describe());
   const double x = value_->get<double>();
   if (!range.contains(x)) expected(range.describe());
@@ -81,6 +95,7 @@ long JsonReader::as_integer(long min, long max) const {
     what += " >= " + std::to_string(min);
   else if (max != std::numeric_limits<long>::max())
     what += " <= " + std::to_string(max);
+  report(path_, what);
   if (!value_->is_number()) expected(what);
   // Compare in the integer domain: 2^63 written as a float equals double(LONG_MAX) after rounding,
   // so a float is first bounded by the exact powers of two before any cast (a cast out of range is UB).
@@ -97,11 +112,13 @@ long JsonReader::as_integer(long min, long max) const {
 }
 
 std::string JsonReader::as_string() const {
+  report(path_, "a string");
   if (!value_->is_string()) expected("a string");
   return value_->get<std::string>();
 }
 
 bool JsonReader::as_bool() const {
+  report(path_, "true or false");
   if (!value_->is_boolean()) expected("true or false");
   return value_->get<bool>();
 }
@@ -110,6 +127,7 @@ std::string JsonReader::as_choice(const std::vector<std::string>& choices) const
   std::string what = choices.size() == 1 ? "\"" + choices[0] + "\"" : "one of ";
   if (choices.size() > 1)
     for (std::size_t k = 0; k < choices.size(); ++k) what += (k ? ", \"" : "\"") + choices[k] + "\"";
+  report(path_, what, choices);
   if (!value_->is_string()) expected(what);
   const std::string s = value_->get<std::string>();
   if (std::find(choices.begin(), choices.end(), s) == choices.end()) expected(what);
@@ -119,6 +137,7 @@ std::string JsonReader::as_choice(const std::vector<std::string>& choices) const
 std::vector<double> JsonReader::as_vector(std::size_t n, const Range& range) const {
   const std::string what =
       "an array of " + std::to_string(n) + (n == 1 ? " number" : " numbers") + " (one per dimension)";
+  report(path_, what + ", each " + range.describe());
   if (!value_->is_array() || value_->size() != n) expected(what);
   std::vector<double> out;
   out.reserve(n);
@@ -127,6 +146,8 @@ std::vector<double> JsonReader::as_vector(std::size_t n, const Range& range) con
 }
 
 std::vector<double> JsonReader::as_number_list(std::size_t min_size, const Range& range) const {
+  report(path_, "an array of " + (min_size > 0 ? "at least " + std::to_string(min_size) + " " : std::string()) +
+                    "numbers, each " + range.describe());
   if (!value_->is_array() || value_->size() < min_size)
     expected("an array of " + (min_size > 0 ? "at least " + std::to_string(min_size) + " " : std::string()) +
              "numbers");
@@ -148,8 +169,18 @@ std::vector<JsonReader> JsonReader::elements(std::size_t min_size) const {
   return out;
 }
 
+namespace {
+JsonReader::KeyTableObserver& key_table_observer() {
+  static JsonReader::KeyTableObserver observer;
+  return observer;
+}
+}  // namespace
+
+void JsonReader::set_key_table_observer(KeyTableObserver observer) { key_table_observer() = std::move(observer); }
+
 std::vector<std::string> JsonReader::keys() const {
   require_object();
+  map_ = true;
   std::vector<std::string> out;
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     out.push_back(it.key());
@@ -175,7 +206,11 @@ bool JsonReader::has(const std::string& key) const {
 JsonReader JsonReader::at(const std::string& key, const std::string& what) const {
   if (!has(key)) {
     const std::string p = member_path(key);
-    throw SceneError(p + ": required key missing" + (what.empty() ? std::string() : " (expected " + what + ")"));
+    std::vector<std::string> present;  // a misspelt required key: name the key that is probably it
+    for (auto it = value_->begin(); it != value_->end(); ++it) present.push_back(it.key());
+    const std::string near = nearest_key(key, present);
+    throw SceneError(p + ": required key missing" + (what.empty() ? std::string() : " (expected " + what + ")") +
+                     (near.empty() ? std::string() : "; is '" + near + "' a misspelling of it?"));
   }
   return JsonReader(value_->at(key), member_path(key));
 }
@@ -226,14 +261,43 @@ std::vector<double> JsonReader::vector(const std::string& key, std::size_t n, co
 
 void JsonReader::finish() const {
   require_object();
+  if (key_table_observer()) key_table_observer()(path_, known_, map_);
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     if (std::find(known_.begin(), known_.end(), it.key()) != known_.end()) continue;
     std::string allowed;
     for (const std::string& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
+    const std::string near = nearest_key(it.key(), known_);
     throw SceneError(member_path(it.key()) + ": unknown key" +
                      (allowed.empty() ? std::string(" (no keys are allowed here)")
-                                      : " (allowed here: " + allowed + ")"));
+                                      : " (allowed here: " + allowed + ")") +
+                     (near.empty() ? std::string() : "; did you mean '" + near + "'?"));
   }
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);  // row[j]: distance of a[0, i) to b[0, j)
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string nearest_key(const std::string& typo, const std::vector<std::string>& allowed) {
+  const std::size_t limit = typo.size() <= 3 ? 1 : std::max<std::size_t>(2, typo.size() / 3);
+  std::string best;
+  std::size_t best_distance = limit + 1;
+  for (const std::string& k : allowed) {
+    const std::size_t d = edit_distance(typo, k);
+    if (d < best_distance && d < typo.size() && d < k.size()) best = k, best_distance = d;  // not a whole new word
+  }
+  return best;
 }
 
 Json parse_json_text(const std::string& text) {

@@ -113,7 +113,7 @@ class Run {
                                                                                 : "completed";
     if (thermal_) thermal_->write_metadata(out, *sim_);  // thermal hook: integrator statistics, energy books
     out.write_metadata("status", status);
-    out.write_metadata("steps", static_cast<double>(r_.steps));
+    out.write_metadata("steps", r_.steps);
     out.write_metadata("final_time", r_.time);
     out.write_metadata("wall_time", r_.wall_time);
     out_ = nullptr;
@@ -243,6 +243,7 @@ class Run {
         if (s_.checkpoint_interval > 0.0)
           next_checkpoint_ = (std::floor(t / s_.checkpoint_interval + 1e-9) + 1.0) * s_.checkpoint_interval;
       }
+      if (o_.observer) o_.observer(StepView(*sim_));  // the user's per-step diagnostics
       progress.update(sim_->step_count(), t);
       if (detail::interrupt_signal() != 0) return interrupted();
     }

@@ -221,13 +221,13 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
   if (localtime_r(&now, &local)) std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S%z", &local);
   out.write_metadata("start_date", date);
   out.write_metadata("status", "running");
-  out.write_metadata("dimension", static_cast<double>(Dim));
+  out.write_metadata("dimension", Dim);
   if (Dim == 2) {
     out.write_metadata("analysis", s.options.analysis == mechanics::Analysis::plane_stress ? "plane_stress" : "plane_strain");
     out.write_metadata("thickness", s.options.thickness);
   }
-  out.write_metadata("particle_count", static_cast<double>(sim.particles().size()));
-  out.write_metadata("threads", static_cast<double>(omp_get_max_threads()));
+  out.write_metadata("particle_count", sim.particles().size());
+  out.write_metadata("threads", omp_get_max_threads());
   const auto& g = sim.grid();
   std::ostringstream grid, materials, bodies;
   grid.precision(10);

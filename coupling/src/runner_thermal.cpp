@@ -6,6 +6,7 @@
 #include <frictherm/mechanics/errors.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -161,18 +162,22 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
   out.write_metadata("thermal_atol", o.integrator_options.atol);
   out.write_metadata("thermal_window_policy", to_string(o.window.kind));
   out.write_metadata("heating_order", to_string(spec_.heating_order));
+  const std::pair<const char*, std::int64_t> counts[] = {
+      {"thermal_steps", static_cast<std::int64_t>(st.steps)},
+      {"thermal_rhs_evals", static_cast<std::int64_t>(st.rhs_evals)},
+      {"thermal_jac_evals", static_cast<std::int64_t>(st.jac_evals)},
+      {"thermal_nonlinear_iters", static_cast<std::int64_t>(st.nonlinear_iters)},
+      {"thermal_linear_iters", static_cast<std::int64_t>(st.linear_iters)},
+      {"thermal_error_test_failures", static_cast<std::int64_t>(st.error_test_failures)},
+      {"thermal_convergence_failures", static_cast<std::int64_t>(st.convergence_failures)},
+      {"thermal_reinits", static_cast<std::int64_t>(st.reinits)},
+      {"thermal_windows", static_cast<std::int64_t>(b.windows)},
+      {"thermal_continuation_intervals", static_cast<std::int64_t>(b.continuation_intervals)},
+      {"hotspots_seen", static_cast<std::int64_t>(coupler_.hotspots().ids_issued())},
+  };
+  for (const auto& [key, value] : counts) out.write_metadata(key, value);
   const std::pair<const char*, double> values[] = {
-      {"thermal_steps", static_cast<double>(st.steps)},
-      {"thermal_rhs_evals", static_cast<double>(st.rhs_evals)},
-      {"thermal_jac_evals", static_cast<double>(st.jac_evals)},
-      {"thermal_nonlinear_iters", static_cast<double>(st.nonlinear_iters)},
-      {"thermal_linear_iters", static_cast<double>(st.linear_iters)},
-      {"thermal_error_test_failures", static_cast<double>(st.error_test_failures)},
-      {"thermal_convergence_failures", static_cast<double>(st.convergence_failures)},
-      {"thermal_reinits", static_cast<double>(st.reinits)},
       {"thermal_wall_time", st.wall_seconds},
-      {"thermal_windows", static_cast<double>(b.windows)},
-      {"thermal_continuation_intervals", static_cast<double>(b.continuation_intervals)},
       {"thermal_min_window", b.windows > 0 ? b.min_window : 0.0},
       {"thermal_max_window", b.max_window},
       {"work_received", b.work_received},
@@ -187,7 +192,6 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"nodal_energy_change", b.nodal_energy_change},
       {"particle_energy_change", coupler_.particle_energy_change(sim.particles())},
       {"max_assembly_residual", b.max_assembly_residual},
-      {"hotspots_seen", static_cast<double>(coupler_.hotspots().ids_issued())},
   };
   for (const auto& [key, value] : values) out.write_metadata(key, value);
   out.write_metadata("plastic_heating", o.plastic.enabled ? "on" : "off");

@@ -210,3 +210,14 @@ TEST_F(Cli, EveryExampleValidates) {
   }
   EXPECT_GE(n, 5);
 }
+
+// The ensemble's member limit is stated in its help and enforced with the same numbers (issue 14 item 7).
+TEST_F(Cli, EnsembleHelpStatesTheMemberLimit) {
+  const Result help = frictherm("ensemble --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_THAT(help.output, HasSubstr("-n, --members N       number of members, 1 to 1024 (default 1)"));
+  const Result over = frictherm("ensemble " + (fs::path(FRICTHERM_SOURCE_DIR) / "examples" / "bar_vibration.json").string() +
+                                " --seed-key output.snapshot_count -n 1025 -o " + path("ens.h5"));
+  EXPECT_EQ(over.code, 2) << over.output;
+  EXPECT_THAT(over.output, HasSubstr("integer in [1, 1024], got '1025'"));
+}

@@ -1,6 +1,6 @@
 // Ensembles (coupling/src/ensemble.cpp): members run with their seed, the aggregate agrees with the
 // members' own files, and the summary statistics follow from the per-hot-spot rows.
-#include <frictherm/coupling/csv_export.hpp>
+#include <frictherm/coupling/results.hpp>
 #include <frictherm/coupling/ensemble.hpp>
 
 #include <gtest/gtest.h>

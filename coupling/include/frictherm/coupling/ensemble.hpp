@@ -19,8 +19,11 @@
 //              the peak was reached), birth_time, duration (last seen − birth), fate (the codes of
 //              /hotspot_fates: 0 undecided or not followed, 1 dying, 2 runaway), time_to_runaway
 //              (s after the end of loading; NaN if none)
-// and root attributes members, completed, hotspots_total, hotspots_per_member_mean/std,
-// critical_fraction (runaway / hot spots with a known fate), members_with_runaway, seed_key, scene.
+//   /member_files  the member HDF5 files (strings), in /members row order
+// and root attributes format = "frictherm-ensemble", format_version = 2, members, completed,
+// hotspots_total, hotspots_per_member_mean/std, critical_fraction (runaway / hot spots with a known
+// fate; NaN when none is known), members_with_runaway, seed_key, scene. Seeds, ids, counts, status
+// and fate columns and the count attributes are int64 (H5Output::is_count_column), the rest double.
 #include <frictherm/coupling/hotspot_fates.hpp>
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>

@@ -3,13 +3,17 @@
 //
 // Layout (all datasets little-endian; names are the contract the plotting scripts rely on):
 //   /                      attrs: format = "frictherm-output", format_version = 2, dim
-//   /meta/<key>            scalar datasets: fixed-length UTF-8 strings or doubles
+//   /meta/<key>            scalar datasets: fixed-length UTF-8 strings, int64 (steps, counts) or doubles
 //   /snapshots/000000 ...  one group per snapshot, attrs step (int64) and time (double);
 //                          datasets (n) for one component, (n, components) otherwise
 //   /failure               the state a failed run stopped in (same shape), attr message
-//   /series/<column>       extendible 1-D doubles, /series/time first; attr columns on /series
-//                          lists the column names in declared order
+//   /series/<column>       extendible 1-D datasets, /series/time first; attr columns on /series
+//                          lists the column names in declared order. Count and id columns
+//                          (is_count_column) are int64, every other column double.
 //   /<table>/<column>      extra tables of the same layout (declare_table), e.g. /hotspots
+// Format version 2 (frictherm 0.1, issue 14): integers (steps, ids, counts) are int64, in /meta
+// and in tables; version 1 stored them as doubles. Readers: frictherm/coupling/results.hpp (C++),
+// the Python package `frictherm` (python/frictherm).
 //   /xdmf/polyvertex_<n>   int32 0..n-1, the Polyvertex connectivity the XDMF file points at
 // Beside RUN.h5 an XDMF file RUN.xdmf (ParaView: Xdmf3ReaderS) lists every ended snapshot.
 //
@@ -18,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -54,6 +59,12 @@ class H5Output {
   /// The file is flushed after each call.
   void write_metadata(const std::string& key, const std::string& value);
   void write_metadata(const std::string& key, double value);
+  /// Integers (steps, counts) are stored as int64.
+  void write_integer_metadata(const std::string& key, std::int64_t value);
+  template <class I, std::enable_if_t<std::is_integral_v<I> && !std::is_same_v<I, bool>, int> = 0>
+  void write_metadata(const std::string& key, I value) {
+    write_integer_metadata(key, static_cast<std::int64_t>(value));
+  }
 
   /// Starts particle snapshot number snapshot_count(). Fields follow, then end_snapshot().
   void begin_snapshot(long step, double time);
@@ -85,6 +96,13 @@ class H5Output {
   void declare_table(const std::string& name, const std::vector<std::string>& columns);
   void append_table_row(const std::string& name, const std::vector<double>& row);
   std::size_t table_rows(const std::string& name) const;  // appended so far
+
+  /// Columns of series and tables stored as int64 rather than double: step, id, fate, seed,
+  /// status, steps, runaway, dying, material_mask, names ending in _count, _nodes, _windows, and
+  /// hotspots (the per-member count of an ensemble), and penalty_contacts.* ; names holding a '.' other than
+  /// penalty_contacts.* are double. Values given as doubles
+  /// are rounded to the nearest integer when written.
+  static bool is_count_column(const std::string& name);
 
   /// Writes buffered series rows and flushes the file to the operating system.
   void flush();

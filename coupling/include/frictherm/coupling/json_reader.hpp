@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -111,8 +112,19 @@ class JsonReader {
                      const std::string& default_value) const;
   std::vector<double> vector(const std::string& key, std::size_t n, const Range& range = Range::any()) const;
 
-  /// Rejects members that no query asked about: "<path>.<key>: unknown key (allowed here: a, b, c)".
+  /// Rejects members that no query asked about: "<path>.<key>: unknown key (allowed here: a, b, c)",
+  /// followed by "; did you mean 'k'?" when an allowed key k is near the unknown one (nearest_key).
   void finish() const;
+  /// The keys asked about so far, in query order: the keys allowed at this place (what finish() checks).
+  const std::vector<std::string>& known_keys() const { return known_; }
+
+  /// The validator's key tables: when set, every finish() reports its object's key path, the keys
+  /// allowed there and whether the object is a map of user names (keys(), e.g. `materials`). The
+  /// scene schema test (tests/coupling/test_scene_schema.cpp) builds docs/scene.schema.json from
+  /// these. One observer for the whole process, not thread-safe: for tools and tests only.
+  using KeyTableObserver =
+      std::function<void(const std::string& path, const std::vector<std::string>& allowed, bool is_map)>;
+  static void set_key_table_observer(KeyTableObserver observer);
 
  private:
   void require_object() const;
@@ -121,7 +133,16 @@ class JsonReader {
   const Json* value_;
   std::string path_;
   mutable std::vector<std::string> known_;  // keys asked about, in query order
+  mutable bool map_ = false;                 // keys() was asked: the keys are user names
 };
+
+/// Levenshtein distance: the fewest single-character insertions, deletions and substitutions that
+/// turn a into b.
+std::size_t edit_distance(const std::string& a, const std::string& b);
+/// The allowed key nearest to a mistyped one (gird -> grid), or "" when none is near: distance at
+/// most 1 for keys of up to 3 characters, else at most max(2, length / 3), and shorter than both
+/// keys (x is not "near" a); ties go to the first key.
+std::string nearest_key(const std::string& typo, const std::vector<std::string>& allowed);
 
 /// Parses scene text (comments allowed). Malformed JSON becomes a SceneError
 /// "malformed JSON at line L, column C: <detail>".

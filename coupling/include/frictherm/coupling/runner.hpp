@@ -2,7 +2,10 @@
 // The run loop: scene -> mechanics::Simulation -> HDF5 output.
 //
 //   RunOptions opt;  opt.output = "out.h5";
+//   std::vector<double> ke;                                        // a diagnostic of your own:
+//   opt.observer = [&](const StepView& s) { ke.push_back(s.kinetic_energy()); };
 //   RunResult r = run_scene(load_scene("bar.json"), opt);
+//   SeriesTable series = read_series(r.output);                    // results.hpp
 //   return r.exit_code();   // 0 completed, 1 the simulation failed
 //
 // The loop clamps time steps so that the run lands exactly on every snapshot time and on end_time.
@@ -10,6 +13,7 @@
 // state goes to /failure, the file is flushed and everything written before stays readable.
 #include <frictherm/coupling/scene.hpp>
 
+#include <functional>
 #include <iosfwd>
 #include <stdexcept>
 #include <string>
@@ -22,6 +26,32 @@ namespace frictherm::coupling {
 class OutputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// The state a per-step observer sees (RunOptions::observer): the simulation right after a mechanics
+/// step, its heat handoff and its series row, read-only. The full simulation of the run's dimension
+/// is simulation<2>() or simulation<3>() (particles, grid, contact statistics, ...).
+class StepView {
+ public:
+  template <int Dim>
+  explicit StepView(const mechanics::Simulation<Dim>& sim) : dim_(Dim), sim_(&sim) {}
+  int dim() const { return dim_; }
+  long step() const { return dim_ == 2 ? simulation<2>().step_count() : simulation<3>().step_count(); }
+  double time() const { return dim_ == 2 ? simulation<2>().time() : simulation<3>().time(); }
+  double dt() const { return dim_ == 2 ? simulation<2>().last_time_step() : simulation<3>().last_time_step(); }
+  double kinetic_energy() const { return dim_ == 2 ? simulation<2>().kinetic_energy() : simulation<3>().kinetic_energy(); }
+  double strain_energy() const { return dim_ == 2 ? simulation<2>().strain_energy() : simulation<3>().strain_energy(); }
+  /// Throws std::logic_error when Dim is not the run's dimension.
+  template <int Dim>
+  const mechanics::Simulation<Dim>& simulation() const {
+    if (Dim != dim_)
+      throw std::logic_error("StepView::simulation<" + std::to_string(Dim) + ">() on a " + std::to_string(dim_) + "D run");
+    return *static_cast<const mechanics::Simulation<Dim>*>(sim_);
+  }
+
+ private:
+  int dim_;
+  const void* sim_;
 };
 
 struct RunOptions {
@@ -52,6 +82,10 @@ struct RunOptions {
   /// snapshot, series and checkpoint times as an uninterrupted run; the output file starts at the
   /// checkpoint's state. Mechanics-only scenes.
   std::string resume_checkpoint;
+  /// Called after every mechanics step (not during the thermal-only continuation), after the step's
+  /// heat handoff and series row, so diagnostics need no copy of the run loop. An exception thrown
+  /// by the observer ends the run and propagates out of run_scene (the file written so far stays).
+  std::function<void(const StepView&)> observer;
 };
 
 struct RunResult {

@@ -1,0 +1,144 @@
+"""A run file written by `frictherm run` (coupling/include/frictherm/coupling/h5_output.hpp)."""
+import numpy as np
+
+from ._h5 import plain, text
+from .snapshot import Snapshot
+from .table import Table
+
+# /meta keys that make up the energy books of a coupled run (docs/coupling.md).
+ENERGY_BOOK_KEYS = ("work_received", "heat_delivered", "plastic_work_received", "plastic_heat_received",
+                    "plastic_heat_delivered", "reaction_heat_released", "particle_reaction_heat", "heat_relocated",
+                    "heat_pending", "nodal_energy_change", "particle_energy_change", "max_assembly_residual")
+SUPPORTED_FORMAT_VERSION = 2
+
+
+class Run:
+    """The results of one run. Open with ``frictherm.open(path)``; use as a context manager or
+    call ``close()``.
+
+    ``dim``, ``format_version``, ``meta`` (dict: str, int or float), ``status``, ``series``,
+    ``hotspots``, ``hotspot_fates`` (Table), ``energy_books`` (dict), ``snapshots`` (list of
+    Snapshot), ``snapshot_times`` (array), ``failure`` (Snapshot or None), ``snapshot(i)``,
+    ``snapshot_at(time)``.
+    """
+
+    def __init__(self, h5file, path):
+        self.file = h5file
+        self.path = path
+        a = h5file.attrs
+        self.format = text(a["format"]) if "format" in a else "frictherm-output"
+        self.format_version = int(a["format_version"]) if "format_version" in a else 1
+        if self.format_version > SUPPORTED_FORMAT_VERSION:
+            raise ValueError(f"{path}: format version {self.format_version} is newer than this reader "
+                             f"({SUPPORTED_FORMAT_VERSION}); update the frictherm Python package")
+        self._meta = None
+        self._series = None
+        self._tables = {}
+        self._snapshots = None
+        if "dim" in a:
+            self.dim = int(a["dim"])
+        elif "meta" in h5file and "dimension" in h5file["meta"]:
+            self.dim = int(h5file["meta"]["dimension"][()])
+        else:
+            first = self.snapshots[0] if self.snapshots else None
+            self.dim = int(first.raw("position").shape[1]) if first is not None and "position" in first else 2
+
+    # ---- life time ----
+    def close(self):
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __repr__(self):
+        return (f"Run('{self.path}', {self.dim}D, status {self.status}, {len(self.snapshots)} snapshots, "
+                f"{len(self.series)} series rows)")
+
+    # ---- metadata ----
+    @property
+    def meta(self):
+        """/meta decoded: strings as str, counts as int, the rest as float."""
+        if self._meta is None:
+            m = self.file["meta"] if "meta" in self.file else {}
+            self._meta = {k: plain(m[k][()]) for k in m}
+        return self._meta
+
+    @property
+    def status(self):
+        """completed, stopped_at_max_steps, failed, interrupted, or running (a run still going or killed)."""
+        return self.meta.get("status", "unknown")
+
+    @property
+    def energy_books(self):
+        """The coupled run's energy books from /meta (J, or J per m of thickness in 2D); empty for a
+        mechanics-only run. heat_delivered equals particle_energy_change when the books close."""
+        return {k: self.meta[k] for k in ENERGY_BOOK_KEYS if k in self.meta}
+
+    # ---- tables ----
+    @property
+    def series(self):
+        if self._series is None:
+            self._series = Table.read(self.file, "series")
+        return self._series
+
+    def table(self, name):
+        """Any column group of the file (/hotspots, /hotspot_fates, ...); empty when absent."""
+        if name not in self._tables:
+            self._tables[name] = Table.read(self.file, name)
+        return self._tables[name]
+
+    @property
+    def hotspots(self):
+        """/hotspots: one row per hot spot per coupling window (time, id, particle_count, peak and mean
+        temperature, size, equivalent_diameter, centroid_*, birth_time, duration, excess_energy,
+        material_mask)."""
+        return self.table("hotspots")
+
+    @property
+    def hotspot_fates(self):
+        """/hotspot_fates of the thermal-only continuation (fate 0 undecided, 1 dying, 2 runaway)."""
+        return self.table("hotspot_fates")
+
+    # ---- snapshots ----
+    @property
+    def snapshots(self):
+        """The ended regular snapshots in time order (the failure state is ``failure``)."""
+        if self._snapshots is None:
+            g = self.file["snapshots"] if "snapshots" in self.file else {}
+            names = sorted(g.keys()) if g else []
+            self._snapshots = [Snapshot(self, g[n], n, i) for i, n in enumerate(names)]
+        return self._snapshots
+
+    @property
+    def snapshot_times(self):
+        return np.array([s.time for s in self.snapshots], dtype=float)
+
+    @property
+    def failure(self):
+        return Snapshot(self, self.file["failure"], "failure", None) if "failure" in self.file else None
+
+    def snapshot(self, which="last"):
+        """A snapshot by index (negative counts from the end), "last" or "failure"."""
+        if which == "failure":
+            if self.failure is None:
+                raise KeyError(f"{self.path}: this run has no failure snapshot")
+            return self.failure
+        if not self.snapshots:
+            raise KeyError(f"{self.path}: this run has no snapshots")
+        if which == "last":
+            return self.snapshots[-1]
+        try:
+            return self.snapshots[int(which)]
+        except (ValueError, IndexError):
+            raise KeyError(f"{self.path}: no snapshot '{which}' ({len(self.snapshots)} snapshots; use an index, "
+                           "'last' or 'failure')") from None
+
+    def snapshot_at(self, time):
+        """The regular snapshot whose time is nearest `time` (s)."""
+        if not self.snapshots:
+            raise KeyError(f"{self.path}: this run has no snapshots")
+        return self.snapshots[int(np.argmin(np.abs(self.snapshot_times - time)))]

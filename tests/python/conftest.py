@@ -1,0 +1,53 @@
+"""Small real runs of the frictherm program, made once per pytest session.
+
+FRICTHERM_EXE (the program), FRICTHERM_SOURCE_DIR and FRICTHERM_TEST_DIR come from ctest
+(tests/python/CMakeLists.txt)."""
+import os
+import shutil
+import subprocess
+
+import pytest
+
+SOURCE = os.environ.get("FRICTHERM_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+SCENE = os.path.join(SOURCE, "examples", "sliding_block_heating.json")
+# The sliding block with heat (the README's main example), every mechanics step in the series so
+# that each snapshot has its series row, and 2 ms of conduction alone instead of 20 ms.
+SETS = ["output.series_interval=0", "coupling.continuation.duration=0.002", "coupling.continuation.intervals=10"]
+
+
+def _exe():
+    exe = os.environ.get("FRICTHERM_EXE", os.path.join(SOURCE, "build", "coupling", "frictherm"))
+    if not os.path.exists(exe):
+        pytest.fail(f"the frictherm program is missing: {exe} (set FRICTHERM_EXE)")
+    return exe
+
+
+@pytest.fixture(scope="session")
+def workdir():
+    d = os.environ.get("FRICTHERM_TEST_DIR") or os.path.join(os.getcwd(), "frictherm_python_test")
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(d)
+    return d
+
+
+def _sets(sets):
+    out = []
+    for s in sets:
+        out += ["--set", s]
+    return out
+
+
+@pytest.fixture(scope="session")
+def run_file(workdir):
+    out = os.path.join(workdir, "run.h5")
+    subprocess.run([_exe(), "run", SCENE, "-o", out, "--quiet", "--threads", "1"] + _sets(SETS), check=True)
+    return out
+
+
+@pytest.fixture(scope="session")
+def ensemble_file(workdir):
+    out = os.path.join(workdir, "ens.h5")
+    # A harmless integer key stands in for a microstructure seed (as in tests/coupling/test_ensemble.cpp).
+    subprocess.run([_exe(), "ensemble", SCENE, "--seed-key", "output.snapshot_count", "--first-seed", "2", "-n", "2",
+                    "-o", out, "--quiet", "--threads", "1"] + _sets(SETS[1:]), check=True)
+    return out

@@ -1,0 +1,181 @@
+"""The frictherm Python package against real runs: what it reads must agree with the physics the
+C++ side wrote (kinetic energy and momentum from the snapshot particles, the energy books, the
+hot-spot table against the series), and integers must arrive as integers."""
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+import frictherm
+
+C_V = 200.0  # J/(kg K), both materials of examples/sliding_block_heating.json
+EXAMPLES = os.path.join(os.environ.get("FRICTHERM_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", "..")),
+                        "examples")
+
+
+@pytest.fixture(scope="module")
+def run(run_file):
+    with frictherm.open(run_file) as r:
+        yield r
+
+
+def test_format_and_integer_storage(run, run_file):
+    assert isinstance(run, frictherm.Run)
+    assert run.format == "frictherm-output" and run.format_version == 2 and run.dim == 2
+    assert run.status == "completed"
+    # On disk (the C++ writer): counts are int64, strings are strings, the rest doubles.
+    with h5py.File(run_file, "r") as f:
+        for path in ("series/step", "series/hotspot_count", "series/contact_nodes", "hotspots/id",
+                     "hotspots/particle_count", "hotspot_fates/fate", "meta/steps", "meta/particle_count",
+                     "meta/thermal_steps", "meta/hotspots_seen"):
+            assert f[path].dtype == np.dtype("<i8"), path
+        for path in ("series/time", "series/kinetic_energy", "hotspots/peak_temperature", "meta/heat_delivered"):
+            assert f[path].dtype == np.dtype("<f8"), path
+        assert f["meta/scene"].dtype.kind == "S" and f["meta/scene"].dtype.char == "S"
+    # Decoded: Python ints and strs.
+    assert isinstance(run.meta["steps"], int) and isinstance(run.meta["particle_count"], int)
+    assert isinstance(run.meta["scene"], str) and '"units": "SI"' in run.meta["scene"]
+    assert run.meta["steps"] == int(run.series["step"][-1]) > 100
+    assert run.series["step"].dtype == np.int64 and run.series["time"].dtype == np.float64
+
+
+def test_kinetic_energy_and_momentum_of_snapshots_match_the_series(run):
+    s = run.series
+    rows = {int(k): i for i, k in enumerate(s["step"]) if i == 0 or s["step"][i] != s["step"][i - 1]}
+    checked = 0
+    for snap in run.snapshots[:-1]:  # the last one ends the thermal-only phase (mechanics frozen)
+        i = rows[snap.step]
+        m, v = snap["mass"], snap["velocity"]
+        assert v.shape == (snap.particle_count, 2)
+        ke = 0.5 * np.sum(m * np.sum(v * v, axis=1))
+        assert abs(s["time"][i] - snap.time) <= 1e-12 * max(snap.time, 1e-3)
+        # Both are the same sums over the same doubles (summation order aside): 1e-12 relative.
+        assert ke == pytest.approx(s["kinetic_energy"][i], rel=1e-12, abs=1e-15)
+        assert np.sum(m * v[:, 0]) == pytest.approx(s["momentum_x"][i], rel=1e-11, abs=1e-15)
+        checked += 1
+    assert checked == len(run.snapshots) - 1 >= 10
+    assert max(abs(s["kinetic_energy"])) > 0.1  # the block does slide (J per m)
+
+
+def test_energy_books_close(run):
+    books = run.energy_books
+    assert books["heat_delivered"] == run.series["heat_delivered"][-1]
+    assert books["heat_delivered"] > 0.0
+    # Heat delivered equals the particles' thermal energy change, recomputed here from the first
+    # and last snapshots: sum m c_v (T_end - T_0). Conservation, to round-off of ~1e5 particle sums.
+    first, last = run.snapshots[0], run.snapshots[-1]
+    de = np.sum(last["mass"] * C_V * (last["temperature"] - first["temperature"]))
+    assert de == pytest.approx(books["particle_energy_change"], rel=1e-9)
+    assert de == pytest.approx(books["heat_delivered"], rel=1e-6)
+
+
+def test_hotspot_table_agrees_with_the_series(run):
+    h, s = run.hotspots, run.series
+    assert len(h) > 0 and h["id"].dtype == np.int64
+    assert h.columns[:3] == ["time", "id", "particle_count"]
+    # Each coupling window's rows are written with the series row of that time: as many rows as the
+    # series' hotspot_count there, and no peak above the series' max_temperature.
+    for t in np.unique(h["time"]):
+        i = int(np.flatnonzero(s["time"] == t)[0])
+        assert np.count_nonzero(h["time"] == t) == s["hotspot_count"][i]
+        assert h.where(h["time"] == t)["peak_temperature"].max() <= s["max_temperature"][i] + 1e-9
+    assert len(run.hotspot_fates) == len(np.unique(run.hotspot_fates["id"])) > 0
+
+
+def test_series_as_dataframe(run):
+    df = run.series.to_dataframe()
+    assert list(df.columns) == run.series.columns
+    assert df.shape == (len(run.series), len(run.series.columns))
+    assert np.array_equal(df["kinetic_energy"].to_numpy(), run.series["kinetic_energy"])
+    assert str(df["step"].dtype) == "int64"
+
+
+def test_snapshots_times_and_selection(run):
+    times = run.snapshot_times
+    assert times[0] == 0.0 and np.all(np.diff(times) > 0)
+    assert run.snapshot("last") is run.snapshots[-1]
+    assert run.snapshot_at(run.meta["end_time"]).time == pytest.approx(run.meta["end_time"], rel=1e-12)
+    assert run.failure is None
+    with pytest.raises(KeyError, match="no field 'nope'"):
+        run.snapshots[0]["nope"]
+
+
+def test_physical_shape_accepts_two_and_three_component_vectors():
+    v2 = np.arange(10.0).reshape(5, 2)
+    v3 = np.column_stack([v2, np.zeros(5)])  # a 2D vector padded for VTK
+    assert np.array_equal(frictherm.physical_shape(v3, 2), v2)
+    assert np.array_equal(frictherm.physical_shape(v2, 2), v2)
+    t4 = np.arange(20.0).reshape(5, 4)
+    t9 = np.zeros((5, 3, 3))
+    t9[:, :2, :2] = t4.reshape(5, 2, 2)
+    assert np.array_equal(frictherm.physical_shape(t9.reshape(5, 9), 2), t4.reshape(5, 2, 2))
+    assert np.array_equal(frictherm.physical_shape(t4, 2), t4.reshape(5, 2, 2))
+    sym = np.array([[1.0, 2.0, 3.0], [2.0, 4.0, 5.0], [3.0, 5.0, 6.0]])
+    t6 = np.tile([1.0, 2.0, 3.0, 4.0, 5.0, 6.0], (5, 1))  # xx, xy, xz, yy, yz, zz
+    assert np.array_equal(frictherm.physical_shape(t6, 3), np.broadcast_to(sym, (5, 3, 3)))
+
+
+def test_format_version_1_counts_come_back_as_integers(tmp_path):
+    p = str(tmp_path / "v1.h5")
+    with h5py.File(p, "w") as f:
+        f.attrs["format"] = np.bytes_("frictherm-output")
+        f.attrs["format_version"] = np.int32(1)
+        f.attrs["dim"] = np.int32(2)
+        g = f.create_group("series")
+        g.attrs["columns"] = np.array([b"time", b"step", b"kinetic_energy"])
+        g["time"], g["step"], g["kinetic_energy"] = [0.0, 1e-6], [0.0, 1.0], [0.0, 2.5]
+        f.create_group("meta")["steps"] = 1.0
+    with frictherm.open(p) as r:
+        assert r.series["step"].dtype == np.int64 and list(r.series["step"]) == [0, 1]
+        assert r.series["kinetic_energy"].dtype == np.float64 and len(r.snapshots) == 0
+
+
+def test_not_a_frictherm_file(tmp_path):
+    p = str(tmp_path / "other.h5")
+    with h5py.File(p, "w") as f:
+        f["x"] = 1
+    with pytest.raises(ValueError, match="not a frictherm file"):
+        frictherm.open(p)
+
+
+def test_ensemble(ensemble_file):
+    with frictherm.open(ensemble_file) as ens:
+        assert isinstance(ens, frictherm.Ensemble) and ens.format_version == 2
+        m, h = ens.members, ens.hotspots
+        assert list(m["seed"]) == [2, 3] and m["seed"].dtype == np.int64
+        assert list(m["status"]) == [0, 0]
+        assert ens.summary["members"] == 2 and isinstance(ens.summary["hotspots_total"], int)
+        assert ens.summary["hotspots_total"] == len(h) == int(m["hotspots"].sum()) > 0
+        decided = np.count_nonzero(h["fate"] > 0)
+        if decided:
+            assert ens.critical_fraction == pytest.approx(np.count_nonzero(h["fate"] == 2) / decided, rel=1e-15)
+        else:
+            assert ens.critical_fraction is None
+        for k, seed in enumerate(m["seed"]):
+            with ens.member(seed) as member:
+                assert isinstance(member, frictherm.Run)
+                assert len(np.unique(member.hotspots["id"])) == m["hotspots"][k]
+                assert member.meta["steps"] == m["steps"][k]
+
+
+def test_examples_read_through_the_package(run_file, ensemble_file, tmp_path):
+    """plot_run.py --list, pbx_figures.py --redraw (no rerun) and ensemble_figures.py on the files."""
+    env = dict(os.environ)
+    out = subprocess.run([sys.executable, os.path.join(EXAMPLES, "plot_run.py"), run_file, "--list"], env=env,
+                         check=True, capture_output=True, text=True).stdout
+    assert "status completed" in out and "hotspots (" in out
+    redraw = subprocess.run([sys.executable, os.path.join(EXAMPLES, "pbx_figures.py"), "--redraw", run_file, "--out",
+                             str(tmp_path)], env=env, check=True, capture_output=True, text=True).stdout
+    with frictherm.open(run_file) as r:  # the hot spots circled: those of the window at the end of loading
+        at_end = int(np.count_nonzero(r.hotspots["time"] == r.hotspots["time"][np.argmin(
+            abs(r.hotspots["time"] - r.meta["end_time"]))]))
+    assert at_end >= 1 and f"{at_end} hot spots at the end of loading" in redraw
+    for suffix in ("_temperature.png", "_hotspots.png", "_series.png"):
+        png = tmp_path / ("run" + suffix)
+        assert png.stat().st_size > 10000, png
+    subprocess.run([sys.executable, os.path.join(EXAMPLES, "ensemble_figures.py"), ensemble_file, "-o",
+                    str(tmp_path / "ens")], env=env, check=True, capture_output=True)
+    assert (tmp_path / "ens_hotspots.png").stat().st_size > 10000
