@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace frictherm::mechanics {
 namespace {
@@ -31,7 +32,30 @@ struct PairContext {
   double cell_volume;  // of the node's cell (2D: times thickness), m^3
   double dt;
   bool heat;           // the momentum-update pass: compute frictional work
+  // Normal-stress regularisation (ContactOptions::regularized): this node's lagged normal traction
+  // σ̃ and the step that last set it, or null; updated in the heating pass only.
+  double* lagged_normal = nullptr;
+  double* lagged_step = nullptr;
+  double step = 0.0;
+  double slip_length = 0.0, relaxation_time = 0.0;
 };
+
+/// The normal impulse the friction law sees: −σ̃ A_c dt with σ̃ the lagged normal traction,
+/// dσ̃/dt = −(|v_slip|/L + 1/τ)(σ̃ − σ) (Prakash–Clifton form, Cochard & Rice 2000 eq. 3), integrated
+/// exactly over the step for frozen v_slip and σ; d_n itself when the regularisation is off.
+inline double regularized_normal(double d_n, double d_t, double reduced_mass, double area, const PairContext& c) {
+  if (!c.lagged_normal) return d_n;
+  const double sigma = std::max(0.0, -d_n) / (area * c.dt);  // N = −d_n/(A_c dt), eq. 15
+  const bool fresh = std::isnan(*c.lagged_normal) || *c.lagged_step < c.step - 1.0;
+  double lagged = fresh ? sigma : *c.lagged_normal;
+  if (c.heat) {
+    const double rate = (d_t / reduced_mass) / c.slip_length + 1.0 / c.relaxation_time;
+    lagged = sigma + (lagged - sigma) * std::exp(-rate * c.dt);
+    *c.lagged_normal = lagged;
+    *c.lagged_step = c.step;
+  }
+  return -lagged * area * c.dt;
+}
 
 /// Applies a friction outcome at a node in contact: stick (stick_change) or slide (eq. 17: the normal
 /// change d_n n̂ plus the sliding impulse along t̂), with the sliding's frictional work in the heating pass.
@@ -119,8 +143,9 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     out.dp = d_n * n;
     return out;
   }
-  apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n, d_t, out.reduced_mass, area, c.dt}), dp_stick, d_n, n,
-                 t_vec, d_t, c, out);
+  const double d_n_law = regularized_normal(d_n, d_t, out.reduced_mass, area, c);
+  apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n_law, d_t, out.reduced_mass, area, c.dt}), dp_stick, d_n,
+                 n, t_vec, d_t, c, out);
   return out;
 }
 
@@ -179,6 +204,11 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   Vec<Dim> h = grid_.cell_size();
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
   if (heat) contact_stats_ = ContactStats{};
+  const bool regularized = contact_opt_.regularized();
+  if (regularized && lagged_normal_traction_.size() != grid_.node_count()) {
+    lagged_normal_traction_.assign(grid_.node_count(), std::numeric_limits<double>::quiet_NaN());
+    lagged_normal_step_.assign(grid_.node_count(), -2.0);
+  }
 
   // The node groups of contact_entries_ (find_contact_nodes): each group reads and writes only its own
   // node's slots and work entries, so groups run in parallel. Stats and pair books go to per-thread
@@ -196,6 +226,9 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     ContactThreadWork& acc = contact_thread_work_[static_cast<std::size_t>(omp_get_thread_num())];
     PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, contact_opt_.extent_tolerance,
                     cell_volume, dt, heat};
+    ctx.step = static_cast<double>(step_);
+    ctx.slip_length = contact_opt_.regularization_slip_length;
+    ctx.relaxation_time = contact_opt_.regularization_time;
     // Per-node scratch, reused from call to call (no allocation per step once grown).
     thread_local std::vector<ContactSide<Dim>> sides;
     thread_local std::vector<int> slots, mats, entries;
@@ -230,7 +263,12 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
         if (sides[0].rigid) std::swap(ia, ib);
         if (!sides[ia].rigid && contact_pair(mats[ia], mats[ib]).method == ContactMethod::multimaterial) {
           ctx.settings = &contact_pair(mats[ia], mats[ib]);
+          if (regularized) {
+            ctx.lagged_normal = &lagged_normal_traction_[static_cast<std::size_t>(node)];
+            ctx.lagged_step = &lagged_normal_step_[static_cast<std::size_t>(node)];
+          }
           const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
+          ctx.lagged_normal = ctx.lagged_step = nullptr;
           if (r.changed) {
             apply(slots[ia], r.dp);
             if (!sides[ib].rigid) apply(slots[ib], Vec<Dim>(-r.dp));

@@ -35,6 +35,7 @@ struct SlidingBlockSetup {
   bool mass_scaled_loads = false;
   int ppc = 2;
   double R = 1.0;  // tangential load R N (paper variant)
+  double regularization_slip_length = 0.0, regularization_time = 0.0;  // ContactOptions (0: off)
 };
 
 struct SlidingBlockConstants {
@@ -148,6 +149,8 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     co.default_pair.normal_vector = Vec<3>(-sn, c, 0.0);  // from base to block
     co.separation = s.separation;
     if (s.separation == SeparationMethod::extent) co.use_extent_detection();
+    co.regularization_slip_length = s.regularization_slip_length;
+    co.regularization_time = s.regularization_time;
     co.default_pair.method = s.method;
     sim.enable_contact(co);
     ContactPairSettings pair = co.default_pair;
@@ -165,8 +168,21 @@ inline double mean_velocity(const mechanics::Simulation<2>& sim, int material, c
   return mv / m;
 }
 
+/// Mass-weighted mean displacement of a material's particles along n (m).
+inline double mean_normal_displacement(const mechanics::Simulation<2>& sim, int material, const mechanics::Vec<2>& n) {
+  const auto& p = sim.particles();
+  double mu = 0.0, m = 0.0;
+  for (std::size_t q = 0; q < p.size(); ++q)
+    if (p.material[q] == material) {
+      mu += p.mass[q] * (p.position[q] - p.initial_position[q]).dot(n);
+      m += p.mass[q];
+    }
+  return mu / m;
+}
+
 struct SlidingHistory {
   std::vector<double> time, velocity, work_first, work_second;
+  std::vector<double> lift;  // the block's mean displacement normal to the surface (m)
   double mass_ratio = 1.0;  // the block's particle mass over ρ l h b
 };
 
@@ -182,6 +198,7 @@ inline SlidingHistory run_sliding_block(const SlidingBlockSetup& s, double sampl
   auto record = [&] {
     h.time.push_back(sim.time());
     h.velocity.push_back(mean_velocity(sim, block, t));
+    h.lift.push_back(mean_normal_displacement(sim, block, mechanics::Vec<2>(-t[1], t[0])));
     h.work_first.push_back(sim.cumulative_frictional_work(mechanics::HeatingOrder::first));
     h.work_second.push_back(sim.cumulative_frictional_work(mechanics::HeatingOrder::second));
   };

@@ -89,6 +89,14 @@ struct ContactOptions {
     sliver_fraction = 1e-3;
     extent_tolerance = 0.01;
   }
+  /// Normal-stress regularisation of friction (Prakash–Clifton type; Cochard & Rice 2000): the friction
+  /// law sees a lagged normal traction σ̃ that follows the instantaneous one as
+  /// dσ̃/dt = −(|v_slip|/L + 1/τ)(σ̃ − σ), not σ itself. Coulomb-type friction tied to the instantaneous
+  /// normal traction makes sliding elastic bodies unstable at the grid scale (docs/contact.md,
+  /// "Normal-stress regularisation"). 0 (either): off. Nodes with three or more materials use σ.
+  double regularization_slip_length = 0.0;  // L (m)
+  double regularization_time = 0.0;         // τ (s)
+  bool regularized() const { return regularization_slip_length > 0.0 && regularization_time > 0.0; }
   /// Penalty contact: spacing of the boundary points sampled on each body's region (m); 0: half
   /// the smallest cell size. Used when a body is added, so set it before add_body().
   double boundary_spacing = 0.0;

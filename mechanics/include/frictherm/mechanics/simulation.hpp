@@ -238,6 +238,10 @@ class Simulation {
     v("pair_work_second", pair_work_second_);
     v("wave_speed", wave_speed_);
     v("wave_speed_ready", wave_speed_ready_);
+    if (contact_opt_.regularized()) {
+      v("contact/lagged_normal_traction", lagged_normal_traction_);
+      v("contact/lagged_normal_step", lagged_normal_step_);
+    }
   }
 
  private:
@@ -312,6 +316,10 @@ class Simulation {
     std::vector<double> pair_first, pair_second;
   };
   std::vector<ContactThreadWork> contact_thread_work_;
+  // Normal-stress regularisation (ContactOptions::regularized): per grid node the lagged normal
+  // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
+  // in contact on the previous step starts again from σ).
+  std::vector<double> lagged_normal_traction_, lagged_normal_step_;
   std::vector<std::uint16_t> node_field_count_;  // per grid node: fields with mass (find_contact_nodes)
   std::vector<int> node_entry_cursor_;           // per grid node: next entry of its run, −1: none
   // Extent separation, per contact entry: the normal from its material to its partners, and the
