@@ -70,6 +70,7 @@ template <int Dim>
 void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
   system_ = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly);
   system_assembled_ = true;
+  system_gathered_ = false;
   system_changed();
   problem_.emplace(system_.mass, system_.conductance);
   for (const FixedTemperatureFace& f : opt_.fixed_faces) {
@@ -115,20 +116,27 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
   if (last_lambda_bound_ > 0.0 &&
       dt / (o.fe_safety * 2.0 / last_lambda_bound_) > 2.0 * static_cast<double>(opt_.matrix_free_max_substeps))
     return false;
-  explicit_.gather(grid_, p, shape_, opt_.materials, opt_.assembly, system_);
-  system_assembled_ = false;
-  system_changed();
-  fixed_nodes_.clear();
-  for (const FixedTemperatureFace& f : opt_.fixed_faces) {
-    const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
-    for (std::size_t u = 0; u < system_.size(); ++u)
-      if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
-        fixed_nodes_.push_back({static_cast<int>(u), f.temperature});
+  const double shift = opt_.reuse_distance * grid_.cell_size().minCoeff();
+  if (system_gathered_ && opt_.reuse_distance > 0.0 && explicit_.reusable(p, shift)) {
+    explicit_.reproject(p, system_);  // same S, M and G'; T_i from the particles now
+  } else {
+    explicit_.gather(grid_, p, shape_, opt_.materials, opt_.assembly, system_);
+    ++books_.matrix_free_gathers;
+    system_assembled_ = false;
+    system_gathered_ = true;
+    system_changed();
+    fixed_nodes_.clear();
+    for (const FixedTemperatureFace& f : opt_.fixed_faces) {
+      const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
+      for (std::size_t u = 0; u < system_.size(); ++u)
+        if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
+          fixed_nodes_.push_back({static_cast<int>(u), f.temperature});
+    }
+    last_lambda_bound_ = explicit_.lambda_bound(system_, fixed_nodes_);
   }
-  // Sub-steps: the stable step from the Gershgorin bound (forward_euler's "substep" policy), and
+  // Sub-steps: the stable step from the bound of M⁻¹K (forward_euler's "substep" policy), and
   // fe_max_dt if set.
-  const double lam = explicit_.lambda_bound(system_, fixed_nodes_);
-  last_lambda_bound_ = lam;
+  const double lam = last_lambda_bound_;
   long n = 1;
   if (lam > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (o.fe_safety * 2.0 / lam) - 1e-12)));
   if (o.fe_max_dt > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / o.fe_max_dt - 1e-12)));

@@ -36,6 +36,8 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   sys.conductance.resize(0, 0);  // no K on this path
   mct_.assign(n_nodes, 0.0);
   nodes_.resize(p.size());
+  heat_capacity_.assign(p.size(), 0.0);
+  gathered_at_.assign(p.position.begin(), p.position.end());
 
   // Pass 1: stencils, M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them.
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -45,6 +47,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
+    heat_capacity_[k] = mc;
     mechanics::Stencil<Dim, Kernel> st;
     st.evaluate(grid, p.position[k], p.half_size[k]);
     st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
@@ -138,6 +141,30 @@ void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mec
   mechanics::dispatch_shape(shape, [&](auto kernel) {
     gather_with<decltype(kernel)>(grid, particles, materials, options, sys);
   });
+}
+
+template <int Dim>
+bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, double max_shift) const {
+  if (gathered_at_.size() != p.size() || nodes_.size() != p.size()) return false;
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) return false;
+  return true;
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
+  if (nodes_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
+  std::fill(mct_.begin(), mct_.end(), 0.0);
+  for (std::size_t k = 0; k < p.size(); ++k) {  // Σ_p m_p C_v,p T_p S_ip (eq. 38), the gather's S
+    const Nodes& nl = nodes_[k];
+    const double mct = heat_capacity_[k] * p.temperature[k];
+    for (int a = 0; a < nl.count; ++a) mct_[static_cast<std::size_t>(nl.node[a])] += mct * nl.S[a];
+  }
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const auto i = static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)]);
+    sys.temperature[u] = mct_[i] / sys.grid_mass[i];
+  }
 }
 
 template <int Dim>

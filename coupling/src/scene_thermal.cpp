@@ -138,6 +138,9 @@ void parse_fixed_faces(const JsonReader& t, ThermalSceneSpec& spec, int dim) {
 // assembly per step, and windows that let no node rise by more than this give the same heat (the
 // books are exact for any window) and lag the every-step temperatures by at most about this much.
 constexpr double kDefaultWindowRise = 0.1;  // K
+// Matrix-free windows reuse their gather while particles moved less than this many cells
+// (docs/performance.md: measured error against gathering every window).
+constexpr double kDefaultReuseDistance = 0.05;
 
 void default_window(WindowPolicy& w) {
   w.kind = WindowPolicy::Kind::adaptive;
@@ -205,6 +208,7 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   if (!t->is_object()) t->expected("an object with at least \"materials\"");
   spec.enabled = true;
   default_window(spec.coupler.window);
+  spec.coupler.reuse_distance = kDefaultReuseDistance;
   spec.coupler.thickness = dimension == 2 ? thickness : 1.0;
   parse_integrator(*t, spec);
   spec.coupler.assembly.active_mass_fraction =
@@ -231,6 +235,7 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   }
   spec.coupler.subgrid_relaxation_time =
       c->number("subgrid_relaxation_time", spec.coupler.subgrid_relaxation_time, Range::positive());
+  spec.coupler.reuse_distance = c->number("reuse_distance", spec.coupler.reuse_distance, Range::closed(0.0, 0.5));
   parse_hotspots(*c, spec.coupler.hotspots, spec.coupler.fates);
   c->finish();
   return spec;

@@ -69,6 +69,11 @@ struct CouplerOptions {
   /// Gershgorin estimate, and not while a reaction is part of the problem. Measured crossover:
   /// docs/performance.md.
   long matrix_free_max_substeps = 4;
+  /// Matrix-free windows: the stencils, M and G' of the last gather serve the next windows while no
+  /// particle has moved more than this fraction of the cell size along any axis since it (T_i is
+  /// re-projected from the particles every window; energy stays exact, the weights lag by at most
+  /// this shift). 0: gather every window. Error against gathering every window: docs/performance.md.
+  double reuse_distance = 0.0;
   AssemblyOptions assembly;
   WindowPolicy window;
   HotSpotOptions hotspots;
@@ -104,6 +109,7 @@ struct EnergyBooks {
   double max_assembly_residual = 0.0;  // worst of M partition-of-unity and K·1 = 0 residuals
   long matrix_free_windows = 0;        // windows integrated matrix-free (explicit_conduction.hpp)
   long matrix_free_substeps = 0;       // their forward-Euler sub-steps
+  long matrix_free_gathers = 0;        // particle passes that built M and G' for them (the rest reused)
 };
 
 template <int Dim>
@@ -171,6 +177,7 @@ class Coupler {
   NodalThermalSystem system_;
   bool has_system_ = false;
   bool system_assembled_ = false;  // system_ has K and problem_ is built on it (not a matrix-free gather)
+  bool system_gathered_ = false;   // system_ is explicit_'s last gather (reusable for matrix-free windows)
   ExplicitConduction<Dim> explicit_;
   double last_lambda_bound_ = 0.0;     // Gershgorin bound of M⁻¹K at the last gather (1/s)
   std::vector<FixedNode> fixed_nodes_;  // unknowns of the gathered system on fixed-temperature faces

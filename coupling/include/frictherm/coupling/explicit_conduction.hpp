@@ -48,6 +48,14 @@ class ExplicitConduction {
               mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
               const AssemblyOptions& options, NodalThermalSystem& sys);
 
+  /// True if a gather was made for these particles (same count) and none has moved more than
+  /// `max_shift` (m, along any axis) since: the kept stencils, M and G' may then serve another window.
+  bool reusable(const mechanics::Particles<Dim>& particles, double max_shift) const;
+
+  /// With the stencils and M of the last gather (reusable() true): T_i from the current particle
+  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay.
+  void reproject(const mechanics::Particles<Dim>& particles, NodalThermalSystem& sys);
+
   /// Upper bound of the largest eigenvalue of M⁻¹K over the free unknowns of the gathered system
   /// (1/s); 0 without conduction.
   double lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const;
@@ -87,6 +95,8 @@ class ExplicitConduction {
                    NodalThermalSystem& sys);
 
   std::vector<Nodes> nodes_;              // by particle; count 0 for particles that hold no heat
+  std::vector<double> heat_capacity_;     // m_p C_v,p by particle at the gather (J/K)
+  std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
   std::vector<Conducting> conducting_;    // conducting particles with a kept node
   std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node
   std::vector<double> row_bound_;         // Σ_j |K_ij| bound by unknown (W/K)
