@@ -140,7 +140,7 @@ void parse_fixed_faces(const JsonReader& t, ThermalSceneSpec& spec, int dim) {
 constexpr double kDefaultWindowRise = 0.1;  // K
 // Matrix-free windows reuse their gather while particles moved less than this many cells
 // (docs/performance.md: measured error against gathering every window).
-constexpr double kDefaultReuseDistance = 0.05;
+constexpr double kDefaultReuseDistance = 0.01;
 
 void default_window(WindowPolicy& w) {
   w.kind = WindowPolicy::Kind::adaptive;

@@ -68,7 +68,7 @@ struct CouplerOptions {
   /// sub-steps on it, or cvode_bdf for auto). Only with the "substep" stability policy and the
   /// Gershgorin estimate, and not while a reaction is part of the problem. Measured crossover:
   /// docs/performance.md.
-  long matrix_free_max_substeps = 4;
+  long matrix_free_max_substeps = 64;
   /// Matrix-free windows: the stencils, M and G' of the last gather serve the next windows while no
   /// particle has moved more than this fraction of the cell size along any axis since it (T_i is
   /// re-projected from the particles every window; energy stays exact, the weights lag by at most
