@@ -153,7 +153,7 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
   const double beta = std::isfinite(opt_.subgrid_relaxation_time)
                           ? -std::expm1(-dt / opt_.subgrid_relaxation_time)
                           : 0.0;
-  explicit_.map_back(p, opt_.materials, system_, delta, beta, beta > 0.0 ? &nodal_temperature_ : nullptr);
+  explicit_.map_back(p, system_, delta, beta, beta > 0.0 ? &nodal_temperature_ : nullptr);
   books_.nodal_energy_change += system_.mass.dot(delta);
   ++books_.matrix_free_windows;
   books_.matrix_free_substeps += n;

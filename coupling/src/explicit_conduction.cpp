@@ -36,18 +36,20 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   sys.conductance.resize(0, 0);  // no K on this path
   mct_.assign(n_nodes, 0.0);
   nodes_.resize(p.size());
-  heat_capacity_.assign(p.size(), 0.0);
+  kept_.resize(p.size());
+  next_mct_valid_ = false;
   gathered_at_.assign(p.position.begin(), p.position.end());
 
   // Pass 1: stencils, M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them.
   for (std::size_t k = 0; k < p.size(); ++k) {
     Nodes& nl = nodes_[k];
     nl.count = 0;
+    kept_[k].count = 0;
     const ThermalProperties& m = props_of(materials, p.material[k]);
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    heat_capacity_[k] = mc;
+    kept_[k].heat_capacity = mc;
     mechanics::Stencil<Dim, Kernel> st;
     st.evaluate(grid, p.position[k], p.half_size[k]);
     st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
@@ -87,17 +89,13 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     sys.temperature[u] = mct_[i] / sys.grid_mass[i];
   }
 
-  // Pass 2: lumped gradients G' of the conducting particles and the Gershgorin row bounds.
-  conducting_.clear();
+  // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
   row_bound_.assign(static_cast<std::size_t>(n), 0.0);
   rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
   for (std::size_t k = 0; k < p.size(); ++k) {
     const Nodes& nl = nodes_[k];
     if (nl.count == 0) continue;
-    const ThermalProperties& m = props_of(materials, p.material[k]);
-    if (!(m.conductivity > 0.0)) continue;
-    Conducting c;
-    double S[capacity];
+    Kept& c = kept_[k];
     double s_kept = 0.0;
     mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
     for (int a = 0; a < nl.count; ++a) {
@@ -106,15 +104,18 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
         s_kept += nl.S[a];
         c.unknown[c.count] = u;
         c.G[c.count] = nl.G[a];
-        S[c.count] = nl.S[a];
+        c.S[c.count] = nl.S[a];
         ++c.count;
       } else {
         g_dropped += nl.G[a];
       }
     }
-    if (c.count == 0 || !(s_kept > 0.0)) continue;  // no heat capacity of its own reaches an unknown
+    const ThermalProperties& m = props_of(materials, p.material[k]);
+    c.conductance = 0.0;
+    // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
+    if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) continue;
     if (c.count < nl.count)
-      for (int a = 0; a < c.count; ++a) c.G[a] += (S[a] / s_kept) * g_dropped;  // lump dropped nodes
+      for (int a = 0; a < c.count; ++a) c.G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
     c.conductance = p.volume[k] * m.conductivity;
     // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
     // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
@@ -130,7 +131,6 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       row_bound_[static_cast<std::size_t>(c.unknown[a])] += c.conductance * gnorm[a] * gsum;
       rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += c.conductance * g2m;
     }
-    conducting_.push_back(c);
   }
 }
 
@@ -145,7 +145,7 @@ void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mec
 
 template <int Dim>
 bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, double max_shift) const {
-  if (gathered_at_.size() != p.size() || nodes_.size() != p.size()) return false;
+  if (gathered_at_.size() != p.size() || kept_.size() != p.size()) return false;
   for (std::size_t k = 0; k < p.size(); ++k)
     if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) return false;
   return true;
@@ -153,18 +153,18 @@ bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, doubl
 
 template <int Dim>
 void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
-  if (nodes_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
-  std::fill(mct_.begin(), mct_.end(), 0.0);
-  for (std::size_t k = 0; k < p.size(); ++k) {  // Σ_p m_p C_v,p T_p S_ip (eq. 38), the gather's S
-    const Nodes& nl = nodes_[k];
-    const double mct = heat_capacity_[k] * p.temperature[k];
-    for (int a = 0; a < nl.count; ++a) mct_[static_cast<std::size_t>(nl.node[a])] += mct * nl.S[a];
-  }
+  if (kept_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
   const auto n = static_cast<Eigen::Index>(sys.size());
-  for (Eigen::Index u = 0; u < n; ++u) {
-    const auto i = static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)]);
-    sys.temperature[u] = mct_[i] / sys.grid_mass[i];
+  if (!next_mct_valid_ || next_mct_.size() != n) {
+    next_mct_.setZero(n);
+    for (std::size_t k = 0; k < p.size(); ++k) {  // Σ_p m_p C_v,p T_p S_ip (eq. 38), the gather's S
+      const Kept& c = kept_[k];
+      const double mct = c.heat_capacity * p.temperature[k];
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
+    }
   }
+  for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
+  next_mct_valid_ = false;  // the particles' temperatures change in this window
 }
 
 template <int Dim>
@@ -203,7 +203,8 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
   force_.resize(n);
   for (long s = 0; s < substeps; ++s) {
     force_.setZero();
-    for (const Conducting& c : conducting_) {
+    for (const Kept& c : kept_) {
+      if (c.conductance == 0.0) continue;
       mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();  // (∇T)_p = Σ_j G'_jp T_j (eq. 37)
       for (int a = 0; a < c.count; ++a) grad += c.G[a] * T[c.unknown[a]];
       grad *= c.conductance;
@@ -216,28 +217,30 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
 }
 
 template <int Dim>
-void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
-                                       const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
-                                       double beta, const Eigen::VectorXd* end) const {
-  if (nodes_.size() != p.size())
+void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
+                                       const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+  if (kept_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
   const bool relax = end && beta > 0.0;
+  next_mct_.setZero(static_cast<Eigen::Index>(sys.size()));
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const Nodes& nl = nodes_[k];
-    if (nl.count == 0 || !materials[static_cast<std::size_t>(p.material[k])].conducts) continue;
+    const Kept& c = kept_[k];
+    if (c.count == 0) continue;
     double dT = 0.0, pic = 0.0, s = 0.0;
-    for (int a = 0; a < nl.count; ++a) {
-      const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
-      if (u < 0) continue;
-      dT += nl.S[a] * delta[u];  // design §4: the increment, not the nodal value
+    for (int a = 0; a < c.count; ++a) {
+      dT += c.S[a] * delta[c.unknown[a]];  // design §4: the increment, not the nodal value
       if (relax) {
-        pic += nl.S[a] * (*end)[u];
-        s += nl.S[a];
+        pic += c.S[a] * (*end)[c.unknown[a]];
+        s += c.S[a];
       }
     }
     const double flip = p.temperature[k] + dT;
-    p.temperature[k] = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    p.temperature[k] = T;
+    const double mct = c.heat_capacity * T;  // eq. 38 sums of the next window, if it reuses this gather
+    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
   }
+  next_mct_valid_ = true;
 }
 
 template class ExplicitConduction<2>;

@@ -53,7 +53,8 @@ class ExplicitConduction {
   bool reusable(const mechanics::Particles<Dim>& particles, double max_shift) const;
 
   /// With the stencils and M of the last gather (reusable() true): T_i from the current particle
-  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay.
+  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums were
+  /// made by the last map_back (same particle order, same weights) unless the particles changed.
   void reproject(const mechanics::Particles<Dim>& particles, NodalThermalSystem& sys);
 
   /// Upper bound of the largest eigenvalue of M⁻¹K over the free unknowns of the gathered system
@@ -68,25 +69,28 @@ class ExplicitConduction {
                           long substeps);
 
   /// T_p += Σ_i S_ip ΔT_i with the stencils of the gather (same positions), and the optional sub-grid
-  /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures).
-  void map_back(mechanics::Particles<Dim>& particles, const std::vector<ThermalProperties>& materials,
-                const NodalThermalSystem& sys, const Eigen::VectorXd& delta, double relaxation,
-                const Eigen::VectorXd* end) const;
+  /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures). Also sums
+  /// Σ_p m_p C_v,p T_p S_ip with the new T_p for the next reproject().
+  void map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
+                double relaxation, const Eigen::VectorXd* end);
 
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
-  /// The node list of one particle: grid node, S_ip and G_ip (all its stencil nodes).
+  /// The stencil of one particle (scratch of the gather): grid node, S_ip and G_ip.
   struct Nodes {
     int count = 0;
     int node[capacity];
     double S[capacity];
     mechanics::Vec<Dim> G[capacity];
   };
-  /// One conducting particle's kept nodes: unknown number and lumped G'_ip, and V_p k_p.
-  struct Conducting {
+  /// One heat-holding particle's nodes that are unknowns, in stencil order: unknown number, S_ip,
+  /// lumped G'_ip; its m_p C_v,p and V_p k_p (0 without conduction). Everything the windows read.
+  struct Kept {
     int count = 0;
-    double conductance = 0.0;  // V_p k_p (W m / K ... times G·G: W/K)
+    double heat_capacity = 0.0;  // m_p C_v,p (J/K)
+    double conductance = 0.0;    // V_p k_p (W m/K): times G'·G' gives W/K
     int unknown[capacity];
+    double S[capacity];
     mechanics::Vec<Dim> G[capacity];
   };
   template <class Kernel>
@@ -94,11 +98,12 @@ class ExplicitConduction {
                    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
                    NodalThermalSystem& sys);
 
-  std::vector<Nodes> nodes_;              // by particle; count 0 for particles that hold no heat
-  std::vector<double> heat_capacity_;     // m_p C_v,p by particle at the gather (J/K)
+  std::vector<Nodes> nodes_;              // gather scratch, by particle
+  std::vector<Kept> kept_;                // by particle; count 0 for particles that hold no heat
   std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
-  std::vector<Conducting> conducting_;    // conducting particles with a kept node
-  std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node
+  std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
+  Eigen::VectorXd next_mct_;              // the same by unknown, with the T_p of the last map_back
+  bool next_mct_valid_ = false;
   std::vector<double> row_bound_;         // Σ_j |K_ij| bound by unknown (W/K)
   std::vector<double> rayleigh_bound_;    // Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a by unknown (1/s)
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
