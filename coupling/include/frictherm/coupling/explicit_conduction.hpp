@@ -15,8 +15,9 @@
 // from bounds of λ_max(M⁻¹K) computed in the same particle pass (the smaller of a Gershgorin bound,
 //   Σ_j |K_ij| ≤ Σ_p V_p k_p |G'_ip| Σ_j |G'_jp|,
 // and a Cauchy–Schwarz bound, λ ≤ max_i Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a), h ≤ safety · 2 / λ. Without
-// K's cancellations they are up to ~2× above the Gershgorin estimate the assembled path takes from
-// K itself, so a window near the limit may take one more sub-step here.
+// K's cancellations they can be ~2× above the Gershgorin estimate the assembled path takes from K
+// itself (linear, uGIMP) or below it (quadratic B-spline), so a window near the limit may take a
+// different number of sub-steps here.
 // Energy: Σ_i M_i ΔT_i = Σ_i q_i window + Σ_i h f_i, and Σ_i f_i = −Σ_p V_p k_p (Σ_i G'_ip)·(∇T)_p
 // vanishes to round-off (Σ_i G'_ip = 0: partition of unity, the lumping keeps it).
 #include <frictherm/coupling/thermal_assembly.hpp>
@@ -42,7 +43,7 @@ class ExplicitConduction {
  public:
   /// Pass over the particles at their current positions: stencils (kept for the map back), M and T
   /// on every node and the unknowns into `sys` (its conductance is left empty), the gradients G'
-  /// with the dropped nodes lumped, and the Gershgorin bound of M⁻¹K. Throws std::invalid_argument
+  /// with the dropped nodes lumped, and the bounds of M⁻¹K. Throws std::invalid_argument
   /// like assemble_thermal for a material id without thermal properties or no conducting particle.
   void gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
               mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
@@ -53,8 +54,9 @@ class ExplicitConduction {
   bool reusable(const mechanics::Particles<Dim>& particles, double max_shift) const;
 
   /// With the stencils and M of the last gather (reusable() true): T_i from the current particle
-  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums were
-  /// made by the last map_back (same particle order, same weights) unless the particles changed.
+  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums are
+  /// those the last map_back made with the new T_p (same order, same weights, so the same numbers):
+  /// nothing but the coupler may change particle temperatures between matrix-free windows.
   void reproject(const mechanics::Particles<Dim>& particles, NodalThermalSystem& sys);
 
   /// Upper bound of the largest eigenvalue of M⁻¹K over the free unknowns of the gathered system
