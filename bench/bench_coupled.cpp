@@ -35,9 +35,12 @@ double cpu_seconds() {
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-enum class Mode { mechanics, every_step, adaptive };
+enum class Mode { mechanics, every_step, adaptive, every_step_gather };
 const char* name(Mode m) {
-  return m == Mode::mechanics ? "mechanics only" : m == Mode::every_step ? "window every step" : "adaptive window";
+  return m == Mode::mechanics    ? "mechanics only"
+         : m == Mode::every_step ? "window every step"
+         : m == Mode::adaptive   ? "adaptive window"
+                                 : "every step, no reuse";
 }
 
 std::string num(double x) {
@@ -72,7 +75,8 @@ std::string twin_scene(double h, double end_time, Mode mode, const std::string& 
       "materials": {"base": {"heat_capacity": 1000, "conductivity": 0.4},
                     "block": {"heat_capacity": 1000, "conductivity": 0.4}}},
     "coupling": {"window": )";
-    s += mode == Mode::every_step ? R"("every_step")" : R"({"policy": "adaptive", "max_temperature_rise": 0.05})";
+    s += mode == Mode::adaptive ? R"({"policy": "adaptive", "max_temperature_rise": 0.05})" : R"("every_step")";
+    if (mode == Mode::every_step_gather) s += R"(, "reuse_distance": 0)";  // gather M and G' every window
     s += "}";
   }
   return s + "}";
@@ -89,6 +93,7 @@ Figures run_case(double h, double end_time, Mode mode, int threads, const std::s
   RunOptions opt;
   opt.threads = threads;
   opt.quiet = true;
+  opt.overwrite = true;  // one scratch file per process, rewritten by every case
   const double c0 = cpu_seconds();
   const RunResult r = run_scene(scene, opt);
   Figures f;
@@ -169,14 +174,16 @@ int main(int argc, char** argv) {
   for (const double h : cells) {
     const double end_time = h > 0.003 ? end5 : end1;
     std::printf("cell %.1f mm, end time %g s\n", h * 1e3, end_time);
-    Figures f1[3], f2[3];
-    for (int m = 0; m < 3; ++m) f1[m] = run_case(h, end_time, static_cast<Mode>(m), 1, scratch);
+    Figures f1[4], f2[3];
+    for (int m = 0; m < 4; ++m) f1[m] = run_case(h, end_time, static_cast<Mode>(m), 1, scratch);
     for (int m = 0; m < 3; ++m) f2[m] = run_case(h, end_time, static_cast<Mode>(m), 2, scratch);
     std::printf("  with a busy process on CPU 0:\n");
     const pid_t busy = start_busy(20.0 * f1[1].wall + 60.0);
     Figures fb1 = run_case(h, end_time, Mode::every_step, 1, scratch);
     Figures fb2 = run_case(h, end_time, Mode::every_step, 2, scratch);
     stop_busy(busy);
+    std::printf("  1 thread: every step without reuse (M, G' gathered every window): coupled/mechanics cpu %.2fx\n",
+                f1[3].cpu / f1[0].cpu);
     for (int t = 0; t < 2; ++t) {
       const Figures* f = t == 0 ? f1 : f2;
       std::printf("  %d thread%s: coupled/mechanics wall  every step %.2fx  adaptive %.2fx;  cpu  every step %.2fx  "

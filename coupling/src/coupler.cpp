@@ -21,7 +21,8 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
     : grid_(grid),
       shape_(shape),
       opt_(std::move(options)),
-      integrator_(thermal::make_integrator(opt_.integrator, opt_.integrator_options)),
+      integrator_(thermal::make_integrator(opt_.integrator == "auto" ? "cvode_bdf" : opt_.integrator,
+                                           opt_.integrator_options)),
       pending_(grid.node_count()),
       plastic_(opt_.plastic),
       tracker_(Dim, opt_.hotspots, opt_.thickness),
@@ -32,6 +33,8 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
   if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
     throw std::invalid_argument("Coupler: adaptive windows need max_temperature_rise > 0");
   if (!(w.max_duration > 0.0)) throw std::invalid_argument("Coupler: max_duration must be > 0");
+  if (opt_.matrix_free_max_substeps < 0)
+    throw std::invalid_argument("Coupler: matrix_free_max_substeps must be >= 0");
   if (!(opt_.subgrid_relaxation_time > 0.0))
     throw std::invalid_argument("Coupler: subgrid_relaxation_time must be > 0");
   for (const FixedTemperatureFace& f : opt_.fixed_faces)
@@ -66,14 +69,9 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
 template <int Dim>
 void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
   system_ = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly);
-  has_system_ = true;
-  const double residual = std::max(system_.mass_residual(), system_.row_sum_residual());
-  books_.max_assembly_residual = std::max(books_.max_assembly_residual, residual);
-  if (!(residual <= kAssemblyTolerance))
-    throw std::logic_error("thermal assembly: partition-of-unity / zero-row-sum residual " +
-                           std::to_string(residual) + " exceeds round-off");
-  min_unknown_mass_ = system_.mass.minCoeff();
-  nearest_mass_.clear();
+  system_assembled_ = true;
+  system_gathered_ = false;
+  system_changed();
   problem_.emplace(system_.mass, system_.conductance);
   for (const FixedTemperatureFace& f : opt_.fixed_faces) {
     const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
@@ -89,6 +87,77 @@ void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
     nodal_progress_ref_ = std::move(r.progress);
     particle_progress_ref_ = particle_progress_;
   }
+}
+
+template <int Dim>
+void Coupler<Dim>::system_changed() {
+  has_system_ = true;
+  // K·1 = 0 only where K was assembled (a matrix-free gather leaves it empty).
+  const double residual = std::max(system_.mass_residual(), system_assembled_ ? system_.row_sum_residual() : 0.0);
+  books_.max_assembly_residual = std::max(books_.max_assembly_residual, residual);
+  if (!(residual <= kAssemblyTolerance))
+    throw std::logic_error("thermal assembly: partition-of-unity / zero-row-sum residual " +
+                           std::to_string(residual) + " exceeds round-off");
+  min_unknown_mass_ = system_.mass.minCoeff();
+  nearest_mass_.clear();
+}
+
+template <int Dim>
+bool Coupler<Dim>::matrix_free_allowed() const {
+  const thermal::IntegratorOptions& o = opt_.integrator_options;
+  return (opt_.integrator == "forward_euler" || opt_.integrator == "auto") && opt_.matrix_free_max_substeps > 0 &&
+         !reaction_active() && o.fe_stability_policy == "substep" && o.fe_limit_estimate == "gershgorin";
+}
+
+template <int Dim>
+bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
+  const thermal::IntegratorOptions& o = opt_.integrator_options;
+  // Far beyond the limit with the last bound (it changes slowly as the particles move): skip the gather.
+  if (last_lambda_bound_ > 0.0 &&
+      dt / (o.fe_safety * 2.0 / last_lambda_bound_) > 2.0 * static_cast<double>(opt_.matrix_free_max_substeps))
+    return false;
+  const double shift = opt_.reuse_distance * grid_.cell_size().minCoeff();
+  if (system_gathered_ && opt_.reuse_distance > 0.0 && explicit_.reusable(p, shift)) {
+    explicit_.reproject(p, system_);  // same S, M and G'; T_i from the particles now
+  } else {
+    explicit_.gather(grid_, p, shape_, opt_.materials, opt_.assembly, system_);
+    ++books_.matrix_free_gathers;
+    system_assembled_ = false;
+    system_gathered_ = true;
+    system_changed();
+    fixed_nodes_.clear();
+    for (const FixedTemperatureFace& f : opt_.fixed_faces) {
+      const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
+      for (std::size_t u = 0; u < system_.size(); ++u)
+        if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
+          fixed_nodes_.push_back({static_cast<int>(u), f.temperature});
+    }
+    last_lambda_bound_ = explicit_.lambda_bound(system_, fixed_nodes_);
+  }
+  // Sub-steps: the stable step from the bound of M⁻¹K (forward_euler's "substep" policy), and
+  // fe_max_dt if set.
+  const double lam = last_lambda_bound_;
+  long n = 1;
+  if (lam > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (o.fe_safety * 2.0 / lam) - 1e-12)));
+  if (o.fe_max_dt > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / o.fe_max_dt - 1e-12)));
+  if (n > opt_.matrix_free_max_substeps) return false;  // the assembled path takes this window
+  const HeatDistribution heat = distribute_heat(grid_, system_, pending_.work());
+  books_.heat_delivered += (heat.joules / dt).sum() * dt;  // as the assembled path books ∫ Σ q dt
+  books_.plastic_heat_delivered += pending_plastic_;
+  books_.heat_relocated += heat.relocated;
+  nodal_temperature_ = explicit_.advance(system_, system_.temperature, heat.joules, fixed_nodes_, dt, n);
+  if (!nodal_temperature_.allFinite())
+    throw thermal::StabilityError("matrix-free forward Euler: temperatures became non-finite", dt / n,
+                                  lam > 0.0 ? 2.0 / lam : 0.0);
+  const Eigen::VectorXd delta = nodal_temperature_ - system_.temperature;
+  const double beta = std::isfinite(opt_.subgrid_relaxation_time)
+                          ? -std::expm1(-dt / opt_.subgrid_relaxation_time)
+                          : 0.0;
+  explicit_.map_back(p, system_, delta, beta, beta > 0.0 ? &nodal_temperature_ : nullptr);
+  books_.nodal_energy_change += system_.mass.dot(delta);
+  ++books_.matrix_free_windows;
+  books_.matrix_free_substeps += n;
+  return true;
 }
 
 template <int Dim>
@@ -168,15 +237,17 @@ template <int Dim>
 bool Coupler<Dim>::close_window(mechanics::Particles<Dim>& p, double time) {
   const double dt = time - window_start_;
   if (!(dt > 0.0)) return false;  // nothing to integrate; pending heat stays for the next window
-  assemble(p);
-  const HeatDistribution heat = distribute_heat(grid_, system_, pending_.work());
-  const Eigen::VectorXd q = heat.joules / dt;  // constant over the window: ∫ q dt = W (design §4)
-  problem_->set_source(q);
-  books_.heat_delivered += q.sum() * dt;
-  books_.plastic_heat_delivered += pending_plastic_;
-  books_.heat_relocated += heat.relocated;
-  nodal_temperature_ = system_.temperature;
-  advance_and_map(p, window_start_, time);
+  if (!matrix_free_allowed() || !matrix_free_window(p, dt)) {
+    assemble(p);
+    const HeatDistribution heat = distribute_heat(grid_, system_, pending_.work());
+    const Eigen::VectorXd q = heat.joules / dt;  // constant over the window: ∫ q dt = W (design §4)
+    problem_->set_source(q);
+    books_.heat_delivered += q.sum() * dt;
+    books_.plastic_heat_delivered += pending_plastic_;
+    books_.heat_relocated += heat.relocated;
+    nodal_temperature_ = system_.temperature;
+    advance_and_map(p, window_start_, time);
+  }
   pending_.clear();
   pending_plastic_ = 0.0;
   ++books_.windows;
@@ -196,7 +267,7 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
   if (!(time > window_start_)) return;
   const bool reaction_starts = opt_.reaction.enabled && !continuing_;
   continuing_ = true;
-  if (!has_system_ || reaction_starts) {  // a reaction held back during loading joins the problem now
+  if (!system_assembled_ || reaction_starts) {  // a reaction held back during loading joins the problem now
     assemble(p);
     nodal_temperature_ = system_.temperature;
   }

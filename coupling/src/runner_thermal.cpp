@@ -172,6 +172,9 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"thermal_convergence_failures", static_cast<std::int64_t>(st.convergence_failures)},
       {"thermal_reinits", static_cast<std::int64_t>(st.reinits)},
       {"thermal_windows", static_cast<std::int64_t>(b.windows)},
+      {"thermal_matrix_free_windows", static_cast<std::int64_t>(b.matrix_free_windows)},
+      {"thermal_matrix_free_substeps", static_cast<std::int64_t>(b.matrix_free_substeps)},
+      {"thermal_matrix_free_gathers", static_cast<std::int64_t>(b.matrix_free_gathers)},
       {"thermal_continuation_intervals", static_cast<std::int64_t>(b.continuation_intervals)},
       {"hotspots_seen", static_cast<std::int64_t>(coupler_.hotspots().ids_issued())},
   };

@@ -15,13 +15,17 @@ namespace {
 void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
   CouplerOptions& c = spec.coupler;
   thermal::IntegratorOptions& o = c.integrator_options;
-  c.integrator = t.choice("integrator", thermal::integrator_names(), "cvode_bdf");
+  std::vector<std::string> names = thermal::integrator_names();
+  names.insert(names.begin(), "auto");  // coupler.hpp: matrix-free forward Euler or cvode_bdf by window
+  c.integrator = t.choice("integrator", names, "auto");
+  const bool explicit_allowed = c.integrator == "forward_euler" || c.integrator == "auto";
   o.rtol = t.number("rtol", o.rtol, Range::open(0.0, 1.0));
   o.atol = t.number("atol", o.atol, Range::positive());
   o.max_steps = t.integer("max_steps", o.max_steps, 1, std::numeric_limits<int>::max());
   if (const auto ls = t.find("linear_solver")) {
     std::vector<std::string> allowed;
-    if (c.integrator == "cvode_bdf" || c.integrator == "arkode_dirk") allowed = {"klu", "pcg"};
+    if (c.integrator == "cvode_bdf" || c.integrator == "arkode_dirk" || c.integrator == "auto")
+      allowed = {"klu", "pcg"};
     if (c.integrator == "cvode_adams") allowed = {"fixed_point", "klu", "pcg"};
     if (allowed.empty()) ls->fail("not used by the explicit integrator " + c.integrator + " (remove it)");
     o.linear_solver = ls->as_choice(allowed);
@@ -29,15 +33,19 @@ void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
   o.krylov_maxl = static_cast<int>(t.integer("krylov_maxl", o.krylov_maxl, 1, 100000));
   o.reinit_every_window = t.find("reinit_every_window") ? t.at("reinit_every_window").as_bool() : false;
   if (const auto fe = t.find("forward_euler")) {
-    if (c.integrator != "forward_euler") fe->fail("only for \"integrator\": \"forward_euler\"");
+    if (!explicit_allowed) fe->fail("only for \"integrator\": \"forward_euler\" or \"auto\"");
     o.fe_stability_policy = fe->choice("stability", {"substep", "refuse", "unguarded"}, "substep");
     o.fe_safety = fe->number("safety", o.fe_safety, Range::left_open(0.0, 1.0));
     o.fe_max_dt = fe->number("max_dt", 0.0, Range::non_negative());
     o.fe_limit_estimate = fe->choice("limit_estimate", {"gershgorin", "power"}, "gershgorin");
     fe->finish();
   }
+  if (const auto mf = t.find("matrix_free_max_substeps")) {
+    if (!explicit_allowed) mf->fail("only for \"integrator\": \"forward_euler\" or \"auto\"");
+    c.matrix_free_max_substeps = t.integer("matrix_free_max_substeps", c.matrix_free_max_substeps, 0, 1000000);
+  }
   try {
-    thermal::make_integrator(c.integrator, o);  // the thermal module's own checks, before any step
+    thermal::make_integrator(c.integrator == "auto" ? "cvode_bdf" : c.integrator, o);  // the thermal module's own checks, before any step
   } catch (const std::invalid_argument& e) {
     t.fail(e.what());
   }
@@ -130,6 +138,9 @@ void parse_fixed_faces(const JsonReader& t, ThermalSceneSpec& spec, int dim) {
 // assembly per step, and windows that let no node rise by more than this give the same heat (the
 // books are exact for any window) and lag the every-step temperatures by at most about this much.
 constexpr double kDefaultWindowRise = 0.1;  // K
+// Matrix-free windows reuse their gather while particles moved less than this many cells
+// (docs/performance.md: measured error against gathering every window).
+constexpr double kDefaultReuseDistance = 0.01;
 
 void default_window(WindowPolicy& w) {
   w.kind = WindowPolicy::Kind::adaptive;
@@ -197,6 +208,7 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   if (!t->is_object()) t->expected("an object with at least \"materials\"");
   spec.enabled = true;
   default_window(spec.coupler.window);
+  spec.coupler.reuse_distance = kDefaultReuseDistance;
   spec.coupler.thickness = dimension == 2 ? thickness : 1.0;
   parse_integrator(*t, spec);
   spec.coupler.assembly.active_mass_fraction =
@@ -223,6 +235,7 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   }
   spec.coupler.subgrid_relaxation_time =
       c->number("subgrid_relaxation_time", spec.coupler.subgrid_relaxation_time, Range::positive());
+  spec.coupler.reuse_distance = c->number("reuse_distance", spec.coupler.reuse_distance, Range::closed(0.0, 0.5));
   parse_hotspots(*c, spec.coupler.hotspots, spec.coupler.fates);
   c->finish();
   return spec;

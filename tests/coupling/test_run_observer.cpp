@@ -37,6 +37,7 @@ TEST(RunObserver, KineticEnergyRecordedEachStepMatchesTheSeries) {
   fc::RunOptions o;
   o.output = (scratch() / "observer.h5").string();
   o.quiet = true;
+  o.overwrite = true;  // a fixed scratch path: the test must run again (outputs are not replaced silently)
   o.threads = 1;
   std::vector<long> steps;
   std::vector<double> ke, time;
@@ -70,6 +71,7 @@ TEST(RunObserver, WrongDimensionAndObserverErrorsAreReported) {
   fc::RunOptions o;
   o.output = (scratch() / "observer_error.h5").string();
   o.quiet = true;
+  o.overwrite = true;  // a fixed scratch path: the test must run again (outputs are not replaced silently)
   o.threads = 1;
   int calls = 0;
   o.observer = [&](const fc::StepView& s) {

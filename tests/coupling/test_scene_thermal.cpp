@@ -88,7 +88,8 @@ TEST(SceneThermal, DefaultsAndAbsence) {
   s["thermal"] = Json::parse(R"({"materials": {"steel": {"heat_capacity": 490, "conductivity": 45}}})");
   const fc::ThermalSceneSpec t = fc::parse_scene(s.dump()).thermal;
   EXPECT_TRUE(t.enabled);
-  EXPECT_EQ(t.coupler.integrator, "cvode_bdf");
+  EXPECT_EQ(t.coupler.integrator, "auto");  // issue 13: matrix-free FE for short windows, cvode_bdf beyond
+  EXPECT_EQ(t.coupler.reuse_distance, 0.01);
   EXPECT_EQ(t.coupler.window.kind, fc::WindowPolicy::Kind::adaptive);  // issue 13: adaptive by default
   EXPECT_EQ(t.coupler.window.max_temperature_rise, 0.1);
   EXPECT_EQ(t.heating_order, fc::HeatingOrder::second);
@@ -110,7 +111,7 @@ TEST(SceneThermal, ErrorsNameTheKeyPath) {
   const std::vector<Bad> cases{
       {"/thermal/rtol", 2.0, "thermal.rtol: expected a number in (0, 1), got 2"},
       {"/thermal/atol", 0.0, "thermal.atol: expected a number > 0, got 0"},
-      {"/thermal/integrator", "rk4", "thermal.integrator: expected one of \"forward_euler\", \"cvode_bdf\""},
+      {"/thermal/integrator", "rk4", "thermal.integrator: expected one of \"auto\", \"forward_euler\", \"cvode_bdf\""},
       {"/thermal/materials/steel/heat_capacity", -1.0, "thermal.materials.steel.heat_capacity: expected a number > 0"},
       {"/thermal/materials/steel/conductivity", "high", "thermal.materials.steel.conductivity: expected a number >= 0"},
       {"/thermal/materials/steel/density", 1.0, "thermal.materials.steel.density: unknown key"},

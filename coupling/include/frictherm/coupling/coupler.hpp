@@ -21,6 +21,7 @@
 // (thermal::Reaction) on the nodes of reacting materials, with the progress λ kept on the particles
 // and gathered at every assembly. Books: Σ_i M_i ΔT_i = frictional + plastic heat delivered +
 // reaction heat released (adiabatic edges; to the solver tolerance with a reaction).
+#include <frictherm/coupling/explicit_conduction.hpp>
 #include <frictherm/coupling/heat_handoff.hpp>
 #include <frictherm/coupling/heat_sources.hpp>
 #include <frictherm/coupling/hotspot_fates.hpp>
@@ -57,8 +58,22 @@ struct FixedTemperatureFace {
 
 struct CouplerOptions {
   std::vector<ThermalProperties> materials;  // by material id
-  std::string integrator = "cvode_bdf";      // thermal::make_integrator name
+  /// thermal::make_integrator name, or "auto": matrix-free forward Euler (explicit_conduction.hpp)
+  /// for a window of at most matrix_free_max_substeps stable steps, cvode_bdf (assembled) beyond,
+  /// with a reaction and in the continuation.
+  std::string integrator = "cvode_bdf";
   thermal::IntegratorOptions integrator_options;
+  /// forward_euler and auto: a window that needs at most this many stable forward-Euler sub-steps is
+  /// integrated matrix-free (no K assembled; 0: never). Longer windows assemble K (forward_euler
+  /// sub-steps on it, or cvode_bdf for auto). Only with the "substep" stability policy and the
+  /// Gershgorin estimate, and not while a reaction is part of the problem. Measured crossover:
+  /// docs/performance.md.
+  long matrix_free_max_substeps = 64;
+  /// Matrix-free windows: the stencils, M and G' of the last gather serve the next windows while no
+  /// particle has moved more than this fraction of the cell size along any axis since it (T_i is
+  /// re-projected from the particles every window; energy stays exact, the weights lag by at most
+  /// this shift). 0: gather every window. Error against gathering every window: docs/performance.md.
+  double reuse_distance = 0.0;
   AssemblyOptions assembly;
   WindowPolicy window;
   HotSpotOptions hotspots;
@@ -92,6 +107,9 @@ struct EnergyBooks {
   double min_window = std::numeric_limits<double>::infinity();  // s
   double max_window = 0.0;                                      // s
   double max_assembly_residual = 0.0;  // worst of M partition-of-unity and K·1 = 0 residuals
+  long matrix_free_windows = 0;        // windows integrated matrix-free (explicit_conduction.hpp)
+  long matrix_free_substeps = 0;       // their forward-Euler sub-steps
+  long matrix_free_gathers = 0;        // particle passes that built M and G' for them (the rest reused)
 };
 
 template <int Dim>
@@ -135,6 +153,11 @@ class Coupler {
 
  private:
   void assemble(const mechanics::Particles<Dim>& particles);
+  /// The checks and caches that follow a new system (assembled or gathered).
+  void system_changed();
+  /// Integrates the window [window_start_, time] matrix-free if it is short enough; false otherwise.
+  bool matrix_free_window(mechanics::Particles<Dim>& particles, double dt);
+  bool matrix_free_allowed() const;
   void advance_and_map(mechanics::Particles<Dim>& particles, double t0, double t1);
   double mass_estimate(std::size_t node) const;
 
@@ -153,6 +176,11 @@ class Coupler {
   Eigen::VectorXd nodal_progress_ref_;          // λ_i gathered at the last assembly
   NodalThermalSystem system_;
   bool has_system_ = false;
+  bool system_assembled_ = false;  // system_ has K and problem_ is built on it (not a matrix-free gather)
+  bool system_gathered_ = false;   // system_ is explicit_'s last gather (reusable for matrix-free windows)
+  ExplicitConduction<Dim> explicit_;
+  double last_lambda_bound_ = 0.0;     // Gershgorin bound of M⁻¹K at the last gather (1/s)
+  std::vector<FixedNode> fixed_nodes_;  // unknowns of the gathered system on fixed-temperature faces
   bool continuing_ = false;  // continue_thermal has been called
   /// The Arrhenius heat is part of the problem: enabled, and during loading or in the continuation.
   bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }

@@ -1,0 +1,117 @@
+#pragma once
+// Matrix-free explicit conduction for one coupling window (issue 13 item 1), as the reference code
+// NairnMPM does: lumped nodal heat capacities, the nodal conduction force from the particles'
+// temperature gradients, forward-Euler sub-steps, no K assembled.
+//
+//   M_i = Σ_p m_p C_v,p S_ip,  T_i = Σ_p m_p C_v,p T_p S_ip / M_i       Nairn et al. 2018 eq. 38
+//   (∇T)_p = Σ_j G'_jp T_j                                             eq. 37 (gradient on the particle)
+//   f_i = −Σ_p V_p k_p G'_ip · (∇T)_p   (= −(K T)_i with K_ij = Σ_p V_p k_p G'_ip·G'_jp)
+//   T_i ← T_i + h (f_i + q_i) / M_i,  h = window / n                    forward Euler
+//   T_p += Σ_i S_ip ΔT_i                                                design §4
+//
+// G' is the gradient with the weights of nodes that are not thermal unknowns lumped onto the kept
+// ones in proportion to S_ip, exactly as thermal_assembly.hpp builds K, so both paths integrate the
+// same semi-discrete system and differ by round-off (one sub-step each). The sub-step count n comes
+// from bounds of λ_max(M⁻¹K) computed in the same particle pass (the smaller of a Gershgorin bound,
+//   Σ_j |K_ij| ≤ Σ_p V_p k_p |G'_ip| Σ_j |G'_jp|,
+// and a Cauchy–Schwarz bound, λ ≤ max_i Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a), h ≤ safety · 2 / λ. Without
+// K's cancellations they can be ~2× above the Gershgorin estimate the assembled path takes from K
+// itself (linear, uGIMP) or below it (quadratic B-spline), so a window near the limit may take a
+// different number of sub-steps here.
+// Energy: Σ_i M_i ΔT_i = Σ_i q_i window + Σ_i h f_i, and Σ_i f_i = −Σ_p V_p k_p (Σ_i G'_ip)·(∇T)_p
+// vanishes to round-off (Σ_i G'_ip = 0: partition of unity, the lumping keeps it).
+#include <frictherm/coupling/thermal_assembly.hpp>
+#include <frictherm/mechanics/grid.hpp>
+#include <frictherm/mechanics/particles.hpp>
+#include <frictherm/mechanics/shape_functions.hpp>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <vector>
+
+namespace frictherm::coupling {
+
+/// A node held at a fixed temperature (an unknown on a fixed-temperature face).
+struct FixedNode {
+  int unknown = 0;
+  double temperature = 0.0;  // K
+};
+
+template <int Dim>
+class ExplicitConduction {
+ public:
+  /// Pass over the particles at their current positions: stencils (kept for the map back), M and T
+  /// on every node and the unknowns into `sys` (its conductance is left empty), the gradients G'
+  /// with the dropped nodes lumped, and the bounds of M⁻¹K. Throws std::invalid_argument
+  /// like assemble_thermal for a material id without thermal properties or no conducting particle.
+  void gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
+              mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
+              const AssemblyOptions& options, NodalThermalSystem& sys);
+
+  /// True if a gather was made for these particles (same count) and none has moved more than
+  /// `max_shift` (m, along any axis) since: the kept stencils, M and G' may then serve another window.
+  bool reusable(const mechanics::Particles<Dim>& particles, double max_shift) const;
+
+  /// With the stencils and M of the last gather (reusable() true): T_i from the current particle
+  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums are
+  /// those the last map_back made with the new T_p (same order, same weights, so the same numbers):
+  /// nothing but the coupler may change particle temperatures between matrix-free windows.
+  void reproject(const mechanics::Particles<Dim>& particles, NodalThermalSystem& sys);
+
+  /// Upper bound of the largest eigenvalue of M⁻¹K over the free unknowns of the gathered system
+  /// (1/s); 0 without conduction.
+  double lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const;
+
+  /// n forward-Euler sub-steps over `window` seconds from `temperature` (on the unknowns of the
+  /// gathered system), with the constant source q = joules / window (W). Fixed nodes take their
+  /// temperature first and keep it. Returns the temperatures at the end.
+  Eigen::VectorXd advance(const NodalThermalSystem& sys, const Eigen::VectorXd& temperature,
+                          const Eigen::VectorXd& joules, const std::vector<FixedNode>& fixed, double window,
+                          long substeps);
+
+  /// T_p += Σ_i S_ip ΔT_i with the stencils of the gather (same positions), and the optional sub-grid
+  /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures). Also sums
+  /// Σ_p m_p C_v,p T_p S_ip with the new T_p for the next reproject().
+  void map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
+                double relaxation, const Eigen::VectorXd* end);
+
+ private:
+  static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
+  /// The stencil of one particle (scratch of the gather): grid node, S_ip and G_ip.
+  struct Nodes {
+    int count = 0;
+    int node[capacity];
+    double S[capacity];
+    mechanics::Vec<Dim> G[capacity];
+  };
+  /// One heat-holding particle's nodes that are unknowns, in stencil order: unknown number, S_ip,
+  /// lumped G'_ip; its m_p C_v,p and V_p k_p (0 without conduction). Everything the windows read.
+  struct Kept {
+    int count = 0;
+    double heat_capacity = 0.0;  // m_p C_v,p (J/K)
+    double conductance = 0.0;    // V_p k_p (W m/K): times G'·G' gives W/K
+    int unknown[capacity];
+    double S[capacity];
+    mechanics::Vec<Dim> G[capacity];
+  };
+  template <class Kernel>
+  void gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
+                   const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
+                   NodalThermalSystem& sys);
+
+  std::vector<Nodes> nodes_;              // gather scratch, by particle
+  std::vector<Kept> kept_;                // by particle; count 0 for particles that hold no heat
+  std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
+  std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
+  Eigen::VectorXd next_mct_;              // the same by unknown, with the T_p of the last map_back
+  bool next_mct_valid_ = false;
+  std::vector<double> row_bound_;         // Σ_j |K_ij| bound by unknown (W/K)
+  std::vector<double> rayleigh_bound_;    // Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a by unknown (1/s)
+  Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
+};
+
+extern template class ExplicitConduction<2>;
+extern template class ExplicitConduction<3>;
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,249 @@
+// Matrix-free explicit conduction over one coupling window (explicit_conduction.hpp; Nairn et al.
+// 2018 eqs. 37–38, as NairnMPM integrates conduction): one particle pass gathers M, T and the lumped
+// gradients, each forward-Euler sub-step is one pass computing (∇T)_p and scattering f_i, and the
+// change goes back to the particles with the stencils of the gather.
+#include <frictherm/coupling/explicit_conduction.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+
+namespace {
+
+const ThermalProperties& props_of(const std::vector<ThermalProperties>& materials, int id) {
+  if (id < 0 || static_cast<std::size_t>(id) >= materials.size())
+    throw std::invalid_argument("thermal assembly: particle of material id " + std::to_string(id) + " but only " +
+                                std::to_string(materials.size()) + " materials have thermal properties");
+  return materials[static_cast<std::size_t>(id)];
+}
+
+}  // namespace
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
+                                          const std::vector<ThermalProperties>& materials,
+                                          const AssemblyOptions& opt, NodalThermalSystem& sys) {
+  static_assert(mechanics::Stencil<Dim, Kernel>::node_count <= capacity, "stencil wider than the node list");
+  const std::size_t n_nodes = grid.node_count();
+  sys.grid_mass.assign(n_nodes, 0.0);
+  sys.grid_node.clear();
+  sys.particle_heat_capacity = 0.0;
+  sys.dropped_mass = 0.0;
+  sys.conductance.resize(0, 0);  // no K on this path
+  mct_.assign(n_nodes, 0.0);
+  nodes_.resize(p.size());
+  kept_.resize(p.size());
+  next_mct_valid_ = false;
+  gathered_at_.assign(p.position.begin(), p.position.end());
+
+  // Pass 1: stencils, M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them.
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    Nodes& nl = nodes_[k];
+    nl.count = 0;
+    kept_[k].count = 0;
+    const ThermalProperties& m = props_of(materials, p.material[k]);
+    if (!m.conducts) continue;
+    const double mc = p.mass[k] * m.heat_capacity;
+    sys.particle_heat_capacity += mc;
+    kept_[k].heat_capacity = mc;
+    mechanics::Stencil<Dim, Kernel> st;
+    st.evaluate(grid, p.position[k], p.half_size[k]);
+    st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
+      nl.node[nl.count] = i;
+      nl.S[nl.count] = w;
+      nl.G[nl.count] = g;
+      ++nl.count;
+    });
+    const double mct = mc * p.temperature[k];
+    for (int a = 0; a < nl.count; ++a) {
+      const auto i = static_cast<std::size_t>(nl.node[a]);
+      sys.grid_mass[i] += mc * nl.S[a];
+      mct_[i] += mct * nl.S[a];
+    }
+  }
+  if (!(sys.particle_heat_capacity > 0.0))
+    throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
+
+  // Unknowns: the same rule as assemble_thermal.
+  sys.max_mass = *std::max_element(sys.grid_mass.begin(), sys.grid_mass.end());
+  const double threshold = opt.active_mass_fraction * sys.max_mass;
+  sys.unknown.assign(n_nodes, -1);
+  for (std::size_t i = 0; i < n_nodes; ++i) {
+    if (sys.grid_mass[i] > threshold && sys.grid_mass[i] > 0.0) {
+      sys.unknown[i] = static_cast<int>(sys.grid_node.size());
+      sys.grid_node.push_back(static_cast<int>(i));
+    } else {
+      sys.dropped_mass += sys.grid_mass[i];
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
+  sys.mass.resize(n);
+  sys.temperature.resize(n);
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const auto i = static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)]);
+    sys.mass[u] = sys.grid_mass[i];
+    sys.temperature[u] = mct_[i] / sys.grid_mass[i];
+  }
+
+  // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
+  row_bound_.assign(static_cast<std::size_t>(n), 0.0);
+  rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Nodes& nl = nodes_[k];
+    if (nl.count == 0) continue;
+    Kept& c = kept_[k];
+    double s_kept = 0.0;
+    mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
+    for (int a = 0; a < nl.count; ++a) {
+      const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
+      if (u >= 0) {
+        s_kept += nl.S[a];
+        c.unknown[c.count] = u;
+        c.G[c.count] = nl.G[a];
+        c.S[c.count] = nl.S[a];
+        ++c.count;
+      } else {
+        g_dropped += nl.G[a];
+      }
+    }
+    const ThermalProperties& m = props_of(materials, p.material[k]);
+    c.conductance = 0.0;
+    // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
+    if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) continue;
+    if (c.count < nl.count)
+      for (int a = 0; a < c.count; ++a) c.G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
+    c.conductance = p.volume[k] * m.conductivity;
+    // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
+    // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
+    // Σ_p c_p (Σ_a |G'_a|²/M_a)(Σ_a M_a x_a²), so λ ≤ max_i Σ_{p∋i} c_p Σ_a |G'_a|²/M_a.
+    double gsum = 0.0, g2m = 0.0;
+    double gnorm[capacity];
+    for (int a = 0; a < c.count; ++a) {
+      gnorm[a] = c.G[a].norm();
+      gsum += gnorm[a];
+      g2m += gnorm[a] * gnorm[a] / sys.mass[c.unknown[a]];
+    }
+    for (int a = 0; a < c.count; ++a) {
+      row_bound_[static_cast<std::size_t>(c.unknown[a])] += c.conductance * gnorm[a] * gsum;
+      rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += c.conductance * g2m;
+    }
+  }
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
+                                     mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
+                                     const AssemblyOptions& options, NodalThermalSystem& sys) {
+  mechanics::dispatch_shape(shape, [&](auto kernel) {
+    gather_with<decltype(kernel)>(grid, particles, materials, options, sys);
+  });
+}
+
+template <int Dim>
+bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, double max_shift) const {
+  if (gathered_at_.size() != p.size() || kept_.size() != p.size()) return false;
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) return false;
+  return true;
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
+  if (kept_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  if (!next_mct_valid_ || next_mct_.size() != n) {
+    next_mct_.setZero(n);
+    for (std::size_t k = 0; k < p.size(); ++k) {  // Σ_p m_p C_v,p T_p S_ip (eq. 38), the gather's S
+      const Kept& c = kept_[k];
+      const double mct = c.heat_capacity * p.temperature[k];
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
+    }
+  }
+  for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
+  next_mct_valid_ = false;  // the particles' temperatures change in this window
+}
+
+template <int Dim>
+double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const {
+  // Rows of fixed nodes do not move (dT/dt = 0): they contribute λ = 0, as in lambda_max_gershgorin.
+  std::vector<char> held;
+  if (!fixed.empty()) {
+    held.assign(row_bound_.size(), 0);
+    for (const FixedNode& f : fixed) held[static_cast<std::size_t>(f.unknown)] = 1;
+  }
+  double gershgorin = 0.0, rayleigh = 0.0;
+  const std::size_t n = row_bound_.size();
+  for (std::size_t u = 0; u < n; ++u) {
+    if (!held.empty() && held[u]) continue;
+    gershgorin = std::max(gershgorin, row_bound_[u] / sys.mass[static_cast<Eigen::Index>(u)]);
+    rayleigh = std::max(rayleigh, rayleigh_bound_[u]);
+  }
+  return std::min(gershgorin, rayleigh);
+}
+
+template <int Dim>
+Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, const Eigen::VectorXd& temperature,
+                                                 const Eigen::VectorXd& joules, const std::vector<FixedNode>& fixed,
+                                                 double window, long substeps) {
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  if (temperature.size() != n || joules.size() != n)
+    throw std::invalid_argument("ExplicitConduction::advance: " + std::to_string(temperature.size()) +
+                                " temperatures and " + std::to_string(joules.size()) + " sources for " +
+                                std::to_string(sys.size()) + " unknowns");
+  if (!(window > 0.0) || substeps < 1)
+    throw std::invalid_argument("ExplicitConduction::advance: need a window > 0 and at least one sub-step");
+  Eigen::VectorXd T = temperature;
+  for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;  // Dirichlet values first
+  const double h = window / static_cast<double>(substeps);
+  const Eigen::VectorXd q = joules / window;  // constant over the window: ∫ q dt = W (design §4)
+  force_.resize(n);
+  for (long s = 0; s < substeps; ++s) {
+    force_.setZero();
+    for (const Kept& c : kept_) {
+      if (c.conductance == 0.0) continue;
+      mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();  // (∇T)_p = Σ_j G'_jp T_j (eq. 37)
+      for (int a = 0; a < c.count; ++a) grad += c.G[a] * T[c.unknown[a]];
+      grad *= c.conductance;
+      for (int a = 0; a < c.count; ++a) force_[c.unknown[a]] -= c.G[a].dot(grad);  // f_i = −V k G'·∇T
+    }
+    for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+    for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+  }
+  return T;
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
+                                       const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+  if (kept_.size() != p.size())
+    throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
+  const bool relax = end && beta > 0.0;
+  next_mct_.setZero(static_cast<Eigen::Index>(sys.size()));
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Kept& c = kept_[k];
+    if (c.count == 0) continue;
+    double dT = 0.0, pic = 0.0, s = 0.0;
+    for (int a = 0; a < c.count; ++a) {
+      dT += c.S[a] * delta[c.unknown[a]];  // design §4: the increment, not the nodal value
+      if (relax) {
+        pic += c.S[a] * (*end)[c.unknown[a]];
+        s += c.S[a];
+      }
+    }
+    const double flip = p.temperature[k] + dT;
+    const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    p.temperature[k] = T;
+    const double mct = c.heat_capacity * T;  // eq. 38 sums of the next window, if it reuses this gather
+    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
+  }
+  next_mct_valid_ = true;
+}
+
+template class ExplicitConduction<2>;
+template class ExplicitConduction<3>;
+
+}  // namespace frictherm::coupling

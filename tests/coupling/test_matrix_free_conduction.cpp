@@ -1,0 +1,229 @@
+// Verification of the matrix-free explicit conduction (explicit_conduction.hpp, issue 13 item 1):
+// it integrates the same semi-discrete system as forward Euler on the assembled K (round-off
+// agreement, with dropped nodes and a fixed-temperature face), keeps the energy books exact with a
+// heat source, reproduces the analytic decay rate of a cosine mode at three resolutions with
+// second-order convergence, and the "auto" integrator takes it only for short windows.
+#include "thermal_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+namespace fc = frictherm::coupling;
+namespace fm = frictherm::mechanics;
+using fc::test::fill_box;
+using fc::test::kPi;
+using fc::test::make_grid;
+
+namespace {
+
+constexpr double kRho = 1900.0, kC = 1100.0, kK = 0.45;  // α = k / (ρ C) = 2.153e-7 m²/s
+constexpr double kAlpha = kK / (kRho * kC);
+
+fc::CouplerOptions options(const std::string& integrator, long matrix_free_max_substeps) {
+  fc::CouplerOptions opt;
+  opt.materials = {{true, kC, kK}, {false, 0.0, 0.0}};
+  opt.integrator = integrator;
+  opt.integrator_options.rtol = 1e-10;
+  opt.integrator_options.atol = 1e-10;
+  opt.matrix_free_max_substeps = matrix_free_max_substeps;
+  opt.window.kind = fc::WindowPolicy::Kind::every_step;
+  return opt;
+}
+
+// An L-shaped body that does not fill its cells (dropped nodes at its edges), a rough temperature
+// field, and a non-conducting particle: the lumping and the material rules of both paths are used.
+// With `to_edge` the body reaches the grid faces x = 0 and y = 0 (unknowns on fixed faces).
+fm::Particles<2> l_shape(bool to_edge = false) {
+  fm::Particles<2> p;
+  const double x0 = to_edge ? 0.0 : 0.0013, y0 = to_edge ? 0.0 : 0.0011;
+  auto T = [](const fm::Vec<2>& x) { return 300.0 + 40.0 * std::sin(900.0 * x[0]) * std::cos(700.0 * x[1]) + 3e4 * x[0]; };
+  fill_box<2>(p, {x0, y0}, {x0 + 0.008, 0.0041}, 1e-3, 2, kRho, 0, T);
+  fill_box<2>(p, {x0, 0.0041}, {x0 + 0.003, 0.0081}, 1e-3, 3, kRho, 0, T);
+  p.add({0.006, 0.006}, fm::Vec<2>::Constant(2.5e-4), 1e-3, 1e-6, 1, 0, 500.0);  // holds no heat
+  return p;
+}
+
+// One window of length dt through each path; returns the particle temperatures.
+std::vector<double> one_window(fm::ShapeKind shape, long matrix_free_max_substeps, double dt, double work,
+                               bool fixed_face, long* matrix_free_windows = nullptr) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 10});
+  fm::Particles<2> p = l_shape(fixed_face);
+  fc::CouplerOptions opt = options("forward_euler", matrix_free_max_substeps);
+  if (fixed_face) opt.fixed_faces.push_back({1, false, 280.0});  // y = 0
+  if (fixed_face) opt.fixed_faces.push_back({0, false, 310.0});  // x = 0
+  fc::Coupler<2> cp(grid, shape, opt);
+  cp.start(p, 0.0);
+  std::vector<double> w(grid.node_count(), 0.0);
+  w[static_cast<std::size_t>(grid.node_index({4, 3}))] = work;  // J, on an interior node
+  w[static_cast<std::size_t>(grid.node_index({0, 0}))] = 0.25 * work;  // a node that is no unknown
+  cp.after_step(p, w, dt);
+  if (matrix_free_windows) *matrix_free_windows = cp.books().matrix_free_windows;
+  EXPECT_EQ(cp.books().matrix_free_substeps + cp.integrator().stats().steps, 1);  // one step on either path
+  if (!fixed_face) {
+    EXPECT_NEAR(cp.particle_energy_change(p), 1.25 * work, 1e-9 * work);  // adiabatic books
+  }
+  return std::vector<double>(p.temperature.begin(), p.temperature.end());
+}
+
+}  // namespace
+
+// Both paths take one forward-Euler step of M dT/dt = −K T + q with the same lumped K: the particle
+// temperatures agree to round-off (relative 1e-12 of the 40 K variation; measured ~1e-14).
+TEST(MatrixFreeConduction, MatchesAssembledForwardEulerToRoundOff) {
+  const fm::ShapeKind shapes[] = {fm::ShapeKind::linear, fm::ShapeKind::ugimp, fm::ShapeKind::quadratic_bspline};
+  for (fm::ShapeKind shape : shapes) {
+    for (bool fixed : {false, true}) {
+      SCOPED_TRACE(std::string(fm::to_string(shape)) + (fixed ? " fixed faces" : " adiabatic"));
+      const double dt = 0.05;  // s: below both paths' stable-step estimates (0.1–0.2 s here): one step each
+      long mf = 0, assembled = 0;
+      const std::vector<double> a = one_window(shape, 4, dt, 20.0, fixed, &mf);
+      const std::vector<double> b = one_window(shape, 0, dt, 20.0, fixed, &assembled);
+      ASSERT_EQ(mf, 1);
+      ASSERT_EQ(assembled, 0);
+      ASSERT_EQ(a.size(), b.size());
+      double worst = 0.0, change = 0.0;
+      const std::vector<double> before = [&] {
+        fm::Particles<2> p = l_shape(fixed);
+        return std::vector<double>(p.temperature.begin(), p.temperature.end());
+      }();
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        worst = std::max(worst, std::fabs(a[k] - b[k]));
+        change = std::max(change, std::fabs(b[k] - before[k]));
+      }
+      std::cout << "[matrix-free vs assembled] " << fm::to_string(shape) << (fixed ? " fixed" : "")
+                << ": max |ΔT_p| difference " << worst << " K of a largest change " << change << " K\n";
+      EXPECT_GT(change, 1e-3);  // the window did conduct
+      EXPECT_LT(worst, 1e-12 * 40.0);
+    }
+  }
+}
+
+// Energy books over many windows with heat on nodes that are not unknowns: Σ_p m C ΔT equals the
+// heat delivered to 1e-9 (round-off of ~1e3 windows), and the work received equals it exactly;
+// with the gather reused (0.05 cells: every 455 windows here) as without.
+fc::Coupler<2> drifting_run(fm::Particles<2>& p, double reuse_distance, long windows) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 10});
+  fc::CouplerOptions opt = options("auto", 4);
+  opt.reuse_distance = reuse_distance;
+  fc::Coupler<2> cp(grid, fm::ShapeKind::ugimp, opt);
+  cp.start(p, 0.0);
+  std::vector<double> w(grid.node_count(), 0.0);
+  for (long k = 1; k <= windows; ++k) {
+    std::fill(w.begin(), w.end(), 0.0);
+    w[static_cast<std::size_t>(grid.node_index({2 + static_cast<int>(k % 6), 3}))] = 1e-3;
+    w[static_cast<std::size_t>(grid.node_index({0, 0}))] = 2e-4;  // relocated
+    cp.after_step(p, w, 0.05 * static_cast<double>(k));
+    for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += 1.1e-7;  // 1.1e-4 cells per window
+  }
+  return cp;
+}
+
+TEST(MatrixFreeConduction, EnergyBooksCloseOverManyWindows) {
+  for (double reuse : {0.0, 0.05}) {
+    SCOPED_TRACE(reuse);
+    fm::Particles<2> p = l_shape();
+    const long windows = 1000;
+    const fc::Coupler<2> cp = drifting_run(p, reuse, windows);
+    const fc::EnergyBooks& b = cp.books();
+    EXPECT_EQ(b.matrix_free_windows, windows);
+    EXPECT_EQ(b.matrix_free_gathers, reuse > 0.0 ? 3 : windows);  // 0.05 cells drift in 455 windows
+    const double W = 1.2e-3 * static_cast<double>(windows);
+    std::cout << "[matrix-free books] reuse " << reuse << ": W = " << W << " J, |Q - W|/W = "
+              << std::fabs(b.heat_delivered - W) / W << ", |ΣmCΔT - Q|/Q = "
+              << std::fabs(cp.particle_energy_change(p) - b.heat_delivered) / b.heat_delivered << ", relocated "
+              << b.heat_relocated << " J\n";
+    EXPECT_NEAR(b.work_received, W, 1e-12 * W);
+    EXPECT_NEAR(b.heat_delivered, W, 1e-12 * W);
+    EXPECT_NEAR(cp.particle_energy_change(p), b.heat_delivered, 1e-9 * W);
+    EXPECT_NEAR(b.nodal_energy_change, b.heat_delivered, 1e-9 * W);
+    EXPECT_GT(b.heat_relocated, 0.0);
+  }
+}
+
+// The error of reusing the gather: weights that lag the particles by at most s cells change each
+// S_ip by at most ~2s (|dS/dx| h ≤ 1 per axis for uGIMP), so the temperature changes differ by a
+// fraction of order s of the change itself. Measured against gathering every window: asserted
+// below 2 × 0.05 of the largest particle temperature change (measured: docs/performance.md).
+TEST(MatrixFreeConduction, ReuseErrorIsOfOrderOfTheShift) {
+  fm::Particles<2> a = l_shape(), b = l_shape();
+  const std::vector<double> T0(a.temperature.begin(), a.temperature.end());
+  drifting_run(a, 0.0, 1000);
+  drifting_run(b, 0.05, 1000);
+  double diff = 0.0, change = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    diff = std::max(diff, std::fabs(a.temperature[k] - b.temperature[k]));
+    change = std::max(change, std::fabs(a.temperature[k] - T0[k]));
+  }
+  std::cout << "[matrix-free reuse 0.05 cells] max |T_p(reuse) - T_p(gather)| = " << diff << " K of a largest change "
+            << change << " K (" << diff / change << ")\n";
+  EXPECT_GT(change, 1.0);
+  EXPECT_LT(diff, 2.0 * 0.05 * change);
+}
+
+// Analytic check: a cosine mode of a 1D slab with adiabatic ends decays as exp(−α (π/L)² t). Windows
+// of half the stable step (matrix-free, one sub-step each) at h = 2, 1 and 0.5 mm: the rate error is
+// within the O((κh)²) spatial budget of test_coupling_decay.cpp (0.6 (κh)²) plus forward Euler's
+// O(λ Δt) in time, and it converges at second order in h (Δt ∝ h² keeps the time error second order).
+TEST(MatrixFreeConduction, CosineModeDecaysAtAnalyticRateAtThreeResolutions) {
+  const double L = 0.04;
+  const double rate = kAlpha * kPi * kPi / (L * L);
+  auto phi = [&](const fm::Vec<2>& x) { return std::cos(kPi * x[0] / L); };
+  double previous = 0.0;
+  for (double h : {2e-3, 1e-3, 0.5e-3}) {
+    const auto grid = make_grid<2>({0.0, 0.0}, h, {static_cast<int>(std::lround(L / h)), 2});
+    fm::Particles<2> p;
+    const double T0 = 300.0;
+    fill_box<2>(p, {0.0, 0.0}, {L, 2 * h}, h, 2, kRho, 0, [&](const fm::Vec<2>& x) { return T0 + 10.0 * phi(x); });
+    fc::CouplerOptions opt = options("auto", 4);
+    fc::Coupler<2> cp(grid, fm::ShapeKind::ugimp, opt);
+    cp.start(p, 0.0);
+    auto amplitude = [&] {
+      double num = 0.0, den = 0.0;
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        num += p.volume[k] * (p.temperature[k] - T0) * phi(p.position[k]);
+        den += p.volume[k] * phi(p.position[k]) * phi(p.position[k]);
+      }
+      return num / den;
+    };
+    const double a0 = amplitude();
+    // Stable step of the lumped 1D Laplacian with uGIMP ~ h² / (2α) · O(1); take windows of h²/(8α).
+    const double duration = 1.0 / rate, window = h * h / (8.0 * kAlpha);
+    const long n = static_cast<long>(std::ceil(duration / window));
+    for (long k = 1; k <= n; ++k) cp.after_step(p, {}, duration * static_cast<double>(k) / static_cast<double>(n));
+    EXPECT_EQ(cp.books().matrix_free_windows, n);
+    EXPECT_EQ(cp.books().matrix_free_substeps, n);  // one stable sub-step per window
+    const double err = -std::log(amplitude() / a0) / duration / rate - 1.0;
+    const double tol = 0.6 * std::pow(kPi * h / L, 2);
+    const double drift = std::fabs(cp.particle_energy_change(p)) / fc::particle_thermal_energy(p, opt.materials);
+    std::cout << "[matrix-free decay] h = " << h * 1e3 << " mm, " << n << " windows: rate error " << err
+              << " (tolerance " << tol << "), energy drift " << drift << '\n';
+    EXPECT_LT(std::fabs(err), tol);
+    EXPECT_LT(drift, 1e-13);
+    if (previous != 0.0) {
+      const double order = std::log2(previous / err);
+      std::cout << "[matrix-free decay] order " << order << '\n';
+      EXPECT_NEAR(order, 2.0, 0.2);
+    }
+    previous = err;
+  }
+}
+
+// "auto": windows of a few stable steps go matrix-free, long ones to cvode_bdf on the assembled K;
+// both conserve the heat content (adiabatic) and give the same field to the tolerance of the
+// comparison (forward Euler's time error, O(λΔt) of the fastest resolved mode).
+TEST(MatrixFreeConduction, AutoPicksByWindowLength) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 10});
+  for (double dt : {0.1, 20.0}) {
+    SCOPED_TRACE(dt);
+    fm::Particles<2> p = l_shape();
+    fc::Coupler<2> cp(grid, fm::ShapeKind::ugimp, options("auto", 4));
+    cp.start(p, 0.0);
+    const double E0 = fc::particle_thermal_energy(p, options("auto", 4).materials);
+    for (int k = 1; k <= 5; ++k) cp.after_step(p, {}, dt * k);
+    EXPECT_EQ(cp.books().matrix_free_windows, dt < 1.0 ? 5 : 0);
+    EXPECT_EQ(cp.integrator().name(), "cvode_bdf");
+    EXPECT_LT(std::fabs(fc::particle_thermal_energy(p, options("auto", 4).materials) - E0), 1e-12 * E0);
+  }
+}
