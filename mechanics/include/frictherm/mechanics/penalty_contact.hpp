@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -205,6 +206,29 @@ class PenaltyContact {
       if (mI > min_mass) frequency_bound2_ = std::max(frequency_bound2_, load / mI);
     }
     return frequency_bound2_;
+  }
+  /// Checkpoints (Simulation::visit_state): calls v(name, member) for what the next compute() and the
+  /// next time step read: the per-pair slip histories (segment, β, l_ms, t_T, stamp per point), the
+  /// call counter, each pair's accumulated heat, the spring energy and the frequency bound. Visitors
+  /// with `reading` true restore them (the pairs must have been added as when written).
+  template <class Visitor>
+  void visit_state(Visitor&& v) {
+    constexpr bool reading = std::decay_t<Visitor>::reading;
+    for (std::size_t k = 0; k < history_.size(); ++k) {
+      const std::string p = "penalty/pair" + std::to_string(k) + "/";
+      History& h = history_[k];
+      v((p + "segment").c_str(), h.segment);
+      v((p + "beta").c_str(), h.beta);
+      v((p + "length").c_str(), h.length);
+      v((p + "traction").c_str(), h.traction);
+      v((p + "stamp").c_str(), h.stamp);
+      v((p + "heat_total").c_str(), books_[k].heat_total);
+    }
+    std::vector<std::uint64_t> stamp{stamp_};
+    v("penalty/stamp", stamp);
+    if constexpr (reading) stamp_ = stamp.at(0);
+    v("penalty/stored_energy", stored_energy_);
+    v("penalty/frequency_bound2", frequency_bound2_);
   }
   /// The bound of the last update_frequency_bound() (1/s²); 0 before any, or without contacts.
   double frequency_bound_squared() const { return frequency_bound2_; }
