@@ -145,7 +145,7 @@ class Coupler {
   /// Checkpoints (issue 17; state_visit.hpp visitors): everything the next step, window or the
   /// continuation reads — pending heat, window state, books, hot-spot tracker, reaction progress,
   /// plastic-work marks, nodal temperatures, the last system's unknowns and masses (adaptive
-  /// estimate) and the integrator statistics. Reading restores them into a coupler built with the
+  /// estimate) and the integrator's counts (not its wall time). Reading restores them into a coupler built with the
   /// same grid and options after start(), and reassembles from `particles` (which must already hold
   /// the restored state): M and K depend only on positions, masses and volumes, so at the end of
   /// loading (a window just closed) the system equals the one written. Throws std::logic_error once
@@ -240,7 +240,9 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
                          {"integrator/convergence_failures", &s.convergence_failures},
                          {"integrator/reinits", &s.reinits}})
     v(name, *x);
-  v("integrator/wall_seconds", s.wall_seconds);
+  // Counts only: wall time is the process's own (after a resume /meta times the resumed part), and
+  // equal states give byte-equal checkpoints.
+  s.wall_seconds = integrator_stats().wall_seconds;
   if constexpr (reading) {
     stats_offset_ = s;
     stats_offset_ -= integrator_->stats();  // integrator_stats() == s from here on

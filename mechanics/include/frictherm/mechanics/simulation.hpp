@@ -235,6 +235,14 @@ class Simulation {
     v("pair_work_second", pair_work_second_);
     v("wave_speed", wave_speed_);
     v("wave_speed_ready", wave_speed_ready_);
+    // The last step's contact counters: only reported (series rows of a thermal continuation).
+    for (auto [name, x] : {std::pair<const char*, long*>{"contact_stats/contact_nodes", &contact_stats_.contact_nodes},
+                           {"contact_stats/multi_nodes", &contact_stats_.multi_nodes},
+                           {"contact_stats/sliding_nodes", &contact_stats_.sliding_nodes},
+                           {"contact_stats/guarded", &contact_stats_.guarded},
+                           {"contact_stats/penalty_contacts", &contact_stats_.penalty_contacts},
+                           {"contact_stats/penalty_sliding", &contact_stats_.penalty_sliding}})
+      v(name, *x);
     if (penalty_) {  // penalty contact: the boundary points move with the bodies; slip histories
       v("boundary/position", boundary_.position);
       v("boundary/velocity", boundary_.velocity);
