@@ -34,7 +34,7 @@ std::string slurp(const std::string& p) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-coupling::Scene heating_scene(long max_steps) {
+coupling::Scene heating_scene(long max_steps, bool penalty = false) {
   std::vector<coupling::SceneOverride> o{{"run.threads", "1"},
                                          {"run.end_time", "0.006"},
                                          {"run.checkpoint_interval", "0.001"},
@@ -43,6 +43,7 @@ coupling::Scene heating_scene(long max_steps) {
                                          // 0.1 mK: the shortened sliding warms the interface by ~1 mK
                                          {"coupling.hotspots.threshold", "1e-4"}};
   if (max_steps > 0) o.push_back({"run.max_steps", std::to_string(max_steps)});
+  if (penalty) o.push_back({"contact.pairs[0].method", "\"penalty\""});  // Kakouris 2024 on boundary points
   return coupling::load_scene(std::string(FRICTHERM_SOURCE_DIR) + "/examples/sliding_block_heating.json", o);
 }
 
@@ -82,14 +83,14 @@ void expect_same_result(const std::string& a, const std::string& b) {
   EXPECT_EQ(coupling::read_metadata_string(b, "status"), "completed");
 }
 
-TEST(ThermalCheckpoint, StoppedResumedAndAppendedRunEqualsUninterruptedRun) {
-  const std::string full = temp_file("full"), stopped = temp_file("stopped"), part = temp_file("part"),
-                    joined = temp_file("joined");
-  const coupling::Scene scene = heating_scene(0);
+void check_stopped_and_resumed(bool penalty) {
+  const std::string full = temp_file(penalty ? "pfull" : "full"), stopped = temp_file(penalty ? "pstopped" : "stopped"), part = temp_file(penalty ? "ppart" : "part"),
+                    joined = temp_file(penalty ? "pjoined" : "joined");
+  const coupling::Scene scene = heating_scene(0, penalty);
   ASSERT_EQ(run(scene, full).status, coupling::RunResult::Status::completed);
   // Stopped at step 4500 of 4620: t ≈ 5.85 ms, while the block slides, heats and a hot spot is
   // tracked (asserted); the resumed tracker must keep its id and birth time.
-  const coupling::RunResult r_stop = run(heating_scene(4500), stopped);
+  const coupling::RunResult r_stop = run(heating_scene(4500, penalty), stopped);
   ASSERT_EQ(r_stop.status, coupling::RunResult::Status::stopped_at_max_steps);
   const coupling::CheckpointMarks marks = coupling::checkpoint_marks(coupling::checkpoint_path(stopped));
   EXPECT_EQ(marks.step, 4500);
@@ -117,6 +118,12 @@ TEST(ThermalCheckpoint, StoppedResumedAndAppendedRunEqualsUninterruptedRun) {
     std::remove(coupling::checkpoint_path(f).c_str());
   }
 }
+
+TEST(ThermalCheckpoint, StoppedResumedAndAppendedRunEqualsUninterruptedRun) { check_stopped_and_resumed(false); }
+
+// The same with penalty contact between block and base: slip histories, boundary points, pair books
+// and contact records (series: penalty force, contacts, minimum gap, contact length) are restored.
+TEST(ThermalCheckpoint, PenaltyContactStoppedResumedAndAppendedEqualsUninterrupted) { check_stopped_and_resumed(true); }
 
 TEST(ThermalCheckpoint, ContinuationRerunFromEndOfLoadingEqualsUninterruptedRun) {
   const std::string full = temp_file("full2"), part = temp_file("part2"), joined = temp_file("joined2");
