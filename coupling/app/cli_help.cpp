@@ -40,6 +40,8 @@ const char* const kRunHelp =
     "                        are never written over.\n"
     "  -t, --threads N       OpenMP threads (default: the scene's run.threads, else all cores)\n"
     "  -q, --quiet           no progress line and no summary\n"
+    "  --checkpoint-every S  also write OUT.h5.checkpoint every S wall-clock seconds (besides the\n"
+    "                        scene's run.checkpoint_interval in simulated time; docs/checkpoints.md)\n"
     "  -s, --set KEY=VALUE   change one scene value before validation (repeatable), e.g.\n"
     "                        --set solver.cfl=0.3 --set 'bodies[0].velocity=[2, 0]'; VALUE is JSON\n"
     "                        (a bare word is a string). Handy for sweeps: a loop over values.\n"

@@ -10,14 +10,16 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
 namespace frictherm::cli {
 
 const char* const kResumeHelp =
-    "usage: frictherm resume RUN.h5 [-o OUT.h5] [--force] [--threads N] [--quiet]\n"
+    "usage: frictherm resume RUN.h5 [-o OUT.h5] [--force] [--threads N] [--quiet] [--checkpoint-every S]\n"
     "\n"
     "Continues a run from its last checkpoint RUN.h5.checkpoint (written when the scene sets\n"
     "run.checkpoint_interval: at that interval, at the end and on SIGINT/SIGTERM; and, for scenes with a\n"
@@ -36,7 +38,8 @@ const char* const kResumeHelp =
     "  -o, --output FILE     write the appended result to FILE instead (RUN.h5 is left as it is)\n"
     "  -f, --force           replace FILE if it exists (else refused)\n"
     "  -t, --threads N       OpenMP threads (1 thread repeats an interrupted 1-thread run bit-for-bit)\n"
-    "  -q, --quiet           no progress line and no summary\n";
+    "  -q, --quiet           no progress line and no summary\n"
+    "  --checkpoint-every S  also checkpoint every S wall-clock seconds (not stored in the checkpoint)\n";
 
 namespace {
 
@@ -53,6 +56,7 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
   ResumeOutcome out;
   coupling::RunOptions opt;
   opt.threads = q.threads;
+  opt.checkpoint_wall_interval = q.checkpoint_wall_interval;
   opt.quiet = q.quiet;
   opt.command_line = q.command_line;
   opt.handle_signals = true;
@@ -119,6 +123,7 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
                                   {{{"-o", "--output"}, true, "output"},
                                    {{"-t", "--threads"}, true, "threads"},
                                    {{"-q", "--quiet"}, false, "quiet"},
+                                   {{"--checkpoint-every"}, true, "checkpoint-every"},
                                    kForceOption});
   if (a.help) {
     std::cout << kResumeHelp;
@@ -132,6 +137,13 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
   q.quiet = a.has("quiet");
   q.force = a.has("force");
   q.command_line = command_line;
+  if (a.has("checkpoint-every")) {
+    const std::string& v = a.options.at("checkpoint-every");
+    char* end = nullptr;
+    q.checkpoint_wall_interval = std::strtod(v.c_str(), &end);
+    if (end == v.c_str() || *end != '\0' || !(q.checkpoint_wall_interval > 0.0) || !std::isfinite(q.checkpoint_wall_interval))
+      throw UsageError("resume", "--checkpoint-every: expected wall-clock seconds > 0, got '" + v + "'");
+  }
   ResumeOutcome o;
   try {
     if (!exists(q.checkpoint)) throw coupling::OutputError("no checkpoint " + q.checkpoint + " to resume " + q.run + " from");

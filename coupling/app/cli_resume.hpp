@@ -13,6 +13,7 @@ struct ResumeRequest {
   std::string output;      // where the appended result goes (may be `run`)
   coupling::Scene scene;   // rebuilt from the checkpoint (with continue's --set)
   int threads = 0;
+  double checkpoint_wall_interval = 0.0;  // --checkpoint-every (resume)
   bool quiet = false;
   bool force = false;      // replace an existing output that is not `run`
   std::string command_line;
