@@ -33,6 +33,30 @@ struct PairContext {
   bool heat;           // the momentum-update pass: compute frictional work
 };
 
+/// Applies a friction outcome at a node in contact: stick (stick_change) or slide (eq. 17: the normal
+/// change d_n n̂ plus the sliding impulse along t̂), with the sliding's frictional work in the heating pass.
+template <int Dim>
+void apply_friction(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const FrictionOutcome& f,
+                    const Vec<Dim>& stick_change, double d_n, const Vec<Dim>& n, const Vec<Dim>& t_vec, double d_t,
+                    const PairContext& c, PairChange<Dim>& out) {
+  out.changed = true;
+  if (f.stick || !(d_t > 0.0)) {
+    out.dp = stick_change;
+    return;
+  }
+  const Vec<Dim> t_hat = t_vec / d_t;
+  out.sliding = true;
+  out.dp = d_n * n + f.slide_impulse * t_hat;  // eq. 17
+  if (c.heat) {
+    // Relative force tangential component f_t (eqs. 29–30); rigid b: Δf_a = m_a a_b − f_a.
+    const Vec<Dim> df = b.rigid ? Vec<Dim>(a.mass * b.rigid_acceleration - a.force)
+                                : Vec<Dim>((a.mass * b.force - b.mass * a.force) / (a.mass + b.mass));
+    out.work_first = frictional_work_first_order(f.slide_impulse, d_t, out.reduced_mass);  // eq. 27
+    out.work_second =
+        frictional_work_second_order(f.slide_impulse, d_t, df.dot(t_hat), out.reduced_mass, c.dt);  // eqs. 34, 36
+  }
+}
+
 template <int Dim>
 PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const Vec<Dim>& h,
                              const PairContext& c) {
@@ -54,7 +78,8 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n);
   else if (c.separation == SeparationMethod::extent)  // particle domains, contact_extents.cpp
     separation = std::isnan(a.extent_gap) ? -1.0 : a.extent_gap - c.extent_tolerance * h_perp;
-  const bool in_contact = approaching && separation < 0.0;
+  const bool touching = separation < 0.0;
+  const bool in_contact = approaching && touching;
 
   // Stick momentum change and reduced mass (eqs. 12–14); a rigid b has v_c = v_b, m_red = m_a.
   Vec<Dim> dp_stick;
@@ -78,7 +103,15 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     if (s.law.holds_when_separated(S_stick, N)) {
       out.changed = true;
       out.dp = dp_stick;
+      return out;
     }
+    // Extent detection: domains that touch but move apart this step still rub through the law's area
+    // term (adhesion S_a A_c, eq. 24 with N = 0); no normal change. Without it an area law loses its
+    // traction at every touching node whose normal velocity noise points outward that step.
+    if (c.separation == SeparationMethod::extent && touching && s.law.needs_area() && !(a.sliver || b.sliver) &&
+        d_t > 0.0)
+      apply_friction(a, b, s.law.in_contact(ContactImpulse{0.0, d_t, out.reduced_mass, area, c.dt}), t_vec, 0.0,
+                     n, t_vec, d_t, c, out);
     return out;
   }
   if (a.sliver || b.sliver) {  // normal change only: no friction, no heat (ContactSide::sliver)
@@ -86,23 +119,8 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     out.dp = d_n * n;
     return out;
   }
-  const FrictionOutcome f = s.law.in_contact(ContactImpulse{d_n, d_t, out.reduced_mass, area, c.dt});
-  out.changed = true;
-  if (f.stick || !(d_t > 0.0)) {
-    out.dp = dp_stick;
-    return out;
-  }
-  const Vec<Dim> t_hat = t_vec / d_t;
-  out.sliding = true;
-  out.dp = d_n * n + f.slide_impulse * t_hat;  // eq. 17
-  if (c.heat) {
-    // Relative force tangential component f_t (eqs. 29–30); rigid b: Δf_a = m_a a_b − f_a.
-    const Vec<Dim> df = b.rigid ? Vec<Dim>(a.mass * b.rigid_acceleration - a.force)
-                                : Vec<Dim>((a.mass * b.force - b.mass * a.force) / (a.mass + b.mass));
-    out.work_first = frictional_work_first_order(f.slide_impulse, d_t, out.reduced_mass);  // eq. 27
-    out.work_second =
-        frictional_work_second_order(f.slide_impulse, d_t, df.dot(t_hat), out.reduced_mass, c.dt);  // eqs. 34, 36
-  }
+  apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n, d_t, out.reduced_mass, area, c.dt}), dp_stick, d_n, n,
+                 t_vec, d_t, c, out);
   return out;
 }
 

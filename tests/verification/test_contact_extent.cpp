@@ -69,8 +69,9 @@ TEST(ExtentSeparation, PreloadedInterfaceRowsCarryTheAppliedPressure) {
 }
 
 // Adhesion (μ = 0.2, S_a = 0.3 N, R = 1) with extent detection against the rigid block, errors relative to
-// its own v_max. Measured with the scene runner: 5.9 % / 1.5 % of v_max and −6.2 % / −1.5 % of the work at
-// 5 / 2.5 mm. At 1.25 mm the sliding block still lifts off (docs/contact.md, "Known limitations").
+// its own v_max. Measured: 3.9 % / 2.0 % of v_max and −3.4 % / −1.7 % of the work at 5 / 2.5 mm (touching
+// nodes that move apart keep S_a A_c). At 1.25 mm the sliding block still floats by about the tolerance
+// (13 %, docs/contact.md, "Known limitations"), so the finest level is not asserted here.
 TEST(ExtentSeparation, AdhesionBlockAtTwoResolutions) {
   using C = SlidingBlockConstants;
   const double S_a = 0.3 * C::normal_stress();
@@ -90,8 +91,8 @@ TEST(ExtentSeparation, AdhesionBlockAtTwoResolutions) {
     std::printf("[adhesion, extent, %.2f mm cells] max |v - v_rigid|/v_max %.4f (v_max %.2f m/s), work %.5g J vs %.5g J\n",
                 cell * 1e3, e, v_max, h.work_second.back(), Q);
   }
-  EXPECT_LT(velocity_error[0], 0.08);
-  EXPECT_LT(velocity_error[1], 0.02);
+  EXPECT_LT(velocity_error[0], 0.05);
+  EXPECT_LT(velocity_error[1], 0.025);
   EXPECT_LT(velocity_error[1], velocity_error[0]);
   EXPECT_LT(work_error[1], 0.03);
   EXPECT_LT(work_error[1], work_error[0]);
