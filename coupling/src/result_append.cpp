@@ -119,6 +119,9 @@ void replace_meta(hid_t out, hid_t cont, const std::string& file, const std::str
   if (!exists(cont, "/meta")) return;
   const Handle mc{check_id(H5Gopen2(cont, "meta", H5P_DEFAULT), cont_file, "/meta"), H5Gclose};
   const Handle mo{check_id(H5Gopen2(out, "meta", H5P_DEFAULT), file, "/meta"), H5Gclose};
+  // How the interrupted part ended: true of the joined result only if the resumed part says so too.
+  for (const char* stale : {"interruption", "failure"})
+    if (exists(mo.get(), stale)) check(H5Ldelete(mo.get(), stale, H5P_DEFAULT), file, "cannot remove /meta/" + std::string(stale));
   for (const std::string& n : members(mc.get())) {
     if (exists(mo.get(), n)) check(H5Ldelete(mo.get(), n.c_str(), H5P_DEFAULT), file, "cannot replace /meta/" + n);
     copy_object(mc.get(), n, mo.get(), n, file);

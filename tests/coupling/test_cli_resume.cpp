@@ -3,6 +3,8 @@
 // final checkpoints (every particle array, time, step count, work books, output marks) are byte-equal
 // files, and the resumed result, appended to the interrupted one, has the uninterrupted run's series
 // row for row (export-csv prints the same text).
+#include <frictherm/coupling/results.hpp>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -66,6 +69,9 @@ TEST(CliResume, InterruptedAndResumedRunEqualsUninterruptedRun) {
   const std::string a = slurp(csv_part), b = slurp(csv_full);
   EXPECT_GT(std::count(b.begin(), b.end(), '\n'), 100);
   EXPECT_TRUE(a == b) << "the appended result's series differ from the uninterrupted run's";
+  // The joined result ended as the resumed part did: completed, the interruption note gone.
+  EXPECT_EQ(frictherm::coupling::read_metadata_string(part, "status"), "completed");
+  EXPECT_THROW(frictherm::coupling::read_metadata_string(part, "interruption"), std::runtime_error);
   fs::remove_all(dir);
 }
 
