@@ -56,6 +56,7 @@ int positive_int(const std::string& command, const std::string& option, const st
 int ensemble_command(const std::vector<std::string>& args, const std::string& command_line);
 int run_command(const std::vector<std::string>& args, const std::string& command_line);
 int resume_command(const std::vector<std::string>& args, const std::string& command_line);  // cli_resume.cpp
+int continue_command(const std::vector<std::string>& args, const std::string& command_line);  // cli_continue.cpp
 int validate_command(const std::vector<std::string>& args);
 int export_csv_command(const std::vector<std::string>& args);
 int microstructure_command(const std::vector<std::string>& args);  // cli_microstructure.cpp
@@ -81,6 +82,7 @@ void print_version(std::ostream& out);
 extern const char* const kProgramHelp;
 extern const char* const kRunHelp;
 extern const char* const kResumeHelp;
+extern const char* const kContinueHelp;
 extern const char* const kValidateHelp;
 extern const char* const kExportCsvHelp;
 extern const char* const kMicrostructureHelp;

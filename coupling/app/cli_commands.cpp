@@ -1,12 +1,17 @@
 // The subcommands: run, validate, export-csv.
 #include "cli.hpp"
 
+#include <frictherm/coupling/checkpoint.hpp>
+
 #include <frictherm/coupling/csv_export.hpp>
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -52,6 +57,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
                                   {{{"-o", "--output"}, true, "output"},
                                    {{"-t", "--threads"}, true, "threads"},
                                    {{"-q", "--quiet"}, false, "quiet"},
+                                   {{"--checkpoint-every"}, true, "checkpoint-every"},
                                    kForceOption, kSetOption});
   if (a.help) {
     std::cout << kRunHelp;
@@ -65,6 +71,13 @@ int run_command(const std::vector<std::string>& args, const std::string& command
   opt.overwrite = a.has("force");
   opt.command_line = command_line;
   opt.handle_signals = true;
+  if (a.has("checkpoint-every")) {
+    const std::string& v = a.options.at("checkpoint-every");
+    char* end = nullptr;
+    opt.checkpoint_wall_interval = std::strtod(v.c_str(), &end);
+    if (end == v.c_str() || *end != '\0' || !(opt.checkpoint_wall_interval > 0.0) || !std::isfinite(opt.checkpoint_wall_interval))
+      throw UsageError("run", "--checkpoint-every: expected wall-clock seconds > 0, got '" + v + "'");
+  }
   coupling::Scene scene;
   if (!load(path, a, scene)) return kUsage;
   coupling::RunResult r;
@@ -88,7 +101,10 @@ int run_command(const std::vector<std::string>& args, const std::string& command
   if (r.status == coupling::RunResult::Status::interrupted) {
     std::cerr << "frictherm: " << r.message << ". Kept in " << r.output << ": " << r.snapshots
               << " snapshots (the last one at the interruption), " << r.series_rows
-              << " series rows; /meta/status = interrupted.\n";
+              << " series rows; /meta/status = interrupted.";
+    if (std::filesystem::exists(coupling::checkpoint_path(r.output)))
+      std::cerr << " Go on with: frictherm resume " << r.output;
+    std::cerr << '\n';
     return r.exit_code();
   }
   if (!opt.quiet) {

@@ -18,6 +18,7 @@ std::string quote_arg(const std::string& a) {
 const char* help_of(const std::string& command) {
   if (command == "run") return frictherm::cli::kRunHelp;
   if (command == "resume") return frictherm::cli::kResumeHelp;
+  if (command == "continue") return frictherm::cli::kContinueHelp;
   if (command == "validate") return frictherm::cli::kValidateHelp;
   if (command == "export-csv") return frictherm::cli::kExportCsvHelp;
   if (command == "microstructure") return frictherm::cli::kMicrostructureHelp;
@@ -48,11 +49,12 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
     std::cout << h;
     return kOk;
   }
-  if (cmd == "run" || cmd == "resume" || cmd == "export-csv" || cmd == "microstructure" || cmd == "ensemble") {
+  if (cmd == "run" || cmd == "resume" || cmd == "continue" || cmd == "export-csv" || cmd == "microstructure" || cmd == "ensemble") {
     if (const int refused = refuse_under_launcher(cmd); refused != kOk) return refused;
   }
   if (cmd == "run") return run_command(rest, command_line);
   if (cmd == "resume") return resume_command(rest, command_line);
+  if (cmd == "continue") return continue_command(rest, command_line);
   if (cmd == "validate") return validate_command(rest);
   if (cmd == "export-csv") return export_csv_command(rest);
   if (cmd == "microstructure") return microstructure_command(rest);

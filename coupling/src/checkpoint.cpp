@@ -1,57 +1,38 @@
-// Mechanics checkpoints in HDF5 (checkpoint.hpp). Layout: root attributes "format" (1) and
-// "dimension"; dataset "/scene" (the scene text, bytes); every member of Simulation::visit_state under
-// "/mechanics/<name>": vectors of n items with c doubles (or int32) each as n × c (c = 1: n), scalars as
-// one-element datasets (long: int64, bool: int32).
+// Checkpoints in HDF5 (checkpoint.hpp). Layout: root attributes "format" (2) and "dimension";
+// datasets "/scene", "/scene_source", "/scene_overrides" (bytes); every member of
+// Simulation::visit_state under "/mechanics/<name>"; the output marks under "/marks/<name>"; what the
+// run loop adds (the thermal coupler, series memory) under its own groups. Vectors of n items with c
+// values each are n × c (c = 1: n), scalars one-element datasets (long: int64, bool: int32).
 #include <frictherm/coupling/checkpoint.hpp>
 
-#include "h5_util.hpp"
+#include "checkpoint_io.hpp"
+
+#include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
-#include <type_traits>
 #include <vector>
 
 namespace frictherm::coupling {
 
-namespace {
+namespace ckpt {
 
 using h5detail::check;
 using h5detail::check_id;
 using h5detail::Handle;
 
-constexpr int kFormat = 1;
-
-// Element type of a member: its HDF5 type and components per item.
-template <class T> struct Layout {  // fixed-size Eigen vector or matrix of doubles
-  static_assert(std::is_same_v<typename T::Scalar, double>, "checkpoint: Eigen members must hold doubles");
-  static_assert(sizeof(T) == sizeof(double) * T::SizeAtCompileTime, "checkpoint: padded Eigen type");
-  using Scalar = double;
-  static constexpr int components = T::SizeAtCompileTime;
-  static hid_t type() { return H5T_NATIVE_DOUBLE; }
-};
-template <> struct Layout<double> {
-  using Scalar = double;
-  static constexpr int components = 1;
-  static hid_t type() { return H5T_NATIVE_DOUBLE; }
-};
-template <> struct Layout<std::int32_t> {
-  using Scalar = std::int32_t;
-  static constexpr int components = 1;
-  static hid_t type() { return H5T_NATIVE_INT32; }
-};
-template <> struct Layout<long> {
-  using Scalar = long;
-  static constexpr int components = 1;
-  static hid_t type() { return H5T_NATIVE_LONG; }
-};
+namespace {
 
 hid_t file_type(hid_t memory_type) {
   if (memory_type == H5T_NATIVE_DOUBLE) return H5T_IEEE_F64LE;
   if (memory_type == H5T_NATIVE_INT32) return H5T_STD_I32LE;
   if (memory_type == H5T_NATIVE_CHAR) return H5T_STD_I8LE;
+  if (memory_type == H5T_NATIVE_UINT64) return H5T_STD_U64LE;
   return H5T_STD_I64LE;
 }
+
+}  // namespace
 
 void write_array(hid_t group, const std::string& file, const std::string& name, hid_t type, const void* data,
                  hsize_t n, int components) {
@@ -68,7 +49,6 @@ void write_array(hid_t group, const std::string& file, const std::string& name, 
   if (n > 0) check(H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, "cannot write '" + name + "'");
 }
 
-// Opens `name`, checks that it holds items of `components` values, returns the item count.
 Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n) {
   Handle d{check_id(H5Dopen2(group, name.c_str(), H5P_DEFAULT), file, "checkpoint has no '" + name + "'"), H5Dclose};
   const Handle space{check_id(H5Dget_space(d.get()), file, "dataspace of '" + name + "'"), H5Sclose};
@@ -82,50 +62,17 @@ Handle open_array(hid_t group, const std::string& file, const std::string& name,
   return d;
 }
 
-struct Writer {
-  hid_t group;
-  const std::string& file;
-  template <class T> void operator()(const char* name, std::vector<T>& data) const {
-    using L = Layout<T>;
-    write_array(group, file, name, L::type(), data.data(), data.size(), L::components);
-  }
-  void operator()(const char* name, double& x) const { write_array(group, file, name, H5T_NATIVE_DOUBLE, &x, 1, 1); }
-  void operator()(const char* name, long& x) const { write_array(group, file, name, H5T_NATIVE_LONG, &x, 1, 1); }
-  void operator()(const char* name, bool& x) const {
-    const std::int32_t b = x ? 1 : 0;
-    write_array(group, file, name, H5T_NATIVE_INT32, &b, 1, 1);
-  }
-};
+}  // namespace ckpt
 
-struct Reader {
-  hid_t group;
-  const std::string& file;
-  std::size_t particles;  // the rebuilt simulation's particle count
-  template <class T> void operator()(const char* name, std::vector<T>& data) const {
-    using L = Layout<T>;
-    hsize_t n = 0;
-    const Handle d = open_array(group, file, name, L::components, n);
-    const std::string key(name);
-    if (key.rfind("particles/", 0) == 0 && n != particles)
-      throw std::runtime_error("checkpoint '" + file + "': '" + key + "' holds " + std::to_string(n) +
-                               " particles, the simulation built from the scene has " + std::to_string(particles));
-    data.resize(n);
-    if (n > 0) check(H5Dread(d.get(), L::type(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file, "cannot read '" + key + "'");
-  }
-  template <class T> void scalar(const char* name, hid_t type, T& x) const {
-    hsize_t n = 0;
-    const Handle d = open_array(group, file, name, 1, n);
-    if (n != 1) throw std::runtime_error("checkpoint '" + file + "': '" + std::string(name) + "' is not one value");
-    check(H5Dread(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &x), file, "cannot read '" + std::string(name) + "'");
-  }
-  void operator()(const char* name, double& x) const { scalar(name, H5T_NATIVE_DOUBLE, x); }
-  void operator()(const char* name, long& x) const { scalar(name, H5T_NATIVE_LONG, x); }
-  void operator()(const char* name, bool& x) const {
-    std::int32_t b = 0;
-    scalar(name, H5T_NATIVE_INT32, b);
-    x = b != 0;
-  }
-};
+namespace {
+
+using ckpt::open_array;
+using ckpt::write_array;
+using h5detail::check;
+using h5detail::check_id;
+using h5detail::Handle;
+
+constexpr int kFormat = 2;  // 2: thermal coupler, penalty contact and output marks (1: mechanics only)
 
 void write_int_attribute(hid_t obj, const std::string& file, const char* name, int value) {
   const Handle space{check_id(H5Screate(H5S_SCALAR), file, "dataspace"), H5Sclose};
@@ -145,8 +92,10 @@ int read_int_attribute(hid_t obj, const std::string& file, const char* name) {
 
 Handle open_checkpoint(const std::string& path, int dimension) {
   Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
-  if (read_int_attribute(f.get(), path, "format") != kFormat)
-    throw std::runtime_error("checkpoint '" + path + "': unknown format (expected " + std::to_string(kFormat) + ")");
+  const int format = read_int_attribute(f.get(), path, "format");
+  if (format != kFormat)
+    throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + " (expected " +
+                             std::to_string(kFormat) + "; written by another frictherm version)");
   if (dimension > 0 && read_int_attribute(f.get(), path, "dimension") != dimension)
     throw std::runtime_error("checkpoint '" + path + "': written by a " +
                              std::to_string(read_int_attribute(f.get(), path, "dimension")) +
@@ -154,41 +103,82 @@ Handle open_checkpoint(const std::string& path, int dimension) {
   return f;
 }
 
+void write_text(hid_t f, const std::string& file, const char* name, const std::string& text) {
+  write_array(f, file, name, H5T_NATIVE_CHAR, text.data(), text.size(), 1);
+}
+
+std::string read_text(hid_t f, const std::string& path, const char* name) {
+  hsize_t n = 0;
+  const Handle d = open_array(f, path, name, 1, n);
+  std::string text(n, '\0');
+  if (n > 0)
+    check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), path,
+          std::string("cannot read ") + name);
+  return text;
+}
+
+std::string read_text(const std::string& path, const char* name) {
+  const h5detail::Quiet quiet;
+  const Handle f = open_checkpoint(path, 0);
+  return read_text(f.get(), path, name);
+}
+
+void write_marks(const ckpt::Writer& w, hid_t f, const std::string& file, CheckpointMarks m) {
+  w("marks/step", m.step);
+  w("marks/time", m.time);
+  w("marks/series_rows", m.series_rows);
+  w("marks/snapshots", m.snapshots);
+  w("marks/end_of_loading", m.end_of_loading);
+  std::string names;
+  std::vector<long> rows;
+  for (const auto& [name, n] : m.table_rows) {
+    names += name + "\n";
+    rows.push_back(n);
+  }
+  write_text(f, file, "marks/table_names", names);
+  w("marks/table_rows", rows);
+}
 
 template <int Dim>
-void write_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const std::string& scene_text,
-                      const std::string& source, const std::string& overrides) {
+void write_file(const std::string& path, mechanics::Simulation<Dim>& sim, const std::string& scene_text,
+                const std::string& source, const std::string& overrides, const CheckpointMarks& marks,
+                const std::function<void(const ckpt::Writer&)>& extra) {
   sim.finalize();  // penalty contact is set up here
-  const std::string why = sim.checkpoint_refusal();
-  if (!why.empty()) throw std::invalid_argument("cannot checkpoint this run: " + why);
-  const std::string tmp = path + ".tmp";
-  {
+  // Per process: two runs checkpointing into one folder never share a temporary.
+  const std::string tmp = path + "." + std::to_string(static_cast<long>(getpid())) + ".tmp";
+  try {
     const h5detail::Quiet quiet;
     const Handle f{check_id(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), tmp,
                             "cannot create the checkpoint"),
                    H5Fclose};
     write_int_attribute(f.get(), tmp, "format", kFormat);
     write_int_attribute(f.get(), tmp, "dimension", Dim);
-    write_array(f.get(), tmp, "scene", H5T_NATIVE_CHAR, scene_text.data(), scene_text.size(), 1);
-    write_array(f.get(), tmp, "scene_source", H5T_NATIVE_CHAR, source.data(), source.size(), 1);
-    write_array(f.get(), tmp, "scene_overrides", H5T_NATIVE_CHAR, overrides.data(), overrides.size(), 1);
-    const Handle g{check_id(H5Gcreate2(f.get(), "mechanics", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp, "group"),
-                   H5Gclose};
-    sim.visit_state(Writer{g.get(), tmp});
+    write_text(f.get(), tmp, "scene", scene_text);
+    write_text(f.get(), tmp, "scene_source", source);
+    write_text(f.get(), tmp, "scene_overrides", overrides);
+    {
+      const Handle g{check_id(H5Gcreate2(f.get(), "mechanics", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp, "group"),
+                     H5Gclose};
+      sim.visit_state(ckpt::Writer{g.get(), tmp});
+    }
+    const ckpt::Writer root{f.get(), tmp};
+    write_marks(root, f.get(), tmp, marks);
+    if (extra) extra(root);
     check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush the checkpoint");
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
   }
   // POSIX rename replaces `path` atomically: a reader sees the old or the new checkpoint, never half.
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
     throw std::runtime_error("checkpoint '" + path + "': cannot rename '" + tmp + "' over it");
+  }
 }
 
-std::string read_text(const std::string& path, const char* name) {
-  const h5detail::Quiet quiet;
-  const Handle f = open_checkpoint(path, 0);
-  hsize_t n = 0;
-  const Handle d = open_array(f.get(), path, name, 1, n);
-  std::string text(n, '\0');
-  if (n > 0) check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), path, std::string("cannot read ") + name);
+std::string joined_overrides(const std::vector<SceneOverride>& list) {
+  std::string text;  // one "path=value" per line
+  for (const SceneOverride& o : list) text += o.path + "=" + o.value + "\n";
   return text;
 }
 
@@ -197,31 +187,64 @@ std::string read_text(const std::string& path, const char* name) {
 std::string checkpoint_path(const std::string& result_path) { return result_path + ".checkpoint"; }
 
 template <int Dim>
-void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
-                                const std::string& scene_text) {
-  write_checkpoint(path, sim, scene_text, "", "");
+void write_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const Scene& scene,
+                      const CheckpointMarks& marks, const std::function<void(const ckpt::Writer&)>& extra) {
+  write_file(path, sim, scene.text, scene.source, joined_overrides(scene.overrides), marks, extra);
 }
 
 template <int Dim>
-void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const Scene& scene) {
-  std::string overrides;  // one "path=value" per line
-  for (const SceneOverride& o : scene.overrides) overrides += o.path + "=" + o.value + "\n";
-  write_checkpoint(path, sim, scene.text, scene.source, overrides);
+void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
+                     const std::function<void(const ckpt::Reader&)>& extra) {
+  const h5detail::Quiet quiet;
+  const Handle f = open_checkpoint(path, Dim);
+  {
+    const Handle g{check_id(H5Gopen2(f.get(), "mechanics", H5P_DEFAULT), path, "checkpoint has no /mechanics"),
+                   H5Gclose};
+    sim.finalize();
+    sim.visit_state(ckpt::Reader{g.get(), path, sim.particles().size()});
+  }
+  if (extra) extra(ckpt::Reader{f.get(), path, sim.particles().size()});
+}
+
+CheckpointMarks checkpoint_marks(const std::string& path) {
+  const h5detail::Quiet quiet;
+  const Handle f = open_checkpoint(path, 0);
+  const ckpt::Reader r{f.get(), path, 0};
+  CheckpointMarks m;
+  r("marks/step", m.step);
+  r("marks/time", m.time);
+  r("marks/series_rows", m.series_rows);
+  r("marks/snapshots", m.snapshots);
+  r("marks/end_of_loading", m.end_of_loading);
+  const std::string names = read_text(f.get(), path, "marks/table_names");
+  std::vector<long> rows;
+  r("marks/table_rows", rows);
+  std::size_t k = 0;
+  for (std::size_t a = 0, b; a < names.size() && k < rows.size(); a = b + 1, ++k) {
+    b = names.find('\n', a);
+    if (b == std::string::npos) b = names.size();
+    m.table_rows.emplace_back(names.substr(a, b - a), rows[k]);
+  }
+  return m;
+}
+
+template <int Dim>
+void write_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
+                                const std::string& scene_text) {
+  CheckpointMarks marks;
+  marks.step = sim.step_count();
+  marks.time = sim.time();
+  write_file(path, sim, scene_text, "", "", marks, {});
 }
 
 template <int Dim>
 void read_mechanics_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim) {
-  const h5detail::Quiet quiet;
-  const Handle f = open_checkpoint(path, Dim);
-  const Handle g{check_id(H5Gopen2(f.get(), "mechanics", H5P_DEFAULT), path, "checkpoint has no /mechanics"), H5Gclose};
-  sim.finalize();
-  sim.visit_state(Reader{g.get(), path, sim.particles().size()});
+  read_checkpoint(path, sim, {});
 }
 
 std::string checkpoint_scene_text(const std::string& path) { return read_text(path, "scene"); }
 
-Scene checkpoint_scene(const std::string& path) {
-  const std::string text = read_text(path, "scene"), source = read_text(path, "scene_source");
+std::vector<SceneOverride> checkpoint_overrides(const std::string& path) {
   std::vector<SceneOverride> overrides;
   const std::string lines = read_text(path, "scene_overrides");
   for (std::size_t a = 0, b; a < lines.size(); a = b + 1) {
@@ -229,6 +252,13 @@ Scene checkpoint_scene(const std::string& path) {
     if (b == std::string::npos) b = lines.size();
     if (b > a) overrides.push_back(parse_override(lines.substr(a, b - a)));
   }
+  return overrides;
+}
+
+Scene checkpoint_scene(const std::string& path, const std::vector<SceneOverride>& more) {
+  const std::string text = read_text(path, "scene"), source = read_text(path, "scene_source");
+  std::vector<SceneOverride> overrides = checkpoint_overrides(path);
+  overrides.insert(overrides.end(), more.begin(), more.end());
   const std::size_t slash = source.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : source.substr(0, slash));
   std::string name = slash == std::string::npos ? source : source.substr(slash + 1);
@@ -237,11 +267,15 @@ Scene checkpoint_scene(const std::string& path) {
   return parse_scene(text, source.empty() ? "<string>" : source, dir, name, overrides);
 }
 
-template void write_mechanics_checkpoint<2>(const std::string&, mechanics::Simulation<2>&, const std::string&);
-template void write_mechanics_checkpoint<3>(const std::string&, mechanics::Simulation<3>&, const std::string&);
-template void write_mechanics_checkpoint<2>(const std::string&, mechanics::Simulation<2>&, const Scene&);
-template void write_mechanics_checkpoint<3>(const std::string&, mechanics::Simulation<3>&, const Scene&);
-template void read_mechanics_checkpoint<2>(const std::string&, mechanics::Simulation<2>&);
-template void read_mechanics_checkpoint<3>(const std::string&, mechanics::Simulation<3>&);
+#define FRICTHERM_INSTANTIATE_CHECKPOINT(D)                                                                  \
+  template void write_checkpoint<D>(const std::string&, mechanics::Simulation<D>&, const Scene&,             \
+                                    const CheckpointMarks&, const std::function<void(const ckpt::Writer&)>&); \
+  template void read_checkpoint<D>(const std::string&, mechanics::Simulation<D>&,                            \
+                                   const std::function<void(const ckpt::Reader&)>&);                         \
+  template void write_mechanics_checkpoint<D>(const std::string&, mechanics::Simulation<D>&, const std::string&); \
+  template void read_mechanics_checkpoint<D>(const std::string&, mechanics::Simulation<D>&);
+FRICTHERM_INSTANTIATE_CHECKPOINT(2)
+FRICTHERM_INSTANTIATE_CHECKPOINT(3)
+#undef FRICTHERM_INSTANTIATE_CHECKPOINT
 
 }  // namespace frictherm::coupling

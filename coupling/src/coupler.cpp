@@ -266,6 +266,10 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
     throw std::logic_error("Coupler::continue_thermal: close the window with pending heat first");
   if (!(time > window_start_)) return;
   const bool reaction_starts = opt_.reaction.enabled && !continuing_;
+  if (!continuing_) {  // a fresh integrator: the continuation depends only on the end-of-loading state
+    stats_offset_ += integrator_->stats();
+    integrator_ = thermal::make_integrator(opt_.integrator, opt_.integrator_options);
+  }
   continuing_ = true;
   if (!system_assembled_ || reaction_starts) {  // a reaction held back during loading joins the problem now
     assemble(p);
@@ -300,6 +304,13 @@ void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, doub
   add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta,
                                 &nodal_temperature_);  // design §4
   books_.nodal_energy_change += system_.mass.dot(delta);
+}
+
+template <int Dim>
+thermal::IntegratorStats Coupler<Dim>::integrator_stats() const {
+  thermal::IntegratorStats s = stats_offset_;
+  s += integrator_->stats();
+  return s;
 }
 
 template <int Dim>

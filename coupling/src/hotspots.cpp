@@ -196,6 +196,52 @@ void HotSpotTracker::cluster_and_match(std::vector<Candidate>& hot, double time)
   current_ = std::move(found);
 }
 
+// Checkpoint layout of one hot spot: id, particle_count, peak, mean, size, diameter, centroid (3),
+// excess_energy, birth_time, duration, 0 (kScalars = 13).
+void HotSpotTracker::flatten(std::vector<double>& scalars, std::vector<long>& particles, std::vector<long>& particle_end,
+                             std::vector<long>& materials, std::vector<long>& material_end) const {
+  for (const HotSpot& h : current_) {
+    scalars.insert(scalars.end(), {static_cast<double>(h.id), static_cast<double>(h.particle_count), h.peak_temperature,
+                                   h.mean_temperature, h.size, h.equivalent_diameter, h.centroid[0], h.centroid[1],
+                                   h.centroid[2], h.excess_energy, h.birth_time, h.duration, 0.0});
+    particles.insert(particles.end(), h.particles.begin(), h.particles.end());
+    particle_end.push_back(static_cast<long>(particles.size()));
+    materials.insert(materials.end(), h.materials.begin(), h.materials.end());
+    material_end.push_back(static_cast<long>(materials.size()));
+  }
+}
+
+void HotSpotTracker::unflatten(const std::vector<double>& scalars, const std::vector<long>& particles,
+                               const std::vector<long>& particle_end, const std::vector<long>& materials,
+                               const std::vector<long>& material_end) {
+  const std::size_t n = particle_end.size();
+  if (scalars.size() != n * kScalars || material_end.size() != n ||
+      (n > 0 && (static_cast<std::size_t>(particle_end.back()) != particles.size() ||
+                 static_cast<std::size_t>(material_end.back()) != materials.size())))
+    throw std::runtime_error("checkpoint: the hot-spot arrays do not fit together");
+  current_.assign(n, HotSpot{});
+  long p0 = 0, m0 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* s = &scalars[i * kScalars];
+    HotSpot& h = current_[i];
+    h.id = static_cast<long>(s[0]);
+    h.particle_count = static_cast<std::size_t>(s[1]);
+    h.peak_temperature = s[2];
+    h.mean_temperature = s[3];
+    h.size = s[4];
+    h.equivalent_diameter = s[5];
+    h.centroid = {s[6], s[7], s[8]};
+    h.excess_energy = s[9];
+    h.birth_time = s[10];
+    h.duration = s[11];
+    if (particle_end[i] < p0 || material_end[i] < m0) throw std::runtime_error("checkpoint: bad hot-spot offsets");
+    h.particles.assign(particles.begin() + p0, particles.begin() + particle_end[i]);
+    h.materials.assign(materials.begin() + m0, materials.begin() + material_end[i]);
+    p0 = particle_end[i];
+    m0 = material_end[i];
+  }
+}
+
 const HotSpot* HotSpotTracker::hottest() const {
   const HotSpot* best = nullptr;
   for (const HotSpot& h : current_)

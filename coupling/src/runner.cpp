@@ -1,5 +1,6 @@
 // The run loop: build the simulation, step to end_time landing on every snapshot time, write
 // snapshots and series, and keep the failing state when the simulation breaks down.
+#include "checkpoint_io.hpp"
 #include "runner_detail.hpp"
 #include "run_signals.hpp"
 #include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
@@ -51,28 +52,29 @@ class Run {
     omp_set_num_threads(threads > 0 ? threads : default_thread_count(sim_->particles().size()));
     r_.particles = sim_->particles().size();
     check_checkpoints();
-    if (!o_.resume_checkpoint.empty()) {
-      if (s_.thermal.enabled)
-        throw SceneError("thermal: resuming runs with a thermal section is not supported yet (expected no thermal section)");
-      read_mechanics_checkpoint(o_.resume_checkpoint, *sim_);
-    }
+    if (!o_.resume_checkpoint.empty()) restore();
     H5Output out = open_output();
     out_ = &out;
-    write_microstructure_images(out);  // generated bodies (ellipse_packing): the image beside the output
+    // Generated bodies (ellipse_packing): the image beside the output (an appended output: the result has it).
+    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) write_microstructure_images(out);
     detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
     std::vector<std::string> series_columns = detail::series_names(Dim);
     detail::append_body_series_names<Dim>(series_columns, *sim_);
     detail::append_contact_series_names<Dim>(series_columns, *sim_);
     if (thermal_) thermal_->declare_output(out, series_columns);  // thermal hook: columns + /hotspots
     out.declare_series(series_columns);
-    series();
-    snapshot();
+    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) {  // appended output: the result has these
+      series();
+      snapshot();
+    }
     std::ostream& log = o_.log ? *o_.log : std::cerr;
     detail::ProgressLine progress(std::cerr, show_progress(o_), s_.end_time);
     last_flush_ = Clock::now();
     try {
       loop(progress);
       if (thermal_ && r_.status == RunResult::Status::completed) {
+        if (thermal_->has_continuation()) checkpoint(true);  // end of loading: always (frictherm continue)
+        continuation_started_ = true;
         const Clock::time_point c0 = Clock::now();
         thermal_->continuation(out, *sim_, s_.output.fields, series_memory_);  // thermal hook: thermal-only phase
         continuation_seconds_ = seconds_since(c0);
@@ -89,9 +91,12 @@ class Run {
     }
     progress.finish();
     if (r_.status != RunResult::Status::failed) {
+      // At the end and on SIGINT/SIGTERM, before the rows the schedule does not have (the state and
+      // marks of an uninterrupted run at this step). After the continuation began, the end-of-loading
+      // checkpoint stays: a resume reruns the continuation from it.
+      if (checkpoints_ && !continuation_started_) checkpoint(false);
       if (last_series_step_ != sim_->step_count()) series();
       if (last_snapshot_step_ != sim_->step_count()) snapshot();
-      if (checkpoints_) checkpoint();  // at the end, and on SIGINT/SIGTERM
     }
     if (r_.status == RunResult::Status::interrupted) {
       r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " +
@@ -105,6 +110,10 @@ class Run {
     r_.time = sim_->time();
     r_.wall_time = seconds_since(t0);
     record_phase_seconds(out);
+    if (checkpoints_written_ > 0) {
+      out.write_metadata("checkpoints_written", checkpoints_written_);
+      out.write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, all checkpoints of this run
+    }
     r_.snapshots = out.snapshot_count();
     r_.series_rows = out.series_rows();
     const char* status = r_.status == RunResult::Status::failed                 ? "failed"
@@ -168,8 +177,13 @@ class Run {
     if (!o_.resume_checkpoint.empty()) inputs.push_back(o_.resume_checkpoint);
     check_output_path(r_.output, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
     check_output_path(xdmf_path_for(r_.output), inputs, true, "");
-    if (s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0)
-      check_output_path(checkpoint_path(r_.output), inputs, true, "");
+    if (s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0 ||
+        (s_.thermal.enabled && s_.thermal.continuation_duration > 0.0)) {
+      std::vector<std::string> others;  // a resumed run may go on replacing its own checkpoint
+      for (const std::string& f : inputs)
+        if (!(f == o_.resume_checkpoint && checkpoint_file() == o_.resume_checkpoint)) others.push_back(f);
+      check_output_path(checkpoint_file(), others, true, "");
+    }
     for (std::size_t i = 0; i < s_.bodies.size(); ++i)
       if (s_.bodies[i].shape.generated) check_output_path(generated_image_path(s_, i, r_.output), inputs, true, "");
   }
@@ -249,24 +263,57 @@ class Run {
     }
   }
 
-  // Checkpoints hold the mechanics state only (checkpoint.hpp): refused for thermal scenes and for
-  // penalty contact rather than written incomplete.
+  std::string checkpoint_file() const {
+    return o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
+  }
+
   void check_checkpoints() {
     checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
-    if (!checkpoints_) return;
-    const std::string key = s_.checkpoint_interval > 0.0 ? "run.checkpoint_interval" : "the checkpoint option";
-    if (s_.thermal.enabled)
-      throw SceneError(key + ": checkpoints of runs with a thermal section are not supported yet (expected no checkpoint interval)");
-    const std::string why = sim_->checkpoint_refusal();
-    if (!why.empty()) throw SceneError(key + ": " + why + " (expected no checkpoint interval)");
     next_checkpoint_ = s_.checkpoint_interval > 0.0 ? s_.checkpoint_interval : std::numeric_limits<double>::infinity();
   }
 
-  void checkpoint() {
+  // What the run loop keeps between steps besides the simulation (checkpoint.hpp "extra").
+  template <class V> void visit_run_state(V&& v) {
+    v("run/last_series_step", last_series_step_);
+    v("run/last_snapshot_step", last_snapshot_step_);
+    v("run/series_memory/time", series_memory_.time);
+    v("run/series_memory/has_previous", series_memory_.has_previous);
+    v("run/series_memory/work", series_memory_.work);
+    if (thermal_) thermal_->visit_state(v, *sim_);
+  }
+
+  void restore() {
+    read_checkpoint(o_.resume_checkpoint, *sim_, [&](const ckpt::Reader& r) { visit_run_state(r); });
+    if (o_.resume_appends) base_marks_ = checkpoint_marks(o_.resume_checkpoint);
+  }
+
+  // Rows and snapshots of the result at this state, counted from the result this output is appended to.
+  CheckpointMarks marks(bool end_of_loading) const {
+    CheckpointMarks m;
+    m.step = sim_->step_count();
+    m.time = sim_->time();
+    m.series_rows = base_marks_.series_rows + static_cast<long>(out_->series_rows());
+    m.snapshots = base_marks_.snapshots + static_cast<long>(out_->snapshot_count());
+    for (const char* t : {"hotspots", "hotspot_fates"}) {
+      long base = 0;
+      for (const auto& [name, rows] : base_marks_.table_rows)
+        if (name == t) base = rows;
+      m.table_rows.emplace_back(t, base + static_cast<long>(out_->table_rows(t)));
+    }
+    m.end_of_loading = end_of_loading;
+    return m;
+  }
+
+  void checkpoint(bool end_of_loading = false) {
     const Clock::time_point c0 = Clock::now();
-    write_mechanics_checkpoint(checkpoint_path(r_.output), *sim_, s_);
+    out_->flush();  // the rows the marks count are in the file
+    write_checkpoint(checkpoint_file(), *sim_, s_, marks(end_of_loading),
+                     [&](const ckpt::Writer& w) { visit_run_state(w); });
     last_checkpoint_ = Clock::now();
-    output_seconds_ += seconds_since(c0);
+    const double seconds = seconds_since(c0);
+    output_seconds_ += seconds;
+    checkpoint_seconds_ += seconds;
+    ++checkpoints_written_;
   }
 
   void interrupted() {
@@ -322,6 +369,10 @@ class Run {
   double output_seconds_ = 0.0;         // series rows and snapshots
   Clock::time_point last_flush_ = Clock::now();  // series rows written and file flushed
   bool checkpoints_ = false;
+  bool continuation_started_ = false;
+  CheckpointMarks base_marks_;  // resume_appends: the result's rows and snapshots at the checkpoint
+  double checkpoint_seconds_ = 0.0;
+  long checkpoints_written_ = 0;
   double next_checkpoint_ = 0.0;                      // simulated time of the next checkpoint
   Clock::time_point last_checkpoint_ = Clock::now();  // wall clock of the last checkpoint
 };

@@ -156,7 +156,7 @@ template <int Dim>
 void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const {
   const CouplerOptions& o = coupler_.options();
   const EnergyBooks& b = coupler_.books();
-  const thermal::IntegratorStats& st = coupler_.integrator().stats();
+  const thermal::IntegratorStats st = coupler_.integrator_stats();
   out.write_metadata("thermal_integrator", o.integrator);
   out.write_metadata("thermal_rtol", o.integrator_options.rtol);
   out.write_metadata("thermal_atol", o.integrator_options.atol);

@@ -36,10 +36,18 @@ class ThermalRun {
   /// Integrator statistics and energy books into /meta (thermal_*).
   void write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const;
 
+  /// Checkpoints: the coupler's state (Coupler::visit_state) and which windows' hot spots are written.
+  template <class V> void visit_state(V&& v, const mechanics::Simulation<Dim>& sim) {
+    coupler_.visit_state(v, sim.particles());
+    v("run/hotspot_windows_written", hotspot_windows_written_);
+  }
+  /// A thermal-only continuation follows the mechanics (coupling.continuation).
+  bool has_continuation() const { return spec_.continuation_duration > 0.0; }
+
   HeatingOrder heating_order() const { return spec_.heating_order; }
   const Coupler<Dim>& coupler() const { return coupler_; }
   /// Wall time spent inside the thermal integrator so far (s).
-  double solve_seconds() const { return coupler_.integrator().stats().wall_seconds; }
+  double solve_seconds() const { return coupler_.integrator_stats().wall_seconds; }
 
  private:
   template <class F>

@@ -1,13 +1,19 @@
 // `frictherm resume` (coupling/app/cli_resume.cpp): examples/sliding_block.json interrupted by SIGINT
 // while running on one thread and resumed ends in the same state as an uninterrupted run: the two
-// final checkpoints (every particle array, time, step count, work books) are byte-equal files.
+// final checkpoints (every particle array, time, step count, work books, output marks) are byte-equal
+// files, and the resumed result, appended to the interrupted one, has the uninterrupted run's series
+// row for row (export-csv prints the same text).
+#include <frictherm/coupling/results.hpp>
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -48,14 +54,24 @@ TEST(CliResume, InterruptedAndResumedRunEqualsUninterruptedRun) {
   ASSERT_TRUE(fs::exists(part + ".checkpoint")) << "SIGINT must leave a checkpoint";
 
   const std::string exe = FRICTHERM_EXE;
+  const std::string at_interruption = slurp(part + ".checkpoint");
   ASSERT_EQ(std::system((exe + " resume " + part + " -t 1 --quiet").c_str()), 0);
   ASSERT_EQ(std::system((exe + " run " + scene + " -o " + full +
                          " --quiet --set run.threads=1 --set run.checkpoint_interval=0.01").c_str()),
             0);
-  const std::string resumed = slurp(dir / "part.resumed.h5.checkpoint"), uninterrupted = slurp(full + ".checkpoint");
+  const std::string resumed = slurp(part + ".checkpoint"), uninterrupted = slurp(full + ".checkpoint");
   ASSERT_FALSE(uninterrupted.empty());
   EXPECT_TRUE(resumed == uninterrupted) << "the resumed run's final checkpoint differs from the uninterrupted run's";
-  EXPECT_FALSE(slurp(part + ".checkpoint") == uninterrupted) << "the interruption must come before the end";
+  EXPECT_FALSE(at_interruption == uninterrupted) << "the interruption must come before the end";
+  const std::string csv_part = (dir / "part.csv").string(), csv_full = (dir / "full.csv").string();
+  ASSERT_EQ(std::system((exe + " export-csv " + part + " -o " + csv_part).c_str()), 0);
+  ASSERT_EQ(std::system((exe + " export-csv " + full + " -o " + csv_full).c_str()), 0);
+  const std::string a = slurp(csv_part), b = slurp(csv_full);
+  EXPECT_GT(std::count(b.begin(), b.end(), '\n'), 100);
+  EXPECT_TRUE(a == b) << "the appended result's series differ from the uninterrupted run's";
+  // The joined result ended as the resumed part did: completed, the interruption note gone.
+  EXPECT_EQ(frictherm::coupling::read_metadata_string(part, "status"), "completed");
+  EXPECT_THROW(frictherm::coupling::read_metadata_string(part, "interruption"), std::runtime_error);
   fs::remove_all(dir);
 }
 

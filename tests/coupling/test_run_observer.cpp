@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <stdexcept>
 
@@ -26,7 +28,9 @@ const char* kScene = R"({
 })";
 
 fs::path scratch() {
-  const fs::path d = fs::temp_directory_path() / "frictherm_test_run_observer";
+  // Per process: a fixed folder made a second run (or another checkout's tests) find the files of
+  // the first, which outputs now refuse to replace.
+  const fs::path d = fs::temp_directory_path() / ("frictherm_test_run_observer_" + std::to_string(getpid()));
   fs::create_directories(d);
   return d;
 }

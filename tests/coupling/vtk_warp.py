@@ -74,7 +74,7 @@ def run(exe, work, dim):
     h5 = os.path.join(work, f"warp_{dim}d.h5")
     with open(scene, "w") as f:
         json.dump(SCENES[dim], f)
-    subprocess.run([exe, "run", scene, "-o", h5], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([exe, "run", scene, "-o", h5, "--force"], check=True, stdout=subprocess.DEVNULL)  # reruns replace
     return h5
 
 

@@ -26,12 +26,16 @@
 #include <frictherm/coupling/heat_sources.hpp>
 #include <frictherm/coupling/hotspot_fates.hpp>
 #include <frictherm/coupling/hotspots.hpp>
+#include <frictherm/coupling/state_visit.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/thermal/integrator.hpp>
 
 #include <limits>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -141,6 +145,11 @@ class Coupler {
   /// Σ_p m_p C_v,p (T_p − T_p(start)) (J).
   double particle_energy_change(const mechanics::Particles<Dim>& particles) const;
   const thermal::Integrator& integrator() const { return *integrator_; }
+  /// Statistics of all integration so far: the loading's integrator and the continuation's (a fresh
+  /// one of the same kind: the continuation starts without the loading's step history, so that it
+  /// depends only on the state at the end of loading; checkpoints, issue 17), and those restored
+  /// from a checkpoint.
+  thermal::IntegratorStats integrator_stats() const;
   const HotSpotTracker& hotspots() const { return tracker_; }
   const HotSpotFates& fates() const { return fates_; }
   /// Reaction progress λ_p of every particle (0 for non-reacting ones); empty without a reaction.
@@ -150,6 +159,18 @@ class Coupler {
   /// The system of the last window (nullptr before the first assembly).
   const NodalThermalSystem* system() const { return has_system_ ? &system_ : nullptr; }
   const CouplerOptions& options() const { return opt_; }
+
+  /// Checkpoints (issue 17; state_visit.hpp visitors): everything the next step, window or the
+  /// continuation reads — pending heat, window state, books, hot-spot tracker, reaction progress,
+  /// plastic-work marks, nodal temperatures, the last system's unknowns and masses (adaptive
+  /// estimate) and the integrator's counts (not its wall time). Reading restores them into a coupler built with the
+  /// same grid and options after start(), and reassembles from `particles` (which must already hold
+  /// the restored state): M and K depend only on positions, masses and volumes, so at the end of
+  /// loading (a window just closed) the system equals the one written. Throws std::logic_error once
+  /// the continuation has begun (checkpoints are taken during loading and at its end).
+  template <class V> void visit_state(V&& v, const mechanics::Particles<Dim>& particles);
+  /// True until the continuation begins.
+  bool checkpointable() const { return !continuing_; }
 
  private:
   void assemble(const mechanics::Particles<Dim>& particles);
@@ -193,7 +214,79 @@ class Coupler {
   double max_rise_ = 0.0;               // adaptive estimate for the open window (K)
   double initial_energy_ = 0.0;
   EnergyBooks books_;
+  thermal::IntegratorStats stats_offset_;  // integrators before the current one, and restored counts
 };
+
+template <int Dim>
+template <class V>
+void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles) {
+  constexpr bool reading = std::decay_t<V>::reading;
+  if (continuing_) throw std::logic_error("Coupler: checkpoints are taken during loading, not in the continuation");
+  pending_.visit_state(v);
+  v("pending_plastic", pending_plastic_);
+  if (opt_.plastic.enabled) plastic_.visit_state(v);
+  tracker_.visit_state(v);
+  std::vector<double> progress = particle_progress_;  // empty without a reaction
+  v("reaction/particle_progress", progress);
+  if constexpr (reading) {
+    // A reaction the loading did not have (frictherm continue): fresh material, λ = 0.
+    if (opt_.reaction.enabled) particle_progress_ = progress.empty() ? std::vector<double>(particles.size(), 0.0) : progress;
+  }
+  std::vector<int> grid_node = system_.grid_node, unknown = system_.unknown;
+  Eigen::VectorXd mass = system_.mass;
+  v("system/grid_node", grid_node);
+  v("system/unknown", unknown);
+  state::vector(v, "system/mass", mass);
+  state::vector(v, "nodal_temperature", nodal_temperature_);
+  v("window_start", window_start_);
+  v("window_steps", window_steps_);
+  v("max_rise", max_rise_);
+  v("initial_energy", initial_energy_);
+  EnergyBooks& b = books_;
+  for (auto [name, x] : {std::pair<const char*, double*>{"books/work_received", &b.work_received},
+                         {"books/plastic_work_received", &b.plastic_work_received},
+                         {"books/plastic_heat_received", &b.plastic_heat_received},
+                         {"books/heat_delivered", &b.heat_delivered},
+                         {"books/plastic_heat_delivered", &b.plastic_heat_delivered},
+                         {"books/reaction_heat_released", &b.reaction_heat_released},
+                         {"books/heat_relocated", &b.heat_relocated},
+                         {"books/nodal_energy_change", &b.nodal_energy_change},
+                         {"books/min_window", &b.min_window},
+                         {"books/max_window", &b.max_window},
+                         {"books/max_assembly_residual", &b.max_assembly_residual}})
+    v(name, *x);
+  v("books/windows", b.windows);
+  v("books/continuation_intervals", b.continuation_intervals);
+  v("books/steps", b.steps);
+  thermal::IntegratorStats s = integrator_stats();
+  for (auto [name, x] : {std::pair<const char*, long*>{"integrator/steps", &s.steps},
+                         {"integrator/rhs_evals", &s.rhs_evals},
+                         {"integrator/jac_evals", &s.jac_evals},
+                         {"integrator/nonlinear_iters", &s.nonlinear_iters},
+                         {"integrator/linear_iters", &s.linear_iters},
+                         {"integrator/error_test_failures", &s.error_test_failures},
+                         {"integrator/convergence_failures", &s.convergence_failures},
+                         {"integrator/reinits", &s.reinits}})
+    v(name, *x);
+  // Counts only: wall time is the process's own (after a resume /meta times the resumed part), and
+  // equal states give byte-equal checkpoints.
+  s.wall_seconds = integrator_stats().wall_seconds;
+  if constexpr (reading) {
+    stats_offset_ = s;
+    stats_offset_ -= integrator_->stats();  // integrator_stats() == s from here on
+    const double residual = books_.max_assembly_residual;
+    assemble(particles);  // problem and reaction state from the restored particles
+    books_.max_assembly_residual = residual;
+    system_.grid_node = std::move(grid_node);  // the adaptive estimate's M: the last window's
+    system_.unknown = std::move(unknown);
+    system_.mass = std::move(mass);
+    min_unknown_mass_ = system_.mass.size() > 0 ? system_.mass.minCoeff() : 0.0;
+    nearest_mass_.clear();
+    if (tracker_.options_changed()) tracker_.redetect(particles, opt_.materials, window_start_);
+  } else {
+    (void)particles;
+  }
+}
 
 extern template class Coupler<2>;
 extern template class Coupler<3>;

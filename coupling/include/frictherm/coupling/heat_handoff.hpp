@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -29,6 +30,18 @@ class HeatAccumulator {
   std::size_t node_count() const { return work_.size(); }
   /// Forgets the pending work (after it was delivered).
   void clear();
+  /// Checkpoints (state_visit.hpp): the nodal work and its running sum (kept, not re-summed, so a
+  /// restored window delivers bit-for-bit the same heat).
+  template <class V> void visit_state(V&& v) {
+    v("pending/work", work_);
+    v("pending/total", total_);
+    if constexpr (std::decay_t<V>::reading) {
+      touched_.clear();
+      is_touched_.assign(work_.size(), 0);
+      for (std::size_t i = 0; i < work_.size(); ++i)
+        if (work_[i] != 0.0) is_touched_[i] = 1, touched_.push_back(i);
+    }
+  }
 
  private:
   std::vector<double> work_;

@@ -55,6 +55,8 @@ class PlasticHeatSource {
   double collect(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                  mechanics::ShapeKind shape, HeatAccumulator& pending, double& plastic_work);
   const PlasticHeatingOptions& options() const { return opt_; }
+  /// Checkpoints: each particle's plastic work at the last call.
+  template <class V> void visit_state(V&& v) { v("plastic/last_work", last_); }
 
  private:
   PlasticHeatingOptions opt_;

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -56,12 +57,24 @@ class HotSpotTracker {
               double time);
 
   const HotSpotOptions& options() const { return opt_; }
+  /// Forgets the hot spots (keeping T0_p) and finds them again at `time` under the current options,
+  /// with ids from 0: a checkpoint restored under another threshold (frictherm continue).
+  template <int Dim>
+  void redetect(const mechanics::Particles<Dim>& particles, const std::vector<ThermalProperties>& materials,
+                double time) {
+    current_.clear();
+    owner_.clear();
+    next_id_ = 0;
+    update(particles, materials, time);
+  }
   /// The hot spots of the last update, ascending id.
   const std::vector<HotSpot>& hot_spots() const { return current_; }
   /// The one with the highest peak temperature; nullptr if there is none.
   const HotSpot* hottest() const;
   /// Ids handed out so far (every hot spot ever seen).
   long ids_issued() const { return next_id_; }
+  /// After a restore (visit_state): the checkpoint was written under other options.
+  bool options_changed() const { return options_changed_; }
   /// Highest particle temperature at the last update (conducting materials; K).
   double max_temperature() const { return max_temperature_; }
   double last_time() const { return last_time_; }
@@ -74,7 +87,39 @@ class HotSpotTracker {
     return level > opt_.threshold;
   }
 
+  /// Checkpoints (state_visit.hpp): T0_p, the current hot spots (matched by the next update), the
+  /// particle owners, the id counter and the last maximum and time.
+  template <class V> void visit_state(V&& v) {
+    v("hotspots/reference", reference_);
+    v("hotspots/owner", owner_);
+    v("hotspots/next_id", next_id_);
+    v("hotspots/max_temperature", max_temperature_);
+    v("hotspots/last_time", last_time_);
+    double options[4] = {opt_.mode == HotSpotOptions::Mode::absolute ? 1.0 : 0.0, opt_.threshold, opt_.link_factor,
+                         static_cast<double>(opt_.min_particles)};
+    std::vector<double> written(options, options + 4);
+    v("hotspots/options", written);  // reading: those of the run that wrote the checkpoint
+    if constexpr (std::decay_t<V>::reading) options_changed_ = written != std::vector<double>(options, options + 4);
+    // current_, flattened: scalars (kScalars per hot spot), then particles and materials with offsets.
+    std::vector<double> scalars;
+    std::vector<long> particles, particle_end, materials, material_end;
+    if constexpr (!std::decay_t<V>::reading) flatten(scalars, particles, particle_end, materials, material_end);
+    v("hotspots/current_scalars", scalars);
+    v("hotspots/current_particles", particles);
+    v("hotspots/current_particle_end", particle_end);
+    v("hotspots/current_materials", materials);
+    v("hotspots/current_material_end", material_end);
+    if constexpr (std::decay_t<V>::reading) unflatten(scalars, particles, particle_end, materials, material_end);
+  }
+
  private:
+  static constexpr std::size_t kScalars = 13;
+  void flatten(std::vector<double>& scalars, std::vector<long>& particles, std::vector<long>& particle_end,
+               std::vector<long>& materials, std::vector<long>& material_end) const;
+  /// Throws std::runtime_error when the arrays do not fit together.
+  void unflatten(const std::vector<double>& scalars, const std::vector<long>& particles,
+                 const std::vector<long>& particle_end, const std::vector<long>& materials,
+                 const std::vector<long>& material_end);
   struct Candidate {
     std::size_t index;
     std::array<double, 3> x;
@@ -92,6 +137,7 @@ class HotSpotTracker {
   long next_id_ = 0;
   double max_temperature_ = 0.0;
   double last_time_ = 0.0;
+  bool options_changed_ = false;
 };
 
 }  // namespace frictherm::coupling

@@ -76,12 +76,20 @@ struct RunOptions {
   double flush_interval = 2.0;
   /// Wall seconds between checkpoints ("<output>.checkpoint", checkpoint.hpp); 0: only the scene's
   /// run.checkpoint_interval. With either, a checkpoint is also written at the end and on SIGINT/SIGTERM.
+  /// A scene with a thermal continuation always gets one at the end of loading (frictherm continue).
   double checkpoint_wall_interval = 0.0;
-  /// A checkpoint (checkpoint.hpp) to start from instead of t = 0: the simulation is built from the
-  /// scene, the checkpoint's state restored, and the run continues to end_time landing on the same
-  /// snapshot, series and checkpoint times as an uninterrupted run; the output file starts at the
-  /// checkpoint's state. Mechanics-only scenes.
+  /// A checkpoint (checkpoint.hpp) to start from instead of t = 0: the simulation (and the thermal
+  /// coupler) is built from the scene, the checkpoint's state restored, and the run continues to
+  /// end_time (and through the thermal continuation) landing on the same snapshot, series and
+  /// checkpoint times as an uninterrupted run; the output file starts at the checkpoint's state.
   std::string resume_checkpoint;
+  /// With resume_checkpoint: the output holds only what an uninterrupted run writes after the
+  /// checkpoint (no first row and snapshot at its state), to be appended to the interrupted result
+  /// (append_result, result_append.hpp); the checkpoints it writes count rows from that result.
+  bool resume_appends = false;
+  /// Where checkpoints go; empty: "<output>.checkpoint". May be resume_checkpoint itself (a resumed
+  /// run goes on replacing the checkpoint it started from, atomically).
+  std::string checkpoint_file;
   /// Called after every mechanics step (not during the thermal-only continuation), after the step's
   /// heat handoff and series row, so diagnostics need no copy of the run loop. An exception thrown
   /// by the observer ends the run and propagates out of run_scene (the file written so far stays).

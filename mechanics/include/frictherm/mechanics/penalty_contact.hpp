@@ -26,7 +26,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -205,6 +207,61 @@ class PenaltyContact {
       if (mI > min_mass) frequency_bound2_ = std::max(frequency_bound2_, load / mI);
     }
     return frequency_bound2_;
+  }
+  /// Checkpoints (Simulation::visit_state): calls v(name, member) for what the next compute() and the
+  /// next time step read: the per-pair slip histories (segment, β, l_ms, t_T, stamp per point), the
+  /// call counter, the spring energy and the frequency bound; and what the series report of the last
+  /// step (the pair books, the contact records). Visitors with `reading` true restore them (the pairs
+  /// must have been added as when written).
+  template <class Visitor>
+  void visit_state(Visitor&& v) {
+    constexpr bool reading = std::decay_t<Visitor>::reading;
+    for (std::size_t k = 0; k < history_.size(); ++k) {
+      const std::string p = "penalty/pair" + std::to_string(k) + "/";
+      History& h = history_[k];
+      v((p + "segment").c_str(), h.segment);
+      v((p + "beta").c_str(), h.beta);
+      v((p + "length").c_str(), h.length);
+      v((p + "traction").c_str(), h.traction);
+      v((p + "stamp").c_str(), h.stamp);
+      PenaltyPairBooks& b = books_[k];
+      std::vector<double> books{static_cast<double>(b.active), static_cast<double>(b.sliding), b.normal_force,
+                                b.tangential_force, b.heat_step, b.heat_total, b.force_on_slave[0],
+                                b.force_on_slave[1]};
+      v((p + "books").c_str(), books);
+      if constexpr (reading) {
+        if (books.size() != 8) throw std::runtime_error("checkpoint: penalty books need 8 values");
+        b.active = static_cast<long>(books[0]);
+        b.sliding = static_cast<long>(books[1]);
+        b.normal_force = books[2], b.tangential_force = books[3], b.heat_step = books[4], b.heat_total = books[5];
+        b.force_on_slave = Vec<2>(books[6], books[7]);
+      }
+    }
+    constexpr std::size_t R = 17;  // values per contact record
+    std::vector<double> rec;
+    if constexpr (!reading)
+      for (const PenaltyContactRecord& r : records_)
+        rec.insert(rec.end(), {double(r.pair), double(r.slave), double(r.segment), double(r.vertex), r.beta, r.gap,
+                               r.slip_increment, r.slip, r.area, r.normal_force, r.tangential_force, r.heat,
+                               double(r.sliding), r.e_nor[0], r.e_nor[1], r.e_tan[0], r.e_tan[1]});
+    v("penalty/records", rec);
+    if constexpr (reading) {
+      if (rec.size() % R != 0) throw std::runtime_error("checkpoint: penalty records need 17 values each");
+      records_.assign(rec.size() / R, PenaltyContactRecord{});
+      for (std::size_t i = 0; i < records_.size(); ++i) {
+        const double* x = &rec[i * R];
+        PenaltyContactRecord& r = records_[i];
+        r.pair = int(x[0]), r.slave = int(x[1]), r.segment = int(x[2]), r.vertex = x[3] != 0.0;
+        r.beta = x[4], r.gap = x[5], r.slip_increment = x[6], r.slip = x[7], r.area = x[8];
+        r.normal_force = x[9], r.tangential_force = x[10], r.heat = x[11], r.sliding = x[12] != 0.0;
+        r.e_nor = Vec<2>(x[13], x[14]), r.e_tan = Vec<2>(x[15], x[16]);
+      }
+    }
+    std::vector<std::uint64_t> stamp{stamp_};
+    v("penalty/stamp", stamp);
+    if constexpr (reading) stamp_ = stamp.at(0);
+    v("penalty/stored_energy", stored_energy_);
+    v("penalty/frequency_bound2", frequency_bound2_);
   }
   /// The bound of the last update_frequency_bound() (1/s²); 0 before any, or without contacts.
   double frequency_bound_squared() const { return frequency_bound2_; }

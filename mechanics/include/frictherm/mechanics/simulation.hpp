@@ -201,15 +201,12 @@ class Simulation {
   double external_work() const { return external_work_; }
 
   // ---- checkpoint -------------------------------------------------------------------------
-  /// Why this simulation cannot be checkpointed (empty: it can). Penalty contact keeps slip
-  /// histories and boundary points that the state below does not hold.
-  std::string checkpoint_refusal() const {
-    return penalty_ ? "penalty contact keeps boundary-point and slip histories that checkpoints do not store" : "";
-  }
   /// Calls v(name, member) for every member that changes while stepping and that the next step
   /// reads: with these restored into a simulation built from the same set-up (after finalize()),
-  /// stepping continues bit-for-bit. Members are std::vector<T> (T double, int32 or a fixed-size
-  /// Eigen type) or double, long, bool. Everything else is rebuilt each step from these.
+  /// stepping continues bit-for-bit. Members are std::vector<T> (T double, int32, uint64 or a
+  /// fixed-size Eigen type) or double, long, bool; visitors declare `static constexpr bool reading`.
+  /// Penalty contact adds its boundary points and slip histories (PenaltyContact::visit_state); EBS
+  /// bases, contact nodes and nodal fields are rebuilt each step from these.
   template <class Visitor> void visit_state(Visitor&& v) {
     if (!finalized_) finalize();
     v("particles/position", p_.position);
@@ -241,6 +238,19 @@ class Simulation {
     if (contact_opt_.regularized()) {
       v("contact/lagged_normal_traction", lagged_normal_traction_);
       v("contact/lagged_normal_step", lagged_normal_step_);
+    }
+    // The last step's contact counters: only reported (series rows of a thermal continuation).
+    for (auto [name, x] : {std::pair<const char*, long*>{"contact_stats/contact_nodes", &contact_stats_.contact_nodes},
+                           {"contact_stats/multi_nodes", &contact_stats_.multi_nodes},
+                           {"contact_stats/sliding_nodes", &contact_stats_.sliding_nodes},
+                           {"contact_stats/guarded", &contact_stats_.guarded},
+                           {"contact_stats/penalty_contacts", &contact_stats_.penalty_contacts},
+                           {"contact_stats/penalty_sliding", &contact_stats_.penalty_sliding}})
+      v(name, *x);
+    if (penalty_) {  // penalty contact: the boundary points move with the bodies; slip histories
+      v("boundary/position", boundary_.position);
+      v("boundary/velocity", boundary_.velocity);
+      penalty_->visit_state(v);
     }
   }
 

@@ -1,0 +1,35 @@
+#pragma once
+// Shared by `frictherm resume` and `frictherm continue` (cli_resume.cpp, cli_continue.cpp).
+#include <frictherm/coupling/runner.hpp>
+#include <frictherm/coupling/scene.hpp>
+
+#include <string>
+
+namespace frictherm::cli {
+
+struct ResumeRequest {
+  std::string run;         // the result the checkpoint belongs to
+  std::string checkpoint;  // RUN.h5.checkpoint
+  std::string output;      // where the appended result goes (may be `run`)
+  coupling::Scene scene;   // rebuilt from the checkpoint (with continue's --set)
+  int threads = 0;
+  double checkpoint_wall_interval = 0.0;  // --checkpoint-every (resume)
+  bool quiet = false;
+  bool force = false;      // replace an existing output that is not `run`
+  std::string command_line;
+};
+
+struct ResumeOutcome {
+  coupling::RunResult result;
+  bool appended = false;  // to the interrupted result (else written alone: no RUN.h5)
+};
+
+/// Runs the scene from the checkpoint and appends the output to `run` (result_append.hpp) into
+/// `output`; without `run` writes `output` alone. Throws OutputError when `output` is refused,
+/// SceneError / std::runtime_error as run_scene and append_result do.
+ResumeOutcome resume_from_checkpoint(const ResumeRequest& request);
+
+/// The exit code and message of a resumed run ("resumed" / "continued").
+int report_resumed(const char* command, const ResumeOutcome& outcome, bool quiet);
+
+}  // namespace frictherm::cli

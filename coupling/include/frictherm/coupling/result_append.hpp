@@ -1,0 +1,25 @@
+#pragma once
+// One result from an interrupted run and its resumption (issue 17, frictherm resume/continue): the
+// rows and snapshots the interrupted result had at the checkpoint (CheckpointMarks), then everything
+// the resumed run wrote (RunOptions::resume_appends), so the file reads as one run.
+#include <frictherm/coupling/checkpoint.hpp>
+
+#include <string>
+
+namespace frictherm::coupling {
+
+/// Writes `output` = `original` cut at `marks` (its first marks.series_rows series rows, the first
+/// rows of each table, the first marks.snapshots snapshots, no /failure) followed by `continuation`'s
+/// series and table rows and snapshots (renumbered after the kept ones, /failure if it has one);
+/// /meta keys the continuation wrote replace the original's. The file is built as
+/// "<output>.<pid>.part" (a copy of `original`) and renamed onto `output` only when complete, so
+/// `original` (which may be `output` itself) stays whole if anything fails; `output`'s XDMF file is
+/// rebuilt. Throws std::runtime_error naming the file and what does not fit (columns differ, fewer
+/// rows than the marks).
+void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
+                   const std::string& output);
+
+/// The XDMF document of every snapshot (and /failure) in `h5_path`, pointing at `h5_name`.
+std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name);
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,103 @@
+#pragma once
+// Private: the HDF5 visitors of checkpoints (checkpoint.cpp). A visitor is called as v(name, member)
+// for every member of a state (Simulation::visit_state, Coupler::visit_state, the run's marks); names
+// with '/' make groups. Members: std::vector<T> (T double, int32, long, uint64 or a fixed-size Eigen
+// type of doubles) stored n × components, and double, long, bool scalars stored as one-element
+// datasets. `reading` tells a state whether it is being written (false) or restored (true), for
+// members it must convert (Eigen::VectorXd, structures of nested vectors).
+#include "h5_util.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace frictherm::coupling::ckpt {
+
+namespace detail {
+
+template <class T> struct Layout {  // fixed-size Eigen vector or matrix of doubles
+  static_assert(std::is_same_v<typename T::Scalar, double>, "checkpoint: Eigen members must hold doubles");
+  static_assert(sizeof(T) == sizeof(double) * T::SizeAtCompileTime, "checkpoint: padded Eigen type");
+  static constexpr int components = T::SizeAtCompileTime;
+  static hid_t type() { return H5T_NATIVE_DOUBLE; }
+};
+template <> struct Layout<double> {
+  static constexpr int components = 1;
+  static hid_t type() { return H5T_NATIVE_DOUBLE; }
+};
+template <> struct Layout<std::int32_t> {
+  static constexpr int components = 1;
+  static hid_t type() { return H5T_NATIVE_INT32; }
+};
+template <> struct Layout<long> {
+  static constexpr int components = 1;
+  static hid_t type() { return H5T_NATIVE_LONG; }
+};
+template <> struct Layout<std::uint64_t> {
+  static constexpr int components = 1;
+  static hid_t type() { return H5T_NATIVE_UINT64; }
+};
+
+}  // namespace detail
+
+/// Writes `n` items of `components` values of `type` as `name` under `group` (no time stamps: equal
+/// states give byte-equal files).
+void write_array(hid_t group, const std::string& file, const std::string& name, hid_t type, const void* data,
+                 hsize_t n, int components);
+/// Opens `name`, checks that it holds items of `components` values and returns their count in `n`.
+h5detail::Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n);
+
+struct Writer {
+  static constexpr bool reading = false;
+  hid_t group;
+  const std::string& file;
+  template <class T> void operator()(const char* name, std::vector<T>& data) const {
+    using L = detail::Layout<T>;
+    write_array(group, file, name, L::type(), data.data(), data.size(), L::components);
+  }
+  void operator()(const char* name, double& x) const { write_array(group, file, name, H5T_NATIVE_DOUBLE, &x, 1, 1); }
+  void operator()(const char* name, long& x) const { write_array(group, file, name, H5T_NATIVE_LONG, &x, 1, 1); }
+  void operator()(const char* name, bool& x) const {
+    const std::int32_t b = x ? 1 : 0;
+    write_array(group, file, name, H5T_NATIVE_INT32, &b, 1, 1);
+  }
+};
+
+struct Reader {
+  static constexpr bool reading = true;
+  hid_t group;
+  const std::string& file;
+  std::size_t particles;  // "particles/..." arrays must hold this many items
+  template <class T> void operator()(const char* name, std::vector<T>& data) const {
+    using L = detail::Layout<T>;
+    hsize_t n = 0;
+    const h5detail::Handle d = open_array(group, file, name, L::components, n);
+    const std::string key(name);
+    if (key.rfind("particles/", 0) == 0 && n != particles)
+      throw std::runtime_error("checkpoint '" + file + "': '" + key + "' holds " + std::to_string(n) +
+                               " particles, the simulation built from the scene has " + std::to_string(particles));
+    data.resize(n);
+    if (n > 0)
+      h5detail::check(H5Dread(d.get(), L::type(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file,
+                      "cannot read '" + key + "'");
+  }
+  template <class T> void scalar(const char* name, hid_t type, T& x) const {
+    hsize_t n = 0;
+    const h5detail::Handle d = open_array(group, file, name, 1, n);
+    if (n != 1) throw std::runtime_error("checkpoint '" + file + "': '" + std::string(name) + "' is not one value");
+    h5detail::check(H5Dread(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &x), file,
+                    "cannot read '" + std::string(name) + "'");
+  }
+  void operator()(const char* name, double& x) const { scalar(name, H5T_NATIVE_DOUBLE, x); }
+  void operator()(const char* name, long& x) const { scalar(name, H5T_NATIVE_LONG, x); }
+  void operator()(const char* name, bool& x) const {
+    std::int32_t b = 0;
+    scalar(name, H5T_NATIVE_INT32, b);
+    x = b != 0;
+  }
+};
+
+}  // namespace frictherm::coupling::ckpt

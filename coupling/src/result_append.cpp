@@ -1,0 +1,212 @@
+// Appending a resumed run's output to the interrupted result (result_append.hpp).
+#include <frictherm/coupling/result_append.hpp>
+
+#include "h5_util.hpp"
+
+#include <frictherm/coupling/output_files.hpp>
+#include <frictherm/coupling/xdmf.hpp>
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+namespace frictherm::coupling {
+
+namespace {
+
+using h5detail::check;
+using h5detail::check_id;
+using h5detail::Handle;
+
+herr_t collect_name(hid_t, const char* name, const H5L_info_t*, void* out) {
+  static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+  return 0;
+}
+
+// Link names of a group in creation order (names sort the same for snapshots).
+std::vector<std::string> members(hid_t group) {
+  std::vector<std::string> names;
+  hsize_t idx = 0;
+  H5Literate(group, H5_INDEX_NAME, H5_ITER_INC, &idx, collect_name, &names);
+  return names;
+}
+
+bool exists(hid_t loc, const std::string& path) { return H5Lexists(loc, path.c_str(), H5P_DEFAULT) > 0; }
+
+hsize_t rows_of(hid_t d, const std::string& file, const std::string& where) {
+  const Handle s{check_id(H5Dget_space(d), file, "dataspace of " + where), H5Sclose};
+  hsize_t n = 0;
+  if (H5Sget_simple_extent_ndims(s.get()) != 1) throw std::runtime_error("'" + file + "': " + where + " is not a column");
+  H5Sget_simple_extent_dims(s.get(), &n, nullptr);
+  return n;
+}
+
+// /<group>/<column>: the original's first `keep` rows, then all of the continuation's rows.
+void append_columns(hid_t out, hid_t cont, const std::string& group, long keep, const std::string& file,
+                    const std::string& cont_file) {
+  const bool in_out = exists(out, "/" + group), in_cont = exists(cont, "/" + group);
+  if (!in_out && !in_cont) return;
+  if (!in_out || !in_cont)
+    throw std::runtime_error("'" + file + "' and '" + cont_file + "': only one of them has /" + group);
+  const Handle go{check_id(H5Gopen2(out, group.c_str(), H5P_DEFAULT), file, "/" + group), H5Gclose};
+  const Handle gc{check_id(H5Gopen2(cont, group.c_str(), H5P_DEFAULT), cont_file, "/" + group), H5Gclose};
+  const std::vector<std::string> cols = members(go.get()), cont_cols = members(gc.get());
+  if (cols != cont_cols)
+    throw std::runtime_error("'" + file + "': the columns of /" + group + " differ from those of the resumed run");
+  for (const std::string& c : cols) {
+    const std::string where = "/" + group + "/" + c;
+    const Handle d{check_id(H5Dopen2(go.get(), c.c_str(), H5P_DEFAULT), file, where), H5Dclose};
+    const Handle e{check_id(H5Dopen2(gc.get(), c.c_str(), H5P_DEFAULT), cont_file, where), H5Dclose};
+    const hsize_t have = rows_of(d.get(), file, where), add = rows_of(e.get(), cont_file, where);
+    if (have < static_cast<hsize_t>(keep))
+      throw std::runtime_error("'" + file + "': " + where + " has " + std::to_string(have) +
+                               " rows, the checkpoint counts " + std::to_string(keep) +
+                               " (the result was written after the checkpoint by another run?)");
+    const Handle type{check_id(H5Dget_type(d.get()), file, "type of " + where), H5Tclose};
+    const bool integer = H5Tget_class(type.get()) == H5T_INTEGER;
+    const hid_t mem = integer ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
+    std::vector<double> vd(integer ? 0 : add);
+    std::vector<std::int64_t> vi(integer ? add : 0);
+    void* buf = integer ? static_cast<void*>(vi.data()) : static_cast<void*>(vd.data());
+    if (add > 0) check(H5Dread(e.get(), mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf), cont_file, "cannot read " + where);
+    const hsize_t start = static_cast<hsize_t>(keep), total = start + add;
+    check(H5Dset_extent(d.get(), &total), file, "cannot resize " + where);
+    if (add == 0) continue;
+    const Handle fs{check_id(H5Dget_space(d.get()), file, "dataspace of " + where), H5Sclose};
+    check(H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, &start, nullptr, &add, nullptr), file, "rows of " + where);
+    const Handle ms{check_id(H5Screate_simple(1, &add, nullptr), file, "dataspace"), H5Sclose};
+    check(H5Dwrite(d.get(), mem, ms.get(), fs.get(), H5P_DEFAULT, buf), file, "cannot write " + where);
+  }
+}
+
+void copy_object(hid_t from, const std::string& src, hid_t to, const std::string& dst, const std::string& file) {
+  check(H5Ocopy(from, src.c_str(), to, dst.c_str(), H5P_DEFAULT, H5P_DEFAULT), file, "cannot copy " + src + " to " + dst);
+}
+
+std::string snapshot_name(std::size_t k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06zu", k);
+  return name;
+}
+
+void append_snapshots(hid_t out, hid_t cont, long keep, const std::string& file, const std::string& cont_file) {
+  if (exists(out, "/failure")) check(H5Ldelete(out, "/failure", H5P_DEFAULT), file, "cannot remove /failure");
+  if (!exists(out, "/snapshots")) throw std::runtime_error("'" + file + "' has no /snapshots: not a frictherm result");
+  const Handle so{check_id(H5Gopen2(out, "snapshots", H5P_DEFAULT), file, "/snapshots"), H5Gclose};
+  const std::vector<std::string> have = members(so.get());
+  if (have.size() < static_cast<std::size_t>(keep))
+    throw std::runtime_error("'" + file + "' has " + std::to_string(have.size()) + " snapshots, the checkpoint counts " +
+                             std::to_string(keep));
+  for (const std::string& n : have)
+    if (std::stol(n) >= keep) check(H5Ldelete(so.get(), n.c_str(), H5P_DEFAULT), file, "cannot remove a snapshot");
+  if (exists(cont, "/snapshots")) {
+    const Handle sc{check_id(H5Gopen2(cont, "snapshots", H5P_DEFAULT), cont_file, "/snapshots"), H5Gclose};
+    std::size_t k = static_cast<std::size_t>(keep);
+    for (const std::string& n : members(sc.get())) copy_object(sc.get(), n, so.get(), snapshot_name(k++), file);
+  }
+  if (exists(cont, "/failure")) copy_object(cont, "/failure", out, "/failure", file);
+  if (exists(cont, "/xdmf")) {  // Polyvertex connectivities of new particle counts
+    if (!exists(out, "/xdmf")) check_id(H5Gclose(H5Gcreate2(out, "xdmf", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)), file, "/xdmf");
+    const Handle xc{check_id(H5Gopen2(cont, "xdmf", H5P_DEFAULT), cont_file, "/xdmf"), H5Gclose};
+    for (const std::string& n : members(xc.get()))
+      if (!exists(out, "/xdmf/" + n)) copy_object(xc.get(), n, out, "/xdmf/" + n, file);
+  }
+}
+
+void replace_meta(hid_t out, hid_t cont, const std::string& file, const std::string& cont_file) {
+  if (!exists(cont, "/meta")) return;
+  const Handle mc{check_id(H5Gopen2(cont, "meta", H5P_DEFAULT), cont_file, "/meta"), H5Gclose};
+  const Handle mo{check_id(H5Gopen2(out, "meta", H5P_DEFAULT), file, "/meta"), H5Gclose};
+  // How the interrupted part ended: true of the joined result only if the resumed part says so too.
+  for (const char* stale : {"interruption", "failure"})
+    if (exists(mo.get(), stale)) check(H5Ldelete(mo.get(), stale, H5P_DEFAULT), file, "cannot remove /meta/" + std::string(stale));
+  for (const std::string& n : members(mc.get())) {
+    if (exists(mo.get(), n)) check(H5Ldelete(mo.get(), n.c_str(), H5P_DEFAULT), file, "cannot replace /meta/" + n);
+    copy_object(mc.get(), n, mo.get(), n, file);
+  }
+}
+
+template <class T> T read_attribute(hid_t obj, const char* name, hid_t type, const std::string& file) {
+  const Handle a{check_id(H5Aopen(obj, name, H5P_DEFAULT), file, std::string("attribute ") + name), H5Aclose};
+  T value{};
+  check(H5Aread(a.get(), type, &value), file, std::string("attribute ") + name);
+  return value;
+}
+
+XdmfGrid grid_of(hid_t g, const std::string& name, const std::string& path, const std::string& file) {
+  XdmfGrid grid;
+  grid.name = name;
+  grid.h5_group = path;
+  grid.step = static_cast<long>(read_attribute<std::int64_t>(g, "step", H5T_NATIVE_INT64, file));
+  grid.time = read_attribute<double>(g, "time", H5T_NATIVE_DOUBLE, file);
+  for (const std::string& f : members(g)) {
+    const Handle d{check_id(H5Dopen2(g, f.c_str(), H5P_DEFAULT), file, path + "/" + f), H5Dclose};
+    const Handle s{check_id(H5Dget_space(d.get()), file, "dataspace"), H5Sclose};
+    hsize_t dims[2] = {0, 1};
+    const int rank = H5Sget_simple_extent_dims(s.get(), dims, nullptr);
+    const Handle t{check_id(H5Dget_type(d.get()), file, "type"), H5Tclose};
+    grid.points = static_cast<std::size_t>(dims[0]);
+    grid.fields.push_back({f, rank == 2 ? static_cast<int>(dims[1]) : 1, H5Tget_class(t.get()) == H5T_INTEGER});
+  }
+  grid.connectivity = "/xdmf/polyvertex_" + std::to_string(grid.points);
+  return grid;
+}
+
+}  // namespace
+
+std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name) {
+  const h5detail::Quiet quiet;
+  const Handle f{check_id(H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), h5_path, "cannot open"), H5Fclose};
+  const int dim = read_attribute<int>(f.get(), "dim", H5T_NATIVE_INT, h5_path);
+  std::vector<std::string> xml;
+  const auto add = [&](hid_t g, const std::string& name, const std::string& path) {
+    const XdmfGrid grid = grid_of(g, name, path, h5_path);
+    bool drawable = false;
+    for (const XdmfField& fd : grid.fields) drawable = drawable || (fd.name == "position" && fd.components == dim);
+    if (drawable && grid.points > 0 && exists(f.get(), grid.connectivity)) xml.push_back(xdmf_grid_xml(grid, h5_name, dim));
+  };
+  if (exists(f.get(), "/snapshots")) {
+    const Handle s{check_id(H5Gopen2(f.get(), "snapshots", H5P_DEFAULT), h5_path, "/snapshots"), H5Gclose};
+    for (const std::string& n : members(s.get())) {
+      const Handle g{check_id(H5Gopen2(s.get(), n.c_str(), H5P_DEFAULT), h5_path, "/snapshots/" + n), H5Gclose};
+      add(g.get(), n, "/snapshots/" + n);
+    }
+  }
+  if (exists(f.get(), "/failure")) {
+    const Handle g{check_id(H5Gopen2(f.get(), "failure", H5P_DEFAULT), h5_path, "/failure"), H5Gclose};
+    add(g.get(), "failure", "/failure");
+  }
+  return xdmf_document(xml);
+}
+
+void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
+                   const std::string& output) {
+  const std::string tmp = temporary_path(output);
+  try {
+    std::filesystem::copy_file(original, tmp);
+    {
+      const h5detail::Quiet quiet;
+      const Handle out{check_id(H5Fopen(tmp.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), tmp, "cannot open the copy"), H5Fclose};
+      const Handle cont{check_id(H5Fopen(continuation.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), continuation, "cannot open"),
+                        H5Fclose};
+      append_columns(out.get(), cont.get(), "series", marks.series_rows, original, continuation);
+      for (const auto& [table, rows] : marks.table_rows)
+        append_columns(out.get(), cont.get(), table, rows, original, continuation);
+      append_snapshots(out.get(), cont.get(), marks.snapshots, original, continuation);
+      replace_meta(out.get(), cont.get(), original, continuation);
+      check(H5Fflush(out.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush");
+    }
+    const std::size_t slash = output.find_last_of('/');
+    const std::string name = slash == std::string::npos ? output : output.substr(slash + 1);
+    const std::string xdmf = xdmf_of_result(tmp, name);
+    publish_file(tmp, output, true);
+    write_text_atomically(xdmf_path_for(output), xdmf);
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+}
+
+}  // namespace frictherm::coupling
