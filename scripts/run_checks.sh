@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Standing checks (issue 15, docs/robustness.md): a clang build with AddressSanitizer +
+# UndefinedBehaviorSanitizer and the libFuzzer target, in its own folder (build-checks), then
+#   1. the unit tests (ctest -L unit) under the sanitizers,
+#   2. the fuzzer on scene parsing and validation for FUZZ_SECONDS (default 60) from the seed corpus
+#      (examples/*.json and tests/fuzz/regressions), and the bad-input sweep (tests/robustness).
+#   scripts/run_checks.sh [extra ctest arguments, e.g. -L verification]
+# Environment: FUZZ_SECONDS (0 skips the fuzzer), CHECKS_BUILD_DIR (default build-checks),
+# CHECKS_LABEL (ctest label, default unit). Uses ccache when it is installed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+build=${CHECKS_BUILD_DIR:-build-checks}
+label=${CHECKS_LABEL:-unit}
+fuzz_seconds=${FUZZ_SECONDS:-60}
+jobs=$(nproc 2>/dev/null || echo 2)
+
+scripts/install_deps.sh
+launcher=()
+if command -v ccache >/dev/null 2>&1; then
+  export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(dirname "$root")}
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+fi
+# -O1 keeps the instrumented build and its tests fast enough for CI; line tables name source lines in
+# sanitizer reports.
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" \
+      -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+      -DCMAKE_CXX_FLAGS_RELEASE="-O1 -gline-tables-only -DNDEBUG" -DCMAKE_C_FLAGS_RELEASE="-O1 -DNDEBUG" \
+      -DFRICTHERM_SANITIZE=ON -DFRICTHERM_FUZZ=ON -DFRICTHERM_BUILD_BENCH=OFF
+cmake --build "$build" -j "$jobs"
+
+# Leaks are findings too; the suppressions name third-party libraries only (none so far).
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+ctest --test-dir "$build" --output-on-failure -j "$jobs" -L "$label" "$@"
+
+if [ "$fuzz_seconds" -gt 0 ]; then
+  scripts/run_fuzzer.sh "$build" "$fuzz_seconds"
+fi
