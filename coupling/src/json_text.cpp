@@ -139,7 +139,7 @@ class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   void open(bool object) {
     value();
     if (frames_.size() >= kMaxJsonDepth)
-      fail(named_path() + ": objects and arrays nested deeper than " +
+      fail(outer_path() + ": objects and arrays nested deeper than " +
            std::to_string(kMaxJsonDepth) + " levels at " + here() + "; expected at most " + std::to_string(kMaxJsonDepth));
     frames_.push_back(Frame{object, {}, -1, {}});
   }
@@ -150,6 +150,16 @@ class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
       if (!f.object && f.index >= 0) p += "[" + std::to_string(f.index) + "]";
     }
     return p;
+  }
+  // The key path down to the first array below the top level ("description" for a deep array in
+  // it; "scene" when the document itself is the deep array): a deep path would fill the message.
+  std::string outer_path() const {
+    std::string p = root_path_;
+    for (const Frame& f : frames_) {
+      if (!f.object || f.key.empty()) break;
+      p += (p.empty() ? "" : ".") + f.key;
+    }
+    return p.empty() ? std::string("scene") : p;
   }
   std::string named_path() const {  // "scene" for the document itself
     const std::string p = path();

@@ -179,7 +179,7 @@ TEST(SceneValidation, ContactMistakesNameTheKey) {
   EXPECT_THAT(scene_error(s), StartsWith("contact.law.type: expected one of"));
   s = contact_scene();
   s["contact"]["pairs"][0]["materials"] = Json::parse(R"(["base", "wood"])");
-  EXPECT_THAT(scene_error(s), AllOf(StartsWith("contact.pairs[0].materials[1]: unknown material 'wood'"),
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("contact.pairs[0].materials[1]: unknown material \"wood\""),
                                     HasSubstr("steel, base")));
   s = contact_scene();
   s["contact"]["normal"] = Json::parse("[0, 1]");
@@ -283,7 +283,7 @@ TEST(SceneValidation, JsonLimitsNameTheKeyPathAndLine) {
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');
   EXPECT_THAT(scene_error(deep), StartsWith("scene: objects and arrays nested deeper than 64 levels at line 1, column 65"));
   const std::string nested = scene_error("{\"description\": " + deep + "}");
-  EXPECT_THAT(nested, StartsWith("description[0][0][0]"));
+  EXPECT_THAT(nested, StartsWith("description: objects and arrays"));
   EXPECT_THAT(nested, HasSubstr("nested deeper than 64 levels at line 1, column 80"));
   Json s = good_scene();
   const std::string text = s.dump(1);
@@ -309,6 +309,6 @@ TEST(SceneValidation, JsonLimitsNameTheKeyPathAndLine) {
     return "";
   };
   EXPECT_THAT(set_error("run.end_time", "1e999"), StartsWith("--set run.end_time: the number 1e999 at line 1, column"));
-  EXPECT_THAT(set_error("description", deep), StartsWith("--set description[0][0]"));
+  EXPECT_THAT(set_error("description", deep), StartsWith("--set description: objects and arrays"));
   EXPECT_THAT(set_error("description", deep), HasSubstr("nested deeper than 64 levels"));
 }
