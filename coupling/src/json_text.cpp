@@ -90,7 +90,7 @@ class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   bool key(string_t& k) {
     Frame& f = frames_.back();
     if (k.size() > kMaxKeyLength)
-      fail(path() + ": a key of " + std::to_string(k.size()) + " characters at " + here() + "; expected at most " +
+      fail(named_path() + ": a key of " + std::to_string(k.size()) + " characters at " + here() + "; expected at most " +
            std::to_string(kMaxKeyLength));
     f.key = k;
     if (!f.keys.insert(k).second)

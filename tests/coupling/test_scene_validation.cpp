@@ -296,7 +296,7 @@ TEST(SceneValidation, JsonLimitsNameTheKeyPathAndLine) {
   overflow.insert(first_end + 1, " 1e999,");
   EXPECT_THAT(scene_error(overflow), StartsWith("grid.lo[1]: the number 1e999 at line "));
   EXPECT_THAT(scene_error("{\"" + std::string(300, 'k') + "\": 1}"),
-              StartsWith(std::string(300, 'k') + ": a key of 300 characters at line 1"));
+              StartsWith("scene: a key of 300 characters at line 1, column 303; expected at most 256"));
   EXPECT_THAT(scene_error("{\"description\": \"" + std::string((1 << 20) + 1, 'x') + "\"}"),
               StartsWith("description: a string of 1048577 characters at line 1"));
   // --set values obey the same limits, named by their key.

@@ -205,6 +205,9 @@ CASES = [
      "--set description"),
     ("20 MB unknown key", scene().replace('"dimension": 2', '"' + "k" * 20000000 + '": 1, "dimension": 2'), {},
      ["validate", "SCENE"], "scene"),
+    ("300-character key in a material", scene().replace('"density": 1000', '"' + "d" * 300 + '": 1, "density": 1000'), {},
+     ["validate", "SCENE"], "materials.soft: a key of 300 characters"),
+    ("2 MB description string", scene(description="x" * 2000000), {}, ["validate", "SCENE"], "description: a string of"),
     ("1 MB material name in a body", scene(bodies=[dict(BASE["bodies"][0], material="m" * 1000000)]), {},
      ["validate", "SCENE"], "bodies[0].material"),
     # --- wrong types at every level -------------------------------------------------------------
