@@ -68,7 +68,7 @@ TEST_F(SeriesColumns, MeanDisplacementOfARigidlyTranslatingBodyIsVt) {
     s["materials"] = Json::parse(R"({"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}})");
     s["run"] = Json::parse(R"({"end_time": 2e-3, "threads": 1})");
     s["output"] = Json::parse(R"({"snapshot_count": 2, "series_interval": 0})");
-    const fc::RunResult r = run(s, "translate.h5");
+    const fc::RunResult r = run(s, "translate" + std::to_string(dim) + "d.h5");
     ASSERT_EQ(r.status, fc::RunResult::Status::completed) << r.message;
     const fc::SeriesTable series = fc::read_series(r.output);
     const std::vector<double> t = column(series, "time");
