@@ -89,6 +89,7 @@ class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   }
   bool key(string_t& k) {
     Frame& f = frames_.back();
+    f.key.clear();  // the path of the object itself until the key is accepted
     if (k.size() > kMaxKeyLength)
       fail(named_path() + ": a key of " + std::to_string(k.size()) + " characters at " + here() + "; expected at most " +
            std::to_string(kMaxKeyLength));
