@@ -40,10 +40,16 @@ fi
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 # Skipped under the sanitizers: the mpirun test, whose Open MPI library leaks its own buffers at
-# MPI_Finalize (LeakSanitizer reports inside libmpi and its unloaded components, nothing of ours), and
-# the Python package test (pytest driving the instrumented program exceeds its 300 s limit; it reads
-# files, the C++ it runs is covered by the other tests).
-ctest --test-dir "$build" --output-on-failure -j "$jobs" -L "$label" -E '^(CliMpi\.MpirunEnsemble.*|python\.frictherm_package)$' "$@"
+# MPI_Finalize (LeakSanitizer reports inside libmpi and its unloaded components, nothing of ours); the
+# Python package test (pytest driving the instrumented program exceeds its 300 s limit; it reads
+# files); and, to keep CI short (CHECKS_ALL=1 runs them), the four long run-equals-run comparisons
+# (resume and checkpoint round trips, the ensemble aggregate): 2400 of the 2700 s the unit label took
+# under the sanitizers here. They passed under ASan/UBSan locally (docs/robustness.md).
+skip='^(CliMpi\.MpirunEnsemble.*|python\.frictherm_package)$'
+if [ -z "${CHECKS_ALL:-}" ]; then
+  skip='^(CliMpi\.MpirunEnsemble.*|python\.frictherm_package|CliResume\.InterruptedAndResumedRunEqualsUninterruptedRun|Ensemble\.AggregateMatchesMemberFiles|Checkpoint\.Resumed(Run|SlidingBlock)Equals.*)$'
+fi
+ctest --test-dir "$build" --output-on-failure -j "$jobs" -L "$label" -E "$skip" "$@"
 
 if [ "$fuzz_seconds" -gt 0 ]; then
   scripts/run_fuzzer.sh "$build" "$fuzz_seconds"
