@@ -3,7 +3,8 @@
 set -euo pipefail
 packages=(build-essential cmake pkg-config libeigen3-dev libsundials-dev libhdf5-dev libgtest-dev
           nlohmann-json3-dev libboost-dev libmuparser-dev libpng-dev libtiff-dev libopenmpi-dev openmpi-bin python3 python3-numpy python3-matplotlib python3-h5py
-          python3-paraview python3-pandas python3-pytest)
+          python3-paraview python3-pandas python3-pytest
+          clang libclang-rt-dev libomp-dev)  # clang, its sanitizer/libFuzzer runtimes and OpenMP: scripts/run_checks.sh
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

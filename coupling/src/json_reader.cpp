@@ -300,45 +300,5 @@ std::string nearest_key(const std::string& typo, const std::vector<std::string>&
   return best;
 }
 
-Json parse_json_text(const std::string& text) {
-  try {
-    // Duplicate keys refused (nlohmann keeps the last silently): one key set per open object.
-    std::vector<std::set<std::string>> keys;
-    const Json::parser_callback_t no_duplicates = [&keys](int, Json::parse_event_t event, Json& parsed) {
-      if (event == Json::parse_event_t::object_start) keys.emplace_back();
-      else if (event == Json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
-      else if (event == Json::parse_event_t::key && !keys.empty() && parsed.is_string() &&
-               !keys.back().insert(parsed.get<std::string>()).second)
-        throw SceneError("duplicate key '" + parsed.get<std::string>() + "' in one JSON object");
-      return true;
-    };
-    return Json::parse(text, no_duplicates, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const Json::parse_error& e) {
-    // Line and column of the byte where parsing stopped (e.byte is 1-based).
-    const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
-    std::size_t line = 1, column = 1;
-    for (std::size_t k = 0; k < end; ++k) {
-      if (text[k] == '\n') {
-        ++line;
-        column = 1;
-      } else {
-        ++column;
-      }
-    }
-    // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column 5: detail".
-    std::string detail = e.what();
-    const std::size_t colon = detail.find(": ", detail.find("parse error"));
-    if (colon != std::string::npos) detail = detail.substr(colon + 2);
-    std::ostringstream msg;
-    msg << "malformed JSON at line " << line << ", column " << column << ": " << detail;
-    throw SceneError(msg.str());
-  } catch (const Json::exception& e) {
-    // e.g. out_of_range.406 "number overflow" for 1e999: nlohmann gives no position here.
-    std::string detail = e.what();
-    const std::size_t close = detail.find("] ");
-    if (close != std::string::npos) detail = detail.substr(close + 2);
-    throw SceneError("malformed JSON: " + detail);
-  }
-}
 
 }  // namespace frictherm::coupling

@@ -224,7 +224,7 @@ int ParseContext::material_id(const JsonReader& name) const {
   const std::string n = name.as_string();
   const auto it = std::find(material_names.begin(), material_names.end(), n);
   if (it == material_names.end())
-    name.fail("unknown material \"" + n + "\" (materials defined: " + join_names(material_names) + ")");
+    name.fail("unknown material " + describe_json(name.json()) + " (materials defined: " + join_names(material_names) + ")");
   return static_cast<int>(it - material_names.begin());
 }
 

@@ -201,7 +201,7 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
     if (it == material_names.end()) {
       std::string known;
       for (const auto& m : material_names) known += (known.empty() ? "" : ", ") + m;
-      name.fail("unknown material '" + n + "' (defined: " + known + ")");
+      name.fail("unknown material " + describe_json(name.json()) + " (defined: " + known + ")");
     }
     return static_cast<int>(it - material_names.begin());
   };

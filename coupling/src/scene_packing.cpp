@@ -86,8 +86,9 @@ void parse_ellipse_packing(const JsonReader& shape, Scene& s, ParseContext& ctx,
       size_r.fail("expected a whole number of pixels of pixel_size = " + format_number(out.pixel_size) + " m, got " +
                   format_number(n) + (d == 0 ? " across" : " up"));
   }
-  if (size[0] / out.pixel_size * size[1] / out.pixel_size > 1e8)
-    size_r.fail("expected at most 1e8 pixels of pixel_size");
+  if (!(size[0] / out.pixel_size * size[1] / out.pixel_size <= mechanics::kMaxImagePixels))  // image.hpp
+    size_r.fail("expected at most 25e6 pixels of pixel_size, got " +
+                format_number(size[0] / out.pixel_size * size[1] / out.pixel_size));
   // Inside the grid, checked before anything is generated (a rectangle far larger than the grid
   // would otherwise be packed first).
   for (int d = 0; d < 2; ++d) {

@@ -270,9 +270,11 @@ void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
   for (const SceneOverride& o : overrides) {
     Json value;
     try {
-      value = Json::parse(o.value);
-    } catch (const Json::parse_error&) {
+      value = parse_json_text(o.value, o.path);  // the limits of scene text (json_text.cpp) hold here too
+    } catch (const JsonSyntaxError&) {
       value = o.value;  // a bare word: a string
+    } catch (const SceneError& e) {
+      throw SceneError(std::string("--set ") + e.what());
     }
     try {
       const Json::json_pointer ptr = pointer_of(o.path);
@@ -371,8 +373,16 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
 Scene load_scene(const std::string& path, const std::vector<SceneOverride>& overrides) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw SceneError("cannot read scene file '" + path + "': it is a folder");
+  // A regular file of bounded size: /dev/zero, a FIFO or /dev/stdin would be read without end.
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw SceneError("cannot read scene file '" + path + "': not a regular file (a device, pipe or socket)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError("cannot open scene file '" + path + "'");
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxSceneBytes)
+    throw SceneError("scene file '" + path + "' holds " + std::to_string(bytes) + " bytes; expected at most " +
+                     std::to_string(kMaxSceneBytes) + " (8 MiB)");
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw SceneError("cannot read scene file '" + path + "'");

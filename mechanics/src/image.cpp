@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -40,7 +41,18 @@ std::uint16_t u16(const unsigned char* p) { return static_cast<std::uint16_t>(p[
 // ITU-R BT.601 luma, rounded; R = G = B gives that value back exactly.
 std::uint16_t luma(int r, int g, int b) { return static_cast<std::uint16_t>((299 * r + 587 * g + 114 * b + 500) / 1000); }
 
+// Images are regular files: a folder, /dev/zero, /dev/urandom or a FIFO would be read without end
+// (or block), and their size cannot bound a header's claim.
+void require_regular_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw std::runtime_error("cannot open image file '" + path + "'");
+  if (!std::filesystem::is_regular_file(status))
+    throw std::runtime_error("image file '" + path + "' is not a regular file (a folder, device or pipe)");
+}
+
 std::vector<unsigned char> read_all(const std::string& path) {
+  require_regular_file(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot open image file '" + path + "'");
   std::ostringstream s;
@@ -51,6 +63,7 @@ std::vector<unsigned char> read_all(const std::string& path) {
 }  // namespace
 
 GreyImage read_pgm(const std::string& path) {
+  require_regular_file(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot open image file '" + path + "'");
   char magic[2] = {0, 0};
@@ -63,6 +76,9 @@ GreyImage read_pgm(const std::string& path) {
   img.max_value = read_header_int(in, path);
   if (img.width <= 0 || img.height <= 0 || img.max_value <= 0 || img.max_value > 65535)
     throw std::runtime_error("PGM file '" + path + "': bad width, height or maximum grey value");
+  if (static_cast<double>(img.width) * img.height > kMaxImagePixels)
+    throw std::runtime_error("PGM file '" + path + "': " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                             " pixels; expected at most 25e6 pixels (kMaxImagePixels)");
   const std::size_t n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
   // Header checked against the file size before the pixel buffer is sized: a P5 pixel takes 1 or 2
   // bytes, a P2 pixel at least one digit plus a separator (the last one none).
@@ -126,6 +142,9 @@ GreyImage read_bmp(const std::string& path) {
   if (width <= 0 || height_signed == 0 || height_signed == INT32_MIN || width > 1000000 ||
       std::abs(height_signed) > 1000000)
     throw std::runtime_error(where + "bad width or height");
+  if (static_cast<double>(width) * std::abs(static_cast<double>(height_signed)) > kMaxImagePixels)
+    throw std::runtime_error(where + std::to_string(width) + "x" + std::to_string(std::abs(height_signed)) +
+                             " pixels; expected at most 25e6 pixels (kMaxImagePixels)");
   const bool top_down = height_signed < 0;
   const int height = std::abs(height_signed);
   // Palette (8 bit): entries of B, G, R, 0 right after the info header.
@@ -171,6 +190,7 @@ GreyImage read_bmp(const std::string& path) {
 }
 
 GreyImage read_grey_image(const std::string& path) {
+  require_regular_file(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot open image file '" + path + "'");
   char magic[2] = {0, 0};

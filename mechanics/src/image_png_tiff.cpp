@@ -27,6 +27,8 @@ std::uint16_t luma(unsigned r, unsigned g, unsigned b) {
 
 std::uintmax_t file_size(const std::string& path, const std::string& kind) {
   std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw std::runtime_error(kind + " file '" + path + "' is not a regular file (a folder, device or pipe)");
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) throw std::runtime_error("cannot open image file '" + path + "': " + ec.message());
   if (size == 0) throw std::runtime_error(kind + " file '" + path + "' is empty");
@@ -38,6 +40,9 @@ std::string claim_problem(const std::string& where, std::uint32_t width, std::ui
                           std::uintmax_t file_bytes, double ratio) {
   if (width == 0 || height == 0 || width > 1000000 || height > 1000000)
     return where + "bad width or height " + std::to_string(width) + "x" + std::to_string(height);
+  if (static_cast<double>(width) * height > kMaxImagePixels)
+    return where + std::to_string(width) + "x" + std::to_string(height) +
+           " pixels; expected at most 25e6 pixels (kMaxImagePixels)";
   if (bytes_needed > ratio * static_cast<double>(file_bytes))
     return where + "header claims " + std::to_string(width) + "x" + std::to_string(height) +
            " pixels but the file holds only " + std::to_string(file_bytes) + " bytes (truncated or corrupt)";

@@ -27,11 +27,15 @@ const char* kScene = R"({
   "output": {"snapshot_count": 2, "series_interval": 0}
 })";
 
+// One folder per process, emptied first: outputs are never replaced (issue 15), so a file left by
+// an earlier or concurrent run would make this one refuse to write.
 fs::path scratch() {
-  // Per process: a fixed folder made a second run (or another checkout's tests) find the files of
-  // the first, which outputs now refuse to replace.
-  const fs::path d = fs::temp_directory_path() / ("frictherm_test_run_observer_" + std::to_string(getpid()));
-  fs::create_directories(d);
+  static const fs::path d = [] {
+    const fs::path p = fs::temp_directory_path() / ("frictherm_test_run_observer_" + std::to_string(getpid()));
+    fs::remove_all(p);
+    fs::create_directories(p);
+    return p;
+  }();
   return d;
 }
 

@@ -179,7 +179,7 @@ TEST(SceneValidation, ContactMistakesNameTheKey) {
   EXPECT_THAT(scene_error(s), StartsWith("contact.law.type: expected one of"));
   s = contact_scene();
   s["contact"]["pairs"][0]["materials"] = Json::parse(R"(["base", "wood"])");
-  EXPECT_THAT(scene_error(s), AllOf(StartsWith("contact.pairs[0].materials[1]: unknown material 'wood'"),
+  EXPECT_THAT(scene_error(s), AllOf(StartsWith("contact.pairs[0].materials[1]: unknown material \"wood\""),
                                     HasSubstr("steel, base")));
   s = contact_scene();
   s["contact"]["normal"] = Json::parse("[0, 1]");
@@ -265,7 +265,8 @@ TEST(SceneValidation, MieGruneisenMaterial) {
 // Issue 15 class 3: numbers outside what the reader can hold are scene errors, never UB or a raw
 // nlohmann exception; duplicate keys are refused instead of last-wins.
 TEST(SceneValidation, NumbersOutOfRangeAndDuplicateKeysAreRefused) {
-  EXPECT_THAT(scene_error(std::string("{\"dimension\": 1e999}")), HasSubstr("number overflow"));
+  EXPECT_THAT(scene_error(std::string("{\"dimension\": 1e999}")),
+              StartsWith("dimension: the number 1e999 at line 1, column"));
   Json s = good_scene();
   s["dimension"] = 9223372036854775808.0;  // 2^63 as a float: rounds to double(LONG_MAX)
   EXPECT_THAT(scene_error(s), StartsWith("dimension: expected an integer in [2, 3]"));
@@ -273,5 +274,41 @@ TEST(SceneValidation, NumbersOutOfRangeAndDuplicateKeysAreRefused) {
   EXPECT_THAT(scene_error(s), StartsWith("dimension: expected an integer in [2, 3]"));
   const std::string text = good_scene().dump();
   const std::string twice = "{\"dimension\": 2, " + text.substr(1);
-  EXPECT_THAT(scene_error(twice), HasSubstr("duplicate key 'dimension'"));
+  EXPECT_THAT(scene_error(twice), StartsWith("dimension: duplicate key 'dimension' at line 1, column "));
+}
+
+// Issue 15 (fuzzing, docs/robustness.md): scene text beyond the reader's limits is refused with the
+// key path, line and column before anything recursive touches it.
+TEST(SceneValidation, JsonLimitsNameTheKeyPathAndLine) {
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_THAT(scene_error(deep), StartsWith("scene: objects and arrays nested deeper than 64 levels at line 1, column 65"));
+  const std::string nested = scene_error("{\"description\": " + deep + "}");
+  EXPECT_THAT(nested, StartsWith("description: objects and arrays"));
+  EXPECT_THAT(nested, HasSubstr("nested deeper than 64 levels at line 1, column 80"));
+  Json s = good_scene();
+  const std::string text = s.dump(1);
+  // A nested overflow names the element: grid.lo[1] on the line of "lo".
+  const std::string lo = "\"lo\": [";
+  std::string overflow = text;
+  const std::size_t at = overflow.find(lo);
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t first_end = overflow.find(',', at);
+  overflow.insert(first_end + 1, " 1e999,");
+  EXPECT_THAT(scene_error(overflow), StartsWith("grid.lo[1]: the number 1e999 at line "));
+  EXPECT_THAT(scene_error("{\"" + std::string(300, 'k') + "\": 1}"),
+              StartsWith("scene: a key of 300 characters at line 1, column 303; expected at most 256"));
+  EXPECT_THAT(scene_error("{\"description\": \"" + std::string((1 << 20) + 1, 'x') + "\"}"),
+              StartsWith("description: a string of 1048577 characters at line 1"));
+  // --set values obey the same limits, named by their key.
+  auto set_error = [&text](const std::string& key, const std::string& value) -> std::string {
+    try {
+      parse_scene(text, "<test>", ".", "scene", {frictherm::coupling::SceneOverride{key, value}});
+    } catch (const frictherm::coupling::SceneError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_THAT(set_error("run.end_time", "1e999"), StartsWith("--set run.end_time: the number 1e999 at line 1, column"));
+  EXPECT_THAT(set_error("description", deep), StartsWith("--set description: objects and arrays"));
+  EXPECT_THAT(set_error("description", deep), HasSubstr("nested deeper than 64 levels"));
 }

@@ -74,7 +74,8 @@ def run(exe, work, dim):
     h5 = os.path.join(work, f"warp_{dim}d.h5")
     with open(scene, "w") as f:
         json.dump(SCENES[dim], f)
-    subprocess.run([exe, "run", scene, "-o", h5, "--force"], check=True, stdout=subprocess.DEVNULL)  # reruns replace
+    # --force: a rerun in the same build folder replaces the previous result (refused by default)
+    subprocess.run([exe, "run", scene, "-o", h5, "--force"], check=True, stdout=subprocess.DEVNULL)
     return h5
 
 

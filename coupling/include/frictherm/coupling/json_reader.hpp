@@ -144,8 +144,22 @@ std::size_t edit_distance(const std::string& a, const std::string& b);
 /// keys (x is not "near" a); ties go to the first key.
 std::string nearest_key(const std::string& typo, const std::vector<std::string>& allowed);
 
-/// Parses scene text (comments allowed). Malformed JSON becomes a SceneError
-/// "malformed JSON at line L, column C: <detail>".
-Json parse_json_text(const std::string& text);
+/// Malformed JSON (a syntax error; json_text.cpp). A --set value that is not JSON is a bare word.
+class JsonSyntaxError : public SceneError {
+ public:
+  using SceneError::SceneError;
+};
+
+/// Limits on scene text (json_text.cpp), each refused with the key path, line and column.
+constexpr std::size_t kMaxJsonDepth = 64;           // objects and arrays inside each other
+constexpr std::size_t kMaxKeyLength = 256;          // characters of an object key
+constexpr std::size_t kMaxStringLength = 1 << 20;   // characters of a string value
+constexpr std::size_t kMaxSceneBytes = 8u << 20;    // a scene file (scene_parse.cpp: load_scene)
+
+/// Parses scene text (comments allowed; json_text.cpp). Malformed JSON becomes a JsonSyntaxError
+/// "malformed JSON at line L, column C: <detail> (in PATH)"; duplicate keys, numbers beyond a double
+/// and the limits above a SceneError "PATH: ... at line L, column C; expected ...". `root_path`
+/// prefixes the key paths (a --set value: its key).
+Json parse_json_text(const std::string& text, const std::string& root_path = "");
 
 }  // namespace frictherm::coupling

@@ -8,6 +8,11 @@
 
 namespace frictherm::mechanics {
 
+/// The most pixels an image may have (25 megapixels, e.g. 5000 x 5000): refused from the header,
+/// before any pixel buffer exists, so a compressed image cannot decode into gigabytes (a PNG packs
+/// zeros about 1000:1). A microstructure finer than the particles gains nothing; downsample larger ones.
+constexpr double kMaxImagePixels = 25e6;
+
 struct GreyImage {
   int width = 0, height = 0;
   int max_value = 255;

@@ -1,0 +1,319 @@
+#!/usr/bin/env python3
+"""Bad-input sweep (issue 15): bad scenes and command lines of every class the issue names.
+
+Each case must be refused by the frictherm program with exit code 2 and a message whose first line
+starts with "frictherm: ...: KEY" (the key path, or the option, it is about), within CPU_LIMIT
+seconds of CPU time and RSS_LIMIT_MB of peak resident memory (the issue's bounds: under a second,
+under 200 MB). Each case runs in a fresh temporary folder that also holds the files it refers to.
+
+    bad_inputs.py FRICTHERM_EXE [--keep DIR] [-k SUBSTRING]
+
+Prints one line per case (exit code, CPU and wall seconds, peak MB, the message) and exits 1 when a
+case is not refused as expected. Sanitizer builds: set BAD_INPUTS_RSS_MB (their shadow memory and
+quarantine count as resident).
+"""
+import argparse
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+
+CPU_LIMIT = float(os.environ.get("BAD_INPUTS_CPU_S", "1"))
+RSS_LIMIT_MB = float(os.environ.get("BAD_INPUTS_RSS_MB", "200"))
+
+BASE = {
+    "dimension": 2,
+    "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+    "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6,
+                           "poisson_ratio": 0.3}},
+    "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
+                "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+    "run": {"end_time": 2e-3, "threads": 1},
+    "output": {"snapshot_count": 4},
+}
+
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+with open(os.path.join(HERE, "..", "..", "examples", "pbx_microstructure_small.json")) as f:
+    PACKING = f.read()  # a scene with an ellipse_packing body
+
+
+def scene(**changes):
+    """BASE with top-level sections replaced (a value None removes the key)."""
+    s = json.loads(json.dumps(BASE))
+    for k, v in changes.items():
+        if v is None:
+            s.pop(k, None)
+        else:
+            s[k] = v
+    return json.dumps(s)
+
+
+def image_scene(file, levels=None, **extra):
+    s = json.loads(scene(materials={"a": BASE["materials"]["soft"], "b": BASE["materials"]["soft"]}))
+    s["bodies"] = [{"name": "img", "particles_per_cell": 1,
+                    "shape": {"type": "image", "file": file, "origin": [0, 0], "pixel_size": 0.01,
+                              "levels": levels or [{"range": [0, 127], "material": "a"},
+                                                   {"range": [128, 255], "material": "b"}]}}]
+    s.update(extra)
+    return json.dumps(s)
+
+
+def png_bytes(width, height, idat=b""):
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(idat)) + chunk(b"IEND", b"")
+
+
+def png_zero_bytes(width, height):
+    """A valid 8-bit grey PNG of zero pixels, a deflate bomb (about 1000:1). Blocks of 1000 rows are
+    compressed once and repeated (a full flush makes each one independent), then closed by an empty
+    final block and the Adler-32 of the whole stream."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+    rows = b"\0" * ((width + 1) * 1000)  # filter byte + pixels, 1000 rows
+    assert height % 1000 == 0
+    z = zlib.compressobj(9)
+    first = z.compress(rows) + z.flush(zlib.Z_FULL_FLUSH)
+    again = z.compress(rows) + z.flush(zlib.Z_FULL_FLUSH)
+    adler = ((len(rows) * (height // 1000)) % 65521) << 16 | 1  # Adler-32 of zeros: A = 1, B = length
+    idat = first + again * (height // 1000 - 1) + b"\x03\x00" + struct.pack(">I", adler)
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", idat) + chunk(b"IEND", b"")
+
+
+def bmp_bytes(width, height):
+    header = b"BM" + struct.pack("<IHHI", 54 + 8, 0, 0, 54)
+    info = struct.pack("<IiiHHIIiiII", 40, width, height, 1, 24, 0, 0, 0, 0, 0, 0)
+    return header + info + b"\0" * 8
+
+
+def deep(n):
+    return "[" * n + "]" * n
+
+
+# (name, scene text or None, extra files {name: bytes}, argv after the program (SCENE = the scene file),
+#  expected start of the message after "frictherm: ...: ")
+CASES = [
+    # --- resource bombs -------------------------------------------------------------------------
+    ("particles 7000x7000 cells x 100 per cell",
+     scene(grid={"lo": [0, 0], "hi": [7, 7], "cell_size": 0.001},
+           bodies=[{"name": "b", "material": "soft", "particles_per_cell": 10,
+                    "shape": {"type": "rectangle", "lo": [0, 0], "hi": [6.9, 6.9]}}]),
+     {}, ["validate", "SCENE"], "bodies[0]"),
+    ("3D 1000 particles per cell",
+     json.dumps({"dimension": 3, "grid": {"lo": [0, 0, 0], "hi": [1, 1, 1], "cell_size": 0.01},
+                 "materials": BASE["materials"], "run": {"end_time": 1e-3},
+                 "bodies": [{"name": "b", "material": "soft", "particles_per_cell": 10,
+                             "shape": {"type": "box", "lo": [0, 0, 0], "hi": [1, 1, 1]}}]}),
+     {}, ["validate", "SCENE"], "bodies[0]"),
+    ("particles_per_cell 1e9", scene(bodies=[dict(BASE["bodies"][0], particles_per_cell=1000000000)]),
+     {}, ["validate", "SCENE"], "bodies[0]"),
+    ("mostly empty grid of 4.9e7 nodes", scene(grid={"lo": [0, 0], "hi": [70, 70], "cell_size": 0.01}),
+     {}, ["validate", "SCENE"], "grid"),
+    ("PGM header 100000x100000, 8 pixel bytes", image_scene("big.pgm"),
+     {"big.pgm": b"P5\n100000 100000\n255\n" + b"\x80" * 8}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    ("BMP header 1000000x1000000", image_scene("big.bmp"),
+     {"big.bmp": bmp_bytes(1000000, 1000000)}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    ("PNG header 1000000x1000000", image_scene("big.png"),
+     {"big.png": png_bytes(1000000, 1000000, b"\0" * 100)}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    ("--set grows an array to 2e8", scene(), {}, ["validate", "SCENE", "--set", "bodies[200000000]=1"],
+     "--set bodies[200000000]"),
+    ("--set index beyond 2^64", scene(), {}, ["validate", "SCENE", "--set", "bodies[99999999999999999999999]=1"],
+     "--set bodies[99999999999999999999999]"),
+    ("--set negative index", scene(), {}, ["validate", "SCENE", "--set", "bodies[-1].velocity=[0,0]"],
+     "--set bodies[-1]"),
+    ("ellipse packing far larger than the grid",
+     json.dumps(dict(json.loads(scene()), materials={"hmx": BASE["materials"]["soft"], "binder": BASE["materials"]["soft"]},
+                     bodies=[{"name": "pbx", "particles_per_cell": 1,
+                              "shape": {"type": "ellipse_packing", "origin": [0, 0], "size": [100, 100],
+                                        "pixel_size": 0.001, "seed": 1, "fraction": 0.5,
+                                        "major_axis": {"distribution": "uniform", "min": 0.002, "max": 0.004},
+                                        "grain_material": "hmx", "binder_material": "binder"}}])),
+     {}, ["validate", "SCENE"], "bodies[0].shape"),
+    ("ellipse packing of 1e10 pixels",
+     json.dumps(dict(json.loads(scene()), materials={"hmx": BASE["materials"]["soft"], "binder": BASE["materials"]["soft"]},
+                     bodies=[{"name": "pbx", "particles_per_cell": 1,
+                              "shape": {"type": "ellipse_packing", "origin": [0, 0], "size": [0.1, 0.05],
+                                        "pixel_size": 1e-6, "seed": 1, "fraction": 0.5,
+                                        "major_axis": {"distribution": "uniform", "min": 0.01, "max": 0.02},
+                                        "grain_material": "hmx", "binder_material": "binder"}}])),
+     {}, ["validate", "SCENE"], "bodies[0].shape"),
+    ("PNG of 20000x20000 zero pixels (deflate bomb)", image_scene("bomb.png"),
+     {"bomb.png": lambda: png_zero_bytes(20000, 20000)}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    # --- endless runs ---------------------------------------------------------------------------
+    ("snapshot_interval 1e-300", scene(output={"snapshot_interval": 1e-300}), {}, ["validate", "SCENE"], "output"),
+    ("snapshot_count 1e6", scene(output={"snapshot_count": 1000000}), {}, ["validate", "SCENE"], "output"),
+    ("max_time_step 1e-300", scene(solver={"max_time_step": 1e-300}), {}, ["validate", "SCENE"], "run.end_time"),
+    ("end_time 1e300 at rest", scene(run={"end_time": 1e300},
+                                     bodies=[dict(BASE["bodies"][0], velocity=[0, 0])]),
+     {}, ["validate", "SCENE"], "run.end_time"),
+    ("damping rate 1e300", scene(solver={"damping": {"rate": 1e300, "until": 1e-3}}), {}, ["validate", "SCENE"],
+     "run.end_time"),
+    # --- numbers --------------------------------------------------------------------------------
+    ("1e999 density", scene().replace('"density": 1000', '"density": 1e999'), {}, ["validate", "SCENE"],
+     "materials.soft.density"),
+    ("-1e999 in grid.lo", scene().replace('"lo": [0, 0]', '"lo": [-1e999, 0]'), {}, ["validate", "SCENE"], "grid.lo"),
+    ("max_steps 2^63 as a float", scene(run={"end_time": 2e-3, "max_steps": 9.223372036854775808e18}), {},
+     ["validate", "SCENE"], "run.max_steps"),
+    ("max_steps 2^64 as an integer", scene(run={"end_time": 2e-3}).replace('"end_time": 0.002', '"end_time": 0.002, "max_steps": 18446744073709551616'),
+     {}, ["validate", "SCENE"], "run.max_steps"),
+    ("snapshot_count -3", scene(output={"snapshot_count": -3}), {}, ["validate", "SCENE"], "output.snapshot_count"),
+    ("particles_per_cell 0", scene(bodies=[dict(BASE["bodies"][0], particles_per_cell=0)]), {}, ["validate", "SCENE"],
+     "bodies[0].particles_per_cell"),
+    ("threads -1", scene(run={"end_time": 2e-3, "threads": -1}), {}, ["validate", "SCENE"], "run.threads"),
+    ("density 1e-300", scene().replace('"density": 1000', '"density": 1e-300'), {}, ["validate", "SCENE"],
+     "run.end_time"),
+    ("velocity 1e300", scene(bodies=[dict(BASE["bodies"][0], velocity=[1e300, 0])]), {}, ["validate", "SCENE"],
+     "bodies[0].velocity"),
+    ("NaN literal", scene().replace('"density": 1000', '"density": NaN'), {}, ["validate", "SCENE"], "malformed JSON at line 1"),
+    ("cell_size 0", scene(grid={"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0}), {}, ["validate", "SCENE"],
+     "grid.cell_size"),
+    ("dimension 2.5", scene(dimension=2.5), {}, ["validate", "SCENE"], "dimension"),
+    ("dimension 1e19", scene(dimension=1e19), {}, ["validate", "SCENE"], "dimension"),
+    ("duplicate key grid", scene().replace('"grid":', '"grid": {"lo": [0, 0], "hi": [1, 1], "cell_size": 0.1}, "grid":'),
+     {}, ["validate", "SCENE"], "grid"),
+    ("duplicate key in a material", scene().replace('"density": 1000', '"density": 1000, "density": 2000'), {},
+     ["validate", "SCENE"], "materials.soft.density"),
+    ("P2 pixel above maxval", image_scene("hi.pgm"), {"hi.pgm": b"P2\n2 1\n255\n10 300\n"}, ["validate", "SCENE"],
+     "bodies[0].shape.file"),
+    ("P2 negative pixel", image_scene("neg.pgm"), {"neg.pgm": b"P2\n2 1\n255\n10 -1\n"}, ["validate", "SCENE"],
+     "bodies[0].shape.file"),
+    ("PGM maxval 0", image_scene("zero.pgm"), {"zero.pgm": b"P2\n2 1\n0\n0 0\n"}, ["validate", "SCENE"],
+     "bodies[0].shape.file"),
+    ("level range beyond maxval", image_scene("ok.pgm", levels=[{"range": [0, 70000], "material": "a"}]),
+     {"ok.pgm": b"P2\n2 1\n255\n10 200\n"}, ["validate", "SCENE"], "bodies[0].shape.levels[0].range[1]"),
+    # --- bad images and files -------------------------------------------------------------------
+    ("image file is a folder", image_scene("sub"), {"sub/x": b""}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    ("image file /dev/zero", image_scene("/dev/zero"), {}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    ("image file /dev/urandom", image_scene("/dev/urandom"), {}, ["validate", "SCENE"], "bodies[0].shape.file"),
+    ("truncated PNG", image_scene("cut.png"), {"cut.png": png_bytes(4, 4, b"\0" * 20)[:40]}, ["validate", "SCENE"],
+     "bodies[0].shape.file"),
+    ("scene file /dev/zero", None, {}, ["validate", "/dev/zero"], "/dev/zero"),
+    ("scene file is a folder", None, {"d/x": b""}, ["validate", "d"], "d"),
+    # --- deep nesting and huge strings ----------------------------------------------------------
+    ("100000 nested arrays in description", scene().replace('"dimension": 2', '"description": ' + deep(100000) + ', "dimension": 2'),
+     {}, ["validate", "SCENE"], "description"),
+    ("100000 nested arrays as the scene", deep(100000), {}, ["validate", "SCENE"], "scene"),
+    ("50000 nested arrays in --set", scene(), {}, ["validate", "SCENE", "--set", "description=" + deep(50000)],
+     "--set description"),
+    ("20 MB unknown key", scene().replace('"dimension": 2', '"' + "k" * 20000000 + '": 1, "dimension": 2'), {},
+     ["validate", "SCENE"], "scene"),
+    ("300-character key in a material", scene().replace('"density": 1000', '"' + "d" * 300 + '": 1, "density": 1000'), {},
+     ["validate", "SCENE"], "materials.soft: a key of 300 characters"),
+    ("2 MB description string", scene(description="x" * 2000000), {}, ["validate", "SCENE"], "description: a string of"),
+    ("1 MB material name in a body", scene(bodies=[dict(BASE["bodies"][0], material="m" * 1000000)]), {},
+     ["validate", "SCENE"], "bodies[0].material"),
+    # --- wrong types at every level -------------------------------------------------------------
+    ("top level an array", json.dumps([BASE]), {}, ["validate", "SCENE"], "scene"),
+    ("grid a number", scene(grid=1), {}, ["validate", "SCENE"], "grid"),
+    ("grid.lo of 3 numbers in 2D", scene(grid={"lo": [0, 0, 0], "hi": [0.1, 0.05], "cell_size": 0.01}), {},
+     ["validate", "SCENE"], "grid.lo"),
+    ("materials an array", scene(materials=[1]), {}, ["validate", "SCENE"], "materials"),
+    ("material density a string", scene().replace('"density": 1000', '"density": "1000"'), {}, ["validate", "SCENE"],
+     "materials.soft.density"),
+    ("bodies an object", scene(bodies={"a": 1}), {}, ["validate", "SCENE"], "bodies"),
+    ("body shape a string", scene(bodies=[dict(BASE["bodies"][0], shape="rectangle")]), {}, ["validate", "SCENE"],
+     "bodies[0].shape"),
+    ("velocity of strings", scene(bodies=[dict(BASE["bodies"][0], velocity=["1", "0"])]), {}, ["validate", "SCENE"],
+     "bodies[0].velocity"),
+    ("run.end_time null", scene(run={"end_time": None}), {}, ["validate", "SCENE"], "run.end_time"),
+    ("output.fields an object", scene(output={"snapshot_count": 4, "fields": {"a": 1}}), {}, ["validate", "SCENE"],
+     "output.fields"),
+    # --- output over inputs and absurd command lines --------------------------------------------
+    ("run -o the scene itself", scene(), {}, ["run", "SCENE", "-o", "SCENE"], "refusing to write"),
+    ("run -o the image it reads", image_scene("ok.pgm"), {"ok.pgm": b"P2\n2 1\n255\n10 200\n"},
+     ["run", "SCENE", "-o", "ok.pgm"], "refusing to write"),
+    ("microstructure -o the scene itself", PACKING, {}, ["microstructure", "SCENE", "-o", "SCENE"], "refusing to write"),
+    ("--threads 1e9", scene(), {}, ["run", "SCENE", "--threads", "1000000000"], "option '--threads'"),
+    ("--set value 1e999", scene(), {}, ["validate", "SCENE", "--set", "run.end_time=1e999"], "--set run.end_time"),
+    ("--set duplicate key in the value", scene(), {}, ["validate", "SCENE", "--set", 'run={"end_time": 1, "end_time": 2}'],
+     "--set run.end_time"),
+    ("--set without =", scene(), {}, ["validate", "SCENE", "--set", "solver.cfl"], "--set solver.cfl"),
+    ("--set into a number", scene(), {}, ["validate", "SCENE", "--set", "dimension.x=1"], "--set dimension.x"),
+]
+
+
+def run_case(exe, workdir, case):
+    name, text, files, argv, key = case
+    for rel, data in files.items():
+        path = os.path.join(workdir, rel)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "wb") as f:
+            f.write(data() if callable(data) else data)
+    scene_path = os.path.join(workdir, "scene.json")
+    if text is not None:
+        with open(scene_path, "w") as f:
+            f.write(text)
+    args = [a.replace("SCENE", scene_path) if a == "SCENE" else a for a in argv]
+    key = key.replace("SCENE", scene_path)
+    t0 = time.monotonic()
+    with open(os.path.join(workdir, ".stdout"), "w+b") as out, open(os.path.join(workdir, ".stderr"), "w+b") as err:
+        proc = subprocess.Popen([exe] + args, cwd=workdir, stdin=subprocess.DEVNULL, stdout=out, stderr=err)
+        # wait4: the exit status with this child's own CPU time and peak resident size.
+        while True:
+            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.monotonic() - t0 > 30:
+                proc.kill()
+            time.sleep(0.005)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        wall = time.monotonic() - t0
+        out.seek(0)
+        err.seek(0)
+        text_out, text_err = out.read().decode(errors="replace"), err.read().decode(errors="replace")
+    return proc.returncode, text_out, text_err, wall, usage, key
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("exe")
+    ap.add_argument("--keep")
+    ap.add_argument("-k", default="")
+    a = ap.parse_args()
+    failures = 0
+    count = 0
+    for case in CASES:
+        if a.k not in case[0]:
+            continue
+        count += 1
+        workdir = tempfile.mkdtemp(prefix="frictherm_bad_")
+        code, out, err, wall, usage, key = run_case(os.path.abspath(a.exe), workdir, case)
+        cpu = usage.ru_utime + usage.ru_stime
+        rss_mb = usage.ru_maxrss / 1024.0
+        first = (err.strip().splitlines() or [""])[0]
+        message = first.split(": ", 1)[1] if first.startswith("frictherm") and ": " in first else first
+        # "frictherm: PATH: KEY..." or "frictherm run: option ...": the part after the scene path.
+        after_path = first.split(": ", 2)[2] if first.count(": ") >= 2 else message
+        problems = []
+        if code != 2:
+            problems.append("exit code %s (expected 2)" % code)
+        if not (after_path.startswith(key) or message.startswith(key)):
+            problems.append("message does not start with '%s'" % key)
+        if cpu > CPU_LIMIT:
+            problems.append("%.2f s CPU (limit %.1f)" % (cpu, CPU_LIMIT))
+        if rss_mb > RSS_LIMIT_MB:
+            problems.append("%.0f MB resident (limit %.0f)" % (rss_mb, RSS_LIMIT_MB))
+        status = "FAIL" if problems else "ok"
+        shown = first if len(first) < 220 else first[:217] + "..."
+        print("%-4s rc=%s cpu=%.2fs wall=%.2fs rss=%.0fMB  %-44s %s" % (status, code, cpu, wall, rss_mb, case[0], shown))
+        for p in problems:
+            print("     -> " + p)
+        if problems:
+            failures += 1
+        if a.keep:
+            shutil.copytree(workdir, os.path.join(a.keep, case[0].replace(" ", "_").replace("/", "_")), dirs_exist_ok=True)
+        shutil.rmtree(workdir, ignore_errors=True)
+    print("%d of %d bad inputs refused as expected" % (count - failures, count))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
