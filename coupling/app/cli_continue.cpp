@@ -78,8 +78,7 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
                                          "coupling.hotspots.* or run.threads; rerun the scene to change the loading)");
       overrides.push_back(o);
     }
-  ResumeOutcome o;
-  try {
+  return run_from_checkpoint(q, "continue", [&] {
     if (!std::filesystem::exists(q.checkpoint))
       throw coupling::OutputError("no checkpoint " + q.checkpoint + " (runs with coupling.continuation write one at the end of loading)");
     const coupling::CheckpointMarks marks = coupling::checkpoint_marks(q.checkpoint);
@@ -89,18 +88,7 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
     q.scene = coupling::checkpoint_scene(q.checkpoint, overrides);
     if (!(q.scene.thermal.enabled && q.scene.thermal.continuation_duration > 0.0))
       throw coupling::SceneError("coupling.continuation: the scene has no thermal continuation (expected a duration > 0)");
-    o = resume_from_checkpoint(q);
-  } catch (const coupling::SceneError& e) {
-    std::cerr << "frictherm: " << q.checkpoint << ": " << e.what() << '\n';
-    return kUsage;
-  } catch (const coupling::OutputError& e) {
-    std::cerr << "frictherm: " << e.what() << '\n';
-    return kUsage;
-  } catch (const std::exception& e) {
-    std::cerr << "frictherm: continue of " << q.run << " failed: " << e.what() << '\n';
-    return kSimulationFailed;
-  }
-  return report_resumed("continued", o, q.quiet);
+  });
 }
 
 }  // namespace frictherm::cli

@@ -144,10 +144,16 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
     if (end == v.c_str() || *end != '\0' || !(q.checkpoint_wall_interval > 0.0) || !std::isfinite(q.checkpoint_wall_interval))
       throw UsageError("resume", "--checkpoint-every: expected wall-clock seconds > 0, got '" + v + "'");
   }
-  ResumeOutcome o;
-  try {
+  return run_from_checkpoint(q, "resume", [&q] {
     if (!exists(q.checkpoint)) throw coupling::OutputError("no checkpoint " + q.checkpoint + " to resume " + q.run + " from");
     q.scene = coupling::checkpoint_scene(q.checkpoint);
+  });
+}
+
+int run_from_checkpoint(ResumeRequest& q, const char* command, const std::function<void()>& prepare) {
+  ResumeOutcome o;
+  try {
+    prepare();
     o = resume_from_checkpoint(q);
   } catch (const coupling::SceneError& e) {
     std::cerr << "frictherm: " << q.checkpoint << ": " << e.what() << '\n';
@@ -156,10 +162,10 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
     std::cerr << "frictherm: " << e.what() << '\n';
     return kUsage;
   } catch (const std::exception& e) {
-    std::cerr << "frictherm: resume of " << q.run << " failed: " << e.what() << '\n';
+    std::cerr << "frictherm: " << command << " of " << q.run << " failed: " << e.what() << '\n';
     return kSimulationFailed;
   }
-  return report_resumed("resumed", o, q.quiet);
+  return report_resumed(std::string(command) == "resume" ? "resumed" : "continued", o, q.quiet);
 }
 
 }  // namespace frictherm::cli

@@ -3,6 +3,7 @@
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
+#include <functional>
 #include <string>
 
 namespace frictherm::cli {
@@ -31,5 +32,10 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& request);
 
 /// The exit code and message of a resumed run ("resumed" / "continued").
 int report_resumed(const char* command, const ResumeOutcome& outcome, bool quiet);
+
+/// `prepare` (which fills request.scene and may throw), then resume_from_checkpoint and
+/// report_resumed: scene and output errors exit kUsage with their message, others kSimulationFailed.
+/// `command` is "resume" or "continue".
+int run_from_checkpoint(ResumeRequest& request, const char* command, const std::function<void()>& prepare);
 
 }  // namespace frictherm::cli

@@ -69,25 +69,8 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
 
   // Unknowns: the same rule as assemble_thermal.
-  sys.max_mass = *std::max_element(sys.grid_mass.begin(), sys.grid_mass.end());
-  const double threshold = opt.active_mass_fraction * sys.max_mass;
-  sys.unknown.assign(n_nodes, -1);
-  for (std::size_t i = 0; i < n_nodes; ++i) {
-    if (sys.grid_mass[i] > threshold && sys.grid_mass[i] > 0.0) {
-      sys.unknown[i] = static_cast<int>(sys.grid_node.size());
-      sys.grid_node.push_back(static_cast<int>(i));
-    } else {
-      sys.dropped_mass += sys.grid_mass[i];
-    }
-  }
+  sys.select_unknowns(mct_, opt.active_mass_fraction);
   const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
-  sys.mass.resize(n);
-  sys.temperature.resize(n);
-  for (Eigen::Index u = 0; u < n; ++u) {
-    const auto i = static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)]);
-    sys.mass[u] = sys.grid_mass[i];
-    sys.temperature[u] = mct_[i] / sys.grid_mass[i];
-  }
 
   // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
   row_bound_.assign(static_cast<std::size_t>(n), 0.0);

@@ -111,25 +111,8 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
 
   // Unknowns: nodes carrying more than a tiny fraction of the largest nodal heat capacity.
-  sys.max_mass = *std::max_element(sys.grid_mass.begin(), sys.grid_mass.end());
-  const double threshold = opt.active_mass_fraction * sys.max_mass;
-  sys.unknown.assign(n_nodes, -1);
-  for (std::size_t i = 0; i < n_nodes; ++i) {
-    if (sys.grid_mass[i] > threshold && sys.grid_mass[i] > 0.0) {
-      sys.unknown[i] = static_cast<int>(sys.grid_node.size());
-      sys.grid_node.push_back(static_cast<int>(i));
-    } else {
-      sys.dropped_mass += sys.grid_mass[i];
-    }
-  }
+  sys.select_unknowns(mct, opt.active_mass_fraction);
   const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
-  sys.mass.resize(n);
-  sys.temperature.resize(n);
-  for (Eigen::Index u = 0; u < n; ++u) {
-    const auto i = static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)]);
-    sys.mass[u] = sys.grid_mass[i];
-    sys.temperature[u] = mct[i] / sys.grid_mass[i];
-  }
 
   // Pass 2: K_ij = Σ_p V_p k_p G'_ip·G'_jp, accumulated per unknown row in slots indexed by the lattice
   // offset of j from i (each component in [-(K-1), K-1]).
@@ -297,6 +280,31 @@ double NodalThermalSystem::row_sum_residual() const {
 
 double NodalThermalSystem::energy(const Eigen::VectorXd& nodal_temperature) const {
   return mass.dot(nodal_temperature);
+}
+
+void NodalThermalSystem::select_unknowns(const std::vector<double>& mct, double active_mass_fraction) {
+  const std::size_t n_nodes = grid_mass.size();
+  max_mass = *std::max_element(grid_mass.begin(), grid_mass.end());
+  const double threshold = active_mass_fraction * max_mass;
+  unknown.assign(n_nodes, -1);
+  grid_node.clear();
+  dropped_mass = 0.0;
+  for (std::size_t i = 0; i < n_nodes; ++i) {
+    if (grid_mass[i] > threshold && grid_mass[i] > 0.0) {
+      unknown[i] = static_cast<int>(grid_node.size());
+      grid_node.push_back(static_cast<int>(i));
+    } else {
+      dropped_mass += grid_mass[i];
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(grid_node.size());
+  mass.resize(n);
+  temperature.resize(n);
+  for (Eigen::Index u = 0; u < n; ++u) {
+    const auto i = static_cast<std::size_t>(grid_node[static_cast<std::size_t>(u)]);
+    mass[u] = grid_mass[i];
+    temperature[u] = mct[i] / grid_mass[i];
+  }
 }
 
 template <int Dim>

@@ -50,6 +50,10 @@ struct NodalThermalSystem {
   double max_mass = 0.0;                // max_i M_i (J/K)
 
   std::size_t size() const { return grid_node.size(); }
+  /// From grid_mass and Σ_p m_p C_v,p T_p S_ip per node (mct): the unknowns (nodes carrying more than
+  /// active_mass_fraction of the largest nodal heat capacity), their M and their T (eq. 38); sets
+  /// max_mass and dropped_mass.
+  void select_unknowns(const std::vector<double>& mct, double active_mass_fraction);
   /// |Σ_i M_i(all nodes) − Σ_p m_p C_v,p| / Σ_p m_p C_v,p: partition of unity, round-off only.
   double mass_residual() const;
   /// max_i |(K·1)_i| / max_i K_ii: zero row sums, round-off only (0 without conduction).
