@@ -11,16 +11,6 @@
 
 namespace frictherm::coupling {
 
-namespace {
-
-const ThermalProperties& props_of(const std::vector<ThermalProperties>& materials, int id) {
-  if (id < 0 || static_cast<std::size_t>(id) >= materials.size())
-    throw std::invalid_argument("thermal assembly: particle of material id " + std::to_string(id) + " but only " +
-                                std::to_string(materials.size()) + " materials have thermal properties");
-  return materials[static_cast<std::size_t>(id)];
-}
-
-}  // namespace
 
 template <int Dim>
 template <class Kernel>
@@ -45,7 +35,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     Nodes& nl = nodes_[k];
     nl.count = 0;
     kept_[k].count = 0;
-    const ThermalProperties& m = props_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
@@ -93,7 +83,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
         g_dropped += nl.G[a];
       }
     }
-    const ThermalProperties& m = props_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     c.conductance = 0.0;
     // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
     if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) continue;

@@ -11,12 +11,6 @@ namespace frictherm::coupling {
 
 namespace {
 
-const ThermalProperties& props_of(const std::vector<ThermalProperties>& materials, int id) {
-  if (id < 0 || static_cast<std::size_t>(id) >= materials.size())
-    throw std::invalid_argument("thermal assembly: particle of material id " + std::to_string(id) + " but only " +
-                                std::to_string(materials.size()) + " materials have thermal properties");
-  return materials[static_cast<std::size_t>(id)];
-}
 
 /// One particle's nodes, weights S_ip and gradients G_ip, in the order the stencil visits them.
 template <int Dim, class Kernel>
@@ -96,7 +90,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 
   // Pass 1: M_i and M_i T_i (eq. 38).
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = props_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
@@ -143,7 +137,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   mechanics::IVec<Dim> lat[Nodes::capacity];
   int row[Nodes::capacity], gnode[Nodes::capacity];
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = props_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (!m.conducts || !(m.conductivity > 0.0)) continue;
     Nodes nl = cache.lists[k];  // filled by pass 1 (a copy: the lumping below reorders S)
     double s_kept = 0.0;
@@ -244,7 +238,7 @@ void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>
   NodeList<Dim, Kernel> fresh;
   const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!props_of(materials, p.material[k]).conducts) continue;
+    if (!thermal_properties_of(materials, p.material[k]).conducts) continue;
     const NodeList<Dim, Kernel>* cached = cache.find(grid, p, k);  // the assembly's, when still exact
     if (!cached) fresh.fill(grid, p, k);
     const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;
@@ -307,6 +301,13 @@ void NodalThermalSystem::select_unknowns(const std::vector<double>& mct, double 
   }
 }
 
+const ThermalProperties& thermal_properties_of(const std::vector<ThermalProperties>& materials, int id) {
+  if (id < 0 || static_cast<std::size_t>(id) >= materials.size())
+    throw std::invalid_argument("thermal assembly: particle of material id " + std::to_string(id) + " but only " +
+                                std::to_string(materials.size()) + " materials have thermal properties");
+  return materials[static_cast<std::size_t>(id)];
+}
+
 template <int Dim>
 NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                     mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
@@ -337,7 +338,7 @@ template <int Dim>
 double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials) {
   double e = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = props_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (m.conducts) e += p.mass[k] * m.heat_capacity * p.temperature[k];
   }
   return e;

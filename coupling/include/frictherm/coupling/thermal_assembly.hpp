@@ -62,6 +62,9 @@ struct NodalThermalSystem {
   double energy(const Eigen::VectorXd& nodal_temperature) const;
 };
 
+/// The thermal properties of material `id`; throws std::invalid_argument when it has none.
+const ThermalProperties& thermal_properties_of(const std::vector<ThermalProperties>& materials, int id);
+
 /// Builds the system from the current particle state. `materials` is indexed by material id.
 /// Throws std::invalid_argument if a material id has no entry, or if no node carries heat capacity
 /// (no particle of a conducting material).
