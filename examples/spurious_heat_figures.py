@@ -8,18 +8,19 @@ each configuration and CFL factor C, the oscillating block (work of the oscillat
 (pushers still: all work after the preload is spurious) and, for the scene's own configuration, the
 pressed block (examples/pressed_block.json: no pushers). Configurations:
 
-  trusted   the scene as it is: settled preload, displacement separation, FLIP/PIC blend tau = 15 us
-  FLIP      the same without the PIC blend
-  XPIC(4), FMPM(4)   the same with those particle updates instead of the blend
-  paper     the paper's set-up as printed: undamped 0.25 ms ramp, position separation, pure FLIP
+  trusted     the scene as it is: settled preload, displacement separation, USL update, pure FLIP
+  MUSL        the same with the MUSL update
+  MUSL blend  MUSL with a FLIP/PIC blend, tau = 15 us (the trusted set-up before USL was measured)
+  XPIC(4), FMPM(4)   the trusted set-up with those particle updates
+  paper       the paper's set-up as printed: undamped 0.25 ms ramp, position separation, MUSL, FLIP
 
 It writes DIR/spurious_work_vs_cfl.png (oscillating and held work against C, with the values a widely
 used public MPM code gives for the paper's set-up as a reference line), DIR/spurious_fraction.png
 (held and pressed work as a fraction of the oscillating work) and DIR/spurious_work_precision.png
 (error of the oscillating work against its own smallest-C value, against wall time on one thread),
 and prints the table. --pbx adds the 60 um PBX specimen (examples/pbx_microstructure_small.json,
-3.9 us of compaction) over five packing seeds at C = 0.5, 0.25 and 0.1, for FLIP and the PIC blend
-(DIR/pbx_work_vs_cfl.png: median and spread; DIR/pbx_work_precision.png: the median's error against
+3.9 us of compaction) over five packing seeds at C = 0.5, 0.25 and 0.1, for the scene (USL with a
+FLIP/PIC blend, tau = 30 ns), USL with FLIP and MUSL with FLIP (DIR/pbx_work_vs_cfl.png: median and spread; DIR/pbx_work_precision.png: the median's error against
 the scheme's own C = 0.1 median, against the runs' wall time). --reuse reads runs already in DIR. --check exits 1 unless the trusted held block stays
 below 5 % of the rubbing work at C = 0.5 and the trusted oscillating work at C = 0.5 is within 5 %
 of the smallest C run.
@@ -62,10 +63,11 @@ OMEGA = PUSH["omega"]
 PAPER_T1 = 0.25e-3
 CONFIGS = {
     "trusted": [],
-    "FLIP": ["solver.pic_relaxation_time=null"],
-    "XPIC(4)": ["solver.pic_relaxation_time=null", 'solver.particle_update={"type": "xpic", "order": 4}'],
-    "FMPM(4)": ["solver.pic_relaxation_time=null", 'solver.particle_update={"type": "fmpm", "order": 4}'],
-    "paper": ["solver.pic_relaxation_time=null", "solver.damping=null", "contact.separation=position",
+    "MUSL": ["solver.scheme=musl"],
+    "MUSL blend": ["solver.scheme=musl", "solver.pic_relaxation_time=1.5e-5"],
+    "XPIC(4)": ['solver.particle_update={"type": "xpic", "order": 4}'],
+    "FMPM(4)": ['solver.particle_update={"type": "fmpm", "order": 4}'],
+    "paper": ["solver.scheme=musl", "solver.damping=null", "contact.separation=position",
               "materials.pusher.velocity[0].start=%r" % PAPER_T1,
               "materials.pusher.velocity[0].end=%r" % (PAPER_T1 + np.pi / OMEGA),
               "run.end_time=%r" % (PAPER_T1 + np.pi / OMEGA)],
@@ -179,7 +181,8 @@ def pbx_study(exe, out_dir):
     cfls = (0.5, 0.25, 0.1)
     # XPIC(4) is left out: on this specimen at C = 0.5 it gave a median work of 6.72 J/m (180 times
     # FLIP's) and a median particle speed of 11.8 m/s, 10 times as long a run (docs/transfer.md).
-    configs = {"FLIP": [], "PIC blend": ["solver.pic_relaxation_time=%r" % PBX_TAU]}
+    configs = {"USL blend (scene)": [], "USL FLIP": ["solver.pic_relaxation_time=null"],
+               "MUSL FLIP": ["solver.scheme=musl", "solver.pic_relaxation_time=null"]}
     result, wall, speed = {}, {}, {}
     for name, sets in configs.items():
         for c in cfls:
@@ -227,7 +230,6 @@ def pbx_study(exe, out_dir):
     return result
 
 
-PBX_TAU = 30e-9
 REUSE = False
 
 

@@ -28,7 +28,8 @@ const std::string kSets =
     // and only the continuation's integrator differs between `continue` and a run from scratch.
     " --set coupling.reuse_distance=0"
     " --set 'thermal.reaction={\"kinetics\": \"hmx_rogers1975\", \"materials\": [\"hmx\"], \"during_loading\": false}'"
-    " --set 'coupling.hotspots={\"mode\": \"rise\", \"threshold\": 3.0, \"min_particles\": 2}'"
+    // 2 K: the scene's USL update with the PIC blend heats less than MUSL with FLIP did (7 hot spots).
+    " --set 'coupling.hotspots={\"mode\": \"rise\", \"threshold\": 2.0, \"min_particles\": 2}'"
     " --set 'coupling.continuation={\"duration\": 20e-6, \"intervals\": 20}'";
 
 int sh(const std::string& command) { return std::system(command.c_str()); }

@@ -29,6 +29,7 @@ struct OscillatingBlockVariant {
   bool pushers = true;   // false: the block is only pressed onto its base ("pressed block")
   mechanics::SeparationMethod separation = mechanics::SeparationMethod::position;
   mechanics::ParticleUpdate update = mechanics::ParticleUpdate::flip;
+  mechanics::UpdateScheme scheme = mechanics::UpdateScheme::musl;
   int order = 1;
   double pic_relaxation_time = std::numeric_limits<double>::infinity();
 };
@@ -62,6 +63,7 @@ struct OscillatingBlock {
     o.shape = shape;
     o.cfl = cfl;
     o.particle_update = v.update;
+    o.scheme = v.scheme;
     o.transfer_order = v.order;
     o.pic_relaxation_time = v.pic_relaxation_time;
     if (v.settled) o.damping_rate = settle_damping, o.damping_until = settle_until;

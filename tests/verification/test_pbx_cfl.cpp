@@ -28,6 +28,8 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 using namespace frictherm;
 
@@ -38,10 +40,12 @@ struct Work {
   long steps = 0;
 };
 
-Work run(double cfl) {
+/// The small specimen compacted for 3.9 µs at CFL factor `cfl`, with `overrides` on top.
+Work run(double cfl, std::vector<coupling::SceneOverride> overrides = {}) {
   const std::string path = std::string(FRICTHERM_SOURCE_DIR) + "/examples/pbx_microstructure_small.json";
-  const coupling::Scene scene =
-      coupling::load_scene(path, {{"solver.cfl", std::to_string(cfl)}, {"run.end_time", "3.9e-6"}});
+  overrides.push_back({"solver.cfl", std::to_string(cfl)});
+  overrides.push_back({"run.end_time", "3.9e-6"});
+  const coupling::Scene scene = coupling::load_scene(path, overrides);
   auto sim = coupling::build_simulation<2>(scene);
   const double end = scene.end_time;
   while (sim->time() < end * (1 - 1e-12)) sim->step(end - sim->time());
@@ -52,6 +56,11 @@ Work run(double cfl) {
 }  // namespace
 
 TEST(PbxCompaction, SecondOrderHeatingConvergesFasterWithC) {
+  // The paper's update (MUSL-like: NairnMPM's default projects the updated velocities again) with
+  // pure FLIP, as measured above; the example scene's combination is tested below.
+  const auto run = [](double c) {
+    return ::run(c, {{"solver.scheme", "\"musl\""}, {"solver.pic_relaxation_time", "null"}});
+  };
   const double smallest = 0.05;
   const Work ref = run(smallest);
   std::printf("[pbx cfl] C = %.3g: W1 = %.6g J, W2 = %.6g J (%ld steps)\n", smallest, ref.first, ref.second, ref.steps);
@@ -76,6 +85,30 @@ TEST(PbxCompaction, SecondOrderHeatingConvergesFasterWithC) {
       EXPECT_LT(std::max(e1, e2), 0.10) << "both orders within 10 % at C = 0.1";
     }
   }
+}
+
+// The target on the example's own combination (USL, FLIP/PIC blend τ = 30 ns): over five
+// packings, the median second-order work at C = 0.5 within 10 % of its value at C = 0.1. Measured
+// (J/m): C = 0.5 median 0.0145, C = 0.1 median 0.0154 (−5.4 %); MUSL with pure FLIP gives +68 %, the
+// work growing linearly with C (docs/transfer.md). The seeds scatter the work by ±15 %, so one seed
+// alone would not show the trend.
+TEST(PbxCompaction, MedianWorkOfFivePackingsAtHalfCflWithinTenPercentOfSmallCfl) {
+  std::vector<double> half, small;
+  for (const int seed : {2018, 1, 2, 3, 4}) {
+    const coupling::SceneOverride packing{"bodies[0].shape.seed", std::to_string(seed)};
+    half.push_back(run(0.5, {packing}).second);
+    small.push_back(run(0.1, {packing}).second);
+    std::printf("[pbx seeds] seed %d: W2 = %.5g J/m at C = 0.5, %.5g J/m at C = 0.1\n", seed, half.back(),
+                small.back());
+    ASSERT_GT(small.back(), 0.0) << "grains must slide";
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + 2, v.end());
+    return v[2];
+  };
+  const double ratio = median(half) / median(small);
+  std::printf("[pbx seeds] median W2 at C = 0.5 is %+.1f %% of C = 0.1\n", 100 * (ratio - 1));
+  EXPECT_LT(std::fabs(ratio - 1.0), 0.10);
 }
 
 // The contact passes run their nodes in parallel (per-thread stats and pair books, summed in thread
