@@ -211,7 +211,7 @@ def pbx_study(exe, out_dir):
                         color="C%d" % j, label="C = %g" % c if i == 0 else None, capsize=4)
     ax.set_xticks(range(len(configs)))
     ax.set_xticklabels(list(configs))
-    ax.set_ylabel("second-order frictional work (J/m), median and range of 5 seeds")
+    ax.set_ylabel("second-order work (J/m): median, range of 5 packings")
     ax.legend()
     fig.tight_layout()
     fig.savefig(os.path.join(out_dir, "pbx_work_vs_cfl.png"), dpi=150)
