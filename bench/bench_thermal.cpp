@@ -11,7 +11,7 @@
 // (HMX-like P-wave speed) = 0.2 ns at h = 1 µm, i.e. dt_FE ≈ 5 800 dt_mech (2D), 3 900 (3D).
 // Windows of m = 1, 10, 100, 10 000 dt_mech; 4 consecutive windows each (--count-last for the
 // largest, also 4 by default: the whole default run takes about 30 s on one core),
-// integrated as the coupler does (coupling/src/coupler.cpp): one advance() per window, and a
+// integrated as the coupler does (coupling/src/heat/coupler.cpp): one advance() per window, and a
 // freshly assembled Problem each window (new revision → the SUNDIALS integrators rebuild their
 // system and restart at order 1; forward Euler only re-estimates its limit). The Problem is
 // built outside the timing, as the coupler's assembly is not thermal integration.

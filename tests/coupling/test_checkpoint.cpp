@@ -1,4 +1,4 @@
-// Mechanics checkpoints (coupling/src/checkpoint.cpp, issue 17): a run restored from a checkpoint
+// Mechanics checkpoints (coupling/src/run/checkpoint.cpp, issue 17): a run restored from a checkpoint
 // into a simulation rebuilt from the same set-up continues bit-for-bit (positions, velocities,
 // stresses, frictional work, time); a write killed before its rename leaves the previous checkpoint
 // usable; a checkpoint refuses to restore into a different set-up.

@@ -1,4 +1,4 @@
-// Ensembles (coupling/src/ensemble.cpp): members run with their seed, the aggregate agrees with the
+// Ensembles (coupling/src/run/ensemble.cpp): members run with their seed, the aggregate agrees with the
 // members' own files, and the summary statistics follow from the per-hot-spot rows.
 #include <frictherm/coupling/results.hpp>
 #include <frictherm/coupling/ensemble.hpp>

@@ -1,4 +1,4 @@
-// Scene keys of penalty contact (coupling/src/scene_contact.cpp, docs/scenes.md): the method for all
+// Scene keys of penalty contact (coupling/src/scene/scene_contact.cpp, docs/scenes.md): the method for all
 // pairs or per pair, penalty settings, master, boundary spacing; errors name the key path; the
 // sliding-block example runs with either method from one key.
 #include "test_scene_support.hpp"

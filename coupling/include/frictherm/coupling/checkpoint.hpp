@@ -16,7 +16,7 @@
 namespace frictherm::coupling {
 
 namespace ckpt {
-struct Writer;  // checkpoint visitors (coupling/src/checkpoint_io.hpp)
+struct Writer;  // checkpoint visitors (coupling/src/run/checkpoint_io.hpp)
 struct Reader;
 }  // namespace ckpt
 

@@ -1,5 +1,5 @@
 // Scene parsing: boundary conditions, loads and time functions.
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // What the run loop writes: snapshot fields, series rows and run metadata.
-#include "runner_detail.hpp"
+#include "run/runner_detail.hpp"
 
 #include <omp.h>
 

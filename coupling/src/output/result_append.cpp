@@ -1,7 +1,7 @@
 // Appending a resumed run's output to the interrupted result (result_append.hpp).
 #include <frictherm/coupling/result_append.hpp>
 
-#include "h5_util.hpp"
+#include "output/h5_util.hpp"
 
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/xdmf.hpp>

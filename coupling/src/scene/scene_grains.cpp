@@ -3,7 +3,7 @@
 // grains and between grains and binder). A grain material is a copy of a declared "template"
 // material named "<template>#<k>"; contact pairs and thermal properties given for the template
 // apply to its grains.
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <algorithm>
 #include <map>

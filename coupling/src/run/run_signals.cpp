@@ -1,5 +1,5 @@
 // Signal handling of a run (see run_signals.hpp).
-#include "run_signals.hpp"
+#include "run/run_signals.hpp"
 
 #include <csignal>
 

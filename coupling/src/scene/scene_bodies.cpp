@@ -1,7 +1,7 @@
 // Scene parsing: bodies and their shapes (rectangle/box, disk/sphere, ellipse/ellipsoid, annulus,
 // polygon, image; ellipse_packing in scene_packing.cpp, grains as materials in scene_grains.cpp), with
 // the check that every body lies inside the grid.
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <algorithm>
 #include <cmath>

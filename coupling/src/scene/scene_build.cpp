@@ -1,5 +1,5 @@
 // From a parsed Scene to a finalized mechanics::Simulation<Dim>, and the `validate` summary.
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <cmath>
 #include <ostream>

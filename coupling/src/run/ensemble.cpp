@@ -4,7 +4,7 @@
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/h5_output.hpp>
 
-#include "h5_util.hpp"
+#include "output/h5_util.hpp"
 
 #include <algorithm>
 #include <cmath>

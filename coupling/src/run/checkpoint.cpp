@@ -5,7 +5,7 @@
 // values each are n × c (c = 1: n), scalars one-element datasets (long: int64, bool: int32).
 #include <frictherm/coupling/checkpoint.hpp>
 
-#include "checkpoint_io.hpp"
+#include "run/checkpoint_io.hpp"
 
 #include <unistd.h>
 

@@ -5,7 +5,7 @@
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/mechanics/ellipse_packing.hpp>
 
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <algorithm>
 #include <cstdio>

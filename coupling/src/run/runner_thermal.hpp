@@ -2,7 +2,7 @@
 // The thermal side of a run (scenes with a `thermal` section): owns the Coupler and writes its
 // series columns, the /hotspots table and the thermal metadata. The run loop (runner.cpp) calls it
 // at a handful of places; without a `thermal` section it is never created.
-#include "runner_detail.hpp"
+#include "run/runner_detail.hpp"
 
 #include <frictherm/coupling/coupler.hpp>
 

@@ -1,9 +1,9 @@
 // The run loop: build the simulation, step to end_time landing on every snapshot time, write
 // snapshots and series, and keep the failing state when the simulation breaks down.
-#include "checkpoint_io.hpp"
-#include "runner_detail.hpp"
-#include "run_signals.hpp"
-#include "runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
+#include "run/checkpoint_io.hpp"
+#include "run/runner_detail.hpp"
+#include "run/run_signals.hpp"
+#include "run/runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
 #include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/microstructure.hpp>

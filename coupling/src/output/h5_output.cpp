@@ -24,8 +24,8 @@
 
 #include <hdf5.h>
 
-#include "h5_io.hpp"
-#include "h5_util.hpp"
+#include "output/h5_io.hpp"
+#include "output/h5_util.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // The thermal side of a run: coupler calls, series columns, /hotspots, metadata, continuation.
-#include "runner_thermal.hpp"
+#include "run/runner_thermal.hpp"
 
-#include "run_signals.hpp"
+#include "run/run_signals.hpp"
 
 #include <frictherm/mechanics/errors.hpp>
 

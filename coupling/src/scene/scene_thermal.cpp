@@ -1,7 +1,7 @@
 // Scene sections `thermal` and `coupling`: validated into a ThermalSceneSpec (docs/scenes.md).
 #include <frictherm/coupling/scene_thermal.hpp>
 
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <algorithm>
 #include <limits>

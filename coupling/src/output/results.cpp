@@ -3,7 +3,7 @@
 
 #include <hdf5.h>
 
-#include "h5_util.hpp"
+#include "output/h5_util.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -1,6 +1,6 @@
 // Scene parsing: the document root, grid, materials, solver, run and output sections.
 // Bodies and loads live in scene_bodies.cpp and scene_loads.cpp.
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 

@@ -1,5 +1,5 @@
 // The progress line of `frictherm run` (stderr, terminals only).
-#include "runner_detail.hpp"
+#include "run/runner_detail.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -5,7 +5,7 @@
 // type of doubles) stored n × components, and double, long, bool scalars stored as one-element
 // datasets. `reading` tells a state whether it is being written (false) or restored (true), for
 // members it must convert (Eigen::VectorXd, structures of nested vectors).
-#include "h5_util.hpp"
+#include "output/h5_util.hpp"
 
 #include <Eigen/Core>
 

@@ -1,5 +1,5 @@
 // The human-readable summary `frictherm validate` prints.
-#include "scene_detail.hpp"
+#include "scene/scene_detail.hpp"
 
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 
