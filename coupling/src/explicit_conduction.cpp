@@ -16,7 +16,8 @@ template <int Dim>
 template <class Kernel>
 void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                                           const std::vector<ThermalProperties>& materials,
-                                          const AssemblyOptions& opt, NodalThermalSystem& sys) {
+                                          const AssemblyOptions& opt, NodalThermalSystem& sys,
+                                          const mechanics::StencilView<Dim>& view) {
   static_assert(mechanics::Stencil<Dim, Kernel>::node_count <= capacity, "stencil wider than the node list");
   const std::size_t n_nodes = grid.node_count();
   sys.grid_mass.assign(n_nodes, 0.0);
@@ -29,6 +30,8 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   kept_.resize(p.size());
   next_mct_valid_ = false;
   gathered_at_.assign(p.position.begin(), p.position.end());
+  // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
 
   // Pass 1: stencils, M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them.
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -40,9 +43,13 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
     kept_[k].heat_capacity = mc;
-    mechanics::Stencil<Dim, Kernel> st;
-    st.evaluate(grid, p.position[k], p.half_size[k]);
-    st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
+    mechanics::Stencil<Dim, Kernel> own;
+    const mechanics::Stencil<Dim, Kernel>* st = &own;
+    if (step_stencils)
+      st = &step_stencils[k];
+    else
+      own.evaluate(grid, p.position[k], p.half_size[k]);
+    st->for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
       nl.node[nl.count] = i;
       nl.S[nl.count] = w;
       nl.G[nl.count] = g;
@@ -110,9 +117,10 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
 template <int Dim>
 void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                      mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                     const AssemblyOptions& options, NodalThermalSystem& sys) {
+                                     const AssemblyOptions& options, NodalThermalSystem& sys,
+                                     const mechanics::StencilView<Dim>& stencils) {
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    gather_with<decltype(kernel)>(grid, particles, materials, options, sys);
+    gather_with<decltype(kernel)>(grid, particles, materials, options, sys, stencils);
   });
 }
 

@@ -21,9 +21,13 @@ struct NodeList {
   double S[capacity];
   mechanics::Vec<Dim> G[capacity];
 
-  void fill(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, std::size_t k) {
-    mechanics::Stencil<Dim, Kernel> st;
-    st.evaluate(grid, p.position[k], p.half_size[k]);
+  /// From the MPM step's stencils (`step`, when given: the same S_ip, G_ip at these positions) or a
+  /// fresh evaluation.
+  void fill(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, std::size_t k,
+            const mechanics::Stencil<Dim, Kernel>* step) {
+    mechanics::Stencil<Dim, Kernel> own;
+    const mechanics::Stencil<Dim, Kernel>& st = step ? step[k] : own;
+    if (!step) own.evaluate(grid, p.position[k], p.half_size[k]);
     count = 0;
     st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
       node[count] = i;
@@ -59,8 +63,9 @@ struct StencilCache {
     position.resize(n);
     half_size.resize(n);
   }
-  const NodeList<Dim, Kernel>& fill(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p, std::size_t k) {
-    lists[k].fill(g, p, k);
+  const NodeList<Dim, Kernel>& fill(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p, std::size_t k,
+                                    const mechanics::Stencil<Dim, Kernel>* step) {
+    lists[k].fill(g, p, k, step);
     position[k] = p.position[k];
     half_size[k] = p.half_size[k];
     return lists[k];
@@ -77,8 +82,10 @@ struct StencilCache {
 
 template <int Dim, class Kernel>
 NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
-                                 const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt) {
+                                 const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt,
+                                 const mechanics::StencilView<Dim>& view) {
   using Nodes = NodeList<Dim, Kernel>;
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
   const std::size_t n_nodes = grid.node_count();
   NodalThermalSystem sys;
   sys.grid_mass.assign(n_nodes, 0.0);
@@ -94,7 +101,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    const Nodes& nl = cache.fill(grid, p, k);
+    const Nodes& nl = cache.fill(grid, p, k, step_stencils);
     for (int a = 0; a < nl.count; ++a) {
       const auto i = static_cast<std::size_t>(nl.node[a]);
       sys.grid_mass[i] += mc * nl.S[a];
@@ -234,13 +241,15 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 template <int Dim, class Kernel>
 void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
                      const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
-                     const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+                     const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end,
+                     const mechanics::StencilView<Dim>& view) {
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
   NodeList<Dim, Kernel> fresh;
   const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!thermal_properties_of(materials, p.material[k]).conducts) continue;
     const NodeList<Dim, Kernel>* cached = cache.find(grid, p, k);  // the assembly's, when still exact
-    if (!cached) fresh.fill(grid, p, k);
+    if (!cached) fresh.fill(grid, p, k, step_stencils);
     const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;
     double dT = 0.0, pic = 0.0, s = 0.0;
     for (int a = 0; a < nl.count; ++a) {
@@ -311,9 +320,9 @@ const ThermalProperties& thermal_properties_of(const std::vector<ThermalProperti
 template <int Dim>
 NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                     mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                    const AssemblyOptions& options) {
+                                    const AssemblyOptions& options, const mechanics::StencilView<Dim>& stencils) {
   return mechanics::dispatch_shape(shape, [&](auto kernel) {
-    return assemble_with<Dim, decltype(kernel)>(grid, particles, materials, options);
+    return assemble_with<Dim, decltype(kernel)>(grid, particles, materials, options, stencils);
   });
 }
 
@@ -321,7 +330,8 @@ template <int Dim>
 void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                    const NodalThermalSystem& system, const Eigen::VectorXd& delta,
-                                   double relaxation, const Eigen::VectorXd* end) {
+                                   double relaxation, const Eigen::VectorXd* end,
+                                   const mechanics::StencilView<Dim>& stencils) {
   const auto n = static_cast<Eigen::Index>(system.size());
   if (delta.size() != n || (end && end->size() != n))
     throw std::invalid_argument("add_nodal_change_to_particles: " + std::to_string(delta.size()) +
@@ -330,7 +340,7 @@ void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::
     throw std::invalid_argument("add_nodal_change_to_particles: relaxation must be in [0, 1]");
   const Eigen::VectorXd* pic = relaxation > 0.0 ? end : nullptr;
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, relaxation, pic);
+    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, relaxation, pic, stencils);
   });
 }
 
@@ -347,11 +357,11 @@ double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::ve
 #define FRICTHERM_INSTANTIATE_ASSEMBLY(D)                                                                       \
   template NodalThermalSystem assemble_thermal<D>(const mechanics::Grid<D>&, const mechanics::Particles<D>&,   \
                                                   mechanics::ShapeKind, const std::vector<ThermalProperties>&, \
-                                                  const AssemblyOptions&);                                     \
+                                                  const AssemblyOptions&, const mechanics::StencilView<D>&);   \
   template void add_nodal_change_to_particles<D>(const mechanics::Grid<D>&, mechanics::Particles<D>&,          \
                                                  mechanics::ShapeKind, const std::vector<ThermalProperties>&,  \
                                                  const NodalThermalSystem&, const Eigen::VectorXd&, double,    \
-                                                 const Eigen::VectorXd*);                                      \
+                                                 const Eigen::VectorXd*, const mechanics::StencilView<D>&);    \
   template double particle_thermal_energy<D>(const mechanics::Particles<D>&, const std::vector<ThermalProperties>&);
 FRICTHERM_INSTANTIATE_ASSEMBLY(2)
 FRICTHERM_INSTANTIATE_ASSEMBLY(3)

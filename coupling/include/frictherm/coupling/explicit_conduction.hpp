@@ -45,9 +45,12 @@ class ExplicitConduction {
   /// on every node and the unknowns into `sys` (its conductance is left empty), the gradients G'
   /// with the dropped nodes lumped, and the bounds of M⁻¹K. Throws std::invalid_argument
   /// like assemble_thermal for a material id without thermal properties or no conducting particle.
+  /// `stencils`: the MPM step's stencils at these positions (mechanics::Simulation::current_stencils),
+  /// read instead of evaluating them again (same numbers); an empty view evaluates them here.
   void gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
               mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-              const AssemblyOptions& options, NodalThermalSystem& sys);
+              const AssemblyOptions& options, NodalThermalSystem& sys,
+              const mechanics::StencilView<Dim>& stencils = {});
 
   /// True if a gather was made for these particles (same count) and none has moved more than
   /// `max_shift` (m, along any axis) since: the kept stencils, M and G' may then serve another window.
@@ -98,7 +101,7 @@ class ExplicitConduction {
   template <class Kernel>
   void gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
-                   NodalThermalSystem& sys);
+                   NodalThermalSystem& sys, const mechanics::StencilView<Dim>& stencils);
 
   std::vector<Nodes> nodes_;              // gather scratch, by particle
   std::vector<Kept> kept_;                // by particle; count 0 for particles that hold no heat
