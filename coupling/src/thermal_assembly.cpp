@@ -80,6 +80,36 @@ struct StencilCache {
   }
 };
 
+/// K's sparsity pattern of the last assembly (per dimension and kernel, per thread): the unknowns, the
+/// CSR arrays and the row slot of every stored entry (the diagonal at the centre slot). A new assembly
+/// with the same unknowns and the same slots holding non-zero products has the same pattern: only
+/// the values are written (same numbers, same order as a fresh build).
+template <int Dim, class Kernel>
+struct ConductancePattern {
+  std::vector<int> grid_node;
+  std::vector<int> slot;  // by stored entry, CSR order
+  thermal::SparseMatrix matrix;
+
+  static ConductancePattern& local() {
+    thread_local ConductancePattern pattern;
+    return pattern;
+  }
+  /// True if `rows` (n rows of `slots` products) gives this pattern for these unknowns.
+  bool matches(const std::vector<int>& unknowns, const std::vector<double>& rows, int slots, int centre) const {
+    if (unknowns != grid_node || matrix.rows() != static_cast<Eigen::Index>(unknowns.size())) return false;
+    const auto* outer = matrix.outerIndexPtr();
+    for (std::size_t u = 0; u < unknowns.size(); ++u) {
+      const double* r = &rows[u * static_cast<std::size_t>(slots)];
+      int count = 0;
+      for (int s = 0; s < slots; ++s) count += s != centre && r[s] != 0.0;
+      if (count + 1 != outer[u + 1] - outer[u]) return false;
+      for (auto e = outer[u]; e < outer[u + 1]; ++e)
+        if (slot[static_cast<std::size_t>(e)] != centre && r[slot[static_cast<std::size_t>(e)]] == 0.0) return false;
+    }
+    return true;
+  }
+};
+
 template <int Dim, class Kernel>
 NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                                  const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt,
@@ -193,11 +223,30 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   // conduction part conserve Σ M_i T_i exactly). Rows are written in place (Eigen's sorted
   // startVec/insertBack fill): no triplet list, no temporary column-major copy.
   constexpr int centre = (slots - 1) / 2;
+  ConductancePattern<Dim, Kernel>& pattern = ConductancePattern<Dim, Kernel>::local();
+  if (pattern.matches(sys.grid_node, rows, slots, centre)) {  // same layout: refill the values
+    sys.conductance = pattern.matrix;
+    double* value = sys.conductance.valuePtr();
+    const auto* outer = sys.conductance.outerIndexPtr();
+    for (Eigen::Index u = 0; u < n; ++u) {
+      const double* r = &rows[static_cast<std::size_t>(u) * slots];
+      double off_sum = 0.0;  // in slot order, as the fresh build sums it
+      for (int s = 0; s < slots; ++s)
+        if (s != centre && r[s] != 0.0) off_sum += r[s];
+      for (auto e = outer[u]; e < outer[u + 1]; ++e) {
+        const int sl = pattern.slot[static_cast<std::size_t>(e)];
+        value[e] = sl == centre ? -off_sum : r[sl];
+      }
+    }
+    return sys;
+  }
   std::size_t nnz = 0;
   for (double v : rows) nnz += v != 0.0;
   sys.conductance.resize(n, n);
   sys.conductance.reserve(static_cast<Eigen::Index>(nnz) + n);
-  int col[slots];
+  pattern.slot.clear();
+  pattern.slot.reserve(nnz + static_cast<std::size_t>(n));
+  int col[slots], slot_at[slots];
   double val[slots];
   for (Eigen::Index u = 0; u < n; ++u) {
     const double* r = &rows[static_cast<std::size_t>(u) * slots];
@@ -212,6 +261,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         rem /= kw;
       }
       col[count] = sys.unknown[static_cast<std::size_t>(j)];
+      slot_at[count] = s;
       val[count++] = r[s];
       off_sum += r[s];
     }
@@ -221,6 +271,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     for (int a = 1; a < count; ++a)
       for (int b = a; b > 0 && col[b - 1] > col[b]; --b) {
         std::swap(col[b - 1], col[b]);
+        std::swap(slot_at[b - 1], slot_at[b]);
         std::swap(val[b - 1], val[b]);
       }
     sys.conductance.startVec(u);
@@ -228,13 +279,17 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     for (int a = 0; a < count; ++a) {
       if (!diagonal && col[a] > u) {
         sys.conductance.insertBack(u, u) = -off_sum;
+        pattern.slot.push_back(centre);
         diagonal = true;
       }
       sys.conductance.insertBack(u, col[a]) = val[a];
+      pattern.slot.push_back(slot_at[a]);
     }
-    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum;
+    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum, pattern.slot.push_back(centre);
   }
   sys.conductance.finalize();
+  pattern.grid_node = sys.grid_node;
+  pattern.matrix = sys.conductance;
   return sys;
 }
 
