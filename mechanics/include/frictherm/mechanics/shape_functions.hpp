@@ -82,22 +82,6 @@ struct UGIMPKernel {
   static double weight(double d, double h, double lp, double& grad) {
     return weight(d, h, lp, 1.0 / h, 1.0 / (h * lp), grad);
   }
-  /// weight() without branches: every piece is computed and the one that applies is selected, so
-  /// the numbers are the same. The piece depends on where the particle sits in its cell, which the
-  /// branch predictor cannot guess from one particle to the next.
-  static double weight_select(double d, double h, double lp, double inv_h, double inv_hlp, double& grad) {
-    const double a = std::fabs(d);
-    const double sgn = d < 0.0 ? -1.0 : 1.0;
-    const double r = h + lp - a;
-    const double w_in = 1.0 - 0.5 * (d * d + lp * lp) * inv_hlp, g_in = -d * inv_hlp;
-    const double w_mid = 1.0 - a * inv_h, g_mid = -sgn * inv_h;
-    const double w_out = 0.25 * r * r * inv_hlp, g_out = -0.5 * sgn * r * inv_hlp;
-    const bool in = a < lp, mid = a < h - lp, out = a < h + lp;
-    const double w_far = out ? w_out : 0.0, g_far = out ? g_out : 0.0;
-    const double w_near = mid ? w_mid : w_far, g_near = mid ? g_mid : g_far;
-    grad = in ? g_in : g_near;
-    return in ? w_in : w_near;
-  }
   static void eval(double x, double lo, double h, double inv_h, double lp, Weights1D<K>& out) {
     const double s = (x - lo) * inv_h;
     const int j = static_cast<int>(std::floor(s));
@@ -105,7 +89,7 @@ struct UGIMPKernel {
     const double inv_hlp = inv_h / lp;
     for (int a = 0; a < K; ++a) {
       const double d = x - (lo + h * (out.base + a));
-      out.w[a] = weight_select(d, h, lp, inv_h, inv_hlp, out.dw[a]);
+      out.w[a] = weight(d, h, lp, inv_h, inv_hlp, out.dw[a]);
     }
   }
 };
