@@ -72,8 +72,13 @@ void Simulation<Dim>::step_with(double dt) {
   if constexpr (is_extended<Kernel>) {
     prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
   } else {
-    stencils<Kernel>().resize(p_.size());
-    if (contact_) evaluate_stencils<Kernel>();  // also lays out the per-material boxes of nodes
+    auto& st = stencils<Kernel>();
+    if (st.size() != p_.size()) st.resize(p_.size()), stencils_current_ = false;
+    if (contact_) {
+      // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
+      if (!stencils_current_) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
+      layout_fields(box_lo_, box_hi_);
+    }
   }
   if (contact_) {
     std::fill(work_first_.begin(), work_first_.end(), 0.0);
@@ -109,6 +114,7 @@ void Simulation<Dim>::step_with(double dt) {
   const long bad = update_particles<Kernel>(dt);
   if (opt_.scheme == UpdateScheme::usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
   move_rigid_particles(dt, t);
+  stencils_current_ = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
   lap_.to(pt.grid_to_particle);
   time_ += dt;
   ++step_;
@@ -129,11 +135,18 @@ void Simulation<Dim>::step_with(double dt) {
   }
 }
 
-// Contact: every particle's stencil (rigid ones too), and per material the box of nodes it reaches.
+// Every particle's stencil (rigid ones too), and with contact per material the box of nodes it reaches
+// (laid out by the step: layout_fields).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::evaluate_stencils() {
   auto& st = stencils<Kernel>();
+  st.resize(p_.size());
+  if (!contact_) {
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (std::size_t k = 0; k < p_.size(); ++k) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+    return;
+  }
   const std::size_t nm = materials_.size();
   for (std::size_t m = 0; m < nm; ++m) box_lo_[m].fill(INT_MAX), box_hi_[m].fill(INT_MIN);
   // One parallel region for all materials (a grain is a few hundred particles: a region per
@@ -163,7 +176,22 @@ void Simulation<Dim>::evaluate_stencils() {
         box_hi_[m][d] = std::max(box_hi_[m][d], hi[m][d]);
       }
   }
-  layout_fields(box_lo_, box_hi_);
+}
+
+template <int Dim>
+StencilView<Dim> Simulation<Dim>::current_stencils() {
+  if (!finalized_ || opt_.shape == ShapeKind::extended_bspline) return {};
+  return dispatch_shape(opt_.shape, [&](auto kernel) {
+    using Kernel = decltype(kernel);
+    auto& st = stencils<Kernel>();
+    if (!stencils_current_ || st.size() != p_.size()) {
+      PhaseLap lap;
+      evaluate_stencils<Kernel>();
+      stencils_current_ = true;
+      lap.to(phase_times_.shape_functions);
+    }
+    return StencilView<Dim>{opt_.shape, static_cast<const void*>(st.data()), st.size()};
+  });
 }
 
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:
@@ -177,6 +205,7 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
+  const bool prepared = stencils_current_;  // by current_stencils() since the last step
   nodes_.clear_accumulators();
 #pragma omp parallel num_threads(threads_)
   {
@@ -191,7 +220,8 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
       if (!contact_) {
 #pragma omp for schedule(static) nowait
         for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-          if constexpr (!is_extended<Kernel>) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+          if constexpr (!is_extended<Kernel>)
+            if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
           const auto& s = st[k];  // EBS: a view of the precomputed entries
           const double mp = p_.mass[k];
           const Vec<Dim> mv = mp * p_.velocity[k];
@@ -436,7 +466,9 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   wave_speed_ready_ = true;
 }
 
-#define FRICTHERM_INSTANTIATE_STEP(D) template double Simulation<D>::step(double);
+#define FRICTHERM_INSTANTIATE_STEP(D) \
+  template double Simulation<D>::step(double); \
+  template StencilView<D> Simulation<D>::current_stencils();
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)
 #undef FRICTHERM_INSTANTIATE_STEP

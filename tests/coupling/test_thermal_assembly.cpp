@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace fc = frictherm::coupling;
@@ -224,5 +225,95 @@ TEST(IncrementalMapping, ParticleEnergyChangeEqualsNodalEnergyChange) {
     EXPECT_NEAR(de, expected, 1e-12 * e0);
     // The rigid body (no thermal properties) keeps its temperatures.
     EXPECT_EQ(std::vector<double>(p.temperature.end() - 8, p.temperature.end()), rigid_before);
+  }
+}
+
+namespace {
+
+// Exact equality of two systems: unknowns, M, T and K's CSR arrays and values.
+void expect_identical(const fc::NodalThermalSystem& a, const fc::NodalThermalSystem& b) {
+  EXPECT_EQ(a.grid_node, b.grid_node);
+  EXPECT_EQ(a.grid_mass, b.grid_mass);
+  EXPECT_TRUE(a.mass == b.mass);
+  EXPECT_TRUE(a.temperature == b.temperature);
+  ASSERT_EQ(a.conductance.nonZeros(), b.conductance.nonZeros());
+  ASSERT_EQ(a.conductance.rows(), b.conductance.rows());
+  const auto nnz = static_cast<std::size_t>(a.conductance.nonZeros());
+  const auto rows = static_cast<std::size_t>(a.conductance.rows());
+  EXPECT_TRUE(std::equal(a.conductance.outerIndexPtr(), a.conductance.outerIndexPtr() + rows + 1,
+                         b.conductance.outerIndexPtr()));
+  EXPECT_TRUE(std::equal(a.conductance.innerIndexPtr(), a.conductance.innerIndexPtr() + nnz,
+                         b.conductance.innerIndexPtr()));
+  EXPECT_TRUE(std::equal(a.conductance.valuePtr(), a.conductance.valuePtr() + nnz, b.conductance.valuePtr()));
+}
+
+// The particles of block_2d with material 1 moved by `shift` along x.
+fm::Particles<2> shifted_block(double shift) {
+  fm::Particles<2> p = block_2d();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (p.material[k] == 1) p.position[k][0] += shift;
+  return p;
+}
+
+}  // namespace
+
+// The MPM step's stencils handed in as a StencilView (Simulation::current_stencils) give the system,
+// the map back and the matrix-free gather of a fresh evaluation bit for bit; a view of another
+// kernel or particle count is not used.
+TEST(ThermalAssembly, StencilsOfTheStepGiveTheSameNumbers) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
+  const auto mats = two_materials();
+  const fm::Particles<2> p = block_2d();
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    fm::dispatch_shape(shape, [&](auto kernel) {
+      using Kernel = decltype(kernel);
+      std::vector<fm::Stencil<2, Kernel>> st(p.size());
+      for (std::size_t k = 0; k < p.size(); ++k) st[k].evaluate(grid, p.position[k], p.half_size[k]);
+      const fm::StencilView<2> view{shape, st.data(), st.size()};
+      const fm::StencilView<2> wrong_size{shape, st.data(), st.size() - 1};
+      const fc::NodalThermalSystem own = fc::assemble_thermal(grid, p, shape, mats);
+      expect_identical(own, fc::assemble_thermal(grid, p, shape, mats, {}, view));
+      expect_identical(own, fc::assemble_thermal(grid, p, shape, mats, {}, wrong_size));
+      // Map back with the stencils (the assembly's kept lists made stale by assembling elsewhere).
+      fc::assemble_thermal(grid, shifted_block(0.3e-3), shape, mats);
+      Eigen::VectorXd delta(own.mass.size());
+      for (Eigen::Index u = 0; u < delta.size(); ++u) delta[u] = 0.01 * static_cast<double>(u % 7) - 0.02;
+      fm::Particles<2> pa = p, pb = p;
+      fc::add_nodal_change_to_particles(grid, pa, shape, mats, own, delta);
+      fc::add_nodal_change_to_particles(grid, pb, shape, mats, own, delta, 0.0, nullptr, view);
+      EXPECT_EQ(pa.temperature, pb.temperature);
+      EXPECT_NE(pa.temperature, p.temperature);
+      // Matrix-free gather and one sub-step.
+      fc::ExplicitConduction<2> ea, eb;
+      fc::NodalThermalSystem sa, sb;
+      ea.gather(grid, p, shape, mats, {}, sa);
+      eb.gather(grid, p, shape, mats, {}, sb, view);
+      EXPECT_EQ(sa.grid_mass, sb.grid_mass);
+      EXPECT_TRUE(sa.temperature == sb.temperature);
+      const Eigen::VectorXd q = Eigen::VectorXd::Constant(sa.mass.size(), 1e-6);
+      EXPECT_TRUE(ea.advance(sa, sa.temperature, q, {}, 1e-6, 1) == eb.advance(sb, sb.temperature, q, {}, 1e-6, 1));
+    });
+  }
+}
+
+// K's pattern is kept per layout: an assembly whose unknowns and non-zero products sit where the last
+// one's did only refills the values, and equals a fresh build bit for bit; a changed layout (a
+// particle moved into another cell) is built afresh.
+TEST(ThermalAssembly, RefilledConductanceEqualsFreshBuild) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
+  const auto other_grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 9});  // other node numbers: forgets the pattern
+  const auto mats = two_materials();
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    const fm::Particles<2> small = shifted_block(1e-6), moved = shifted_block(0.6e-3);
+    fc::assemble_thermal(grid, block_2d(), shape, mats);
+    const fc::NodalThermalSystem refilled = fc::assemble_thermal(grid, small, shape, mats);  // same layout
+    const fc::NodalThermalSystem after_refill = fc::assemble_thermal(grid, moved, shape, mats);  // new layout
+    fc::assemble_thermal(other_grid, small, shape, mats);
+    expect_identical(refilled, fc::assemble_thermal(grid, small, shape, mats));
+    fc::assemble_thermal(other_grid, small, shape, mats);
+    expect_identical(after_refill, fc::assemble_thermal(grid, moved, shape, mats));
+    EXPECT_NE(refilled.conductance.nonZeros(), 0);
   }
 }

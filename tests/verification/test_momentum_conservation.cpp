@@ -4,6 +4,8 @@
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
+#include "sliding_block.hpp"
+
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -136,4 +138,74 @@ TEST(MomentumConservation, PicBlendXpicAndFmpmKeepUniformTranslation) {
     std::printf("[%s translation] max |v_p - v0| / |v0| after 200 steps = %.2e\n", name, worst);
     EXPECT_LT(worst, 1e-12) << name;
   }
+}
+
+namespace {
+
+// Two identical simulations stepped side by side; before each step one of them hands out its
+// stencils (Simulation::current_stencils, what the thermal coupling reads). The view must hold, for
+// every particle, the stencil a fresh evaluation at its current position gives, and the run that
+// starts its steps from these stencils must stay bit-identical to the one that evaluates its own.
+void expect_current_stencils_change_nothing(Simulation<2>& a, Simulation<2>& b, int steps) {
+  EXPECT_EQ(b.current_stencils().data, nullptr);  // before finalize(): none
+  a.finalize();
+  b.finalize();
+  for (int s = 0; s < steps; ++s) {
+    const auto& p = b.particles();
+    const StencilView<2> view = b.current_stencils();
+    const Stencil<2, UGIMPKernel>* st = view.as<UGIMPKernel>(p.size());
+    ASSERT_NE(st, nullptr) << "step " << s;
+    EXPECT_EQ(view.as<LinearKernel>(p.size()), nullptr);  // typed: no other kernel's view
+    EXPECT_EQ(view.as<UGIMPKernel>(p.size() + 1), nullptr);
+    long differ = 0;
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      Stencil<2, UGIMPKernel> fresh;
+      fresh.evaluate(b.grid(), p.position[k], p.half_size[k]);
+      for (int d = 0; d < 2; ++d) {
+        differ += fresh.axis[d].base != st[k].axis[d].base;
+        for (int i = 0; i < 3; ++i)
+          differ += fresh.axis[d].w[i] != st[k].axis[d].w[i] || fresh.axis[d].dw[i] != st[k].axis[d].dw[i];
+      }
+    }
+    ASSERT_EQ(differ, 0) << "step " << s;
+    if (s % 3 == 0) b.current_stencils();  // asking twice evaluates nothing new
+    a.step();
+    b.step();
+  }
+  const auto &pa = a.particles(), &pb = b.particles();
+  long differ = 0;
+  for (std::size_t k = 0; k < pa.size(); ++k)
+    differ += pa.position[k] != pb.position[k] || pa.velocity[k] != pb.velocity[k] || pa.stress[k] != pb.stress[k] ||
+              pa.deformation_gradient[k] != pb.deformation_gradient[k];
+  EXPECT_EQ(differ, 0);
+  for (auto order : {HeatingOrder::first, HeatingOrder::second})
+    EXPECT_TRUE(a.frictional_work(order) == b.frictional_work(order));
+  EXPECT_EQ(a.time(), b.time());
+}
+
+}  // namespace
+
+TEST(CurrentStencils, SteppingFromHandedOutStencilsIsBitIdenticalWithoutContact) {
+  omp_set_num_threads(1);
+  auto a = spinning_disk<2>(MaterialKind::linear_elastic, ShapeKind::ugimp, UpdateScheme::musl);
+  auto b = spinning_disk<2>(MaterialKind::linear_elastic, ShapeKind::ugimp, UpdateScheme::musl);
+  expect_current_stencils_change_nothing(*a, *b, 60);
+}
+
+TEST(CurrentStencils, SteppingFromHandedOutStencilsIsBitIdenticalWithContact) {
+  omp_set_num_threads(1);
+  frictherm::verification::SlidingBlockSetup s;  // multimaterial Coulomb contact, uGIMP, loads
+  s.cfl = 0.5;
+  int block = 0;
+  Simulation<2> a = frictherm::verification::make_sliding_block(s, block);
+  Simulation<2> b = frictherm::verification::make_sliding_block(s, block);
+  ASSERT_TRUE(a.contact_enabled());
+  expect_current_stencils_change_nothing(a, b, 300);
+  EXPECT_GT(a.contact_stats().contact_nodes, 0);  // the contact passes ran on the shared nodes
+}
+
+TEST(CurrentStencils, ExtendedBSplineHandsOutNone) {
+  auto sim = spinning_disk<2>(MaterialKind::linear_elastic, ShapeKind::extended_bspline, UpdateScheme::musl);
+  sim->step();
+  EXPECT_EQ(sim->current_stencils().data, nullptr);
 }

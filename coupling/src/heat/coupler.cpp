@@ -68,7 +68,7 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
 
 template <int Dim>
 void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
-  system_ = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly);
+  system_ = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly, step_stencils());
   system_assembled_ = true;
   system_gathered_ = false;
   system_changed();
@@ -120,7 +120,7 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
   if (system_gathered_ && opt_.reuse_distance > 0.0 && explicit_.reusable(p, shift)) {
     explicit_.reproject(p, system_);  // same S, M and G'; T_i from the particles now
   } else {
-    explicit_.gather(grid_, p, shape_, opt_.materials, opt_.assembly, system_);
+    explicit_.gather(grid_, p, shape_, opt_.materials, opt_.assembly, system_, step_stencils());
     ++books_.matrix_free_gathers;
     system_assembled_ = false;
     system_gathered_ = true;
@@ -301,8 +301,8 @@ void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, doub
   const double beta = std::isfinite(opt_.subgrid_relaxation_time)
                           ? -std::expm1(-(t1 - t0) / opt_.subgrid_relaxation_time)
                           : 0.0;
-  add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta,
-                                &nodal_temperature_);  // design §4
+  add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta, &nodal_temperature_,
+                                step_stencils());  // design §4
   books_.nodal_energy_change += system_.mass.dot(delta);
 }
 

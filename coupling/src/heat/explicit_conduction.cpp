@@ -16,7 +16,8 @@ template <int Dim>
 template <class Kernel>
 void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                                           const std::vector<ThermalProperties>& materials,
-                                          const AssemblyOptions& opt, NodalThermalSystem& sys) {
+                                          const AssemblyOptions& opt, NodalThermalSystem& sys,
+                                          const mechanics::StencilView<Dim>& view) {
   static_assert(mechanics::Stencil<Dim, Kernel>::node_count <= capacity, "stencil wider than the node list");
   const std::size_t n_nodes = grid.node_count();
   sys.grid_mass.assign(n_nodes, 0.0);
@@ -25,21 +26,38 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   sys.dropped_mass = 0.0;
   sys.conductance.resize(0, 0);  // no K on this path
   mct_.assign(n_nodes, 0.0);
-  nodes_.resize(p.size());
-  kept_.resize(p.size());
+  if (!view.template as<Kernel>(p.size())) nodes_.resize(p.size());  // scratch only without the step's stencils
+  kept_mass_.resize(p.size());
+  kept_flux_.resize(p.size());
   next_mct_valid_ = false;
   gathered_at_.assign(p.position.begin(), p.position.end());
+  // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
 
-  // Pass 1: stencils, M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them.
+  // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them. With the step's
+  // stencils nothing is stored (pass 2 reads them again); otherwise each stencil is evaluated once and
+  // its node list kept for pass 2.
+  holds_heat_.assign(p.size(), 0);
   for (std::size_t k = 0; k < p.size(); ++k) {
-    Nodes& nl = nodes_[k];
-    nl.count = 0;
-    kept_[k].count = 0;
+    kept_mass_[k].count = 0;
+    kept_flux_[k].count = 0;
+    kept_flux_[k].conductance = 0.0;
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (!m.conducts) continue;
+    holds_heat_[k] = 1;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    kept_[k].heat_capacity = mc;
+    kept_mass_[k].heat_capacity = mc;
+    const double mct = mc * p.temperature[k];
+    if (step_stencils) {
+      step_stencils[k].for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>&) {
+        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+        mct_[static_cast<std::size_t>(i)] += mct * w;
+      });
+      continue;
+    }
+    Nodes& nl = nodes_[k];
+    nl.count = 0;
     mechanics::Stencil<Dim, Kernel> st;
     st.evaluate(grid, p.position[k], p.half_size[k]);
     st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
@@ -48,7 +66,6 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       nl.G[nl.count] = g;
       ++nl.count;
     });
-    const double mct = mc * p.temperature[k];
     for (int a = 0; a < nl.count; ++a) {
       const auto i = static_cast<std::size_t>(nl.node[a]);
       sys.grid_mass[i] += mc * nl.S[a];
@@ -65,10 +82,21 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
   row_bound_.assign(static_cast<std::size_t>(n), 0.0);
   rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
+  Nodes from_step;
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const Nodes& nl = nodes_[k];
-    if (nl.count == 0) continue;
-    Kept& c = kept_[k];
+    if (!holds_heat_[k]) continue;
+    if (step_stencils) {
+      from_step.count = 0;
+      step_stencils[k].for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
+        from_step.node[from_step.count] = i;
+        from_step.S[from_step.count] = w;
+        from_step.G[from_step.count] = g;
+        ++from_step.count;
+      });
+    }
+    const Nodes& nl = step_stencils ? from_step : nodes_[k];
+    KeptMass& c = kept_mass_[k];
+    mechanics::Vec<Dim> G[capacity];  // G' of the kept nodes
     double s_kept = 0.0;
     mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
     for (int a = 0; a < nl.count; ++a) {
@@ -76,7 +104,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       if (u >= 0) {
         s_kept += nl.S[a];
         c.unknown[c.count] = u;
-        c.G[c.count] = nl.G[a];
+        G[c.count] = nl.G[a];
         c.S[c.count] = nl.S[a];
         ++c.count;
       } else {
@@ -84,25 +112,27 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       }
     }
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
-    c.conductance = 0.0;
     // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
     if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) continue;
     if (c.count < nl.count)
-      for (int a = 0; a < c.count; ++a) c.G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
-    c.conductance = p.volume[k] * m.conductivity;
+      for (int a = 0; a < c.count; ++a) G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
+    KeptFlux& f = kept_flux_[k];
+    f.conductance = p.volume[k] * m.conductivity;
+    f.count = c.count;
+    for (int a = 0; a < c.count; ++a) f.unknown[a] = c.unknown[a], f.G[a] = G[a];
     // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
     // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
     // Σ_p c_p (Σ_a |G'_a|²/M_a)(Σ_a M_a x_a²), so λ ≤ max_i Σ_{p∋i} c_p Σ_a |G'_a|²/M_a.
     double gsum = 0.0, g2m = 0.0;
     double gnorm[capacity];
     for (int a = 0; a < c.count; ++a) {
-      gnorm[a] = c.G[a].norm();
+      gnorm[a] = G[a].norm();
       gsum += gnorm[a];
       g2m += gnorm[a] * gnorm[a] / sys.mass[c.unknown[a]];
     }
     for (int a = 0; a < c.count; ++a) {
-      row_bound_[static_cast<std::size_t>(c.unknown[a])] += c.conductance * gnorm[a] * gsum;
-      rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += c.conductance * g2m;
+      row_bound_[static_cast<std::size_t>(c.unknown[a])] += f.conductance * gnorm[a] * gsum;
+      rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += f.conductance * g2m;
     }
   }
 }
@@ -110,15 +140,16 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
 template <int Dim>
 void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                      mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                     const AssemblyOptions& options, NodalThermalSystem& sys) {
+                                     const AssemblyOptions& options, NodalThermalSystem& sys,
+                                     const mechanics::StencilView<Dim>& stencils) {
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    gather_with<decltype(kernel)>(grid, particles, materials, options, sys);
+    gather_with<decltype(kernel)>(grid, particles, materials, options, sys, stencils);
   });
 }
 
 template <int Dim>
 bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, double max_shift) const {
-  if (gathered_at_.size() != p.size() || kept_.size() != p.size()) return false;
+  if (gathered_at_.size() != p.size() || kept_mass_.size() != p.size()) return false;
   for (std::size_t k = 0; k < p.size(); ++k)
     if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) return false;
   return true;
@@ -126,12 +157,12 @@ bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, doubl
 
 template <int Dim>
 void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
-  if (kept_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
+  if (kept_mass_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
   const auto n = static_cast<Eigen::Index>(sys.size());
   if (!next_mct_valid_ || next_mct_.size() != n) {
     next_mct_.setZero(n);
     for (std::size_t k = 0; k < p.size(); ++k) {  // Σ_p m_p C_v,p T_p S_ip (eq. 38), the gather's S
-      const Kept& c = kept_[k];
+      const KeptMass& c = kept_mass_[k];
       const double mct = c.heat_capacity * p.temperature[k];
       for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
     }
@@ -176,7 +207,7 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
   force_.resize(n);
   for (long s = 0; s < substeps; ++s) {
     force_.setZero();
-    for (const Kept& c : kept_) {
+    for (const KeptFlux& c : kept_flux_) {
       if (c.conductance == 0.0) continue;
       mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();  // (∇T)_p = Σ_j G'_jp T_j (eq. 37)
       for (int a = 0; a < c.count; ++a) grad += c.G[a] * T[c.unknown[a]];
@@ -192,12 +223,12 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
 template <int Dim>
 void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
                                        const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
-  if (kept_.size() != p.size())
+  if (kept_mass_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
   const bool relax = end && beta > 0.0;
   next_mct_.setZero(static_cast<Eigen::Index>(sys.size()));
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const Kept& c = kept_[k];
+    const KeptMass& c = kept_mass_[k];
     if (c.count == 0) continue;
     double dT = 0.0, pic = 0.0, s = 0.0;
     for (int a = 0; a < c.count; ++a) {

@@ -21,9 +21,13 @@ struct NodeList {
   double S[capacity];
   mechanics::Vec<Dim> G[capacity];
 
-  void fill(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, std::size_t k) {
-    mechanics::Stencil<Dim, Kernel> st;
-    st.evaluate(grid, p.position[k], p.half_size[k]);
+  /// From the MPM step's stencils (`step`, when given: the same S_ip, G_ip at these positions) or a
+  /// fresh evaluation.
+  void fill(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, std::size_t k,
+            const mechanics::Stencil<Dim, Kernel>* step) {
+    mechanics::Stencil<Dim, Kernel> own;
+    const mechanics::Stencil<Dim, Kernel>& st = step ? step[k] : own;
+    if (!step) own.evaluate(grid, p.position[k], p.half_size[k]);
     count = 0;
     st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
       node[count] = i;
@@ -59,8 +63,9 @@ struct StencilCache {
     position.resize(n);
     half_size.resize(n);
   }
-  const NodeList<Dim, Kernel>& fill(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p, std::size_t k) {
-    lists[k].fill(g, p, k);
+  const NodeList<Dim, Kernel>& fill(const mechanics::Grid<Dim>& g, const mechanics::Particles<Dim>& p, std::size_t k,
+                                    const mechanics::Stencil<Dim, Kernel>* step) {
+    lists[k].fill(g, p, k, step);
     position[k] = p.position[k];
     half_size[k] = p.half_size[k];
     return lists[k];
@@ -75,10 +80,42 @@ struct StencilCache {
   }
 };
 
+/// K's sparsity pattern of the last assembly (per dimension and kernel, per thread): the unknowns, the
+/// CSR arrays and the row slot of every stored entry (the diagonal at the centre slot). A new assembly
+/// with the same unknowns and the same slots holding non-zero products has the same pattern: only
+/// the values are written (same numbers, same order as a fresh build).
+template <int Dim, class Kernel>
+struct ConductancePattern {
+  std::vector<int> grid_node;
+  std::vector<int> slot;  // by stored entry, CSR order
+  thermal::SparseMatrix matrix;
+
+  static ConductancePattern& local() {
+    thread_local ConductancePattern pattern;
+    return pattern;
+  }
+  /// True if `rows` (n rows of `slots` products) gives this pattern for these unknowns.
+  bool matches(const std::vector<int>& unknowns, const std::vector<double>& rows, int slots, int centre) const {
+    if (unknowns != grid_node || matrix.rows() != static_cast<Eigen::Index>(unknowns.size())) return false;
+    const auto* outer = matrix.outerIndexPtr();
+    for (std::size_t u = 0; u < unknowns.size(); ++u) {
+      const double* r = &rows[u * static_cast<std::size_t>(slots)];
+      int count = 0;
+      for (int s = 0; s < slots; ++s) count += s != centre && r[s] != 0.0;
+      if (count + 1 != outer[u + 1] - outer[u]) return false;
+      for (auto e = outer[u]; e < outer[u + 1]; ++e)
+        if (slot[static_cast<std::size_t>(e)] != centre && r[slot[static_cast<std::size_t>(e)]] == 0.0) return false;
+    }
+    return true;
+  }
+};
+
 template <int Dim, class Kernel>
 NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
-                                 const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt) {
+                                 const std::vector<ThermalProperties>& materials, const AssemblyOptions& opt,
+                                 const mechanics::StencilView<Dim>& view) {
   using Nodes = NodeList<Dim, Kernel>;
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
   const std::size_t n_nodes = grid.node_count();
   NodalThermalSystem sys;
   sys.grid_mass.assign(n_nodes, 0.0);
@@ -94,7 +131,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     if (!m.conducts) continue;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    const Nodes& nl = cache.fill(grid, p, k);
+    const Nodes& nl = cache.fill(grid, p, k, step_stencils);
     for (int a = 0; a < nl.count; ++a) {
       const auto i = static_cast<std::size_t>(nl.node[a]);
       sys.grid_mass[i] += mc * nl.S[a];
@@ -186,11 +223,30 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   // conduction part conserve Σ M_i T_i exactly). Rows are written in place (Eigen's sorted
   // startVec/insertBack fill): no triplet list, no temporary column-major copy.
   constexpr int centre = (slots - 1) / 2;
+  ConductancePattern<Dim, Kernel>& pattern = ConductancePattern<Dim, Kernel>::local();
+  if (pattern.matches(sys.grid_node, rows, slots, centre)) {  // same layout: refill the values
+    sys.conductance = pattern.matrix;
+    double* value = sys.conductance.valuePtr();
+    const auto* outer = sys.conductance.outerIndexPtr();
+    for (Eigen::Index u = 0; u < n; ++u) {
+      const double* r = &rows[static_cast<std::size_t>(u) * slots];
+      double off_sum = 0.0;  // in slot order, as the fresh build sums it
+      for (int s = 0; s < slots; ++s)
+        if (s != centre && r[s] != 0.0) off_sum += r[s];
+      for (auto e = outer[u]; e < outer[u + 1]; ++e) {
+        const int sl = pattern.slot[static_cast<std::size_t>(e)];
+        value[e] = sl == centre ? -off_sum : r[sl];
+      }
+    }
+    return sys;
+  }
   std::size_t nnz = 0;
   for (double v : rows) nnz += v != 0.0;
   sys.conductance.resize(n, n);
   sys.conductance.reserve(static_cast<Eigen::Index>(nnz) + n);
-  int col[slots];
+  pattern.slot.clear();
+  pattern.slot.reserve(nnz + static_cast<std::size_t>(n));
+  int col[slots], slot_at[slots];
   double val[slots];
   for (Eigen::Index u = 0; u < n; ++u) {
     const double* r = &rows[static_cast<std::size_t>(u) * slots];
@@ -205,6 +261,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         rem /= kw;
       }
       col[count] = sys.unknown[static_cast<std::size_t>(j)];
+      slot_at[count] = s;
       val[count++] = r[s];
       off_sum += r[s];
     }
@@ -214,6 +271,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     for (int a = 1; a < count; ++a)
       for (int b = a; b > 0 && col[b - 1] > col[b]; --b) {
         std::swap(col[b - 1], col[b]);
+        std::swap(slot_at[b - 1], slot_at[b]);
         std::swap(val[b - 1], val[b]);
       }
     sys.conductance.startVec(u);
@@ -221,26 +279,32 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     for (int a = 0; a < count; ++a) {
       if (!diagonal && col[a] > u) {
         sys.conductance.insertBack(u, u) = -off_sum;
+        pattern.slot.push_back(centre);
         diagonal = true;
       }
       sys.conductance.insertBack(u, col[a]) = val[a];
+      pattern.slot.push_back(slot_at[a]);
     }
-    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum;
+    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum, pattern.slot.push_back(centre);
   }
   sys.conductance.finalize();
+  pattern.grid_node = sys.grid_node;
+  pattern.matrix = sys.conductance;
   return sys;
 }
 
 template <int Dim, class Kernel>
 void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
                      const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
-                     const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+                     const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end,
+                     const mechanics::StencilView<Dim>& view) {
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
   NodeList<Dim, Kernel> fresh;
   const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!thermal_properties_of(materials, p.material[k]).conducts) continue;
     const NodeList<Dim, Kernel>* cached = cache.find(grid, p, k);  // the assembly's, when still exact
-    if (!cached) fresh.fill(grid, p, k);
+    if (!cached) fresh.fill(grid, p, k, step_stencils);
     const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;
     double dT = 0.0, pic = 0.0, s = 0.0;
     for (int a = 0; a < nl.count; ++a) {
@@ -311,9 +375,9 @@ const ThermalProperties& thermal_properties_of(const std::vector<ThermalProperti
 template <int Dim>
 NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                     mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                    const AssemblyOptions& options) {
+                                    const AssemblyOptions& options, const mechanics::StencilView<Dim>& stencils) {
   return mechanics::dispatch_shape(shape, [&](auto kernel) {
-    return assemble_with<Dim, decltype(kernel)>(grid, particles, materials, options);
+    return assemble_with<Dim, decltype(kernel)>(grid, particles, materials, options, stencils);
   });
 }
 
@@ -321,7 +385,8 @@ template <int Dim>
 void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                    const NodalThermalSystem& system, const Eigen::VectorXd& delta,
-                                   double relaxation, const Eigen::VectorXd* end) {
+                                   double relaxation, const Eigen::VectorXd* end,
+                                   const mechanics::StencilView<Dim>& stencils) {
   const auto n = static_cast<Eigen::Index>(system.size());
   if (delta.size() != n || (end && end->size() != n))
     throw std::invalid_argument("add_nodal_change_to_particles: " + std::to_string(delta.size()) +
@@ -330,7 +395,7 @@ void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::
     throw std::invalid_argument("add_nodal_change_to_particles: relaxation must be in [0, 1]");
   const Eigen::VectorXd* pic = relaxation > 0.0 ? end : nullptr;
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, relaxation, pic);
+    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, relaxation, pic, stencils);
   });
 }
 
@@ -347,11 +412,11 @@ double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::ve
 #define FRICTHERM_INSTANTIATE_ASSEMBLY(D)                                                                       \
   template NodalThermalSystem assemble_thermal<D>(const mechanics::Grid<D>&, const mechanics::Particles<D>&,   \
                                                   mechanics::ShapeKind, const std::vector<ThermalProperties>&, \
-                                                  const AssemblyOptions&);                                     \
+                                                  const AssemblyOptions&, const mechanics::StencilView<D>&);   \
   template void add_nodal_change_to_particles<D>(const mechanics::Grid<D>&, mechanics::Particles<D>&,          \
                                                  mechanics::ShapeKind, const std::vector<ThermalProperties>&,  \
                                                  const NodalThermalSystem&, const Eigen::VectorXd&, double,    \
-                                                 const Eigen::VectorXd*);                                      \
+                                                 const Eigen::VectorXd*, const mechanics::StencilView<D>&);    \
   template double particle_thermal_energy<D>(const mechanics::Particles<D>&, const std::vector<ThermalProperties>&);
 FRICTHERM_INSTANTIATE_ASSEMBLY(2)
 FRICTHERM_INSTANTIATE_ASSEMBLY(3)

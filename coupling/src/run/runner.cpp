@@ -236,8 +236,11 @@ class Run {
       if (thermal_) {
         const Clock::time_point c0 = Clock::now();
         const double solve0 = thermal_->solve_seconds();
+        const double shape0 = sim_->phase_times().shape_functions;
         thermal_->after_step(*sim_, sim_->frictional_work(thermal_->heating_order()), t >= next_snap - eps);
-        coupling_seconds_ += seconds_since(c0);
+        // Less the next step's stencils the coupler had evaluated (current_stencils): timed as the
+        // step's shape_functions phase.
+        coupling_seconds_ += seconds_since(c0) - (sim_->phase_times().shape_functions - shape0);
         loading_solve_seconds_ += thermal_->solve_seconds() - solve0;
       }
       if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {

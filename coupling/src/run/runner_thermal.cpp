@@ -38,6 +38,8 @@ const char* const kFateColumns[] = {"id",           "fate",          "particle_c
 template <int Dim>
 ThermalRun<Dim>::ThermalRun(const Scene& scene, mechanics::Simulation<Dim>& sim)
     : spec_(scene.thermal), coupler_(sim.grid(), sim.options().shape, scene.thermal.coupler) {
+  // The coupler reads the MPM step's stencils instead of evaluating its own (sim outlives this run).
+  coupler_.set_stencil_source([&sim] { return sim.current_stencils(); });
   try {
     coupler_.start(sim.particles(), sim.time());
   } catch (const std::invalid_argument& e) {

@@ -30,6 +30,7 @@
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/thermal/integrator.hpp>
 
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -122,6 +123,12 @@ class Coupler {
   /// Throws std::invalid_argument for a bad integrator name or options.
   Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind shape, CouplerOptions options);
 
+  /// Where the particles' current shape functions come from: typically the MPM step's own,
+  /// [&sim] { return sim.current_stencils(); }. Asked once per gather or assembly (and its map back),
+  /// with the particles where they will be read; the coupler then evaluates no stencil itself (the
+  /// numbers are the same). Without a source, or when it gives an empty view (EBS), it evaluates its own.
+  void set_stencil_source(std::function<mechanics::StencilView<Dim>()> source) { stencil_source_ = std::move(source); }
+
   /// Records each particle's initial temperature and the initial energy, assembles once (for the
   /// adaptive policy's estimate) and finds the initial hot spots. Throws std::invalid_argument if
   /// no particle belongs to a conducting material.
@@ -174,6 +181,9 @@ class Coupler {
 
  private:
   void assemble(const mechanics::Particles<Dim>& particles);
+  mechanics::StencilView<Dim> step_stencils() const {
+    return stencil_source_ ? stencil_source_() : mechanics::StencilView<Dim>{};
+  }
   /// The checks and caches that follow a new system (assembled or gathered).
   void system_changed();
   /// Integrates the window [window_start_, time] matrix-free if it is short enough; false otherwise.
@@ -184,6 +194,7 @@ class Coupler {
 
   mechanics::Grid<Dim> grid_;
   mechanics::ShapeKind shape_;
+  std::function<mechanics::StencilView<Dim>()> stencil_source_;
   CouplerOptions opt_;
   std::unique_ptr<thermal::Integrator> integrator_;
   HeatAccumulator pending_;

@@ -45,9 +45,12 @@ class ExplicitConduction {
   /// on every node and the unknowns into `sys` (its conductance is left empty), the gradients G'
   /// with the dropped nodes lumped, and the bounds of M⁻¹K. Throws std::invalid_argument
   /// like assemble_thermal for a material id without thermal properties or no conducting particle.
+  /// `stencils`: the MPM step's stencils at these positions (mechanics::Simulation::current_stencils),
+  /// read instead of evaluating them again (same numbers); an empty view evaluates them here.
   void gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
               mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-              const AssemblyOptions& options, NodalThermalSystem& sys);
+              const AssemblyOptions& options, NodalThermalSystem& sys,
+              const mechanics::StencilView<Dim>& stencils = {});
 
   /// True if a gather was made for these particles (same count) and none has moved more than
   /// `max_shift` (m, along any axis) since: the kept stencils, M and G' may then serve another window.
@@ -85,23 +88,31 @@ class ExplicitConduction {
     double S[capacity];
     mechanics::Vec<Dim> G[capacity];
   };
-  /// One heat-holding particle's nodes that are unknowns, in stencil order: unknown number, S_ip,
-  /// lumped G'_ip; its m_p C_v,p and V_p k_p (0 without conduction). Everything the windows read.
-  struct Kept {
+  /// One heat-holding particle's nodes that are unknowns, in stencil order, split by the pass that
+  /// reads them (each window streams its part only): the map back and the re-projection read the
+  /// unknown numbers, S_ip and m_p C_v,p; the conduction sub-steps the unknown numbers, the lumped G'_ip
+  /// and V_p k_p (0 without conduction).
+  struct KeptMass {
     int count = 0;
     double heat_capacity = 0.0;  // m_p C_v,p (J/K)
-    double conductance = 0.0;    // V_p k_p (W m/K): times G'·G' gives W/K
     int unknown[capacity];
     double S[capacity];
+  };
+  struct KeptFlux {
+    int count = 0;
+    double conductance = 0.0;  // V_p k_p (W m/K): times G'·G' gives W/K
+    int unknown[capacity];
     mechanics::Vec<Dim> G[capacity];
   };
   template <class Kernel>
   void gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
-                   NodalThermalSystem& sys);
+                   NodalThermalSystem& sys, const mechanics::StencilView<Dim>& stencils);
 
-  std::vector<Nodes> nodes_;              // gather scratch, by particle
-  std::vector<Kept> kept_;                // by particle; count 0 for particles that hold no heat
+  std::vector<Nodes> nodes_;              // gather scratch, by particle (when the coupler evaluates the stencils)
+  std::vector<unsigned char> holds_heat_;  // gather: particle of a material with thermal properties
+  std::vector<KeptMass> kept_mass_;       // by particle; count 0 for particles that hold no heat
+  std::vector<KeptFlux> kept_flux_;       // by particle; conductance 0 for particles that do not conduct
   std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
   std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
   Eigen::VectorXd next_mct_;              // the same by unknown, with the T_p of the last map_back

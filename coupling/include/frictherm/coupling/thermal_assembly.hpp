@@ -66,12 +66,15 @@ struct NodalThermalSystem {
 const ThermalProperties& thermal_properties_of(const std::vector<ThermalProperties>& materials, int id);
 
 /// Builds the system from the current particle state. `materials` is indexed by material id.
+/// `stencils`: the MPM step's stencils at the current positions (mechanics::Simulation::
+/// current_stencils), read instead of evaluating them again (same numbers); empty: evaluated here.
 /// Throws std::invalid_argument if a material id has no entry, or if no node carries heat capacity
 /// (no particle of a conducting material).
 template <int Dim>
 NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                     mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
-                                    const AssemblyOptions& options = {});
+                                    const AssemblyOptions& options = {},
+                                    const mechanics::StencilView<Dim>& stencils = {});
 
 /// T_p += Σ_i S_ip ΔT_i for the particles of conducting materials (design §4); `delta` is on the
 /// unknowns of `system`, which must have been assembled from the same particle positions.
@@ -79,12 +82,14 @@ NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mech
 /// Optional sub-grid relaxation (`relaxation` β in [0, 1], `end` the nodal temperatures after the
 /// window): T_p ← (1 − β) (T_p + Σ_i S_ip ΔT_i) + β Σ_i S_ip T_i,end / Σ_i S_ip, a FLIP/PIC blend that
 /// damps particle-scale structure the grid cannot see (it never decays with β = 0). A uniform β keeps
-/// Σ_p m_p C_v,p T_p exact wherever every node of a particle is an unknown.
+/// Σ_p m_p C_v,p T_p exact wherever every node of a particle is an unknown. `stencils` as for
+/// assemble_thermal.
 template <int Dim>
 void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                    const NodalThermalSystem& system, const Eigen::VectorXd& delta,
-                                   double relaxation = 0.0, const Eigen::VectorXd* end = nullptr);
+                                   double relaxation = 0.0, const Eigen::VectorXd* end = nullptr,
+                                   const mechanics::StencilView<Dim>& stencils = {});
 
 /// Σ_p m_p C_v,p T_p over the particles of conducting materials (J).
 template <int Dim>
@@ -93,18 +98,18 @@ double particle_thermal_energy(const mechanics::Particles<Dim>& particles,
 
 extern template NodalThermalSystem assemble_thermal<2>(const mechanics::Grid<2>&, const mechanics::Particles<2>&,
                                                        mechanics::ShapeKind, const std::vector<ThermalProperties>&,
-                                                       const AssemblyOptions&);
+                                                       const AssemblyOptions&, const mechanics::StencilView<2>&);
 extern template NodalThermalSystem assemble_thermal<3>(const mechanics::Grid<3>&, const mechanics::Particles<3>&,
                                                        mechanics::ShapeKind, const std::vector<ThermalProperties>&,
-                                                       const AssemblyOptions&);
+                                                       const AssemblyOptions&, const mechanics::StencilView<3>&);
 extern template void add_nodal_change_to_particles<2>(const mechanics::Grid<2>&, mechanics::Particles<2>&,
                                                       mechanics::ShapeKind, const std::vector<ThermalProperties>&,
                                                       const NodalThermalSystem&, const Eigen::VectorXd&, double,
-                                                      const Eigen::VectorXd*);
+                                                      const Eigen::VectorXd*, const mechanics::StencilView<2>&);
 extern template void add_nodal_change_to_particles<3>(const mechanics::Grid<3>&, mechanics::Particles<3>&,
                                                       mechanics::ShapeKind, const std::vector<ThermalProperties>&,
                                                       const NodalThermalSystem&, const Eigen::VectorXd&, double,
-                                                      const Eigen::VectorXd*);
+                                                      const Eigen::VectorXd*, const mechanics::StencilView<3>&);
 extern template double particle_thermal_energy<2>(const mechanics::Particles<2>&,
                                                   const std::vector<ThermalProperties>&);
 extern template double particle_thermal_energy<3>(const mechanics::Particles<3>&,

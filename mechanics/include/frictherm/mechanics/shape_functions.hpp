@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 #include <stdexcept>
 #include <string>
@@ -205,6 +206,30 @@ struct PrecomputedStencils {
   std::size_t entries() const { return begin.back(); }
   PrecomputedStencil<Dim> operator[](std::size_t k) const {
     return {slot.data(), S.data(), G.data(), begin[k], begin[k + 1]};
+  }
+};
+
+/// The ShapeKind of a kernel (extended_bspline has no Stencil: its weights are built per field).
+template <class Kernel>
+constexpr ShapeKind shape_kind_of() {
+  if constexpr (std::is_same_v<Kernel, LinearKernel>) return ShapeKind::linear;
+  else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return ShapeKind::ugimp;
+  else return ShapeKind::quadratic_bspline;
+}
+
+/// Read-only view of every particle's stencil (by particle index) at the particles' current
+/// positions, as the MPM step evaluates them: a plain array of Stencil<Dim, Kernel> for the kernel
+/// named by `kind`. Empty (data == nullptr) when there is none to give.
+template <int Dim>
+struct StencilView {
+  ShapeKind kind = ShapeKind::extended_bspline;
+  const void* data = nullptr;
+  std::size_t count = 0;
+  /// The stencils if they are of this kernel and there are `particles` of them, else nullptr.
+  template <class Kernel>
+  const Stencil<Dim, Kernel>* as(std::size_t particles) const {
+    if (data == nullptr || count != particles || kind != shape_kind_of<Kernel>()) return nullptr;
+    return static_cast<const Stencil<Dim, Kernel>*>(data);
   }
 };
 

@@ -35,6 +35,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -193,6 +194,17 @@ class Simulation {
   double last_time_step() const { return last_dt_; }
   /// Wall time spent in each phase of step() since the start.
   const StepPhaseTimes& phase_times() const { return phase_times_; }
+  /// The shape functions of every particle at the current positions, read-only, for code outside the
+  /// step (the thermal coupling's M, K and map back: Nairn et al. 2018 eqs. 37-38 use the same
+  /// S_ip and G_ip). They are the stencils the next step starts from: evaluated here if the last
+  /// step moved the particles (timed as the step's shape_functions phase), and the next step then
+  /// uses them instead of evaluating them again (same inputs, same numbers). Valid until the
+  /// particles move (the next step). A change of positions or half-sizes through particles() between
+  /// steps must be followed by forget_stencils(). Empty for the extended B-spline (built per field
+  /// inside the step) and before finalize().
+  StencilView<Dim> current_stencils();
+  /// Drops the stencils current_stencils() evaluated (the next step evaluates its own).
+  void forget_stencils() { stencils_current_ = false; }
 
   double kinetic_energy() const;  // of deformable particles (J)
   double strain_energy() const;   // J
@@ -209,6 +221,7 @@ class Simulation {
   /// bases, contact nodes and nodal fields are rebuilt each step from these.
   template <class Visitor> void visit_state(Visitor&& v) {
     if (!finalized_) finalize();
+    if constexpr (std::decay_t<Visitor>::reading) stencils_current_ = false;  // positions may change
     v("particles/position", p_.position);
     v("particles/initial_position", p_.initial_position);
     v("particles/velocity", p_.velocity);
@@ -264,7 +277,7 @@ class Simulation {
   template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
   template <class Kernel> long update_particles(double dt);
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
-  template <class Kernel> void evaluate_stencils();
+  template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
   void prepare_extended_stencils();  // EBS: rebuild per field, lay out the fields, flatten the weights
   template <class Kernel> void map_rigid_fields();
   void init_fields();
@@ -398,6 +411,9 @@ class Simulation {
   StepPhaseTimes phase_times_;
   PhaseLap lap_;  // step(): phase boundaries
   double nested_phase_ = 0.0;  // contact time inside the phase the lap is in
+  // The stencils of st_linear_/st_ugimp_/st_quadratic_ were evaluated at the current positions (and,
+  // with contact, box_lo_/box_hi_ from them) by current_stencils(): the next step starts from them.
+  bool stencils_current_ = false;
   int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves
 };
 
