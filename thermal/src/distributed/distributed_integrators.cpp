@@ -3,6 +3,7 @@
 // below the global Gershgorin limit, source at sub-step midpoints), cvode_bdf / cvode_adams
 // (CVODE) and arkode_erk / arkode_dirk (ARKODE) on N_Vector_Parallel vectors, the Krylov solvers
 // (PCG on the symmetric form, or SPGMR) preconditioned by a PETSc PC (distributed_ode.hpp).
+#include "conservative_krylov.hpp"
 #include "distributed_ode.hpp"
 
 #include <arkode/arkode_arkstep.h>
@@ -225,6 +226,11 @@ void DistSundials::create(double t0) {
   ls_ = LinSolPtr(lin_ == Linear::Pcg ? SUNLinSol_PCG(y, SUN_PREC_LEFT, opt_.krylov_maxl, ctx)
                                       : SUNLinSol_SPGMR(y, SUN_PREC_LEFT, opt_.krylov_maxl, ctx));
   check_ptr(ls_.get(), lin_ == Linear::Pcg ? "SUNLinSol_PCG" : "SUNLinSol_SPGMR", name_);
+  if (sys_.conserves()) {  // insulated: keep Σ M T exact whatever the preconditioner
+    NVectorPtr c(N_VClone(y));
+    sys_.to_y(Eigen::VectorXd::Ones(sys_.nodes()), c.get());  // c = M^{1/2}·1
+    ls_ = make_conservative_krylov(std::move(ls_), c.get(), ctx);
+  }
   if (cvode) {
     check(CVodeSetLinearSolver(mem, ls_.get(), nullptr), "CVodeSetLinearSolver");
     check(CVodeSetJacTimes(mem, nullptr, &DistributedOde::jtimes), "CVodeSetJacTimes");

@@ -5,6 +5,7 @@
 #include <nvector/nvector_parallel.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace frictherm::thermal::detail {
 namespace {
@@ -101,6 +102,18 @@ void DistributedOde::build(const DistributedProblem& problem, bool symmetric, co
   }
   t_work_.resize(n);
   w_work_.resize(n);
+  int mine = 1, all = 0;  // an insulated problem conserves Σ M T (conservative_krylov.hpp)
+  for (Index i = 0; i < n && mine; ++i) {
+    double sum = 0.0, diag = 0.0;
+    for (Index e = start[static_cast<std::size_t>(i)]; e < start[static_cast<std::size_t>(i) + 1]; ++e) {
+      sum += kv[e];
+      if (kcol[e] == problem.first_row() + i) diag = kv[e];
+    }
+    mine = free[i] > 0.0 && std::abs(sum) <= 1e-12 * diag ? 1 : 0;
+  }
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, problem.comm());
+  DistributedProblem::count_reductions(1);
+  conserves_ = all == 1;
 
   destroy_petsc();
   if (preconditioner.empty()) return;

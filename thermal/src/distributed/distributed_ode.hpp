@@ -48,6 +48,9 @@ class DistributedOde {
                     sunrealtype delta, int lr, void* user_data);
 
   long preconditioner_setups() const { return setups_; }
+  // True on every rank when no rank has a Dirichlet node and every row of K sums to zero (to
+  // 1e-12 of its diagonal): then Σ M T is invariant under conduction (conservative_krylov.hpp).
+  bool conserves() const { return conserves_; }
 
  private:
   void destroy_petsc();
@@ -55,6 +58,7 @@ class DistributedOde {
 
   const DistributedProblem* problem_ = nullptr;
   bool symmetric_ = false;
+  bool conserves_ = false;
   Eigen::VectorXd s_;       // y = s ⊙ T
   Eigen::VectorXd fscale_;  // f = fscale ⊙ w, 0 on Dirichlet rows
   std::vector<double> jval_;  // J in the problem's local CSR (row_start, local_col); 0 on dropped entries
