@@ -1,0 +1,261 @@
+#include "distributed_ode.hpp"
+
+#include "petsc_check.hpp"
+
+#include <nvector/nvector_parallel.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace frictherm::thermal::detail {
+namespace {
+
+Eigen::Map<Eigen::VectorXd> view(N_Vector v) {
+  return {N_VGetArrayPointer(v), static_cast<Index>(N_VGetLocalLength_Parallel(v))};
+}
+
+// Each N_Vector_Parallel reduction is one MPI_Allreduce: count it, then do it.
+void count() { DistributedProblem::count_reductions(1); }
+sunrealtype c_dot(N_Vector x, N_Vector y) { count(); return N_VDotProd_Parallel(x, y); }
+sunrealtype c_maxnorm(N_Vector x) { count(); return N_VMaxNorm_Parallel(x); }
+sunrealtype c_wrms(N_Vector x, N_Vector w) { count(); return N_VWrmsNorm_Parallel(x, w); }
+sunrealtype c_wrmsmask(N_Vector x, N_Vector w, N_Vector id) { count(); return N_VWrmsNormMask_Parallel(x, w, id); }
+sunrealtype c_min(N_Vector x) { count(); return N_VMin_Parallel(x); }
+sunrealtype c_wl2(N_Vector x, N_Vector w) { count(); return N_VWL2Norm_Parallel(x, w); }
+sunrealtype c_l1(N_Vector x) { count(); return N_VL1Norm_Parallel(x); }
+sunbooleantype c_invtest(N_Vector x, N_Vector z) { count(); return N_VInvTest_Parallel(x, z); }
+sunbooleantype c_constrmask(N_Vector c, N_Vector x, N_Vector m) { count(); return N_VConstrMask_Parallel(c, x, m); }
+sunrealtype c_minquot(N_Vector n, N_Vector d) { count(); return N_VMinQuotient_Parallel(n, d); }
+int c_dotmulti(int nv, N_Vector x, N_Vector* y, sunrealtype* d) { count(); return N_VDotProdMulti_Parallel(nv, x, y, d); }
+int c_wrmsarray(int nv, N_Vector* x, N_Vector* w, sunrealtype* d) {
+  count();
+  return N_VWrmsNormVectorArray_Parallel(nv, x, w, d);
+}
+int c_wrmsmaskarray(int nv, N_Vector* x, N_Vector* w, N_Vector id, sunrealtype* d) {
+  count();
+  return N_VWrmsNormMaskVectorArray_Parallel(nv, x, w, id, d);
+}
+
+}  // namespace
+
+NVectorPtr make_parallel_vector(MPI_Comm comm, Index local, Index global, SUNContext ctx) {
+  N_Vector v = N_VNew_Parallel(comm, static_cast<sunindextype>(local), static_cast<sunindextype>(global), ctx);
+  check_ptr(v, "N_VNew_Parallel", "thermal (distributed)");
+  N_Vector_Ops o = v->ops;
+  o->nvdotprod = c_dot;
+  o->nvmaxnorm = c_maxnorm;
+  o->nvwrmsnorm = c_wrms;
+  o->nvwrmsnormmask = c_wrmsmask;
+  o->nvmin = c_min;
+  o->nvwl2norm = c_wl2;
+  o->nvl1norm = c_l1;
+  o->nvinvtest = c_invtest;
+  o->nvconstrmask = c_constrmask;
+  o->nvminquotient = c_minquot;
+  if (o->nvdotprodmulti != nullptr) o->nvdotprodmulti = c_dotmulti;
+  if (o->nvwrmsnormvectorarray != nullptr) o->nvwrmsnormvectorarray = c_wrmsarray;
+  if (o->nvwrmsnormmaskvectorarray != nullptr) o->nvwrmsnormmaskvectorarray = c_wrmsmaskarray;
+  o->nvdotprodmultiallreduce = nullptr;  // would bypass the count; SUNDIALS falls back to nvdotprodmulti
+  return NVectorPtr(v);
+}
+
+DistributedOde::~DistributedOde() { destroy_petsc(); }
+
+void DistributedOde::destroy_petsc() {
+  KSPDestroy(&ksp_);
+  MatDestroy(&pmat_);
+  VecDestroy(&r_vec_);
+  VecDestroy(&z_vec_);
+  gamma_ = -1.0;
+}
+
+void DistributedOde::build(const DistributedProblem& problem, bool symmetric, const std::string& preconditioner) {
+  problem_ = &problem;
+  symmetric_ = symmetric;
+  const Index n = problem.local_size();
+  const Eigen::VectorXd& m = problem.mass();
+  s_ = symmetric ? Eigen::VectorXd(m.cwiseSqrt()) : Eigen::VectorXd::Ones(n);
+  fscale_ = s_.cwiseQuotient(m);  // 1/M (plain) or M^{-1/2} (symmetric)
+  Eigen::VectorXd free(n);
+  for (Index i = 0; i < n; ++i) free[i] = problem.is_dirichlet_local(i) ? 0.0 : 1.0;
+  for (Index i = 0; i < n; ++i) fscale_[i] *= free[i];
+  const auto ng = problem.ghost_ids().size();
+  const double* gs = problem.exchange(s_.data());
+  const std::vector<double> s_ghost(gs, gs + ng);
+  const double* gf = problem.exchange(free.data());
+  const std::vector<double> free_ghost(gf, gf + ng);
+
+  // J_ij = −fscale_i K_ij / s_j over free i, j (ode_system.cpp), kept in the problem's local CSR.
+  const auto& start = problem.row_start();
+  const auto& col = problem.local_col();
+  const double* kv = problem.conductance().valuePtr();
+  const auto* kcol = problem.conductance().innerIndexPtr();
+  jval_.assign(col.size(), 0.0);
+  for (Index i = 0; i < n; ++i) {
+    for (Index e = start[static_cast<std::size_t>(i)]; e < start[static_cast<std::size_t>(i) + 1]; ++e) {
+      const auto ue = static_cast<std::size_t>(e);
+      const Index c = col[ue];
+      const double sj = c < n ? s_[c] : s_ghost[static_cast<std::size_t>(c - n)];
+      const double fj = c < n ? free[c] : free_ghost[static_cast<std::size_t>(c - n)];
+      jval_[ue] = fj > 0.0 ? -fscale_[i] * kv[e] / sj : 0.0;
+    }
+  }
+  t_work_.resize(n);
+  w_work_.resize(n);
+  int mine = 1, all = 0;  // an insulated problem conserves Σ M T (conservative_krylov.hpp)
+  for (Index i = 0; i < n && mine; ++i) {
+    double sum = 0.0, diag = 0.0;
+    for (Index e = start[static_cast<std::size_t>(i)]; e < start[static_cast<std::size_t>(i) + 1]; ++e) {
+      sum += kv[e];
+      if (kcol[e] == problem.first_row() + i) diag = kv[e];
+    }
+    mine = free[i] > 0.0 && std::abs(sum) <= 1e-12 * diag ? 1 : 0;
+  }
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, problem.comm());
+  DistributedProblem::count_reductions(1);
+  conserves_ = all == 1;
+
+  destroy_petsc();
+  if (preconditioner.empty()) return;
+  // P = I − γJ with K's pattern plus an explicit diagonal: rows owned, columns global.
+  const Index first = problem.first_row();
+  p_start_.assign(1, 0);
+  p_col_.clear();
+  p_j_.clear();
+  p_diag_.clear();
+  std::vector<PetscInt> d_nnz(static_cast<std::size_t>(n), 0), o_nnz(static_cast<std::size_t>(n), 0);
+  for (Index i = 0; i < n; ++i) {
+    PetscInt diag = -1;
+    for (Index e = start[static_cast<std::size_t>(i)]; e < start[static_cast<std::size_t>(i) + 1]; ++e) {
+      const PetscInt gcol = kcol[e];
+      if (gcol == first + i) diag = static_cast<PetscInt>(p_col_.size());
+      p_col_.push_back(gcol);
+      p_j_.push_back(jval_[static_cast<std::size_t>(e)]);
+    }
+    if (diag < 0) {
+      diag = static_cast<PetscInt>(p_col_.size());
+      p_col_.push_back(static_cast<PetscInt>(first + i));
+      p_j_.push_back(0.0);
+    }
+    p_diag_.push_back(diag);
+    p_start_.push_back(static_cast<PetscInt>(p_col_.size()));
+    for (PetscInt e = p_start_[static_cast<std::size_t>(i)]; e < p_start_.back(); ++e) {
+      const bool own = problem.owns(p_col_[static_cast<std::size_t>(e)]);
+      ++(own ? d_nnz : o_nnz)[static_cast<std::size_t>(i)];
+    }
+  }
+  p_val_.assign(p_col_.size(), 0.0);
+  const MPI_Comm comm = problem.comm();
+  const auto pn = static_cast<PetscInt>(n), pN = static_cast<PetscInt>(problem.global_size());
+  petsc_check(MatCreateAIJ(comm, pn, pn, pN, pN, 0, d_nnz.data(), 0, o_nnz.data(), &pmat_), "MatCreateAIJ");
+  petsc_check(MatSetOption(pmat_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  petsc_check(VecCreateMPIWithArray(comm, 1, pn, pN, nullptr, &r_vec_), "VecCreateMPIWithArray");
+  petsc_check(VecCreateMPIWithArray(comm, 1, pn, pN, nullptr, &z_vec_), "VecCreateMPIWithArray");
+  petsc_check(KSPCreate(comm, &ksp_), "KSPCreate");
+  petsc_check(KSPSetType(ksp_, KSPPREONLY), "KSPSetType");  // the PC alone: SUNDIALS runs the Krylov method
+  PC pc = nullptr;
+  petsc_check(KSPGetPC(ksp_, &pc), "KSPGetPC");
+  if (preconditioner == "jacobi") {
+    petsc_check(PCSetType(pc, PCJACOBI), "PCSetType(jacobi)");
+  } else if (preconditioner == "bjacobi") {
+    petsc_check(PCSetType(pc, PCBJACOBI), "PCSetType(bjacobi)");  // ILU(0) per rank by default
+  } else if (preconditioner == "hypre") {
+    petsc_check(PCSetType(pc, PCHYPRE), "PCSetType(hypre)");
+    petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType(boomeramg)");
+  } else {
+    throw std::invalid_argument("thermal (distributed): unknown preconditioner \"" + preconditioner +
+                                "\" (valid: jacobi, bjacobi, hypre)");
+  }
+}
+
+void DistributedOde::assemble(double gamma) {
+  // P_ij = δ_ij − γ J_ij (Dirichlet rows: the identity)
+  for (std::size_t e = 0; e < p_j_.size(); ++e) p_val_[e] = -gamma * p_j_[e];
+  const Index n = nodes();
+  const auto first = static_cast<PetscInt>(problem_->first_row());
+  for (Index i = 0; i < n; ++i) {
+    p_val_[static_cast<std::size_t>(p_diag_[static_cast<std::size_t>(i)])] += 1.0;
+    const PetscInt row = first + static_cast<PetscInt>(i);
+    const PetscInt b = p_start_[static_cast<std::size_t>(i)], e = p_start_[static_cast<std::size_t>(i) + 1];
+    petsc_check(MatSetValues(pmat_, 1, &row, e - b, p_col_.data() + b, p_val_.data() + b, INSERT_VALUES),
+                "MatSetValues");
+  }
+  petsc_check(MatAssemblyBegin(pmat_, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  petsc_check(MatAssemblyEnd(pmat_, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  petsc_check(KSPSetOperators(ksp_, pmat_, pmat_), "KSPSetOperators");
+  petsc_check(KSPSetUp(ksp_), "KSPSetUp");
+  gamma_ = gamma;
+  ++setups_;
+}
+
+void DistributedOde::to_y(const Eigen::VectorXd& T, N_Vector y) const { view(y) = s_.cwiseProduct(T); }
+
+void DistributedOde::to_T(N_Vector y, Eigen::VectorXd& T) const { T = view(y).cwiseQuotient(s_); }
+
+void DistributedOde::fill_abstol(double atol, N_Vector out) const { view(out) = atol * s_; }
+
+int DistributedOde::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
+  auto* self = static_cast<DistributedOde*>(user_data);
+  try {
+    self->t_work_ = view(y).cwiseQuotient(self->s_);
+    self->problem_->heat_rate(t, self->t_work_.data(), self->w_work_.data());
+    view(ydot) = self->fscale_.cwiseProduct(self->w_work_);
+    return 0;
+  } catch (...) {
+    return -1;  // unrecoverable
+  }
+}
+
+int DistributedOde::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector, N_Vector, void* user_data, N_Vector) {
+  auto* self = static_cast<DistributedOde*>(user_data);
+  try {
+    const double* in = N_VGetArrayPointer(v);
+    double* out = N_VGetArrayPointer(jv);
+    const double* g = self->problem_->exchange(in);
+    const auto& start = self->problem_->row_start();
+    const auto& col = self->problem_->local_col();
+    const Index n = self->nodes();
+    for (Index i = 0; i < n; ++i) {
+      double acc = 0.0;
+      for (Index e = start[static_cast<std::size_t>(i)]; e < start[static_cast<std::size_t>(i) + 1]; ++e) {
+        const Index c = col[static_cast<std::size_t>(e)];
+        acc += self->jval_[static_cast<std::size_t>(e)] * (c < n ? in[c] : g[c - n]);
+      }
+      out[i] = acc;
+    }
+    return 0;
+  } catch (...) {
+    return -1;
+  }
+}
+
+int DistributedOde::psetup(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
+                           void* user_data) {
+  auto* self = static_cast<DistributedOde*>(user_data);
+  try {
+    // J is constant: only a new γ changes P (the jok flag carries no information here).
+    if (gamma != self->gamma_) self->assemble(gamma);
+    *jcur = SUNTRUE;
+    return 0;
+  } catch (...) {
+    return -1;
+  }
+}
+
+int DistributedOde::psolve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, sunrealtype, sunrealtype, int,
+                           void* user_data) {
+  auto* self = static_cast<DistributedOde*>(user_data);
+  try {
+    petsc_check(VecPlaceArray(self->r_vec_, N_VGetArrayPointer(r)), "VecPlaceArray");
+    petsc_check(VecPlaceArray(self->z_vec_, N_VGetArrayPointer(z)), "VecPlaceArray");
+    const PetscErrorCode code = KSPSolve(self->ksp_, self->r_vec_, self->z_vec_);
+    VecResetArray(self->r_vec_);
+    VecResetArray(self->z_vec_);
+    petsc_check(code, "KSPSolve");
+    return 0;
+  } catch (...) {
+    return -1;
+  }
+}
+
+}  // namespace frictherm::thermal::detail

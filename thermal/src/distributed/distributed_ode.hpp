@@ -1,0 +1,77 @@
+// The DistributedProblem as an ODE y' = f(t, y) on SUNDIALS N_Vector_Parallel vectors, in the
+// serial module's two forms (ode_system.hpp):
+//   plain      y = T,          f = M⁻¹(−K T + q),           J = −M⁻¹K
+//   symmetric  y = M^{1/2} T,  f = M^{-1/2}(−K T + q),      J = −M^{-1/2} K M^{-1/2}  (PCG)
+// over the owned rows, Dirichlet rows and columns of J dropped. J·v and the preconditioner
+// P = I − γJ (a parallel PETSc AIJ matrix, owned rows, global columns) use the ghost values of
+// v fetched by the problem's VecScatter. Internal header; callbacks take this object as user_data.
+#pragma once
+
+#include "../sundials_support.hpp"
+#include "frictherm/thermal/distributed.hpp"
+
+#include <petscksp.h>
+
+#include <string>
+#include <vector>
+
+namespace frictherm::thermal::detail {
+
+// N_VNew_Parallel whose reductions (dot products, norms, min …) count themselves in
+// DistributedProblem::count_reductions; clones inherit the counting operations.
+NVectorPtr make_parallel_vector(MPI_Comm comm, Index local, Index global, SUNContext ctx);
+
+class DistributedOde {
+ public:
+  DistributedOde() = default;
+  DistributedOde(const DistributedOde&) = delete;
+  DistributedOde& operator=(const DistributedOde&) = delete;
+  ~DistributedOde();
+
+  // Collective (two ghost exchanges: s and the Dirichlet mask of the ghost columns).
+  // preconditioner: "jacobi", "bjacobi", "hypre", or empty for none (no PETSc objects).
+  void build(const DistributedProblem& problem, bool symmetric, const std::string& preconditioner);
+  void bind(const DistributedProblem& problem) { problem_ = &problem; }
+  Index nodes() const { return s_.size(); }
+
+  void to_y(const Eigen::VectorXd& T, N_Vector y) const;
+  void to_T(N_Vector y, Eigen::VectorXd& T) const;
+  void fill_abstol(double atol, N_Vector out) const;  // s_i·atol
+
+  static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data);
+  static int jtimes(N_Vector v, N_Vector jv, sunrealtype t, N_Vector y, N_Vector fy, void* user_data, N_Vector tmp);
+  // Assembles P = I − γJ when γ changed and sets the PETSc PC up on it.
+  static int psetup(sunrealtype t, N_Vector y, N_Vector fy, sunbooleantype jok, sunbooleantype* jcur,
+                    sunrealtype gamma, void* user_data);
+  // z = PC⁻¹ r (one KSPSolve with KSPPREONLY).
+  static int psolve(sunrealtype t, N_Vector y, N_Vector fy, N_Vector r, N_Vector z, sunrealtype gamma,
+                    sunrealtype delta, int lr, void* user_data);
+
+  long preconditioner_setups() const { return setups_; }
+  // True on every rank when no rank has a Dirichlet node and every row of K sums to zero (to
+  // 1e-12 of its diagonal): then Σ M T is invariant under conduction (conservative_krylov.hpp).
+  bool conserves() const { return conserves_; }
+
+ private:
+  void destroy_petsc();
+  void assemble(double gamma);
+
+  const DistributedProblem* problem_ = nullptr;
+  bool symmetric_ = false;
+  bool conserves_ = false;
+  Eigen::VectorXd s_;       // y = s ⊙ T
+  Eigen::VectorXd fscale_;  // f = fscale ⊙ w, 0 on Dirichlet rows
+  std::vector<double> jval_;  // J in the problem's local CSR (row_start, local_col); 0 on dropped entries
+  // Preconditioner matrix rows: global columns (K's, plus the diagonal when K lacks it) and the
+  // position of the diagonal among them.
+  std::vector<PetscInt> p_start_, p_col_, p_diag_;
+  std::vector<double> p_j_, p_val_;
+  Mat pmat_ = nullptr;
+  KSP ksp_ = nullptr;
+  Vec r_vec_ = nullptr, z_vec_ = nullptr;
+  double gamma_ = -1.0;
+  long setups_ = 0;
+  mutable Eigen::VectorXd t_work_, w_work_;
+};
+
+}  // namespace frictherm::thermal::detail
