@@ -1,11 +1,14 @@
-# frictherm_add_module(<module> [LINK_PUBLIC ...] [LINK_PRIVATE ...])
+# frictherm_add_module(<module> [LINK_PUBLIC ...] [LINK_PRIVATE ...] [EXCLUDE_DIRS sub-folder ...])
 # One library per top-level module folder: sources from <module>/src/**/*.cpp (sub-folders name the
 # concerns, private headers included from src/ as "scene/x.hpp"), public headers under
 # <module>/include, target frictherm_<module> with the alias and export name frictherm::<module>.
 function(frictherm_add_module module)
-  cmake_parse_arguments(M "" "" "LINK_PUBLIC;LINK_PRIVATE" ${ARGN})
+  cmake_parse_arguments(M "" "" "LINK_PUBLIC;LINK_PRIVATE;EXCLUDE_DIRS" ${ARGN})
   set(target frictherm_${module})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp)
+  foreach(dir ${M_EXCLUDE_DIRS})  # sub-folders built as libraries of their own (thermal/src/distributed)
+    list(FILTER sources EXCLUDE REGEX "^${CMAKE_CURRENT_SOURCE_DIR}/src/${dir}/")
+  endforeach()
   add_library(${target} ${sources})
   add_library(frictherm::${module} ALIAS ${target})
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${module} OUTPUT_NAME ${target})
