@@ -47,6 +47,23 @@ TEST(SceneBuild, ThreeDimensionalBoxAndSphere) {
   EXPECT_NEAR(static_cast<double>(sim->bodies()[1].particle_count), expected_ball, 0.03 * expected_ball);
 }
 
+// The update scheme a scene gets when it names none: USL with multimaterial (grid) contact, whose
+// frictional heat MUSL makes grow with the time step (docs/transfer.md); MUSL without contact or with
+// penalty contact only; a named scheme always wins.
+TEST(SceneBuild, DefaultUpdateSchemeFollowsTheContactMethod) {
+  using frictherm::mechanics::UpdateScheme;
+  Json j = good_scene();
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::musl);
+  j["contact"] = Json::parse(R"({"law": {"type": "coulomb", "mu": 0.3}})");
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::usl);
+  j["solver"] = Json::parse(R"({"scheme": "musl"})");
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::musl);
+  j["solver"] = Json::parse(R"({"cfl": 0.4})");
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::usl);
+  j["contact"] = Json::parse(R"({"method": "penalty", "boundary_spacing": 0.005})");
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::musl);
+}
+
 TEST(SceneBuild, DefaultsAreApplied) {
   const fc::Scene s = parse_scene(good_scene().dump(), "<test>", ".", "my_scene");
   EXPECT_EQ(s.output.file, "my_scene.h5");

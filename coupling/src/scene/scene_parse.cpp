@@ -144,6 +144,17 @@ void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
   mats.finish();
 }
 
+/// The update scheme of a scene that names none: USL when a pair uses multimaterial (grid) contact,
+/// whose frictional heat MUSL makes grow with the time step (docs/transfer.md, "What they do for
+/// frictional heat"), MUSL otherwise.
+mechanics::UpdateScheme default_update_scheme(const ContactSpec& contact) {
+  if (!contact.enabled) return mechanics::UpdateScheme::musl;
+  bool grid_contact = contact.options.default_pair.method == mechanics::ContactMethod::multimaterial;
+  for (const ContactPairSpec& p : contact.pairs)
+    grid_contact = grid_contact || p.settings.method == mechanics::ContactMethod::multimaterial;
+  return grid_contact ? mechanics::UpdateScheme::usl : mechanics::UpdateScheme::musl;
+}
+
 void parse_solver(const JsonReader& root, Scene& s) {
   const auto solver = root.find("solver");
   if (!solver) return;
@@ -153,7 +164,8 @@ void parse_solver(const JsonReader& root, Scene& s) {
     s.options.ebs_occupation = solver->number("ebs_occupation", s.options.ebs_occupation, Range::closed(0.0, 1.0));
   else if (const auto c = solver->find("ebs_occupation"))
     c->fail("only with \"shape_function\": \"extended_bspline\"");
-  s.options.scheme = mechanics::update_scheme_from_string(solver->choice("scheme", {"usf", "usl", "musl"}, "musl"));
+  if (solver->find("scheme"))  // absent: default_update_scheme once the contact section is read
+    s.options.scheme = mechanics::update_scheme_from_string(solver->choice("scheme", {"usf", "usl", "musl"}, "musl"));
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
   if (const auto t = solver->find("pic_relaxation_time")) s.options.pic_relaxation_time = t->as_number(Range::positive());
@@ -358,6 +370,8 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   detail::parse_loads(root, s, ctx);
   parse_solver(root, s);
   s.contact = parse_contact_section(root, s.dimension, ctx.material_names);  // scene_contact.cpp
+  const auto solver = root.find("solver");
+  if (!solver || !solver->find("scheme")) s.options.scheme = default_update_scheme(s.contact);
   detail::expand_grain_contact_pairs(s, ctx);  // scene_grains.cpp: pairs of a grain template -> its grains
   parse_output(root, s);
   // Thermal properties are given per declared material; grain materials take their template's.
