@@ -2,10 +2,13 @@
 // ranks: (a) an isolated elastic body moving and spinning across rank boundaries keeps every particle
 // (count and each mass bit for bit) and conserves linear momentum to round-off; (b) two colliding
 // blocks of one material give, decomposed, the positions, velocities and stresses of the same run on
-// one rank (MPI_COMM_SELF, in the same process) to round-off; plus the DMDA's stencil width from the
+// one rank (MPI_COMM_SELF, in the same process) to round-off; (c) and those of the serial module's
+// Simulation<2> (USL, FLIP, no contact) to round-off; plus the DMDA's stencil width from the
 // kernels' reach and the refusals. Prints the traffic of the exchange phases (docs/distributed.md).
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
 #include "frictherm/mechanics/distributed.hpp"
+#include "frictherm/mechanics/geometry.hpp"
+#include "frictherm/mechanics/simulation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -232,6 +235,62 @@ INSTANTIATE_TEST_SUITE_P(Kernels, DecomposedEqualsOneRank,
                          ::testing::Values(fm::ShapeKind::linear, fm::ShapeKind::ugimp,
                                            fm::ShapeKind::quadratic_bspline),
                          [](const auto& p) { return std::string(fm::to_string(p.param)); });
+
+// ---- (c) the decomposed run equals the serial module's Simulation<2> (USL, FLIP, no contact) ----
+TEST(DecomposedMechanics, EqualsTheSerialSimulation) {
+  const double h = 1e-3, rho = 1000.0;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {28, 16});
+  fm::SimulationOptions so;
+  so.shape = fm::ShapeKind::ugimp;
+  so.scheme = fm::UpdateScheme::usl;
+  so.gravity = fm::Vec<3>(0.0, -200.0, 0.0);
+  fm::Simulation<2> serial(grid, so);
+  const fm::Material mat = elastic(1e6, 0.3, rho);
+  const int m = serial.add_material(mat);
+  serial.add_body("left", *fm::make_box<2>(V2(7e-3, 4e-3), V2(13e-3, 10e-3), m), 2, V2(8.0, 0.5));
+  serial.add_body("right", *fm::make_box<2>(V2(15e-3, 5e-3), V2(21e-3, 11e-3), m), 2, V2(-8.0, 0.0));
+  serial.finalize();
+  const auto& sp = serial.particles();
+  std::vector<fm::DecomposedParticle> all(sp.position.size());
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    all[k].id = static_cast<std::int64_t>(k);
+    all[k].mass = sp.mass[k];
+    all[k].volume = sp.volume[k];
+    all[k].position = sp.position[k];
+    all[k].velocity = sp.velocity[k];
+    all[k].half_size = sp.half_size[k];
+  }
+  fm::DecomposedOptions opt;
+  opt.shape = so.shape;
+  opt.gravity = V2(0.0, -200.0);
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mat, opt);
+  split.add_particles(on_rank0(all, MPI_COMM_WORLD));
+  const double dt = 0.3 * h / (std::sqrt(mat.p_wave_modulus(fm::Analysis::plane_strain) / rho) + 8.0);
+  double taken = 0.0;
+  for (int s = 0; s < 80; ++s) {
+    taken = std::max(taken, std::fabs(serial.step(dt) - dt));
+    split.step(dt);
+  }
+  EXPECT_EQ(taken, 0.0);  // the serial step took dt (below its CFL limit)
+  const auto a = split.gather();
+  EXPECT_EQ(a.size(), all.size());
+  double dx = 0.0, dv = 0.0, ds = 0.0, vmax = 0.0, smax = 0.0;
+  for (std::size_t k = 0; k < std::min(a.size(), all.size()); ++k) {
+    dx = std::max(dx, (a[k].position - sp.position[k]).norm());
+    dv = std::max(dv, (a[k].velocity - sp.velocity[k]).norm());
+    ds = std::max(ds, (a[k].stress - sp.stress[k]).norm());
+    vmax = std::max(vmax, sp.velocity[k].norm());
+    smax = std::max(smax, sp.stress[k].norm());
+  }
+  EXPECT_GT(smax, 1e4);  // the blocks met
+  // Round-off: the same operations per particle, the nodal sums in another order.
+  EXPECT_LE(dx / (28.0 * h), 1e-12);
+  EXPECT_LE(dv / vmax, 1e-12);
+  EXPECT_LE(ds / smax, 1e-12);
+  if (comm_rank() == 0)
+    std::printf("[serial] uGIMP, USL: max |Δx|/L %.2e, |Δv|/v_max %.2e, |Δσ|/σ_max %.2e\n", dx / (28.0 * h),
+                dv / vmax, ds / smax);
+}
 
 }  // namespace
 
