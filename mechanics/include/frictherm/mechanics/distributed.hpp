@@ -1,0 +1,124 @@
+#pragma once
+// Decomposed 2D MPM on PETSc (issue 16, item 1, first piece): the structured grid as a DMDA whose
+// points are the grid's nodes (the serial Grid<2>'s nodes, its ghost layer included), particles in a
+// DMSwarm of type DMSWARM_PIC with the DMDA as cell DM, and one explicit USL step of one
+// linear-elastic material without contact, written as a list of named phases in which the three
+// exchanges are phases of their own (docs/distributed.md):
+//
+//   particle_to_grid   local: m_i, p_i, f_i scattered into the ghosted local vector (N·1–3)
+//   sum_to_owners      exchange: DMLocalToGlobal(ADD_VALUES), ghost contributions summed into owners
+//   grid_update        owned nodes: p_i += f_i dt, v_i = p_i/m_i, a_i = f_i/m_i
+//   ghost_velocities   exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get v_i, a_i
+//   grid_to_particle   FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i
+//   stress_update      L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ (material.hpp)
+//   migrate            exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
+//
+// Ownership: a particle belongs to the rank that owns the grid node nearest to it (the node's dual
+// cell [x_n − h/2, x_n + h/2)). With that rule the stencil of the linear, uGIMP (l_p ≤ h/2) and
+// quadratic B-spline kernels reaches one node beyond the nearest node on either side, so the DMDA's
+// stencil width is 1; it is measured from the kernel's own evaluation (stencil_reach), not assumed.
+// The extended B-spline is refused (its weights are built per body, not per particle).
+// Only this library needs PETSc; its header needs MPI only.
+#include <frictherm/mechanics/grid.hpp>
+#include <frictherm/mechanics/material.hpp>
+#include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/types.hpp>
+
+#include <mpi.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace frictherm::mechanics {
+
+/// PETSc initialised for the lifetime of the object (MPI too unless already initialised). A
+/// process that already holds PETSc (e.g. through the distributed thermal solve) may create it too:
+/// it then neither initialises nor finalises.
+class DecomposedPetscSession {
+ public:
+  DecomposedPetscSession(int* argc, char*** argv);
+  ~DecomposedPetscSession();
+  DecomposedPetscSession(const DecomposedPetscSession&) = delete;
+  DecomposedPetscSession& operator=(const DecomposedPetscSession&) = delete;
+
+ private:
+  bool owns_ = false;
+};
+
+/// Nodes beyond the particle's nearest node that a kernel's stencil reaches, the largest over a
+/// cell (sampled on both sides of every break point of the kernel's node choice): the DMDA's
+/// stencil width. lp = h/2 for uGIMP (its widest particle).
+int stencil_reach(ShapeKind kind);
+
+/// One particle as given to and gathered from the decomposed run.
+struct DecomposedParticle {
+  std::int64_t id = 0;   // global id, kept through migration
+  double mass = 0.0;     // m_p (kg per unit thickness in 2D)
+  double volume = 0.0;   // V_p, current
+  Vec<2> position = Vec<2>::Zero();
+  Vec<2> velocity = Vec<2>::Zero();
+  Vec<2> half_size = Vec<2>::Zero();  // uGIMP half-widths l_p (fixed)
+  Mat<2> stress = Mat<2>::Zero();
+  double stress_zz = 0.0;
+};
+
+struct DecomposedOptions {
+  ShapeKind shape = ShapeKind::linear;
+  Analysis analysis = Analysis::plane_strain;
+  Vec<2> gravity = Vec<2>::Zero();  // body force per unit mass (m/s²)
+};
+
+/// Traffic of the exchange phases, this rank's view, accumulated over steps.
+struct DecomposedTraffic {
+  long steps = 0;
+  long ghost_nodes = 0;               // nodes of the local (ghosted) vector this rank does not own
+  int values_per_node = 0;            // doubles per node in each grid exchange
+  long particles_sent = 0;            // by migration, over all steps
+  long particles_received = 0;
+  int particle_bytes = 0;             // payload per migrated particle (all swarm fields)
+  std::array<double, 7> phase_seconds{};  // per phase, in phase_names() order
+};
+
+class DecomposedMpm2D {
+ public:
+  /// Collective over comm. The grid is the serial Grid<2> (nodes −1 … cells+1 per direction);
+  /// PETSc must be initialised. Throws std::invalid_argument for a material other than
+  /// linear_elastic or for the extended B-spline.
+  DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Material& material, const DecomposedOptions& options);
+  ~DecomposedMpm2D();
+  DecomposedMpm2D(const DecomposedMpm2D&) = delete;
+  DecomposedMpm2D& operator=(const DecomposedMpm2D&) = delete;
+
+  /// Collective, once: each rank passes any particles (ids unique over all ranks); they are
+  /// migrated to their owners. Every particle must lie inside the grid's physical region.
+  void add_particles(const std::vector<DecomposedParticle>& particles);
+
+  /// One USL step of size dt (collective): the phases listed above, in that order.
+  void step(double dt);
+  static const std::array<const char*, 7>& phase_names();
+
+  int stencil_width() const;
+  /// DMDA processes per direction (m, n) and this rank's owned node range [begin, end) per direction
+  /// in DMDA indices (= serial lattice index + Grid<2>::ghost).
+  std::array<int, 2> processes() const;
+  std::array<int, 4> owned_nodes() const;
+  std::size_t local_particles() const;
+  const DecomposedTraffic& traffic() const;
+
+  /// Collective reductions over all ranks.
+  long long global_particles() const;
+  double total_mass() const;
+  Vec<2> total_momentum() const;
+  double total_momentum_scale() const;  // Σ m_p |v_p|
+  /// Collective: every particle of every rank, sorted by id, on every rank.
+  std::vector<DecomposedParticle> gather() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace frictherm::mechanics

@@ -1,0 +1,174 @@
+// The decomposed USL step (frictherm/mechanics/distributed.hpp) as a list of named phases; the three
+// exchanges (sum_to_owners, ghost_velocities, migrate) are phases of their own. The particle loops
+// reuse the serial module's Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted
+// local vector, and its linear_elastic_update (material.hpp), so they compute what the serial
+// Simulation<2>'s USL step computes (mechanics/src/simulation_step.cpp) on this rank's particles.
+#include "distributed/decomposed_state.hpp"
+
+#include <mpi.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::mechanics {
+
+using detail::petsc_check;
+
+namespace {
+
+// Stencil nodes must lie in the ghosted box: holds when every particle sits with the owner of its
+// nearest node and the DMDA's stencil width is the kernel's reach (stencil_reach).
+template <class Kernel>
+void check_in_box(const Stencil<2, Kernel>& st, PetscInt gxs, PetscInt gys, PetscInt gxm, PetscInt gym, long id) {
+  const IVec<2> b = st.first_node();
+  if (b[0] < gxs || b[1] < gys || b[0] + Kernel::K > gxs + gxm || b[1] + Kernel::K > gys + gym)
+    throw std::logic_error("decomposed mechanics: particle " + std::to_string(id) + " (first node " +
+                           std::to_string(b[0]) + ", " + std::to_string(b[1]) + ") reaches nodes outside its rank's " +
+                           "ghosted box [" + std::to_string(gxs) + ", " + std::to_string(gxs + gxm) + ") x [" +
+                           std::to_string(gys) + ", " + std::to_string(gys + gym) + ") (not migrated?)");
+}
+
+}  // namespace
+
+// Phase 1, local: m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p, f_i = Σ (S_ip m_p g − V_p σ_p G_ip)
+// (Nairn 2018 eqs. 1–3) into the ghosted local vector; the stencils are kept for the later phases.
+template <class Kernel>
+void DecomposedMpm2D::Impl::particle_to_grid(double /*dt*/) {
+  using namespace node_dof;
+  SwarmFields f(swarm);
+  auto& st = stencils<Kernel>();
+  st.resize(static_cast<std::size_t>(f.n));
+  petsc_check(VecZeroEntries(local), "VecZeroEntries");
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(local, &a), "VecGetArray");
+  const NodeIndexer<2> ix = local_indexer();
+  const Vec<2> g = opt.gravity;
+  for (PetscInt k = 0; k < f.n; ++k) {
+    auto& s = st[static_cast<std::size_t>(k)];
+    s.evaluate(grid, Eigen::Map<const Vec<2>>(f.x + 2 * k), Eigen::Map<const Vec<2>>(f.half_size + 2 * k));
+    check_in_box(s, gxs, gys, gxm, gym, f.id[k]);
+    const double mp = f.mass[k];
+    const Vec<2> mv = mp * Eigen::Map<const Vec<2>>(f.velocity + 2 * k);
+    const Mat<2> Vsig = f.volume[k] * Eigen::Map<const Mat<2>>(f.stress + 4 * k);
+    const Vec<2> mg = mp * g;
+    s.for_each(ix, [&](int i, double S, const Vec<2>& G) {
+      double* node = a + count * i;
+      const Vec<2> fi = S * mg - Vsig * G;
+      node[mass] += S * mp;
+      node[momentum] += S * mv[0];
+      node[momentum + 1] += S * mv[1];
+      node[force] += fi[0];
+      node[force + 1] += fi[1];
+    });
+  }
+  petsc_check(VecRestoreArray(local, &a), "VecRestoreArray");
+}
+
+// Phase 2, exchange: ghost nodes' contributions summed into their owners.
+void DecomposedMpm2D::Impl::sum_to_owners(double /*dt*/) {
+  petsc_check(VecZeroEntries(global), "VecZeroEntries");
+  petsc_check(DMLocalToGlobalBegin(da, local, ADD_VALUES, global), "DMLocalToGlobalBegin");
+  petsc_check(DMLocalToGlobalEnd(da, local, ADD_VALUES, global), "DMLocalToGlobalEnd");
+}
+
+// Phase 3, owned nodes: p_i^{n+1} = p_i^n + f_i dt, v_i = p_i^{n+1}/m_i, a_i = f_i/m_i; nodes below
+// the empty-node mass get neither (as the serial update_grid).
+void DecomposedMpm2D::Impl::grid_update(double dt) {
+  using namespace node_dof;
+  PetscScalar* a = nullptr;
+  PetscInt n = 0;
+  petsc_check(VecGetLocalSize(global, &n), "VecGetLocalSize");
+  petsc_check(VecGetArray(global, &a), "VecGetArray");
+  for (PetscInt i = 0; i < n / count; ++i) {
+    double* node = a + count * i;
+    const double m = node[mass];
+    for (int d = 0; d < 2; ++d) {
+      const double f = node[force + d];
+      const double p = node[momentum + d] + f * dt;
+      node[velocity + d] = m > empty_node_mass ? p / m : 0.0;
+      node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
+    }
+  }
+  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
+}
+
+// Phase 4, exchange: owners' v_i, a_i copied to the ranks holding the node as a ghost.
+void DecomposedMpm2D::Impl::ghost_velocities(double /*dt*/) {
+  petsc_check(DMGlobalToLocalBegin(da, global, INSERT_VALUES, local), "DMGlobalToLocalBegin");
+  petsc_check(DMGlobalToLocalEnd(da, global, INSERT_VALUES, local), "DMGlobalToLocalEnd");
+}
+
+// Phase 5, local (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1}, start-of-step stencils.
+template <class Kernel>
+void DecomposedMpm2D::Impl::grid_to_particle(double dt) {
+  using namespace node_dof;
+  SwarmFields f(swarm);
+  const auto& st = stencils<Kernel>();
+  const PetscScalar* a = nullptr;
+  petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+  const NodeIndexer<2> ix = local_indexer();
+  for (PetscInt k = 0; k < f.n; ++k) {
+    Vec<2> acc = Vec<2>::Zero(), v = Vec<2>::Zero();
+    st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double S, const Vec<2>&) {
+      const double* node = a + count * i;
+      acc += S * Vec<2>(node[acceleration], node[acceleration + 1]);
+      v += S * Vec<2>(node[velocity], node[velocity + 1]);
+    });
+    Eigen::Map<Vec<2>>(f.velocity + 2 * k) += dt * acc;
+    Eigen::Map<Vec<2>>(f.x + 2 * k) += dt * v;
+  }
+  petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
+}
+
+// Phase 6, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, hypoelastic σ (Jaumann).
+template <class Kernel>
+void DecomposedMpm2D::Impl::stress_update(double dt) {
+  using namespace node_dof;
+  SwarmFields f(swarm);
+  const auto& st = stencils<Kernel>();
+  const PetscScalar* a = nullptr;
+  petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+  const NodeIndexer<2> ix = local_indexer();
+  const double lam = material.lame_lambda(), mu = material.shear_modulus();
+  for (PetscInt k = 0; k < f.n; ++k) {
+    Mat<2> L = Mat<2>::Zero();
+    st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double, const Vec<2>& G) {
+      const double* node = a + count * i;
+      L.noalias() += Vec<2>(node[velocity], node[velocity + 1]) * G.transpose();
+    });
+    Eigen::Map<Mat<2>> F(f.F + 4 * k);
+    F = ((Mat<2>::Identity() + dt * L) * F).eval();
+    f.volume[k] = F.determinant() * f.volume0[k];
+    Mat<2> sigma = Eigen::Map<const Mat<2>>(f.stress + 4 * k);
+    linear_elastic_update<2>(L, dt, lam, mu, opt.analysis, sigma, f.stress_zz[k]);
+    Eigen::Map<Mat<2>>(f.stress + 4 * k) = sigma;
+  }
+  petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
+}
+
+const std::array<const char*, 7>& DecomposedMpm2D::phase_names() {
+  static const std::array<const char*, 7> names{
+      {"particle_to_grid", "sum_to_owners", "grid_update", "ghost_velocities", "grid_to_particle", "stress_update",
+       "migrate"}};
+  return names;
+}
+
+void DecomposedMpm2D::step(double dt) {
+  Impl& s = *impl_;
+  dispatch_shape(s.opt.shape, [&](auto kernel) {
+    using Kernel = decltype(kernel);
+    using Phase = void (Impl::*)(double);
+    // The step, in order (names: phase_names()).
+    static constexpr Phase phases[7] = {&Impl::particle_to_grid<Kernel>, &Impl::sum_to_owners, &Impl::grid_update,
+                                        &Impl::ghost_velocities,        &Impl::grid_to_particle<Kernel>,
+                                        &Impl::stress_update<Kernel>,   &Impl::migrate};
+    for (std::size_t p = 0; p < 7; ++p) {
+      const double t0 = MPI_Wtime();
+      (s.*phases[p])(dt);
+      s.traffic.phase_seconds[p] += MPI_Wtime() - t0;
+    }
+  });
+  ++s.traffic.steps;
+}
+
+}  // namespace frictherm::mechanics
