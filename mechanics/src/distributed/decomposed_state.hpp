@@ -45,6 +45,20 @@ struct SwarmFields {
 
   explicit SwarmFields(DM swarm);
   ~SwarmFields();
+  /// f(name, pointer) for every field the step reads, in one list for getting and restoring.
+  template <class Visit>
+  void each_field(Visit&& f) {
+    f(DMSwarmPICField_coor, x);
+    f(swarm_field::id, id);
+    f(swarm_field::mass, mass);
+    f(swarm_field::volume, volume);
+    f(swarm_field::volume0, volume0);
+    f(swarm_field::velocity, velocity);
+    f(swarm_field::half_size, half_size);
+    f(swarm_field::stress, stress);
+    f(swarm_field::stress_zz, stress_zz);
+    f(swarm_field::deformation, F);
+  }
   SwarmFields(const SwarmFields&) = delete;
   SwarmFields& operator=(const SwarmFields&) = delete;
 };

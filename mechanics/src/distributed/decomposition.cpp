@@ -53,35 +53,15 @@ int stencil_reach(ShapeKind kind) {
 
 SwarmFields::SwarmFields(DM swarm) : sw(swarm) {
   petsc_check(DMSwarmGetLocalSize(sw, &n), "DMSwarmGetLocalSize");
-  auto get = [&](const char* name, auto*& ptr) {
+  each_field([&](const char* name, auto*& ptr) {
     petsc_check(DMSwarmGetField(sw, name, nullptr, nullptr, reinterpret_cast<void**>(&ptr)), "DMSwarmGetField");
-  };
-  get(DMSwarmPICField_coor, x);
-  get(swarm_field::id, id);
-  get(swarm_field::mass, mass);
-  get(swarm_field::volume, volume);
-  get(swarm_field::volume0, volume0);
-  get(swarm_field::velocity, velocity);
-  get(swarm_field::half_size, half_size);
-  get(swarm_field::stress, stress);
-  get(swarm_field::stress_zz, stress_zz);
-  get(swarm_field::deformation, F);
+  });
 }
 
 SwarmFields::~SwarmFields() {
-  auto put = [&](const char* name, auto*& ptr) {
+  each_field([&](const char* name, auto*& ptr) {
     DMSwarmRestoreField(sw, name, nullptr, nullptr, reinterpret_cast<void**>(&ptr));
-  };
-  put(DMSwarmPICField_coor, x);
-  put(swarm_field::id, id);
-  put(swarm_field::mass, mass);
-  put(swarm_field::volume, volume);
-  put(swarm_field::volume0, volume0);
-  put(swarm_field::velocity, velocity);
-  put(swarm_field::half_size, half_size);
-  put(swarm_field::stress, stress);
-  put(swarm_field::stress_zz, stress_zz);
-  put(swarm_field::deformation, F);
+  });
 }
 
 DecomposedMpm2D::Impl::~Impl() {
