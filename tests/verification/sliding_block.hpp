@@ -23,6 +23,7 @@ struct SlidingBlockSetup {
   mechanics::NormalMethod normal = mechanics::NormalMethod::specified;
   mechanics::SeparationMethod separation = mechanics::SeparationMethod::position;
   mechanics::ShapeKind shape = mechanics::ShapeKind::ugimp;
+  mechanics::UpdateScheme scheme = mechanics::UpdateScheme::musl;
   double cell = 0.005;
   double cfl = 0.5;
   double angle = 0.0;    // radians; rotated variant only
@@ -81,6 +82,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
   o.analysis = Analysis::plane_strain;
   o.thickness = C::b;
   o.shape = s.shape;
+  o.scheme = s.scheme;
   o.cfl = s.cfl;
   const double c = std::cos(s.angle), sn = std::sin(s.angle);
   auto rot = [&](double x, double y) { return Vec<2>(c * x - sn * y, sn * x + c * y); };

@@ -66,12 +66,16 @@ TEST(ContactRegularization, HighFrictionBlockStaysOnItsBase) {
   EXPECT_LT(lagged.work_error, 0.02);
 }
 
-TEST(ContactRegularization, AdhesionBlockConvergesWithRefinement) {
+// Both updates: MUSL (the library's default) and USL (what a scene with grid contact gets).
+class AdhesionRefinement : public ::testing::TestWithParam<mechanics::UpdateScheme> {};
+
+TEST_P(AdhesionRefinement, AdhesionBlockConvergesWithRefinement) {
   const double S_a = 0.3 * SlidingBlockConstants::normal_stress();
   const RigidBlock r = rigid_solution(0.2, 0.2, 0.0, S_a);
   std::vector<Measured> m;
   for (double cell : {0.005, 0.0025, 0.00125}) {
     SlidingBlockSetup s;
+    s.scheme = GetParam();
     s.cell = cell;
     s.separation = SeparationMethod::extent;  // the scene default for a law with an area term
     s.law = FrictionLaw::adhesion(0.2, S_a);
@@ -84,3 +88,7 @@ TEST(ContactRegularization, AdhesionBlockConvergesWithRefinement) {
   EXPECT_LT(m[2].work_error, 0.02);
   for (const Measured& x : m) EXPECT_LT(x.max_lift, 1e-6);
 }
+
+INSTANTIATE_TEST_SUITE_P(ContactRegularization, AdhesionRefinement,
+                         ::testing::Values(mechanics::UpdateScheme::musl, mechanics::UpdateScheme::usl),
+                         [](const auto& info) { return std::string(mechanics::to_string(info.param)); });

@@ -146,5 +146,11 @@ TEST(SlidingBlock, CompositeLawWithExtentDetectionMatchesRigidBlock) {
   const Comparison c = compare(run_sliding_block(s), rigid_solution(0.35, 0.2, k, S_a, 1.5), "composite, extent");
   EXPECT_LT(c.velocity_error, 0.03);  // the target for the composite law at 2.5 mm
   EXPECT_LT(c.work_error, 0.06);
+  // USL, what a scene with grid contact gets unless it names a scheme: the same target.
+  s.scheme = mechanics::UpdateScheme::usl;
+  const Comparison u =
+      compare(run_sliding_block(s), rigid_solution(0.35, 0.2, k, S_a, 1.5), "composite, extent, USL");
+  EXPECT_LT(u.velocity_error, 0.03);
+  EXPECT_LT(u.work_error, 0.06);
 }
 
