@@ -19,3 +19,49 @@ function(frictherm_add_module module)
   target_compile_features(${target} PUBLIC cxx_std_17)
   frictherm_set_warnings(${target})
 endfunction()
+
+# MPI and PETSc (Debian libopenmpi-dev, petsc-dev with pkg-config PETSc) for the distributed parts;
+# a macro so that MPI::* and PkgConfig::PETSC are defined in the calling folder.
+macro(frictherm_find_mpi_petsc)
+  find_package(MPI COMPONENTS C CXX QUIET)
+  find_package(PkgConfig QUIET)
+  if(PkgConfig_FOUND)
+    pkg_check_modules(PETSC QUIET IMPORTED_TARGET PETSc)
+  endif()
+endmacro()
+
+# frictherm_add_mpi_library(<module> [LINK_PRIVATE ...]): the module's distributed part,
+# <module>/src/distributed/*.cpp, as frictherm_<module>_mpi (alias frictherm::<module>_mpi) on top of
+# frictherm_<module>, MPI and PETSc, compiled with FRICTHERM_<MODULE>_MPI. Call after
+# frictherm_find_mpi_petsc found both.
+function(frictherm_add_mpi_library module)
+  cmake_parse_arguments(M "" "" "LINK_PRIVATE" ${ARGN})
+  set(target frictherm_${module}_mpi)
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/distributed/*.cpp)
+  add_library(${target} ${sources})
+  add_library(frictherm::${module}_mpi ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${module}_mpi OUTPUT_NAME ${target})
+  target_include_directories(${target} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(${target} PUBLIC frictherm_${module} MPI::MPI_CXX
+                        PRIVATE PkgConfig::PETSC MPI::MPI_C ${M_LINK_PRIVATE})
+  string(TOUPPER ${module} upper)
+  target_compile_definitions(${target} PUBLIC FRICTHERM_${upper}_MPI)
+  frictherm_set_warnings(${target})
+endfunction()
+
+# frictherm_add_mpi_test(<name> <source> <library>): a test program with its own main (PETSc and MPI
+# initialised once per process), run by ctest as <name>_np2 and <name>_np4 under mpirun
+# (oversubscribed: CI has 2 cores; --allow-run-as-root: CI runs as root).
+function(frictherm_add_mpi_test name source library)
+  add_executable(test_${name} ${source})
+  target_link_libraries(test_${name} PRIVATE ${library} GTest::gtest)
+  frictherm_set_warnings(test_${name})
+  foreach(ranks 2 4)
+    add_test(NAME ${name}_np${ranks}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${ranks} --oversubscribe --allow-run-as-root
+                     ${MPIEXEC_PREFLAGS} $<TARGET_FILE:test_${name}> ${MPIEXEC_POSTFLAGS})
+    set_tests_properties(${name}_np${ranks} PROPERTIES
+      LABELS "verification;mpi" PROCESSORS ${ranks} TIMEOUT 120
+      ENVIRONMENT "OMP_NUM_THREADS=1;OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_MCA_mpi_yield_when_idle=1")
+  endforeach()
+endfunction()

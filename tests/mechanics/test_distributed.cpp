@@ -10,6 +10,8 @@
 #include "frictherm/mechanics/geometry.hpp"
 #include "frictherm/mechanics/simulation.hpp"
 
+#include "../mpi_ranks.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,16 +24,8 @@ namespace {
 namespace fm = frictherm::mechanics;
 using V2 = fm::Vec<2>;
 
-int comm_rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-int comm_size() {
-  int s = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &s);
-  return s;
-}
+using frictherm::test::comm_rank;
+using frictherm::test::comm_size;
 
 fm::Material elastic(double E, double nu, double rho) {
   fm::Material m;

@@ -9,6 +9,8 @@
 
 #include "frictherm/thermal/integrator.hpp"
 
+#include "../mpi_ranks.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,16 +23,8 @@ using thermal_test::Grid2D;
 using thermal_test::make_grid_2d;
 using thermal_test::Material;
 
-int comm_rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-int comm_size() {
-  int s = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &s);
-  return s;
-}
+using frictherm::test::comm_rank;
+using frictherm::test::comm_size;
 
 double global_max(double x) {
   double out = 0.0;

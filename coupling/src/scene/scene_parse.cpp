@@ -155,7 +155,8 @@ mechanics::UpdateScheme default_update_scheme(const ContactSpec& contact) {
   return grid_contact ? mechanics::UpdateScheme::usl : mechanics::UpdateScheme::musl;
 }
 
-void parse_solver(const JsonReader& root, Scene& s) {
+void parse_solver(const JsonReader& root, Scene& s) {  // after the contact section: default_update_scheme
+  s.options.scheme = default_update_scheme(s.contact);
   const auto solver = root.find("solver");
   if (!solver) return;
   s.options.shape = mechanics::shape_kind_from_string(solver->choice(
@@ -164,8 +165,8 @@ void parse_solver(const JsonReader& root, Scene& s) {
     s.options.ebs_occupation = solver->number("ebs_occupation", s.options.ebs_occupation, Range::closed(0.0, 1.0));
   else if (const auto c = solver->find("ebs_occupation"))
     c->fail("only with \"shape_function\": \"extended_bspline\"");
-  if (solver->find("scheme"))  // absent: default_update_scheme once the contact section is read
-    s.options.scheme = mechanics::update_scheme_from_string(solver->choice("scheme", {"usf", "usl", "musl"}, "musl"));
+  s.options.scheme = mechanics::update_scheme_from_string(
+      solver->choice("scheme", {"usf", "usl", "musl"}, mechanics::to_string(s.options.scheme)));
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
   if (const auto t = solver->find("pic_relaxation_time")) s.options.pic_relaxation_time = t->as_number(Range::positive());
@@ -368,10 +369,8 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   detail::parse_bodies(root, s, ctx);
   detail::parse_boundary(root, s, ctx);
   detail::parse_loads(root, s, ctx);
-  parse_solver(root, s);
   s.contact = parse_contact_section(root, s.dimension, ctx.material_names);  // scene_contact.cpp
-  const auto solver = root.find("solver");
-  if (!solver || !solver->find("scheme")) s.options.scheme = default_update_scheme(s.contact);
+  parse_solver(root, s);
   detail::expand_grain_contact_pairs(s, ctx);  // scene_grains.cpp: pairs of a grain template -> its grains
   parse_output(root, s);
   // Thermal properties are given per declared material; grain materials take their template's.
