@@ -162,6 +162,69 @@ TEST(MatrixFreeConduction, ReuseErrorIsOfOrderOfTheShift) {
   EXPECT_LT(diff, 2.0 * 0.05 * change);
 }
 
+// Refreshing only the particles that moved (ExplicitConduction::refresh): a slider of 8 particles on
+// a base of 160, moved 0.0125 cells per window with reuse_distance 0.01 cells, is gathered again
+// every window while the base never moves, so no weight lags its particle and the run must give the
+// temperatures of gathering every window up to the order of the sums. Round-off bound: ~10 terms of
+// relative error 1.1e-16 on T ≈ 300 K per window over 240 windows, summed linearly, is 8e-11 K; the
+// allowance is 1e-9 K. The books stay exact (1e-9 of the heat), and the unknowns change as the slider
+// reaches new nodes (full gathers), not every window.
+fc::Coupler<2> slider_run(fm::Particles<2>& p, double reuse_distance, long windows, std::size_t first_slider) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 10});
+  fc::CouplerOptions opt = options("auto", 4);
+  opt.reuse_distance = reuse_distance;
+  fc::Coupler<2> cp(grid, fm::ShapeKind::ugimp, opt);
+  cp.start(p, 0.0);
+  std::vector<double> w(grid.node_count(), 0.0);
+  for (long k = 1; k <= windows; ++k) {
+    std::fill(w.begin(), w.end(), 0.0);
+    w[static_cast<std::size_t>(grid.node_index({3 + static_cast<int>(k / 80), 5}))] = 1e-3;  // under the slider
+    cp.after_step(p, w, 0.01 * static_cast<double>(k));  // well below the stable step: one sub-step (asserted)
+    for (std::size_t i = first_slider; i < p.size(); ++i) p.position[i][0] += 1.25e-5;
+  }
+  return cp;
+}
+
+TEST(MatrixFreeConduction, RefreshingTheMovedParticlesEqualsGatheringEveryWindow) {
+  auto T = [](const fm::Vec<2>& x) { return 300.0 + 40.0 * std::sin(900.0 * x[0]) * std::cos(700.0 * x[1]); };
+  auto bodies = [&] {
+    fm::Particles<2> p;
+    fill_box<2>(p, {0.001, 0.001}, {0.011, 0.005}, 1e-3, 2, kRho, 0, T);
+    fill_box<2>(p, {0.002, 0.005}, {0.004, 0.006}, 1e-3, 2, kRho, 0, T);
+    return p;
+  };
+  const std::size_t first_slider = 160;
+  const long windows = 240;
+  fm::Particles<2> a = bodies(), b = bodies();
+  ASSERT_EQ(a.size(), first_slider + 8);
+  const std::vector<double> T0(a.temperature.begin(), a.temperature.end());
+  const fc::Coupler<2> refreshed = slider_run(a, 0.01, windows, first_slider);
+  const fc::Coupler<2> gathered = slider_run(b, 0.0, windows, first_slider);
+  double diff = 0.0, change = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    diff = std::max(diff, std::fabs(a.temperature[k] - b.temperature[k]));
+    change = std::max(change, std::fabs(b.temperature[k] - T0[k]));
+  }
+  const fc::EnergyBooks& r = refreshed.books();
+  const double W = 1e-3 * static_cast<double>(windows);
+  std::cout << "[matrix-free refresh] " << r.matrix_free_refreshes << " refreshes, " << r.matrix_free_gathers
+            << " full gathers in " << windows << " windows; max |T_p(refresh) - T_p(gather)| = " << diff
+            << " K of a largest change " << change << " K; |ΣmCΔT - Q|/Q = "
+            << std::fabs(refreshed.particle_energy_change(a) - r.heat_delivered) / W << "; sub-steps "
+            << r.matrix_free_substeps << " and " << gathered.books().matrix_free_substeps << '\n';
+  EXPECT_EQ(r.matrix_free_windows, windows);
+  EXPECT_EQ(gathered.books().matrix_free_gathers, windows);
+  EXPECT_EQ(r.matrix_free_gathers + r.matrix_free_refreshes, windows);  // every window moved the slider
+  EXPECT_EQ(r.matrix_free_substeps, windows);  // so both take the same sub-steps
+  EXPECT_EQ(gathered.books().matrix_free_substeps, windows);
+  EXPECT_GT(r.matrix_free_refreshes, windows * 9 / 10);
+  EXPECT_GT(change, 1.0);
+  EXPECT_LT(diff, 1e-9);
+  EXPECT_NEAR(r.heat_delivered, W, 1e-12 * W);
+  EXPECT_NEAR(refreshed.particle_energy_change(a), r.heat_delivered, 1e-9 * W);
+  EXPECT_NEAR(r.nodal_energy_change, r.heat_delivered, 1e-9 * W);
+}
+
 // Analytic check: a cosine mode of a 1D slab with adiabatic ends decays as exp(−α (π/L)² t). Windows
 // of half the stable step (matrix-free, one sub-step each) at h = 2, 1 and 0.5 mm: the rate error is
 // within the O((κh)²) spatial budget of test_coupling_decay.cpp (0.6 (κh)²) plus forward Euler's

@@ -116,9 +116,19 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
   if (last_lambda_bound_ > 0.0 &&
       dt / (o.fe_safety * 2.0 / last_lambda_bound_) > 2.0 * static_cast<double>(opt_.matrix_free_max_substeps))
     return false;
+  using Refresh = typename ExplicitConduction<Dim>::Refresh;
   const double shift = opt_.reuse_distance * grid_.cell_size().minCoeff();
-  if (system_gathered_ && opt_.reuse_distance > 0.0 && explicit_.reusable(p, shift)) {
-    explicit_.reproject(p, system_);  // same S, M and G'; T_i from the particles now
+  const Refresh reuse = system_gathered_ && opt_.reuse_distance > 0.0
+                            ? explicit_.refresh(grid_, p, shape_, opt_.materials, opt_.assembly, system_, shift,
+                                                step_stencils())
+                            : Refresh::regather;
+  if (reuse == Refresh::refreshed) {  // the particles that moved were gathered again: M and the bound changed
+    ++books_.matrix_free_refreshes;
+    system_changed();
+    last_lambda_bound_ = explicit_.lambda_bound(system_, fixed_nodes_);
+  }
+  if (reuse != Refresh::regather) {
+    explicit_.reproject(p, system_);  // kept S, M and G'; T_i from the particles now
   } else {
     explicit_.gather(grid_, p, shape_, opt_.materials, opt_.assembly, system_, step_stencils());
     ++books_.matrix_free_gathers;

@@ -10,7 +10,37 @@
 #include <string>
 
 namespace frictherm::coupling {
+namespace {
 
+// A stencil's grid nodes, S_ip and G_ip, in stencil order.
+template <class NodeList, class Stencil, class Grid>
+void copy_nodes(const Grid& grid, const Stencil& st, NodeList& nl) {
+  nl.count = 0;
+  st.for_each(grid, [&](int i, double w, const auto& g) {
+    nl.node[nl.count] = i;
+    nl.S[nl.count] = w;
+    nl.G[nl.count] = g;
+    ++nl.count;
+  });
+}
+
+// Σ_a f(a) for a < count in three interleaved partial sums: the chain of dependent additions is a
+// third as long as a running sum's (which the per-window passes were bound by); the order of the
+// additions, hence the round-off, differs from a running sum.
+template <class Value, class Term>
+Value interleaved_sum(int count, const Value& zero, Term&& f) {
+  Value s0 = zero, s1 = zero, s2 = zero;
+  int a = 0;
+  for (; a + 3 <= count; a += 3) {
+    s0 += f(a);
+    s1 += f(a + 1);
+    s2 += f(a + 2);
+  }
+  for (; a < count; ++a) s0 += f(a);
+  return Value((s0 + s1) + s2);
+}
+
+}  // namespace
 
 template <int Dim>
 template <class Kernel>
@@ -42,6 +72,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     kept_mass_[k].count = 0;
     kept_flux_[k].count = 0;
     kept_flux_[k].conductance = 0.0;
+    kept_flux_[k].rayleigh = 0.0;
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
@@ -57,15 +88,9 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       continue;
     }
     Nodes& nl = nodes_[k];
-    nl.count = 0;
     mechanics::Stencil<Dim, Kernel> st;
     st.evaluate(grid, p.position[k], p.half_size[k]);
-    st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
-      nl.node[nl.count] = i;
-      nl.S[nl.count] = w;
-      nl.G[nl.count] = g;
-      ++nl.count;
-    });
+    copy_nodes(grid, st, nl);
     for (int a = 0; a < nl.count; ++a) {
       const auto i = static_cast<std::size_t>(nl.node[a]);
       sys.grid_mass[i] += mc * nl.S[a];
@@ -82,58 +107,75 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
   row_bound_.assign(static_cast<std::size_t>(n), 0.0);
   rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
+  mass_peak_ = sys.mass;
+  rayleigh_scale_ = 1.0;
   Nodes from_step;
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k]) continue;
-    if (step_stencils) {
-      from_step.count = 0;
-      step_stencils[k].for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>& g) {
-        from_step.node[from_step.count] = i;
-        from_step.S[from_step.count] = w;
-        from_step.G[from_step.count] = g;
-        ++from_step.count;
-      });
+    if (step_stencils) copy_nodes(grid, step_stencils[k], from_step);
+    keep(k, step_stencils ? from_step : nodes_[k], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
+  }
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::keep(std::size_t k, const Nodes& nl, const ThermalProperties& m, double volume,
+                                   const NodalThermalSystem& sys) {
+  KeptMass& c = kept_mass_[k];
+  KeptFlux& f = kept_flux_[k];
+  c.count = 0;
+  f.count = 0;
+  f.conductance = 0.0;
+  f.rayleigh = 0.0;
+  mechanics::Vec<Dim> G[capacity];  // G' of the kept nodes
+  double s_kept = 0.0;
+  mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
+  for (int a = 0; a < nl.count; ++a) {
+    const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
+    if (u >= 0) {
+      s_kept += nl.S[a];
+      c.unknown[c.count] = u;
+      G[c.count] = nl.G[a];
+      c.S[c.count] = nl.S[a];
+      ++c.count;
+    } else {
+      g_dropped += nl.G[a];
     }
-    const Nodes& nl = step_stencils ? from_step : nodes_[k];
-    KeptMass& c = kept_mass_[k];
-    mechanics::Vec<Dim> G[capacity];  // G' of the kept nodes
-    double s_kept = 0.0;
-    mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
-    for (int a = 0; a < nl.count; ++a) {
-      const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
-      if (u >= 0) {
-        s_kept += nl.S[a];
-        c.unknown[c.count] = u;
-        G[c.count] = nl.G[a];
-        c.S[c.count] = nl.S[a];
-        ++c.count;
-      } else {
-        g_dropped += nl.G[a];
-      }
-    }
-    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
-    // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
-    if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) continue;
-    if (c.count < nl.count)
-      for (int a = 0; a < c.count; ++a) G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
-    KeptFlux& f = kept_flux_[k];
-    f.conductance = p.volume[k] * m.conductivity;
-    f.count = c.count;
-    for (int a = 0; a < c.count; ++a) f.unknown[a] = c.unknown[a], f.G[a] = G[a];
-    // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
-    // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
-    // Σ_p c_p (Σ_a |G'_a|²/M_a)(Σ_a M_a x_a²), so λ ≤ max_i Σ_{p∋i} c_p Σ_a |G'_a|²/M_a.
-    double gsum = 0.0, g2m = 0.0;
-    double gnorm[capacity];
-    for (int a = 0; a < c.count; ++a) {
-      gnorm[a] = G[a].norm();
-      gsum += gnorm[a];
-      g2m += gnorm[a] * gnorm[a] / sys.mass[c.unknown[a]];
-    }
-    for (int a = 0; a < c.count; ++a) {
-      row_bound_[static_cast<std::size_t>(c.unknown[a])] += f.conductance * gnorm[a] * gsum;
-      rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += f.conductance * g2m;
-    }
+  }
+  // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
+  if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) return;
+  if (c.count < nl.count)
+    for (int a = 0; a < c.count; ++a) G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
+  f.conductance = volume * m.conductivity;
+  f.count = c.count;
+  for (int a = 0; a < c.count; ++a) f.unknown[a] = c.unknown[a], f.G[a] = G[a];
+  // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
+  // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
+  // Σ_p c_p (Σ_a |G'_a|²/M_a)(Σ_a M_a x_a²), so λ ≤ max_i Σ_{p∋i} c_p Σ_a |G'_a|²/M_a.
+  double gsum = 0.0, g2m = 0.0;
+  double gnorm[capacity];
+  for (int a = 0; a < c.count; ++a) {
+    gnorm[a] = G[a].norm();
+    gsum += gnorm[a];
+    g2m += gnorm[a] * gnorm[a] / sys.mass[c.unknown[a]];
+  }
+  f.rayleigh = f.conductance * g2m;
+  for (int a = 0; a < c.count; ++a) {
+    row_bound_[static_cast<std::size_t>(c.unknown[a])] += f.conductance * gnorm[a] * gsum;
+    rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += f.rayleigh;
+  }
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::remove_bounds(const KeptFlux& f) {
+  double gsum = 0.0;
+  double gnorm[capacity];
+  for (int a = 0; a < f.count; ++a) {
+    gnorm[a] = f.G[a].norm();
+    gsum += gnorm[a];
+  }
+  for (int a = 0; a < f.count; ++a) {
+    row_bound_[static_cast<std::size_t>(f.unknown[a])] -= f.conductance * gnorm[a] * gsum;
+    rayleigh_bound_[static_cast<std::size_t>(f.unknown[a])] -= f.rayleigh;
   }
 }
 
@@ -148,11 +190,93 @@ void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mec
 }
 
 template <int Dim>
-bool ExplicitConduction<Dim>::reusable(const mechanics::Particles<Dim>& p, double max_shift) const {
-  if (gathered_at_.size() != p.size() || kept_mass_.size() != p.size()) return false;
-  for (std::size_t k = 0; k < p.size(); ++k)
-    if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) return false;
-  return true;
+template <class Kernel>
+typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
+    const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
+    const AssemblyOptions& opt, NodalThermalSystem& sys, double max_shift, const mechanics::StencilView<Dim>& view) {
+  if (gathered_at_.size() != p.size() || kept_mass_.size() != p.size()) return Refresh::regather;
+  moved_.clear();
+  std::size_t holding = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (!holds_heat_[k]) continue;
+    ++holding;
+    if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) moved_.push_back(k);
+  }
+  if (moved_.empty()) return Refresh::kept;
+  if (4 * moved_.size() > holding) return Refresh::regather;  // a full gather costs less
+
+  // M_i on every node (eq. 38): each moved particle's weights at its last gather out, at its
+  // position now in (the step's stencils when given: the same numbers as evaluating them here).
+  const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
+  moved_nodes_.resize(moved_.size());
+  for (std::size_t j = 0; j < moved_.size(); ++j) {
+    const std::size_t k = moved_[j];
+    const double mc = kept_mass_[k].heat_capacity;
+    mechanics::Stencil<Dim, Kernel> st;
+    st.evaluate(grid, gathered_at_[k], p.half_size[k]);
+    st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>&) {
+      sys.grid_mass[static_cast<std::size_t>(i)] -= mc * w;
+    });
+    if (step_stencils) {
+      copy_nodes(grid, step_stencils[k], moved_nodes_[j]);
+    } else {
+      st.evaluate(grid, p.position[k], p.half_size[k]);
+      copy_nodes(grid, st, moved_nodes_[j]);
+    }
+    const Nodes& now = moved_nodes_[j];
+    for (int a = 0; a < now.count; ++a) sys.grid_mass[static_cast<std::size_t>(now.node[a])] += mc * now.S[a];
+  }
+
+  // The unknowns must stay those of the gather (select_unknowns' rule): the kept lists, the lumping
+  // of G' and the fixed nodes are numbered by them.
+  const double max_mass = *std::max_element(sys.grid_mass.begin(), sys.grid_mass.end());
+  const double threshold = opt.active_mass_fraction * max_mass;
+  double dropped = 0.0;
+  for (std::size_t i = 0; i < sys.grid_mass.size(); ++i) {
+    const bool active = sys.grid_mass[i] > threshold && sys.grid_mass[i] > 0.0;
+    if (active != (sys.unknown[i] >= 0)) {
+      gathered_at_.clear();  // M is half refreshed: only a gather may follow
+      return Refresh::regather;
+    }
+    if (!active) dropped += sys.grid_mass[i];
+  }
+  sys.max_mass = max_mass;
+  sys.dropped_mass = dropped;
+  double scale = 1.0;
+  for (Eigen::Index u = 0; u < sys.mass.size(); ++u) {
+    sys.mass[u] = sys.grid_mass[static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)])];
+    mass_peak_[u] = std::max(mass_peak_[u], sys.mass[u]);
+    scale = std::max(scale, mass_peak_[u] / sys.mass[u]);
+  }
+  rayleigh_scale_ = scale;
+
+  // The moved particles' kept lists, bounds and eq. 38 sums for the next reproject(), anew.
+  for (std::size_t j = 0; j < moved_.size(); ++j) {
+    const std::size_t k = moved_[j];
+    const double mct = kept_mass_[k].heat_capacity * p.temperature[k];
+    if (next_mct_valid_) {
+      const KeptMass& c = kept_mass_[k];
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] -= mct * c.S[a];
+    }
+    remove_bounds(kept_flux_[k]);
+    keep(k, moved_nodes_[j], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
+    if (next_mct_valid_) {
+      const KeptMass& c = kept_mass_[k];
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
+    }
+    gathered_at_[k] = p.position[k];
+  }
+  return Refresh::refreshed;
+}
+
+template <int Dim>
+typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh(
+    const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles, mechanics::ShapeKind shape,
+    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options, NodalThermalSystem& sys,
+    double max_shift, const mechanics::StencilView<Dim>& stencils) {
+  return mechanics::dispatch_shape(shape, [&](auto kernel) {
+    return refresh_with<decltype(kernel)>(grid, particles, materials, options, sys, max_shift, stencils);
+  });
 }
 
 template <int Dim>
@@ -186,7 +310,7 @@ double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, cons
     gershgorin = std::max(gershgorin, row_bound_[u] / sys.mass[static_cast<Eigen::Index>(u)]);
     rayleigh = std::max(rayleigh, rayleigh_bound_[u]);
   }
-  return std::min(gershgorin, rayleigh);
+  return std::min(gershgorin, rayleigh * rayleigh_scale_);  // stale M in refreshed terms: rayleigh_scale_
 }
 
 template <int Dim>
@@ -209,9 +333,10 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
     force_.setZero();
     for (const KeptFlux& c : kept_flux_) {
       if (c.conductance == 0.0) continue;
-      mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();  // (∇T)_p = Σ_j G'_jp T_j (eq. 37)
-      for (int a = 0; a < c.count; ++a) grad += c.G[a] * T[c.unknown[a]];
-      grad *= c.conductance;
+      // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
+      const mechanics::Vec<Dim> grad =
+          c.conductance * interleaved_sum(c.count, mechanics::Vec<Dim>(mechanics::Vec<Dim>::Zero()),
+                                          [&](int a) { return mechanics::Vec<Dim>(c.G[a] * T[c.unknown[a]]); });
       for (int a = 0; a < c.count; ++a) force_[c.unknown[a]] -= c.G[a].dot(grad);  // f_i = −V k G'·∇T
     }
     for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
@@ -230,10 +355,11 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
   for (std::size_t k = 0; k < p.size(); ++k) {
     const KeptMass& c = kept_mass_[k];
     if (c.count == 0) continue;
-    double dT = 0.0, pic = 0.0, s = 0.0;
-    for (int a = 0; a < c.count; ++a) {
-      dT += c.S[a] * delta[c.unknown[a]];  // design §4: the increment, not the nodal value
-      if (relax) {
+    // design §4: the increment, not the nodal value
+    const double dT = interleaved_sum(c.count, 0.0, [&](int a) { return c.S[a] * delta[c.unknown[a]]; });
+    double pic = 0.0, s = 0.0;
+    if (relax) {
+      for (int a = 0; a < c.count; ++a) {
         pic += c.S[a] * (*end)[c.unknown[a]];
         s += c.S[a];
       }

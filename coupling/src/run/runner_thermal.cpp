@@ -177,6 +177,7 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"thermal_matrix_free_windows", static_cast<std::int64_t>(b.matrix_free_windows)},
       {"thermal_matrix_free_substeps", static_cast<std::int64_t>(b.matrix_free_substeps)},
       {"thermal_matrix_free_gathers", static_cast<std::int64_t>(b.matrix_free_gathers)},
+      {"thermal_matrix_free_refreshes", static_cast<std::int64_t>(b.matrix_free_refreshes)},
       {"thermal_continuation_intervals", static_cast<std::int64_t>(b.continuation_intervals)},
       {"hotspots_seen", static_cast<std::int64_t>(coupler_.hotspots().ids_issued())},
   };

@@ -115,6 +115,7 @@ struct EnergyBooks {
   long matrix_free_windows = 0;        // windows integrated matrix-free (explicit_conduction.hpp)
   long matrix_free_substeps = 0;       // their forward-Euler sub-steps
   long matrix_free_gathers = 0;        // particle passes that built M and G' for them (the rest reused)
+  long matrix_free_refreshes = 0;      // windows that gathered again only the particles that moved
 };
 
 template <int Dim>

@@ -52,9 +52,25 @@ class ExplicitConduction {
               const AssemblyOptions& options, NodalThermalSystem& sys,
               const mechanics::StencilView<Dim>& stencils = {});
 
-  /// True if a gather was made for these particles (same count) and none has moved more than
-  /// `max_shift` (m, along any axis) since: the kept stencils, M and G' may then serve another window.
-  bool reusable(const mechanics::Particles<Dim>& particles, double max_shift) const;
+  /// What refresh() did.
+  enum class Refresh {
+    kept,       // no particle moved more than max_shift: the last gather serves this window as it is
+    refreshed,  // the moved particles were gathered again at their positions, the others kept
+    regather,   // a full gather() is needed (none made yet, particles added, too many moved, or the
+                // unknowns would change); the kept state is then unusable until gather()
+  };
+  /// Reuse of the last gather (coupling.reuse_distance): a particle whose position differs from the
+  /// one it was last gathered at by more than `max_shift` (m, along any axis) is gathered again —
+  /// its old weights taken out of M_i and of the bounds, its stencil at its current position put in
+  /// (from `stencils` when given, same numbers) — while the others keep theirs, so no particle's
+  /// weights lag its position by more than max_shift and a window costs a pass over the particles
+  /// that moved. M_i stays Σ_p m_p C_v,p S_ip over the kept weights to round-off, so the energy
+  /// books stay exact. A full gather is asked for when more than a quarter of the heat-holding
+  /// particles moved (cheaper) or when a node would become or stop being an unknown.
+  Refresh refresh(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
+                  mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
+                  const AssemblyOptions& options, NodalThermalSystem& sys, double max_shift,
+                  const mechanics::StencilView<Dim>& stencils = {});
 
   /// With the stencils and M of the last gather (reusable() true): T_i from the current particle
   /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums are
@@ -101,9 +117,19 @@ class ExplicitConduction {
   struct KeptFlux {
     int count = 0;
     double conductance = 0.0;  // V_p k_p (W m/K): times G'·G' gives W/K
+    double rayleigh = 0.0;     // V_p k_p Σ_a |G'_ap|²/M_a as added to rayleigh_bound_ (M of that time)
     int unknown[capacity];
     mechanics::Vec<Dim> G[capacity];
   };
+  /// The particle's kept lists from its stencil nodes and the unknowns of `sys`, its bounds added.
+  void keep(std::size_t k, const Nodes& nodes, const ThermalProperties& material, double volume,
+            const NodalThermalSystem& sys);
+  /// Its bound contributions taken out again (a refresh), as keep() added them.
+  void remove_bounds(const KeptFlux& f);
+  template <class Kernel>
+  Refresh refresh_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
+                       const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
+                       NodalThermalSystem& sys, double max_shift, const mechanics::StencilView<Dim>& stencils);
   template <class Kernel>
   void gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
@@ -119,6 +145,12 @@ class ExplicitConduction {
   bool next_mct_valid_ = false;
   std::vector<double> row_bound_;         // Σ_j |K_ij| bound by unknown (W/K)
   std::vector<double> rayleigh_bound_;    // Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a by unknown (1/s)
+  // Refreshes: each particle's terms of rayleigh_bound_ used M of their time; M_peak_a / M_a bounds
+  // how much they can have grown since (1 after a gather).
+  Eigen::VectorXd mass_peak_;              // largest M_a since the gather, by unknown
+  double rayleigh_scale_ = 1.0;            // max_a M_peak_a / M_a
+  std::vector<std::size_t> moved_;         // refresh scratch: particles to gather again
+  std::vector<Nodes> moved_nodes_;         // refresh scratch: their stencils now, in moved_ order
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
 };
 
