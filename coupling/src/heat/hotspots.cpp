@@ -49,42 +49,63 @@ void HotSpotTracker::update(const mechanics::Particles<Dim>& p, const std::vecto
                             double time) {
   if (Dim != dim_) throw std::logic_error("HotSpotTracker: particles of another dimension");
   if (reference_.size() != p.size()) set_reference(p);
-  std::vector<Candidate> hot;
-  max_temperature_ = -std::numeric_limits<double>::infinity();
+  double max_temperature = 0.0;
+  std::vector<HotCandidate> hot = candidates(p, materials, max_temperature);
+  update_from(std::move(hot), max_temperature, p.size(), time);
+}
+
+template <int Dim>
+std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<Dim>& p,
+                                                     const std::vector<ThermalProperties>& materials,
+                                                     double& max_temperature,
+                                                     const std::vector<std::int64_t>* ids,
+                                                     const std::vector<double>* reference) const {
+  if (Dim != dim_) throw std::logic_error("HotSpotTracker: particles of another dimension");
+  if ((ids && ids->size() != p.size()) || (reference && reference->size() != p.size()))
+    throw std::invalid_argument("HotSpotTracker: one id and one reference temperature per particle");
+  const std::vector<double>& T0_p = reference ? *reference : reference_;
+  std::vector<HotCandidate> hot;
+  max_temperature = -std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < p.size(); ++k) {
     const auto id = static_cast<std::size_t>(p.material[k]);
     if (id >= materials.size() || !materials[id].conducts) continue;
     const double T = p.temperature[k];
-    max_temperature_ = std::max(max_temperature_, T);
-    const double level = opt_.mode == HotSpotOptions::Mode::absolute ? T : T - reference_[k];
+    max_temperature = std::max(max_temperature, T);
+    const double T0 = k < T0_p.size() ? T0_p[k] : 0.0;
+    const double level = opt_.mode == HotSpotOptions::Mode::absolute ? T : T - T0;
     if (!(level > opt_.threshold)) continue;
-    Candidate c{};
-    c.index = k;
+    HotCandidate c{};
+    c.index = ids ? static_cast<std::size_t>((*ids)[k]) : k;
     for (int d = 0; d < Dim; ++d) c.x[static_cast<std::size_t>(d)] = p.position[k][d];
     c.spacing = 2.0 * p.half_size[k].maxCoeff();
     c.temperature = T;
     c.volume = p.volume[k];
-    c.excess = p.mass[k] * materials[id].heat_capacity * (T - reference_[k]);
+    c.excess = p.mass[k] * materials[id].heat_capacity * (T - T0);
     c.material = p.material[k];
     hot.push_back(c);
   }
-  if (!std::isfinite(max_temperature_)) max_temperature_ = 0.0;
-  if (owner_.size() != p.size()) owner_.assign(p.size(), -1);
+  return hot;
+}
+
+void HotSpotTracker::update_from(std::vector<HotCandidate> hot, double max_temperature, std::size_t particle_count,
+                                 double time) {
+  max_temperature_ = std::isfinite(max_temperature) ? max_temperature : 0.0;
+  if (owner_.size() != particle_count) owner_.assign(particle_count, -1);
   cluster_and_match(hot, time);
 }
 
-void HotSpotTracker::cluster_and_match(std::vector<Candidate>& hot, double time) {
+void HotSpotTracker::cluster_and_match(std::vector<HotCandidate>& hot, double time) {
   last_time_ = time;
   const std::size_t n = hot.size();
   UnionFind uf(n);
   if (n > 1) {
     // Cell list with cells of the largest link distance: linked pairs are in neighbouring cells.
     double cell = 0.0;
-    for (const Candidate& c : hot) cell = std::max(cell, opt_.link_factor * c.spacing);
+    for (const HotCandidate& c : hot) cell = std::max(cell, opt_.link_factor * c.spacing);
     std::array<double, 3> lo{};
     for (int d = 0; d < dim_; ++d) {
       lo[static_cast<std::size_t>(d)] = hot[0].x[static_cast<std::size_t>(d)];
-      for (const Candidate& c : hot) lo[static_cast<std::size_t>(d)] = std::min(lo[static_cast<std::size_t>(d)], c.x[static_cast<std::size_t>(d)]);
+      for (const HotCandidate& c : hot) lo[static_cast<std::size_t>(d)] = std::min(lo[static_cast<std::size_t>(d)], c.x[static_cast<std::size_t>(d)]);
     }
     std::vector<std::array<std::int64_t, 3>> coord(n);
     std::array<std::int64_t, 3> extent{1, 1, 1};
@@ -135,7 +156,7 @@ void HotSpotTracker::cluster_and_match(std::vector<Candidate>& hot, double time)
     std::array<double, 3> xv{};
     h.peak_temperature = -std::numeric_limits<double>::infinity();
     for (std::size_t m : members) {
-      const Candidate& c = hot[m];
+      const HotCandidate& c = hot[m];
       h.particles.push_back(c.index);
       h.peak_temperature = std::max(h.peak_temperature, c.temperature);
       vol += c.volume;
@@ -251,6 +272,14 @@ const HotSpot* HotSpotTracker::hottest() const {
 
 template void HotSpotTracker::set_reference<2>(const mechanics::Particles<2>&);
 template void HotSpotTracker::set_reference<3>(const mechanics::Particles<3>&);
+template std::vector<HotCandidate> HotSpotTracker::candidates<2>(const mechanics::Particles<2>&,
+                                                                  const std::vector<ThermalProperties>&, double&,
+                                                                  const std::vector<std::int64_t>*,
+                                                                  const std::vector<double>*) const;
+template std::vector<HotCandidate> HotSpotTracker::candidates<3>(const mechanics::Particles<3>&,
+                                                                  const std::vector<ThermalProperties>&, double&,
+                                                                  const std::vector<std::int64_t>*,
+                                                                  const std::vector<double>*) const;
 template void HotSpotTracker::update<2>(const mechanics::Particles<2>&, const std::vector<ThermalProperties>&, double);
 template void HotSpotTracker::update<3>(const mechanics::Particles<3>&, const std::vector<ThermalProperties>&, double);
 

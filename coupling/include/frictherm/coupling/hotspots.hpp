@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <type_traits>
 #include <vector>
 
@@ -44,6 +45,15 @@ struct HotSpot {
   std::vector<std::size_t> particles;  // particle indices, ascending
 };
 
+/// One hot particle as the clustering sees it. `index` names the particle: its index in the run's
+/// particles, or its global id in a decomposed run (distributed.hpp).
+struct HotCandidate {
+  std::size_t index;
+  std::array<double, 3> x;
+  double spacing, temperature, volume, excess;
+  int material;
+};
+
 class HotSpotTracker {
  public:
   explicit HotSpotTracker(int dim = 2, HotSpotOptions options = {}, double thickness = 1.0);
@@ -51,10 +61,23 @@ class HotSpotTracker {
   /// Records T0_p (the reference of mode rise and of excess_energy).
   template <int Dim>
   void set_reference(const mechanics::Particles<Dim>& particles);
-  /// Finds the hot spots of the current state at `time` and matches them with the previous ones.
+  /// Finds the hot spots of the current state at `time` and matches them with the previous ones
+  /// (candidates() then update_from()).
   template <int Dim>
   void update(const mechanics::Particles<Dim>& particles, const std::vector<ThermalProperties>& materials,
               double time);
+  /// The hot particles of the current state, with `index` = ids[k] when ids are given (else k), and
+  /// the highest temperature of the conducting particles (−∞ without any). T0_p from `reference`
+  /// when given (a decomposed run carries it with the particles), else set_reference's.
+  template <int Dim>
+  std::vector<HotCandidate> candidates(const mechanics::Particles<Dim>& particles,
+                                       const std::vector<ThermalProperties>& materials, double& max_temperature,
+                                       const std::vector<std::int64_t>* ids = nullptr,
+                                       const std::vector<double>* reference = nullptr) const;
+  /// Clusters and matches candidates gathered from anywhere (every rank of a decomposed run: the same
+  /// list in the same order on every rank gives the same hot spots and ids everywhere). Particle
+  /// indices are below `particle_count`.
+  void update_from(std::vector<HotCandidate> hot, double max_temperature, std::size_t particle_count, double time);
 
   const HotSpotOptions& options() const { return opt_; }
   /// Forgets the hot spots (keeping T0_p) and finds them again at `time` under the current options,
@@ -120,13 +143,7 @@ class HotSpotTracker {
   void unflatten(const std::vector<double>& scalars, const std::vector<long>& particles,
                  const std::vector<long>& particle_end, const std::vector<long>& materials,
                  const std::vector<long>& material_end);
-  struct Candidate {
-    std::size_t index;
-    std::array<double, 3> x;
-    double spacing, temperature, volume, excess;
-    int material;
-  };
-  void cluster_and_match(std::vector<Candidate>& hot, double time);
+  void cluster_and_match(std::vector<HotCandidate>& hot, double time);
 
   int dim_;
   HotSpotOptions opt_;

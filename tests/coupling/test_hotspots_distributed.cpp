@@ -1,0 +1,119 @@
+// Hot spots across rank boundaries (frictherm/coupling/distributed.hpp), under mpirun with 2 and 4
+// ranks. A 40 × 10 lattice of particles numbered column by column is split into slabs of columns, one
+// per rank; a hot disc centred on a slab boundary and a second one inside the first slab. Checks: the
+// straddling disc is one hot spot holding particles of two ranks; every rank holds the same hot spots
+// as a serial tracker given all particles (ids, members, peak, mean, size, centroid, excess energy:
+// exactly, since the gathered candidates come in the serial order), also after a second update in
+// which the discs grow and one more appears (tracking by overlap); the maximum temperature is the
+// global one.
+#include <frictherm/coupling/distributed.hpp>
+
+#include "../mpi_ranks.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+namespace fc = frictherm::coupling;
+namespace fm = frictherm::mechanics;
+using frictherm::test::comm_rank;
+using frictherm::test::comm_size;
+
+namespace {
+
+constexpr int kColumns = 40, kRows = 10;
+constexpr double kSpacing = 1e-3, kT0 = 300.0;
+
+// Column i (0 … 39) of rank r's slab: [r·40/P, (r+1)·40/P).
+int first_column(int rank, int ranks) { return rank * kColumns / ranks; }
+
+// The temperature field at a given update: discs of 60 K above T0, centred on the boundary of the
+// first two slabs and inside the first slab; at update 1 both grow by half a spacing and a third disc
+// appears at the right end.
+double temperature(const fm::Vec<2>& x, int update, int ranks) {
+  const double boundary = first_column(1, ranks) * kSpacing;
+  const double grow = 0.5 * kSpacing * update;
+  auto in_disc = [&](double cx, double cy, double r) { return std::hypot(x[0] - cx, x[1] - cy) < r; };
+  bool hot = in_disc(boundary, 5e-3, 2.6e-3 + grow) || in_disc(2.5e-3, 2.5e-3, 1.6e-3 + grow);
+  if (update == 1) hot = hot || in_disc(38.5e-3, 8e-3, 1.2e-3);
+  return kT0 + (hot ? 60.0 + 0.1 * x[0] / kSpacing : 0.0);  // a gradient so that peaks differ
+}
+
+// Particles of columns [c0, c1) in id order (id = column · rows + row).
+void lattice(int c0, int c1, int update, int ranks, fm::Particles<2>& p, std::vector<std::int64_t>& ids) {
+  p = fm::Particles<2>{};
+  ids.clear();
+  for (int i = c0; i < c1; ++i)
+    for (int j = 0; j < kRows; ++j) {
+      const fm::Vec<2> x((i + 0.5) * kSpacing, (j + 0.5) * kSpacing);
+      p.add(x, fm::Vec<2>::Constant(0.5 * kSpacing), 1e-3, kSpacing * kSpacing, 0, 0, temperature(x, update, ranks));
+      ids.push_back(static_cast<std::int64_t>(i) * kRows + j);
+    }
+}
+
+void expect_same(const std::vector<fc::HotSpot>& a, const std::vector<fc::HotSpot>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t s = 0; s < a.size(); ++s) {
+    EXPECT_EQ(a[s].id, b[s].id);
+    EXPECT_EQ(a[s].particles, b[s].particles);
+    EXPECT_EQ(a[s].peak_temperature, b[s].peak_temperature);
+    EXPECT_EQ(a[s].mean_temperature, b[s].mean_temperature);
+    EXPECT_EQ(a[s].size, b[s].size);
+    EXPECT_EQ(a[s].centroid, b[s].centroid);
+    EXPECT_EQ(a[s].excess_energy, b[s].excess_energy);
+    EXPECT_EQ(a[s].birth_time, b[s].birth_time);
+  }
+}
+
+}  // namespace
+
+TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
+  const int rank = comm_rank(), ranks = comm_size();
+  ASSERT_GE(ranks, 2);
+  const std::vector<fc::ThermalProperties> materials = {{true, 1000.0, 0.5}};
+  fc::HotSpotOptions opt;
+  opt.threshold = 20.0;
+  fc::HotSpotTracker serial(2, opt), decomposed(2, opt);
+  const std::size_t total = static_cast<std::size_t>(kColumns) * kRows;
+  for (int update = 0; update < 2; ++update) {
+    SCOPED_TRACE(update);
+    const double time = 1e-6 * update;
+    fm::Particles<2> all, mine;
+    std::vector<std::int64_t> all_ids, my_ids;
+    lattice(0, kColumns, update, ranks, all, all_ids);
+    lattice(first_column(rank, ranks), first_column(rank + 1, ranks), update, ranks, mine, my_ids);
+    const std::vector<double> reference(mine.size(), kT0), all_reference(all.size(), kT0);
+    double max_serial = 0.0;
+    serial.update_from(serial.candidates(all, materials, max_serial, &all_ids, &all_reference), max_serial, total, time);
+    fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, materials, total, time);
+
+    const auto& spots = decomposed.hot_spots();
+    ASSERT_EQ(spots.size(), update == 0 ? 2u : 3u);
+    expect_same(spots, serial.hot_spots());
+    EXPECT_EQ(decomposed.max_temperature(), max_serial);
+    // The disc on the boundary of slabs 0 and 1 holds particles of both.
+    const std::int64_t boundary_id = static_cast<std::int64_t>(first_column(1, ranks)) * kRows;
+    int straddling = 0;
+    for (const fc::HotSpot& h : spots) {
+      bool left = false, right = false;
+      for (std::size_t id : h.particles) (static_cast<std::int64_t>(id) < boundary_id ? left : right) = true;
+      if (left && right) ++straddling;
+    }
+    EXPECT_EQ(straddling, 1);
+    if (rank == 0) {
+      std::cout << "[hot spots across " << ranks << " ranks] update " << update << ": " << spots.size()
+                << " hot spots, sizes";
+      for (const fc::HotSpot& h : spots) std::cout << ' ' << h.particle_count << " (id " << h.id << ")";
+      std::cout << '\n';
+    }
+  }
+}
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  const int rc = RUN_ALL_TESTS();
+  MPI_Finalize();
+  return rc;
+}
