@@ -12,6 +12,11 @@
 namespace frictherm::coupling {
 namespace {
 
+// Relative spread of a particle's nodal temperatures below which they are taken as equal in the
+// sub-steps: 256 ε, the order of the re-projection's own round-off (T_i = Σ m C T S / Σ m C S over
+// ~10–30 terms). At 300 K it is 1.7e-11 K.
+constexpr double kQuietSpread = 256.0 * 2.220446049250313e-16;
+
 // A stencil's grid nodes, S_ip and G_ip, in stencil order.
 template <class NodeList, class Stencil, class Grid>
 void copy_nodes(const Grid& grid, const Stencil& st, NodeList& nl) {
@@ -61,6 +66,10 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   kept_flux_.resize(p.size());
   next_mct_valid_ = false;
   gathered_at_.assign(p.position.begin(), p.position.end());
+  unknown_lo_.assign(p.size(), 1);  // empty ranges until keep()
+  unknown_hi_.assign(p.size(), 0);
+  quiet_.assign(p.size(), 0);
+  flux_temperature_.resize(0);  // new unknowns: every particle is looked at in the next sub-step
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
 
@@ -103,6 +112,10 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Unknowns: the same rule as assemble_thermal.
   sys.select_unknowns(mct_, opt.active_mass_fraction);
   const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
+  // The eq. 38 sums the windows re-project from, kept up to date with the particles' temperatures
+  // by map_back and refresh from here on.
+  next_mct_.resize(n);
+  for (Eigen::Index u = 0; u < n; ++u) next_mct_[u] = mct_[static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)])];
 
   // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
   row_bound_.assign(static_cast<std::size_t>(n), 0.0);
@@ -115,6 +128,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     if (step_stencils) copy_nodes(grid, step_stencils[k], from_step);
     keep(k, step_stencils ? from_step : nodes_[k], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
   }
+  next_mct_valid_ = true;
 }
 
 template <int Dim>
@@ -141,6 +155,10 @@ void ExplicitConduction<Dim>::keep(std::size_t k, const Nodes& nl, const Thermal
       g_dropped += nl.G[a];
     }
   }
+  // The range of its unknowns (the per-window passes skip it while no node in the range changed).
+  unknown_lo_[k] = c.count > 0 ? *std::min_element(c.unknown, c.unknown + c.count) : 1;
+  unknown_hi_[k] = c.count > 0 ? *std::max_element(c.unknown, c.unknown + c.count) : 0;
+  quiet_[k] = 0;
   // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
   if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) return;
   if (c.count < nl.count)
@@ -292,7 +310,7 @@ void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, Noda
     }
   }
   for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
-  next_mct_valid_ = false;  // the particles' temperatures change in this window
+  next_mct_valid_ = true;  // map_back keeps the sums with the temperatures it gives the particles
 }
 
 template <int Dim>
@@ -331,8 +349,35 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
   force_.resize(n);
   for (long s = 0; s < substeps; ++s) {
     force_.setZero();
-    for (const KeptFlux& c : kept_flux_) {
-      if (c.conductance == 0.0) continue;
+    // Nodes whose temperature changed since the last sub-step, as a prefix count over the unknowns:
+    // a particle whose nodes all kept theirs and that was quiet then is quiet now, and is passed over
+    // reading 10 bytes instead of its kept list.
+    const bool first = flux_temperature_.size() != n;
+    changed_before_.resize(static_cast<std::size_t>(n) + 1);
+    changed_before_[0] = 0;
+    for (Eigen::Index u = 0; u < n; ++u)
+      changed_before_[static_cast<std::size_t>(u) + 1] =
+          changed_before_[static_cast<std::size_t>(u)] + (first || T[u] != flux_temperature_[u] ? 1 : 0);
+    flux_temperature_ = T;
+    for (std::size_t k = 0; k < kept_flux_.size(); ++k) {
+      if (quiet_[k] && changed_before_[static_cast<std::size_t>(unknown_hi_[k]) + 1] ==
+                           changed_before_[static_cast<std::size_t>(unknown_lo_[k])])
+        continue;
+      const KeptFlux& c = kept_flux_[k];
+      if (c.conductance == 0.0) {
+        quiet_[k] = 1;  // carries no flux whatever its nodes do
+        continue;
+      }
+      // Nodal temperatures that agree to round-off (the re-projection's own, kQuietSpread) carry no
+      // flux through the particle: its terms are left out, which keeps Σ_i f_i = 0 exactly and the
+      // nodes it alone touches unchanged (their ΔT_i = 0 lets the map back pass over their particles).
+      double lo = T[c.unknown[0]], hi = lo;
+      for (int a = 1; a < c.count; ++a) {
+        lo = std::min(lo, T[c.unknown[a]]);
+        hi = std::max(hi, T[c.unknown[a]]);
+      }
+      quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+      if (quiet_[k]) continue;
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
       const mechanics::Vec<Dim> grad =
           c.conductance * interleaved_sum(c.count, mechanics::Vec<Dim>(mechanics::Vec<Dim>::Zero()),
@@ -351,8 +396,19 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
   if (kept_mass_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
   const bool relax = end && beta > 0.0;
-  next_mct_.setZero(static_cast<Eigen::Index>(sys.size()));
+  if (!next_mct_valid_ || next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
+    throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
+  // Unknowns whose temperature changed in the window, as a prefix count: a particle with none in the
+  // range of its unknowns keeps its temperature (ΔT_p = 0 exactly) and is passed over.
+  const auto n = static_cast<std::size_t>(sys.size());
+  changed_before_.resize(n + 1);
+  changed_before_[0] = 0;
+  for (std::size_t u = 0; u < n; ++u)
+    changed_before_[u + 1] = changed_before_[u] + (relax || delta[static_cast<Eigen::Index>(u)] != 0.0 ? 1 : 0);
   for (std::size_t k = 0; k < p.size(); ++k) {
+    if (changed_before_[static_cast<std::size_t>(unknown_hi_[k]) + 1] ==
+        changed_before_[static_cast<std::size_t>(unknown_lo_[k])])
+      continue;  // also every particle that holds no heat or reaches no unknown (empty range)
     const KeptMass& c = kept_mass_[k];
     if (c.count == 0) continue;
     // design §4: the increment, not the nodal value
@@ -364,13 +420,15 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
         s += c.S[a];
       }
     }
-    const double flip = p.temperature[k] + dT;
+    const double before = p.temperature[k];
+    const double flip = before + dT;
     const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
-    const double mct = c.heat_capacity * T;  // eq. 38 sums of the next window, if it reuses this gather
-    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
+    // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
+    const double change = c.heat_capacity * (T - before);
+    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
   }
-  next_mct_valid_ = true;
 }
 
 template class ExplicitConduction<2>;

@@ -72,10 +72,11 @@ class ExplicitConduction {
                   const AssemblyOptions& options, NodalThermalSystem& sys, double max_shift,
                   const mechanics::StencilView<Dim>& stencils = {});
 
-  /// With the stencils and M of the last gather (reusable() true): T_i from the current particle
-  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums are
-  /// those the last map_back made with the new T_p (same order, same weights, so the same numbers):
-  /// nothing but the coupler may change particle temperatures between matrix-free windows.
+  /// With the kept stencils and M (refresh() kept or refreshed): T_i from the current particle
+  /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums
+  /// Σ_p m_p C_v,p T_p S_ip are kept up to date by the gather, refresh() and map_back() (which adds
+  /// m_p C_v,p ΔT_p S_ip for the particles it changes): nothing but the coupler may change particle
+  /// temperatures between matrix-free windows.
   void reproject(const mechanics::Particles<Dim>& particles, NodalThermalSystem& sys);
 
   /// Upper bound of the largest eigenvalue of M⁻¹K over the free unknowns of the gathered system
@@ -84,14 +85,17 @@ class ExplicitConduction {
 
   /// n forward-Euler sub-steps over `window` seconds from `temperature` (on the unknowns of the
   /// gathered system), with the constant source q = joules / window (W). Fixed nodes take their
-  /// temperature first and keep it. Returns the temperatures at the end.
+  /// temperature first and keep it. Returns the temperatures at the end. A particle whose nodal
+  /// temperatures agree to round-off (relative spread ≤ 256 ε) carries no flux; it is looked at again
+  /// only when one of its nodes changes.
   Eigen::VectorXd advance(const NodalThermalSystem& sys, const Eigen::VectorXd& temperature,
                           const Eigen::VectorXd& joules, const std::vector<FixedNode>& fixed, double window,
                           long substeps);
 
   /// T_p += Σ_i S_ip ΔT_i with the stencils of the gather (same positions), and the optional sub-grid
-  /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures). Also sums
-  /// Σ_p m_p C_v,p T_p S_ip with the new T_p for the next reproject().
+  /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures). Also adds
+  /// m_p C_v,p ΔT_p S_ip to the sums of the next reproject(). Particles with no unknown of ΔT_i ≠ 0
+  /// in the range of their unknowns keep their temperature exactly and are passed over.
   void map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
                 double relaxation, const Eigen::VectorXd* end);
 
@@ -152,6 +156,14 @@ class ExplicitConduction {
   std::vector<std::size_t> moved_;         // refresh scratch: particles to gather again
   std::vector<Nodes> moved_nodes_;         // refresh scratch: their stencils now, in moved_ order
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
+  // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
+  // streaming every particle's kept lists): per particle the range of its unknowns and whether its
+  // nodal temperatures agreed to round-off when last looked at; per unknown the temperature of the
+  // last sub-step, and a prefix count of the nodes that changed.
+  std::vector<int> unknown_lo_, unknown_hi_;  // by particle; lo > hi: no unknown
+  std::vector<unsigned char> quiet_;          // by particle
+  Eigen::VectorXd flux_temperature_;          // T_i of the last sub-step (empty: look at every particle)
+  std::vector<int> changed_before_;           // scratch: changed unknowns with index < u
 };
 
 extern template class ExplicitConduction<2>;
