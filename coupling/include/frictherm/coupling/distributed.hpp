@@ -1,5 +1,6 @@
 #pragma once
-// The coupling layer of a decomposed run (issue 16): what needs every rank's particles at once.
+// The coupling layer of a decomposed run (issue 16): what needs every rank's particles at once —
+// hot spots across rank boundaries and the output.
 // Library target frictherm::coupling_mpi (coupling/src/distributed/), built when MPI is found; its
 // header needs MPI only.
 //
@@ -13,6 +14,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -29,5 +31,46 @@ void update_hot_spots_across_ranks(MPI_Comm comm, HotSpotTracker& tracker, const
                                    const std::vector<double>& reference_temperature,
                                    const std::vector<ThermalProperties>& materials,
                                    std::size_t global_particle_count, double time);
+
+/// One rank's particles for a snapshot of a decomposed run (n particles).
+struct DecomposedSnapshot {
+  std::vector<std::int64_t> id;     // global ids
+  std::vector<double> position;     // n × dim, m
+  std::vector<double> velocity;     // n × dim, m/s
+  std::vector<double> temperature;  // n, K (empty: not written)
+  std::vector<int> material;        // n
+};
+
+/// Particle snapshots of a decomposed run (issue 16 item 3): one HDF5 file per rank,
+/// BASE.rank<r>.h5, written by that rank alone with the serial HDF5 library, and one XDMF file,
+/// BASE.xdmf, written by rank 0, that joins them: per snapshot a spatial collection of the ranks'
+/// grids inside one temporal collection, which ParaView (Xdmf3ReaderS) opens as one data set per
+/// time. Vectors are written with 3 components in 2D too (ParaView's vector filters need 3). The
+/// XDMF is rewritten atomically after each snapshot and each rank file flushed, so a run stopped at
+/// any point leaves readable files of what it wrote. Every call is collective; a failure on one rank
+/// (e.g. a file that exists without `overwrite`) makes every rank throw.
+class DecomposedOutput {
+ public:
+  DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite);
+  ~DecomposedOutput();
+  DecomposedOutput(const DecomposedOutput&) = delete;
+  DecomposedOutput& operator=(const DecomposedOutput&) = delete;
+
+  void write(long step, double time, const DecomposedSnapshot& particles);
+  /// Closes the rank files (also done by the destructor).
+  void close();
+
+  const std::string& xdmf_path() const { return xdmf_path_; }
+  std::string rank_file(int rank) const;
+  static std::string rank_file(const std::string& base, int rank);
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1, dim_ = 2;
+  std::string base_, xdmf_path_;
+  long long file_ = -1;              // hid_t of this rank's file
+  std::vector<std::string> grids_;  // rank 0: the XDMF text of every snapshot so far
+  long snapshots_ = 0;
+};
 
 }  // namespace frictherm::coupling

@@ -1,0 +1,199 @@
+// Particle snapshots of a decomposed run (frictherm/coupling/distributed.hpp): one HDF5 file per rank
+// and one XDMF file joining them (a temporal collection of spatial collections of the ranks' grids).
+#include <frictherm/coupling/distributed.hpp>
+#include <frictherm/coupling/xdmf.hpp>
+
+#include "output/h5_util.hpp"
+
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+
+namespace h5 = h5detail;
+
+namespace {
+
+// Every rank learns whether any rank failed, and why (the first failing rank's message), so no rank
+// is left waiting in the next collective call.
+void agree(MPI_Comm comm, const std::string& local_error) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const int mine = local_error.empty() ? size : rank;
+  int first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return;
+  int length = rank == first ? static_cast<int>(local_error.size()) : 0;
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  std::string text = rank == first ? local_error : std::string(static_cast<std::size_t>(length), ' ');
+  MPI_Bcast(text.data(), length, MPI_CHAR, first, comm);
+  throw std::runtime_error("decomposed output (rank " + std::to_string(first) + "): " + text);
+}
+
+std::string base_name(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+void write_dataset(hid_t group, const std::string& file, const std::string& name, hid_t type, const void* data,
+                   hsize_t rows, hsize_t columns) {
+  const std::array<hsize_t, 2> dims{rows, columns};
+  const h5::Handle space{h5::check_id(H5Screate_simple(columns > 1 ? 2 : 1, dims.data(), nullptr), file,
+                                      "cannot create a dataspace"),
+                         H5Sclose};
+  const h5::Handle d{h5::check_id(H5Dcreate2(group, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT,
+                                             H5P_DEFAULT),
+                                  file, "cannot create dataset " + name),
+                     H5Dclose};
+  if (rows > 0) h5::check(H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, "cannot write " + name);
+}
+
+// n × dim values padded to n × 3 (ParaView's vectors).
+std::vector<double> padded(const std::vector<double>& v, std::size_t n, int dim) {
+  std::vector<double> out(3 * n, 0.0);
+  for (std::size_t k = 0; k < n; ++k)
+    for (int d = 0; d < dim; ++d) out[3 * k + static_cast<std::size_t>(d)] = v[static_cast<std::size_t>(dim) * k + static_cast<std::size_t>(d)];
+  return out;
+}
+
+}  // namespace
+
+std::string DecomposedOutput::rank_file(const std::string& base, int rank) {
+  return base + ".rank" + std::to_string(rank) + ".h5";
+}
+
+std::string DecomposedOutput::rank_file(int rank) const { return rank_file(base_, rank); }
+
+DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite)
+    : comm_(comm), dim_(dim), base_(std::move(base)), xdmf_path_(base_ + ".xdmf") {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+  std::string error;
+  if (dim != 2 && dim != 3) error = "dimension " + std::to_string(dim) + " (expected 2 or 3)";
+  const std::string file = rank_file(rank_);
+  if (error.empty() && !overwrite && ::access(file.c_str(), F_OK) == 0)
+    error = "'" + file + "' exists (pass --force to overwrite it)";
+  if (error.empty() && rank_ == 0 && !overwrite && ::access(xdmf_path_.c_str(), F_OK) == 0)
+    error = "'" + xdmf_path_ + "' exists (pass --force to overwrite it)";
+  if (error.empty()) {
+    try {
+      const h5::Quiet quiet;
+      file_ = h5::check_id(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), file,
+                           "cannot create the file");
+      const h5::Handle g{h5::check_id(H5Gcreate2(file_, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
+                                      "cannot create /snapshots"),
+                         H5Gclose};
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  try {
+    agree(comm_, error);
+  } catch (...) {
+    close();
+    throw;
+  }
+}
+
+DecomposedOutput::~DecomposedOutput() { close(); }
+
+void DecomposedOutput::close() {
+  if (file_ >= 0) H5Fclose(file_);
+  file_ = -1;
+}
+
+void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s) {
+  const std::size_t n = s.id.size();
+  const auto dim = static_cast<std::size_t>(dim_);
+  // Temperatures from every rank that has particles, or from none (the XDMF names the same fields
+  // in every rank's grid).
+  int temperature = s.temperature.empty() ? 0 : 1, any_temperature = 0;
+  MPI_Allreduce(&temperature, &any_temperature, 1, MPI_INT, MPI_MAX, comm_);
+  std::string error;
+  if (file_ < 0) error = "the output is closed";
+  else if (any_temperature && n > 0 && s.temperature.empty())
+    error = "temperatures given on some ranks but not on this one";
+  else if (s.position.size() != dim * n || s.velocity.size() != dim * n || s.material.size() != n ||
+           (!s.temperature.empty() && s.temperature.size() != n))
+    error = "snapshot arrays of different lengths (" + std::to_string(n) + " ids)";
+  const std::string index = [&] {
+    char b[16];
+    std::snprintf(b, sizeof b, "%06ld", snapshots_);
+    return std::string(b);
+  }();
+  const std::string file = rank_file(rank_);
+  if (error.empty()) {
+    try {
+      const h5::Quiet quiet;
+      const std::string path = "/snapshots/" + index;
+      const h5::Handle g{h5::check_id(H5Gcreate2(file_, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
+                                      "cannot create " + path),
+                         H5Gclose};
+      std::vector<int> connectivity(n);
+      for (std::size_t k = 0; k < n; ++k) connectivity[k] = static_cast<int>(k);
+      write_dataset(g.get(), file, "connectivity", H5T_NATIVE_INT, connectivity.data(), n, 1);
+      write_dataset(g.get(), file, "id", H5T_NATIVE_INT64, s.id.data(), n, 1);
+      write_dataset(g.get(), file, "position", H5T_NATIVE_DOUBLE, s.position.data(), n, dim);
+      const std::vector<double> v = padded(s.velocity, n, dim_);
+      write_dataset(g.get(), file, "velocity", H5T_NATIVE_DOUBLE, v.data(), n, 3);
+      if (!s.temperature.empty()) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
+      write_dataset(g.get(), file, "material", H5T_NATIVE_INT, s.material.data(), n, 1);
+      h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  agree(comm_, error);
+
+  // Rank 0 joins the ranks' grids (ranks without particles have none) and rewrites the XDMF file.
+  const unsigned long long mine = n;
+  std::vector<unsigned long long> counts(static_cast<std::size_t>(size_));
+  MPI_Gather(&mine, 1, MPI_UNSIGNED_LONG_LONG, counts.data(), 1, MPI_UNSIGNED_LONG_LONG, 0, comm_);
+  error.clear();
+  if (rank_ == 0) {
+    try {
+      std::string xml = "    <Grid Name=\"" + index + "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+      char time_text[32];
+      std::snprintf(time_text, sizeof time_text, "%.17g", time);
+      xml += "      <Time Value=\"" + std::string(time_text) + "\"/>\n";
+      for (int r = 0; r < size_; ++r) {
+        if (counts[static_cast<std::size_t>(r)] == 0) continue;
+        XdmfGrid grid;
+        grid.name = "rank" + std::to_string(r);
+        grid.h5_group = "/snapshots/" + index;
+        grid.connectivity = grid.h5_group + "/connectivity";
+        grid.step = step;
+        grid.time = time;
+        grid.points = static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+        grid.fields = {{"position", dim_, false}, {"velocity", 3, false}, {"material", 1, true}};
+        if (any_temperature) grid.fields.push_back({"temperature", 1, false});
+        std::string g = xdmf_grid_xml(grid, base_name(rank_file(r)), dim_);
+        // Indented one level deeper: inside this snapshot's spatial collection.
+        std::string indented;
+        std::size_t at = 0;
+        while (at < g.size()) {
+          const std::size_t end = g.find('\n', at);
+          indented += "  " + g.substr(at, end - at + 1);
+          at = end + 1;
+        }
+        xml += indented;
+      }
+      xml += "    </Grid>\n";
+      grids_.push_back(xml);
+      write_text_atomically(xdmf_path_, xdmf_document(grids_));
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  agree(comm_, error);
+  ++snapshots_;
+}
+
+}  // namespace frictherm::coupling
