@@ -9,6 +9,7 @@
 #include <frictherm/coupling/distributed.hpp>
 
 #include "../mpi_ranks.hpp"
+#include "../mpi_test_main.hpp"
 
 #include <gtest/gtest.h>
 
@@ -110,10 +111,4 @@ TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
   }
 }
 
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int rc = RUN_ALL_TESTS();
-  MPI_Finalize();
-  return rc;
-}
+int main(int argc, char** argv) { return frictherm::test::run_tests_under_mpi(argc, argv); }

@@ -100,10 +100,11 @@ TEST(MatrixFreeConduction, MatchesAssembledForwardEulerToRoundOff) {
   }
 }
 
-// Energy books over many windows with heat on nodes that are not unknowns: Σ_p m C ΔT equals the
-// heat delivered to 1e-9 (round-off of ~1e3 windows), and the work received equals it exactly;
-// with the gather reused (0.05 cells: every 455 windows here) as without.
-fc::Coupler<2> drifting_run(fm::Particles<2>& p, double reuse_distance, long windows) {
+// Windows of `window` seconds on a 12 × 10 grid of 1 mm cells with reuse of the gather: heat(k, grid,
+// w) puts window k's work on the nodes, then the particles from `first_moving` on move `shift` along x.
+template <class Heat>
+fc::Coupler<2> moving_run(fm::Particles<2>& p, double reuse_distance, long windows, double window, Heat&& heat,
+                          std::size_t first_moving, double shift) {
   const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 10});
   fc::CouplerOptions opt = options("auto", 4);
   opt.reuse_distance = reuse_distance;
@@ -112,12 +113,22 @@ fc::Coupler<2> drifting_run(fm::Particles<2>& p, double reuse_distance, long win
   std::vector<double> w(grid.node_count(), 0.0);
   for (long k = 1; k <= windows; ++k) {
     std::fill(w.begin(), w.end(), 0.0);
-    w[static_cast<std::size_t>(grid.node_index({2 + static_cast<int>(k % 6), 3}))] = 1e-3;
-    w[static_cast<std::size_t>(grid.node_index({0, 0}))] = 2e-4;  // relocated
-    cp.after_step(p, w, 0.05 * static_cast<double>(k));
-    for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += 1.1e-7;  // 1.1e-4 cells per window
+    heat(k, grid, w);
+    cp.after_step(p, w, window * static_cast<double>(k));
+    for (std::size_t i = first_moving; i < p.size(); ++i) p.position[i][0] += shift;
   }
   return cp;
+}
+
+// Energy books over many windows with heat on nodes that are not unknowns: Σ_p m C ΔT equals the
+// heat delivered to 1e-9 (round-off of ~1e3 windows), and the work received equals it exactly;
+// with the gather reused (0.05 cells: every 455 windows here) as without.
+fc::Coupler<2> drifting_run(fm::Particles<2>& p, double reuse_distance, long windows) {
+  auto heat = [](long k, const fm::Grid<2>& grid, std::vector<double>& w) {
+    w[static_cast<std::size_t>(grid.node_index({2 + static_cast<int>(k % 6), 3}))] = 1e-3;
+    w[static_cast<std::size_t>(grid.node_index({0, 0}))] = 2e-4;  // relocated
+  };
+  return moving_run(p, reuse_distance, windows, 0.05, heat, 0, 1.1e-7);  // 1.1e-4 cells per window
 }
 
 TEST(MatrixFreeConduction, EnergyBooksCloseOverManyWindows) {
@@ -170,19 +181,11 @@ TEST(MatrixFreeConduction, ReuseErrorIsOfOrderOfTheShift) {
 // allowance is 1e-9 K. The books stay exact (1e-9 of the heat), and the unknowns change as the slider
 // reaches new nodes (full gathers), not every window.
 fc::Coupler<2> slider_run(fm::Particles<2>& p, double reuse_distance, long windows, std::size_t first_slider) {
-  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {12, 10});
-  fc::CouplerOptions opt = options("auto", 4);
-  opt.reuse_distance = reuse_distance;
-  fc::Coupler<2> cp(grid, fm::ShapeKind::ugimp, opt);
-  cp.start(p, 0.0);
-  std::vector<double> w(grid.node_count(), 0.0);
-  for (long k = 1; k <= windows; ++k) {
-    std::fill(w.begin(), w.end(), 0.0);
-    w[static_cast<std::size_t>(grid.node_index({3 + static_cast<int>(k / 80), 5}))] = 1e-3;  // under the slider
-    cp.after_step(p, w, 0.01 * static_cast<double>(k));  // well below the stable step: one sub-step (asserted)
-    for (std::size_t i = first_slider; i < p.size(); ++i) p.position[i][0] += 1.25e-5;
-  }
-  return cp;
+  auto heat = [](long k, const fm::Grid<2>& grid, std::vector<double>& w) {  // under the slider
+    w[static_cast<std::size_t>(grid.node_index({3 + static_cast<int>(k / 80), 5}))] = 1e-3;
+  };
+  // Windows well below the stable step: one sub-step each (asserted).
+  return moving_run(p, reuse_distance, windows, 0.01, heat, first_slider, 1.25e-5);
 }
 
 TEST(MatrixFreeConduction, RefreshingTheMovedParticlesEqualsGatheringEveryWindow) {

@@ -8,6 +8,7 @@
 #include <frictherm/coupling/distributed.hpp>
 
 #include "../mpi_ranks.hpp"
+#include "../mpi_test_main.hpp"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -167,10 +168,4 @@ TEST(DecomposedOutput, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
   if (rank == 0 && !std::getenv("FRICTHERM_TEST_KEEP")) std::system(("rm -rf '" + dir + "'").c_str());
 }
 
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int rc = RUN_ALL_TESTS();
-  MPI_Finalize();
-  return rc;
-}
+int main(int argc, char** argv) { return frictherm::test::run_tests_under_mpi(argc, argv); }
