@@ -10,6 +10,7 @@
 #include <petscdmswarm.h>
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace frictherm::mechanics {
@@ -26,12 +27,17 @@ inline constexpr const char* half_size = "frictherm_half_size";
 inline constexpr const char* stress = "frictherm_stress";
 inline constexpr const char* stress_zz = "frictherm_stress_zz";
 inline constexpr const char* deformation = "frictherm_F";
+inline constexpr const char* material = "frictherm_material";
+inline constexpr const char* initial_position = "frictherm_x0";  // displacement separation (N·9)
 }  // namespace swarm_field
 
-/// Degrees of freedom per node in both grid exchanges: after particle_to_grid (m, p_x, p_y, f_x, f_y),
-/// after grid_update (m, v_x, v_y, a_x, a_y) in the same slots.
+/// Values of one velocity field at a node, in both grid exchanges: after particle_to_grid m, p, f
+/// (and with contact Σ S m x, Ω, g: N·4–6, 9); after nodal_velocities v and a in the slots of p and f.
+/// A node holds `fields` such blocks (one per material with contact), `per_field` values each.
 namespace node_dof {
-inline constexpr int count = 5, mass = 0, momentum = 1, force = 3, velocity = 1, acceleration = 3;
+inline constexpr int mass = 0, momentum = 1, force = 3, velocity = 1, acceleration = 3;
+inline constexpr int mass_position = 5, domain = 7, domain_gradient = 8;
+inline constexpr int without_contact = 5, with_contact = 10;  // values per field
 }
 
 /// Every registered field of the swarm, gotten for the object's lifetime (no migration meanwhile).
@@ -41,7 +47,8 @@ struct SwarmFields {
   double* x = nullptr;  // DMSwarmPIC_coor, 2 per particle
   long* id = nullptr;
   double *mass = nullptr, *volume = nullptr, *volume0 = nullptr, *velocity = nullptr, *half_size = nullptr;
-  double *stress = nullptr, *stress_zz = nullptr, *F = nullptr;
+  double *stress = nullptr, *stress_zz = nullptr, *F = nullptr, *x0 = nullptr;
+  PetscInt* material = nullptr;
 
   explicit SwarmFields(DM swarm);
   ~SwarmFields();
@@ -58,6 +65,8 @@ struct SwarmFields {
     f(swarm_field::stress, stress);
     f(swarm_field::stress_zz, stress_zz);
     f(swarm_field::deformation, F);
+    f(swarm_field::material, material);
+    f(swarm_field::initial_position, x0);
   }
   SwarmFields(const SwarmFields&) = delete;
   SwarmFields& operator=(const SwarmFields&) = delete;
@@ -67,9 +76,13 @@ struct DecomposedMpm2D::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
   int rank = 0, size = 1;
   Grid<2> grid;
-  Material material;
+  std::vector<Material> materials;
   DecomposedOptions opt;
-  int width = 1;  // DMDA stencil width (stencil_reach)
+  int width = 1;                 // DMDA stencil width (stencil_reach)
+  int fields = 1;                // velocity fields per node: 1, or one per material with contact
+  int per_field = node_dof::without_contact;
+  int dof = node_dof::without_contact;  // fields × per_field
+  int field_of(PetscInt material) const { return opt.contact ? static_cast<int>(material) : 0; }
   DM da = nullptr, swarm = nullptr;
   ::Vec local = nullptr, global = nullptr;  // PETSc vectors (mechanics::Vec is the Eigen one)
   PetscInt xs = 0, ys = 0, xm = 0, ym = 0;      // owned nodes
@@ -78,6 +91,15 @@ struct DecomposedMpm2D::Impl {
   std::array<std::vector<PetscInt>, 2> starts;  // first owned node per process column / row, + end
   double empty_node_mass = 0.0;                 // 1e-12 of the largest particle mass (as the serial step)
   DecomposedTraffic traffic;
+  std::vector<std::uint8_t> fixed_mask;  // per owned node (x fastest): bit d set, component d fixed to 0
+  // Contact (contact_phases.cpp): settings per ordered material pair, the owned nodes where two or
+  // more fields have mass (indices into the owned block), frictional work per owned node (last step)
+  // and since the start on this rank, counters of the last step on this rank.
+  std::vector<ContactPairSettings> pair_table;  // materials², [a·n + b]
+  std::vector<PetscInt> contact_nodes;
+  std::vector<double> work_first, work_second;
+  double cumulative_first = 0.0, cumulative_second = 0.0;
+  DecomposedContactStats stats;
   std::vector<Stencil<2, LinearKernel>> stencils_linear;
   std::vector<Stencil<2, UGIMPKernel>> stencils_ugimp;
   std::vector<Stencil<2, QuadraticBSplineKernel>> stencils_quadratic;
@@ -97,12 +119,20 @@ struct DecomposedMpm2D::Impl {
   /// The rank owning the node nearest to x.
   int owner_of(const double* x) const;
 
-  // The phases (usl_phases.cpp) and the migration (decomposition.cpp).
+  void setup_contact();  // contact_phases.cpp: checks and pair_table
+  void setup_fixed_faces();
+
+  // The phases (usl_phases.cpp, contact_phases.cpp) and the migration (decomposition.cpp).
   template <class Kernel>
   void particle_to_grid(double dt);
   void sum_to_owners(double dt);
-  void grid_update(double dt);
+  void find_contact_nodes(double dt);
+  void contact_extrapolated(double dt);
+  void momentum_update(double dt);
+  void contact_updated(double dt);
+  void nodal_velocities(double dt);
   void ghost_velocities(double dt);
+  void resolve_contact(bool updated, double dt);
   template <class Kernel>
   void grid_to_particle(double dt);
   template <class Kernel>
