@@ -98,17 +98,28 @@ double owned_sum(const std::vector<double>& w) {
   return s;
 }
 
+// Per-material entries sent over the star forest, over all ranks and steps (the sparse exchange).
+long field_entries(const fm::DecomposedMpm2D& run) {
+  long e = run.traffic().field_entries_sent;
+  MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  return e;
+}
+
 void print_phases(const char* label, const fm::DecomposedMpm2D& run) {
   const fm::DecomposedTraffic& t = run.traffic();
-  long ghost = t.ghost_nodes, sent = t.particles_sent;
+  long ghost = t.ghost_nodes, sent = t.particles_sent, multi = t.multi_ghost_nodes, entries = t.field_entries_sent;
   MPI_Allreduce(MPI_IN_PLACE, &ghost, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &multi, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &entries, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   if (comm_rank() != 0) return;
-  std::printf("[traffic] %s: %d ranks, %d velocity fields, %d doubles per node, ghost nodes %ld in all = %.1f kB per "
-              "grid exchange in all; migration %.2f particles per step at %d B\n",
+  const double steps = t.steps > 0 ? static_cast<double>(t.steps) : 1.0;
+  std::printf("[traffic] %s: %d ranks, %d velocity fields; DMDA exchanges %d doubles per ghost node, %ld ghost nodes "
+              "in all = %.2f kB per exchange in all; per step in all: %.1f multi-material ghost nodes, %.1f "
+              "per-material entries of %d B each way = %.2f kB; migration %.2f particles at %d B\n",
               label, comm_size(), run.velocity_fields(), t.values_per_node, ghost,
-              ghost * t.values_per_node * 8.0 / 1024.0, t.steps ? static_cast<double>(sent) / t.steps : 0.0,
-              t.particle_bytes);
+              ghost * t.values_per_node * 8.0 / 1024.0, multi / steps, entries / steps, t.field_entry_bytes,
+              entries / steps * t.field_entry_bytes / 1024.0, sent / steps, t.particle_bytes);
   std::printf("[phases] %s, rank 0, s:", label);
   for (std::size_t p = 0; p < fm::DecomposedMpm2D::phase_names().size(); ++p)
     std::printf(" %s %.4f", fm::DecomposedMpm2D::phase_names()[p], t.phase_seconds[p]);
@@ -196,8 +207,10 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
   EXPECT_GT(ws2, 0.0);
   long sent = split.traffic().particles_sent;
   MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  const long entries = field_entries(split);
   if (comm_size() > 1) {
-    EXPECT_GT(sent, 0L);  // block particles crossed rank boundaries
+    EXPECT_GT(sent, 0L);     // block particles crossed rank boundaries
+    EXPECT_GT(entries, 0L);  // and the contact surface: per-material sums travelled over the star forest
   }
   // Round-off grows in the contact decisions and the stress; 1e-9 of the case's scales (the issue's
   // tolerance): positions against the cell size, velocities against v0, work against its final value.
@@ -223,7 +236,8 @@ INSTANTIATE_TEST_SUITE_P(Kernels, DecomposedSlidingBlock,
 // ---- (b) an isolated impact of two materials: momentum conserved, particles kept, = serial ----
 TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
   // Two blocks meeting obliquely (relative velocity (−12, 4) m/s) with Coulomb μ = 0.4 and the
-  // default normal (maximum volume gradient); no velocity condition, no gravity.
+  // default normal (maximum volume gradient), at x ≈ 14.75 mm, where the 2-rank split (x = 14.5 mm)
+  // puts the contact nodes on both ranks; no velocity condition, no gravity.
   const double h = 1e-3, rho = 1000.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {28, 18});
   fm::SimulationOptions so;
@@ -232,8 +246,8 @@ TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
   fm::Simulation<2> serial(grid, so);
   const std::vector<fm::Material> mats{elastic("left", 1e7, 0.3, rho), elastic("right", 2e7, 0.3, 1500.0)};
   const int a = serial.add_material(mats[0]), b = serial.add_material(mats[1]);
-  serial.add_body("left", *fm::make_box<2>(V2(5e-3, 4e-3), V2(12e-3, 10e-3), a), 2, V2(6.0, -1.0));
-  serial.add_body("right", *fm::make_box<2>(V2(12.5e-3, 7e-3), V2(19e-3, 13e-3), b), 2, V2(-6.0, 3.0));
+  serial.add_body("left", *fm::make_box<2>(V2(7.5e-3, 4e-3), V2(14.5e-3, 10e-3), a), 2, V2(6.0, -1.0));
+  serial.add_body("right", *fm::make_box<2>(V2(15e-3, 7e-3), V2(21.5e-3, 13e-3), b), 2, V2(-6.0, 3.0));
   fm::ContactOptions co;
   co.default_pair.law = fm::FrictionLaw::coulomb(0.4);
   serial.enable_contact(co);
@@ -281,8 +295,10 @@ TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
   EXPECT_LE(std::fabs(w - ws) / ws, 1e-9);
   long sent = split.traffic().particles_sent;
   MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  const long entries = field_entries(split);
   if (comm_size() > 1) {
-    EXPECT_GT(sent, 0L);  // particles crossed rank boundaries
+    EXPECT_GT(sent, 0L);     // particles crossed rank boundaries
+    EXPECT_GT(entries, 0L);  // per-material sums travelled over the star forest
   }
   if (comm_rank() == 0)
     std::printf("[impact] 150 steps: momentum drift %.2e of Σm|v|; vs serial |dx|/h %.2e, |dv|/12 m/s %.2e, work %.6e "

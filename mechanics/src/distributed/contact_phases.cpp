@@ -1,10 +1,10 @@
 // Multimaterial contact and frictional heating in the decomposed step (frictherm/mechanics/
-// distributed.hpp; Nairn, Bardenhagen & Smith 2018 §2.2–2.12). After sum_to_owners every owned node
-// holds the complete per-material sums (m, p, f, Σ S m x, Ω, g) of all ranks, so contact is resolved
-// node-locally at owned nodes by the serial module's code (contact_pair.hpp: normal eq. 7, detection
-// eqs. 8–10, area eq. 11, stick change eqs. 12–15, friction law eqs. 16–25, consistent forces eq. 19,
-// frictional work eqs. 27, 34, 36, 40), and ghost_velocities hands the resulting per-material v, a
-// to the ranks holding the node as a ghost. The gathering of a node's sides follows the serial
+// distributed.hpp; Nairn, Bardenhagen & Smith 2018 §2.2–2.12). After fields_to_owners every owned
+// node that two or more materials reach holds the complete per-material sums (m, p, f, Σ S m x, Ω, g)
+// of all ranks (sparse_exchange.cpp), so contact is resolved node-locally at owned nodes by the
+// serial module's code (contact_pair.hpp: normal eq. 7, detection eqs. 8–10, area eq. 11, stick
+// change eqs. 12–15, friction law eqs. 16–25, consistent forces eq. 19, frictional work eqs. 27, 34,
+// 36, 40), and fields_to_ghosts hands the resulting per-material v, a to the ranks that sent them. The gathering of a node's sides follows the serial
 // Simulation::gather_contact_sides (materials above min_mass_fraction of the node's mass, in material
 // order; slivers marked).
 #include "distributed/decomposed_state.hpp"
@@ -18,8 +18,6 @@
 #include <string>
 
 namespace frictherm::mechanics {
-
-using detail::petsc_check;
 
 // Checks the contact settings (the serial enable_contact / set_contact_pair rules plus what the
 // decomposed step does not support) and fills pair_table as the serial contact_pair(a, b) reads:
@@ -70,29 +68,29 @@ void DecomposedMpm2D::Impl::setup_contact() {
   }
 }
 
-// Phase 3, owned nodes: those where two or more fields have mass (the serial find_contact_nodes);
-// the step's frictional work per owned node starts at zero.
+// Phase 5, owned nodes: the multi-material ones where two or more fields have mass (the serial
+// find_contact_nodes); the step's frictional work per owned node starts at zero.
 void DecomposedMpm2D::Impl::find_contact_nodes(double /*dt*/) {
   const PetscInt owned = xm * ym;
   work_first.assign(static_cast<std::size_t>(owned), 0.0);
   work_second.assign(static_cast<std::size_t>(owned), 0.0);
   contact_nodes.clear();
   if (!opt.contact) return;
-  const PetscScalar* a = nullptr;
-  petsc_check(VecGetArrayRead(global, &a), "VecGetArrayRead");
   for (PetscInt q = 0; q < owned; ++q) {
+    const PetscInt l = owned_local[static_cast<std::size_t>(q)];
+    const std::size_t u = static_cast<std::size_t>(l);
+    if (!multi[u]) continue;
     int present = 0;
-    for (int fl = 0; fl < fields; ++fl)
-      if (a[dof * q + per_field * fl + node_dof::mass] > empty_node_mass) ++present;
-    if (present >= 2) contact_nodes.push_back(q);
+    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl)
+      if (field_at(l, static_cast<int>(fl))[node_dof::mass] > empty_node_mass) ++present;
+    if (present >= 2) contact_nodes.push_back({q, l});
   }
-  petsc_check(VecRestoreArrayRead(global, &a), "VecRestoreArrayRead");
 }
 
-// Phase 4: contact on the extrapolated momenta (momentum changes only).
+// Phase 6: contact on the extrapolated momenta (momentum changes only).
 void DecomposedMpm2D::Impl::contact_extrapolated(double dt) { resolve_contact(false, dt); }
 
-// Phase 6: contact on p^{n+1}, forces kept consistent (eq. 19), frictional work (eqs. 27, 34, 36, 40).
+// Phase 8: contact on p^{n+1}, forces kept consistent (eq. 19), frictional work (eqs. 27, 34, 36, 40).
 void DecomposedMpm2D::Impl::contact_updated(double dt) { resolve_contact(true, dt); }
 
 void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
@@ -113,17 +111,17 @@ void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
   thread_local std::vector<int> mats;
   thread_local std::vector<double*> values;
   thread_local std::vector<Vec<2>> dps;
-  PetscScalar* a = nullptr;
-  petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for (const PetscInt q : contact_nodes) {
-    double* node = a + dof * q;
+  for (const auto& [q, l] : contact_nodes) {
+    const std::size_t u = static_cast<std::size_t>(l);
     double node_mass = 0.0;
-    for (int fl = 0; fl < fields; ++fl)
-      if (node[per_field * fl + mass] > empty_node_mass) node_mass += node[per_field * fl + mass];
+    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
+      const double m = field_at(l, static_cast<int>(fl))[mass];
+      if (m > empty_node_mass) node_mass += m;
+    }
     sides.clear(), mats.clear(), values.clear();
     long guarded = 0;
-    for (int fl = 0; fl < fields; ++fl) {
-      double* v = node + per_field * fl;
+    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
+      double* v = field_at(l, static_cast<int>(fl));
       const double m = v[mass];
       if (!(m > empty_node_mass)) continue;
       if (m < co.min_mass_fraction * node_mass) {
@@ -139,7 +137,7 @@ void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
       sd.domain_gradient = Vec<2>(v[domain_gradient], v[domain_gradient + 1]);
       sd.sliver = m < co.sliver_fraction * node_mass;
       sides.push_back(sd);
-      mats.push_back(fl);  // with contact, field = material
+      mats.push_back(static_cast<int>(fl));  // with contact, field = material
       values.push_back(v);
     }
     if (updated) {
@@ -166,7 +164,6 @@ void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
         },
         stats.sliding_nodes);
   }
-  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
 }
 
 const std::vector<double>& DecomposedMpm2D::frictional_work(HeatingOrder order) const {

@@ -65,6 +65,9 @@ SwarmFields::~SwarmFields() {
 }
 
 DecomposedMpm2D::Impl::~Impl() {
+  PetscSFDestroy(&entry_sf);
+  PetscSFDestroy(&node_sf);
+  if (field_unit != MPI_DATATYPE_NULL) MPI_Type_free(&field_unit);
   VecDestroy(&local);
   VecDestroy(&global);
   DMDestroy(&swarm);
@@ -109,7 +112,6 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
   s.setup_contact();  // checks the contact settings before any collective PETSc call
   s.fields = options.contact ? static_cast<int>(materials.size()) : 1;
   s.per_field = options.contact ? node_dof::with_contact : node_dof::without_contact;
-  s.dof = s.fields * s.per_field;
   const IVec<2>& nodes = grid.nodes_per_dim();
   petsc_check(DMDACreate2d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, nodes[0], nodes[1],
                            PETSC_DECIDE, PETSC_DECIDE, s.dof, s.width, nullptr, nullptr, &s.da),
@@ -165,7 +167,9 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
   // Traffic bookkeeping: ghost nodes of this rank and the bytes of one particle (every field).
   s.traffic.ghost_nodes = static_cast<long>(s.gxm * s.gym - s.xm * s.ym);
   s.traffic.values_per_node = s.dof;
+  s.traffic.field_entry_bytes = s.per_field * static_cast<int>(sizeof(double));
   s.setup_fixed_faces();
+  s.setup_sparse_exchange();
   int bytes = 0;
   for (const char* name : {DMSwarmPICField_coor, DMSwarmField_pid, DMSwarmField_rank, DMSwarmPICField_cellid,
                            swarm_field::id, swarm_field::mass, swarm_field::volume, swarm_field::volume0,

@@ -33,16 +33,17 @@ void check_in_box(const Stencil<2, Kernel>& st, PetscInt gxs, PetscInt gys, Pets
 // Phase 1, local: per velocity field m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p,
 // f_i = Σ (S_ip m_p g − V_p σ_p G_ip) (Nairn 2018 eqs. 1–3) and, with contact, Σ S_ip m_p x_p (or
 // the displacement x_p − x_p^(0), eq. 9), Ω_i = Σ S_ip V_p and g_i = Σ G_ip V_p (eqs. 4–6), into the
-// ghosted local vector, as the serial map_to_grid; the stencils are kept for the later phases.
+// per-field values of the ghosted box, as the serial map_to_grid; each node records the range of
+// fields reaching it. The stencils are kept for the later phases.
 template <class Kernel>
 void DecomposedMpm2D::Impl::particle_to_grid(double /*dt*/) {
   using namespace node_dof;
   SwarmFields f(swarm);
   auto& st = stencils<Kernel>();
   st.resize(static_cast<std::size_t>(f.n));
-  petsc_check(VecZeroEntries(local), "VecZeroEntries");
-  PetscScalar* a = nullptr;
-  petsc_check(VecGetArray(local, &a), "VecGetArray");
+  std::fill(field_values.begin(), field_values.end(), 0.0);
+  std::fill(field_lo.begin(), field_lo.end(), fields);
+  std::fill(field_hi.begin(), field_hi.end(), -1);
   const NodeIndexer<2> ix = local_indexer();
   const Vec<2> g = opt.gravity;
   const bool contact = opt.contact;
@@ -51,7 +52,7 @@ void DecomposedMpm2D::Impl::particle_to_grid(double /*dt*/) {
     auto& s = st[static_cast<std::size_t>(k)];
     s.evaluate(grid, Eigen::Map<const Vec<2>>(f.x + 2 * k), Eigen::Map<const Vec<2>>(f.half_size + 2 * k));
     check_in_box(s, gxs, gys, gxm, gym, f.id[k]);
-    const int field = field_of(f.material[k]) * per_field;
+    const int field = field_of(f.material[k]);
     const double mp = f.mass[k], Vp = f.volume[k];
     const Vec<2> mv = mp * Eigen::Map<const Vec<2>>(f.velocity + 2 * k);
     const Mat<2> Vsig = Vp * Eigen::Map<const Mat<2>>(f.stress + 4 * k);
@@ -59,7 +60,10 @@ void DecomposedMpm2D::Impl::particle_to_grid(double /*dt*/) {
     const Eigen::Map<const Vec<2>> xp(f.x + 2 * k), x0(f.x0 + 2 * k);
     const Vec<2> mx = mp * (displacement ? Vec<2>(xp - x0) : Vec<2>(xp));
     s.for_each(ix, [&](int i, double S, const Vec<2>& G) {
-      double* node = a + dof * i + field;
+      const std::size_t u = static_cast<std::size_t>(i);
+      field_lo[u] = std::min<PetscInt>(field_lo[u], field);
+      field_hi[u] = std::max<PetscInt>(field_hi[u], field);
+      double* node = field_at(i, field);
       const Vec<2> fi = S * mg - Vsig * G;
       node[mass] += S * mp;
       node[momentum] += S * mv[0];
@@ -76,63 +80,68 @@ void DecomposedMpm2D::Impl::particle_to_grid(double /*dt*/) {
       }
     });
   }
-  petsc_check(VecRestoreArray(local, &a), "VecRestoreArray");
 }
 
-// Phase 2, exchange: ghost nodes' contributions summed into their owners (every field).
+// Phase 2, exchange: each local node's m, p, f summed over the fields reaching it into the DMDA's
+// local vector (one field: its values exactly), and the ghost nodes' sums added into their owners.
 void DecomposedMpm2D::Impl::sum_to_owners(double /*dt*/) {
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(local, &a), "VecGetArray");
+  const PetscInt n = gxm * gym;
+  for (PetscInt l = 0; l < n; ++l) {
+    double* node = a + dof * l;
+    std::fill(node, node + dof, 0.0);
+    for (PetscInt fl = field_lo[static_cast<std::size_t>(l)]; fl <= field_hi[static_cast<std::size_t>(l)]; ++fl) {
+      const double* v = field_at(l, static_cast<int>(fl));
+      for (int c = 0; c < dof; ++c) node[c] += v[c];
+    }
+  }
+  petsc_check(VecRestoreArray(local, &a), "VecRestoreArray");
   petsc_check(VecZeroEntries(global), "VecZeroEntries");
   petsc_check(DMLocalToGlobalBegin(da, local, ADD_VALUES, global), "DMLocalToGlobalBegin");
   petsc_check(DMLocalToGlobalEnd(da, local, ADD_VALUES, global), "DMLocalToGlobalEnd");
 }
 
-// Phase 5, owned nodes: velocity conditions of the fixed faces on p_i and f_i (the serial
+// Phase 7, owned nodes: velocity conditions of the fixed faces on p_i and f_i (the serial
 // apply_velocity_bc: fixed components of both zeroed), then p_i^{n+1} = p_i^n + f_i dt.
 void DecomposedMpm2D::Impl::momentum_update(double dt) {
   using namespace node_dof;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  const PetscInt owned = xm * ym;
-  for (PetscInt q = 0; q < owned; ++q) {
+  for_each_owned_field(a, [&](PetscInt q, double* node) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
-    for (int fl = 0; fl < fields; ++fl) {
-      double* node = a + dof * q + per_field * fl;
-      for (int d = 0; d < 2; ++d) {
-        if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
-        node[momentum + d] += node[force + d] * dt;
-      }
+    for (int d = 0; d < 2; ++d) {
+      if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
+      node[momentum + d] += node[force + d] * dt;
     }
-  }
+  });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
 }
 
-// Phase 7, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
+// Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
 // below the empty-node mass get neither (as the serial update_grid).
 void DecomposedMpm2D::Impl::nodal_velocities(double /*dt*/) {
   using namespace node_dof;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  const PetscInt owned = xm * ym;
-  for (PetscInt q = 0; q < owned; ++q)
-    for (int fl = 0; fl < fields; ++fl) {
-      double* node = a + dof * q + per_field * fl;
-      const double m = node[mass];
-      for (int d = 0; d < 2; ++d) {
-        const double p = node[momentum + d], f = node[force + d];
-        node[velocity + d] = m > empty_node_mass ? p / m : 0.0;
-        node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
-      }
+  for_each_owned_field(a, [&](PetscInt, double* node) {
+    const double m = node[mass];
+    for (int d = 0; d < 2; ++d) {
+      const double p = node[momentum + d], f = node[force + d];
+      node[velocity + d] = m > empty_node_mass ? p / m : 0.0;
+      node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
     }
+  });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
 }
 
-// Phase 8, exchange: owners' v_i, a_i (every field) copied to the ranks holding the node as a ghost.
+// Phase 10, exchange: owners' v_i, a_i (the DMDA totals) copied to the ranks holding the node as a ghost.
 void DecomposedMpm2D::Impl::ghost_velocities(double /*dt*/) {
   petsc_check(DMGlobalToLocalBegin(da, global, INSERT_VALUES, local), "DMGlobalToLocalBegin");
   petsc_check(DMGlobalToLocalEnd(da, global, INSERT_VALUES, local), "DMGlobalToLocalEnd");
 }
 
-// Phase 9, local (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
+// Phase 12, local (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
 // field, start-of-step stencils.
 template <class Kernel>
 void DecomposedMpm2D::Impl::grid_to_particle(double dt) {
@@ -144,9 +153,9 @@ void DecomposedMpm2D::Impl::grid_to_particle(double dt) {
   const NodeIndexer<2> ix = local_indexer();
   for (PetscInt k = 0; k < f.n; ++k) {
     Vec<2> acc = Vec<2>::Zero(), v = Vec<2>::Zero();
-    const int field = field_of(f.material[k]) * per_field;
+    const int field = field_of(f.material[k]);
     st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double S, const Vec<2>&) {
-      const double* node = a + dof * i + field;
+      const double* node = node_values(a, i, field);
       acc += S * Vec<2>(node[acceleration], node[acceleration + 1]);
       v += S * Vec<2>(node[velocity], node[velocity + 1]);
     });
@@ -156,7 +165,7 @@ void DecomposedMpm2D::Impl::grid_to_particle(double dt) {
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
-// Phase 10, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, hypoelastic σ (Jaumann).
+// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, hypoelastic σ (Jaumann).
 template <class Kernel>
 void DecomposedMpm2D::Impl::stress_update(double dt) {
   using namespace node_dof;
@@ -168,10 +177,10 @@ void DecomposedMpm2D::Impl::stress_update(double dt) {
   for (PetscInt k = 0; k < f.n; ++k) {
     const Material& material = materials[static_cast<std::size_t>(f.material[k])];
     const double lam = material.lame_lambda(), mu = material.shear_modulus();
-    const int field = field_of(f.material[k]) * per_field;
+    const int field = field_of(f.material[k]);
     Mat<2> L = Mat<2>::Zero();
     st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double, const Vec<2>& G) {
-      const double* node = a + dof * i + field;
+      const double* node = node_values(a, i, field);
       L.noalias() += Vec<2>(node[velocity], node[velocity + 1]) * G.transpose();
     });
     Eigen::Map<Mat<2>> F(f.F + 4 * k);
@@ -184,10 +193,11 @@ void DecomposedMpm2D::Impl::stress_update(double dt) {
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
-const std::array<const char*, 11>& DecomposedMpm2D::phase_names() {
-  static const std::array<const char*, 11> names{
-      {"particle_to_grid", "sum_to_owners", "find_contact_nodes", "contact_extrapolated", "momentum_update",
-       "contact_updated", "nodal_velocities", "ghost_velocities", "grid_to_particle", "stress_update", "migrate"}};
+const std::array<const char*, 14>& DecomposedMpm2D::phase_names() {
+  static const std::array<const char*, 14> names{
+      {"particle_to_grid", "sum_to_owners", "exchange_field_ranges", "fields_to_owners", "find_contact_nodes",
+       "contact_extrapolated", "momentum_update", "contact_updated", "nodal_velocities", "ghost_velocities",
+       "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate"}};
   return names;
 }
 
@@ -196,13 +206,15 @@ void DecomposedMpm2D::step(double dt) {
   dispatch_shape(s.opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
     using Phase = void (Impl::*)(double);
-    // The step, in order (names: phase_names()). Without contact the contact phases find no node.
-    static constexpr Phase phases[11] = {
-        &Impl::particle_to_grid<Kernel>, &Impl::sum_to_owners,   &Impl::find_contact_nodes,
-        &Impl::contact_extrapolated,     &Impl::momentum_update, &Impl::contact_updated,
-        &Impl::nodal_velocities,         &Impl::ghost_velocities, &Impl::grid_to_particle<Kernel>,
+    // The step, in order (names: phase_names()). Without contact (one velocity field) the per-field
+    // exchanges and the contact phases have nothing to do.
+    static constexpr Phase phases[14] = {
+        &Impl::particle_to_grid<Kernel>, &Impl::sum_to_owners,        &Impl::exchange_field_ranges,
+        &Impl::fields_to_owners,         &Impl::find_contact_nodes,   &Impl::contact_extrapolated,
+        &Impl::momentum_update,          &Impl::contact_updated,      &Impl::nodal_velocities,
+        &Impl::ghost_velocities,         &Impl::fields_to_ghosts,     &Impl::grid_to_particle<Kernel>,
         &Impl::stress_update<Kernel>,    &Impl::migrate};
-    for (std::size_t p = 0; p < 11; ++p) {
+    for (std::size_t p = 0; p < 14; ++p) {
       const double t0 = MPI_Wtime();
       (s.*phases[p])(dt);
       s.traffic.phase_seconds[p] += MPI_Wtime() - t0;

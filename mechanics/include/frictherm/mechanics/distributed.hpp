@@ -117,7 +117,12 @@ struct DecomposedTraffic {
   long particles_sent = 0;            // by migration, over all steps
   long particles_received = 0;
   int particle_bytes = 0;             // payload per migrated particle (all swarm fields)
-  std::array<double, 11> phase_seconds{};  // per phase, in phase_names() order
+  // Per-field exchanges (contact): ghost nodes this rank found multi-material and (ghost node,
+  // field) entries it sent to their owners (and received back), over all steps; bytes per entry.
+  long multi_ghost_nodes = 0;
+  long field_entries_sent = 0;
+  int field_entry_bytes = 0;
+  std::array<double, 14> phase_seconds{};  // per phase, in phase_names() order
 };
 
 class DecomposedMpm2D {
@@ -139,7 +144,7 @@ class DecomposedMpm2D {
 
   /// One USL step of size dt (collective): the phases listed above, in that order.
   void step(double dt);
-  static const std::array<const char*, 11>& phase_names();
+  static const std::array<const char*, 14>& phase_names();
 
   int stencil_width() const;
   /// DMDA processes per direction (m, n) and this rank's owned node range [begin, end) per direction
