@@ -1,12 +1,15 @@
-// The decomposed USL step (frictherm/mechanics/distributed.hpp) as a list of named phases; the three
-// exchanges (sum_to_owners, ghost_velocities, migrate) are phases of their own. The particle loops
-// reuse the serial module's Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted
-// local vector, and its linear_elastic_update (material.hpp), so they compute what the serial
-// Simulation<2>'s USL step computes (mechanics/src/simulation_step.cpp) on this rank's particles.
+// The decomposed USL step (frictherm/mechanics/distributed.hpp) as a list of named phases; the
+// exchanges (sum_to_owners, exchange_field_ranges, fields_to_owners, ghost_velocities,
+// fields_to_ghosts, migrate) are phases of their own, the contact phases are in contact_phases.cpp
+// and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
+// Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted box, and its
+// linear_elastic_update (material.hpp), so they compute what the serial Simulation<2>'s USL step
+// computes (mechanics/src/simulation_step.cpp, simulation_fields.cpp) on this rank's particles.
 #include "distributed/decomposed_state.hpp"
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 

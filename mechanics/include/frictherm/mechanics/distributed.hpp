@@ -6,26 +6,32 @@
 // grid faces and gravity, written as a list of named phases in which the three exchanges are phases
 // of their own (docs/distributed.md):
 //
-//   particle_to_grid      local: per velocity field m_i, p_i, f_i (N·1–3) and, with contact,
-//                         Σ S m x (or the displacement form), Ω_i, g_i (N·4–6, 9) into the ghosted vector
-//   sum_to_owners         exchange: DMLocalToGlobal(ADD_VALUES), every field's sums complete at its owner
-//   find_contact_nodes    owned nodes where two or more fields have mass
-//   contact_extrapolated  contact on the extrapolated momenta (N·7–18), node-local
-//   momentum_update       owned nodes: fixed faces (p, f components zeroed), p_i += f_i dt
-//   contact_updated       contact on p^{n+1} with consistent forces (N·19) and frictional work (N·27, 34, 36, 40)
-//   nodal_velocities      owned nodes: v_i = p_i/m_i, a_i = f_i/m_i
-//   ghost_velocities      exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get every field's v_i, a_i
-//   grid_to_particle      FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i (the particle's own field)
-//   stress_update         L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ (material.hpp)
-//   migrate               exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
+//   particle_to_grid       local: per velocity field m_i, p_i, f_i (N·1–3) and, with contact,
+//                          Σ S m x (or the displacement form), Ω_i, g_i (N·4–6, 9)
+//   sum_to_owners          exchange: every node's m, p, f summed over its fields into the DMDA,
+//                          DMLocalToGlobal(ADD_VALUES) into the owners
+//   exchange_field_ranges  exchange (PetscSF): which materials reach each node, completed at the
+//                          owner; the multi-material flag back to every rank holding the node
+//   fields_to_owners       exchange (PetscSF): per-material sums at multi-material ghost nodes into the owner
+//   find_contact_nodes     owned nodes where two or more fields have mass
+//   contact_extrapolated   contact on the extrapolated momenta (N·7–18), node-local
+//   momentum_update        owned nodes: fixed faces (p, f components zeroed), p_i += f_i dt
+//   contact_updated        contact on p^{n+1} with consistent forces (N·19) and frictional work (N·27, 34, 36, 40)
+//   nodal_velocities       owned nodes: v_i = p_i/m_i, a_i = f_i/m_i
+//   ghost_velocities       exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get the totals' v_i, a_i
+//   fields_to_ghosts       exchange (PetscSF): per-material v_i, a_i back to the ranks that sent the sums
+//   grid_to_particle       FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i (the particle's own field)
+//   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ (material.hpp)
+//   migrate                exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
 //
 // Velocity fields: without contact every material shares one field (as the serial Simulation);
-// with contact each material has its own. This first version carries a FIXED number of field slots
-// per node through the DMDA (dof = fields × values per field, 10 values with contact), so the two
-// grid exchanges move every field at every ghost node, whether the material is there or not. The
-// sparse exchange over the DM's PetscSF restricted to the shared nodes that hold two or more
-// materials (issue 16) is not done; for a few materials the fixed slots cost little, for a PBX with
-// hundreds of grains they are unusable (docs/distributed.md).
+// with contact each material has its own. A node that one material reaches (on every rank) needs no
+// per-material data: the DMDA's total is that material's field. Only at shared nodes that two or
+// more materials reach do per-material values travel, as (node, material) entries over a PetscSF
+// rebuilt each step (mechanics/src/distributed/sparse_exchange.cpp). Each rank still stores every
+// field densely over its ghosted box (materials × 10 doubles per node): fine for a few materials,
+// not for a PBX with hundreds of grains (per-material boxes, as the serial step has, are the next
+// step; docs/distributed.md).
 //
 // Ownership: a particle belongs to the rank that owns the grid node nearest to it (the node's dual
 // cell [x_n − h/2, x_n + h/2)). With that rule the stencil of the linear, uGIMP (l_p ≤ h/2) and
