@@ -4,9 +4,9 @@
 // of all ranks (sparse_exchange.cpp), so contact is resolved node-locally at owned nodes by the
 // serial module's code (contact_pair.hpp: normal eq. 7, detection eqs. 8–10, area eq. 11, stick
 // change eqs. 12–15, friction law eqs. 16–25, consistent forces eq. 19, frictional work eqs. 27, 34,
-// 36, 40), and fields_to_ghosts hands the resulting per-material v, a to the ranks that sent them. The gathering of a node's sides follows the serial
-// Simulation::gather_contact_sides (materials above min_mass_fraction of the node's mass, in material
-// order; slivers marked).
+// 36, 40), and fields_to_ghosts hands the resulting per-material v, a to the ranks that sent them.
+// The gathering of a node's sides follows the serial Simulation::gather_contact_sides (materials
+// above min_mass_fraction of the node's mass, in material order; slivers marked).
 #include "distributed/decomposed_state.hpp"
 
 #include "contact_pair.hpp"
