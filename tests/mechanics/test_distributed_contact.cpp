@@ -375,6 +375,51 @@ TEST(DecomposedContact, ThreeMaterialsMeetingAtNodesEqualTheSerialRun) {
   print_phases("three materials, uGIMP", split);
 }
 
+// ---- (e) fixed faces on the upper sides (no contact): the serial fix_face's nodes ----
+TEST(DecomposedContact, UpperFixedFacesEqualTheSerialRun) {
+  // One elastic block pressed by a body force (3e4, 3e4) m/s² into the corner of the x_max face
+  // (x component fixed) and the y_max face (both fixed); it starts half a cell from both, so its
+  // particles reach the faces' nodes from the first step. Quadratic B-spline, 150 steps.
+  const double h = 1e-3, rho = 1000.0;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {20, 14});
+  fm::SimulationOptions so;
+  so.shape = fm::ShapeKind::quadratic_bspline;
+  so.scheme = fm::UpdateScheme::usl;
+  so.gravity = fm::Vec<3>(3e4, 3e4, 0.0);
+  fm::Simulation<2> serial(grid, so);
+  const fm::Material mat = elastic("block", 1e7, 0.3, rho);
+  const int m = serial.add_material(mat);
+  serial.add_body("block", *fm::make_box<2>(V2(9.5e-3, 5.5e-3), V2(19.5e-3, 13.5e-3), m), 2, V2(1.0, 0.0));
+  const fm::FixedFace right{0, true, {{true, false, false}}}, top{1, true, {{true, true, true}}};
+  serial.fix_face(right);
+  serial.fix_face(top);
+  serial.finalize();
+  fm::DecomposedOptions opt;
+  opt.shape = so.shape;
+  opt.gravity = V2(3e4, 3e4);
+  opt.fixed_faces = {right, top};
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, {mat}, opt);
+  split.add_particles(from_serial(serial));
+  const double dt = 0.3 * h / (std::sqrt(mat.p_wave_modulus(fm::Analysis::plane_strain) / rho) + 2.0);
+  for (int s = 0; s < 150; ++s) {
+    serial.step(dt);
+    split.step(dt);
+  }
+  const Difference d = compare(split.gather(), serial);
+  double smax = 0.0, vmax = 0.0;
+  for (std::size_t k = 0; k < serial.particles().size(); ++k) {
+    smax = std::max(smax, serial.particles().stress[k].norm());
+    vmax = std::max(vmax, serial.particles().velocity[k].norm());
+  }
+  EXPECT_TRUE(d.same_ids);
+  EXPECT_GT(smax, 1e4);  // the faces held the block: ρ g H ≈ 2.4e5 Pa along y
+  EXPECT_LE(d.position / h, 1e-9);
+  EXPECT_LE(d.velocity / vmax, 1e-9);
+  if (comm_rank() == 0)
+    std::printf("[upper faces] 150 steps: σ_max %.3e Pa; vs serial |dx|/h %.2e, |dv|/v_max %.2e\n", smax,
+                d.position / h, d.velocity / vmax);
+}
+
 // ---- (c) what the decomposed contact refuses, with the key and the expected value ----
 TEST(DecomposedContact, RefusesWhatItDoesNotSupport) {
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {8, 8});
