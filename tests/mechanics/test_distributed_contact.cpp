@@ -10,7 +10,11 @@
 //   (b) an isolated oblique impact of two materials (no velocity condition, no gravity): linear
 //       momentum conserved to round-off at every step, every particle kept, and again the serial
 //       run to 1e-9;
-//   (c) the refusals of what the decomposed contact does not support.
+//   (c) the refusals of what the decomposed contact does not support;
+//   (d) three materials meeting at nodes (lumped virtual material, eqs. 39–40) = the serial run;
+//   (e) fixed faces on the upper sides (the serial fix_face's nodes) = the serial run.
+// Every case also passes per-material entries over the star forest on 2 and 4 ranks (asserted where
+// the case has a contact surface crossing the split).
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
 #include "frictherm/mechanics/distributed.hpp"
 #include "frictherm/mechanics/geometry.hpp"
