@@ -13,8 +13,8 @@
 //   (c) the refusals of what the decomposed contact does not support;
 //   (d) three materials meeting at nodes (lumped virtual material, eqs. 39–40) = the serial run;
 //   (e) fixed faces on the upper sides (the serial fix_face's nodes) = the serial run.
-// Every case also passes per-material entries over the star forest on 2 and 4 ranks (asserted where
-// the case has a contact surface crossing the split).
+// The contact cases (a), (b), (d) also assert that per-material entries crossed the star forest on
+// 2 and 4 ranks (their contact surfaces cross the split).
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
 #include "frictherm/mechanics/distributed.hpp"
 #include "frictherm/mechanics/geometry.hpp"
