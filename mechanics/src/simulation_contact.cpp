@@ -3,7 +3,7 @@
 // frictional work. Sign convention in contact.hpp: n̂ points from material a to material b.
 #include <frictherm/mechanics/simulation.hpp>
 
-#include "contact_side.hpp"
+#include "contact_pair.hpp"
 
 #include <omp.h>
 
@@ -12,145 +12,8 @@
 #include <limits>
 
 namespace frictherm::mechanics {
-namespace {
 
-/// Result of one material pair at one node: the momentum change of material a and its friction work.
-template <int Dim>
-struct PairChange {
-  bool changed = false;
-  bool sliding = false;
-  Vec<Dim> dp = Vec<Dim>::Zero();  // Δp'_{i,a}
-  double work_first = 0.0, work_second = 0.0;
-  double reduced_mass = 0.0;
-};
-
-struct PairContext {
-  const ContactPairSettings* settings;
-  SeparationMethod separation;
-  double position_correction;
-  double extent_tolerance;
-  double cell_volume;  // of the node's cell (2D: times thickness), m^3
-  double dt;
-  bool heat;           // the momentum-update pass: compute frictional work
-  // Normal-stress regularisation (ContactOptions::regularized): this node's lagged normal traction
-  // σ̃ and the step that last set it, or null; updated in the heating pass only.
-  double* lagged_normal = nullptr;
-  double* lagged_step = nullptr;
-  double step = 0.0;
-  double slip_length = 0.0, relaxation_time = 0.0;
-};
-
-/// The normal impulse the friction law sees: −σ̃ A_c dt with σ̃ the lagged normal traction,
-/// dσ̃/dt = −(|v_slip|/L + 1/τ)(σ̃ − σ) (Prakash–Clifton form, Cochard & Rice 2000 eq. 3), integrated
-/// exactly over the step for frozen v_slip and σ; d_n itself when the regularisation is off.
-inline double regularized_normal(double d_n, double d_t, double reduced_mass, double area, const PairContext& c) {
-  if (!c.lagged_normal) return d_n;
-  const double sigma = std::max(0.0, -d_n) / (area * c.dt);  // N = −d_n/(A_c dt), eq. 15
-  const bool fresh = std::isnan(*c.lagged_normal) || *c.lagged_step < c.step - 1.0;
-  double lagged = fresh ? sigma : *c.lagged_normal;
-  if (c.heat) {
-    const double rate = (d_t / reduced_mass) / c.slip_length + 1.0 / c.relaxation_time;
-    lagged = sigma + (lagged - sigma) * std::exp(-rate * c.dt);
-    *c.lagged_normal = lagged;
-    *c.lagged_step = c.step;
-  }
-  return -lagged * area * c.dt;
-}
-
-/// Applies a friction outcome at a node in contact: stick (stick_change) or slide (eq. 17: the normal
-/// change d_n n̂ plus the sliding impulse along t̂), with the sliding's frictional work in the heating pass.
-template <int Dim>
-void apply_friction(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const FrictionOutcome& f,
-                    const Vec<Dim>& stick_change, double d_n, const Vec<Dim>& n, const Vec<Dim>& t_vec, double d_t,
-                    const PairContext& c, PairChange<Dim>& out) {
-  out.changed = true;
-  if (f.stick || !(d_t > 0.0)) {
-    out.dp = stick_change;
-    return;
-  }
-  const Vec<Dim> t_hat = t_vec / d_t;
-  out.sliding = true;
-  out.dp = d_n * n + f.slide_impulse * t_hat;  // eq. 17
-  if (c.heat) {
-    // Relative force tangential component f_t (eqs. 29–30); rigid b: Δf_a = m_a a_b − f_a.
-    const Vec<Dim> df = b.rigid ? Vec<Dim>(a.mass * b.rigid_acceleration - a.force)
-                                : Vec<Dim>((a.mass * b.force - b.mass * a.force) / (a.mass + b.mass));
-    out.work_first = frictional_work_first_order(f.slide_impulse, d_t, out.reduced_mass);  // eq. 27
-    out.work_second =
-        frictional_work_second_order(f.slide_impulse, d_t, df.dot(t_hat), out.reduced_mass, c.dt);  // eqs. 34, 36
-  }
-}
-
-template <int Dim>
-PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const Vec<Dim>& h,
-                             const PairContext& c) {
-  PairChange<Dim> out;
-  // Normal from a to b (eq. 7 and §2.3): specified, maximum or average volume gradient.
-  Vec<Dim> n;
-  const ContactPairSettings& s = *c.settings;
-  if (!contact_normal(a, b, s, n)) return out;
-  // Effective cell thickness across the interface, exact for rectangular cells: h⊥ = 1/|n ⊘ h|.
-  const double h_perp = 1.0 / n.cwiseQuotient(h).norm();
-
-  const Vec<Dim> va = a.momentum / a.mass;
-  const Vec<Dim> vb = b.rigid ? b.rigid_velocity : Vec<Dim>(b.momentum / b.mass);
-  const bool approaching = (vb - va).dot(n) < 0.0;
-  double separation = -1.0;  // velocity-only detection: contact whenever approaching
-  if (c.separation == SeparationMethod::position)  // eq. 8
-    separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n) - c.position_correction * h_perp;
-  else if (c.separation == SeparationMethod::displacement)  // eqs. 9–10
-    separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n);
-  else if (c.separation == SeparationMethod::extent)  // particle domains, contact_extents.cpp
-    separation = std::isnan(a.extent_gap) ? -1.0 : a.extent_gap - c.extent_tolerance * h_perp;
-  const bool touching = separation < 0.0;
-  const bool in_contact = approaching && touching;
-
-  // Stick momentum change and reduced mass (eqs. 12–14); a rigid b has v_c = v_b, m_red = m_a.
-  Vec<Dim> dp_stick;
-  if (b.rigid) {
-    dp_stick = a.mass * vb - a.momentum;
-    out.reduced_mass = a.mass;
-  } else {
-    dp_stick = (a.mass * b.momentum - b.mass * a.momentum) / (a.mass + b.mass);
-    out.reduced_mass = a.mass * b.mass / (a.mass + b.mass);
-  }
-  const double d_n = dp_stick.dot(n);  // eq. 15
-  const Vec<Dim> t_vec = dp_stick - d_n * n;
-  const double d_t = t_vec.norm();
-  // Eq. 11 with Ω_i = Σ_j Ω_{i,j}, the node's total extrapolated domain (a volume, so the 2D thickness
-  // is already in it).
-  const double area = std::sqrt(2.0 * (a.domain + b.domain) * std::min(a.domain, b.domain)) / h_perp;
-  if (!(area > 0.0)) return out;
-
-  if (!in_contact) {  // separated: only an adhesive interface with tensile strength may hold (eq. 25)
-    const double N = -d_n / (area * c.dt), S_stick = d_t / (area * c.dt);
-    if (s.law.holds_when_separated(S_stick, N)) {
-      out.changed = true;
-      out.dp = dp_stick;
-      return out;
-    }
-    // Extent detection: domains that touch but move apart this step still rub through the law's area
-    // term (adhesion S_a A_c, eq. 24 with N = 0); no normal change. Without it an area law loses its
-    // traction at every touching node whose normal velocity noise points outward that step.
-    if (c.separation == SeparationMethod::extent && touching && s.law.needs_area() && !(a.sliver || b.sliver) &&
-        d_t > 0.0)
-      apply_friction(a, b, s.law.in_contact(ContactImpulse{0.0, d_t, out.reduced_mass, area, c.dt}), t_vec, 0.0,
-                     n, t_vec, d_t, c, out);
-    return out;
-  }
-  if (a.sliver || b.sliver) {  // normal change only: no friction, no heat (ContactSide::sliver)
-    out.changed = true;
-    out.dp = d_n * n;
-    return out;
-  }
-  const double d_n_law = regularized_normal(d_n, d_t, out.reduced_mass, area, c);
-  apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n_law, d_t, out.reduced_mass, area, c.dt}), dp_stick, d_n,
-                 n, t_vec, d_t, c, out);
-  return out;
-}
-
-}  // namespace
-
+using contact_detail::PairContext;
 // Lists (node, slot) for every node where two or more fields have mass, grouped by node; within a
 // node the slots come in material order because fields are laid out in material order.
 template <int Dim>
@@ -246,6 +109,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       acc.pair_second[k] += w2;
     };
     ContactStats& stats = acc.stats;
+    auto pair_of = [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); };
 
 #pragma omp for schedule(static)
     for (long g = 0; g < groups; ++g) {
@@ -257,62 +121,12 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
         ++stats.contact_nodes;
         if (count > 2) ++stats.multi_nodes;
       }
-      if (count == 2) {
-        // Two materials: a is the deformable one when the other is rigid.
-        std::size_t ia = 0, ib = 1;
-        if (sides[0].rigid) std::swap(ia, ib);
-        if (!sides[ia].rigid && contact_pair(mats[ia], mats[ib]).method == ContactMethod::multimaterial) {
-          ctx.settings = &contact_pair(mats[ia], mats[ib]);
-          if (regularized) {
-            ctx.lagged_normal = &lagged_normal_traction_[static_cast<std::size_t>(node)];
-            ctx.lagged_step = &lagged_normal_step_[static_cast<std::size_t>(node)];
-          }
-          const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
-          ctx.lagged_normal = ctx.lagged_step = nullptr;
-          if (r.changed) {
-            apply(slots[ia], r.dp);
-            if (!sides[ib].rigid) apply(slots[ib], Vec<Dim>(-r.dp));
-          }
-          if (r.sliding && heat) {
-            ++stats.sliding_nodes;
-            add_work(node, mats[ia], mats[ib], r.work_first, r.work_second);
-          }
-        }
-      } else if (count > 2) {
-        // Three or more: each material against the others lumped into one virtual material; its
-        // change is applied to it alone, frictional work summed with eq. 40 (1/m_red = Σ_j 1/m_j, eq. 39).
-        bool any_rigid = false;
-        double inv_mred = 0.0, total = 0.0;
-        for (const auto& sd : sides) {
-          any_rigid = any_rigid || sd.rigid;
-          if (!sd.rigid) inv_mred += 1.0 / sd.mass, total += sd.mass;
-        }
-        const double m_red_node = 1.0 / inv_mred;
-        dps.assign(count, Vec<Dim>::Zero());
-        for (std::size_t a = 0; a < count; ++a) {
-          if (sides[a].rigid) continue;
-          ContactSide<Dim> rest;
-          const std::size_t dominant = lump_partners(sides, mats, a, rest);
-          if (dominant == count) continue;  // all its partners here use penalty contact
-          ctx.settings = &contact_pair(mats[a], mats[dominant]);
-          const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
-          if (r.changed) dps[a] = r.dp;
-          if (r.sliding && heat) {
-            ++stats.sliding_nodes;
-            const double w = m_red_node / sides[a].mass;  // eq. 40
-            add_work(node, mats[a], mats[dominant], w * r.work_first, w * r.work_second);
-          }
-        }
-        if (!any_rigid) {
-          // The lumped changes need not cancel; removing their mass-weighted mean keeps the node's total
-          // momentum exact without changing any relative velocity (an addition to the paper's §2.12).
-          Vec<Dim> residual = Vec<Dim>::Zero();
-          for (const auto& d : dps) residual += d;
-          for (std::size_t a = 0; a < count; ++a) dps[a] -= (sides[a].mass / total) * residual;
-        }
-        for (std::size_t a = 0; a < count; ++a)
-          if (!sides[a].rigid) apply(slots[a], dps[a]);
-      }
+      double* lagged_normal = regularized ? &lagged_normal_traction_[static_cast<std::size_t>(node)] : nullptr;
+      double* lagged_step = regularized ? &lagged_normal_step_[static_cast<std::size_t>(node)] : nullptr;
+      contact_detail::resolve_contact_node(
+          sides, mats, h, ctx, lagged_normal, lagged_step, pair_of, dps,
+          [&](std::size_t j, const Vec<Dim>& dp) { apply(slots[j], dp); },
+          [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); }, stats.sliding_nodes);
     }
   }
   for (const auto& t : contact_thread_work_) {
@@ -370,31 +184,12 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
   return guarded;
 }
 
-// sides[a]'s multimaterial partners lumped into one virtual material (§2.12); a rigid partner
-// dominates the lump. Returns the heaviest partner, or sides.size() when every partner here uses
-// penalty contact.
+// sides[a]'s multimaterial partners lumped into one virtual material (contact_pair.hpp).
 template <int Dim>
 std::size_t Simulation<Dim>::lump_partners(const std::vector<ContactSide<Dim>>& sides, const std::vector<int>& mats,
                                            std::size_t a, ContactSide<Dim>& rest) const {
-  const std::size_t count = sides.size();
-  rest = ContactSide<Dim>{};
-  std::size_t dominant = count;
-  double rigid_weight = -1.0;
-  bool all_slivers = true;
-  for (std::size_t j = 0; j < count; ++j) {
-    if (j == a || contact_pair(mats[a], mats[j]).method == ContactMethod::penalty) continue;  // penalty pairs meet elsewhere
-    rest.add(sides[j]);
-    all_slivers = all_slivers && sides[j].sliver;
-    if (dominant == count || sides[j].mass > sides[dominant].mass) dominant = j;
-    if (sides[j].rigid && sides[j].mass > rigid_weight) {
-      rigid_weight = sides[j].mass;
-      rest.rigid = true;
-      rest.rigid_velocity = sides[j].rigid_velocity;
-      rest.rigid_acceleration = sides[j].rigid_acceleration;
-    }
-  }
-  rest.sliver = dominant != count && all_slivers;
-  return dominant;
+  return contact_detail::lump_partners(
+      sides, mats, a, rest, [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); });
 }
 
 // Extent separation: per contact entry, the normal from its material to its partners, as

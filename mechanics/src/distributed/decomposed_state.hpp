@@ -8,8 +8,10 @@
 
 #include <petscdmda.h>
 #include <petscdmswarm.h>
+#include <petscsf.h>
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace frictherm::mechanics {
@@ -26,12 +28,18 @@ inline constexpr const char* half_size = "frictherm_half_size";
 inline constexpr const char* stress = "frictherm_stress";
 inline constexpr const char* stress_zz = "frictherm_stress_zz";
 inline constexpr const char* deformation = "frictherm_F";
+inline constexpr const char* material = "frictherm_material";
+inline constexpr const char* initial_position = "frictherm_x0";  // displacement separation (N·9)
 }  // namespace swarm_field
 
-/// Degrees of freedom per node in both grid exchanges: after particle_to_grid (m, p_x, p_y, f_x, f_y),
-/// after grid_update (m, v_x, v_y, a_x, a_y) in the same slots.
+/// Values of one velocity field at a node: after particle_to_grid m, p, f (and with contact Σ S m x,
+/// Ω, g: N·4–6, 9); after nodal_velocities v and a in the slots of p and f. The DMDA carries, per
+/// node, the first five summed over the fields (exact for a node that one field reaches); the
+/// per-field values live in Impl::field_values and travel over PetscSFs (sparse_exchange.cpp).
 namespace node_dof {
-inline constexpr int count = 5, mass = 0, momentum = 1, force = 3, velocity = 1, acceleration = 3;
+inline constexpr int mass = 0, momentum = 1, force = 3, velocity = 1, acceleration = 3;
+inline constexpr int mass_position = 5, domain = 7, domain_gradient = 8;
+inline constexpr int without_contact = 5, with_contact = 10;  // values per field
 }
 
 /// Every registered field of the swarm, gotten for the object's lifetime (no migration meanwhile).
@@ -41,7 +49,8 @@ struct SwarmFields {
   double* x = nullptr;  // DMSwarmPIC_coor, 2 per particle
   long* id = nullptr;
   double *mass = nullptr, *volume = nullptr, *volume0 = nullptr, *velocity = nullptr, *half_size = nullptr;
-  double *stress = nullptr, *stress_zz = nullptr, *F = nullptr;
+  double *stress = nullptr, *stress_zz = nullptr, *F = nullptr, *x0 = nullptr;
+  PetscInt* material = nullptr;
 
   explicit SwarmFields(DM swarm);
   ~SwarmFields();
@@ -58,6 +67,8 @@ struct SwarmFields {
     f(swarm_field::stress, stress);
     f(swarm_field::stress_zz, stress_zz);
     f(swarm_field::deformation, F);
+    f(swarm_field::material, material);
+    f(swarm_field::initial_position, x0);
   }
   SwarmFields(const SwarmFields&) = delete;
   SwarmFields& operator=(const SwarmFields&) = delete;
@@ -67,9 +78,47 @@ struct DecomposedMpm2D::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
   int rank = 0, size = 1;
   Grid<2> grid;
-  Material material;
+  std::vector<Material> materials;
   DecomposedOptions opt;
-  int width = 1;  // DMDA stencil width (stencil_reach)
+  int width = 1;                 // DMDA stencil width (stencil_reach)
+  int fields = 1;                // velocity fields per node: 1, or one per material with contact
+  int per_field = node_dof::without_contact;  // values per field (10 with contact)
+  static constexpr int dof = node_dof::without_contact;  // DMDA values per node: m, p, f over all fields
+  int field_of(PetscInt material) const { return opt.contact ? static_cast<int>(material) : 0; }
+  // Per-field values of the ghosted box (sparse_exchange.cpp), [(l·fields + field)·per_field + value]
+  // for local node l; field_lo / field_hi: the smallest and largest field whose particles' stencils
+  // reach node l (fields / −1 when none), at owned nodes over all ranks after exchange_field_ranges;
+  // multi: 1 where they differ (two or more fields reach the node on some rank), at every local node.
+  std::vector<double> field_values;
+  std::vector<PetscInt> field_lo, field_hi, multi, root_lo, root_hi;
+  std::vector<PetscInt> owned_local;             // owned node q (x fastest) -> local node l
+  PetscSF node_sf = nullptr;                     // leaves: this rank's ghost nodes; roots: owners' local nodes
+  std::vector<PetscInt> ghost_local;             // leaves of node_sf (local node ids)
+  std::vector<PetscSFNode> ghost_remote;         // their owners (rank, owner's local node id)
+  PetscSF entry_sf = nullptr;                    // this step's (ghost node, field) entries at multi nodes
+  MPI_Datatype field_unit = MPI_DATATYPE_NULL;   // per_field doubles
+  std::vector<PetscInt> entry_local;             // scratch of the entry graph
+  std::vector<PetscSFNode> entry_remote;
+  double* field_at(PetscInt l, int field) { return field_values.data() + (l * fields + field) * per_field; }
+  /// visit(q, values) for every field at owned node q: the per-field values at a multi-material node,
+  /// else the DMDA's total (`total`: the global vector's array; one field).
+  template <class Visit>
+  void for_each_owned_field(PetscScalar* total, Visit&& visit) {
+    const PetscInt owned = xm * ym;
+    for (PetscInt q = 0; q < owned; ++q) {
+      const PetscInt l = owned_local[static_cast<std::size_t>(q)];
+      const std::size_t u = static_cast<std::size_t>(l);
+      if (multi[u])
+        for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) visit(q, field_at(l, static_cast<int>(fl)));
+      else
+        visit(q, total + dof * q);
+    }
+  }
+  /// A particle's field at local node l after the exchanges: per-field values at a multi-material
+  /// node, else the DMDA's ghosted total `local_total`.
+  const double* node_values(const PetscScalar* local_total, PetscInt l, int field) {
+    return multi[static_cast<std::size_t>(l)] ? field_at(l, field) : local_total + dof * l;
+  }
   DM da = nullptr, swarm = nullptr;
   ::Vec local = nullptr, global = nullptr;  // PETSc vectors (mechanics::Vec is the Eigen one)
   PetscInt xs = 0, ys = 0, xm = 0, ym = 0;      // owned nodes
@@ -78,6 +127,15 @@ struct DecomposedMpm2D::Impl {
   std::array<std::vector<PetscInt>, 2> starts;  // first owned node per process column / row, + end
   double empty_node_mass = 0.0;                 // 1e-12 of the largest particle mass (as the serial step)
   DecomposedTraffic traffic;
+  std::vector<std::uint8_t> fixed_mask;  // per owned node (x fastest): bit d set, component d fixed to 0
+  // Contact (contact_phases.cpp): settings per ordered material pair, the owned nodes where two or
+  // more fields have mass (indices into the owned block), frictional work per owned node (last step)
+  // and since the start on this rank, counters of the last step on this rank.
+  std::vector<ContactPairSettings> pair_table;  // materials², [a·n + b]
+  std::vector<std::array<PetscInt, 2>> contact_nodes;  // (owned node q, local node l)
+  std::vector<double> work_first, work_second;
+  double cumulative_first = 0.0, cumulative_second = 0.0;
+  DecomposedContactStats stats;
   std::vector<Stencil<2, LinearKernel>> stencils_linear;
   std::vector<Stencil<2, UGIMPKernel>> stencils_ugimp;
   std::vector<Stencil<2, QuadraticBSplineKernel>> stencils_quadratic;
@@ -97,12 +155,24 @@ struct DecomposedMpm2D::Impl {
   /// The rank owning the node nearest to x.
   int owner_of(const double* x) const;
 
-  // The phases (usl_phases.cpp) and the migration (decomposition.cpp).
+  void setup_contact();  // contact_phases.cpp: checks and pair_table
+  void setup_fixed_faces();
+  void setup_sparse_exchange();  // sparse_exchange.cpp: node_sf, owned_local, field_unit
+
+  // The phases (usl_phases.cpp, contact_phases.cpp) and the migration (decomposition.cpp).
   template <class Kernel>
   void particle_to_grid(double dt);
   void sum_to_owners(double dt);
-  void grid_update(double dt);
+  void exchange_field_ranges(double dt);
+  void fields_to_owners(double dt);
+  void find_contact_nodes(double dt);
+  void contact_extrapolated(double dt);
+  void momentum_update(double dt);
+  void contact_updated(double dt);
+  void nodal_velocities(double dt);
   void ghost_velocities(double dt);
+  void fields_to_ghosts(double dt);
+  void resolve_contact(bool updated, double dt);
   template <class Kernel>
   void grid_to_particle(double dt);
   template <class Kernel>

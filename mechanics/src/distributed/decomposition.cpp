@@ -65,6 +65,9 @@ SwarmFields::~SwarmFields() {
 }
 
 DecomposedMpm2D::Impl::~Impl() {
+  PetscSFDestroy(&entry_sf);
+  PetscSFDestroy(&node_sf);
+  if (field_unit != MPI_DATATYPE_NULL) MPI_Type_free(&field_unit);
   VecDestroy(&local);
   VecDestroy(&global);
   DMDestroy(&swarm);
@@ -84,21 +87,34 @@ int DecomposedMpm2D::Impl::owner_of(const double* x) const {
 
 DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Material& material,
                                  const DecomposedOptions& options)
+    : DecomposedMpm2D(comm, grid, std::vector<Material>{material}, options) {}
+
+DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::vector<Material>& materials,
+                                 const DecomposedOptions& options)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
-  if (material.kind != MaterialKind::linear_elastic)
-    throw std::invalid_argument("decomposed mechanics: material '" + material.name + "' has kind '" +
-                                to_string(material.kind) + "' (expected linear_elastic)");
+  if (materials.empty()) throw std::invalid_argument("decomposed mechanics: no material given");
+  for (const Material& material : materials)
+    if (material.kind != MaterialKind::linear_elastic)
+      throw std::invalid_argument("decomposed mechanics: material '" + material.name + "' has kind '" +
+                                  to_string(material.kind) + "' (expected linear_elastic)");
+  for (const FixedFace& face : options.fixed_faces)
+    if (face.axis < 0 || face.axis >= 2)
+      throw std::invalid_argument("decomposed mechanics: fixed face axis " + std::to_string(face.axis) +
+                                  " (expected 0 or 1)");
   s.width = stencil_reach(options.shape);
   s.comm = comm;
   MPI_Comm_rank(comm, &s.rank);
   MPI_Comm_size(comm, &s.size);
   s.grid = grid;
-  s.material = material;
+  s.materials = materials;
   s.opt = options;
+  s.setup_contact();  // checks the contact settings before any collective PETSc call
+  s.fields = options.contact ? static_cast<int>(materials.size()) : 1;
+  s.per_field = options.contact ? node_dof::with_contact : node_dof::without_contact;
   const IVec<2>& nodes = grid.nodes_per_dim();
   petsc_check(DMDACreate2d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, nodes[0], nodes[1],
-                           PETSC_DECIDE, PETSC_DECIDE, node_dof::count, s.width, nullptr, nullptr, &s.da),
+                           PETSC_DECIDE, PETSC_DECIDE, s.dof, s.width, nullptr, nullptr, &s.da),
               "DMDACreate2d");
   petsc_check(DMSetUp(s.da), "DMSetUp(DMDA)");
   const Vec<2> first = grid.lo() - grid.cell_size(), last = grid.hi() + grid.cell_size();  // ghost layer
@@ -137,6 +153,8 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Mater
   reg(swarm_field::stress, 4, PETSC_DOUBLE);
   reg(swarm_field::stress_zz, 1, PETSC_DOUBLE);
   reg(swarm_field::deformation, 4, PETSC_DOUBLE);
+  reg(swarm_field::material, 1, PETSC_INT);
+  reg(swarm_field::initial_position, 2, PETSC_DOUBLE);
   petsc_check(DMSwarmFinalizeFieldRegister(s.swarm), "DMSwarmFinalizeFieldRegister");
   petsc_check(DMSwarmSetLocalSizes(s.swarm, 0, 64), "DMSwarmSetLocalSizes");
   petsc_check(DMSetUp(s.swarm), "DMSetUp(DMSwarm)");
@@ -148,12 +166,16 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Mater
 
   // Traffic bookkeeping: ghost nodes of this rank and the bytes of one particle (every field).
   s.traffic.ghost_nodes = static_cast<long>(s.gxm * s.gym - s.xm * s.ym);
-  s.traffic.values_per_node = node_dof::count;
+  s.traffic.values_per_node = s.dof;
+  s.traffic.field_entry_bytes = s.per_field * static_cast<int>(sizeof(double));
+  s.setup_fixed_faces();
+  s.setup_sparse_exchange();
   int bytes = 0;
   for (const char* name : {DMSwarmPICField_coor, DMSwarmField_pid, DMSwarmField_rank, DMSwarmPICField_cellid,
                            swarm_field::id, swarm_field::mass, swarm_field::volume, swarm_field::volume0,
                            swarm_field::velocity, swarm_field::half_size, swarm_field::stress,
-                           swarm_field::stress_zz, swarm_field::deformation}) {
+                           swarm_field::stress_zz, swarm_field::deformation, swarm_field::material,
+                           swarm_field::initial_position}) {
     PetscInt bs = 0;
     PetscDataType type;
     void* ptr = nullptr;
@@ -175,6 +197,10 @@ void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& parti
     if (!s.grid.contains(p.position))
       throw std::invalid_argument("decomposed mechanics: particle " + std::to_string(p.id) +
                                   " lies outside the grid's region");
+    if (p.material < 0 || p.material >= static_cast<int>(s.materials.size()))
+      throw std::invalid_argument("decomposed mechanics: particle " + std::to_string(p.id) + " has material " +
+                                  std::to_string(p.material) + " (expected 0 … " +
+                                  std::to_string(s.materials.size() - 1) + ")");
     mmax = std::max(mmax, p.mass);
   }
   MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
@@ -192,12 +218,13 @@ void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& parti
       f.mass[k] = p.mass;
       f.volume[k] = f.volume0[k] = p.volume;
       for (int d = 0; d < 2; ++d) {
-        f.x[2 * k + d] = p.position[d];
+        f.x[2 * k + d] = f.x0[2 * k + d] = p.position[d];
         f.velocity[2 * k + d] = p.velocity[d];
         f.half_size[2 * k + d] = p.half_size[d];
       }
       Eigen::Map<Mat<2>>(f.stress + 4 * k) = p.stress;
       f.stress_zz[k] = p.stress_zz;
+      f.material[k] = static_cast<PetscInt>(p.material);
       Eigen::Map<Mat<2>>(f.F + 4 * k) = Mat<2>::Identity();
     }
   }
@@ -248,6 +275,24 @@ std::size_t DecomposedMpm2D::local_particles() const {
   return static_cast<std::size_t>(n);
 }
 const DecomposedTraffic& DecomposedMpm2D::traffic() const { return impl_->traffic; }
+int DecomposedMpm2D::velocity_fields() const { return impl_->fields; }
+
+// Fixed faces as Simulation::fix_face: nodes at lattice index ≤ 0 (lower) or ≥ cells (upper) along
+// the axis, i.e. DMDA index ≤ 1 or ≥ cells + 1 (DMDA index = lattice + Grid<2>::ghost).
+void DecomposedMpm2D::Impl::setup_fixed_faces() {
+  fixed_mask.assign(static_cast<std::size_t>(xm * ym), 0);
+  for (const FixedFace& face : opt.fixed_faces) {  // axes checked by the constructor
+    const PetscInt last = grid.cells()[face.axis] + Grid<2>::ghost;
+    for (PetscInt j = ys; j < ys + ym; ++j)
+      for (PetscInt i = xs; i < xs + xm; ++i) {
+        const PetscInt l = face.axis == 0 ? i : j;
+        if (face.upper ? l < last : l > Grid<2>::ghost) continue;
+        for (int d = 0; d < 2; ++d)
+          if (face.components[static_cast<std::size_t>(d)])
+            fixed_mask[static_cast<std::size_t>((j - ys) * xm + (i - xs))] |= static_cast<std::uint8_t>(1u << d);
+      }
+  }
+}
 
 long long DecomposedMpm2D::global_particles() const {
   long long n = static_cast<long long>(local_particles());
@@ -292,7 +337,8 @@ std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
     v[4] = f.velocity[2 * k], v[5] = f.velocity[2 * k + 1], v[6] = f.half_size[2 * k], v[7] = f.half_size[2 * k + 1];
     for (int c = 0; c < 4; ++c) v[8 + c] = f.stress[4 * k + c];
     v[12] = f.stress_zz[k];
-    v[13] = v[14] = v[15] = 0.0;
+    v[13] = static_cast<double>(f.material[k]);
+    v[14] = v[15] = 0.0;
   }
   const int ranks = impl_->size;
   std::vector<int> counts(static_cast<std::size_t>(ranks)), displs(static_cast<std::size_t>(ranks));
@@ -316,6 +362,7 @@ std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
     p.half_size = Vec<2>(v[6], v[7]);
     p.stress = Eigen::Map<const Mat<2>>(v + 8);
     p.stress_zz = v[12];
+    p.material = static_cast<int>(v[13]);
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;

@@ -1,25 +1,49 @@
 #pragma once
-// Decomposed 2D MPM on PETSc (issue 16, item 1, first piece): the structured grid as a DMDA whose
-// points are the grid's nodes (the serial Grid<2>'s nodes, its ghost layer included), particles in a
-// DMSwarm of type DMSWARM_PIC with the DMDA as cell DM, and one explicit USL step of one
-// linear-elastic material without contact, written as a list of named phases in which the three
-// exchanges are phases of their own (docs/distributed.md):
+// Decomposed 2D MPM on PETSc (issue 16, item 1): the structured grid as a DMDA whose points are the
+// grid's nodes (the serial Grid<2>'s nodes, its ghost layer included), particles in a DMSwarm of type
+// DMSWARM_PIC with the DMDA as cell DM, and one explicit USL step of linear-elastic materials with
+// optional multimaterial contact and frictional heating (Nairn, Bardenhagen & Smith 2018), fixed
+// grid faces and gravity, written as a list of named phases in which the three exchanges are phases
+// of their own (docs/distributed.md):
 //
-//   particle_to_grid   local: m_i, p_i, f_i scattered into the ghosted local vector (N·1–3)
-//   sum_to_owners      exchange: DMLocalToGlobal(ADD_VALUES), ghost contributions summed into owners
-//   grid_update        owned nodes: p_i += f_i dt, v_i = p_i/m_i, a_i = f_i/m_i
-//   ghost_velocities   exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get v_i, a_i
-//   grid_to_particle   FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i
-//   stress_update      L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ (material.hpp)
-//   migrate            exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
+//   particle_to_grid       local: per velocity field m_i, p_i, f_i (N·1–3) and, with contact,
+//                          Σ S m x (or the displacement form), Ω_i, g_i (N·4–6, 9)
+//   sum_to_owners          exchange: every node's m, p, f summed over its fields into the DMDA,
+//                          DMLocalToGlobal(ADD_VALUES) into the owners
+//   exchange_field_ranges  exchange (PetscSF): which materials reach each node, completed at the
+//                          owner; the multi-material flag back to every rank holding the node
+//   fields_to_owners       exchange (PetscSF): per-material sums at multi-material ghost nodes into the owner
+//   find_contact_nodes     owned nodes where two or more fields have mass
+//   contact_extrapolated   contact on the extrapolated momenta (N·7–18), node-local
+//   momentum_update        owned nodes: fixed faces (p, f components zeroed), p_i += f_i dt
+//   contact_updated        contact on p^{n+1} with consistent forces (N·19) and frictional work (N·27, 34, 36, 40)
+//   nodal_velocities       owned nodes: v_i = p_i/m_i, a_i = f_i/m_i
+//   ghost_velocities       exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get the totals' v_i, a_i
+//   fields_to_ghosts       exchange (PetscSF): per-material v_i, a_i back to the ranks that sent the sums
+//   grid_to_particle       FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i (the particle's own field)
+//   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ (material.hpp)
+//   migrate                exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
+//
+// Velocity fields: without contact every material shares one field (as the serial Simulation);
+// with contact each material has its own. A node that one material reaches (on every rank) needs no
+// per-material data: the DMDA's total is that material's field. Only at shared nodes that two or
+// more materials reach do per-material values travel, as (node, material) entries over a PetscSF
+// rebuilt each step (mechanics/src/distributed/sparse_exchange.cpp). Each rank still stores every
+// field densely over its ghosted box (materials × 10 doubles per node): fine for a few materials,
+// not for a PBX with hundreds of grains (per-material boxes, as the serial step has, are the next
+// step; docs/distributed.md).
 //
 // Ownership: a particle belongs to the rank that owns the grid node nearest to it (the node's dual
 // cell [x_n − h/2, x_n + h/2)). With that rule the stencil of the linear, uGIMP (l_p ≤ h/2) and
 // quadratic B-spline kernels reaches one node beyond the nearest node on either side, so the DMDA's
 // stencil width is 1; it is measured from the kernel's own evaluation (stencil_reach), not assumed.
 // The extended B-spline is refused (its weights are built per body, not per particle).
+// Contact is resolved at owned nodes only, after the one exchange that completes their sums, by the
+// serial module's node-local code (mechanics/src/contact_pair.hpp).
 // Only this library needs PETSc; its header needs MPI only.
+#include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/grid.hpp>
+#include <frictherm/mechanics/loads.hpp>
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
 #include <frictherm/mechanics/types.hpp>
@@ -63,12 +87,32 @@ struct DecomposedParticle {
   Vec<2> half_size = Vec<2>::Zero();  // uGIMP half-widths l_p (fixed)
   Mat<2> stress = Mat<2>::Zero();
   double stress_zz = 0.0;
+  int material = 0;  // index into the materials given to DecomposedMpm2D
+};
+
+/// Settings of one material pair in contact (as Simulation::set_contact_pair).
+struct DecomposedContactPair {
+  int material_a = 0, material_b = 1;
+  ContactPairSettings settings;
 };
 
 struct DecomposedOptions {
   ShapeKind shape = ShapeKind::linear;
   Analysis analysis = Analysis::plane_strain;
+  double thickness = 1.0;           // 2D out-of-plane thickness (m), as SimulationOptions::thickness
   Vec<2> gravity = Vec<2>::Zero();  // body force per unit mass (m/s²)
+  std::vector<FixedFace> fixed_faces;  // grid faces with velocity components fixed to 0 (Simulation::fix_face)
+  /// Multimaterial contact (one velocity field per material), as Simulation::enable_contact and
+  /// set_contact_pair. Supported: multimaterial pairs with any friction law, separation position,
+  /// displacement or velocity_only; refused: penalty pairs, extent separation, regularisation.
+  bool contact = false;
+  ContactOptions contact_options;
+  std::vector<DecomposedContactPair> contact_pairs;
+};
+
+/// Contact counters of the last step, summed over ranks (as the serial ContactStats).
+struct DecomposedContactStats {
+  long contact_nodes = 0, multi_nodes = 0, sliding_nodes = 0, guarded = 0;
 };
 
 /// Traffic of the exchange phases, this rank's view, accumulated over steps.
@@ -79,14 +123,22 @@ struct DecomposedTraffic {
   long particles_sent = 0;            // by migration, over all steps
   long particles_received = 0;
   int particle_bytes = 0;             // payload per migrated particle (all swarm fields)
-  std::array<double, 7> phase_seconds{};  // per phase, in phase_names() order
+  // Per-field exchanges (contact): ghost nodes this rank found multi-material and (ghost node,
+  // field) entries it sent to their owners (and received back), over all steps; bytes per entry.
+  long multi_ghost_nodes = 0;
+  long field_entries_sent = 0;
+  int field_entry_bytes = 0;
+  std::array<double, 14> phase_seconds{};  // per phase, in phase_names() order
 };
 
 class DecomposedMpm2D {
  public:
   /// Collective over comm. The grid is the serial Grid<2> (nodes −1 … cells+1 per direction);
   /// PETSc must be initialised. Throws std::invalid_argument for a material other than
-  /// linear_elastic or for the extended B-spline.
+  /// linear_elastic, for the extended B-spline and for unsupported contact settings.
+  DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::vector<Material>& materials,
+                  const DecomposedOptions& options);
+  /// One material.
   DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Material& material, const DecomposedOptions& options);
   ~DecomposedMpm2D();
   DecomposedMpm2D(const DecomposedMpm2D&) = delete;
@@ -98,7 +150,7 @@ class DecomposedMpm2D {
 
   /// One USL step of size dt (collective): the phases listed above, in that order.
   void step(double dt);
-  static const std::array<const char*, 7>& phase_names();
+  static const std::array<const char*, 14>& phase_names();
 
   int stencil_width() const;
   /// DMDA processes per direction (m, n) and this rank's owned node range [begin, end) per direction
@@ -113,6 +165,15 @@ class DecomposedMpm2D {
   double total_mass() const;
   Vec<2> total_momentum() const;
   double total_momentum_scale() const;  // Σ m_p |v_p|
+  /// Velocity fields per node (1 without contact, one per material with it).
+  int velocity_fields() const;
+  /// Frictional work of the last step at this rank's owned nodes (J; x fastest over owned_nodes()),
+  /// added once per contact node (N·27, 34, 36, 40). Zeros without contact.
+  const std::vector<double>& frictional_work(HeatingOrder order) const;
+  /// Collective: frictional work since the start, summed over owned nodes and ranks (J).
+  double cumulative_frictional_work(HeatingOrder order) const;
+  /// Collective: the last step's contact counters summed over ranks.
+  DecomposedContactStats contact_stats() const;
   /// Collective: every particle of every rank, sorted by id, on every rank.
   std::vector<DecomposedParticle> gather() const;
 

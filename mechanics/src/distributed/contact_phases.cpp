@@ -1,0 +1,186 @@
+// Multimaterial contact and frictional heating in the decomposed step (frictherm/mechanics/
+// distributed.hpp; Nairn, Bardenhagen & Smith 2018 §2.2–2.12). After fields_to_owners every owned
+// node that two or more materials reach holds the complete per-material sums (m, p, f, Σ S m x, Ω, g)
+// of all ranks (sparse_exchange.cpp), so contact is resolved node-locally at owned nodes by the
+// serial module's code (contact_pair.hpp: normal eq. 7, detection eqs. 8–10, area eq. 11, stick
+// change eqs. 12–15, friction law eqs. 16–25, consistent forces eq. 19, frictional work eqs. 27, 34,
+// 36, 40), and fields_to_ghosts hands the resulting per-material v, a to the ranks that sent them.
+// The gathering of a node's sides follows the serial Simulation::gather_contact_sides (materials
+// above min_mass_fraction of the node's mass, in material order; slivers marked).
+#include "distributed/decomposed_state.hpp"
+
+#include "contact_pair.hpp"
+
+#include <mpi.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::mechanics {
+
+// Checks the contact settings (the serial enable_contact / set_contact_pair rules plus what the
+// decomposed step does not support) and fills pair_table as the serial contact_pair(a, b) reads:
+// the default pair for pairs not set, an explicit pair (a, b) as given, (b, a) with the normal
+// reversed, a specified normal made unit.
+void DecomposedMpm2D::Impl::setup_contact() {
+  const std::size_t n = materials.size();
+  if (!opt.contact) {
+    if (!opt.contact_pairs.empty())
+      throw std::invalid_argument("decomposed mechanics: contact_pairs given but contact is off (set contact = true)");
+    return;
+  }
+  const ContactOptions& co = opt.contact_options;
+  const std::string where = "decomposed mechanics: contact ";
+  if (co.separation == SeparationMethod::extent)
+    throw std::invalid_argument(where + "separation 'extent' is not supported (expected position, displacement or "
+                                        "velocity_only): it needs particle domains across ranks");
+  if (co.regularized())
+    throw std::invalid_argument(where + "normal-stress regularisation is not supported (expected "
+                                        "regularization_slip_length = 0 or regularization_time = 0)");
+  if (!(co.position_correction >= 0.0 && co.position_correction < 2.0))
+    throw std::invalid_argument(where + "position_correction must be in [0, 2) cell sizes");
+  if (!(co.min_mass_fraction >= 0.0 && co.min_mass_fraction < 0.5))
+    throw std::invalid_argument(where + "min_mass_fraction must be in [0, 0.5)");
+  auto multimaterial_only = [&](const ContactPairSettings& s, const std::string& pair) {
+    if (s.method == ContactMethod::penalty)
+      throw std::invalid_argument(where + pair + ": method 'penalty' is not supported in a decomposed run (expected "
+                                  "'multimaterial'; penalty contact stays serial)");
+  };
+  multimaterial_only(co.default_pair, "default pair");
+  pair_table.assign(n * n, co.default_pair);
+  for (const DecomposedContactPair& p : opt.contact_pairs) {
+    const int a = p.material_a, b = p.material_b;
+    const std::string pair = "pair (" + std::to_string(a) + ", " + std::to_string(b) + ")";
+    if (a < 0 || b < 0 || a >= static_cast<int>(n) || b >= static_cast<int>(n) || a == b)
+      throw std::invalid_argument(where + pair + ": expected two different materials in 0 … " + std::to_string(n - 1));
+    multimaterial_only(p.settings, pair);
+    ContactPairSettings s = p.settings;
+    if (s.normal == NormalMethod::specified) {
+      const double len = s.normal_vector.head<2>().norm();
+      if (!(len > 0.0)) throw std::invalid_argument(where + pair + ": a specified normal must be non-zero");
+      s.normal_vector /= len;
+    }
+    ContactPairSettings flipped = s;  // seen from b: the normal points from b to a
+    flipped.normal_vector = -s.normal_vector;
+    pair_table[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = s;
+    pair_table[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = flipped;
+  }
+}
+
+// Phase 5, owned nodes: the multi-material ones where two or more fields have mass (the serial
+// find_contact_nodes); the step's frictional work per owned node starts at zero.
+void DecomposedMpm2D::Impl::find_contact_nodes(double /*dt*/) {
+  const PetscInt owned = xm * ym;
+  work_first.assign(static_cast<std::size_t>(owned), 0.0);
+  work_second.assign(static_cast<std::size_t>(owned), 0.0);
+  contact_nodes.clear();
+  if (!opt.contact) return;
+  for (PetscInt q = 0; q < owned; ++q) {
+    const PetscInt l = owned_local[static_cast<std::size_t>(q)];
+    const std::size_t u = static_cast<std::size_t>(l);
+    if (!multi[u]) continue;
+    int present = 0;
+    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl)
+      if (field_at(l, static_cast<int>(fl))[node_dof::mass] > empty_node_mass) ++present;
+    if (present >= 2) contact_nodes.push_back({q, l});
+  }
+}
+
+// Phase 6: contact on the extrapolated momenta (momentum changes only).
+void DecomposedMpm2D::Impl::contact_extrapolated(double dt) { resolve_contact(false, dt); }
+
+// Phase 8: contact on p^{n+1}, forces kept consistent (eq. 19), frictional work (eqs. 27, 34, 36, 40).
+void DecomposedMpm2D::Impl::contact_updated(double dt) { resolve_contact(true, dt); }
+
+void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
+  using namespace node_dof;
+  if (updated) stats = DecomposedContactStats{};
+  if (contact_nodes.empty()) return;
+  const ContactOptions& co = opt.contact_options;
+  const std::size_t n = materials.size();
+  const Vec<2> h = grid.cell_size();
+  const double cell_volume = grid.cell_volume() * opt.thickness;
+  contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
+                                  dt, updated};
+  auto pair_of = [&](int x, int y) -> const ContactPairSettings& {
+    return pair_table[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)];
+  };
+  // Per-node scratch, reused from call to call (no allocation per step once grown).
+  thread_local std::vector<ContactSide<2>> sides;
+  thread_local std::vector<int> mats;
+  thread_local std::vector<double*> values;
+  thread_local std::vector<Vec<2>> dps;
+  for (const auto& [q, l] : contact_nodes) {
+    const std::size_t u = static_cast<std::size_t>(l);
+    double node_mass = 0.0;
+    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
+      const double m = field_at(l, static_cast<int>(fl))[mass];
+      if (m > empty_node_mass) node_mass += m;
+    }
+    sides.clear(), mats.clear(), values.clear();
+    long guarded = 0;
+    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
+      double* v = field_at(l, static_cast<int>(fl));
+      const double m = v[mass];
+      if (!(m > empty_node_mass)) continue;
+      if (m < co.min_mass_fraction * node_mass) {
+        ++guarded;
+        continue;
+      }
+      ContactSide<2> sd;
+      sd.mass = m;
+      sd.momentum = Vec<2>(v[momentum], v[momentum + 1]);
+      sd.force = Vec<2>(v[force], v[force + 1]);
+      sd.mass_position = Vec<2>(v[mass_position], v[mass_position + 1]);
+      sd.domain = v[domain];
+      sd.domain_gradient = Vec<2>(v[domain_gradient], v[domain_gradient + 1]);
+      sd.sliver = m < co.sliver_fraction * node_mass;
+      sides.push_back(sd);
+      mats.push_back(static_cast<int>(fl));  // with contact, field = material
+      values.push_back(v);
+    }
+    if (updated) {
+      stats.guarded += guarded;
+      ++stats.contact_nodes;
+      if (sides.size() > 2) ++stats.multi_nodes;
+    }
+    const std::size_t uq = static_cast<std::size_t>(q);
+    contact_detail::resolve_contact_node(
+        sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
+        [&](std::size_t j, const Vec<2>& dp) {
+          double* v = values[j];
+          for (int d = 0; d < 2; ++d) {
+            v[momentum + d] += dp[d];
+            if (updated) v[force + d] += dp[d] / dt;  // eq. 19
+          }
+        },
+        [&](int, int, double w1, double w2) {
+          if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // never inject NaN heat (as the serial step)
+          work_first[uq] += w1;
+          work_second[uq] += w2;
+          cumulative_first += w1;
+          cumulative_second += w2;
+        },
+        stats.sliding_nodes);
+  }
+}
+
+const std::vector<double>& DecomposedMpm2D::frictional_work(HeatingOrder order) const {
+  return order == HeatingOrder::first ? impl_->work_first : impl_->work_second;
+}
+
+double DecomposedMpm2D::cumulative_frictional_work(HeatingOrder order) const {
+  double w = order == HeatingOrder::first ? impl_->cumulative_first : impl_->cumulative_second;
+  MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
+}
+
+DecomposedContactStats DecomposedMpm2D::contact_stats() const {
+  const DecomposedContactStats& s = impl_->stats;
+  long v[4] = {s.contact_nodes, s.multi_nodes, s.sliding_nodes, s.guarded};
+  MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_LONG, MPI_SUM, impl_->comm);
+  return DecomposedContactStats{v[0], v[1], v[2], v[3]};
+}
+
+}  // namespace frictherm::mechanics
