@@ -254,6 +254,11 @@ void DecomposedMpm2D::Impl::migrate(double /*dt*/) {
     DMSwarmRestoreField(swarm, DMSwarmField_rank, nullptr, nullptr, reinterpret_cast<void**>(&dest));
     DMSwarmRestoreField(swarm, DMSwarmPICField_coor, nullptr, nullptr, reinterpret_cast<void**>(&x));
   }
+  // DMSwarmMigrate walks every particle and talks to every rank; most steps no particle changes
+  // owner (one sum over the ranks says so) and it is skipped.
+  long leaving = 0;
+  MPI_Allreduce(&sent, &leaving, 1, MPI_LONG, MPI_SUM, comm);
+  if (leaving == 0) return;
   petsc_check(DMSwarmMigrate(swarm, PETSC_TRUE), "DMSwarmMigrate");
   PetscInt after = 0;
   petsc_check(DMSwarmGetLocalSize(swarm, &after), "DMSwarmGetLocalSize");
