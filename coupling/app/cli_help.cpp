@@ -55,7 +55,11 @@ const char* const kRunHelp =
     "(130 for SIGINT, 143 for SIGTERM); a second signal ends the program at once. Series rows reach\n"
     "the file at least every 2 s of wall time.\n"
     "While it runs the output is OUT.h5.<pid>.part (readable at any time); it is renamed to OUT.h5 when\n"
-    "the run ends (completed, failed or interrupted), so a second run writing OUT.h5 cannot destroy it.\n";
+    "the run ends (completed, failed or interrupted), so a second run writing OUT.h5 cannot destroy it.\n"
+    "\n"
+    "One process runs the whole scene (threads: --threads). `mpirun -n K frictherm run` is refused: the\n"
+    "domain-decomposed engine (docs/distributed.md) is a library for now, for 2D linear-elastic\n"
+    "multimaterial contact with frictional work; penalty contact stays serial and is refused there.\n";
 
 const char* const kValidateHelp =
     "usage: frictherm validate SCENE [--set KEY=VALUE ...]\n"
