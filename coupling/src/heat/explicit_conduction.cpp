@@ -66,8 +66,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   kept_flux_.resize(p.size());
   next_mct_valid_ = false;
   gathered_at_.assign(p.position.begin(), p.position.end());
-  unknown_lo_.assign(p.size(), 1);  // empty ranges until keep()
-  unknown_hi_.assign(p.size(), 0);
+  unknown_runs_.assign(p.size() * kMaxRuns, UnknownRun{1, 0});  // empty until keep()
   quiet_.assign(p.size(), 0);
   flux_temperature_.resize(0);  // new unknowns: every particle is looked at in the next sub-step
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
@@ -155,9 +154,20 @@ void ExplicitConduction<Dim>::keep(std::size_t k, const Nodes& nl, const Thermal
       g_dropped += nl.G[a];
     }
   }
-  // The range of its unknowns (the per-window passes skip it while no node in the range changed).
-  unknown_lo_[k] = c.count > 0 ? *std::min_element(c.unknown, c.unknown + c.count) : 1;
-  unknown_hi_[k] = c.count > 0 ? *std::max_element(c.unknown, c.unknown + c.count) : 0;
+  // The per-window passes skip it while none of its unknowns changed (any_changed).
+  // Its unknowns as runs of numbers: the stencil lists them x fastest, so a new row starts where the
+  // number jumps by more than a row of the stencil could (the unknowns of a grid row are numbered
+  // in order). Up to kMaxRuns runs; the last takes the rest.
+  UnknownRun* runs = &unknown_runs_[k * kMaxRuns];
+  std::fill(runs, runs + kMaxRuns, UnknownRun{1, 0});
+  int r = 0;
+  for (int a = 0; a < c.count; ++a) {
+    const int u = c.unknown[a];
+    if (a > 0 && r + 1 < kMaxRuns && (u < runs[r].lo || u > runs[r].hi + capacity)) ++r;
+    if (runs[r].lo > runs[r].hi) runs[r] = {u, u};
+    runs[r].lo = std::min(runs[r].lo, u);
+    runs[r].hi = std::max(runs[r].hi, u);
+  }
   quiet_[k] = 0;
   // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
   if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) return;
@@ -332,6 +342,16 @@ double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, cons
 }
 
 template <int Dim>
+bool ExplicitConduction<Dim>::any_changed(std::size_t k) const {
+  const UnknownRun* runs = &unknown_runs_[k * kMaxRuns];
+  for (int r = 0; r < kMaxRuns; ++r)
+    if (runs[r].lo <= runs[r].hi &&
+        changed_before_[static_cast<std::size_t>(runs[r].hi) + 1] != changed_before_[static_cast<std::size_t>(runs[r].lo)])
+      return true;
+  return false;
+}
+
+template <int Dim>
 Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, const Eigen::VectorXd& temperature,
                                                  const Eigen::VectorXd& joules, const std::vector<FixedNode>& fixed,
                                                  double window, long substeps) {
@@ -351,7 +371,7 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
     force_.setZero();
     // Nodes whose temperature changed since the last sub-step, as a prefix count over the unknowns:
     // a particle whose nodes all kept theirs and that was quiet then is quiet now, and is passed over
-    // reading 10 bytes instead of its kept list.
+    // reading a few bytes instead of its kept list.
     const bool first = flux_temperature_.size() != n;
     changed_before_.resize(static_cast<std::size_t>(n) + 1);
     changed_before_[0] = 0;
@@ -360,9 +380,7 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
           changed_before_[static_cast<std::size_t>(u)] + (first || T[u] != flux_temperature_[u] ? 1 : 0);
     flux_temperature_ = T;
     for (std::size_t k = 0; k < kept_flux_.size(); ++k) {
-      if (quiet_[k] && changed_before_[static_cast<std::size_t>(unknown_hi_[k]) + 1] ==
-                           changed_before_[static_cast<std::size_t>(unknown_lo_[k])])
-        continue;
+      if (quiet_[k] && !any_changed(k)) continue;
       const KeptFlux& c = kept_flux_[k];
       if (c.conductance == 0.0) {
         quiet_[k] = 1;  // carries no flux whatever its nodes do
@@ -399,16 +417,14 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
   if (!next_mct_valid_ || next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
     throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
   // Unknowns whose temperature changed in the window, as a prefix count: a particle with none in the
-  // range of its unknowns keeps its temperature (ΔT_p = 0 exactly) and is passed over.
+  // runs of its unknowns keeps its temperature (ΔT_p = 0 exactly) and is passed over.
   const auto n = static_cast<std::size_t>(sys.size());
   changed_before_.resize(n + 1);
   changed_before_[0] = 0;
   for (std::size_t u = 0; u < n; ++u)
     changed_before_[u + 1] = changed_before_[u] + (relax || delta[static_cast<Eigen::Index>(u)] != 0.0 ? 1 : 0);
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (changed_before_[static_cast<std::size_t>(unknown_hi_[k]) + 1] ==
-        changed_before_[static_cast<std::size_t>(unknown_lo_[k])])
-      continue;  // also every particle that holds no heat or reaches no unknown (empty range)
+    if (!any_changed(k)) continue;  // also every particle that holds no heat or reaches no unknown (no run)
     const KeptMass& c = kept_mass_[k];
     if (c.count == 0) continue;
     // design §4: the increment, not the nodal value

@@ -157,10 +157,16 @@ class ExplicitConduction {
   std::vector<Nodes> moved_nodes_;         // refresh scratch: their stencils now, in moved_ order
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
   // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
-  // streaming every particle's kept lists): per particle the range of its unknowns and whether its
+  // streaming every particle's kept lists): per particle the runs of its unknown numbers (row by row) and whether its
   // nodal temperatures agreed to round-off when last looked at; per unknown the temperature of the
   // last sub-step, and a prefix count of the nodes that changed.
-  std::vector<int> unknown_lo_, unknown_hi_;  // by particle; lo > hi: no unknown
+  struct UnknownRun {
+    int lo, hi;  // lo > hi: empty
+  };
+  static constexpr int kMaxRuns = Dim == 2 ? 3 : 9;  // rows of the widest stencil
+  std::vector<UnknownRun> unknown_runs_;      // kMaxRuns per particle: its unknowns, row by row
+  /// Whether an unknown of particle k changed (changed_before_ of this pass).
+  bool any_changed(std::size_t k) const;
   std::vector<unsigned char> quiet_;          // by particle
   Eigen::VectorXd flux_temperature_;          // T_i of the last sub-step (empty: look at every particle)
   std::vector<int> changed_before_;           // scratch: changed unknowns with index < u
