@@ -191,9 +191,9 @@ TEST(DecomposedHeat, SlidingBlockEqualsTheSerialRunAndClosesItsBooks) {
   EXPECT_LE(b.max_capacity_residual, 1e-12);  // Σ_i M_i = Σ_p m_p C_p (partition of unity)
   if (comm_rank() == 0)
     std::printf("[heated sliding block] %d ranks, %d steps: block %.3f -> %.3f m/s, W2 %.6e J, max rise %.4f K, "
-                "%ld sub-steps; max over steps |dv|/v0 %.2e, |dW2|/W2 %.2e, |dT|/rise %.2e; books (/W2): delivered "
+                "%ld sub-steps, %ld dropped nodes at the end; max over steps |dv|/v0 %.2e, |dW2|/W2 %.2e, |dT|/rise %.2e; books (/W2): delivered "
                 "%.2e, nodal %.2e, particles %.2e, content %.2e; serial books: particles %.2e\n",
-                comm_size(), steps, v0, v_end, ws, rise, b.substeps, dhist / v0, dw / ws, dT / rise,
+                comm_size(), steps, v0, v_end, ws, rise, b.substeps, b.dropped_nodes, dhist / v0, dw / ws, dT / rise,
                 (b.heat_delivered - b.work_received) / ws, (b.nodal_energy_change - b.work_received) / ws,
                 (b.particle_energy_change - b.work_received) / ws, (content - b.work_received) / ws,
                 (coupler.particle_energy_change(sp) - sb.work_received) / ws);
