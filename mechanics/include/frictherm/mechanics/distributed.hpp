@@ -40,6 +40,10 @@
 // The extended B-spline is refused (its weights are built per body, not per particle).
 // Contact is resolved at owned nodes only, after the one exchange that completes their sums, by the
 // serial module's node-local code (mechanics/src/contact_pair.hpp).
+// For coupled physics (the coupling's decomposed heat conduction) the run also carries named
+// per-particle scalars in the swarm and offers the step's maps without physics: the particles' current
+// stencils in local node numbering, local node values summed into their owners, owner values to the
+// ghosts (transfer.cpp).
 // Only this library needs PETSc; its header needs MPI only.
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/grid.hpp>
