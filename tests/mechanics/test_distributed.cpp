@@ -4,7 +4,8 @@
 // blocks of one material give, decomposed, the positions, velocities and stresses of the same run on
 // one rank (MPI_COMM_SELF, in the same process) to round-off; (c) and those of the serial module's
 // Simulation<2> (USL, FLIP, no contact) to round-off; plus the DMDA's stencil width from the
-// kernels' reach and the refusals. Prints the traffic of the exchange phases (docs/distributed.md).
+// kernels' reach and the refusals; (a') the transfers coupled physics uses (particle scalars through
+// migration, node sums at the owners, owner values on the ghosts). Prints the traffic of the exchange phases (docs/distributed.md).
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
 #include "frictherm/mechanics/distributed.hpp"
 #include "frictherm/mechanics/geometry.hpp"
@@ -160,6 +161,70 @@ TEST(DecomposedMechanics, IsolatedBodyKeepsEveryParticleAndConservesMomentum) {
   }
   if (comm_rank() == 0) std::printf("[momentum] largest relative drift %.3e over 150 steps\n", worst);
   print_traffic("isolated body, uGIMP", run);
+}
+
+// ---- (a') the transfers for coupled physics: particle scalars migrate, node sums complete at the
+// owners and owner values reach the ghosts ----
+TEST(DecomposedMechanics, TransfersCarryScalarsAndCompleteNodeSums) {
+  const double h = 1e-3, rho = 1000.0;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {30, 20});
+  fm::DecomposedOptions opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  opt.particle_scalars = {"temperature", "tag"};
+  fm::DecomposedMpm2D run(MPI_COMM_WORLD, grid, elastic(1e7, 0.3, rho), opt);
+  auto velocity = [](const V2&) { return V2(40.0, 25.0); };
+  auto initial = block(V2(6e-3, 4e-3), V2(14e-3, 10e-3), h, 2, rho, 0, velocity);
+  for (auto& p : initial) p.scalars = {300.0 + 0.01 * static_cast<double>(p.id), -static_cast<double>(p.id)};
+  run.add_particles(on_rank0(initial, MPI_COMM_WORLD));
+  const double cp = std::sqrt((elastic(1e7, 0.3, rho).p_wave_modulus(fm::Analysis::plane_strain)) / rho);
+  const double dt = 0.3 * h / (cp + 50.0);
+  for (int s = 0; s < 60; ++s) run.step(dt);  // the body moves ≈ 4 cells, into the next rank
+  long sent = run.traffic().particles_sent;
+  MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  if (comm_size() > 1) {
+    EXPECT_GT(sent, 0L);  // the scalars did travel with migrating particles
+  }
+  const auto fin = run.gather();
+  bool same = fin.size() == initial.size();
+  for (std::size_t k = 0; same && k < fin.size(); ++k)
+    same = fin[k].id == initial[k].id && fin[k].scalars == initial[k].scalars;  // bit for bit
+  EXPECT_TRUE(same);
+  EXPECT_EQ(run.particle_scalar_index("tag"), 1);
+  EXPECT_THROW(run.particle_scalar_index("pressure"), std::invalid_argument);
+
+  // M_i = Σ_p m_p S_ip from every rank's particles summed at the owners: Σ_i M_i = Σ_p m_p (partition
+  // of unity), and with M_i back on the ghosts, Σ_p m_p Σ_i S_ip M_i = Σ_i M_i² (both sides over ranks).
+  const fm::DecomposedStencils& st = run.current_stencils();
+  const fm::DecomposedLocalParticles lp = run.local_particle_data();
+  const std::vector<double> tag = run.particle_scalar(1);
+  std::vector<double> local(static_cast<std::size_t>(run.local_node_count()), 0.0), owned, ghosted;
+  bool tags = tag.size() == lp.id.size();
+  for (std::size_t k = 0; k < lp.id.size(); ++k) {
+    tags = tags && tag[k] == -static_cast<double>(lp.id[k]);
+    for (int a = st.first[k]; a < st.first[k + 1]; ++a)
+      local[static_cast<std::size_t>(st.node[static_cast<std::size_t>(a)])] += lp.mass[k] * st.S[static_cast<std::size_t>(a)];
+  }
+  EXPECT_TRUE(tags);  // the scalars in swarm order belong to the local particles
+  run.sum_to_owned(local, 1, owned);
+  run.owned_to_local(owned, 1, ghosted);
+  double sums[4] = {0.0, 0.0, 0.0, 0.0};  // Σ M_i, Σ m_p, Σ_p m_p Σ_i S_ip M_i, Σ M_i²
+  for (double M : owned) sums[0] += M, sums[3] += M * M;
+  for (std::size_t k = 0; k < lp.id.size(); ++k) {
+    sums[1] += lp.mass[k];
+    for (int a = st.first[k]; a < st.first[k + 1]; ++a)
+      sums[2] += lp.mass[k] * st.S[static_cast<std::size_t>(a)] * ghosted[static_cast<std::size_t>(st.node[static_cast<std::size_t>(a)])];
+  }
+  bool owners_kept = true;  // the owned nodes keep their values through owned_to_local
+  for (std::size_t q = 0; q < owned.size(); ++q)
+    owners_kept = owners_kept && ghosted[static_cast<std::size_t>(run.owned_local_nodes()[q])] == owned[q];
+  EXPECT_TRUE(owners_kept);
+  MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_LE(std::fabs(sums[0] - sums[1]) / sums[1], 1e-14);
+  EXPECT_LE(std::fabs(sums[2] - sums[3]) / sums[3], 1e-14);
+  EXPECT_THROW(run.sum_to_owned(local, fm::DecomposedMpm2D::max_transfer_components + 1, owned), std::invalid_argument);
+  if (comm_rank() == 0)
+    std::printf("[transfers] partition of unity %.2e, ghost identity %.2e\n", std::fabs(sums[0] - sums[1]) / sums[1],
+                std::fabs(sums[2] - sums[3]) / sums[3]);
 }
 
 // ---- (b) the decomposed run equals the same run on one rank ----

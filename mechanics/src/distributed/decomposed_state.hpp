@@ -30,6 +30,7 @@ inline constexpr const char* stress_zz = "frictherm_stress_zz";
 inline constexpr const char* deformation = "frictherm_F";
 inline constexpr const char* material = "frictherm_material";
 inline constexpr const char* initial_position = "frictherm_x0";  // displacement separation (N·9)
+inline constexpr const char* scalars = "frictherm_scalars";  // DecomposedOptions::particle_scalars, when any
 }  // namespace swarm_field
 
 /// Values of one velocity field at a node: after particle_to_grid m, p, f (and with contact Σ S m x,
@@ -136,6 +137,10 @@ struct DecomposedMpm2D::Impl {
   std::vector<double> work_first, work_second;
   double cumulative_first = 0.0, cumulative_second = 0.0;
   DecomposedContactStats stats;
+  int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
+  DecomposedStencils current;            // current_stencils(), valid until the next step or add
+  bool current_valid = false;
+  std::vector<int> owned_local_int;      // owned_local as int (owned_local_nodes())
   std::vector<Stencil<2, LinearKernel>> stencils_linear;
   std::vector<Stencil<2, UGIMPKernel>> stencils_ugimp;
   std::vector<Stencil<2, QuadraticBSplineKernel>> stencils_quadratic;
@@ -155,6 +160,7 @@ struct DecomposedMpm2D::Impl {
   /// The rank owning the node nearest to x.
   int owner_of(const double* x) const;
 
+  std::vector<double> scalar_values() const;  // transfer.cpp: every particle scalar, particle-major
   void setup_contact();  // contact_phases.cpp: checks and pair_table
   void setup_fixed_faces();
   void setup_sparse_exchange();  // sparse_exchange.cpp: node_sf, owned_local, field_unit

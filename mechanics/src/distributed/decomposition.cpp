@@ -155,6 +155,8 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
   reg(swarm_field::deformation, 4, PETSC_DOUBLE);
   reg(swarm_field::material, 1, PETSC_INT);
   reg(swarm_field::initial_position, 2, PETSC_DOUBLE);
+  s.scalars = static_cast<int>(options.particle_scalars.size());
+  if (s.scalars > 0) reg(swarm_field::scalars, s.scalars, PETSC_DOUBLE);
   petsc_check(DMSwarmFinalizeFieldRegister(s.swarm), "DMSwarmFinalizeFieldRegister");
   petsc_check(DMSwarmSetLocalSizes(s.swarm, 0, 64), "DMSwarmSetLocalSizes");
   petsc_check(DMSetUp(s.swarm), "DMSetUp(DMSwarm)");
@@ -185,7 +187,9 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
     petsc_check(DMSwarmRestoreField(s.swarm, name, &bs, &type, &ptr), "DMSwarmRestoreField");
     bytes += static_cast<int>(bs * static_cast<PetscInt>(size));
   }
+  bytes += s.scalars * static_cast<int>(sizeof(double));
   s.traffic.particle_bytes = bytes;
+  s.owned_local_int.assign(s.owned_local.begin(), s.owned_local.end());
 }
 
 DecomposedMpm2D::~DecomposedMpm2D() = default;
@@ -201,6 +205,10 @@ void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& parti
       throw std::invalid_argument("decomposed mechanics: particle " + std::to_string(p.id) + " has material " +
                                   std::to_string(p.material) + " (expected 0 … " +
                                   std::to_string(s.materials.size() - 1) + ")");
+    if (!p.scalars.empty() && p.scalars.size() != static_cast<std::size_t>(s.scalars))
+      throw std::invalid_argument("decomposed mechanics: particle " + std::to_string(p.id) + " has " +
+                                  std::to_string(p.scalars.size()) + " scalars (expected " +
+                                  std::to_string(s.scalars) + ", DecomposedOptions::particle_scalars)");
     mmax = std::max(mmax, p.mass);
   }
   MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
@@ -228,6 +236,17 @@ void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& parti
       Eigen::Map<Mat<2>>(f.F + 4 * k) = Mat<2>::Identity();
     }
   }
+  if (s.scalars > 0) {
+    double* v = nullptr;
+    petsc_check(DMSwarmGetField(s.swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v)),
+                "DMSwarmGetField");
+    for (std::size_t q = 0; q < particles.size(); ++q)
+      for (int c = 0; c < s.scalars; ++c)
+        v[(static_cast<std::size_t>(before) + q) * static_cast<std::size_t>(s.scalars) + static_cast<std::size_t>(c)] =
+            particles[q].scalars.empty() ? 0.0 : particles[q].scalars[static_cast<std::size_t>(c)];
+    DMSwarmRestoreField(s.swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v));
+  }
+  s.current_valid = false;
   const long sent = s.traffic.particles_sent, received = s.traffic.particles_received;
   s.migrate(0.0);
   s.traffic.particles_sent = sent, s.traffic.particles_received = received;  // the set-up is not a step
@@ -331,7 +350,9 @@ double DecomposedMpm2D::total_momentum_scale() const {
 }
 
 std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
-  constexpr int per = 16;  // doubles per particle below
+  const int ns = impl_->scalars;
+  const int per = 14 + ns;  // doubles per particle below
+  const std::vector<double> sc = ns > 0 ? impl_->scalar_values() : std::vector<double>{};
   SwarmFields f(impl_->swarm);
   std::vector<long long> ids(static_cast<std::size_t>(f.n));
   std::vector<double> vals(static_cast<std::size_t>(f.n) * per);
@@ -343,7 +364,7 @@ std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
     for (int c = 0; c < 4; ++c) v[8 + c] = f.stress[4 * k + c];
     v[12] = f.stress_zz[k];
     v[13] = static_cast<double>(f.material[k]);
-    v[14] = v[15] = 0.0;
+    for (int c = 0; c < ns; ++c) v[14 + c] = sc[static_cast<std::size_t>(k * ns + c)];
   }
   const int ranks = impl_->size;
   std::vector<int> counts(static_cast<std::size_t>(ranks)), displs(static_cast<std::size_t>(ranks));
@@ -368,6 +389,7 @@ std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
     p.stress = Eigen::Map<const Mat<2>>(v + 8);
     p.stress_zz = v[12];
     p.material = static_cast<int>(v[13]);
+    p.scalars.assign(v + 14, v + 14 + ns);
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;

@@ -206,6 +206,7 @@ const std::array<const char*, 14>& DecomposedMpm2D::phase_names() {
 
 void DecomposedMpm2D::step(double dt) {
   Impl& s = *impl_;
+  s.current_valid = false;  // the particles move: current_stencils() evaluates them again
   dispatch_shape(s.opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
     using Phase = void (Impl::*)(double);

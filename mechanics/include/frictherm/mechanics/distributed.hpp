@@ -40,6 +40,10 @@
 // The extended B-spline is refused (its weights are built per body, not per particle).
 // Contact is resolved at owned nodes only, after the one exchange that completes their sums, by the
 // serial module's node-local code (mechanics/src/contact_pair.hpp).
+// For coupled physics (the coupling's decomposed heat conduction) the run also carries named
+// per-particle scalars in the swarm and offers the step's maps without physics: the particles' current
+// stencils in local node numbering, local node values summed into their owners, owner values to the
+// ghosts (transfer.cpp).
 // Only this library needs PETSc; its header needs MPI only.
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/grid.hpp>
@@ -88,6 +92,8 @@ struct DecomposedParticle {
   Mat<2> stress = Mat<2>::Zero();
   double stress_zz = 0.0;
   int material = 0;  // index into the materials given to DecomposedMpm2D
+  /// Values of DecomposedOptions::particle_scalars, in that order (empty: zeros).
+  std::vector<double> scalars;
 };
 
 /// Settings of one material pair in contact (as Simulation::set_contact_pair).
@@ -108,6 +114,27 @@ struct DecomposedOptions {
   bool contact = false;
   ContactOptions contact_options;
   std::vector<DecomposedContactPair> contact_pairs;
+  /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
+  /// one swarm field, migrated with the particles, untouched by the step.
+  std::vector<std::string> particle_scalars;
+};
+
+/// The shape functions of this rank's particles at their current positions (after the last step's
+/// migration), in the local node numbering of the rank's ghosted box (x fastest): particle k (swarm
+/// order) has entries [first[k], first[k+1]) with node, S_ip and G_ip (1/m), in stencil order.
+struct DecomposedStencils {
+  std::vector<int> first;
+  std::vector<int> node;
+  std::vector<double> S;
+  std::vector<Vec<2>> G;
+};
+
+/// This rank's particles in swarm order (the order of DecomposedStencils and particle scalars).
+struct DecomposedLocalParticles {
+  std::vector<std::int64_t> id;
+  std::vector<double> mass;    // m_p (kg per unit thickness in 2D)
+  std::vector<double> volume;  // V_p (m² per unit thickness in 2D)
+  std::vector<int> material;
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).
@@ -176,6 +203,32 @@ class DecomposedMpm2D {
   DecomposedContactStats contact_stats() const;
   /// Collective: every particle of every rank, sorted by id, on every rank.
   std::vector<DecomposedParticle> gather() const;
+
+  // ---- Transfers for coupled physics (transfer.cpp): the particle–grid maps of the step, without
+  // any physics of their own, so that a caller (the coupling's decomposed heat conduction) can
+  // scatter particle values to the nodes and read node values back on the particles. ----
+  MPI_Comm communicator() const;
+  /// Index of a name in DecomposedOptions::particle_scalars; std::invalid_argument if absent.
+  int particle_scalar_index(const std::string& name) const;
+  /// This rank's values of one particle scalar, in swarm order; set them (same size) back.
+  std::vector<double> particle_scalar(int index) const;
+  void set_particle_scalar(int index, const std::vector<double>& values);
+  DecomposedLocalParticles local_particle_data() const;
+  /// S_ip and G_ip at the particles' current positions, evaluated once after each step (the serial
+  /// Stencil, as the step evaluates them).
+  const DecomposedStencils& current_stencils();
+  /// Nodes of the ghosted box (the local numbering) and, per owned node (x fastest over
+  /// owned_nodes()), its local node.
+  int local_node_count() const;
+  const std::vector<int>& owned_local_nodes() const;
+  /// Collective: values on the ghosted box (`components` per node, ≤ max_transfer_components) summed
+  /// over every rank holding the node into its owner (DMLocalToGlobal, ADD_VALUES): `owned` gets,
+  /// per owned node, the sum over ranks.
+  static constexpr int max_transfer_components = 5;
+  void sum_to_owned(const std::vector<double>& local, int components, std::vector<double>& owned);
+  /// Collective: owned node values to every rank holding the node (DMGlobalToLocal, INSERT_VALUES):
+  /// `local` gets the owners' values on the whole ghosted box.
+  void owned_to_local(const std::vector<double>& owned, int components, std::vector<double>& local);
 
  private:
   struct Impl;

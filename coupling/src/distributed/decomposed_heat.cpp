@@ -1,0 +1,240 @@
+// Frictional heating and matrix-free explicit conduction on the decomposed mechanics
+// (frictherm/coupling/decomposed_heat.hpp): the serial ExplicitConduction window (explicit_conduction.cpp,
+// Nairn et al. 2018 eqs. 37–38) with its particle loops over this rank's particles and its nodal sums
+// completed at the owners by the mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal).
+#include <frictherm/coupling/decomposed_heat.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+namespace {
+
+// The serial sub-steps' quiet rule (explicit_conduction.cpp): a particle whose nodal temperatures agree
+// to 256 ε relative carries no flux.
+constexpr double kQuietSpread = 256.0 * 2.220446049250313e-16;
+
+double sum_over(MPI_Comm comm, double x) {
+  MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return x;
+}
+
+}  // namespace
+
+DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm2D& mpm, DecomposedHeatOptions options)
+    : mpm_(mpm), opt_(std::move(options)) {
+  if (!(opt_.fe_safety > 0.0 && opt_.fe_safety <= 1.0))
+    throw std::invalid_argument("decomposed heat: fe_safety " + std::to_string(opt_.fe_safety) +
+                                " (expected a value in (0, 1])");
+  scalar_ = mpm_.particle_scalar_index(opt_.temperature);
+  // Every rank checks its own particles' materials and all agree before any window.
+  int bad = -1;
+  for (int m : mpm_.local_particle_data().material)
+    if (m < 0 || m >= static_cast<int>(opt_.materials.size())) bad = std::max(bad, m);
+  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, mpm_.communicator());
+  if (bad >= 0)
+    throw std::invalid_argument("decomposed heat: material " + std::to_string(bad) +
+                                " has no thermal properties (expected " + std::to_string(opt_.materials.size()) +
+                                " entries in materials to cover it)");
+}
+
+double DecomposedHeat::heat_content() const {
+  const mechanics::DecomposedLocalParticles P = mpm_.local_particle_data();
+  const std::vector<double> T = mpm_.particle_scalar(scalar_);
+  double e = 0.0;
+  for (std::size_t k = 0; k < T.size(); ++k) {
+    const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
+    if (m.conducts) e += P.mass[k] * m.heat_capacity * T[k];
+  }
+  return sum_over(mpm_.communicator(), e);
+}
+
+void DecomposedHeat::after_step(double dt) {
+  const std::vector<double>& work = mpm_.frictional_work(opt_.order);
+  double w = 0.0;
+  for (double x : work) w += x;
+  books_.work_received += sum_over(mpm_.communicator(), w);
+  window(work, dt);
+}
+
+void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
+  const MPI_Comm comm = mpm_.communicator();
+  const std::vector<int>& owned_local = mpm_.owned_local_nodes();
+  const std::size_t no = owned_local.size(), nl = static_cast<std::size_t>(mpm_.local_node_count());
+  if (joules.size() != no)
+    throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
+                                std::to_string(no) + " owned nodes");
+  if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
+  const mechanics::DecomposedStencils& st = mpm_.current_stencils();
+  const mechanics::DecomposedLocalParticles P = mpm_.local_particle_data();
+  std::vector<double> T = mpm_.particle_scalar(scalar_);
+  const std::size_t np = T.size();
+
+  // Pass 1: M_i and M_i T_i (eq. 38) on the ghosted box, completed at the owners.
+  capacity_.assign(np, 0.0);
+  local_.assign(2 * nl, 0.0);
+  double particle_capacity = 0.0;
+  for (std::size_t k = 0; k < np; ++k) {
+    const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
+    if (!m.conducts) continue;
+    const double mc = P.mass[k] * m.heat_capacity, mct = mc * T[k];
+    capacity_[k] = mc;
+    particle_capacity += mc;
+    for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
+      const auto i = static_cast<std::size_t>(st.node[static_cast<std::size_t>(a)]);
+      local_[2 * i] += mc * st.S[static_cast<std::size_t>(a)];
+      local_[2 * i + 1] += mct * st.S[static_cast<std::size_t>(a)];
+    }
+  }
+  std::vector<double> mass_temp;
+  mpm_.sum_to_owned(local_, 2, mass_temp);
+  // Unknowns: M_i > active_mass_fraction · max M (select_unknowns' rule, max over ranks).
+  double sums[3] = {0.0, particle_capacity, 0.0};  // Σ M_i, Σ m C, max M
+  for (std::size_t q = 0; q < no; ++q) sums[0] += mass_temp[2 * q], sums[2] = std::max(sums[2], mass_temp[2 * q]);
+  double reduced[2] = {sums[0], sums[1]};
+  MPI_Allreduce(MPI_IN_PLACE, reduced, 2, MPI_DOUBLE, MPI_SUM, comm);
+  MPI_Allreduce(MPI_IN_PLACE, &sums[2], 1, MPI_DOUBLE, MPI_MAX, comm);
+  if (!(reduced[1] > 0.0)) throw std::invalid_argument("decomposed heat: no particle of a material with thermal properties");
+  books_.max_capacity_residual = std::max(books_.max_capacity_residual, std::fabs(reduced[0] - reduced[1]) / reduced[1]);
+  const double threshold = opt_.assembly.active_mass_fraction * sums[2];
+  auto is_unknown = [threshold](double M) { return M > threshold && M > 0.0; };
+  std::vector<double> M(no), T0(no, 0.0);
+  long dropped = 0;
+  for (std::size_t q = 0; q < no; ++q) {
+    M[q] = mass_temp[2 * q];
+    if (is_unknown(M[q])) T0[q] = mass_temp[2 * q + 1] / M[q];
+    else if (M[q] > 0.0) ++dropped;
+  }
+  std::vector<double> local_M;
+  mpm_.owned_to_local(M, 1, local_M);  // the same values at every rank's ghosts: the same unknowns
+
+  // Pass 2: each heat-holding particle's kept nodes (unknowns), the lumped gradients G' and the two
+  // bounds of λ_max(M⁻¹K) of ExplicitConduction::keep (Gershgorin row sums and Cauchy–Schwarz).
+  kept_first_.assign(1, 0);
+  kept_node_.clear();
+  kept_S_.clear();
+  kept_G_.clear();
+  conductance_.assign(np, 0.0);
+  local_.assign(2 * nl, 0.0);
+  for (std::size_t k = 0; k < np; ++k) {
+    const std::size_t begin = kept_node_.size();
+    if (capacity_[k] > 0.0) {
+      double s_kept = 0.0;
+      mechanics::Vec<2> g_dropped = mechanics::Vec<2>::Zero();
+      for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
+        const auto ua = static_cast<std::size_t>(a);
+        const int i = st.node[ua];
+        if (is_unknown(local_M[static_cast<std::size_t>(i)])) {
+          s_kept += st.S[ua];
+          kept_node_.push_back(i);
+          kept_S_.push_back(st.S[ua]);
+          kept_G_.push_back(st.G[ua]);
+        } else {
+          g_dropped += st.G[ua];
+        }
+      }
+      const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
+      const std::size_t end = kept_node_.size();
+      if (m.conductivity > 0.0 && end > begin && s_kept > 0.0) {
+        if (end - begin < static_cast<std::size_t>(st.first[k + 1] - st.first[k]))
+          for (std::size_t a = begin; a < end; ++a) kept_G_[a] += (kept_S_[a] / s_kept) * g_dropped;  // lump
+        conductance_[k] = P.volume[k] * m.conductivity;  // V_p k_p
+        double gsum = 0.0, g2m = 0.0;
+        for (std::size_t a = begin; a < end; ++a) {
+          const double g = kept_G_[a].norm();
+          gsum += g;
+          g2m += g * g / local_M[static_cast<std::size_t>(kept_node_[a])];
+        }
+        for (std::size_t a = begin; a < end; ++a) {
+          const auto i = static_cast<std::size_t>(kept_node_[a]);
+          local_[2 * i] += conductance_[k] * kept_G_[a].norm() * gsum;
+          local_[2 * i + 1] += conductance_[k] * g2m;
+        }
+      }
+    }
+    kept_first_.push_back(static_cast<int>(kept_node_.size()));
+  }
+  std::vector<double> bounds;
+  mpm_.sum_to_owned(local_, 2, bounds);
+  double lam[2] = {0.0, 0.0};  // Gershgorin, Rayleigh: maxima over the unknowns of all ranks
+  for (std::size_t q = 0; q < no; ++q) {
+    if (!is_unknown(M[q])) continue;
+    lam[0] = std::max(lam[0], bounds[2 * q] / M[q]);
+    lam[1] = std::max(lam[1], bounds[2 * q + 1]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, lam, 2, MPI_DOUBLE, MPI_MAX, comm);
+  const double lambda = std::min(lam[0], lam[1]);
+  long n = 1;
+  if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (opt_.fe_safety * 2.0 / lambda) - 1e-12)));
+
+  // The heat: q_i = W_i / Δt on the owned unknowns. Work on a node that is not an unknown is refused.
+  double off = 0.0, delivered = 0.0;
+  std::vector<double> q(no, 0.0);
+  for (std::size_t u = 0; u < no; ++u) {
+    if (joules[u] == 0.0) continue;
+    if (is_unknown(M[u])) q[u] = joules[u] / dt, delivered += q[u];
+    else off += std::fabs(joules[u]);
+  }
+  off = sum_over(comm, off);
+  if (off > 0.0)
+    throw std::runtime_error("decomposed heat: " + std::to_string(off) +
+                             " J of work on nodes that are not thermal unknowns (relocation is serial only)");
+
+  // Forward-Euler sub-steps: ghost T_j from the owners, f_i = −Σ_p V_p k_p G'_ip·(∇T)_p summed at the owners.
+  std::vector<double> Tn = T0;
+  const double h = dt / static_cast<double>(n);
+  std::vector<double> f;
+  for (long s = 0; s < n; ++s) {
+    mpm_.owned_to_local(Tn, 1, local_T_);
+    force_.assign(nl, 0.0);
+    for (std::size_t k = 0; k < np; ++k) {
+      if (conductance_[k] == 0.0) continue;
+      const auto b = static_cast<std::size_t>(kept_first_[k]), e = static_cast<std::size_t>(kept_first_[k + 1]);
+      double lo = local_T_[static_cast<std::size_t>(kept_node_[b])], hi = lo;
+      for (std::size_t a = b + 1; a < e; ++a) {
+        lo = std::min(lo, local_T_[static_cast<std::size_t>(kept_node_[a])]);
+        hi = std::max(hi, local_T_[static_cast<std::size_t>(kept_node_[a])]);
+      }
+      if (hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi))) continue;  // quiet
+      mechanics::Vec<2> grad = mechanics::Vec<2>::Zero();  // (∇T)_p, eq. 37
+      for (std::size_t a = b; a < e; ++a) grad += kept_G_[a] * local_T_[static_cast<std::size_t>(kept_node_[a])];
+      grad *= conductance_[k];
+      for (std::size_t a = b; a < e; ++a) force_[static_cast<std::size_t>(kept_node_[a])] -= kept_G_[a].dot(grad);
+    }
+    mpm_.sum_to_owned(force_, 1, f);
+    for (std::size_t u = 0; u < no; ++u)
+      if (is_unknown(M[u])) Tn[u] += h * (f[u] + q[u]) / M[u];
+  }
+
+  // Back to the particles incrementally (design §4): T_p += Σ_i S_ip ΔT_i over its unknowns.
+  std::vector<double> dT(no, 0.0);
+  double nodal = 0.0;
+  for (std::size_t u = 0; u < no; ++u)
+    if (is_unknown(M[u])) dT[u] = Tn[u] - T0[u], nodal += M[u] * dT[u];
+  std::vector<double> local_dT;
+  mpm_.owned_to_local(dT, 1, local_dT);
+  double particle = 0.0;
+  for (std::size_t k = 0; k < np; ++k) {
+    double change = 0.0;
+    for (int a = kept_first_[k]; a < kept_first_[k + 1]; ++a)
+      change += kept_S_[static_cast<std::size_t>(a)] * local_dT[static_cast<std::size_t>(kept_node_[static_cast<std::size_t>(a)])];
+    const double before = T[k];
+    T[k] = before + change;
+    particle += capacity_[k] * (T[k] - before);
+  }
+  mpm_.set_particle_scalar(scalar_, T);
+  double b[3] = {delivered * dt, nodal, particle};
+  MPI_Allreduce(MPI_IN_PLACE, b, 3, MPI_DOUBLE, MPI_SUM, comm);
+  books_.heat_delivered += b[0];
+  books_.nodal_energy_change += b[1];
+  books_.particle_energy_change += b[2];
+  long d = dropped;
+  MPI_Allreduce(MPI_IN_PLACE, &d, 1, MPI_LONG, MPI_SUM, comm);
+  books_.dropped_nodes = d;
+  ++books_.windows;
+  books_.substeps += n;
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,161 @@
+// Transfers for coupled physics on the decomposed grid (frictherm/mechanics/distributed.hpp): the
+// particles' current stencils in the local node numbering, per-particle scalars carried by the swarm,
+// and the two node exchanges of the step (local → owners summed, owners → ghosts) for caller values.
+// No physics here: the coupling module builds its heat conduction on them.
+#include "distributed/decomposed_state.hpp"
+
+#include <stdexcept>
+
+namespace frictherm::mechanics {
+
+using detail::petsc_check;
+
+MPI_Comm DecomposedMpm2D::communicator() const { return impl_->comm; }
+
+int DecomposedMpm2D::particle_scalar_index(const std::string& name) const {
+  const auto& names = impl_->opt.particle_scalars;
+  for (std::size_t c = 0; c < names.size(); ++c)
+    if (names[c] == name) return static_cast<int>(c);
+  throw std::invalid_argument("decomposed mechanics: no particle scalar '" + name +
+                              "' (expected one of DecomposedOptions::particle_scalars)");
+}
+
+std::vector<double> DecomposedMpm2D::Impl::scalar_values() const {
+  PetscInt n = 0;
+  petsc_check(DMSwarmGetLocalSize(swarm, &n), "DMSwarmGetLocalSize");
+  std::vector<double> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(scalars));
+  if (scalars == 0) return out;
+  double* v = nullptr;
+  petsc_check(DMSwarmGetField(swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v)),
+              "DMSwarmGetField");
+  std::copy(v, v + out.size(), out.begin());
+  DMSwarmRestoreField(swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v));
+  return out;
+}
+
+std::vector<double> DecomposedMpm2D::particle_scalar(int index) const {
+  const Impl& s = *impl_;
+  if (index < 0 || index >= s.scalars) throw std::out_of_range("decomposed mechanics: particle scalar index");
+  const std::vector<double> all = s.scalar_values();
+  const std::size_t n = all.size() / static_cast<std::size_t>(s.scalars);
+  std::vector<double> out(n);
+  for (std::size_t k = 0; k < n; ++k) out[k] = all[k * static_cast<std::size_t>(s.scalars) + static_cast<std::size_t>(index)];
+  return out;
+}
+
+void DecomposedMpm2D::set_particle_scalar(int index, const std::vector<double>& values) {
+  Impl& s = *impl_;
+  if (index < 0 || index >= s.scalars) throw std::out_of_range("decomposed mechanics: particle scalar index");
+  if (values.size() != local_particles())
+    throw std::invalid_argument("decomposed mechanics: set_particle_scalar got " + std::to_string(values.size()) +
+                                " values for " + std::to_string(local_particles()) + " local particles");
+  double* v = nullptr;
+  petsc_check(DMSwarmGetField(s.swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v)),
+              "DMSwarmGetField");
+  for (std::size_t k = 0; k < values.size(); ++k)
+    v[k * static_cast<std::size_t>(s.scalars) + static_cast<std::size_t>(index)] = values[k];
+  DMSwarmRestoreField(s.swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v));
+}
+
+DecomposedLocalParticles DecomposedMpm2D::local_particle_data() const {
+  SwarmFields f(impl_->swarm);
+  DecomposedLocalParticles out;
+  const auto n = static_cast<std::size_t>(f.n);
+  out.id.assign(f.id, f.id + n);
+  out.mass.assign(f.mass, f.mass + n);
+  out.volume.assign(f.volume, f.volume + n);
+  out.material.assign(f.material, f.material + n);
+  return out;
+}
+
+const DecomposedStencils& DecomposedMpm2D::current_stencils() {
+  Impl& s = *impl_;
+  if (s.current_valid) return s.current;
+  dispatch_shape(s.opt.shape, [&](auto kernel) {
+    using Kernel = decltype(kernel);
+    SwarmFields f(s.swarm);
+    DecomposedStencils& c = s.current;
+    const auto n = static_cast<std::size_t>(f.n);
+    c.first.assign(1, 0);
+    c.node.clear();
+    c.S.clear();
+    c.G.clear();
+    const NodeIndexer<2> ix = s.local_indexer();
+    Stencil<2, Kernel> st;
+    for (std::size_t k = 0; k < n; ++k) {
+      st.evaluate(s.grid, Eigen::Map<const Vec<2>>(f.x + 2 * k), Eigen::Map<const Vec<2>>(f.half_size + 2 * k));
+      const IVec<2> b = st.first_node();
+      if (b[0] < s.gxs || b[1] < s.gys || b[0] + Kernel::K > s.gxs + s.gxm || b[1] + Kernel::K > s.gys + s.gym)
+        throw std::logic_error("decomposed mechanics: particle " + std::to_string(f.id[k]) +
+                               " reaches nodes outside its rank's ghosted box (not migrated?)");
+      st.for_each(ix, [&](int i, double S, const Vec<2>& G) {
+        c.node.push_back(i);
+        c.S.push_back(S);
+        c.G.push_back(G);
+      });
+      c.first.push_back(static_cast<int>(c.node.size()));
+    }
+  });
+  s.current_valid = true;
+  return s.current;
+}
+
+int DecomposedMpm2D::local_node_count() const { return static_cast<int>(impl_->gxm * impl_->gym); }
+const std::vector<int>& DecomposedMpm2D::owned_local_nodes() const { return impl_->owned_local_int; }
+
+namespace {
+void check_components(int components) {
+  if (components < 1 || components > DecomposedMpm2D::max_transfer_components)
+    throw std::invalid_argument("decomposed mechanics: " + std::to_string(components) +
+                                " components per node (expected 1 to " +
+                                std::to_string(DecomposedMpm2D::max_transfer_components) + ")");
+}
+}  // namespace
+
+// The step's grid vectors carry dof = 5 values per node; a transfer of fewer components pads with 0.
+void DecomposedMpm2D::sum_to_owned(const std::vector<double>& local, int components, std::vector<double>& owned) {
+  Impl& s = *impl_;
+  check_components(components);
+  const auto nl = static_cast<std::size_t>(s.gxm * s.gym), no = static_cast<std::size_t>(s.xm * s.ym);
+  const auto c = static_cast<std::size_t>(components);
+  if (local.size() != nl * c)
+    throw std::invalid_argument("decomposed mechanics: sum_to_owned got " + std::to_string(local.size()) +
+                                " values (expected local nodes × components = " + std::to_string(nl * c) + ")");
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(s.local, &a), "VecGetArray");
+  for (std::size_t l = 0; l < nl; ++l)
+    for (std::size_t d = 0; d < static_cast<std::size_t>(Impl::dof); ++d) a[Impl::dof * l + d] = d < c ? local[l * c + d] : 0.0;
+  petsc_check(VecRestoreArray(s.local, &a), "VecRestoreArray");
+  petsc_check(VecSet(s.global, 0.0), "VecSet");
+  petsc_check(DMLocalToGlobal(s.da, s.local, ADD_VALUES, s.global), "DMLocalToGlobal");
+  const PetscScalar* g = nullptr;
+  petsc_check(VecGetArrayRead(s.global, &g), "VecGetArrayRead");
+  owned.resize(no * c);
+  for (std::size_t q = 0; q < no; ++q)
+    for (std::size_t d = 0; d < c; ++d) owned[q * c + d] = g[Impl::dof * q + d];
+  petsc_check(VecRestoreArrayRead(s.global, &g), "VecRestoreArrayRead");
+}
+
+void DecomposedMpm2D::owned_to_local(const std::vector<double>& owned, int components, std::vector<double>& local) {
+  Impl& s = *impl_;
+  check_components(components);
+  const auto nl = static_cast<std::size_t>(s.gxm * s.gym), no = static_cast<std::size_t>(s.xm * s.ym);
+  const auto c = static_cast<std::size_t>(components);
+  if (owned.size() != no * c)
+    throw std::invalid_argument("decomposed mechanics: owned_to_local got " + std::to_string(owned.size()) +
+                                " values (expected owned nodes × components = " + std::to_string(no * c) + ")");
+  PetscScalar* g = nullptr;
+  petsc_check(VecGetArray(s.global, &g), "VecGetArray");
+  for (std::size_t q = 0; q < no; ++q)
+    for (std::size_t d = 0; d < static_cast<std::size_t>(Impl::dof); ++d) g[Impl::dof * q + d] = d < c ? owned[q * c + d] : 0.0;
+  petsc_check(VecRestoreArray(s.global, &g), "VecRestoreArray");
+  petsc_check(DMGlobalToLocal(s.da, s.global, INSERT_VALUES, s.local), "DMGlobalToLocal");
+  const PetscScalar* a = nullptr;
+  petsc_check(VecGetArrayRead(s.local, &a), "VecGetArrayRead");
+  local.resize(nl * c);
+  for (std::size_t l = 0; l < nl; ++l)
+    for (std::size_t d = 0; d < c; ++d) local[l * c + d] = a[Impl::dof * l + d];
+  petsc_check(VecRestoreArrayRead(s.local, &a), "VecRestoreArrayRead");
+}
+
+}  // namespace frictherm::mechanics

@@ -1,0 +1,303 @@
+// Frictional heating and matrix-free conduction in a decomposed run (frictherm/coupling/decomposed_heat.hpp),
+// run by ctest under mpirun with 2 and 4 ranks, against the serial Simulation<2> + Coupler (a window
+// every step, forward_euler taken matrix-free, the gather every window: reuse_distance 0):
+//   (a) the sliding block with heating (elastic base fixed at y_min, elastic block sliding on it at
+//       10 m/s across the rank split, gravity, Coulomb μ = 0.3, USL, uGIMP; both materials conduct):
+//       the block's velocity history and the second-order frictional work within 1e-9 of v0 and of the
+//       final work at every step, every particle's temperature within 1e-9 of the run's largest
+//       temperature rise every 20 steps and at the end, the same sub-step counts; the books summed
+//       over ranks close: work received = heat delivered = Σ_i M_i ΔT_i = Σ_p m_p C_p ΔT_p (and the
+//       change of Σ_p m_p C_p T_p) to 1e-9 of the work;
+//   (b) conduction alone across rank boundaries: a still body (no step, no heat) with a hot diagonal
+//       stripe crossing both splits, 8 windows of several sub-steps: particle temperatures within
+//       1e-12 of the stripe's 50 K amplitude of the serial Coupler's, the same sub-steps, heat
+//       content kept to 1e-14; once with every node an unknown, once with sliver nodes that are not
+//       (the lumped gradients G');
+//   (c) work on a node that is no thermal unknown is refused on every rank.
+// No ASSERT before a collective call: a rank that returned early would leave the others waiting.
+#include "frictherm/coupling/coupler.hpp"
+#include "frictherm/coupling/decomposed_heat.hpp"
+#include "frictherm/mechanics/distributed.hpp"
+#include "frictherm/mechanics/geometry.hpp"
+#include "frictherm/mechanics/simulation.hpp"
+
+#include "../mpi_ranks.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace {
+
+namespace fm = frictherm::mechanics;
+namespace fc = frictherm::coupling;
+using V2 = fm::Vec<2>;
+using frictherm::test::comm_rank;
+using frictherm::test::comm_size;
+
+constexpr double kT0 = 300.0;  // K
+
+fm::Material elastic(const char* name, double E, double nu, double rho) {
+  fm::Material m;
+  m.name = name;
+  m.kind = fm::MaterialKind::linear_elastic;
+  m.youngs_modulus = E;
+  m.poisson_ratio = nu;
+  m.density = rho;
+  return m;
+}
+
+// Serial particles as decomposed particles (id = serial index, temperature as the one scalar); only
+// rank 0 passes them, the first migration distributes them.
+std::vector<fm::DecomposedParticle> decomposed(const fm::Particles<2>& sp) {
+  std::vector<fm::DecomposedParticle> all(sp.position.size());
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    all[k].id = static_cast<std::int64_t>(k);
+    all[k].mass = sp.mass[k];
+    all[k].volume = sp.volume[k];
+    all[k].position = sp.position[k];
+    all[k].velocity = sp.velocity[k];
+    all[k].half_size = sp.half_size[k];
+    all[k].material = sp.material[k];
+    all[k].scalars = {sp.temperature[k]};
+  }
+  return comm_rank() == 0 ? all : std::vector<fm::DecomposedParticle>{};
+}
+
+// Largest |T_p − T_p(serial)| over the gathered particles (by id), and whether the ids match.
+double temperature_difference(const std::vector<fm::DecomposedParticle>& a, const fm::Particles<2>& sp, bool& same) {
+  double d = 0.0;
+  same = same && a.size() == sp.position.size();
+  for (std::size_t k = 0; same && k < a.size(); ++k) {
+    same = a[k].id == static_cast<std::int64_t>(k) && a[k].scalars.size() == 1;
+    if (same) d = std::max(d, std::fabs(a[k].scalars[0] - sp.temperature[k]));
+  }
+  return d;
+}
+
+double mean_velocity_x(const std::vector<fm::DecomposedParticle>& a, int material) {
+  double mv = 0.0, m = 0.0;
+  for (const auto& p : a)
+    if (p.material == material) mv += p.mass * p.velocity[0], m += p.mass;
+  return mv / m;
+}
+double mean_velocity_x(const fm::Particles<2>& p, int material) {
+  double mv = 0.0, m = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (p.material[k] == material) mv += p.mass[k] * p.velocity[k][0], m += p.mass[k];
+  return mv / m;
+}
+
+fc::CouplerOptions serial_options(const std::vector<fc::ThermalProperties>& materials) {
+  fc::CouplerOptions opt;
+  opt.materials = materials;
+  opt.integrator = "forward_euler";  // matrix-free for windows of ≤ 64 stable sub-steps
+  opt.window.kind = fc::WindowPolicy::Kind::every_step;
+  opt.reuse_distance = 0.0;  // gather every window
+  return opt;
+}
+
+// ---- (a) the sliding block with heating ----
+TEST(DecomposedHeat, SlidingBlockEqualsTheSerialRunAndClosesItsBooks) {
+  // The scene of test_distributed_contact.cpp (a): base 24 × 4 mm fixed at y_min, block 8 × 4 mm at
+  // 10 m/s crossing the 2-rank split, g = 2e4 m/s², Coulomb μ = 0.3, 1 mm cells, 2 × 2 particles per
+  // cell. Thermal: base C = 100 J/(kg K), k = 50 W/(m K) (α = 5e-4 m²/s), block C = 150, k = 20, so
+  // heat spreads ≈ 0.4 mm in the 200 steps (3.4e-4 s) and the interface warms by ≈ 0.1–1 K.
+  const double h = 1e-3, rho = 1000.0, v0 = 10.0, g = 2e4, mu = 0.3;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {26, 12});
+  fm::SimulationOptions so;
+  so.shape = fm::ShapeKind::ugimp;
+  so.scheme = fm::UpdateScheme::usl;
+  so.gravity = fm::Vec<3>(0.0, -g, 0.0);
+  fm::Simulation<2> serial(grid, so);
+  const std::vector<fm::Material> mats{elastic("base", 2e7, 0.3, rho), elastic("block", 1.5e7, 0.25, rho)};
+  const int base = serial.add_material(mats[0]), blk = serial.add_material(mats[1]);
+  serial.add_body("base", *fm::make_box<2>(V2(1e-3, 0.0), V2(25e-3, 4e-3), base), 2, V2::Zero());
+  serial.add_body("block", *fm::make_box<2>(V2(6e-3, 4e-3), V2(14e-3, 8e-3), blk), 2, V2(v0, 0.0));
+  const fm::FixedFace bottom{1, false, {{true, true, true}}};
+  serial.fix_face(bottom);
+  fm::ContactOptions co;
+  co.default_pair.law = fm::FrictionLaw::coulomb(mu);
+  co.default_pair.normal = fm::NormalMethod::specified;
+  co.default_pair.normal_vector = fm::Vec<3>(0.0, 1.0, 0.0);
+  serial.enable_contact(co);
+  serial.set_contact_pair(base, blk, co.default_pair);
+  serial.finalize();
+  fm::Particles<2>& sp = serial.particles();
+  std::fill(sp.temperature.begin(), sp.temperature.end(), kT0);
+  const std::vector<fc::ThermalProperties> thermal{{true, 100.0, 50.0}, {true, 150.0, 20.0}};
+  fc::Coupler<2> coupler(grid, so.shape, serial_options(thermal));
+  coupler.start(sp, 0.0);
+
+  fm::DecomposedOptions opt;
+  opt.shape = so.shape;
+  opt.gravity = V2(0.0, -g);
+  opt.fixed_faces = {bottom};
+  opt.contact = true;
+  opt.contact_options = co;
+  opt.contact_pairs = {fm::DecomposedContactPair{base, blk, co.default_pair}};
+  opt.particle_scalars = {"temperature"};
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(decomposed(sp));
+  fc::DecomposedHeatOptions ho;
+  ho.materials = thermal;
+  ho.order = fm::HeatingOrder::second;
+  fc::DecomposedHeat heat(split, ho);
+  const double content0 = heat.heat_content();
+
+  const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
+  const double dt = 0.3 * h / (c + v0);
+  const int steps = 200;
+  double dhist = 0.0, dw = 0.0, dT = 0.0, rise = 0.0, time = 0.0, w = 0.0, ws = 0.0;
+  bool same = true;
+  for (int s = 1; s <= steps; ++s) {
+    serial.step(dt);
+    time += dt;
+    coupler.after_step(sp, serial.frictional_work(fm::HeatingOrder::second), time);
+    split.step(dt);
+    heat.after_step(dt);
+    w = split.cumulative_frictional_work(fm::HeatingOrder::second);
+    ws = serial.cumulative_frictional_work(fm::HeatingOrder::second);
+    dw = std::max(dw, std::fabs(w - ws));
+    const auto a = split.gather();
+    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, blk) - mean_velocity_x(sp, blk)));
+    if (s % 20 == 0) dT = std::max(dT, temperature_difference(a, sp, same));
+  }
+  for (double T : sp.temperature) rise = std::max(rise, T - kT0);
+  const fc::DecomposedHeatBooks& b = heat.books();
+  const double content = heat.heat_content() - content0;
+  const fc::EnergyBooks& sb = coupler.books();
+  const double v_end = mean_velocity_x(sp, blk);
+
+  EXPECT_TRUE(same);  // every particle kept, with its temperature
+  EXPECT_EQ(sb.matrix_free_windows, steps);  // the serial run took the matrix-free path every step
+  EXPECT_EQ(sb.heat_relocated, 0.0);         // as the decomposed run requires
+  EXPECT_EQ(b.windows, steps);
+  EXPECT_EQ(b.substeps, sb.matrix_free_substeps);
+  EXPECT_LT(v_end, v0 - 0.5);  // friction braked the block
+  EXPECT_GT(rise, 0.05);       // and heated the interface
+  // The 1e-9 of the case's own scales: v0, the final work, the largest temperature rise.
+  EXPECT_LE(dhist / v0, 1e-9);
+  EXPECT_LE(dw / ws, 1e-9);
+  EXPECT_LE(dT / rise, 1e-9);
+  EXPECT_LE(std::fabs(b.work_received - ws) / ws, 1e-9);
+  // Books over ranks: heat delivered = work received (no relocation), and conduction creates no heat.
+  EXPECT_LE(std::fabs(b.heat_delivered - b.work_received) / ws, 1e-9);
+  EXPECT_LE(std::fabs(b.nodal_energy_change - b.work_received) / ws, 1e-9);
+  EXPECT_LE(std::fabs(b.particle_energy_change - b.work_received) / ws, 1e-9);
+  EXPECT_LE(std::fabs(content - b.work_received) / ws, 1e-9);
+  EXPECT_LE(b.max_capacity_residual, 1e-12);  // Σ_i M_i = Σ_p m_p C_p (partition of unity)
+  if (comm_rank() == 0)
+    std::printf("[heated sliding block] %d ranks, %d steps: block %.3f -> %.3f m/s, W2 %.6e J, max rise %.4f K, "
+                "%ld sub-steps, %ld dropped nodes at the end; max over steps |dv|/v0 %.2e, |dW2|/W2 %.2e, |dT|/rise %.2e; books (/W2): delivered "
+                "%.2e, nodal %.2e, particles %.2e, content %.2e; serial books: particles %.2e\n",
+                comm_size(), steps, v0, v_end, ws, rise, b.substeps, b.dropped_nodes, dhist / v0, dw / ws, dT / rise,
+                (b.heat_delivered - b.work_received) / ws, (b.nodal_energy_change - b.work_received) / ws,
+                (b.particle_energy_change - b.work_received) / ws, (content - b.work_received) / ws,
+                (coupler.particle_energy_change(sp) - sb.work_received) / ws);
+}
+
+// A still body on a 26 × 12 grid of 1 mm cells: a 22 × 8 mm box from (x0, y0), 2 × 2 particles per
+// cell, uGIMP, with a hot diagonal stripe crossing the 2- and 4-rank splits. With x0 = y0 = 1.3 mm,
+// 1.1 mm (edges off the grid lines) every node with mass is an unknown; with the box starting 20 nm
+// before the grid lines x = 1 mm and y = 1 mm, the particles' domains reach 20 nm into the hats of
+// the nodes on x = 0 and y = 0, whose M_i (≈ 4e-10 of a full node's) falls below
+// active_mass_fraction · max M: nodes with mass that are not unknowns, and gradients lumped (G').
+fm::Particles<2> striped_body(int material, bool slivers = false) {
+  fm::Particles<2> p;
+  const double s = 0.5e-3, rho = 1900.0, x0 = slivers ? 1e-3 - 2e-8 : 1.3e-3, y0 = slivers ? 1e-3 - 2e-8 : 1.1e-3;
+  for (int j = 0; j < 16; ++j)
+    for (int i = 0; i < 44; ++i) {
+      const V2 x(x0 + (i + 0.5) * s, y0 + (j + 0.5) * s);
+      const double d = (x[0] + x[1] - 18e-3) / 2e-3;
+      p.add(x, V2::Constant(0.5 * s), rho * s * s, s * s, material, 0, kT0 + 50.0 * std::exp(-d * d));
+    }
+  return p;
+}
+
+// ---- (b) conduction alone across rank boundaries ----
+class DecomposedConduction : public ::testing::TestWithParam<bool> {};
+
+TEST_P(DecomposedConduction, EqualsTheSerialConduction) {
+  const bool slivers = GetParam();
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
+  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
+  // α = k / (ρ C) = 2.15e-7 m²/s: λ bound ≈ a few 1/s; windows of 1 s take several sub-steps.
+  const std::vector<fc::ThermalProperties> thermal{{true, 1100.0, 0.45}};
+  fm::Particles<2> sp = striped_body(0, slivers);
+  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_options(thermal));
+  coupler.start(sp, 0.0);
+  fm::DecomposedOptions opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  opt.particle_scalars = {"temperature"};
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(decomposed(sp));
+  fc::DecomposedHeatOptions ho;
+  ho.materials = thermal;
+  fc::DecomposedHeat heat(split, ho);
+  const double content0 = heat.heat_content();
+  const std::vector<double> none(split.owned_local_nodes().size(), 0.0);
+  const double window = 1.0;  // s
+  const int windows = 8;
+  for (int k = 1; k <= windows; ++k) {
+    coupler.after_step(sp, {}, window * k);
+    heat.window(none, window);
+  }
+  bool same = true;
+  const double dT = temperature_difference(split.gather(), sp, same);
+  const fm::Particles<2> start = striped_body(0, slivers);
+  double change = 0.0;
+  for (std::size_t k = 0; k < sp.size(); ++k) change = std::max(change, std::fabs(sp.temperature[k] - start.temperature[k]));
+  const double drift = std::fabs(heat.heat_content() - content0);
+  EXPECT_TRUE(same);
+  EXPECT_EQ(coupler.books().matrix_free_windows, windows);
+  EXPECT_EQ(heat.books().substeps, coupler.books().matrix_free_substeps);
+  EXPECT_GE(heat.books().substeps, 2L * windows);  // more than one sub-step per window
+  EXPECT_GT(change, 1.0);                          // the stripe did spread (K)
+  if (slivers) {
+    EXPECT_GT(heat.books().dropped_nodes, 0L);  // the lumping of G' was used
+  }
+  // Round-off of reordered sums (measured ≤ 1e-14 of the amplitude); heat conserved by Σ_i G'_ip = 0.
+  EXPECT_LE(dT / 50.0, 1e-12);
+  EXPECT_LE(drift / content0, 1e-14);
+  EXPECT_LE(std::fabs(heat.books().nodal_energy_change) / content0, 1e-14);
+  if (comm_rank() == 0)
+    std::printf("[conduction%s] %d ranks, %d windows of %.1f s, %ld sub-steps, %ld dropped nodes: largest change "
+                "%.3f K, |dT| vs serial %.2e K (%.2e of 50 K), heat content drift %.2e of %.4e J\n",
+                slivers ? ", slivers" : "", comm_size(), windows, window, heat.books().substeps, heat.books().dropped_nodes, change, dT,
+                dT / 50.0, drift / content0, content0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Edges, DecomposedConduction, ::testing::Values(false, true),
+                         [](const auto& p) { return std::string(p.param ? "slivers" : "off_grid_lines"); });
+
+// ---- (c) work on a node that is no unknown: refused on every rank ----
+TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
+  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
+  fm::DecomposedOptions opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  opt.particle_scalars = {"temperature"};
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(decomposed(striped_body(0)));
+  fc::DecomposedHeatOptions ho;
+  ho.materials = {{true, 1100.0, 0.45}};
+  fc::DecomposedHeat heat(split, ho);
+  // The owned node at DMDA index (0, 0) (the grid's ghost corner) holds no mass: work there on rank 0.
+  std::vector<double> joules(split.owned_local_nodes().size(), 0.0);
+  const std::array<int, 4> box = split.owned_nodes();
+  if (box[0] == 0 && box[2] == 0) joules[0] = 1.0;
+  EXPECT_THROW(heat.window(joules, 1.0), std::runtime_error);
+  fc::DecomposedHeatOptions missing;  // no thermal properties for material 0
+  EXPECT_THROW(fc::DecomposedHeat(split, missing), std::invalid_argument);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fm::DecomposedPetscSession session(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
