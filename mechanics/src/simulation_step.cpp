@@ -7,6 +7,7 @@
 // read them.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/plane_strain_update.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <omp.h>
@@ -68,8 +69,10 @@ void Simulation<Dim>::step_with(double dt) {
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
       field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
-  map_rigid_particles<Kernel>(t);  // nodes driven by rigid boundary materials (EBS keeps them)
+  // Nodes driven by rigid boundary materials (EBS keeps them); with contact from the stencils the step
+  // evaluates anyway.
   if constexpr (is_extended<Kernel>) {
+    map_rigid_particles<Kernel>(t, nullptr);
     prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
   } else {
     auto& st = stencils<Kernel>();
@@ -78,6 +81,9 @@ void Simulation<Dim>::step_with(double dt) {
       // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
       if (!stencils_current_) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
       layout_fields(box_lo_, box_hi_);
+      map_rigid_particles<Kernel>(t, st.data());
+    } else {
+      map_rigid_particles<Kernel>(t, nullptr);
     }
   }
   if (contact_) {
@@ -294,7 +300,7 @@ void Simulation<Dim>::add_internal_forces() {
 // with contact): every node they touch takes their prescribed velocity components.
 template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::map_rigid_particles(double t) {
+void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated) {
   std::fill(rigid_mask_.begin(), rigid_mask_.end(), std::uint8_t{0});
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid() || field_of_material_[m] >= 0) continue;
@@ -304,7 +310,10 @@ void Simulation<Dim>::map_rigid_particles(double t) {
       if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Stencil<Dim, Kernel> s;
-      s.evaluate(grid_, p_.position[k], p_.half_size[k]);
+      if (evaluated)
+        s = evaluated[k];
+      else
+        s.evaluate(grid_, p_.position[k], p_.half_size[k]);
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
         if (S > 0.0) {
           rigid_mask_[static_cast<std::size_t>(i)] |= bits;
@@ -431,16 +440,39 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
     const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
     const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
+    const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
+    if constexpr (Dim == 2) {
+      if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
+#pragma omp for schedule(static) nowait
+        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+          VelocityGradient2 L;
+          st[k].for_each(ix, [&](int i, double, const Vec<2>& G) { L.add(v[static_cast<std::size_t>(i)], G); });
+          Mat<2>& F = p_.deformation_gradient[k];
+          const double det_A = deformation_update_2d(L, dt, F);
+          p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
+          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+          if (mie_gruneisen_update_plane_strain(L, dt, p_.volume[k] / p_.initial_volume[k], det_A, mat.mie_gruneisen,
+                                                min_J, p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
+                                                p_.internal_energy[k], wp, wave_speed_[k]) != MieGruneisenStatus::ok)
+            beyond = std::max(beyond, static_cast<long>(k));
+          p_.plastic_work[k] += wp * p_.volume[k];
+        }
+        continue;
+      }
+    }
 #pragma omp for schedule(static) nowait
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
       st[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });
       Mat<Dim>& F = p_.deformation_gradient[k];
-      F = (Mat<Dim>::Identity() + dt * L) * F;
+      const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+      Mat<Dim> F_new;
+      F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
+      F = F_new;
       p_.volume[k] = F.determinant() * p_.initial_volume[k];
       if (mg) {
         double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-        if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, p_.stress[k],
+        if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J, p_.stress[k],
                                       p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k], wp,
                                       &wave_speed_[k]) != MieGruneisenStatus::ok)
           beyond = std::max(beyond, static_cast<long>(k));

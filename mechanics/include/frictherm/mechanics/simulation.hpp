@@ -271,7 +271,8 @@ class Simulation {
   template <class Kernel> void step_with(double dt);
   template <class Kernel> void map_to_grid(double dt, bool with_forces);
   template <class Kernel> void add_internal_forces();
-  template <class Kernel> void map_rigid_particles(double t);
+  /// `evaluated`: this step's stencils of every particle (contact), or null to evaluate them here.
+  template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);
   template <class Kernel> void map_external_loads(double t);
   template <class Kernel> void remap_momentum();
   template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
@@ -322,6 +323,8 @@ class Simulation {
   std::vector<VelocityField<Dim>> fields_;
   std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
   std::vector<int> slot_node_;
+  bool slot_node_valid_ = false;
+  std::vector<int> occupied_slots_;  // find_contact_nodes: slots with mass, in slot order  // slot_node_ matches the per-material layout of fields_ (layout_fields)
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
   bool contact_ = false;
