@@ -179,8 +179,16 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
 template <int Dim>
 void Simulation<Dim>::reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
   if (thread_nodes_.empty()) return;
+#pragma omp parallel num_threads(threads_)
+  sum_thread_buffers(mass, momentum, force, contact_terms);
+}
+
+// The loop of reduce_thread_buffers, shared among the threads of the enclosing parallel region (an
+// orphaned worksharing loop: a scatter phase calls it after its barrier, saving a fork and join).
+template <int Dim>
+void Simulation<Dim>::sum_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
   const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     for (const auto& b : thread_nodes_) {
       if (mass) nodes_.mass[i] += b.mass[i];
@@ -348,6 +356,20 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   throw SimulationError(msg.str(), step_, time_, k);
 }
 
+// A particle compressed past the limit of its Hugoniot in the stress update (simulation_step.cpp).
+template <int Dim>
+void Simulation<Dim>::throw_beyond_hugoniot(long beyond) const {
+  if (beyond >= 0) {
+    const std::size_t k = static_cast<std::size_t>(beyond);
+    std::ostringstream msg;
+    msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '"
+        << materials_[static_cast<std::size_t>(p_.material[k])].name
+        << "' is compressed past the limit of its Hugoniot (J = " << p_.volume[k] / p_.initial_volume[k]
+        << "; try a smaller CFL factor)";
+    throw SimulationError(msg.str(), step_, time_, beyond);
+  }
+}
+
 template struct NodalFields<2>;
 template struct NodalFields<3>;
 #define FRICTHERM_INSTANTIATE_FIELDS(D)                                                                       \
@@ -357,11 +379,13 @@ template struct NodalFields<3>;
   template void Simulation<D>::init_fields();                                                                 \
   template void Simulation<D>::layout_fields(const std::vector<IVec<D>>&, const std::vector<IVec<D>>&);      \
   template void Simulation<D>::reduce_thread_buffers(bool, bool, bool, bool);                                    \
+  template void Simulation<D>::sum_thread_buffers(bool, bool, bool, bool);                                       \
   template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::update_grid(double);                                                           \
   template void Simulation<D>::move_rigid_particles(double, double);                                          \
-  template void Simulation<D>::check_particle(long, double) const;
+  template void Simulation<D>::check_particle(long, double) const;                                            \
+  template void Simulation<D>::throw_beyond_hugoniot(long) const;
 FRICTHERM_INSTANTIATE_FIELDS(2)
 FRICTHERM_INSTANTIATE_FIELDS(3)
 #undef FRICTHERM_INSTANTIATE_FIELDS

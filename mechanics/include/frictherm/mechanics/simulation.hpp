@@ -275,7 +275,8 @@ class Simulation {
   template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);
   template <class Kernel> void map_external_loads(double t);
   template <class Kernel> void remap_momentum();
-  template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
+  template <class Kernel> long update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
+  void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
   template <class Kernel> long update_particles(double dt);
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
   template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
@@ -284,6 +285,7 @@ class Simulation {
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
   void reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);
+  void sum_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);  // inside a parallel region
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead.
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
