@@ -454,7 +454,6 @@ void Simulation<Dim>::remap_momentum() {
 }
 
 // Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
-
 // Returns the first particle compressed past its Hugoniot's limit, or -1 (throw_beyond_hugoniot reports it).
 template <int Dim>
 template <class Kernel>
