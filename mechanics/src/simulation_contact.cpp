@@ -23,34 +23,46 @@ void Simulation<Dim>::find_contact_nodes() {
     contact_groups_.assign(1, 0);
     return;
   }
-  // Counting sort by node, O(slots) (no pass over the whole grid and no comparison sort): count the
-  // fields with mass at each node, give each node with two or more a run of entries in order of first
-  // appearance, fill the runs in field order. The counts and cursors are reset slot by slot.
+  // Counting sort by node, O(slots) (no comparison sort): count the fields with mass at each node,
+  // give each node with two or more a run of entries in order of first appearance, fill the runs in
+  // field order (slots are laid out in field order). Only the slots with mass are visited after the
+  // first pass. The counts and cursors are reset slot by slot, or over the grid when that is shorter.
   const double mmin = empty_node_mass_;
   const std::size_t total = nodes_.mass.size();
-  for (std::size_t s = 0; s < total; ++s) {
-    const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
-    node_field_count_[node] = 0;
-    node_entry_cursor_[node] = -1;
+  if (total >= node_field_count_.size()) {
+    std::fill(node_field_count_.begin(), node_field_count_.end(), 0);
+    std::fill(node_entry_cursor_.begin(), node_entry_cursor_.end(), -1);
+  } else {
+    for (std::size_t s = 0; s < total; ++s) {
+      const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
+      node_field_count_[node] = 0;
+      node_entry_cursor_[node] = -1;
+    }
   }
+  occupied_slots_.clear();
   for (std::size_t s = 0; s < total; ++s)
-    if (nodes_.mass[s] > mmin) ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
+    if (nodes_.mass[s] > mmin) {
+      ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
+      occupied_slots_.push_back(static_cast<int>(s));
+    }
   int entries = 0;
-  for (std::size_t s = 0; s < total; ++s) {
-    const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
-    if (nodes_.mass[s] > mmin && node_field_count_[node] >= 2 && node_entry_cursor_[node] < 0) {
+  for (const int s : occupied_slots_) {
+    const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(s)]);
+    if (node_field_count_[node] >= 2 && node_entry_cursor_[node] < 0) {
       node_entry_cursor_[node] = entries;
       entries += node_field_count_[node];
     }
   }
   contact_entries_.resize(static_cast<std::size_t>(entries));
-  for (std::size_t f = 0; f < fields_.size(); ++f)
-    for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) {
-      const int node = slot_node_[s];
-      if (nodes_.mass[s] > mmin && node_field_count_[static_cast<std::size_t>(node)] >= 2)
-        contact_entries_[static_cast<std::size_t>(node_entry_cursor_[static_cast<std::size_t>(node)]++)] = {
-            node, static_cast<int>(s), static_cast<int>(f)};
-    }
+  std::size_t f = 0;  // the field of slot s: fields are laid out in order, so f only advances
+  for (const int s : occupied_slots_) {
+    const std::size_t su = static_cast<std::size_t>(s);
+    while (su >= fields_[f].first + fields_[f].count) ++f;
+    const int node = slot_node_[su];
+    if (node_field_count_[static_cast<std::size_t>(node)] >= 2)
+      contact_entries_[static_cast<std::size_t>(node_entry_cursor_[static_cast<std::size_t>(node)]++)] = {
+          node, s, static_cast<int>(f)};
+  }
   // Node groups of contact_entries_: the start of each contact node's run, then the end.
   contact_groups_.clear();
   for (std::size_t e = 0; e < contact_entries_.size(); ++e)

@@ -93,6 +93,7 @@ void Simulation<Dim>::init_fields() {
       if (!materials_[m].is_rigid()) field_of_material_[m] = 0;
     slot_node_.resize(grid_.node_count());
     for (std::size_t i = 0; i < slot_node_.size(); ++i) slot_node_[i] = static_cast<int>(i);
+    slot_node_valid_ = false;  // (the per-material layout is not this one)
     nodes_.resize(grid_.node_count(), false);
   } else {
     for (std::size_t m = 0; m < nm; ++m) {
@@ -104,6 +105,7 @@ void Simulation<Dim>::init_fields() {
       fields_.push_back(f);
     }
     if (pair_index_.size() != nm * nm) pair_index_.assign(nm * nm, 0);
+    slot_node_valid_ = false;
     box_lo_.assign(nm, IVec<Dim>{});
     box_hi_.assign(nm, IVec<Dim>{});
     node_field_count_.assign(grid_.node_count(), 0);
@@ -119,18 +121,26 @@ void Simulation<Dim>::init_fields() {
 
 // Each material's field covers the box [lo, hi] of nodes its particles reach, stored contiguously:
 // slot = first + Σ (L_d − lo_d) stride_d. Storage only grows, so steady runs do not allocate.
+// The boxes move only when particles cross cells, so most steps keep the last layout: the slot-to-node
+// map is then rebuilt only when some field's box changed.
 template <int Dim>
 void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi) {
   std::size_t total = 0;
+  bool changed = false;
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     VelocityField<Dim>& F = fields_[f];
     const std::size_t m = static_cast<std::size_t>(F.material);
+    changed = changed || F.first != total;
     F.first = total;
     if (material_end_[m] == material_begin_[m]) {
+      changed = changed || F.count != 0;
       F.count = 0;
       F.extent = IVec<Dim>{};
       continue;
     }
+    IVec<Dim> extent;
+    for (int d = 0; d < Dim; ++d) extent[d] = hi[m][d] - lo[m][d] + 1;
+    changed = changed || F.lo != lo[m] || F.extent != extent;
     F.lo = lo[m];
     std::size_t count = 1;
     int shift = static_cast<int>(total);
@@ -148,6 +158,8 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
     nodes_.resize(total, true);
     for (auto& t : thread_nodes_) t.resize(total, true);
   }
+  if (!changed && slot_node_.size() == total && slot_node_valid_) return;
+  slot_node_valid_ = true;
   slot_node_.resize(total);
   const IVec<Dim>& gs = grid_.strides();
   for (const VelocityField<Dim>& F : fields_) {
@@ -167,8 +179,16 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
 template <int Dim>
 void Simulation<Dim>::reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
   if (thread_nodes_.empty()) return;
+#pragma omp parallel num_threads(threads_)
+  sum_thread_buffers(mass, momentum, force, contact_terms);
+}
+
+// The loop of reduce_thread_buffers, shared among the threads of the enclosing parallel region (an
+// orphaned worksharing loop: a scatter phase calls it after its barrier, saving a fork and join).
+template <int Dim>
+void Simulation<Dim>::sum_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
   const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     for (const auto& b : thread_nodes_) {
       if (mass) nodes_.mass[i] += b.mass[i];
@@ -305,9 +325,16 @@ void Simulation<Dim>::move_rigid_particles(double dt, double t) {
 template <int Dim>
 void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   long k = bad;
-  for (std::size_t j = 0; k < 0 && j < p_.size(); ++j)  // rigid particles are checked here
-    if (materials_[static_cast<std::size_t>(p_.material[j])].is_rigid() && !grid_.contains(p_.position[j]))
-      k = static_cast<long>(j);
+  // Rigid particles are checked here; particles are grouped by material (finalize), so only the rigid
+  // materials' ranges are visited, and the first one found is the lowest index as before.
+  for (std::size_t m = 0; k < 0 && m < materials_.size(); ++m) {
+    if (!materials_[m].is_rigid()) continue;
+    for (std::size_t j = material_begin_[m]; j < material_end_[m]; ++j)
+      if (!grid_.contains(p_.position[j]) && (k < 0 || static_cast<long>(j) < k)) {
+        k = static_cast<long>(j);
+        break;
+      }
+  }
   if (k < 0) return;
   const std::size_t u = static_cast<std::size_t>(k);
   std::ostringstream msg;
@@ -329,6 +356,20 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   throw SimulationError(msg.str(), step_, time_, k);
 }
 
+// A particle compressed past the limit of its Hugoniot in the stress update (simulation_step.cpp).
+template <int Dim>
+void Simulation<Dim>::throw_beyond_hugoniot(long beyond) const {
+  if (beyond >= 0) {
+    const std::size_t k = static_cast<std::size_t>(beyond);
+    std::ostringstream msg;
+    msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '"
+        << materials_[static_cast<std::size_t>(p_.material[k])].name
+        << "' is compressed past the limit of its Hugoniot (J = " << p_.volume[k] / p_.initial_volume[k]
+        << "; try a smaller CFL factor)";
+    throw SimulationError(msg.str(), step_, time_, beyond);
+  }
+}
+
 template struct NodalFields<2>;
 template struct NodalFields<3>;
 #define FRICTHERM_INSTANTIATE_FIELDS(D)                                                                       \
@@ -338,11 +379,13 @@ template struct NodalFields<3>;
   template void Simulation<D>::init_fields();                                                                 \
   template void Simulation<D>::layout_fields(const std::vector<IVec<D>>&, const std::vector<IVec<D>>&);      \
   template void Simulation<D>::reduce_thread_buffers(bool, bool, bool, bool);                                    \
+  template void Simulation<D>::sum_thread_buffers(bool, bool, bool, bool);                                       \
   template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::update_grid(double);                                                           \
   template void Simulation<D>::move_rigid_particles(double, double);                                          \
-  template void Simulation<D>::check_particle(long, double) const;
+  template void Simulation<D>::check_particle(long, double) const;                                            \
+  template void Simulation<D>::throw_beyond_hugoniot(long) const;
 FRICTHERM_INSTANTIATE_FIELDS(2)
 FRICTHERM_INSTANTIATE_FIELDS(3)
 #undef FRICTHERM_INSTANTIATE_FIELDS

@@ -7,6 +7,7 @@
 // read them.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/plane_strain_update.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <omp.h>
@@ -21,6 +22,14 @@ namespace frictherm::mechanics {
 namespace {
 template <class Kernel>
 constexpr bool is_extended = std::is_same_v<Kernel, ExtendedBSplineKernel>;
+
+// The step's stencils for hot loops: a plain pointer to an array of Stencil (kept in a register, see
+// map_to_grid), or the precomputed EBS entries themselves.
+template <class T>
+const T* indexable(const std::vector<T>& v) { return v.data(); }
+template <int D>
+const PrecomputedStencils<D>& indexable(const PrecomputedStencils<D>& p) { return p; }
+
 }  // namespace
 
 template <int Dim>
@@ -68,8 +77,10 @@ void Simulation<Dim>::step_with(double dt) {
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
       field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
-  map_rigid_particles<Kernel>(t);  // nodes driven by rigid boundary materials (EBS keeps them)
+  // Nodes driven by rigid boundary materials (EBS keeps them); with contact from the stencils the step
+  // evaluates anyway.
   if constexpr (is_extended<Kernel>) {
+    map_rigid_particles<Kernel>(t, nullptr);
     prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
   } else {
     auto& st = stencils<Kernel>();
@@ -78,6 +89,9 @@ void Simulation<Dim>::step_with(double dt) {
       // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
       if (!stencils_current_) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
       layout_fields(box_lo_, box_hi_);
+      map_rigid_particles<Kernel>(t, st.data());
+    } else {
+      map_rigid_particles<Kernel>(t, nullptr);
     }
   }
   if (contact_) {
@@ -97,7 +111,7 @@ void Simulation<Dim>::step_with(double dt) {
   if (usf) {
     velocity_from_momentum();
     lap_.to(pt.grid_update);
-    update_stress<Kernel>(nodes_.velocity, dt);
+    throw_beyond_hugoniot(update_stress<Kernel>(nodes_.velocity, dt));
     lap_.to(pt.stress_update);
     add_internal_forces<Kernel>();
     lap_.to(pt.particle_to_grid);
@@ -127,10 +141,10 @@ void Simulation<Dim>::step_with(double dt) {
     velocity_from_momentum();
     move_boundary_points(dt, t);  // MUSL: with the remapped velocity, as the stress update
     lap_.to(pt.grid_update);
-    update_stress<Kernel>(nodes_.velocity, dt);
+    throw_beyond_hugoniot(update_stress<Kernel>(nodes_.velocity, dt));
     lap_.to(pt.stress_update);
   } else if (opt_.scheme == UpdateScheme::usl) {
-    update_stress<Kernel>(nodes_.velocity, dt);
+    throw_beyond_hugoniot(update_stress<Kernel>(nodes_.velocity, dt));
     lap_.to(pt.stress_update);
   }
 }
@@ -142,9 +156,14 @@ template <class Kernel>
 void Simulation<Dim>::evaluate_stencils() {
   auto& st = stencils<Kernel>();
   st.resize(p_.size());
+  // Local copies (see map_to_grid): the stencil stores cannot reach them, so nothing is reloaded.
+  const Grid<Dim> grid = grid_;
+  Stencil<Dim, Kernel>* const stk = st.data();
+  const Vec<Dim>* const position = p_.position.data();
+  const Vec<Dim>* const half_size = p_.half_size.data();
   if (!contact_) {
 #pragma omp parallel for num_threads(threads_) schedule(static)
-    for (std::size_t k = 0; k < p_.size(); ++k) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+    for (std::size_t k = 0; k < p_.size(); ++k) stk[k].evaluate(grid, position[k], half_size[k]);
     return;
   }
   const std::size_t nm = materials_.size();
@@ -161,8 +180,8 @@ void Simulation<Dim>::evaluate_stencils() {
     for (std::size_t m = 0; m < nm; ++m) {
 #pragma omp for schedule(static) nowait
       for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-        st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
-        const IVec<Dim> f = st[k].first_node();
+        stk[k].evaluate(grid, position[k], half_size[k]);
+        const IVec<Dim> f = stk[k].first_node();
         for (int d = 0; d < Dim; ++d) {
           lo[m][d] = std::min(lo[m][d], f[d]);
           hi[m][d] = std::max(hi[m][d], f[d] + Kernel::K - 1);
@@ -206,12 +225,13 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
   const bool prepared = stencils_current_;  // by current_stencils() since the last step
-  nodes_.clear_accumulators();
+  // One region: each thread clears its own buffer (thread 0 the nodes' own fields), scatters, and
+  // after a barrier the buffers are summed into the nodes.
 #pragma omp parallel num_threads(threads_)
   {
     const int tid = omp_get_thread_num();
     NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
-    if (tid != 0) acc.clear_accumulators();
+    acc.clear_accumulators();
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const int f = field_of_material_[m];
       if (f < 0) continue;
@@ -242,6 +262,15 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
         }
       } else {
         const bool forces = with_forces && !rigid;
+        // Plain pointers, held in registers: Eigen's vector stores may alias anything, so through the
+        // std::vectors every store would reload every array's address.
+        double* const mass = acc.mass.data();
+        double* const domain = acc.domain.data();
+        Vec<Dim>* const momentum = acc.momentum.data();
+        Vec<Dim>* const force = acc.force.data();
+        Vec<Dim>* const mass_position = acc.mass_position.data();
+        Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
+        decltype(auto) stk = indexable(st);
 #pragma omp for schedule(static) nowait
         for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
           const double mp = p_.mass[k], Vp = p_.volume[k];
@@ -249,19 +278,22 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
           const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
           const Mat<Dim> Vsig = Vp * p_.stress[k];
           const Vec<Dim> mg = mp * g;
-          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-            acc.mass[i] += S * mp;
-            acc.momentum[i] += S * mv;
-            if (forces) acc.force[i] += S * mg - Vsig * G;
-            acc.mass_position[i] += S * mx;
-            acc.domain[i] += S * Vp;
-            acc.domain_gradient[i] += Vp * G;
+          stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
+            mass[i] += S * mp;
+            momentum[i] += S * mv;
+            if (forces) force[i] += S * mg - Vsig * G;
+            mass_position[i] += S * mx;
+            domain[i] += S * Vp;
+            domain_gradient[i] += Vp * G;
           });
         }
       }
     }
+    if (!thread_nodes_.empty()) {
+#pragma omp barrier
+      sum_thread_buffers(true, true, with_forces, contact_);
+    }
   }
-  reduce_thread_buffers(true, true, with_forces, contact_);
 }
 
 // USF: internal and body forces from the freshly updated stress.
@@ -294,7 +326,7 @@ void Simulation<Dim>::add_internal_forces() {
 // with contact): every node they touch takes their prescribed velocity components.
 template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::map_rigid_particles(double t) {
+void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated) {
   std::fill(rigid_mask_.begin(), rigid_mask_.end(), std::uint8_t{0});
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid() || field_of_material_[m] >= 0) continue;
@@ -304,7 +336,10 @@ void Simulation<Dim>::map_rigid_particles(double t) {
       if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Stencil<Dim, Kernel> s;
-      s.evaluate(grid_, p_.position[k], p_.half_size[k]);
+      if (evaluated)
+        s = evaluated[k];
+      else
+        s.evaluate(grid_, p_.position[k], p_.half_size[k]);
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
         if (S > 0.0) {
           rigid_mask_[static_cast<std::size_t>(i)] |= bits;
@@ -343,6 +378,11 @@ long Simulation<Dim>::update_particles(double dt) {
   const double pic = std::isfinite(opt_.pic_relaxation_time) ? -std::expm1(-dt / opt_.pic_relaxation_time) : 0.0;
   const ParticleUpdate update = opt_.particle_update;
   const std::vector<Vec<Dim>>& filtered = transfer_.filtered;  // v* of XPIC/FMPM (transfer.hpp)
+  // Plain pointers (see map_to_grid): the particle stores below would otherwise reload them.
+  const Vec<Dim>* const acceleration = nodes_.acceleration.data();
+  const Vec<Dim>* const velocity = nodes_.velocity.data();
+  const Vec<Dim>* const filtered_v = filtered.data();
+  decltype(auto) stk = indexable(st);
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const int f = field_of_material_[m];
@@ -354,15 +394,15 @@ long Simulation<Dim>::update_particles(double dt) {
       const std::size_t k = static_cast<std::size_t>(kk);
       Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
       if (update == ParticleUpdate::flip) {
-        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-          a += S * nodes_.acceleration[i];
-          v += S * nodes_.velocity[i];
+        stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+          a += S * acceleration[i];
+          v += S * velocity[i];
         });
       } else {
-        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-          a += S * nodes_.acceleration[i];
-          v += S * nodes_.velocity[i];
-          vf += S * filtered[static_cast<std::size_t>(i)];
+        stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+          a += S * acceleration[i];
+          v += S * velocity[i];
+          vf += S * filtered_v[i];
         });
       }
       const Vec<Dim> v_old = p_.velocity[k];
@@ -414,14 +454,17 @@ void Simulation<Dim>::remap_momentum() {
 }
 
 // Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
+// Returns the first particle compressed past its Hugoniot's limit, or -1 (throw_beyond_hugoniot reports it).
 template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
+long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   auto& st = stencils<Kernel>();
   const Analysis an = opt_.analysis;
   if (wave_speed_.size() != p_.size())
     wave_speed_.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
   long beyond = -1;  // a particle compressed past the Hugoniot's limit
+  const Vec<Dim>* const vi = v.data();  // plain pointers (see map_to_grid)
+  decltype(auto) stk = indexable(st);
 #pragma omp parallel num_threads(threads_) reduction(max : beyond)
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const Material& mat = materials_[m];
@@ -431,16 +474,42 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
     const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
     const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
     const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
+    const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
+    if constexpr (Dim == 2) {
+      if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
+        // A local copy: no particle store can touch it, so the compiler hoists what depends on the
+        // material only (ρ0 C0², −2G/3, …) out of the loop.
+        const MieGruneisenParams params = mat.mie_gruneisen;
+#pragma omp for schedule(static) nowait
+        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+          VelocityGradient2 L;
+          stk[k].for_each(ix, [&](int i, double, const Vec<2>& G) { L.add(vi[i], G); });
+          Mat<2>& F = p_.deformation_gradient[k];
+          const double det_A = deformation_update_2d(L, dt, F);
+          p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
+          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+          if (mie_gruneisen_update_plane_strain(L, dt, p_.volume[k] / p_.initial_volume[k], det_A, params,
+                                                min_J, p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
+                                                p_.internal_energy[k], wp, wave_speed_[k]) != MieGruneisenStatus::ok)
+            beyond = std::max(beyond, static_cast<long>(k));
+          p_.plastic_work[k] += wp * p_.volume[k];
+        }
+        continue;
+      }
+    }
 #pragma omp for schedule(static) nowait
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
-      st[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += v[static_cast<std::size_t>(i)] * G.transpose(); });
+      stk[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += vi[i] * G.transpose(); });
       Mat<Dim>& F = p_.deformation_gradient[k];
-      F = (Mat<Dim>::Identity() + dt * L) * F;
+      const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+      Mat<Dim> F_new;
+      F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
+      F = F_new;
       p_.volume[k] = F.determinant() * p_.initial_volume[k];
       if (mg) {
         double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-        if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, p_.stress[k],
+        if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J, p_.stress[k],
                                       p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k], wp,
                                       &wave_speed_[k]) != MieGruneisenStatus::ok)
           beyond = std::max(beyond, static_cast<long>(k));
@@ -454,17 +523,10 @@ void Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
       }
     }
   }
-  if (beyond >= 0) {
-    const std::size_t k = static_cast<std::size_t>(beyond);
-    std::ostringstream msg;
-    msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '"
-        << materials_[static_cast<std::size_t>(p_.material[k])].name
-        << "' is compressed past the limit of its Hugoniot (J = " << p_.volume[k] / p_.initial_volume[k]
-        << "; try a smaller CFL factor)";
-    throw SimulationError(msg.str(), step_, time_, beyond);
-  }
   wave_speed_ready_ = true;
+  return beyond;
 }
+
 
 #define FRICTHERM_INSTANTIATE_STEP(D) \
   template double Simulation<D>::step(double); \

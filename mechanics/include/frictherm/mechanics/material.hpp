@@ -66,13 +66,18 @@ struct Material {
 /// Hypoelastic linear elastic update with the Jaumann rate: the increment dε = sym(L) dt rotated
 /// objectively, σ += λ tr(dε) I + 2 μ dε (plane stress uses λ* = 2λμ/(λ+2μ) and σ_zz = 0).
 template <int Dim>
-inline void linear_elastic_update(const Mat<Dim>& L, double dt, double lambda, double mu, Analysis a,
+FRICTHERM_ALWAYS_INLINE void linear_elastic_update(const Mat<Dim>& L, double dt, double lambda, double mu, Analysis a,
                                   Mat<Dim>& sigma, double& sigma_zz) {
   const Mat<Dim> de = 0.5 * (L + L.transpose()) * dt;
   const Mat<Dim> w = 0.5 * (L - L.transpose()) * dt;
   const double tr = de.trace();
   const double lam = (a == Analysis::plane_stress) ? 2.0 * lambda * mu / (lambda + 2.0 * mu) : lambda;
-  sigma += w * sigma - sigma * w;
+  // σ += w σ − σ w, spelled out as Eigen evaluates that expression (a temporary w σ, minus σ w, then
+  // added): GCC keeps Eigen's combined form out of line; this inlines with the same arithmetic.
+  Mat<Dim> rotation;
+  rotation.noalias() = w * sigma;
+  rotation.noalias() -= sigma * w;
+  sigma += rotation;
   sigma += 2.0 * mu * de;
   sigma.diagonal().array() += lam * tr;
   if (a == Analysis::plane_strain) sigma_zz += lambda * tr;

@@ -83,7 +83,7 @@ struct MieGruneisenState {
 };
 
 /// The energy-independent part f(η) of p = f(η) + γ0 ρ0 e and its derivative f'(η).
-inline void mie_gruneisen_reference_part(const MieGruneisenParams& m, double J, double& f, double& df) {
+FRICTHERM_ALWAYS_INLINE void mie_gruneisen_reference_part(const MieGruneisenParams& m, double J, double& f, double& df) {
   const double eta = 1.0 - J;
   const double rc2 = m.density * m.C0 * m.C0;
   if (eta > 0.0) {  // compression: p_H (1 − γ0 η/2)
@@ -131,7 +131,7 @@ struct J2Increment {
 ///   Δε_p = (3/2) Δε̄p s/q,  σ:Δε_p = q Δε̄p (q after the return).
 /// 2D is plane strain: s_zz is the out-of-plane deviator (dε_zz = 0); in 3D s_zz is unused.
 template <int Dim>
-inline J2Increment j2_deviatoric_update(const Mat<Dim>& L, double dt, double G, double yield_stress,
+FRICTHERM_ALWAYS_INLINE J2Increment j2_deviatoric_update(const Mat<Dim>& L, double dt, double G, double yield_stress,
                                         double hardening, double plastic_strain, Mat<Dim>& s, double& s_zz) {
   constexpr Analysis an = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
   linear_elastic_update<Dim>(L, dt, -2.0 * G / 3.0, G, an, s, s_zz);
@@ -165,13 +165,16 @@ enum class MieGruneisenStatus { ok, beyond_hugoniot_limit };
 /// wave_speed the dilatational wave speed of the new state (as mie_gruneisen_wave_speed, for the CFL step).
 /// J_old = J / det(I + dt L). If J is at or beyond the Hugoniot limit (J <= mie_gruneisen_min_J, or
 /// J <= 0) nothing is changed and beyond_hugoniot_limit is returned.
+/// min_J = mie_gruneisen_min_J(m), a constant of the material: the particle loop passes it in rather
+/// than solving the quadratic (a square root and two divisions) for every particle.
 template <int Dim>
-inline MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& L, double dt, double J, const MieGruneisenParams& m,
-                                               Mat<Dim>& sigma, double& sigma_zz, double& plastic_strain,
-                                               double& energy, double& plastic_work,
-                                               double* wave_speed = nullptr) {
+FRICTHERM_ALWAYS_INLINE MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& L, double dt, double J,
+                                                                const MieGruneisenParams& m, double min_J,
+                                                                Mat<Dim>& sigma, double& sigma_zz,
+                                                                double& plastic_strain, double& energy,
+                                                                double& plastic_work, double* wave_speed) {
   plastic_work = 0.0;
-  if (!(J > mie_gruneisen_min_J(m))) return MieGruneisenStatus::beyond_hugoniot_limit;  // also J <= 0, NaN
+  if (!(J > min_J)) return MieGruneisenStatus::beyond_hugoniot_limit;  // also J <= 0, NaN
   const double J_old = J / (Mat<Dim>::Identity() + dt * L).determinant();
   const double zz = Dim == 2 ? sigma_zz : 0.0;
   const double p_old = -(sigma.trace() + zz) / 3.0;
@@ -197,6 +200,16 @@ inline MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& L, double dt, dou
   sigma.diagonal().array() -= p;
   sigma_zz = Dim == 2 ? s_zz - p : 0.0;
   return MieGruneisenStatus::ok;
+}
+
+/// Same, solving for the material's limit J itself.
+template <int Dim>
+inline MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& L, double dt, double J, const MieGruneisenParams& m,
+                                               Mat<Dim>& sigma, double& sigma_zz, double& plastic_strain,
+                                               double& energy, double& plastic_work,
+                                               double* wave_speed = nullptr) {
+  return mie_gruneisen_update<Dim>(L, dt, J, m, mie_gruneisen_min_J(m), sigma, sigma_zz, plastic_strain, energy,
+                                   plastic_work, wave_speed);
 }
 
 }  // namespace frictherm::mechanics

@@ -30,6 +30,13 @@ struct NodeIndexer {
   int shift = 0;
 };
 
+/// ⌊s⌋ as an int for s within int range: truncation corrected for negative s. Cheaper than
+/// static_cast<int>(std::floor(s)) on baseline x86-64 (no SSE4.1 rounding instruction), same result.
+inline int floor_to_int(double s) {
+  const int t = static_cast<int>(s);
+  return t - (s < static_cast<double>(t));
+}
+
 /// 1D weights of one particle: nodes base, base+1, ..., base+K-1 along one direction.
 template <int K>
 struct Weights1D {
@@ -43,7 +50,7 @@ struct LinearKernel {
   static constexpr int K = 2;
   static void eval(double x, double lo, double h, double inv_h, double /*lp*/, Weights1D<K>& out) {
     const double s = (x - lo) * inv_h;
-    const int j = static_cast<int>(std::floor(s));
+    const int j = floor_to_int(s);
     const double xi = s - j;
     out.base = j;
     out.w[0] = 1.0 - xi;
@@ -84,7 +91,7 @@ struct UGIMPKernel {
   }
   static void eval(double x, double lo, double h, double inv_h, double lp, Weights1D<K>& out) {
     const double s = (x - lo) * inv_h;
-    const int j = static_cast<int>(std::floor(s));
+    const int j = floor_to_int(s);
     out.base = (s - j < 0.5) ? j - 1 : j;
     const double inv_hlp = inv_h / lp;
     for (int a = 0; a < K; ++a) {
@@ -99,7 +106,7 @@ struct QuadraticBSplineKernel {
   static constexpr int K = 3;
   static void eval(double x, double lo, double /*h*/, double inv_h, double /*lp*/, Weights1D<K>& out) {
     const double s = (x - lo) * inv_h;
-    const int k = static_cast<int>(std::floor(s + 0.5));
+    const int k = floor_to_int(s + 0.5);
     const double xi = s - k;  // in [-0.5, 0.5)
     out.base = k - 1;
     const double a = 0.5 - xi, b = 0.5 + xi;

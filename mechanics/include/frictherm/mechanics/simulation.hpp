@@ -271,10 +271,12 @@ class Simulation {
   template <class Kernel> void step_with(double dt);
   template <class Kernel> void map_to_grid(double dt, bool with_forces);
   template <class Kernel> void add_internal_forces();
-  template <class Kernel> void map_rigid_particles(double t);
+  /// `evaluated`: this step's stencils of every particle (contact), or null to evaluate them here.
+  template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);
   template <class Kernel> void map_external_loads(double t);
   template <class Kernel> void remap_momentum();
-  template <class Kernel> void update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
+  template <class Kernel> long update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
+  void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
   template <class Kernel> long update_particles(double dt);
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
   template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
@@ -283,6 +285,7 @@ class Simulation {
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
   void reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);
+  void sum_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);  // inside a parallel region
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead.
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
@@ -322,6 +325,8 @@ class Simulation {
   std::vector<VelocityField<Dim>> fields_;
   std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
   std::vector<int> slot_node_;
+  bool slot_node_valid_ = false;
+  std::vector<int> occupied_slots_;  // find_contact_nodes: slots with mass, in slot order  // slot_node_ matches the per-material layout of fields_ (layout_fields)
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
   bool contact_ = false;

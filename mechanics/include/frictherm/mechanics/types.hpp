@@ -5,6 +5,14 @@
 #include <array>
 #include <cstdint>
 
+/// For the small constitutive functions called once per particle in the stress update: inlined into
+/// the particle loop (GCC otherwise keeps some of them out of line and passes the matrices through memory).
+#if defined(__GNUC__)
+#define FRICTHERM_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define FRICTHERM_ALWAYS_INLINE inline
+#endif
+
 namespace frictherm::mechanics {
 
 template <int Dim> using Vec = Eigen::Matrix<double, Dim, 1>;
