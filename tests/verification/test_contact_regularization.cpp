@@ -91,4 +91,4 @@ TEST_P(AdhesionRefinement, AdhesionBlockConvergesWithRefinement) {
 
 INSTANTIATE_TEST_SUITE_P(ContactRegularization, AdhesionRefinement,
                          ::testing::Values(mechanics::UpdateScheme::musl, mechanics::UpdateScheme::usl),
-                         [](const auto& info) { return std::string(mechanics::to_string(info.param)); });
+                         [](const auto& param_info) { return std::string(mechanics::to_string(param_info.param)); });
