@@ -7,12 +7,14 @@
 // 1 and 2 threads, and 2 threads while a busy child process spins on one core. Prints wall time, CPU
 // time of this process (getrusage: all its threads), particle-steps per wall second and per CPU-second,
 // and the ratios coupled/mechanics and (2 threads)/(1 thread). Asserts nothing.
-//   bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--scratch DIR]
-// --quick: 5 mm only, 2 ms. The default end times are 10 ms at 5 mm and 1 ms at 1 mm.
+//   bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--repeat N] [--scratch DIR]
+// --quick: 5 mm only, 2 ms. The default end times are 10 ms at 5 mm and 1 ms at 1 mm. --repeat N
+// (default 3): the idle cases N times, interleaved; the median-CPU run of each stands for it.
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/coupling/thread_policy.hpp>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -116,6 +118,11 @@ Figures run_case(double h, double end_time, Mode mode, int threads, const std::s
   return f;
 }
 
+Figures median_by_cpu(std::vector<Figures> runs) {
+  std::sort(runs.begin(), runs.end(), [](const Figures& a, const Figures& b) { return a.cpu < b.cpu; });
+  return runs[runs.size() / 2];
+}
+
 // A child process that spins on one core (CPU 0 when affinity can be set) for at most `limit` seconds.
 pid_t start_busy(double limit) {
   const pid_t pid = fork();
@@ -144,6 +151,7 @@ int main(int argc, char** argv) {
   std::vector<double> cells = {0.005, 0.001};
   double end5 = 0.010, end1 = 0.001;
   std::string scratch = "/tmp";
+  int repeat = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
@@ -163,8 +171,10 @@ int main(int argc, char** argv) {
       end1 = std::atof(argv[++i]);
     } else if (a == "--scratch" && i + 1 < argc) {
       scratch = argv[++i];
+    } else if (a == "--repeat" && i + 1 < argc) {
+      repeat = std::max(1, std::atoi(argv[++i]));
     } else {
-      std::fprintf(stderr, "usage: bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--scratch DIR]\n");
+      std::fprintf(stderr, "usage: bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--repeat N] [--scratch DIR]\n");
       return 2;
     }
   }
@@ -174,9 +184,23 @@ int main(int argc, char** argv) {
   for (const double h : cells) {
     const double end_time = h > 0.003 ? end5 : end1;
     std::printf("cell %.1f mm, end time %g s\n", h * 1e3, end_time);
+    // Each case `repeat` times, the cases interleaved (the machine's drift hits them alike); the run
+    // with the median CPU time stands for the case.
+    std::vector<Figures> runs1[4], runs2[3];
+    for (int r = 0; r < repeat; ++r) {
+      for (int m = 0; m < 4; ++m) runs1[m].push_back(run_case(h, end_time, static_cast<Mode>(m), 1, scratch));
+      for (int m = 0; m < 3; ++m) runs2[m].push_back(run_case(h, end_time, static_cast<Mode>(m), 2, scratch));
+    }
     Figures f1[4], f2[3];
-    for (int m = 0; m < 4; ++m) f1[m] = run_case(h, end_time, static_cast<Mode>(m), 1, scratch);
-    for (int m = 0; m < 3; ++m) f2[m] = run_case(h, end_time, static_cast<Mode>(m), 2, scratch);
+    for (int m = 0; m < 4; ++m) f1[m] = median_by_cpu(runs1[m]);
+    for (int m = 0; m < 3; ++m) f2[m] = median_by_cpu(runs2[m]);
+    if (repeat > 1) {
+      std::printf("  medians of %d runs (CPU s): 1 thread: mechanics %.3f, every step %.3f, adaptive %.3f, no reuse %.3f; "
+                  "2 threads: %.3f, %.3f, %.3f\n",
+                  repeat, f1[0].cpu, f1[1].cpu, f1[2].cpu, f1[3].cpu, f2[0].cpu, f2[1].cpu, f2[2].cpu);
+      std::printf("  M p-steps per CPU-second (medians): mechanics %.2f, every step %.2f (1 thread); %.2f, %.2f (2 threads)\n",
+                  f1[0].rate_cpu / 1e6, f1[1].rate_cpu / 1e6, f2[0].rate_cpu / 1e6, f2[1].rate_cpu / 1e6);
+    }
     std::printf("  with a busy process on CPU 0:\n");
     const pid_t busy = start_busy(20.0 * f1[1].wall + 60.0);
     Figures fb1 = run_case(h, end_time, Mode::every_step, 1, scratch);
