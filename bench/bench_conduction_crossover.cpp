@@ -7,6 +7,7 @@
 // reuse off). Prints microseconds per window (CPU time of the process) and the ratio to matrix-free.
 // Asserts nothing.
 //   bench_conduction_crossover [--cells NX,NY] [--windows N]
+#include "cpu_time.hpp"
 #include <frictherm/coupling/coupler.hpp>
 
 #include <cmath>
@@ -21,12 +22,7 @@ namespace fm = frictherm::mechanics;
 
 namespace {
 
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
+using frictherm::bench::cpu_seconds;
 
 constexpr double kRho = 1000.0, kC = 1000.0, kK = 0.4, kH = 0.005;  // the twin scene's block
 

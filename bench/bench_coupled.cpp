@@ -10,6 +10,7 @@
 //   bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--repeat N] [--scratch DIR]
 // --quick: 5 mm only, 2 ms. The default end times are 10 ms at 5 mm and 1 ms at 1 mm. --repeat N
 // (default 3): the idle cases N times, interleaved; the median-CPU run of each stands for it.
+#include "cpu_time.hpp"
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/coupling/thread_policy.hpp>
@@ -30,12 +31,7 @@ using namespace frictherm::coupling;
 
 namespace {
 
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
+using frictherm::bench::cpu_seconds;
 
 enum class Mode { mechanics, every_step, adaptive, every_step_gather };
 const char* name(Mode m) {

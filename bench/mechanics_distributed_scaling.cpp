@@ -9,6 +9,7 @@
 // every rank keeps the particles of --cells at one rank. Asserts nothing.
 //
 //   mpirun -n 4 mechanics_distributed_scaling [--cells 200] [--steps 100] [--weak] [--cases block,sliding]
+#include "cpu_time.hpp"
 #include <frictherm/mechanics/distributed.hpp>
 
 #include <sys/resource.h>
@@ -25,12 +26,7 @@ using V2 = fm::Vec<2>;
 
 namespace {
 
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
+using frictherm::bench::cpu_seconds;
 
 fm::Material elastic(const char* name, double E) {
   fm::Material m;

@@ -21,6 +21,7 @@
 #include "frictherm/mechanics/geometry.hpp"
 #include "frictherm/mechanics/simulation.hpp"
 
+#include "../decomposed_test_support.hpp"
 #include "../mpi_ranks.hpp"
 
 #include <gtest/gtest.h>
@@ -36,35 +37,10 @@ namespace fc = frictherm::coupling;
 using V2 = fm::Vec<2>;
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
+using frictherm::test::decomposed;
+using frictherm::test::elastic;
 
 constexpr double kT0 = 300.0;  // K
-
-fm::Material elastic(const char* name, double E, double nu, double rho) {
-  fm::Material m;
-  m.name = name;
-  m.kind = fm::MaterialKind::linear_elastic;
-  m.youngs_modulus = E;
-  m.poisson_ratio = nu;
-  m.density = rho;
-  return m;
-}
-
-// Serial particles as decomposed particles (id = serial index, temperature as the one scalar); only
-// rank 0 passes them, the first migration distributes them.
-std::vector<fm::DecomposedParticle> decomposed(const fm::Particles<2>& sp) {
-  std::vector<fm::DecomposedParticle> all(sp.position.size());
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    all[k].id = static_cast<std::int64_t>(k);
-    all[k].mass = sp.mass[k];
-    all[k].volume = sp.volume[k];
-    all[k].position = sp.position[k];
-    all[k].velocity = sp.velocity[k];
-    all[k].half_size = sp.half_size[k];
-    all[k].material = sp.material[k];
-    all[k].scalars = {sp.temperature[k]};
-  }
-  return comm_rank() == 0 ? all : std::vector<fm::DecomposedParticle>{};
-}
 
 // Largest |T_p − T_p(serial)| over the gathered particles (by id), and whether the ids match.
 double temperature_difference(const std::vector<fm::DecomposedParticle>& a, const fm::Particles<2>& sp, bool& same) {
@@ -105,42 +81,22 @@ TEST(DecomposedHeat, SlidingBlockEqualsTheSerialRunAndClosesItsBooks) {
   // 10 m/s crossing the 2-rank split, g = 2e4 m/s², Coulomb μ = 0.3, 1 mm cells, 2 × 2 particles per
   // cell. Thermal: base C = 100 J/(kg K), k = 50 W/(m K) (α = 5e-4 m²/s), block C = 150, k = 20, so
   // heat spreads ≈ 0.4 mm in the 200 steps (3.4e-4 s) and the interface warms by ≈ 0.1–1 K.
-  const double h = 1e-3, rho = 1000.0, v0 = 10.0, g = 2e4, mu = 0.3;
-  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {26, 12});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
-  so.gravity = fm::Vec<3>(0.0, -g, 0.0);
-  fm::Simulation<2> serial(grid, so);
-  const std::vector<fm::Material> mats{elastic("base", 2e7, 0.3, rho), elastic("block", 1.5e7, 0.25, rho)};
-  const int base = serial.add_material(mats[0]), blk = serial.add_material(mats[1]);
-  serial.add_body("base", *fm::make_box<2>(V2(1e-3, 0.0), V2(25e-3, 4e-3), base), 2, V2::Zero());
-  serial.add_body("block", *fm::make_box<2>(V2(6e-3, 4e-3), V2(14e-3, 8e-3), blk), 2, V2(v0, 0.0));
-  const fm::FixedFace bottom{1, false, {{true, true, true}}};
-  serial.fix_face(bottom);
-  fm::ContactOptions co;
-  co.default_pair.law = fm::FrictionLaw::coulomb(mu);
-  co.default_pair.normal = fm::NormalMethod::specified;
-  co.default_pair.normal_vector = fm::Vec<3>(0.0, 1.0, 0.0);
-  serial.enable_contact(co);
-  serial.set_contact_pair(base, blk, co.default_pair);
-  serial.finalize();
+  frictherm::test::SlidingBlock scene(fm::ShapeKind::ugimp);
+  const double h = scene.h, rho = scene.rho, v0 = scene.v0;
+  const fm::Grid<2>& grid = scene.grid;
+  fm::Simulation<2>& serial = *scene.serial;
+  const std::vector<fm::Material>& mats = scene.materials;
+  const int blk = scene.block;
   fm::Particles<2>& sp = serial.particles();
   std::fill(sp.temperature.begin(), sp.temperature.end(), kT0);
   const std::vector<fc::ThermalProperties> thermal{{true, 100.0, 50.0}, {true, 150.0, 20.0}};
-  fc::Coupler<2> coupler(grid, so.shape, serial_options(thermal));
+  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_options(thermal));
   coupler.start(sp, 0.0);
 
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.gravity = V2(0.0, -g);
-  opt.fixed_faces = {bottom};
-  opt.contact = true;
-  opt.contact_options = co;
-  opt.contact_pairs = {fm::DecomposedContactPair{base, blk, co.default_pair}};
+  fm::DecomposedOptions opt = scene.options;
   opt.particle_scalars = {"temperature"};
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(decomposed(sp));
+  split.add_particles(decomposed(sp, true));
   fc::DecomposedHeatOptions ho;
   ho.materials = thermal;
   ho.order = fm::HeatingOrder::second;
@@ -233,7 +189,7 @@ TEST_P(DecomposedConduction, EqualsTheSerialConduction) {
   opt.shape = fm::ShapeKind::ugimp;
   opt.particle_scalars = {"temperature"};
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(decomposed(sp));
+  split.add_particles(decomposed(sp, true));
   fc::DecomposedHeatOptions ho;
   ho.materials = thermal;
   fc::DecomposedHeat heat(split, ho);
@@ -281,7 +237,7 @@ TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
   opt.shape = fm::ShapeKind::ugimp;
   opt.particle_scalars = {"temperature"};
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(decomposed(striped_body(0)));
+  split.add_particles(decomposed(striped_body(0), true));
   fc::DecomposedHeatOptions ho;
   ho.materials = {{true, 1100.0, 0.45}};
   fc::DecomposedHeat heat(split, ho);

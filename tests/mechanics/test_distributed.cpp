@@ -11,6 +11,7 @@
 #include "frictherm/mechanics/geometry.hpp"
 #include "frictherm/mechanics/simulation.hpp"
 
+#include "../decomposed_test_support.hpp"
 #include "../mpi_ranks.hpp"
 
 #include <gtest/gtest.h>
@@ -28,15 +29,7 @@ using V2 = fm::Vec<2>;
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 
-fm::Material elastic(double E, double nu, double rho) {
-  fm::Material m;
-  m.name = "elastic";
-  m.kind = fm::MaterialKind::linear_elastic;
-  m.youngs_modulus = E;
-  m.poisson_ratio = nu;
-  m.density = rho;
-  return m;
-}
+fm::Material elastic(double E, double nu, double rho) { return frictherm::test::elastic("elastic", E, nu, rho); }
 
 // A rectangle [lo, hi] (multiples of h) filled with ppc × ppc particles per cell, ids from first_id.
 std::vector<fm::DecomposedParticle> block(const V2& lo, const V2& hi, double h, int ppc, double rho,

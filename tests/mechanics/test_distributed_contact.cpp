@@ -20,6 +20,7 @@
 #include "frictherm/mechanics/geometry.hpp"
 #include "frictherm/mechanics/simulation.hpp"
 
+#include "../decomposed_test_support.hpp"
 #include "../mpi_ranks.hpp"
 
 #include <gtest/gtest.h>
@@ -35,33 +36,7 @@ using V2 = fm::Vec<2>;
 
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
-
-fm::Material elastic(const char* name, double E, double nu, double rho) {
-  fm::Material m;
-  m.name = name;
-  m.kind = fm::MaterialKind::linear_elastic;
-  m.youngs_modulus = E;
-  m.poisson_ratio = nu;
-  m.density = rho;
-  return m;
-}
-
-// The serial simulation's particles (after finalize) as decomposed particles, id = serial index;
-// only rank 0 passes them, the first migration distributes them.
-std::vector<fm::DecomposedParticle> from_serial(const fm::Simulation<2>& serial) {
-  const auto& sp = serial.particles();
-  std::vector<fm::DecomposedParticle> all(sp.position.size());
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    all[k].id = static_cast<std::int64_t>(k);
-    all[k].mass = sp.mass[k];
-    all[k].volume = sp.volume[k];
-    all[k].position = sp.position[k];
-    all[k].velocity = sp.velocity[k];
-    all[k].half_size = sp.half_size[k];
-    all[k].material = sp.material[k];
-  }
-  return comm_rank() == 0 ? all : std::vector<fm::DecomposedParticle>{};
-}
+using frictherm::test::elastic;
 
 // Largest differences of the decomposed particles (gathered, by id) from the serial ones.
 struct Difference {
@@ -138,36 +113,13 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
   // boundary of the 2-rank split and crossing it), pressed by g = 2e4 m/s²
   // (Coulomb μ = 0.3: deceleration μg = 6e3 m/s², about 2 m/s over the run); 1 mm cells, 2 × 2
   // particles per cell, the interface on a grid line. Specified normal (0, 1) from base to block.
-  const double h = 1e-3, rho = 1000.0, v0 = 10.0, g = 2e4, mu = 0.3;
-  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {26, 12});
-  fm::SimulationOptions so;
-  so.shape = GetParam();
-  so.scheme = fm::UpdateScheme::usl;
-  so.gravity = fm::Vec<3>(0.0, -g, 0.0);
-  fm::Simulation<2> serial(grid, so);
-  const std::vector<fm::Material> mats{elastic("base", 2e7, 0.3, rho), elastic("block", 1.5e7, 0.25, rho)};
-  const int base = serial.add_material(mats[0]), blk = serial.add_material(mats[1]);
-  serial.add_body("base", *fm::make_box<2>(V2(1e-3, 0.0), V2(25e-3, 4e-3), base), 2, V2::Zero());
-  serial.add_body("block", *fm::make_box<2>(V2(6e-3, 4e-3), V2(14e-3, 8e-3), blk), 2, V2(v0, 0.0));
-  const fm::FixedFace bottom{1, false, {{true, true, true}}};
-  serial.fix_face(bottom);
-  fm::ContactOptions co;
-  co.default_pair.law = fm::FrictionLaw::coulomb(mu);
-  co.default_pair.normal = fm::NormalMethod::specified;
-  co.default_pair.normal_vector = fm::Vec<3>(0.0, 1.0, 0.0);
-  serial.enable_contact(co);
-  serial.set_contact_pair(base, blk, co.default_pair);
-  serial.finalize();
-
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.gravity = V2(0.0, -g);
-  opt.fixed_faces = {bottom};
-  opt.contact = true;
-  opt.contact_options = co;
-  opt.contact_pairs = {fm::DecomposedContactPair{base, blk, co.default_pair}};
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(from_serial(serial));
+  const frictherm::test::SlidingBlock sb(GetParam());
+  const double h = sb.h, rho = sb.rho, v0 = sb.v0;
+  fm::Simulation<2>& serial = *sb.serial;
+  const std::vector<fm::Material>& mats = sb.materials;
+  const int blk = sb.block;
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, sb.grid, mats, sb.options);
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
 
   const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
   const double dt = 0.3 * h / (c + v0);
@@ -262,7 +214,7 @@ TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
   opt.contact = true;
   opt.contact_options = co;
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(from_serial(serial));
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
   const V2 p0 = split.total_momentum();
   const double scale = split.total_momentum_scale();
   const double c = std::max(std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho),
@@ -339,7 +291,7 @@ TEST(DecomposedContact, ThreeMaterialsMeetingAtNodesEqualTheSerialRun) {
   opt.contact = true;
   opt.contact_options = co;
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(from_serial(serial));
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
   double c = 0.0;
   for (const auto& m : mats) c = std::max(c, std::sqrt(m.p_wave_modulus(fm::Analysis::plane_strain) / rho));
   const double dt = 0.3 * h / (c + 4.0), vmax = std::hypot(3.0, 4.5);  // largest relative speed
@@ -403,7 +355,7 @@ TEST(DecomposedContact, UpperFixedFacesEqualTheSerialRun) {
   opt.gravity = V2(3e4, 3e4);
   opt.fixed_faces = {right, top};
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, {mat}, opt);
-  split.add_particles(from_serial(serial));
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
   const double dt = 0.3 * h / (std::sqrt(mat.p_wave_modulus(fm::Analysis::plane_strain) / rho) + 2.0);
   for (int s = 0; s < 150; ++s) {
     serial.step(dt);
