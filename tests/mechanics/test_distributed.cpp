@@ -303,20 +303,11 @@ TEST(DecomposedMechanics, EqualsTheSerialSimulation) {
   serial.add_body("right", *fm::make_box<2>(V2(15e-3, 5e-3), V2(21e-3, 11e-3), m), 2, V2(-8.0, 0.0));
   serial.finalize();
   const auto& sp = serial.particles();
-  std::vector<fm::DecomposedParticle> all(sp.position.size());
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    all[k].id = static_cast<std::int64_t>(k);
-    all[k].mass = sp.mass[k];
-    all[k].volume = sp.volume[k];
-    all[k].position = sp.position[k];
-    all[k].velocity = sp.velocity[k];
-    all[k].half_size = sp.half_size[k];
-  }
   fm::DecomposedOptions opt;
   opt.shape = so.shape;
   opt.gravity = V2(0.0, -200.0);
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mat, opt);
-  split.add_particles(on_rank0(all, MPI_COMM_WORLD));
+  split.add_particles(frictherm::test::decomposed(sp));
   const double dt = 0.3 * h / (std::sqrt(mat.p_wave_modulus(fm::Analysis::plane_strain) / rho) + 8.0);
   double taken = 0.0;
   for (int s = 0; s < 80; ++s) {
@@ -325,9 +316,9 @@ TEST(DecomposedMechanics, EqualsTheSerialSimulation) {
   }
   EXPECT_EQ(taken, 0.0);  // the serial step took dt (below its CFL limit)
   const auto a = split.gather();
-  EXPECT_EQ(a.size(), all.size());
+  EXPECT_EQ(a.size(), sp.size());
   double dx = 0.0, dv = 0.0, ds = 0.0, vmax = 0.0, smax = 0.0;
-  for (std::size_t k = 0; k < std::min(a.size(), all.size()); ++k) {
+  for (std::size_t k = 0; k < std::min(a.size(), sp.size()); ++k) {
     dx = std::max(dx, (a[k].position - sp.position[k]).norm());
     dv = std::max(dv, (a[k].velocity - sp.velocity[k]).norm());
     ds = std::max(ds, (a[k].stress - sp.stress[k]).norm());
