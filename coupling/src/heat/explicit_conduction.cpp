@@ -29,22 +29,6 @@ void copy_nodes(const Grid& grid, const Stencil& st, NodeList& nl) {
   });
 }
 
-// Σ_a f(a) for a < count in three interleaved partial sums: the chain of dependent additions is a
-// third as long as a running sum's (which the per-window passes were bound by); the order of the
-// additions, hence the round-off, differs from a running sum.
-template <class Value, class Term>
-Value interleaved_sum(int count, const Value& zero, Term&& f) {
-  Value s0 = zero, s1 = zero, s2 = zero;
-  int a = 0;
-  for (; a + 3 <= count; a += 3) {
-    s0 += f(a);
-    s1 += f(a + 1);
-    s2 += f(a + 2);
-  }
-  for (; a < count; ++a) s0 += f(a);
-  return Value((s0 + s1) + s2);
-}
-
 }  // namespace
 
 template <int Dim>
@@ -64,7 +48,6 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   if (!view.template as<Kernel>(p.size())) nodes_.resize(p.size());  // scratch only without the step's stencils
   kept_mass_.resize(p.size());
   kept_flux_.resize(p.size());
-  next_mct_valid_ = false;
   gathered_at_.assign(p.position.begin(), p.position.end());
   unknown_runs_.assign(p.size() * kMaxRuns, UnknownRun{1, 0});  // empty until keep()
   quiet_.assign(p.size(), 0);
@@ -127,7 +110,6 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     if (step_stencils) copy_nodes(grid, step_stencils[k], from_step);
     keep(k, step_stencils ? from_step : nodes_[k], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
   }
-  next_mct_valid_ = true;
 }
 
 template <int Dim>
@@ -282,14 +264,14 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
     const double mct = kept_mass_[k].heat_capacity * p.temperature[k];
-    if (next_mct_valid_) {
-      const KeptMass& c = kept_mass_[k];
+    {
+      const KeptMass& c = kept_mass_[k];  // the eq. 38 sums: its old terms out
       for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] -= mct * c.S[a];
     }
     remove_bounds(kept_flux_[k]);
     keep(k, moved_nodes_[j], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
-    if (next_mct_valid_) {
-      const KeptMass& c = kept_mass_[k];
+    {
+      const KeptMass& c = kept_mass_[k];  // and its new ones in
       for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
     }
     gathered_at_[k] = p.position[k];
@@ -311,16 +293,9 @@ template <int Dim>
 void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
   if (kept_mass_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
   const auto n = static_cast<Eigen::Index>(sys.size());
-  if (!next_mct_valid_ || next_mct_.size() != n) {
-    next_mct_.setZero(n);
-    for (std::size_t k = 0; k < p.size(); ++k) {  // Σ_p m_p C_v,p T_p S_ip (eq. 38), the gather's S
-      const KeptMass& c = kept_mass_[k];
-      const double mct = c.heat_capacity * p.temperature[k];
-      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
-    }
-  }
+  if (next_mct_.size() != n) throw std::logic_error("ExplicitConduction::reproject: the sums are of other unknowns");
+  // The eq. 38 sums, kept with the particles' temperatures by the gather, refresh and map_back.
   for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
-  next_mct_valid_ = true;  // map_back keeps the sums with the temperatures it gives the particles
 }
 
 template <int Dim>
@@ -397,9 +372,9 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
       quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
       if (quiet_[k]) continue;
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
-      const mechanics::Vec<Dim> grad =
-          c.conductance * interleaved_sum(c.count, mechanics::Vec<Dim>(mechanics::Vec<Dim>::Zero()),
-                                          [&](int a) { return mechanics::Vec<Dim>(c.G[a] * T[c.unknown[a]]); });
+      mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+      for (int a = 0; a < c.count; ++a) grad += c.G[a] * T[c.unknown[a]];
+      grad *= c.conductance;
       for (int a = 0; a < c.count; ++a) force_[c.unknown[a]] -= c.G[a].dot(grad);  // f_i = −V k G'·∇T
     }
     for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
@@ -414,7 +389,7 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
   if (kept_mass_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
   const bool relax = end && beta > 0.0;
-  if (!next_mct_valid_ || next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
+  if (next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
     throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
   // Unknowns whose temperature changed in the window, as a prefix count: a particle with none in the
   // runs of its unknowns keeps its temperature (ΔT_p = 0 exactly) and is passed over.
@@ -428,7 +403,8 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
     const KeptMass& c = kept_mass_[k];
     if (c.count == 0) continue;
     // design §4: the increment, not the nodal value
-    const double dT = interleaved_sum(c.count, 0.0, [&](int a) { return c.S[a] * delta[c.unknown[a]]; });
+    double dT = 0.0;
+    for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
     double pic = 0.0, s = 0.0;
     if (relax) {
       for (int a = 0; a < c.count; ++a) {

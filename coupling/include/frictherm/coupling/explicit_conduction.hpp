@@ -145,8 +145,7 @@ class ExplicitConduction {
   std::vector<KeptFlux> kept_flux_;       // by particle; conductance 0 for particles that do not conduct
   std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
   std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
-  Eigen::VectorXd next_mct_;              // the same by unknown, with the T_p of the last map_back
-  bool next_mct_valid_ = false;
+  Eigen::VectorXd next_mct_;              // the same by unknown, kept with the T_p by refresh and map_back
   std::vector<double> row_bound_;         // Σ_j |K_ij| bound by unknown (W/K)
   std::vector<double> rayleigh_bound_;    // Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a by unknown (1/s)
   // Refreshes: each particle's terms of rayleigh_bound_ used M of their time; M_peak_a / M_a bounds
