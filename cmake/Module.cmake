@@ -49,6 +49,36 @@ function(frictherm_add_mpi_library module)
   frictherm_set_warnings(${target})
 endfunction()
 
+# frictherm_optional_mpi_library(<module> <what> [REQUIRES target ...] [LINK_PRIVATE ...]): the module's
+# distributed part (frictherm_add_mpi_library) when FRICTHERM_WITH_MPI is on and MPI, PETSc and the
+# REQUIRES targets are found; sets the cache flag FRICTHERM_<MODULE>_MPI that tests and benchmarks
+# test, and says what was built or what was missing.
+function(frictherm_optional_mpi_library module what)
+  cmake_parse_arguments(M "" "" "REQUIRES;LINK_PRIVATE" ${ARGN})
+  string(TOUPPER ${module} upper)
+  set(FRICTHERM_${upper}_MPI OFF CACHE INTERNAL "${what} is built")
+  if(NOT FRICTHERM_WITH_MPI)
+    return()
+  endif()
+  frictherm_find_mpi_petsc()
+  set(missing "")
+  if(NOT MPI_CXX_FOUND OR NOT PETSC_FOUND)
+    set(missing "MPI and PETSc")
+  endif()
+  foreach(t ${M_REQUIRES})
+    if(NOT TARGET ${t})
+      list(APPEND missing ${t})
+    endif()
+  endforeach()
+  if(missing)
+    message(STATUS "${module}: ${what} not built (needs ${missing})")
+    return()
+  endif()
+  frictherm_add_mpi_library(${module} LINK_PRIVATE ${M_LINK_PRIVATE})
+  set(FRICTHERM_${upper}_MPI ON CACHE INTERNAL "${what} is built")
+  message(STATUS "${module}: ${what} with MPI ${MPI_CXX_VERSION}, PETSc ${PETSC_VERSION}")
+endfunction()
+
 # frictherm_add_mpi_test(<name> <source> <library>): a test program with its own main (PETSc and MPI
 # initialised once per process), run by ctest as <name>_np2 and <name>_np4 under mpirun
 # (oversubscribed: CI has 2 cores; --allow-run-as-root: CI runs as root).

@@ -41,6 +41,20 @@ inline std::vector<mechanics::DecomposedParticle> decomposed(const mechanics::Pa
   return comm_rank() == 0 ? all : std::vector<mechanics::DecomposedParticle>{};
 }
 
+/// Mass-weighted mean x-velocity of one material's particles (gathered decomposed ones, serial ones).
+inline double mean_velocity_x(const std::vector<mechanics::DecomposedParticle>& a, int material) {
+  double mv = 0.0, m = 0.0;
+  for (const auto& p : a)
+    if (p.material == material) mv += p.mass * p.velocity[0], m += p.mass;
+  return mv / m;
+}
+inline double mean_velocity_x(const mechanics::Particles<2>& p, int material) {
+  double mv = 0.0, m = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (p.material[k] == material) mv += p.mass[k] * p.velocity[k][0], m += p.mass[k];
+  return mv / m;
+}
+
 /// The sliding block both decomposed tests compare with: base 24 × 4 mm fixed at y_min, block 8 × 4 mm
 /// on it at v0 = 10 m/s (crossing the 2-rank split), g = 2e4 m/s², Coulomb μ = 0.3 with the
 /// specified normal (0, 1), 1 mm cells, 2 × 2 particles per cell, USL; and the matching options of

@@ -39,6 +39,7 @@ using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 using frictherm::test::decomposed;
 using frictherm::test::elastic;
+using frictherm::test::mean_velocity_x;
 
 constexpr double kT0 = 300.0;  // K
 
@@ -53,18 +54,6 @@ double temperature_difference(const std::vector<fm::DecomposedParticle>& a, cons
   return d;
 }
 
-double mean_velocity_x(const std::vector<fm::DecomposedParticle>& a, int material) {
-  double mv = 0.0, m = 0.0;
-  for (const auto& p : a)
-    if (p.material == material) mv += p.mass * p.velocity[0], m += p.mass;
-  return mv / m;
-}
-double mean_velocity_x(const fm::Particles<2>& p, int material) {
-  double mv = 0.0, m = 0.0;
-  for (std::size_t k = 0; k < p.size(); ++k)
-    if (p.material[k] == material) mv += p.mass[k] * p.velocity[k][0], m += p.mass[k];
-  return mv / m;
-}
 
 fc::CouplerOptions serial_options(const std::vector<fc::ThermalProperties>& materials) {
   fc::CouplerOptions opt;

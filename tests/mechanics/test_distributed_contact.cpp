@@ -37,6 +37,7 @@ using V2 = fm::Vec<2>;
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 using frictherm::test::elastic;
+using frictherm::test::mean_velocity_x;
 
 // Largest differences of the decomposed particles (gathered, by id) from the serial ones.
 struct Difference {
@@ -53,21 +54,6 @@ Difference compare(const std::vector<fm::DecomposedParticle>& a, const fm::Simul
     d.velocity = std::max(d.velocity, (a[k].velocity - sp.velocity[k]).norm());
   }
   return d;
-}
-
-// Mass-weighted mean x-velocity of one material's particles.
-double mean_velocity_x(const std::vector<fm::DecomposedParticle>& a, int material) {
-  double mv = 0.0, m = 0.0;
-  for (const auto& p : a)
-    if (p.material == material) mv += p.mass * p.velocity[0], m += p.mass;
-  return mv / m;
-}
-double mean_velocity_x(const fm::Simulation<2>& s, int material) {
-  const auto& p = s.particles();
-  double mv = 0.0, m = 0.0;
-  for (std::size_t k = 0; k < p.size(); ++k)
-    if (p.material[k] == material) mv += p.mass[k] * p.velocity[k][0], m += p.mass[k];
-  return mv / m;
 }
 
 double owned_sum(const std::vector<double>& w) {
@@ -148,9 +134,9 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
     same_ids = same_ids && d.same_ids;
     dx = std::max(dx, d.position);
     dv = std::max(dv, d.velocity);
-    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, blk) - mean_velocity_x(serial, blk)));
+    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, blk) - mean_velocity_x(serial.particles(), blk)));
   }
-  const double v_end = mean_velocity_x(serial, blk);
+  const double v_end = mean_velocity_x(serial.particles(), blk);
   EXPECT_EQ(taken, 0.0);  // the serial step took dt (below its CFL limit)
   EXPECT_TRUE(same_ids);  // every particle kept, with its material and mass
   EXPECT_EQ(split.global_particles(), static_cast<long long>(serial.particles().size()));
