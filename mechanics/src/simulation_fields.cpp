@@ -22,16 +22,6 @@ void NodalFields<Dim>::resize(std::size_t n, bool with_contact) {
 }
 
 template <int Dim>
-void NodalFields<Dim>::clear_accumulators() {
-  std::fill(mass.begin(), mass.end(), 0.0);
-  std::fill(momentum.begin(), momentum.end(), Vec<Dim>::Zero());
-  std::fill(force.begin(), force.end(), Vec<Dim>::Zero());
-  std::fill(mass_position.begin(), mass_position.end(), Vec<Dim>::Zero());
-  std::fill(domain.begin(), domain.end(), 0.0);
-  std::fill(domain_gradient.begin(), domain_gradient.end(), Vec<Dim>::Zero());
-}
-
-template <int Dim>
 void Simulation<Dim>::enable_contact(const ContactOptions& options) {
   if (finalized_) throw std::logic_error("contact must be enabled before the simulation is finalized");
   if (!(options.position_correction >= 0.0 && options.position_correction < 2.0))
@@ -177,27 +167,59 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
 }
 
 template <int Dim>
-void Simulation<Dim>::reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
-  if (thread_nodes_.empty()) return;
-#pragma omp parallel num_threads(threads_)
-  sum_thread_buffers(mass, momentum, force, contact_terms);
+void Simulation<Dim>::update_partition() {
+  if (partition_.matches(threads_, fields_.size(), p_.size())) return;
+  partition_.build(threads_, material_begin_, material_end_, field_of_material_, fields_.size(), p_.size());
 }
 
-// The loop of reduce_thread_buffers, shared among the threads of the enclosing parallel region (an
-// orphaned worksharing loop: a scatter phase calls it after its barrier, saving a fork and join).
+// Each thread clears the slots it scatters into: in the nodes, the fields whose first thread it is;
+// in its buffer, the shared fields it holds particles of.
 template <int Dim>
-void Simulation<Dim>::sum_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms) {
-  const std::size_t n = nodes_.mass.size();
-#pragma omp for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    for (const auto& b : thread_nodes_) {
-      if (mass) nodes_.mass[i] += b.mass[i];
-      if (momentum) nodes_.momentum[i] += b.momentum[i];
-      if (force) nodes_.force[i] += b.force[i];
-      if (contact_terms) {
-        nodes_.mass_position[i] += b.mass_position[i];
-        nodes_.domain[i] += b.domain[i];
-        nodes_.domain_gradient[i] += b.domain_gradient[i];
+void Simulation<Dim>::clear_scatter_targets(int tid, Accumulated which) {
+  auto clear = [&](NodalFields<Dim>& a, std::size_t b, std::size_t e) {
+    const auto lo = static_cast<std::ptrdiff_t>(b), hi = static_cast<std::ptrdiff_t>(e);
+    if (which.mass) std::fill(a.mass.begin() + lo, a.mass.begin() + hi, 0.0);
+    if (which.momentum) std::fill(a.momentum.begin() + lo, a.momentum.begin() + hi, Vec<Dim>::Zero());
+    if (which.force) std::fill(a.force.begin() + lo, a.force.begin() + hi, Vec<Dim>::Zero());
+    if (which.contact_terms) {
+      std::fill(a.mass_position.begin() + lo, a.mass_position.begin() + hi, Vec<Dim>::Zero());
+      std::fill(a.domain.begin() + lo, a.domain.begin() + hi, 0.0);
+      std::fill(a.domain_gradient.begin() + lo, a.domain_gradient.begin() + hi, Vec<Dim>::Zero());
+    }
+  };
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    const VelocityField<Dim>& F = fields_[f];
+    if (F.count == 0) continue;
+    const int first = partition_.first_thread[f], last = partition_.last_thread[f];
+    if (tid == first)
+      clear(nodes_, F.first, F.first + F.count);
+    else if (tid > first && tid <= last)
+      clear(thread_nodes_[static_cast<std::size_t>(tid - 1)], F.first, F.first + F.count);
+  }
+}
+
+// The buffers of the threads sharing a field summed into its slots, in thread order; an orphaned
+// worksharing loop per shared field (a scatter phase calls it after its barrier).
+template <int Dim>
+void Simulation<Dim>::sum_shared_fields(Accumulated which) {
+  for (const int f : partition_.shared_fields) {
+    const VelocityField<Dim>& F = fields_[static_cast<std::size_t>(f)];
+    const std::size_t t0 = static_cast<std::size_t>(partition_.first_thread[static_cast<std::size_t>(f)]);
+    const std::size_t t1 = static_cast<std::size_t>(partition_.last_thread[static_cast<std::size_t>(f)]);
+    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
+#pragma omp for schedule(static) nowait
+    for (long ii = b; ii < e; ++ii) {
+      const std::size_t i = static_cast<std::size_t>(ii);
+      for (std::size_t t = t0 + 1; t <= t1; ++t) {
+        const NodalFields<Dim>& buf = thread_nodes_[t - 1];
+        if (which.mass) nodes_.mass[i] += buf.mass[i];
+        if (which.momentum) nodes_.momentum[i] += buf.momentum[i];
+        if (which.force) nodes_.force[i] += buf.force[i];
+        if (which.contact_terms) {
+          nodes_.mass_position[i] += buf.mass_position[i];
+          nodes_.domain[i] += buf.domain[i];
+          nodes_.domain_gradient[i] += buf.domain_gradient[i];
+        }
       }
     }
   }
@@ -378,8 +400,9 @@ template struct NodalFields<3>;
   template const ContactPairSettings& Simulation<D>::contact_pair(int, int) const;                            \
   template void Simulation<D>::init_fields();                                                                 \
   template void Simulation<D>::layout_fields(const std::vector<IVec<D>>&, const std::vector<IVec<D>>&);      \
-  template void Simulation<D>::reduce_thread_buffers(bool, bool, bool, bool);                                    \
-  template void Simulation<D>::sum_thread_buffers(bool, bool, bool, bool);                                       \
+  template void Simulation<D>::update_partition();                                                            \
+  template void Simulation<D>::clear_scatter_targets(int, Accumulated);                                      \
+  template void Simulation<D>::sum_shared_fields(Accumulated);                                               \
   template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::update_grid(double);                                                           \

@@ -27,6 +27,13 @@ constexpr bool is_extended = std::is_same_v<Kernel, ExtendedBSplineKernel>;
 // map_to_grid), or the precomputed EBS entries themselves.
 template <class T>
 const T* indexable(const std::vector<T>& v) { return v.data(); }
+
+// The parts of the thread partition this thread runs: its own, or (if the runtime gave the region
+// fewer threads than asked for) every omp_get_num_threads()-th one.
+template <class Fn>
+void for_each_part(const ThreadPartition& partition, Fn&& fn) {
+  for (int t = omp_get_thread_num(); t < partition.threads; t += omp_get_num_threads()) fn(t);
+}
 template <int D>
 const PrecomputedStencils<D>& indexable(const PrecomputedStencils<D>& p) { return p; }
 
@@ -72,6 +79,7 @@ void Simulation<Dim>::step_with(double dt) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
     for (auto& t : thread_nodes_) t.resize(nodes_.mass.size(), contact_);
   }
+  update_partition();
   StepPhaseTimes& pt = phase_times_;
   const double t = time_;
   for (std::size_t f = 0; f < fields_.size(); ++f)
@@ -167,6 +175,7 @@ void Simulation<Dim>::evaluate_stencils() {
     return;
   }
   const std::size_t nm = materials_.size();
+  update_partition();
   for (std::size_t m = 0; m < nm; ++m) box_lo_[m].fill(INT_MAX), box_hi_[m].fill(INT_MIN);
   // One parallel region for all materials (a grain is a few hundred particles: a region per
   // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
@@ -177,17 +186,19 @@ void Simulation<Dim>::evaluate_stencils() {
     none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
     lo.assign(nm, none_lo);
     hi.assign(nm, none_hi);
-    for (std::size_t m = 0; m < nm; ++m) {
-#pragma omp for schedule(static) nowait
-      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-        stk[k].evaluate(grid, position[k], half_size[k]);
-        const IVec<Dim> f = stk[k].first_node();
-        for (int d = 0; d < Dim; ++d) {
-          lo[m][d] = std::min(lo[m][d], f[d]);
-          hi[m][d] = std::max(hi[m][d], f[d] + Kernel::K - 1);
+    for_each_part(partition_, [&](int t) {
+      for (std::size_t m = 0; m < nm; ++m) {
+        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        for (std::size_t k = kb; k < ke; ++k) {
+          stk[k].evaluate(grid, position[k], half_size[k]);
+          const IVec<Dim> f = stk[k].first_node();
+          for (int d = 0; d < Dim; ++d) {
+            lo[m][d] = std::min(lo[m][d], f[d]);
+            hi[m][d] = std::max(hi[m][d], f[d] + Kernel::K - 1);
+          }
         }
       }
-    }
+    });
 #pragma omp critical(frictherm_stencil_boxes)
     for (std::size_t m = 0; m < nm; ++m)
       for (int d = 0; d < Dim; ++d) {
@@ -225,73 +236,76 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
   const bool prepared = stencils_current_;  // by current_stencils() since the last step
-  // One region: each thread clears its own buffer (thread 0 the nodes' own fields), scatters, and
-  // after a barrier the buffers are summed into the nodes.
+  // One region: each part of the thread partition clears the slots it scatters into (its own fields
+  // in the nodes, its buffer for a field it shares) and scatters; after a barrier the shared fields'
+  // buffers are summed into the nodes.
+  const Accumulated which{true, true, true, contact_};
 #pragma omp parallel num_threads(threads_)
   {
-    const int tid = omp_get_thread_num();
-    NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
-    acc.clear_accumulators();
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const int f = field_of_material_[m];
-      if (f < 0) continue;
-      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-      const bool rigid = materials_[m].is_rigid();
-      if (!contact_) {
-#pragma omp for schedule(static) nowait
-        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-          if constexpr (!is_extended<Kernel>)
-            if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
-          const auto& s = st[k];  // EBS: a view of the precomputed entries
-          const double mp = p_.mass[k];
-          const Vec<Dim> mv = mp * p_.velocity[k];
-          const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
-          const Vec<Dim> mg = mp * g;
-          if (with_forces) {
-            s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-              acc.mass[i] += S * mp;
-              acc.momentum[i] += S * mv;
-              acc.force[i] += S * mg - Vsig * G;
-            });
-          } else {
-            s.for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-              acc.mass[i] += S * mp;
-              acc.momentum[i] += S * mv;
+    for_each_part(partition_, [&](int t) {
+      clear_scatter_targets(t, which);
+      for (std::size_t m = 0; m < materials_.size(); ++m) {
+        const int f = field_of_material_[m];
+        if (f < 0) continue;
+        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        if (kb >= ke) continue;
+        NodalFields<Dim>& acc = scatter_target(t, f);
+        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+        const bool rigid = materials_[m].is_rigid();
+        if (!contact_) {
+          for (std::size_t k = kb; k < ke; ++k) {
+            if constexpr (!is_extended<Kernel>)
+              if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+            const auto& s = st[k];  // EBS: a view of the precomputed entries
+            const double mp = p_.mass[k];
+            const Vec<Dim> mv = mp * p_.velocity[k];
+            const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
+            const Vec<Dim> mg = mp * g;
+            if (with_forces) {
+              s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
+                acc.mass[i] += S * mp;
+                acc.momentum[i] += S * mv;
+                acc.force[i] += S * mg - Vsig * G;
+              });
+            } else {
+              s.for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+                acc.mass[i] += S * mp;
+                acc.momentum[i] += S * mv;
+              });
+            }
+          }
+        } else {
+          const bool forces = with_forces && !rigid;
+          // Plain pointers, held in registers: Eigen's vector stores may alias anything, so through the
+          // std::vectors every store would reload every array's address.
+          double* const mass = acc.mass.data();
+          double* const domain = acc.domain.data();
+          Vec<Dim>* const momentum = acc.momentum.data();
+          Vec<Dim>* const force = acc.force.data();
+          Vec<Dim>* const mass_position = acc.mass_position.data();
+          Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
+          decltype(auto) stk = indexable(st);
+          for (std::size_t k = kb; k < ke; ++k) {
+            const double mp = p_.mass[k], Vp = p_.volume[k];
+            const Vec<Dim> mv = mp * p_.velocity[k];
+            const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
+            const Mat<Dim> Vsig = Vp * p_.stress[k];
+            const Vec<Dim> mg = mp * g;
+            stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
+              mass[i] += S * mp;
+              momentum[i] += S * mv;
+              if (forces) force[i] += S * mg - Vsig * G;
+              mass_position[i] += S * mx;
+              domain[i] += S * Vp;
+              domain_gradient[i] += Vp * G;
             });
           }
         }
-      } else {
-        const bool forces = with_forces && !rigid;
-        // Plain pointers, held in registers: Eigen's vector stores may alias anything, so through the
-        // std::vectors every store would reload every array's address.
-        double* const mass = acc.mass.data();
-        double* const domain = acc.domain.data();
-        Vec<Dim>* const momentum = acc.momentum.data();
-        Vec<Dim>* const force = acc.force.data();
-        Vec<Dim>* const mass_position = acc.mass_position.data();
-        Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
-        decltype(auto) stk = indexable(st);
-#pragma omp for schedule(static) nowait
-        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-          const double mp = p_.mass[k], Vp = p_.volume[k];
-          const Vec<Dim> mv = mp * p_.velocity[k];
-          const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
-          const Mat<Dim> Vsig = Vp * p_.stress[k];
-          const Vec<Dim> mg = mp * g;
-          stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-            mass[i] += S * mp;
-            momentum[i] += S * mv;
-            if (forces) force[i] += S * mg - Vsig * G;
-            mass_position[i] += S * mx;
-            domain[i] += S * Vp;
-            domain_gradient[i] += Vp * G;
-          });
-        }
       }
-    }
-    if (!thread_nodes_.empty()) {
+    });
+    if (!partition_.shared_fields.empty()) {
 #pragma omp barrier
-      sum_thread_buffers(true, true, with_forces, contact_);
+      sum_shared_fields(which);
     }
   }
 }
@@ -302,24 +316,29 @@ template <class Kernel>
 void Simulation<Dim>::add_internal_forces() {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
+  const Accumulated which{false, false, true, false};
 #pragma omp parallel num_threads(threads_)
   {
-    const int tid = omp_get_thread_num();
-    NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
-    if (tid != 0) std::fill(acc.force.begin(), acc.force.end(), Vec<Dim>::Zero());
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const int f = field_of_material_[m];
-      if (f < 0 || materials_[m].is_rigid()) continue;
-      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-#pragma omp for schedule(static) nowait
-      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-        const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
-        const Vec<Dim> mg = p_.mass[k] * g;
-        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
+    for_each_part(partition_, [&](int t) {
+      clear_scatter_targets(t, which);
+      for (std::size_t m = 0; m < materials_.size(); ++m) {
+        const int f = field_of_material_[m];
+        if (f < 0 || materials_[m].is_rigid()) continue;
+        NodalFields<Dim>& acc = scatter_target(t, f);
+        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        for (std::size_t k = kb; k < ke; ++k) {
+          const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
+          const Vec<Dim> mg = p_.mass[k] * g;
+          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
+        }
       }
+    });
+    if (!partition_.shared_fields.empty()) {
+#pragma omp barrier
+      sum_shared_fields(which);
     }
   }
-  reduce_thread_buffers(false, false, true, false);
 }
 
 // Rigid materials without a velocity field of their own (all of them without contact, boundary ones
@@ -384,12 +403,13 @@ long Simulation<Dim>::update_particles(double dt) {
   const Vec<Dim>* const filtered_v = filtered.data();
   decltype(auto) stk = indexable(st);
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
+  for_each_part(partition_, [&](int t) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const int f = field_of_material_[m];
     if (f < 0 || materials_[m].is_rigid()) continue;
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-    const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
-#pragma omp for schedule(static) nowait
+    const long b = static_cast<long>(partition_.lo(t, material_begin_[m]));
+    const long e = static_cast<long>(partition_.hi(t, material_end_[m]));
     for (long kk = b; kk < e; ++kk) {
       const std::size_t k = static_cast<std::size_t>(kk);
       Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
@@ -422,6 +442,7 @@ long Simulation<Dim>::update_particles(double dt) {
       if (!ok) bad = std::min(bad, kk);
     }
   }
+  });
   for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
   external_work_ += work;
   return bad == std::numeric_limits<long>::max() ? -1 : bad;
@@ -433,24 +454,28 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::remap_momentum() {
   auto& st = stencils<Kernel>();
+  const Accumulated which{false, true, false, false};
 #pragma omp parallel num_threads(threads_)
   {
-    const int tid = omp_get_thread_num();
-    NodalFields<Dim>& acc = tid == 0 ? nodes_ : thread_nodes_[static_cast<std::size_t>(tid - 1)];
-    std::fill(acc.momentum.begin(), acc.momentum.end(), Vec<Dim>::Zero());
-#pragma omp barrier
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const int f = field_of_material_[m];
-      if (f < 0 || materials_[m].is_rigid()) continue;
-      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-#pragma omp for schedule(static) nowait
-      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-        const Vec<Dim> mv = p_.mass[k] * p_.velocity[k];
-        st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
+    for_each_part(partition_, [&](int t) {
+      clear_scatter_targets(t, which);
+      for (std::size_t m = 0; m < materials_.size(); ++m) {
+        const int f = field_of_material_[m];
+        if (f < 0 || materials_[m].is_rigid()) continue;
+        NodalFields<Dim>& acc = scatter_target(t, f);
+        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        for (std::size_t k = kb; k < ke; ++k) {
+          const Vec<Dim> mv = p_.mass[k] * p_.velocity[k];
+          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
+        }
       }
+    });
+    if (!partition_.shared_fields.empty()) {
+#pragma omp barrier
+      sum_shared_fields(which);
     }
   }
-  reduce_thread_buffers(false, true, false, false);
 }
 
 // Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
@@ -466,6 +491,7 @@ long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   const Vec<Dim>* const vi = v.data();  // plain pointers (see map_to_grid)
   decltype(auto) stk = indexable(st);
 #pragma omp parallel num_threads(threads_) reduction(max : beyond)
+  for_each_part(partition_, [&](int t) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const Material& mat = materials_[m];
     const int f = field_of_material_[m];
@@ -480,8 +506,8 @@ long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
         // A local copy: no particle store can touch it, so the compiler hoists what depends on the
         // material only (ρ0 C0², −2G/3, …) out of the loop.
         const MieGruneisenParams params = mat.mie_gruneisen;
-#pragma omp for schedule(static) nowait
-        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        for (std::size_t k = kb; k < ke; ++k) {
           VelocityGradient2 L;
           stk[k].for_each(ix, [&](int i, double, const Vec<2>& G) { L.add(vi[i], G); });
           Mat<2>& F = p_.deformation_gradient[k];
@@ -497,8 +523,8 @@ long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
         continue;
       }
     }
-#pragma omp for schedule(static) nowait
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+    const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+    for (std::size_t k = kb; k < ke; ++k) {
       Mat<Dim> L = Mat<Dim>::Zero();
       stk[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += vi[i] * G.transpose(); });
       Mat<Dim>& F = p_.deformation_gradient[k];
@@ -523,6 +549,7 @@ long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
       }
     }
   }
+  });
   wave_speed_ready_ = true;
   return beyond;
 }

@@ -29,6 +29,7 @@
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
+#include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/mechanics/transfer.hpp>
 
 #include <cstdint>
@@ -82,7 +83,6 @@ struct NodalFields {
   std::vector<double> domain;
   std::vector<Vec<Dim>> domain_gradient;
   void resize(std::size_t n, bool with_contact = false);
-  void clear_accumulators();
 };
 
 /// One velocity field: the nodes of a box of the grid, stored in slots first .. first + count − 1.
@@ -284,8 +284,19 @@ class Simulation {
   template <class Kernel> void map_rigid_fields();
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
-  void reduce_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);
-  void sum_thread_buffers(bool mass, bool momentum, bool force, bool contact_terms);  // inside a parallel region
+  // Scatters under the thread partition (partition_, thread_partition.hpp; simulation_fields.cpp):
+  // which arrays a scatter accumulates.
+  struct Accumulated {
+    bool mass = false, momentum = false, force = false, contact_terms = false;
+  };
+  void update_partition();  // partition_ for threads_ and the current fields
+  /// Where thread tid scatters field f's values: the nodes themselves, or its buffer when it shares f.
+  NodalFields<Dim>& scatter_target(int tid, int field) {
+    return tid == partition_.first_thread[static_cast<std::size_t>(field)] ? nodes_
+                                                                            : thread_nodes_[static_cast<std::size_t>(tid - 1)];
+  }
+  void clear_scatter_targets(int tid, Accumulated which);  // inside a parallel region, before the scatter
+  void sum_shared_fields(Accumulated which);  // inside a parallel region, after a barrier
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead.
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
@@ -373,7 +384,8 @@ class Simulation {
   // A boundary point leaves out a node of its field holding less than 0.25 S m_p (a sliver of the
   // body beside its edge, see simulation_penalty.cpp).
   static constexpr double penalty_sliver_ = 0.25;
-  std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1)
+  std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1), shared fields only
+  ThreadPartition partition_;  // each thread's particles, the fields threads share
   struct TransferScratch {  // XPIC/FMPM, per slot
     std::vector<Vec<Dim>> start;     // XPIC: lumped v^n at the momentum update
     std::vector<Vec<Dim>> filtered;  // v* (the series' sum)

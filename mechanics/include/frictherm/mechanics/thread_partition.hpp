@@ -1,0 +1,42 @@
+#pragma once
+// How a step's particle loops are shared among OpenMP threads (thread_partition.cpp).
+//
+// Particles are stored grouped by material, and with contact every material scatters into its own
+// velocity field (a contiguous run of slots). Thread t takes the contiguous particles
+// [begin[t], begin[t+1]), so most fields receive the particles of one thread only: that thread
+// clears and scatters into the nodal arrays directly. Only a field whose particles fall in two or
+// more threads' ranges (at most threads − 1 of them with contact; the one shared field without
+// contact) goes through per-thread buffers, cleared and summed over its own slots. A PBX with 59
+// materials on two threads then sums one field's slots per scatter instead of every field's.
+#include <cstddef>
+#include <vector>
+
+namespace frictherm::mechanics {
+
+struct ThreadPartition {
+  int threads = 0;
+  std::vector<std::size_t> begin;   // threads + 1 entries; begin[0] = 0, begin[threads] = particle count
+  std::vector<int> first_thread;    // per field: the lowest thread holding its particles (0 if none)
+  std::vector<int> last_thread;     // per field: the highest
+  std::vector<int> shared_fields;   // fields with first_thread < last_thread
+  std::size_t particles = 0;
+
+  /// Balanced over the particles of materials that have a velocity field (field_of_material >= 0;
+  /// the others are skipped by every loop). A boundary between threads that falls inside a material
+  /// moves to the nearest material boundary when that changes the thread's share by at most
+  /// `snap_fraction` of it (a split field costs a buffer clear and sum of its slots).
+  void build(int threads, const std::vector<std::size_t>& material_begin, const std::vector<std::size_t>& material_end,
+             const std::vector<int>& field_of_material, std::size_t fields, std::size_t particles,
+             double snap_fraction = 0.02);
+  bool matches(int t, std::size_t fields, std::size_t n) const {
+    return threads == t && first_thread.size() == fields && particles == n;
+  }
+  /// Thread t's particles of a material whose particles are [b, e): [lo, hi), empty when lo >= hi.
+  std::size_t lo(int t, std::size_t b) const { return b > begin[static_cast<std::size_t>(t)] ? b : begin[static_cast<std::size_t>(t)]; }
+  std::size_t hi(int t, std::size_t e) const {
+    const std::size_t x = begin[static_cast<std::size_t>(t) + 1];
+    return e < x ? e : x;
+  }
+};
+
+}  // namespace frictherm::mechanics
