@@ -104,9 +104,11 @@ void measure(const std::string& which, const char* grid_label, const fm::Grid<Di
   MPI_Gather(mine, 6, MPI_DOUBLE, all.data(), 6, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank != 0) return;
   const double ps = static_cast<double>(count) * steps;
-  std::printf("%-8s %dD %d rank%s  %s  %zu particles  %d steps  wall %.3e s/step  cpu %.3e s/step (all ranks)  "
+  std::string procs;
+  for (int p : split.processes()) procs += (procs.empty() ? "" : "x") + std::to_string(p);
+  std::printf("%-8s %dD %d rank%s (%s)  %s  %zu particles  %d steps  wall %.3e s/step  cpu %.3e s/step (all ranks)  "
               "%.2f M p-steps/s (%.2f per rank)  %.2f M p-steps/cpu-s\n",
-              which.c_str(), Dim, ranks, ranks > 1 ? "s" : " ", grid_label, count, steps, wall_max / steps,
+              which.c_str(), Dim, ranks, ranks > 1 ? "s" : " ", procs.c_str(), grid_label, count, steps, wall_max / steps,
               cpu_all / steps, ps / wall_max / 1e6, ps / wall_max / 1e6 / ranks, ps / cpu_all / 1e6);
   std::printf("  phases (slowest rank, %% of the wall time):");
   const auto& names = fm::DecomposedMpm<Dim>::phase_names();
