@@ -1,10 +1,12 @@
 // The decomposed MPM step in 3D (frictherm/mechanics/distributed.hpp, DecomposedMpm<3>), run by ctest
-// under mpirun with 2 and 4 ranks. Small grids (≤ 12 × 6 × 8 cells, ≤ 1000 particles) so that each run
-// stays within seconds on a busy 2-core machine.
+// under mpirun with 2 and 4 ranks. Small grids (≤ 490 cells: 8 × 6 × 6 … 7 × 7 × 10; ≤ 2304 particles)
+// so that each run stays within seconds on a busy 2-core machine.
 //   (a) an isolated elastic body spinning, compressing and translating (no velocity condition, no
 //       gravity): total linear momentum conserved to round-off (1e-13 of Σ m|v|) at every step;
 //   (b) a body translating diagonally across rank cuts along every split axis: the global count,
 //       the set of ids and every mass kept exactly, the first migration moves every field unchanged;
+//       with it, the transfers for coupled physics in 3D (particle scalars through migration, node
+//       sums at the owners, owner values on the ghosts);
 //   (c) the decomposed run = the serial Simulation<3> (USL, FLIP, same dt) particle by particle:
 //       two colliding blocks with gravity (uGIMP), and a body touching all six fixed grid faces
 //       (quadratic B-spline);
@@ -184,10 +186,12 @@ TEST(Decomposed3D, TranslatingBodyKeepsEveryParticle) {
   const fm::Material mat = elastic("elastic", 1e7, 0.3, rho);
   Mpm::Options opt;
   opt.shape = fm::ShapeKind::quadratic_bspline;
+  opt.particle_scalars = {"temperature", "tag"};
   Mpm run(MPI_COMM_WORLD, grid, mat, opt);
-  const auto all = box(V3(1.5e-3, 1.5e-3, 2.5e-3), V3(4.5e-3, 4.5e-3, 5.5e-3), 2, [](const V3&) {
+  auto all = box(V3(1.5e-3, 1.5e-3, 2.5e-3), V3(4.5e-3, 4.5e-3, 5.5e-3), 2, [](const V3&) {
     return V3(20.0, 20.0, 30.0);
   });
+  for (auto& p : all) p.scalars = {300.0 + 0.01 * static_cast<double>(p.id), -static_cast<double>(p.id)};
   run.add_particles(on_rank0(all));
   {
     const auto moved = run.gather();  // the first migration moved every field unchanged
@@ -195,7 +199,8 @@ TEST(Decomposed3D, TranslatingBodyKeepsEveryParticle) {
     for (std::size_t k = 0; same && k < moved.size(); ++k)
       same = moved[k].id == all[k].id && moved[k].position == all[k].position &&
              moved[k].velocity == all[k].velocity && moved[k].volume == all[k].volume &&
-             moved[k].half_size == all[k].half_size && moved[k].mass == all[k].mass;
+             moved[k].half_size == all[k].half_size && moved[k].mass == all[k].mass &&
+             moved[k].scalars == all[k].scalars;
     EXPECT_TRUE(same);
   }
   const double dt = 0.3 * h / (p_wave_speed(mat) + 40.0);
@@ -211,7 +216,8 @@ TEST(Decomposed3D, TranslatingBodyKeepsEveryParticle) {
   bool same_ids = fin.size() == all.size();
   V3 shift = V3::Zero();
   for (std::size_t k = 0; same_ids && k < fin.size(); ++k) {
-    same_ids = fin[k].id == all[k].id && fin[k].mass == all[k].mass;  // ids and masses bit for bit
+    same_ids = fin[k].id == all[k].id && fin[k].mass == all[k].mass &&  // ids, masses and scalars bit for bit
+               fin[k].scalars == all[k].scalars;
     shift += (fin[k].position - all[k].position) / static_cast<double>(fin.size());
   }
   EXPECT_TRUE(same_ids);
@@ -223,6 +229,50 @@ TEST(Decomposed3D, TranslatingBodyKeepsEveryParticle) {
   if (comm_rank() == 0)
     std::printf("[translation 3D] %zu particles kept over 40 steps, shift (%.2f, %.2f, %.2f) mm, %ld migrations\n",
                 fin.size(), 1e3 * shift[0], 1e3 * shift[1], 1e3 * shift[2], sent);
+
+  // Transfers: M_i = Σ_p m_p S_ip from every rank's particles summed at the owners gives Σ_i M_i =
+  // Σ_p m_p (partition of unity); with M_i back on the ghosts, Σ_p m_p Σ_i S_ip M_i = Σ_i M_i². Two
+  // components (m S, then 2 m S) exercise the component layout; 7 is the most (the DMDA's values).
+  const Mpm::Stencils& st = run.current_stencils();
+  const fm::DecomposedLocalParticles lp = run.local_particle_data();
+  const std::vector<double> tag = run.particle_scalar(run.particle_scalar_index("tag"));
+  std::vector<double> local(2 * static_cast<std::size_t>(run.local_node_count()), 0.0), owned, ghosted;
+  bool tags = tag.size() == lp.id.size();
+  for (std::size_t k = 0; k < lp.id.size(); ++k) {
+    tags = tags && tag[k] == -static_cast<double>(lp.id[k]);
+    for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
+      const auto i = static_cast<std::size_t>(st.node[static_cast<std::size_t>(a)]);
+      local[2 * i] += lp.mass[k] * st.S[static_cast<std::size_t>(a)];
+      local[2 * i + 1] += 2.0 * lp.mass[k] * st.S[static_cast<std::size_t>(a)];
+    }
+  }
+  EXPECT_TRUE(tags);  // the scalars in swarm order belong to the local particles
+  run.sum_to_owned(local, 2, owned);
+  run.owned_to_local(owned, 2, ghosted);
+  double sums[5] = {0.0, 0.0, 0.0, 0.0, 0.0};  // Σ M_i, Σ m_p, Σ_p m_p Σ_i S_ip M_i, Σ M_i², Σ (2nd − 2 M_i)²
+  for (std::size_t q = 0; q < owned.size() / 2; ++q) {
+    sums[0] += owned[2 * q], sums[3] += owned[2 * q] * owned[2 * q];
+    sums[4] += std::pow(owned[2 * q + 1] - 2.0 * owned[2 * q], 2);
+  }
+  for (std::size_t k = 0; k < lp.id.size(); ++k) {
+    sums[1] += lp.mass[k];
+    for (int a = st.first[k]; a < st.first[k + 1]; ++a)
+      sums[2] += lp.mass[k] * st.S[static_cast<std::size_t>(a)] *
+                 ghosted[2 * static_cast<std::size_t>(st.node[static_cast<std::size_t>(a)])];
+  }
+  bool owners_kept = 2 * run.owned_local_nodes().size() == owned.size();
+  for (std::size_t q = 0; owners_kept && q < owned.size() / 2; ++q)
+    owners_kept = ghosted[2 * static_cast<std::size_t>(run.owned_local_nodes()[q])] == owned[2 * q];
+  EXPECT_TRUE(owners_kept);
+  MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_LE(std::fabs(sums[0] - sums[1]) / sums[1], 1e-14);
+  EXPECT_LE(std::fabs(sums[2] - sums[3]) / sums[3], 1e-14);
+  EXPECT_EQ(sums[4], 0.0);  // doubling is exact: the second component is twice the first at every node
+  EXPECT_EQ(Mpm::max_transfer_components, 7);
+  EXPECT_THROW(run.sum_to_owned(local, Mpm::max_transfer_components + 1, owned), std::invalid_argument);
+  if (comm_rank() == 0)
+    std::printf("[transfers 3D] partition of unity %.2e, ghost identity %.2e\n", std::fabs(sums[0] - sums[1]) / sums[1],
+                std::fabs(sums[2] - sums[3]) / sums[3]);
   print_traffic("translating body 3D, quadratic B-spline", run);
 }
 
