@@ -1,14 +1,18 @@
-// Decomposed MPM step (frictherm/mechanics/distributed.hpp) under mpirun with any rank count: an
+// Decomposed MPM step (frictherm/mechanics/distributed.hpp) under mpirun with any rank count. 2D: an
 // elastic block (one material, no contact) and a sliding block (base fixed at its bottom, block
 // pressed by gravity and sliding with Coulomb friction: multimaterial contact and frictional work),
-// 2 × 2 uGIMP particles per cell. Prints, per case, the wall time per step (slowest rank) and the
-// CPU time per step (all ranks), particle-steps per second and per CPU-second, the slowest rank's
-// share of each phase, and each rank's communication per step (the two grid exchanges, the
-// per-material entries at multi-material nodes, the migrated particles) in bytes. Strong scaling:
+// 2 × 2 uGIMP particles per cell. 3D (case block3d): an elastic block, 2³ uGIMP particles per cell,
+// measured both ways in one run: strong (the --cells3d grid on any rank count) and weak (the grid's
+// x extent times the rank count, so every rank keeps the particles of one rank's run).
+// Prints, per case, the wall time per step (slowest rank) and the CPU time per step (all ranks),
+// particle-steps per second (all ranks, and per rank), per CPU-second, the slowest rank's share of
+// each phase, and each rank's ghost nodes and communication per step (the two grid exchanges, the
+// per-material entries at multi-material nodes, the migrated particles) in bytes. 2D strong scaling:
 // the same --cells at 1, 2, 4 ranks; weak scaling (--weak): the grid grows with the ranks so that
 // every rank keeps the particles of --cells at one rank. Asserts nothing.
 //
-//   mpirun -n 4 mechanics_distributed_scaling [--cells 200] [--steps 100] [--weak] [--cases block,sliding]
+//   mpirun -n 4 mechanics_distributed_scaling [--cells 200] [--steps 100] [--weak] [--cases block,sliding,block3d]
+//                                             [--cells3d 24]
 #include "cpu_time.hpp"
 #include <frictherm/mechanics/distributed.hpp>
 
@@ -23,6 +27,7 @@
 
 namespace fm = frictherm::mechanics;
 using V2 = fm::Vec<2>;
+using V3 = fm::Vec<3>;
 
 namespace {
 
@@ -56,37 +61,18 @@ void fill(std::vector<fm::DecomposedParticle>& out, V2 lo, V2 hi, double h, int 
     }
 }
 
-void run_case(const std::string& which, int cells, int steps, int rank, int ranks) {
-  const double h = 1e-3, rho = 1000.0, v0 = 10.0, g = 2e4;
-  const int nx = cells, ny = std::max(4, cells / 2);
-  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {nx, ny});
-  fm::DecomposedOptions opt;
-  opt.shape = fm::ShapeKind::ugimp;
-  std::vector<fm::Material> mats;
-  std::vector<fm::DecomposedParticle> particles;
-  const double W = nx * h, H = ny * h;
-  if (which == "block") {
-    mats = {elastic("block", 2e7)};
-    fill(particles, V2(h, h), V2(W - h, H - h), h, 0, V2(v0, 0.0), rho);
-    for (auto& p : particles) p.velocity[1] = v0 * std::sin(3.0 * p.position[0] / W);  // shears the block
-  } else {
-    mats = {elastic("base", 2e7), elastic("block", 1.5e7)};
-    fill(particles, V2(h, 0.0), V2(W - h, 0.5 * H), h, 0, V2::Zero(), rho);
-    fill(particles, V2(0.2 * W, 0.5 * H), V2(0.6 * W, 0.75 * H), h, 1, V2(v0, 0.0), rho);
-    opt.gravity = V2(0.0, -g);
-    opt.fixed_faces = {fm::FixedFace{1, false, {{true, true, true}}}};
-    opt.contact = true;
-    opt.contact_options.default_pair.law = fm::FrictionLaw::coulomb(0.3);
-    opt.contact_options.default_pair.normal = fm::NormalMethod::specified;
-    opt.contact_options.default_pair.normal_vector = fm::Vec<3>(0.0, 1.0, 0.0);
-    opt.contact_pairs = {fm::DecomposedContactPair{0, 1, opt.contact_options.default_pair}};
-  }
-  const std::size_t count = particles.size();
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(rank == 0 ? particles : std::vector<fm::DecomposedParticle>{});
+// One case: set-up (rank 0's particles spread by the first migration), one untimed step, `steps`
+// timed steps, then the figures (see the header).
+template <int Dim>
+void measure(const std::string& which, const char* grid_label, const fm::Grid<Dim>& grid,
+             const std::vector<fm::Material>& mats, const typename fm::DecomposedMpm<Dim>::Options& opt,
+             std::vector<typename fm::DecomposedMpm<Dim>::Particle>& particles, double dt, int steps, int rank,
+             int ranks, std::size_t count = 0) {
+  if (count == 0) count = particles.size();
+  fm::DecomposedMpm<Dim> split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(rank == 0 ? particles : std::vector<typename fm::DecomposedMpm<Dim>::Particle>{});
   particles.clear();
-  const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
-  const double dt = 0.5 * h / (c + 2.0 * v0);
+  particles.shrink_to_fit();
   split.step(dt);  // first step (set-up of the exchanges) not timed
   const fm::DecomposedTraffic before = split.traffic();
   MPI_Barrier(MPI_COMM_WORLD);
@@ -112,64 +98,149 @@ void run_case(const std::string& which, int cells, int steps, int rank, int rank
                              t.field_entry_bytes * per_step;
   const double migration_bytes =
       static_cast<double>(t.particles_received - before.particles_received) * t.particle_bytes * per_step;
-  const double mine[4] = {grid_bytes, field_bytes, migration_bytes, static_cast<double>(split.local_particles())};
-  std::vector<double> all(4 * static_cast<std::size_t>(ranks));
-  MPI_Gather(mine, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  const double mine[6] = {grid_bytes, field_bytes, migration_bytes, static_cast<double>(split.local_particles()),
+                          static_cast<double>(t.ghost_nodes), cpu};
+  std::vector<double> all(6 * static_cast<std::size_t>(ranks));
+  MPI_Gather(mine, 6, MPI_DOUBLE, all.data(), 6, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rank != 0) return;
   const double ps = static_cast<double>(count) * steps;
-  std::printf("%-8s %d rank%s  %dx%d cells  %zu particles  %d steps  wall %.3e s/step  cpu %.3e s/step  "
-              "%.2f M p-steps/s  %.2f M p-steps/cpu-s\n",
-              which.c_str(), ranks, ranks > 1 ? "s" : " ", nx, ny, count, steps, wall_max / steps, cpu_all / steps,
-              ps / wall_max / 1e6, ps / cpu_all / 1e6);
+  std::string procs;
+  for (int p : split.processes()) procs += (procs.empty() ? "" : "x") + std::to_string(p);
+  std::printf("%-8s %dD %d rank%s (%s)  %s  %zu particles  %d steps  wall %.3e s/step  cpu %.3e s/step (all ranks)  "
+              "%.2f M p-steps/s (%.2f per rank)  %.2f M p-steps/cpu-s\n",
+              which.c_str(), Dim, ranks, ranks > 1 ? "s" : " ", procs.c_str(), grid_label, count, steps, wall_max / steps,
+              cpu_all / steps, ps / wall_max / 1e6, ps / wall_max / 1e6 / ranks, ps / cpu_all / 1e6);
   std::printf("  phases (slowest rank, %% of the wall time):");
-  const auto& names = fm::DecomposedMpm2D::phase_names();
+  const auto& names = fm::DecomposedMpm<Dim>::phase_names();
   for (std::size_t p = 0; p < names.size(); ++p)
     if (phases_max[p] > 0.005 * wall_max) std::printf(" %s %.1f", names[p], 100.0 * phases_max[p] / wall_max);
   std::printf("\n");
   for (int r = 0; r < ranks; ++r) {
-    const double* a = &all[4 * static_cast<std::size_t>(r)];
-    std::printf("  rank %d: %.0f particles; received per step: grid %.1f kB, material entries %.2f kB, "
-                "migration %.2f kB\n",
-                r, a[3], a[0] / 1e3, a[1] / 1e3, a[2] / 1e3);
+    const double* a = &all[6 * static_cast<std::size_t>(r)];
+    std::printf("  rank %d: %.0f particles, %.0f ghost nodes, cpu %.3e s/step; received per step: grid %.1f kB, "
+                "material entries %.2f kB, migration %.2f kB\n",
+                r, a[3], a[4], a[5] / steps, a[0] / 1e3, a[1] / 1e3, a[2] / 1e3);
   }
   std::fflush(stdout);
+}
+
+void run_case(const std::string& which, int cells, int steps, int rank, int ranks) {
+  const double h = 1e-3, rho = 1000.0, v0 = 10.0, g = 2e4;
+  const int nx = cells, ny = std::max(4, cells / 2);
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {nx, ny});
+  fm::DecomposedOptions opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  std::vector<fm::Material> mats;
+  std::vector<fm::DecomposedParticle> particles;
+  const double W = nx * h, H = ny * h;
+  if (which == "block") {
+    mats = {elastic("block", 2e7)};
+    fill(particles, V2(h, h), V2(W - h, H - h), h, 0, V2(v0, 0.0), rho);
+    for (auto& p : particles) p.velocity[1] = v0 * std::sin(3.0 * p.position[0] / W);  // shears the block
+  } else {
+    mats = {elastic("base", 2e7), elastic("block", 1.5e7)};
+    fill(particles, V2(h, 0.0), V2(W - h, 0.5 * H), h, 0, V2::Zero(), rho);
+    fill(particles, V2(0.2 * W, 0.5 * H), V2(0.6 * W, 0.75 * H), h, 1, V2(v0, 0.0), rho);
+    opt.gravity = V2(0.0, -g);
+    opt.fixed_faces = {fm::FixedFace{1, false, {{true, true, true}}}};
+    opt.contact = true;
+    opt.contact_options.default_pair.law = fm::FrictionLaw::coulomb(0.3);
+    opt.contact_options.default_pair.normal = fm::NormalMethod::specified;
+    opt.contact_options.default_pair.normal_vector = fm::Vec<3>(0.0, 1.0, 0.0);
+    opt.contact_pairs = {fm::DecomposedContactPair{0, 1, opt.contact_options.default_pair}};
+  }
+  const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
+  const double dt = 0.5 * h / (c + 2.0 * v0);
+  char label[64];
+  std::snprintf(label, sizeof label, "%dx%d cells", nx, ny);
+  measure<2>(which, label, grid, mats, opt, particles, dt, steps, rank, ranks);
+}
+
+// 3D elastic block: nx × n × n cells, the block one cell inside the grid on every side, 2³ uGIMP
+// particles per cell, sheared (v_y, v_z up to 1.5 and 1 m/s, varying along x) and stretched along x
+// (v_x = sin(πx/W) m/s): it moves ≤ 0.5 mm over 100 steps, so it stays inside the grid at any size;
+// particles near the cuts change rank.
+void run_block3d(const std::string& which, int nx, int n, int steps, int rank, int ranks) {
+  const double h = 1e-3, rho = 1000.0, v0 = 2.0;  // v0: the speed bound in dt
+  const fm::Grid<3> grid(V3::Zero(), V3::Constant(h), {nx, n, n});
+  fm::DecomposedMpm3D::Options opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  const std::vector<fm::Material> mats{elastic("block", 2e7)};
+  std::vector<fm::DecomposedMpm3D::Particle> particles;
+  if (rank == 0) {
+    const double s = h / 2.0, W = nx * h;
+    const int m[3] = {2 * (nx - 2), 2 * (n - 2), 2 * (n - 2)};
+    particles.reserve(static_cast<std::size_t>(m[0]) * m[1] * m[2]);
+    for (int k = 0; k < m[2]; ++k)
+      for (int j = 0; j < m[1]; ++j)
+        for (int i = 0; i < m[0]; ++i) {
+          fm::DecomposedMpm3D::Particle p;
+          p.id = static_cast<std::int64_t>(particles.size());
+          p.position = V3::Constant(h) + s * V3(i + 0.5, j + 0.5, k + 0.5);
+          p.half_size = V3::Constant(s / 2.0);
+          p.volume = s * s * s;
+          p.mass = rho * p.volume;
+          const double x = p.position[0];
+          p.velocity = V3(std::sin(M_PI * x / W), 1.5 * std::sin(3.0 * x / W), std::cos(3.0 * x / W));
+          particles.push_back(p);
+        }
+  }
+  long long count = static_cast<long long>(particles.size());
+  MPI_Bcast(&count, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::three_d) / rho);
+  const double dt = 0.5 * h / (c + 2.0 * v0);
+  char label[64];
+  std::snprintf(label, sizeof label, "%dx%dx%d cells", nx, n, n);
+  measure<3>(which, label, grid, mats, opt, particles, dt, steps, rank, ranks, static_cast<std::size_t>(count));
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   fm::DecomposedPetscSession session(&argc, &argv);
-  int cells = 200, steps = 100;
+  int cells = 200, steps = 100, cells3d = 24;
   bool weak = false;
   std::string cases = "block,sliding";
   for (int a = 1; a < argc; ++a) {
     const std::string k = argv[a];
     if (k == "--weak") weak = true;
     else if (a + 1 < argc && k == "--cells") cells = std::atoi(argv[++a]);
+    else if (a + 1 < argc && k == "--cells3d") cells3d = std::atoi(argv[++a]);
     else if (a + 1 < argc && k == "--steps") steps = std::atoi(argv[++a]);
     else if (a + 1 < argc && k == "--cases") cases = argv[++a];
     else {
-      std::fprintf(stderr, "unknown option %s (valid: --cells N, --steps N, --weak, --cases block,sliding)\n", k.c_str());
+      std::fprintf(stderr, "unknown option %s (valid: --cells N, --cells3d N, --steps N, --weak, --cases "
+                   "block,sliding,block3d)\n", k.c_str());
       return 2;
     }
   }
-  if (cells < 8 || steps < 1) {
-    std::fprintf(stderr, "--cells must be at least 8 and --steps at least 1\n");
+  if (cells < 8 || cells3d < 6 || steps < 1) {
+    std::fprintf(stderr, "--cells must be at least 8, --cells3d at least 6 and --steps at least 1\n");
     return 2;
   }
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  // Weak scaling: the area grows with the ranks (cells along x and y by √ranks).
+  // 2D weak scaling: the area grows with the ranks (cells along x and y by √ranks).
   const int n = weak ? static_cast<int>(std::lround(cells * std::sqrt(static_cast<double>(ranks)))) : cells;
   if (rank == 0)
-    std::printf("mechanics_distributed_scaling: %d ranks, %s scaling, 1 mm cells, uGIMP 2x2\n", ranks,
-                weak ? "weak" : "strong");
+    std::printf("mechanics_distributed_scaling: %d ranks, 2D cases %s scaling, 1 mm cells, uGIMP 2 per cell and axis\n",
+                ranks, weak ? "weak" : "strong");
   for (std::size_t at = 0; at <= cases.size();) {
     const std::size_t comma = std::min(cases.find(',', at), cases.size());
     const std::string c = cases.substr(at, comma - at);
-    if (c == "block" || c == "sliding") run_case(c, n, steps, rank, ranks);
-    else if (rank == 0) std::fprintf(stderr, "unknown case '%s' (valid: block, sliding)\n", c.c_str());
+    if (c == "block" || c == "sliding") {
+      run_case(c, n, steps, rank, ranks);
+    } else if (c == "block3d") {
+      // Strong: cells3d × ⅔ cells3d × ⅔ cells3d on any rank count. Weak: the block's x extent (cells3d − 2
+      // cells) times the ranks, so the particles per rank stay those of the one-rank run.
+      const int n3 = std::max(6, 2 * cells3d / 3);
+      run_block3d("strong", cells3d, n3, steps, rank, ranks);
+      if (ranks > 1) run_block3d("weak", (cells3d - 2) * ranks + 2, n3, steps, rank, ranks);
+      else if (rank == 0) std::printf("weak     3D 1 rank: the strong run above\n");
+    } else if (rank == 0) {
+      std::fprintf(stderr, "unknown case '%s' (valid: block, sliding, block3d)\n", c.c_str());
+    }
     at = comma + 1;
   }
   return 0;

@@ -24,10 +24,11 @@ inline mechanics::Material elastic(const char* name, double E, double nu, double
 }
 
 /// Serial particles as decomposed particles (id = serial index; with `temperature` the temperature
-/// as the one scalar). Only rank 0 passes them: the first migration distributes them.
-inline std::vector<mechanics::DecomposedParticle> decomposed(const mechanics::Particles<2>& sp,
-                                                            bool temperature = false) {
-  std::vector<mechanics::DecomposedParticle> all(sp.position.size());
+/// as the one scalar), 2D or 3D. Only rank 0 passes them: the first migration distributes them.
+template <int Dim>
+std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> decomposed(const mechanics::Particles<Dim>& sp,
+                                                                         bool temperature = false) {
+  std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> all(sp.position.size());
   for (std::size_t k = 0; k < all.size(); ++k) {
     all[k].id = static_cast<std::int64_t>(k);
     all[k].mass = sp.mass[k];
@@ -38,17 +39,19 @@ inline std::vector<mechanics::DecomposedParticle> decomposed(const mechanics::Pa
     all[k].material = sp.material[k];
     if (temperature) all[k].scalars = {sp.temperature[k]};
   }
-  return comm_rank() == 0 ? all : std::vector<mechanics::DecomposedParticle>{};
+  return comm_rank() == 0 ? all : decltype(all){};
 }
 
 /// Mass-weighted mean x-velocity of one material's particles (gathered decomposed ones, serial ones).
-inline double mean_velocity_x(const std::vector<mechanics::DecomposedParticle>& a, int material) {
+template <class Particle>
+double mean_velocity_x(const std::vector<Particle>& a, int material) {
   double mv = 0.0, m = 0.0;
   for (const auto& p : a)
     if (p.material == material) mv += p.mass * p.velocity[0], m += p.mass;
   return mv / m;
 }
-inline double mean_velocity_x(const mechanics::Particles<2>& p, int material) {
+template <int Dim>
+double mean_velocity_x(const mechanics::Particles<Dim>& p, int material) {
   double mv = 0.0, m = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k)
     if (p.material[k] == material) mv += p.mass[k] * p.velocity[k][0], m += p.mass[k];

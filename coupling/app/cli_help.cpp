@@ -58,7 +58,7 @@ const char* const kRunHelp =
     "the run ends (completed, failed or interrupted), so a second run writing OUT.h5 cannot destroy it.\n"
     "\n"
     "One process runs the whole scene (threads: --threads). `mpirun -n K frictherm run` is refused: the\n"
-    "domain-decomposed engine (docs/distributed.md) is a library for now, for 2D linear-elastic\n"
+    "domain-decomposed engine (docs/distributed.md) is a library for now, for 2D and 3D linear-elastic\n"
     "multimaterial contact with frictional work; penalty contact stays serial and is refused there.\n";
 
 const char* const kValidateHelp =

@@ -23,7 +23,8 @@ namespace frictherm::mechanics {
 // decomposed step does not support) and fills pair_table as the serial contact_pair(a, b) reads:
 // the default pair for pairs not set, an explicit pair (a, b) as given, (b, a) with the normal
 // reversed, a specified normal made unit.
-void DecomposedMpm2D::Impl::setup_contact() {
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::setup_contact() {
   const std::size_t n = materials.size();
   if (!opt.contact) {
     if (!opt.contact_pairs.empty())
@@ -57,7 +58,7 @@ void DecomposedMpm2D::Impl::setup_contact() {
     multimaterial_only(p.settings, pair);
     ContactPairSettings s = p.settings;
     if (s.normal == NormalMethod::specified) {
-      const double len = s.normal_vector.head<2>().norm();
+      const double len = s.normal_vector.template head<Dim>().norm();
       if (!(len > 0.0)) throw std::invalid_argument(where + pair + ": a specified normal must be non-zero");
       s.normal_vector /= len;
     }
@@ -70,8 +71,9 @@ void DecomposedMpm2D::Impl::setup_contact() {
 
 // Phase 5, owned nodes: the multi-material ones where two or more fields have mass (the serial
 // find_contact_nodes); the step's frictional work per owned node starts at zero.
-void DecomposedMpm2D::Impl::find_contact_nodes(double /*dt*/) {
-  const PetscInt owned = xm * ym;
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::find_contact_nodes(double /*dt*/) {
+  const PetscInt owned = owned_count();
   work_first.assign(static_cast<std::size_t>(owned), 0.0);
   work_second.assign(static_cast<std::size_t>(owned), 0.0);
   contact_nodes.clear();
@@ -82,35 +84,43 @@ void DecomposedMpm2D::Impl::find_contact_nodes(double /*dt*/) {
     if (!multi[u]) continue;
     int present = 0;
     for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl)
-      if (field_at(l, static_cast<int>(fl))[node_dof::mass] > empty_node_mass) ++present;
+      if (field_at(l, static_cast<int>(fl))[Dof::mass] > empty_node_mass) ++present;
     if (present >= 2) contact_nodes.push_back({q, l});
   }
 }
 
 // Phase 6: contact on the extrapolated momenta (momentum changes only).
-void DecomposedMpm2D::Impl::contact_extrapolated(double dt) { resolve_contact(false, dt); }
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::contact_extrapolated(double dt) {
+  resolve_contact(false, dt);
+}
 
 // Phase 8: contact on p^{n+1}, forces kept consistent (eq. 19), frictional work (eqs. 27, 34, 36, 40).
-void DecomposedMpm2D::Impl::contact_updated(double dt) { resolve_contact(true, dt); }
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::contact_updated(double dt) {
+  resolve_contact(true, dt);
+}
 
-void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
-  using namespace node_dof;
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
+  constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
+  constexpr int mass_position = Dof::mass_position, domain = Dof::domain, domain_gradient = Dof::domain_gradient;
   if (updated) stats = DecomposedContactStats{};
   if (contact_nodes.empty()) return;
   const ContactOptions& co = opt.contact_options;
   const std::size_t n = materials.size();
-  const Vec<2> h = grid.cell_size();
-  const double cell_volume = grid.cell_volume() * opt.thickness;
+  const Vec<Dim> h = grid.cell_size();
+  const double cell_volume = grid.cell_volume() * (Dim == 2 ? opt.thickness : 1.0);  // as the serial step
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
                                   dt, updated};
   auto pair_of = [&](int x, int y) -> const ContactPairSettings& {
     return pair_table[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)];
   };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
-  thread_local std::vector<ContactSide<2>> sides;
+  thread_local std::vector<ContactSide<Dim>> sides;
   thread_local std::vector<int> mats;
   thread_local std::vector<double*> values;
-  thread_local std::vector<Vec<2>> dps;
+  thread_local std::vector<Vec<Dim>> dps;
   for (const auto& [q, l] : contact_nodes) {
     const std::size_t u = static_cast<std::size_t>(l);
     double node_mass = 0.0;
@@ -128,13 +138,13 @@ void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
         ++guarded;
         continue;
       }
-      ContactSide<2> sd;
+      ContactSide<Dim> sd;
       sd.mass = m;
-      sd.momentum = Vec<2>(v[momentum], v[momentum + 1]);
-      sd.force = Vec<2>(v[force], v[force + 1]);
-      sd.mass_position = Vec<2>(v[mass_position], v[mass_position + 1]);
+      sd.momentum = Eigen::Map<const Vec<Dim>>(v + momentum);
+      sd.force = Eigen::Map<const Vec<Dim>>(v + force);
+      sd.mass_position = Eigen::Map<const Vec<Dim>>(v + mass_position);
       sd.domain = v[domain];
-      sd.domain_gradient = Vec<2>(v[domain_gradient], v[domain_gradient + 1]);
+      sd.domain_gradient = Eigen::Map<const Vec<Dim>>(v + domain_gradient);
       sd.sliver = m < co.sliver_fraction * node_mass;
       sides.push_back(sd);
       mats.push_back(static_cast<int>(fl));  // with contact, field = material
@@ -148,9 +158,9 @@ void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
     const std::size_t uq = static_cast<std::size_t>(q);
     contact_detail::resolve_contact_node(
         sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
-        [&](std::size_t j, const Vec<2>& dp) {
+        [&](std::size_t j, const Vec<Dim>& dp) {
           double* v = values[j];
-          for (int d = 0; d < 2; ++d) {
+          for (int d = 0; d < Dim; ++d) {
             v[momentum + d] += dp[d];
             if (updated) v[force + d] += dp[d] / dt;  // eq. 19
           }
@@ -166,21 +176,37 @@ void DecomposedMpm2D::Impl::resolve_contact(bool updated, double dt) {
   }
 }
 
-const std::vector<double>& DecomposedMpm2D::frictional_work(HeatingOrder order) const {
+template <int Dim>
+const std::vector<double>& DecomposedMpm<Dim>::frictional_work(HeatingOrder order) const {
   return order == HeatingOrder::first ? impl_->work_first : impl_->work_second;
 }
 
-double DecomposedMpm2D::cumulative_frictional_work(HeatingOrder order) const {
+template <int Dim>
+double DecomposedMpm<Dim>::cumulative_frictional_work(HeatingOrder order) const {
   double w = order == HeatingOrder::first ? impl_->cumulative_first : impl_->cumulative_second;
   MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
   return w;
 }
 
-DecomposedContactStats DecomposedMpm2D::contact_stats() const {
+template <int Dim>
+DecomposedContactStats DecomposedMpm<Dim>::contact_stats() const {
   const DecomposedContactStats& s = impl_->stats;
   long v[4] = {s.contact_nodes, s.multi_nodes, s.sliding_nodes, s.guarded};
   MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_LONG, MPI_SUM, impl_->comm);
   return DecomposedContactStats{v[0], v[1], v[2], v[3]};
 }
+
+#define FRICTHERM_INSTANTIATE_CONTACT(D)                                                \
+  template void DecomposedMpm<D>::Impl::setup_contact();                                \
+  template void DecomposedMpm<D>::Impl::find_contact_nodes(double);                     \
+  template void DecomposedMpm<D>::Impl::contact_extrapolated(double);                   \
+  template void DecomposedMpm<D>::Impl::contact_updated(double);                        \
+  template void DecomposedMpm<D>::Impl::resolve_contact(bool, double);                  \
+  template const std::vector<double>& DecomposedMpm<D>::frictional_work(HeatingOrder) const; \
+  template double DecomposedMpm<D>::cumulative_frictional_work(HeatingOrder) const;     \
+  template DecomposedContactStats DecomposedMpm<D>::contact_stats() const;
+FRICTHERM_INSTANTIATE_CONTACT(2)
+FRICTHERM_INSTANTIATE_CONTACT(3)
+#undef FRICTHERM_INSTANTIATE_CONTACT
 
 }  // namespace frictherm::mechanics

@@ -1,6 +1,7 @@
-// State of the decomposed 2D MPM (frictherm/mechanics/distributed.hpp): the DMDA of the grid's nodes
-// with its local (ghosted) and global vectors, the DMSwarm of the particles and a scoped view of the
-// swarm's fields. Internal header.
+// State of the decomposed MPM, 2D and 3D (frictherm/mechanics/distributed.hpp): the DMDA of the grid's
+// nodes with its local (ghosted) and global vectors, the DMSwarm of the particles and a scoped view of
+// the swarm's fields. Internal header. Box extents are kept for three axes; in 2D the third has one
+// node (start 0, size 1), so the node numbering l = ((k·ny) + j)·nx + i serves both.
 #pragma once
 
 #include "frictherm/mechanics/distributed.hpp"
@@ -12,13 +13,15 @@
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace frictherm::mechanics {
 
 namespace swarm_field {
 // Registered fields (DMSwarmRegisterPetscDatatypeField) besides PETSc's own DMSwarmPIC_coor (x_p),
-// DMSwarm_pid, DMSwarm_rank and DMSwarm_cellid. Tensors are 2×2 column-major (Eigen's layout).
+// DMSwarm_pid, DMSwarm_rank and DMSwarm_cellid. Vectors have Dim components, tensors are Dim×Dim
+// column-major (Eigen's layout); stress_zz (2D plane strain) is registered in 3D too and stays 0.
 inline constexpr const char* id = "frictherm_id";
 inline constexpr const char* mass = "frictherm_mass";
 inline constexpr const char* volume = "frictherm_volume";
@@ -35,19 +38,21 @@ inline constexpr const char* scalars = "frictherm_scalars";  // DecomposedOption
 
 /// Values of one velocity field at a node: after particle_to_grid m, p, f (and with contact Σ S m x,
 /// Ω, g: N·4–6, 9); after nodal_velocities v and a in the slots of p and f. The DMDA carries, per
-/// node, the first five summed over the fields (exact for a node that one field reaches); the
+/// node, the first 1 + 2·Dim summed over the fields (exact for a node that one field reaches); the
 /// per-field values live in Impl::field_values and travel over PetscSFs (sparse_exchange.cpp).
-namespace node_dof {
-inline constexpr int mass = 0, momentum = 1, force = 3, velocity = 1, acceleration = 3;
-inline constexpr int mass_position = 5, domain = 7, domain_gradient = 8;
-inline constexpr int without_contact = 5, with_contact = 10;  // values per field
-}
+/// 2D: m | p p | f f | mx mx | Ω | g g (5 without contact, 10 with); 3D: 7 and 14.
+template <int Dim>
+struct NodeDof {
+  static constexpr int mass = 0, momentum = 1, force = 1 + Dim, velocity = momentum, acceleration = force;
+  static constexpr int mass_position = 1 + 2 * Dim, domain = 1 + 3 * Dim, domain_gradient = 2 + 3 * Dim;
+  static constexpr int without_contact = 1 + 2 * Dim, with_contact = 2 + 4 * Dim;  // values per field
+};
 
 /// Every registered field of the swarm, gotten for the object's lifetime (no migration meanwhile).
 struct SwarmFields {
   DM sw;
   PetscInt n = 0;
-  double* x = nullptr;  // DMSwarmPIC_coor, 2 per particle
+  double* x = nullptr;  // DMSwarmPIC_coor, Dim per particle
   long* id = nullptr;
   double *mass = nullptr, *volume = nullptr, *volume0 = nullptr, *velocity = nullptr, *half_size = nullptr;
   double *stress = nullptr, *stress_zz = nullptr, *F = nullptr, *x0 = nullptr;
@@ -75,16 +80,18 @@ struct SwarmFields {
   SwarmFields& operator=(const SwarmFields&) = delete;
 };
 
-struct DecomposedMpm2D::Impl {
+template <int Dim>
+struct DecomposedMpm<Dim>::Impl {
+  using Dof = NodeDof<Dim>;
   MPI_Comm comm = MPI_COMM_NULL;
   int rank = 0, size = 1;
-  Grid<2> grid;
+  Grid<Dim> grid;
   std::vector<Material> materials;
-  DecomposedOptions opt;
+  Options opt;
   int width = 1;                 // DMDA stencil width (stencil_reach)
   int fields = 1;                // velocity fields per node: 1, or one per material with contact
-  int per_field = node_dof::without_contact;  // values per field (10 with contact)
-  static constexpr int dof = node_dof::without_contact;  // DMDA values per node: m, p, f over all fields
+  int per_field = Dof::without_contact;  // values per field (Dof::with_contact with contact)
+  static constexpr int dof = Dof::without_contact;  // DMDA values per node: m, p, f over all fields
   int field_of(PetscInt material) const { return opt.contact ? static_cast<int>(material) : 0; }
   // Per-field values of the ghosted box (sparse_exchange.cpp), [(l·fields + field)·per_field + value]
   // for local node l; field_lo / field_hi: the smallest and largest field whose particles' stencils
@@ -105,7 +112,7 @@ struct DecomposedMpm2D::Impl {
   /// else the DMDA's total (`total`: the global vector's array; one field).
   template <class Visit>
   void for_each_owned_field(PetscScalar* total, Visit&& visit) {
-    const PetscInt owned = xm * ym;
+    const PetscInt owned = owned_count();
     for (PetscInt q = 0; q < owned; ++q) {
       const PetscInt l = owned_local[static_cast<std::size_t>(q)];
       const std::size_t u = static_cast<std::size_t>(l);
@@ -122,10 +129,17 @@ struct DecomposedMpm2D::Impl {
   }
   DM da = nullptr, swarm = nullptr;
   ::Vec local = nullptr, global = nullptr;  // PETSc vectors (mechanics::Vec is the Eigen one)
-  PetscInt xs = 0, ys = 0, xm = 0, ym = 0;      // owned nodes
-  PetscInt gxs = 0, gys = 0, gxm = 0, gym = 0;  // ghosted box
-  PetscInt procs[2] = {1, 1};
-  std::array<std::vector<PetscInt>, 2> starts;  // first owned node per process column / row, + end
+  // Owned nodes [start, start + size) and the ghosted box, per axis (x, y, z; in 2D z is 0, 1).
+  std::array<PetscInt, 3> owned_start{{0, 0, 0}}, owned_size{{1, 1, 1}};
+  std::array<PetscInt, 3> box_start{{0, 0, 0}}, box_size{{1, 1, 1}};
+  std::array<PetscInt, 3> procs{{1, 1, 1}};
+  std::array<std::vector<PetscInt>, 3> starts;  // first owned node per process column / row / layer, + end
+  PetscInt owned_count() const { return owned_size[0] * owned_size[1] * owned_size[2]; }
+  PetscInt local_count() const { return box_size[0] * box_size[1] * box_size[2]; }
+  /// Local node of DMDA node (i, j, k) (k = 0 in 2D), inside the ghosted box.
+  PetscInt local_node(PetscInt i, PetscInt j, PetscInt k) const {
+    return ((k - box_start[2]) * box_size[1] + (j - box_start[1])) * box_size[0] + (i - box_start[0]);
+  }
   double empty_node_mass = 0.0;                 // 1e-12 of the largest particle mass (as the serial step)
   DecomposedTraffic traffic;
   std::vector<std::uint8_t> fixed_mask;  // per owned node (x fastest): bit d set, component d fixed to 0
@@ -138,24 +152,42 @@ struct DecomposedMpm2D::Impl {
   double cumulative_first = 0.0, cumulative_second = 0.0;
   DecomposedContactStats stats;
   int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
-  DecomposedStencils current;            // current_stencils(), valid until the next step or add
+  Stencils current;                      // current_stencils(), valid until the next step or add
   bool current_valid = false;
   std::vector<int> owned_local_int;      // owned_local as int (owned_local_nodes())
-  std::vector<Stencil<2, LinearKernel>> stencils_linear;
-  std::vector<Stencil<2, UGIMPKernel>> stencils_ugimp;
-  std::vector<Stencil<2, QuadraticBSplineKernel>> stencils_quadratic;
+  std::vector<Stencil<Dim, LinearKernel>> stencils_linear;
+  std::vector<Stencil<Dim, UGIMPKernel>> stencils_ugimp;
+  std::vector<Stencil<Dim, QuadraticBSplineKernel>> stencils_quadratic;
 
   ~Impl();
 
   template <class Kernel>
-  std::vector<Stencil<2, Kernel>>& stencils() {
+  std::vector<Stencil<Dim, Kernel>>& stencils() {
     if constexpr (std::is_same_v<Kernel, LinearKernel>) return stencils_linear;
     else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return stencils_ugimp;
     else return stencils_quadratic;
   }
-  /// Local-vector node index of a stencil's nodes (ghosted box, x fastest).
-  NodeIndexer<2> local_indexer() const {
-    return NodeIndexer<2>{{1, static_cast<int>(gxm)}, -static_cast<int>(gys * gxm + gxs)};
+  /// Local-vector node index of a stencil's nodes (ghosted box, x fastest, then y, then z).
+  NodeIndexer<Dim> local_indexer() const {
+    NodeIndexer<Dim> ix;
+    int stride = 1, shift = 0;
+    for (int d = 0; d < Dim; ++d) {
+      ix.stride[d] = stride;
+      shift -= static_cast<int>(box_start[static_cast<std::size_t>(d)]) * stride;
+      stride *= static_cast<int>(box_size[static_cast<std::size_t>(d)]);
+    }
+    ix.shift = shift;
+    return ix;
+  }
+  /// Whether a stencil's nodes lie in the ghosted box.
+  template <class Kernel>
+  bool in_box(const Stencil<Dim, Kernel>& st) const {
+    const IVec<Dim> b = st.first_node();
+    for (int d = 0; d < Dim; ++d) {
+      const auto u = static_cast<std::size_t>(d);
+      if (b[d] < box_start[u] || b[d] + Kernel::K > box_start[u] + box_size[u]) return false;
+    }
+    return true;
   }
   /// The rank owning the node nearest to x.
   int owner_of(const double* x) const;

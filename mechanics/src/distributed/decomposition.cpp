@@ -1,5 +1,6 @@
-// Decomposed 2D MPM (frictherm/mechanics/distributed.hpp): the DMDA of the grid's nodes, the DMSwarm
-// of the particles, ownership by nearest node, migration, reductions and the gather by global id.
+// Decomposed MPM, 2D and 3D (frictherm/mechanics/distributed.hpp): the DMDA of the grid's nodes
+// (DMDACreate2d / DMDACreate3d), the DMSwarm of the particles, ownership by nearest node, migration,
+// fixed faces, reductions and the gather by global id.
 #include "distributed/decomposed_state.hpp"
 
 // PETSc 3.18 has no public setter of the swarm's migration type (DMSwarmSetMigrateType came in
@@ -64,7 +65,8 @@ SwarmFields::~SwarmFields() {
   });
 }
 
-DecomposedMpm2D::Impl::~Impl() {
+template <int Dim>
+DecomposedMpm<Dim>::Impl::~Impl() {
   PetscSFDestroy(&entry_sf);
   PetscSFDestroy(&node_sf);
   if (field_unit != MPI_DATATYPE_NULL) MPI_Type_free(&field_unit);
@@ -74,23 +76,27 @@ DecomposedMpm2D::Impl::~Impl() {
   DMDestroy(&da);
 }
 
-int DecomposedMpm2D::Impl::owner_of(const double* x) const {
-  int p[2];
-  for (int d = 0; d < 2; ++d) {
+template <int Dim>
+int DecomposedMpm<Dim>::Impl::owner_of(const double* x) const {
+  int p[3] = {0, 0, 0};
+  for (int d = 0; d < Dim; ++d) {
+    const auto& st = starts[static_cast<std::size_t>(d)];
     const double s = (x[d] - grid.lo()[d]) * grid.inverse_cell_size()[d];
-    const PetscInt node =
-        std::clamp<PetscInt>(static_cast<PetscInt>(std::floor(s + 0.5)) + Grid<2>::ghost, 0, starts[d].back() - 1);
-    p[d] = static_cast<int>(std::upper_bound(starts[d].begin(), starts[d].end(), node) - starts[d].begin()) - 1;
+    const PetscInt node = std::clamp<PetscInt>(static_cast<PetscInt>(std::floor(s + 0.5)) + Grid<Dim>::ghost, 0,
+                                               st.back() - 1);
+    p[d] = static_cast<int>(std::upper_bound(st.begin(), st.end(), node) - st.begin()) - 1;
   }
-  return p[0] + static_cast<int>(procs[0]) * p[1];  // DMDA ranks: x fastest
+  return p[0] + static_cast<int>(procs[0]) * (p[1] + static_cast<int>(procs[1]) * p[2]);  // DMDA ranks: x fastest
 }
 
-DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Material& material,
-                                 const DecomposedOptions& options)
-    : DecomposedMpm2D(comm, grid, std::vector<Material>{material}, options) {}
+template <int Dim>
+DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const Material& material,
+                                  const Options& options)
+    : DecomposedMpm(comm, grid, std::vector<Material>{material}, options) {}
 
-DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::vector<Material>& materials,
-                                 const DecomposedOptions& options)
+template <int Dim>
+DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const std::vector<Material>& materials,
+                                  const Options& options)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   if (materials.empty()) throw std::invalid_argument("decomposed mechanics: no material given");
@@ -99,9 +105,13 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
       throw std::invalid_argument("decomposed mechanics: material '" + material.name + "' has kind '" +
                                   to_string(material.kind) + "' (expected linear_elastic)");
   for (const FixedFace& face : options.fixed_faces)
-    if (face.axis < 0 || face.axis >= 2)
+    if (face.axis < 0 || face.axis >= Dim)
       throw std::invalid_argument("decomposed mechanics: fixed face axis " + std::to_string(face.axis) +
-                                  " (expected 0 or 1)");
+                                  (Dim == 2 ? " (expected 0 or 1)" : " (expected 0, 1 or 2)"));
+  if (Dim == 2 ? options.analysis == Analysis::three_d : options.analysis != Analysis::three_d)
+    throw std::invalid_argument(std::string("decomposed mechanics: analysis ") +
+                                (options.analysis == Analysis::three_d ? "three_d" : "plane_strain/plane_stress") +
+                                (Dim == 2 ? " in 2D (expected plane_strain or plane_stress)" : " in 3D (expected three_d)"));
   s.width = stencil_reach(options.shape);
   s.comm = comm;
   MPI_Comm_rank(comm, &s.rank);
@@ -111,33 +121,54 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
   s.opt = options;
   s.setup_contact();  // checks the contact settings before any collective PETSc call
   s.fields = options.contact ? static_cast<int>(materials.size()) : 1;
-  s.per_field = options.contact ? node_dof::with_contact : node_dof::without_contact;
-  const IVec<2>& nodes = grid.nodes_per_dim();
-  petsc_check(DMDACreate2d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, nodes[0], nodes[1],
-                           PETSC_DECIDE, PETSC_DECIDE, s.dof, s.width, nullptr, nullptr, &s.da),
-              "DMDACreate2d");
+  s.per_field = options.contact ? NodeDof<Dim>::with_contact : NodeDof<Dim>::without_contact;
+  const IVec<Dim>& nodes = grid.nodes_per_dim();
+  if constexpr (Dim == 2)
+    petsc_check(DMDACreate2d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, nodes[0], nodes[1],
+                             PETSC_DECIDE, PETSC_DECIDE, s.dof, s.width, nullptr, nullptr, &s.da),
+                "DMDACreate2d");
+  else
+    petsc_check(DMDACreate3d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, nodes[0],
+                             nodes[1], nodes[2], PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, s.dof, s.width, nullptr,
+                             nullptr, nullptr, &s.da),
+                "DMDACreate3d");
   petsc_check(DMSetUp(s.da), "DMSetUp(DMDA)");
-  const Vec<2> first = grid.lo() - grid.cell_size(), last = grid.hi() + grid.cell_size();  // ghost layer
-  petsc_check(DMDASetUniformCoordinates(s.da, first[0], last[0], first[1], last[1], 0.0, 0.0),
+  const Vec<Dim> first = grid.lo() - grid.cell_size(), last = grid.hi() + grid.cell_size();  // ghost layer
+  petsc_check(DMDASetUniformCoordinates(s.da, first[0], last[0], first[1], last[1], Dim == 3 ? first[Dim - 1] : 0.0,
+                                        Dim == 3 ? last[Dim - 1] : 0.0),
               "DMDASetUniformCoordinates");
-  petsc_check(DMDAGetCorners(s.da, &s.xs, &s.ys, nullptr, &s.xm, &s.ym, nullptr), "DMDAGetCorners");
-  petsc_check(DMDAGetGhostCorners(s.da, &s.gxs, &s.gys, nullptr, &s.gxm, &s.gym, nullptr), "DMDAGetGhostCorners");
-  petsc_check(DMDAGetInfo(s.da, nullptr, nullptr, nullptr, nullptr, &s.procs[0], &s.procs[1], nullptr, nullptr,
+  // In 2D PETSc reports the z extent as start 0, size 1 (the layout of Impl's boxes).
+  petsc_check(DMDAGetCorners(s.da, &s.owned_start[0], &s.owned_start[1], &s.owned_start[2], &s.owned_size[0],
+                             &s.owned_size[1], &s.owned_size[2]),
+              "DMDAGetCorners");
+  petsc_check(DMDAGetGhostCorners(s.da, &s.box_start[0], &s.box_start[1], &s.box_start[2], &s.box_size[0],
+                                  &s.box_size[1], &s.box_size[2]),
+              "DMDAGetGhostCorners");
+  if (Dim == 2 && (s.owned_start[2] != 0 || s.owned_size[2] != 1 || s.box_start[2] != 0 || s.box_size[2] != 1))
+    throw std::logic_error("decomposed mechanics: a 2D DMDA with a z extent other than one node");
+  petsc_check(DMDAGetInfo(s.da, nullptr, nullptr, nullptr, nullptr, &s.procs[0], &s.procs[1], &s.procs[2], nullptr,
                           nullptr, nullptr, nullptr, nullptr, nullptr),
               "DMDAGetInfo");
-  const PetscInt* counts[2] = {nullptr, nullptr};
-  petsc_check(DMDAGetOwnershipRanges(s.da, &counts[0], &counts[1], nullptr), "DMDAGetOwnershipRanges");
-  for (int d = 0; d < 2; ++d) {
-    s.starts[d].assign(1, 0);
-    for (PetscInt p = 0; p < s.procs[d]; ++p) s.starts[d].push_back(s.starts[d].back() + counts[d][p]);
+  const PetscInt* counts[3] = {nullptr, nullptr, nullptr};
+  petsc_check(DMDAGetOwnershipRanges(s.da, &counts[0], &counts[1], Dim == 3 ? &counts[2] : nullptr),
+              "DMDAGetOwnershipRanges");
+  for (std::size_t d = 0; d < 3; ++d) {
+    auto& st = s.starts[d];
+    st.assign(1, 0);
+    if (static_cast<int>(d) >= Dim) {  // 2D: one layer of one node
+      s.procs[d] = 1;
+      st.push_back(1);
+      continue;
+    }
+    for (PetscInt p = 0; p < s.procs[d]; ++p) st.push_back(st.back() + counts[d][p]);
   }
   petsc_check(DMCreateLocalVector(s.da, &s.local), "DMCreateLocalVector");
   petsc_check(DMCreateGlobalVector(s.da, &s.global), "DMCreateGlobalVector");
 
-  // The swarm: PIC type over the DMDA (DMSwarmSetType(PIC) registers DMSwarmPIC_coor, 2 per point).
+  // The swarm: PIC type over the DMDA (DMSwarmSetType(PIC) registers DMSwarmPIC_coor, Dim per point).
   petsc_check(DMCreate(comm, &s.swarm), "DMCreate(DMSwarm)");
   petsc_check(DMSetType(s.swarm, DMSWARM), "DMSetType(DMSWARM)");
-  petsc_check(DMSetDimension(s.swarm, 2), "DMSetDimension");
+  petsc_check(DMSetDimension(s.swarm, Dim), "DMSetDimension");
   petsc_check(DMSwarmSetType(s.swarm, DMSWARM_PIC), "DMSwarmSetType");
   petsc_check(DMSwarmSetCellDM(s.swarm, s.da), "DMSwarmSetCellDM");
   auto reg = [&](const char* name, PetscInt bs, PetscDataType type) {
@@ -148,13 +179,13 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
   reg(swarm_field::mass, 1, PETSC_DOUBLE);
   reg(swarm_field::volume, 1, PETSC_DOUBLE);
   reg(swarm_field::volume0, 1, PETSC_DOUBLE);
-  reg(swarm_field::velocity, 2, PETSC_DOUBLE);
-  reg(swarm_field::half_size, 2, PETSC_DOUBLE);
-  reg(swarm_field::stress, 4, PETSC_DOUBLE);
+  reg(swarm_field::velocity, Dim, PETSC_DOUBLE);
+  reg(swarm_field::half_size, Dim, PETSC_DOUBLE);
+  reg(swarm_field::stress, Dim * Dim, PETSC_DOUBLE);
   reg(swarm_field::stress_zz, 1, PETSC_DOUBLE);
-  reg(swarm_field::deformation, 4, PETSC_DOUBLE);
+  reg(swarm_field::deformation, Dim * Dim, PETSC_DOUBLE);
   reg(swarm_field::material, 1, PETSC_INT);
-  reg(swarm_field::initial_position, 2, PETSC_DOUBLE);
+  reg(swarm_field::initial_position, Dim, PETSC_DOUBLE);
   s.scalars = static_cast<int>(options.particle_scalars.size());
   if (s.scalars > 0) reg(swarm_field::scalars, s.scalars, PETSC_DOUBLE);
   petsc_check(DMSwarmFinalizeFieldRegister(s.swarm), "DMSwarmFinalizeFieldRegister");
@@ -167,7 +198,7 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
 #endif
 
   // Traffic bookkeeping: ghost nodes of this rank and the bytes of one particle (every field).
-  s.traffic.ghost_nodes = static_cast<long>(s.gxm * s.gym - s.xm * s.ym);
+  s.traffic.ghost_nodes = static_cast<long>(s.local_count() - s.owned_count());
   s.traffic.values_per_node = s.dof;
   s.traffic.field_entry_bytes = s.per_field * static_cast<int>(sizeof(double));
   s.setup_fixed_faces();
@@ -192,9 +223,11 @@ DecomposedMpm2D::DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::
   s.owned_local_int.assign(s.owned_local.begin(), s.owned_local.end());
 }
 
-DecomposedMpm2D::~DecomposedMpm2D() = default;
+template <int Dim>
+DecomposedMpm<Dim>::~DecomposedMpm() = default;
 
-void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& particles) {
+template <int Dim>
+void DecomposedMpm<Dim>::add_particles(const std::vector<Particle>& particles) {
   Impl& s = *impl_;
   double mmax = 0.0;
   for (const auto& p : particles) {
@@ -220,20 +253,20 @@ void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& parti
   {
     SwarmFields f(s.swarm);
     for (std::size_t q = 0; q < particles.size(); ++q) {
-      const DecomposedParticle& p = particles[q];
+      const Particle& p = particles[q];
       const std::size_t k = static_cast<std::size_t>(before) + q;
       f.id[k] = static_cast<long>(p.id);
       f.mass[k] = p.mass;
       f.volume[k] = f.volume0[k] = p.volume;
-      for (int d = 0; d < 2; ++d) {
-        f.x[2 * k + d] = f.x0[2 * k + d] = p.position[d];
-        f.velocity[2 * k + d] = p.velocity[d];
-        f.half_size[2 * k + d] = p.half_size[d];
+      for (int d = 0; d < Dim; ++d) {
+        f.x[Dim * k + d] = f.x0[Dim * k + d] = p.position[d];
+        f.velocity[Dim * k + d] = p.velocity[d];
+        f.half_size[Dim * k + d] = p.half_size[d];
       }
-      Eigen::Map<Mat<2>>(f.stress + 4 * k) = p.stress;
+      Eigen::Map<Mat<Dim>>(f.stress + Dim * Dim * k) = p.stress;
       f.stress_zz[k] = p.stress_zz;
       f.material[k] = static_cast<PetscInt>(p.material);
-      Eigen::Map<Mat<2>>(f.F + 4 * k) = Mat<2>::Identity();
+      Eigen::Map<Mat<Dim>>(f.F + Dim * Dim * k) = Mat<Dim>::Identity();
     }
   }
   if (s.scalars > 0) {
@@ -253,7 +286,8 @@ void DecomposedMpm2D::add_particles(const std::vector<DecomposedParticle>& parti
 }
 
 // Exchange 3: every particle to the rank owning its nearest node (DMSwarm_rank, basic migration).
-void DecomposedMpm2D::Impl::migrate(double /*dt*/) {
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::migrate(double /*dt*/) {
   PetscInt n = 0;
   petsc_check(DMSwarmGetLocalSize(swarm, &n), "DMSwarmGetLocalSize");
   long sent = 0;
@@ -267,7 +301,7 @@ void DecomposedMpm2D::Impl::migrate(double /*dt*/) {
                 "DMSwarmGetField");
     if (type != PETSC_INT) throw std::logic_error("decomposed mechanics: DMSwarm_rank is not a PetscInt field");
     for (PetscInt k = 0; k < n; ++k) {
-      dest[k] = owner_of(x + 2 * k);
+      dest[k] = owner_of(x + Dim * k);
       if (dest[k] != rank) ++sent;
     }
     DMSwarmRestoreField(swarm, DMSwarmField_rank, nullptr, nullptr, reinterpret_cast<void**>(&dest));
@@ -285,46 +319,72 @@ void DecomposedMpm2D::Impl::migrate(double /*dt*/) {
   traffic.particles_received += static_cast<long>(after) - (static_cast<long>(n) - sent);
 }
 
-int DecomposedMpm2D::stencil_width() const { return impl_->width; }
-std::array<int, 2> DecomposedMpm2D::processes() const {
-  return {static_cast<int>(impl_->procs[0]), static_cast<int>(impl_->procs[1])};
+template <int Dim>
+int DecomposedMpm<Dim>::stencil_width() const {
+  return impl_->width;
 }
-std::array<int, 4> DecomposedMpm2D::owned_nodes() const {
+template <int Dim>
+std::array<int, Dim> DecomposedMpm<Dim>::processes() const {
+  std::array<int, Dim> p{};
+  for (std::size_t d = 0; d < static_cast<std::size_t>(Dim); ++d) p[d] = static_cast<int>(impl_->procs[d]);
+  return p;
+}
+template <int Dim>
+std::array<int, 2 * Dim> DecomposedMpm<Dim>::owned_nodes() const {
   const Impl& s = *impl_;
-  return {static_cast<int>(s.xs), static_cast<int>(s.xs + s.xm), static_cast<int>(s.ys), static_cast<int>(s.ys + s.ym)};
+  std::array<int, 2 * Dim> r{};
+  for (std::size_t d = 0; d < static_cast<std::size_t>(Dim); ++d) {
+    r[2 * d] = static_cast<int>(s.owned_start[d]);
+    r[2 * d + 1] = static_cast<int>(s.owned_start[d] + s.owned_size[d]);
+  }
+  return r;
 }
-std::size_t DecomposedMpm2D::local_particles() const {
+template <int Dim>
+std::size_t DecomposedMpm<Dim>::local_particles() const {
   PetscInt n = 0;
   petsc_check(DMSwarmGetLocalSize(impl_->swarm, &n), "DMSwarmGetLocalSize");
   return static_cast<std::size_t>(n);
 }
-const DecomposedTraffic& DecomposedMpm2D::traffic() const { return impl_->traffic; }
-int DecomposedMpm2D::velocity_fields() const { return impl_->fields; }
+template <int Dim>
+const DecomposedTraffic& DecomposedMpm<Dim>::traffic() const {
+  return impl_->traffic;
+}
+template <int Dim>
+int DecomposedMpm<Dim>::velocity_fields() const {
+  return impl_->fields;
+}
 
 // Fixed faces as Simulation::fix_face: nodes at lattice index ≤ 0 (lower) or ≥ cells (upper) along
-// the axis, i.e. DMDA index ≤ 1 or ≥ cells + 1 (DMDA index = lattice + Grid<2>::ghost).
-void DecomposedMpm2D::Impl::setup_fixed_faces() {
-  fixed_mask.assign(static_cast<std::size_t>(xm * ym), 0);
+// the axis, i.e. DMDA index ≤ 1 or ≥ cells + 1 (DMDA index = lattice + Grid<Dim>::ghost).
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::setup_fixed_faces() {
+  fixed_mask.assign(static_cast<std::size_t>(owned_count()), 0);
+  const auto& o = owned_start;
+  const auto& n = owned_size;
   for (const FixedFace& face : opt.fixed_faces) {  // axes checked by the constructor
-    const PetscInt last = grid.cells()[face.axis] + Grid<2>::ghost;
-    for (PetscInt j = ys; j < ys + ym; ++j)
-      for (PetscInt i = xs; i < xs + xm; ++i) {
-        const PetscInt l = face.axis == 0 ? i : j;
-        if (face.upper ? l < last : l > Grid<2>::ghost) continue;
-        for (int d = 0; d < 2; ++d)
-          if (face.components[static_cast<std::size_t>(d)])
-            fixed_mask[static_cast<std::size_t>((j - ys) * xm + (i - xs))] |= static_cast<std::uint8_t>(1u << d);
-      }
+    const PetscInt last = grid.cells()[face.axis] + Grid<Dim>::ghost;
+    std::size_t q = 0;  // owned node, x fastest
+    for (PetscInt k = o[2]; k < o[2] + n[2]; ++k)
+      for (PetscInt j = o[1]; j < o[1] + n[1]; ++j)
+        for (PetscInt i = o[0]; i < o[0] + n[0]; ++i, ++q) {
+          const PetscInt ijk[3] = {i, j, k};
+          const PetscInt l = ijk[face.axis];
+          if (face.upper ? l < last : l > Grid<Dim>::ghost) continue;
+          for (int d = 0; d < Dim; ++d)
+            if (face.components[static_cast<std::size_t>(d)]) fixed_mask[q] |= static_cast<std::uint8_t>(1u << d);
+        }
   }
 }
 
-long long DecomposedMpm2D::global_particles() const {
+template <int Dim>
+long long DecomposedMpm<Dim>::global_particles() const {
   long long n = static_cast<long long>(local_particles());
   MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_LONG_LONG, MPI_SUM, impl_->comm);
   return n;
 }
 
-double DecomposedMpm2D::total_mass() const {
+template <int Dim>
+double DecomposedMpm<Dim>::total_mass() const {
   SwarmFields f(impl_->swarm);
   double m = 0.0;
   for (PetscInt k = 0; k < f.n; ++k) m += f.mass[k];
@@ -332,26 +392,35 @@ double DecomposedMpm2D::total_mass() const {
   return m;
 }
 
-Vec<2> DecomposedMpm2D::total_momentum() const {
+template <int Dim>
+Vec<Dim> DecomposedMpm<Dim>::total_momentum() const {
   SwarmFields f(impl_->swarm);
-  double p[2] = {0.0, 0.0};
-  for (PetscInt k = 0; k < f.n; ++k)
-    for (int d = 0; d < 2; ++d) p[d] += f.mass[k] * f.velocity[2 * k + d];
-  MPI_Allreduce(MPI_IN_PLACE, p, 2, MPI_DOUBLE, MPI_SUM, impl_->comm);
-  return Vec<2>(p[0], p[1]);
+  Vec<Dim> p = Vec<Dim>::Zero();
+  for (PetscInt k = 0; k < f.n; ++k) p += f.mass[k] * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
+  MPI_Allreduce(MPI_IN_PLACE, p.data(), Dim, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return p;
 }
 
-double DecomposedMpm2D::total_momentum_scale() const {
+template <int Dim>
+double DecomposedMpm<Dim>::total_momentum_scale() const {
   SwarmFields f(impl_->swarm);
   double s = 0.0;
-  for (PetscInt k = 0; k < f.n; ++k) s += f.mass[k] * std::hypot(f.velocity[2 * k], f.velocity[2 * k + 1]);
+  for (PetscInt k = 0; k < f.n; ++k) {
+    const double* v = f.velocity + Dim * k;
+    s += f.mass[k] * (Dim == 2 ? std::hypot(v[0], v[1]) : std::hypot(v[0], v[1], v[Dim - 1]));
+  }
   MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
   return s;
 }
 
-std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
+template <int Dim>
+std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() const {
+  constexpr int D = Dim, DD = Dim * Dim;
+  // Doubles per particle: mass, volume, x, v, l_p, σ, σ_zz, material, the scalars.
+  constexpr int at_x = 2, at_v = at_x + D, at_l = at_v + D, at_s = at_l + D, at_zz = at_s + DD, at_mat = at_zz + 1;
+  constexpr int at_scalars = at_mat + 1;  // 14 in 2D, 22 in 3D
   const int ns = impl_->scalars;
-  const int per = 14 + ns;  // doubles per particle below
+  const int per = at_scalars + ns;
   const std::vector<double> sc = ns > 0 ? impl_->scalar_values() : std::vector<double>{};
   SwarmFields f(impl_->swarm);
   std::vector<long long> ids(static_cast<std::size_t>(f.n));
@@ -359,12 +428,13 @@ std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
   for (PetscInt k = 0; k < f.n; ++k) {
     ids[static_cast<std::size_t>(k)] = f.id[k];
     double* v = vals.data() + per * k;
-    v[0] = f.mass[k], v[1] = f.volume[k], v[2] = f.x[2 * k], v[3] = f.x[2 * k + 1];
-    v[4] = f.velocity[2 * k], v[5] = f.velocity[2 * k + 1], v[6] = f.half_size[2 * k], v[7] = f.half_size[2 * k + 1];
-    for (int c = 0; c < 4; ++c) v[8 + c] = f.stress[4 * k + c];
-    v[12] = f.stress_zz[k];
-    v[13] = static_cast<double>(f.material[k]);
-    for (int c = 0; c < ns; ++c) v[14 + c] = sc[static_cast<std::size_t>(k * ns + c)];
+    v[0] = f.mass[k], v[1] = f.volume[k];
+    for (int d = 0; d < D; ++d)
+      v[at_x + d] = f.x[D * k + d], v[at_v + d] = f.velocity[D * k + d], v[at_l + d] = f.half_size[D * k + d];
+    for (int c = 0; c < DD; ++c) v[at_s + c] = f.stress[DD * k + c];
+    v[at_zz] = f.stress_zz[k];
+    v[at_mat] = static_cast<double>(f.material[k]);
+    for (int c = 0; c < ns; ++c) v[at_scalars + c] = sc[static_cast<std::size_t>(k * ns + c)];
   }
   const int ranks = impl_->size;
   std::vector<int> counts(static_cast<std::size_t>(ranks)), displs(static_cast<std::size_t>(ranks));
@@ -377,22 +447,26 @@ std::vector<DecomposedParticle> DecomposedMpm2D::gather() const {
   for (int r = 0; r < ranks; ++r) counts[static_cast<std::size_t>(r)] *= per, displs[static_cast<std::size_t>(r)] *= per;
   std::vector<double> all(static_cast<std::size_t>(total) * per);
   MPI_Allgatherv(vals.data(), n * per, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, impl_->comm);
-  std::vector<DecomposedParticle> out(static_cast<std::size_t>(total));
+  std::vector<Particle> out(static_cast<std::size_t>(total));
   for (std::size_t k = 0; k < out.size(); ++k) {
     const double* v = all.data() + per * k;
-    DecomposedParticle& p = out[k];
+    Particle& p = out[k];
     p.id = all_ids[k];
     p.mass = v[0], p.volume = v[1];
-    p.position = Vec<2>(v[2], v[3]);
-    p.velocity = Vec<2>(v[4], v[5]);
-    p.half_size = Vec<2>(v[6], v[7]);
-    p.stress = Eigen::Map<const Mat<2>>(v + 8);
-    p.stress_zz = v[12];
-    p.material = static_cast<int>(v[13]);
-    p.scalars.assign(v + 14, v + 14 + ns);
+    p.position = Eigen::Map<const Vec<Dim>>(v + at_x);
+    p.velocity = Eigen::Map<const Vec<Dim>>(v + at_v);
+    p.half_size = Eigen::Map<const Vec<Dim>>(v + at_l);
+    p.stress = Eigen::Map<const Mat<Dim>>(v + at_s);
+    p.stress_zz = v[at_zz];
+    p.material = static_cast<int>(v[at_mat]);
+    p.scalars.assign(v + at_scalars, v + at_scalars + ns);
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
 }
+
+// Every member defined in this file, for both dimensions (the other files instantiate theirs).
+template class DecomposedMpm<2>;
+template class DecomposedMpm<3>;
 
 }  // namespace frictherm::mechanics

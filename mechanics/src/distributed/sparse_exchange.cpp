@@ -1,7 +1,7 @@
 // Per-material fields at shared nodes over PetscSF (issue 16, item 1; docs/distributed.md). With
 // contact every material has its own velocity field (Nairn, Bardenhagen & Smith 2018 eqs. 1–6), but
 // a node that one material reaches needs no per-material data: its field is the node's total, which
-// the DMDA carries (5 values per node, every ghost node). Only nodes that two or more materials
+// the DMDA carries (1 + 2·Dim values per node, every ghost node). Only nodes that two or more materials
 // reach need the per-material values (m, p, f, Σ S m x, Ω, g) complete at their owner, and these
 // travel as (node, material) entries over a star forest built each step:
 //
@@ -29,39 +29,57 @@ using detail::petsc_check;
 
 // node_sf: every ghost node of this rank (local node l, not owned) → its owner's local node. The
 // owner's ghosted box is its owned range widened by the stencil width and clipped to the grid
-// (DM_BOUNDARY_NONE), as DMDAGetGhostCorners gives on that rank (checked on this one).
-void DecomposedMpm2D::Impl::setup_sparse_exchange() {
-  const PetscInt M = starts[0].back(), N = starts[1].back();
-  auto ghost_box = [&](int px, int py, PetscInt box[4]) {  // x start, x size, y start, y size
-    const PetscInt x0 = std::max<PetscInt>(starts[0][px] - width, 0), x1 = std::min<PetscInt>(starts[0][px + 1] + width, M);
-    const PetscInt y0 = std::max<PetscInt>(starts[1][py] - width, 0), y1 = std::min<PetscInt>(starts[1][py + 1] + width, N);
-    box[0] = x0, box[1] = x1 - x0, box[2] = y0, box[3] = y1 - y0;
+// (DM_BOUNDARY_NONE), as DMDAGetGhostCorners gives on that rank (checked on this one). Three axes in
+// 2D and 3D alike (in 2D the z axis has one node and one process).
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::setup_sparse_exchange() {
+  using Box = std::array<std::array<PetscInt, 2>, 3>;  // per axis: start, size
+  auto ghost_box = [&](const std::array<int, 3>& p) {
+    Box box;
+    for (std::size_t d = 0; d < 3; ++d) {
+      const PetscInt w = static_cast<int>(d) < Dim ? width : 0;
+      const PetscInt lo = std::max<PetscInt>(starts[d][static_cast<std::size_t>(p[d])] - w, 0);
+      const PetscInt hi = std::min<PetscInt>(starts[d][static_cast<std::size_t>(p[d]) + 1] + w, starts[d].back());
+      box[d] = {lo, hi - lo};
+    }
+    return box;
   };
-  PetscInt mine[4];
-  ghost_box(rank % static_cast<int>(procs[0]), rank / static_cast<int>(procs[0]), mine);
-  if (mine[0] != gxs || mine[1] != gxm || mine[2] != gys || mine[3] != gym)
-    throw std::logic_error("decomposed mechanics: the DMDA's ghosted box differs from the one computed for the "
-                           "per-material exchange");
-  owned_local.resize(static_cast<std::size_t>(xm * ym));
-  for (PetscInt j = ys; j < ys + ym; ++j)
-    for (PetscInt i = xs; i < xs + xm; ++i)
-      owned_local[static_cast<std::size_t>((j - ys) * xm + (i - xs))] = (j - gys) * gxm + (i - gxs);
+  auto process_of = [&](const std::array<PetscInt, 3>& node) {  // process column / row / layer of a node
+    std::array<int, 3> p{};
+    for (std::size_t d = 0; d < 3; ++d)
+      p[d] = static_cast<int>(std::upper_bound(starts[d].begin(), starts[d].end(), node[d]) - starts[d].begin()) - 1;
+    return p;
+  };
+  const int px = static_cast<int>(procs[0]), py = static_cast<int>(procs[1]);
+  const Box mine = ghost_box({rank % px, (rank / px) % py, rank / (px * py)});
+  for (std::size_t d = 0; d < 3; ++d)
+    if (mine[d][0] != box_start[d] || mine[d][1] != box_size[d])
+      throw std::logic_error("decomposed mechanics: the DMDA's ghosted box differs from the one computed for the "
+                             "per-material exchange");
+  const auto& o = owned_start;
+  const auto& on = owned_size;
+  const auto& b = box_start;
+  const auto& bn = box_size;
+  owned_local.clear();
+  owned_local.reserve(static_cast<std::size_t>(owned_count()));
+  for (PetscInt k = o[2]; k < o[2] + on[2]; ++k)
+    for (PetscInt j = o[1]; j < o[1] + on[1]; ++j)
+      for (PetscInt i = o[0]; i < o[0] + on[0]; ++i) owned_local.push_back(local_node(i, j, k));
   ghost_local.clear();
   ghost_remote.clear();
-  for (PetscInt j = gys; j < gys + gym; ++j)
-    for (PetscInt i = gxs; i < gxs + gxm; ++i) {
-      if (i >= xs && i < xs + xm && j >= ys && j < ys + ym) continue;
-      const int px = static_cast<int>(std::upper_bound(starts[0].begin(), starts[0].end(), i) - starts[0].begin()) - 1;
-      const int py = static_cast<int>(std::upper_bound(starts[1].begin(), starts[1].end(), j) - starts[1].begin()) - 1;
-      PetscInt box[4];
-      ghost_box(px, py, box);
-      ghost_local.push_back((j - gys) * gxm + (i - gxs));
-      PetscSFNode owner;
-      owner.rank = px + static_cast<int>(procs[0]) * py;
-      owner.index = (j - box[2]) * box[1] + (i - box[0]);
-      ghost_remote.push_back(owner);
-    }
-  const PetscInt local_nodes = gxm * gym;
+  for (PetscInt k = b[2]; k < b[2] + bn[2]; ++k)
+    for (PetscInt j = b[1]; j < b[1] + bn[1]; ++j)
+      for (PetscInt i = b[0]; i < b[0] + bn[0]; ++i) {
+        if (i >= o[0] && i < o[0] + on[0] && j >= o[1] && j < o[1] + on[1] && k >= o[2] && k < o[2] + on[2]) continue;
+        const std::array<int, 3> p = process_of({i, j, k});
+        const Box box = ghost_box(p);
+        ghost_local.push_back(local_node(i, j, k));
+        PetscSFNode owner;
+        owner.rank = p[0] + px * (p[1] + py * p[2]);
+        owner.index = ((k - box[2][0]) * box[1][1] + (j - box[1][0])) * box[0][1] + (i - box[0][0]);
+        ghost_remote.push_back(owner);
+      }
+  const PetscInt local_nodes = local_count();
   petsc_check(PetscSFCreate(comm, &node_sf), "PetscSFCreate");
   petsc_check(PetscSFSetType(node_sf, PETSCSFBASIC), "PetscSFSetType");
   petsc_check(PetscSFSetGraph(node_sf, local_nodes, static_cast<PetscInt>(ghost_local.size()), ghost_local.data(),
@@ -77,7 +95,8 @@ void DecomposedMpm2D::Impl::setup_sparse_exchange() {
 
 // Exchange: the range of materials reaching each node, completed at the owner, and the multi flag
 // back to every rank holding the node.
-void DecomposedMpm2D::Impl::exchange_field_ranges(double /*dt*/) {
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::exchange_field_ranges(double /*dt*/) {
   if (fields == 1) return;  // one velocity field: no node holds two
   root_lo = field_lo, root_hi = field_hi;
   petsc_check(PetscSFReduceBegin(node_sf, MPIU_INT, field_lo.data(), root_lo.data(), MPI_MIN), "PetscSFReduceBegin");
@@ -97,7 +116,8 @@ void DecomposedMpm2D::Impl::exchange_field_ranges(double /*dt*/) {
 // Exchange: this rank's per-material sums at multi-material ghost nodes, one entry per material with
 // a non-zero value, summed into the owner's (the star forest is rebuilt: the entries change as the
 // bodies move).
-void DecomposedMpm2D::Impl::fields_to_owners(double /*dt*/) {
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::fields_to_owners(double /*dt*/) {
   if (fields == 1) return;
   entry_local.clear();
   entry_remote.clear();
@@ -119,7 +139,7 @@ void DecomposedMpm2D::Impl::fields_to_owners(double /*dt*/) {
   petsc_check(PetscSFDestroy(&entry_sf), "PetscSFDestroy");
   petsc_check(PetscSFCreate(comm, &entry_sf), "PetscSFCreate");
   petsc_check(PetscSFSetType(entry_sf, PETSCSFBASIC), "PetscSFSetType");
-  petsc_check(PetscSFSetGraph(entry_sf, gxm * gym * fields, static_cast<PetscInt>(entry_local.size()),
+  petsc_check(PetscSFSetGraph(entry_sf, local_count() * fields, static_cast<PetscInt>(entry_local.size()),
                               entry_local.data(), PETSC_COPY_VALUES, entry_remote.data(), PETSC_COPY_VALUES),
               "PetscSFSetGraph");
   petsc_check(PetscSFSetUp(entry_sf), "PetscSFSetUp");
@@ -131,12 +151,22 @@ void DecomposedMpm2D::Impl::fields_to_owners(double /*dt*/) {
 }
 
 // Exchange: the owners' per-material v, a (and the rest of the entry) back to the ghosts that sent it.
-void DecomposedMpm2D::Impl::fields_to_ghosts(double /*dt*/) {
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::fields_to_ghosts(double /*dt*/) {
   if (fields == 1) return;
   petsc_check(PetscSFBcastBegin(entry_sf, field_unit, field_values.data(), field_values.data(), MPI_REPLACE),
               "PetscSFBcastBegin");
   petsc_check(PetscSFBcastEnd(entry_sf, field_unit, field_values.data(), field_values.data(), MPI_REPLACE),
               "PetscSFBcastEnd");
 }
+
+#define FRICTHERM_INSTANTIATE_SPARSE(D)                              \
+  template void DecomposedMpm<D>::Impl::setup_sparse_exchange();      \
+  template void DecomposedMpm<D>::Impl::exchange_field_ranges(double); \
+  template void DecomposedMpm<D>::Impl::fields_to_owners(double);     \
+  template void DecomposedMpm<D>::Impl::fields_to_ghosts(double);
+FRICTHERM_INSTANTIATE_SPARSE(2)
+FRICTHERM_INSTANTIATE_SPARSE(3)
+#undef FRICTHERM_INSTANTIATE_SPARSE
 
 }  // namespace frictherm::mechanics

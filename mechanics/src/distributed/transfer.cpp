@@ -10,9 +10,13 @@ namespace frictherm::mechanics {
 
 using detail::petsc_check;
 
-MPI_Comm DecomposedMpm2D::communicator() const { return impl_->comm; }
+template <int Dim>
+MPI_Comm DecomposedMpm<Dim>::communicator() const {
+  return impl_->comm;
+}
 
-int DecomposedMpm2D::particle_scalar_index(const std::string& name) const {
+template <int Dim>
+int DecomposedMpm<Dim>::particle_scalar_index(const std::string& name) const {
   const auto& names = impl_->opt.particle_scalars;
   for (std::size_t c = 0; c < names.size(); ++c)
     if (names[c] == name) return static_cast<int>(c);
@@ -20,7 +24,8 @@ int DecomposedMpm2D::particle_scalar_index(const std::string& name) const {
                               "' (expected one of DecomposedOptions::particle_scalars)");
 }
 
-std::vector<double> DecomposedMpm2D::Impl::scalar_values() const {
+template <int Dim>
+std::vector<double> DecomposedMpm<Dim>::Impl::scalar_values() const {
   PetscInt n = 0;
   petsc_check(DMSwarmGetLocalSize(swarm, &n), "DMSwarmGetLocalSize");
   std::vector<double> out(static_cast<std::size_t>(n) * static_cast<std::size_t>(scalars));
@@ -33,7 +38,8 @@ std::vector<double> DecomposedMpm2D::Impl::scalar_values() const {
   return out;
 }
 
-std::vector<double> DecomposedMpm2D::particle_scalar(int index) const {
+template <int Dim>
+std::vector<double> DecomposedMpm<Dim>::particle_scalar(int index) const {
   const Impl& s = *impl_;
   if (index < 0 || index >= s.scalars) throw std::out_of_range("decomposed mechanics: particle scalar index");
   const std::vector<double> all = s.scalar_values();
@@ -43,7 +49,8 @@ std::vector<double> DecomposedMpm2D::particle_scalar(int index) const {
   return out;
 }
 
-void DecomposedMpm2D::set_particle_scalar(int index, const std::vector<double>& values) {
+template <int Dim>
+void DecomposedMpm<Dim>::set_particle_scalar(int index, const std::vector<double>& values) {
   Impl& s = *impl_;
   if (index < 0 || index >= s.scalars) throw std::out_of_range("decomposed mechanics: particle scalar index");
   if (values.size() != local_particles())
@@ -57,7 +64,8 @@ void DecomposedMpm2D::set_particle_scalar(int index, const std::vector<double>& 
   DMSwarmRestoreField(s.swarm, swarm_field::scalars, nullptr, nullptr, reinterpret_cast<void**>(&v));
 }
 
-DecomposedLocalParticles DecomposedMpm2D::local_particle_data() const {
+template <int Dim>
+DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
   SwarmFields f(impl_->swarm);
   DecomposedLocalParticles out;
   const auto n = static_cast<std::size_t>(f.n);
@@ -68,27 +76,27 @@ DecomposedLocalParticles DecomposedMpm2D::local_particle_data() const {
   return out;
 }
 
-const DecomposedStencils& DecomposedMpm2D::current_stencils() {
+template <int Dim>
+const typename DecomposedMpm<Dim>::Stencils& DecomposedMpm<Dim>::current_stencils() {
   Impl& s = *impl_;
   if (s.current_valid) return s.current;
   dispatch_shape(s.opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
     SwarmFields f(s.swarm);
-    DecomposedStencils& c = s.current;
+    Stencils& c = s.current;
     const auto n = static_cast<std::size_t>(f.n);
     c.first.assign(1, 0);
     c.node.clear();
     c.S.clear();
     c.G.clear();
-    const NodeIndexer<2> ix = s.local_indexer();
-    Stencil<2, Kernel> st;
+    const NodeIndexer<Dim> ix = s.local_indexer();
+    Stencil<Dim, Kernel> st;
     for (std::size_t k = 0; k < n; ++k) {
-      st.evaluate(s.grid, Eigen::Map<const Vec<2>>(f.x + 2 * k), Eigen::Map<const Vec<2>>(f.half_size + 2 * k));
-      const IVec<2> b = st.first_node();
-      if (b[0] < s.gxs || b[1] < s.gys || b[0] + Kernel::K > s.gxs + s.gxm || b[1] + Kernel::K > s.gys + s.gym)
+      st.evaluate(s.grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
+      if (!s.in_box(st))
         throw std::logic_error("decomposed mechanics: particle " + std::to_string(f.id[k]) +
                                " reaches nodes outside its rank's ghosted box (not migrated?)");
-      st.for_each(ix, [&](int i, double S, const Vec<2>& G) {
+      st.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
         c.node.push_back(i);
         c.S.push_back(S);
         c.G.push_back(G);
@@ -100,23 +108,29 @@ const DecomposedStencils& DecomposedMpm2D::current_stencils() {
   return s.current;
 }
 
-int DecomposedMpm2D::local_node_count() const { return static_cast<int>(impl_->gxm * impl_->gym); }
-const std::vector<int>& DecomposedMpm2D::owned_local_nodes() const { return impl_->owned_local_int; }
+template <int Dim>
+int DecomposedMpm<Dim>::local_node_count() const {
+  return static_cast<int>(impl_->local_count());
+}
+template <int Dim>
+const std::vector<int>& DecomposedMpm<Dim>::owned_local_nodes() const {
+  return impl_->owned_local_int;
+}
 
 namespace {
-void check_components(int components) {
-  if (components < 1 || components > DecomposedMpm2D::max_transfer_components)
+void check_components(int components, int max) {
+  if (components < 1 || components > max)
     throw std::invalid_argument("decomposed mechanics: " + std::to_string(components) +
-                                " components per node (expected 1 to " +
-                                std::to_string(DecomposedMpm2D::max_transfer_components) + ")");
+                                " components per node (expected 1 to " + std::to_string(max) + ")");
 }
 }  // namespace
 
-// The step's grid vectors carry dof = 5 values per node; a transfer of fewer components pads with 0.
-void DecomposedMpm2D::sum_to_owned(const std::vector<double>& local, int components, std::vector<double>& owned) {
+// The step's grid vectors carry dof = 1 + 2·Dim values per node; a transfer of fewer components pads with 0.
+template <int Dim>
+void DecomposedMpm<Dim>::sum_to_owned(const std::vector<double>& local, int components, std::vector<double>& owned) {
   Impl& s = *impl_;
-  check_components(components);
-  const auto nl = static_cast<std::size_t>(s.gxm * s.gym), no = static_cast<std::size_t>(s.xm * s.ym);
+  check_components(components, max_transfer_components);
+  const auto nl = static_cast<std::size_t>(s.local_count()), no = static_cast<std::size_t>(s.owned_count());
   const auto c = static_cast<std::size_t>(components);
   if (local.size() != nl * c)
     throw std::invalid_argument("decomposed mechanics: sum_to_owned got " + std::to_string(local.size()) +
@@ -136,10 +150,11 @@ void DecomposedMpm2D::sum_to_owned(const std::vector<double>& local, int compone
   petsc_check(VecRestoreArrayRead(s.global, &g), "VecRestoreArrayRead");
 }
 
-void DecomposedMpm2D::owned_to_local(const std::vector<double>& owned, int components, std::vector<double>& local) {
+template <int Dim>
+void DecomposedMpm<Dim>::owned_to_local(const std::vector<double>& owned, int components, std::vector<double>& local) {
   Impl& s = *impl_;
-  check_components(components);
-  const auto nl = static_cast<std::size_t>(s.gxm * s.gym), no = static_cast<std::size_t>(s.xm * s.ym);
+  check_components(components, max_transfer_components);
+  const auto nl = static_cast<std::size_t>(s.local_count()), no = static_cast<std::size_t>(s.owned_count());
   const auto c = static_cast<std::size_t>(components);
   if (owned.size() != no * c)
     throw std::invalid_argument("decomposed mechanics: owned_to_local got " + std::to_string(owned.size()) +
@@ -157,5 +172,21 @@ void DecomposedMpm2D::owned_to_local(const std::vector<double>& owned, int compo
     for (std::size_t d = 0; d < c; ++d) local[l * c + d] = a[Impl::dof * l + d];
   petsc_check(VecRestoreArrayRead(s.local, &a), "VecRestoreArrayRead");
 }
+
+#define FRICTHERM_INSTANTIATE_TRANSFER(D)                                                              \
+  template MPI_Comm DecomposedMpm<D>::communicator() const;                                            \
+  template int DecomposedMpm<D>::particle_scalar_index(const std::string&) const;                      \
+  template std::vector<double> DecomposedMpm<D>::Impl::scalar_values() const;                          \
+  template std::vector<double> DecomposedMpm<D>::particle_scalar(int) const;                           \
+  template void DecomposedMpm<D>::set_particle_scalar(int, const std::vector<double>&);                \
+  template DecomposedLocalParticles DecomposedMpm<D>::local_particle_data() const;                     \
+  template const DecomposedMpm<D>::Stencils& DecomposedMpm<D>::current_stencils();                     \
+  template int DecomposedMpm<D>::local_node_count() const;                                             \
+  template const std::vector<int>& DecomposedMpm<D>::owned_local_nodes() const;                        \
+  template void DecomposedMpm<D>::sum_to_owned(const std::vector<double>&, int, std::vector<double>&); \
+  template void DecomposedMpm<D>::owned_to_local(const std::vector<double>&, int, std::vector<double>&);
+FRICTHERM_INSTANTIATE_TRANSFER(2)
+FRICTHERM_INSTANTIATE_TRANSFER(3)
+#undef FRICTHERM_INSTANTIATE_TRANSFER
 
 }  // namespace frictherm::mechanics

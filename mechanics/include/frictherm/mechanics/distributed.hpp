@@ -1,10 +1,12 @@
 #pragma once
-// Decomposed 2D MPM on PETSc (issue 16, item 1): the structured grid as a DMDA whose points are the
-// grid's nodes (the serial Grid<2>'s nodes, its ghost layer included), particles in a DMSwarm of type
-// DMSWARM_PIC with the DMDA as cell DM, and one explicit USL step of linear-elastic materials with
-// optional multimaterial contact and frictional heating (Nairn, Bardenhagen & Smith 2018), fixed
-// grid faces and gravity, written as a list of named phases in which the three exchanges are phases
-// of their own (docs/distributed.md):
+// Decomposed MPM on PETSc, 2D and 3D (issue 16, "Beyond one machine"): the structured grid as a DMDA
+// (DMDACreate2d / DMDACreate3d) whose points are the grid's nodes (the serial Grid<Dim>'s nodes, its
+// ghost layer included), particles in a DMSwarm of type DMSWARM_PIC with the DMDA as cell DM, and one
+// explicit USL step of linear-elastic materials with optional multimaterial contact and frictional
+// heating (Nairn, Bardenhagen & Smith 2018), fixed grid faces (the 4 faces in 2D, the 6 in 3D) and
+// gravity, written as a list of named phases in which the exchanges are phases of their own
+// (docs/distributed.md). DecomposedMpm<Dim> is instantiated for Dim = 2 and 3; DecomposedMpm2D,
+// DecomposedParticle, DecomposedOptions and DecomposedStencils name the 2D ones.
 //
 //   particle_to_grid       local: per velocity field m_i, p_i, f_i (N·1–3) and, with contact,
 //                          Σ S m x (or the displacement form), Ω_i, g_i (N·4–6, 9)
@@ -21,7 +23,8 @@
 //   ghost_velocities       exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get the totals' v_i, a_i
 //   fields_to_ghosts       exchange (PetscSF): per-material v_i, a_i back to the ranks that sent the sums
 //   grid_to_particle       FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i (the particle's own field)
-//   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ (material.hpp)
+//   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ
+//                          (material.hpp's linear_elastic_update<Dim>)
 //   migrate                exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
 //
 // Velocity fields: without contact every material shares one field (as the serial Simulation);
@@ -29,18 +32,19 @@
 // per-material data: the DMDA's total is that material's field. Only at shared nodes that two or
 // more materials reach do per-material values travel, as (node, material) entries over a PetscSF
 // rebuilt each step (mechanics/src/distributed/sparse_exchange.cpp). Each rank still stores every
-// field densely over its ghosted box (materials × 10 doubles per node): fine for a few materials,
-// not for a PBX with hundreds of grains (per-material boxes, as the serial step has, are the next
-// step; docs/distributed.md).
+// field densely over its ghosted box (materials × (2 + 4·Dim) doubles per node): fine for a few
+// materials, not for a PBX with hundreds of grains (per-material boxes, as the serial step has, are
+// the next step; docs/distributed.md).
 //
 // Ownership: a particle belongs to the rank that owns the grid node nearest to it (the node's dual
-// cell [x_n − h/2, x_n + h/2)). With that rule the stencil of the linear, uGIMP (l_p ≤ h/2) and
-// quadratic B-spline kernels reaches one node beyond the nearest node on either side, so the DMDA's
-// stencil width is 1; it is measured from the kernel's own evaluation (stencil_reach), not assumed.
-// The extended B-spline is refused (its weights are built per body, not per particle).
+// cell [x_n − h/2, x_n + h/2) along every axis). With that rule the stencil of the linear, uGIMP
+// (l_p ≤ h/2) and quadratic B-spline kernels reaches one node beyond the nearest node on either side
+// along each axis, so the DMDA's stencil width is 1 in 2D and 3D; it is measured from the kernel's
+// own evaluation (stencil_reach), not assumed. The extended B-spline is refused (its weights are
+// built per body, not per particle).
 // Contact is resolved at owned nodes only, after the one exchange that completes their sums, by the
-// serial module's node-local code (mechanics/src/contact_pair.hpp).
-// For coupled physics (the coupling's decomposed heat conduction) the run also carries named
+// serial module's node-local code (mechanics/src/contact_pair.hpp, templated on Dim).
+// For coupled physics (the coupling's decomposed heat conduction, 2D) the run also carries named
 // per-particle scalars in the swarm and offers the step's maps without physics: the particles' current
 // stencils in local node numbering, local node values summed into their owners, owner values to the
 // ghosts (transfer.cpp).
@@ -78,23 +82,9 @@ class DecomposedPetscSession {
 
 /// Nodes beyond the particle's nearest node that a kernel's stencil reaches, the largest over a
 /// cell (sampled on both sides of every break point of the kernel's node choice): the DMDA's
-/// stencil width. lp = h/2 for uGIMP (its widest particle).
+/// stencil width (the same along every axis: the stencils are tensor products). lp = h/2 for uGIMP
+/// (its widest particle).
 int stencil_reach(ShapeKind kind);
-
-/// One particle as given to and gathered from the decomposed run.
-struct DecomposedParticle {
-  std::int64_t id = 0;   // global id, kept through migration
-  double mass = 0.0;     // m_p (kg per unit thickness in 2D)
-  double volume = 0.0;   // V_p, current
-  Vec<2> position = Vec<2>::Zero();
-  Vec<2> velocity = Vec<2>::Zero();
-  Vec<2> half_size = Vec<2>::Zero();  // uGIMP half-widths l_p (fixed)
-  Mat<2> stress = Mat<2>::Zero();
-  double stress_zz = 0.0;
-  int material = 0;  // index into the materials given to DecomposedMpm2D
-  /// Values of DecomposedOptions::particle_scalars, in that order (empty: zeros).
-  std::vector<double> scalars;
-};
 
 /// Settings of one material pair in contact (as Simulation::set_contact_pair).
 struct DecomposedContactPair {
@@ -102,38 +92,11 @@ struct DecomposedContactPair {
   ContactPairSettings settings;
 };
 
-struct DecomposedOptions {
-  ShapeKind shape = ShapeKind::linear;
-  Analysis analysis = Analysis::plane_strain;
-  double thickness = 1.0;           // 2D out-of-plane thickness (m), as SimulationOptions::thickness
-  Vec<2> gravity = Vec<2>::Zero();  // body force per unit mass (m/s²)
-  std::vector<FixedFace> fixed_faces;  // grid faces with velocity components fixed to 0 (Simulation::fix_face)
-  /// Multimaterial contact (one velocity field per material), as Simulation::enable_contact and
-  /// set_contact_pair. Supported: multimaterial pairs with any friction law, separation position,
-  /// displacement or velocity_only; refused: penalty pairs, extent separation, regularisation.
-  bool contact = false;
-  ContactOptions contact_options;
-  std::vector<DecomposedContactPair> contact_pairs;
-  /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
-  /// one swarm field, migrated with the particles, untouched by the step.
-  std::vector<std::string> particle_scalars;
-};
-
-/// The shape functions of this rank's particles at their current positions (after the last step's
-/// migration), in the local node numbering of the rank's ghosted box (x fastest): particle k (swarm
-/// order) has entries [first[k], first[k+1]) with node, S_ip and G_ip (1/m), in stencil order.
-struct DecomposedStencils {
-  std::vector<int> first;
-  std::vector<int> node;
-  std::vector<double> S;
-  std::vector<Vec<2>> G;
-};
-
-/// This rank's particles in swarm order (the order of DecomposedStencils and particle scalars).
+/// This rank's particles in swarm order (the order of the stencils and particle scalars).
 struct DecomposedLocalParticles {
   std::vector<std::int64_t> id;
-  std::vector<double> mass;    // m_p (kg per unit thickness in 2D)
-  std::vector<double> volume;  // V_p (m² per unit thickness in 2D)
+  std::vector<double> mass;    // m_p (kg; kg per unit thickness in 2D)
+  std::vector<double> volume;  // V_p (m³; m² per unit thickness in 2D)
   std::vector<int> material;
 };
 
@@ -146,7 +109,7 @@ struct DecomposedContactStats {
 struct DecomposedTraffic {
   long steps = 0;
   long ghost_nodes = 0;               // nodes of the local (ghosted) vector this rank does not own
-  int values_per_node = 0;            // doubles per node in each grid exchange
+  int values_per_node = 0;            // doubles per node in each grid exchange (1 + 2·Dim)
   long particles_sent = 0;            // by migration, over all steps
   long particles_received = 0;
   int particle_bytes = 0;             // payload per migrated particle (all swarm fields)
@@ -158,39 +121,87 @@ struct DecomposedTraffic {
   std::array<double, 14> phase_seconds{};  // per phase, in phase_names() order
 };
 
-class DecomposedMpm2D {
+template <int Dim>
+class DecomposedMpm {
+  static_assert(Dim == 2 || Dim == 3, "the decomposed MPM step is 2D or 3D");
+
  public:
-  /// Collective over comm. The grid is the serial Grid<2> (nodes −1 … cells+1 per direction);
+  /// One particle as given to and gathered from the decomposed run.
+  struct Particle {
+    std::int64_t id = 0;   // global id, kept through migration
+    double mass = 0.0;     // m_p (kg; kg per unit thickness in 2D)
+    double volume = 0.0;   // V_p, current
+    Vec<Dim> position = Vec<Dim>::Zero();
+    Vec<Dim> velocity = Vec<Dim>::Zero();
+    Vec<Dim> half_size = Vec<Dim>::Zero();  // uGIMP half-widths l_p (fixed)
+    Mat<Dim> stress = Mat<Dim>::Zero();
+    double stress_zz = 0.0;  // 2D plane strain σ_zz; unused (0) in 3D
+    int material = 0;        // index into the materials given to DecomposedMpm
+    /// Values of Options::particle_scalars, in that order (empty: zeros).
+    std::vector<double> scalars;
+  };
+
+  struct Options {
+    ShapeKind shape = ShapeKind::linear;
+    /// 2D: plane_strain or plane_stress; 3D: three_d (as the serial Simulation<3> sets it).
+    Analysis analysis = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
+    double thickness = 1.0;               // 2D out-of-plane thickness (m), as SimulationOptions::thickness; unused in 3D
+    Vec<Dim> gravity = Vec<Dim>::Zero();  // body force per unit mass (m/s²)
+    std::vector<FixedFace> fixed_faces;   // grid faces with velocity components fixed to 0 (Simulation::fix_face)
+    /// Multimaterial contact (one velocity field per material), as Simulation::enable_contact and
+    /// set_contact_pair. Supported: multimaterial pairs with any friction law, separation position,
+    /// displacement or velocity_only; refused: penalty pairs, extent separation, regularisation.
+    bool contact = false;
+    ContactOptions contact_options;
+    std::vector<DecomposedContactPair> contact_pairs;
+    /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
+    /// one swarm field, migrated with the particles, untouched by the step.
+    std::vector<std::string> particle_scalars;
+  };
+
+  /// The shape functions of this rank's particles at their current positions (after the last step's
+  /// migration), in the local node numbering of the rank's ghosted box (x fastest, then y, then z):
+  /// particle k (swarm order) has entries [first[k], first[k+1]) with node, S_ip and G_ip (1/m), in
+  /// stencil order.
+  struct Stencils {
+    std::vector<int> first;
+    std::vector<int> node;
+    std::vector<double> S;
+    std::vector<Vec<Dim>> G;
+  };
+
+  /// Collective over comm. The grid is the serial Grid<Dim> (nodes −1 … cells+1 per direction);
   /// PETSc must be initialised. Throws std::invalid_argument for a material other than
-  /// linear_elastic, for the extended B-spline and for unsupported contact settings.
-  DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const std::vector<Material>& materials,
-                  const DecomposedOptions& options);
+  /// linear_elastic, for the extended B-spline, an analysis that does not fit Dim and for
+  /// unsupported contact settings.
+  DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const std::vector<Material>& materials, const Options& options);
   /// One material.
-  DecomposedMpm2D(MPI_Comm comm, const Grid<2>& grid, const Material& material, const DecomposedOptions& options);
-  ~DecomposedMpm2D();
-  DecomposedMpm2D(const DecomposedMpm2D&) = delete;
-  DecomposedMpm2D& operator=(const DecomposedMpm2D&) = delete;
+  DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const Material& material, const Options& options);
+  ~DecomposedMpm();
+  DecomposedMpm(const DecomposedMpm&) = delete;
+  DecomposedMpm& operator=(const DecomposedMpm&) = delete;
 
   /// Collective, once: each rank passes any particles (ids unique over all ranks); they are
   /// migrated to their owners. Every particle must lie inside the grid's physical region.
-  void add_particles(const std::vector<DecomposedParticle>& particles);
+  void add_particles(const std::vector<Particle>& particles);
 
   /// One USL step of size dt (collective): the phases listed above, in that order.
   void step(double dt);
   static const std::array<const char*, 14>& phase_names();
 
   int stencil_width() const;
-  /// DMDA processes per direction (m, n) and this rank's owned node range [begin, end) per direction
-  /// in DMDA indices (= serial lattice index + Grid<2>::ghost).
-  std::array<int, 2> processes() const;
-  std::array<int, 4> owned_nodes() const;
+  /// DMDA processes per direction and this rank's owned node range [begin, end) per direction
+  /// (x begin, x end, y begin, y end[, z begin, z end]) in DMDA indices (= serial lattice index +
+  /// Grid<Dim>::ghost).
+  std::array<int, Dim> processes() const;
+  std::array<int, 2 * Dim> owned_nodes() const;
   std::size_t local_particles() const;
   const DecomposedTraffic& traffic() const;
 
   /// Collective reductions over all ranks.
   long long global_particles() const;
   double total_mass() const;
-  Vec<2> total_momentum() const;
+  Vec<Dim> total_momentum() const;
   double total_momentum_scale() const;  // Σ m_p |v_p|
   /// Velocity fields per node (1 without contact, one per material with it).
   int velocity_fields() const;
@@ -202,13 +213,13 @@ class DecomposedMpm2D {
   /// Collective: the last step's contact counters summed over ranks.
   DecomposedContactStats contact_stats() const;
   /// Collective: every particle of every rank, sorted by id, on every rank.
-  std::vector<DecomposedParticle> gather() const;
+  std::vector<Particle> gather() const;
 
   // ---- Transfers for coupled physics (transfer.cpp): the particle–grid maps of the step, without
   // any physics of their own, so that a caller (the coupling's decomposed heat conduction) can
   // scatter particle values to the nodes and read node values back on the particles. ----
   MPI_Comm communicator() const;
-  /// Index of a name in DecomposedOptions::particle_scalars; std::invalid_argument if absent.
+  /// Index of a name in Options::particle_scalars; std::invalid_argument if absent.
   int particle_scalar_index(const std::string& name) const;
   /// This rank's values of one particle scalar, in swarm order; set them (same size) back.
   std::vector<double> particle_scalar(int index) const;
@@ -216,7 +227,7 @@ class DecomposedMpm2D {
   DecomposedLocalParticles local_particle_data() const;
   /// S_ip and G_ip at the particles' current positions, evaluated once after each step (the serial
   /// Stencil, as the step evaluates them).
-  const DecomposedStencils& current_stencils();
+  const Stencils& current_stencils();
   /// Nodes of the ghosted box (the local numbering) and, per owned node (x fastest over
   /// owned_nodes()), its local node.
   int local_node_count() const;
@@ -224,7 +235,7 @@ class DecomposedMpm2D {
   /// Collective: values on the ghosted box (`components` per node, ≤ max_transfer_components) summed
   /// over every rank holding the node into its owner (DMLocalToGlobal, ADD_VALUES): `owned` gets,
   /// per owned node, the sum over ranks.
-  static constexpr int max_transfer_components = 5;
+  static constexpr int max_transfer_components = 1 + 2 * Dim;  // the DMDA's values per node
   void sum_to_owned(const std::vector<double>& local, int components, std::vector<double>& owned);
   /// Collective: owned node values to every rank holding the node (DMGlobalToLocal, INSERT_VALUES):
   /// `local` gets the owners' values on the whole ghosted box.
@@ -234,5 +245,14 @@ class DecomposedMpm2D {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Explicitly instantiated for Dim = 2 and 3 in mechanics/src/distributed/.
+
+/// The 2D names (the first decomposed step was 2D only; the coupling's decomposed heat uses them).
+using DecomposedMpm2D = DecomposedMpm<2>;
+using DecomposedMpm3D = DecomposedMpm<3>;
+using DecomposedParticle = DecomposedMpm<2>::Particle;
+using DecomposedOptions = DecomposedMpm<2>::Options;
+using DecomposedStencils = DecomposedMpm<2>::Stencils;
 
 }  // namespace frictherm::mechanics
