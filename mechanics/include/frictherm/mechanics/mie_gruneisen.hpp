@@ -90,12 +90,28 @@ FRICTHERM_ALWAYS_INLINE void mie_gruneisen_reference_part(const MieGruneisenPara
     const double d = 1.0 - eta * (m.S1 + m.S2 * eta);
     const double dd = -(m.S1 + 2.0 * m.S2 * eta);
     const double g = 1.0 - 0.5 * m.gamma0 * eta;
-    f = rc2 * eta * g / (d * d);
-    df = rc2 * ((1.0 - m.gamma0 * eta) / (d * d) - 2.0 * eta * g * dd / (d * d * d));
+    // One division: the stress update of a PBX is bound by the divider, not by multiplications.
+    const double inv_d = 1.0 / d, inv_d2 = inv_d * inv_d;
+    f = rc2 * eta * g * inv_d2;
+    df = rc2 * ((1.0 - m.gamma0 * eta) * inv_d2 - 2.0 * eta * g * dd * inv_d2 * inv_d);
   } else {  // tension: ρ0 C0² μ, μ = 1/J − 1, dμ/dη = 1/J²
-    f = rc2 * (1.0 / J - 1.0);
-    df = rc2 / (J * J);
+    const double inv_J = 1.0 / J;
+    f = rc2 * (inv_J - 1.0);
+    df = rc2 * inv_J * inv_J;
   }
+}
+
+/// The bulk sound speed squared c² = (J²/ρ0)(∂p/∂η|_e + γ0 p), negative values clipped to 0 (a state
+/// without a real sound speed), and the dilatational wave speed sqrt(c² + (4/3) G J/ρ0) from it.
+/// inv_density = 1/ρ0.
+FRICTHERM_ALWAYS_INLINE double mie_gruneisen_sound_speed_squared(const MieGruneisenParams& m, double inv_density,
+                                                                 double J, double df, double p) {
+  const double c2 = J * J * inv_density * (df + m.gamma0 * p);
+  return c2 > 0.0 ? c2 : 0.0;
+}
+FRICTHERM_ALWAYS_INLINE double mie_gruneisen_wave_speed_from(const MieGruneisenParams& m, double inv_density,
+                                                             double J, double c2) {
+  return std::sqrt(c2 + 4.0 / 3.0 * m.shear_modulus * J * inv_density);
 }
 
 /// Mie-Grüneisen pressure and bulk sound speed at volume ratio J and specific internal energy e (J/kg).
@@ -106,15 +122,17 @@ inline MieGruneisenState mie_gruneisen_eos(const MieGruneisenParams& m, double J
   MieGruneisenState s;
   s.pressure = f + m.gamma0 * m.density * e;
   s.dp_deta = df;
-  const double c2 = J * J / m.density * (df + m.gamma0 * s.pressure);
-  s.sound_speed = c2 > 0.0 ? std::sqrt(c2) : 0.0;
+  s.sound_speed = std::sqrt(mie_gruneisen_sound_speed_squared(m, 1.0 / m.density, J, df, s.pressure));
   return s;
 }
 
 /// Dilatational wave speed for the CFL time step: sqrt(c² + (4/3) G/ρ) with ρ = ρ0/J.
 inline double mie_gruneisen_wave_speed(const MieGruneisenParams& m, double J, double e) {
-  const double c = mie_gruneisen_eos(m, J, e).sound_speed;
-  return std::sqrt(c * c + 4.0 / 3.0 * m.shear_modulus * J / m.density);
+  double f = 0.0, df = 0.0;
+  mie_gruneisen_reference_part(m, J, f, df);
+  const double inv_density = 1.0 / m.density;
+  const double p = f + m.gamma0 * m.density * e;
+  return mie_gruneisen_wave_speed_from(m, inv_density, J, mie_gruneisen_sound_speed_squared(m, inv_density, J, df, p));
 }
 
 /// One step of plastic flow: equivalent plastic strain increment Δε̄p and plastic work per unit
@@ -139,9 +157,9 @@ FRICTHERM_ALWAYS_INLINE J2Increment j2_deviatoric_update(const Mat<Dim>& L, doub
   const double sy = yield_stress + hardening * plastic_strain;
   if (!(sy < std::numeric_limits<double>::infinity())) return inc;
   const double ss = s.squaredNorm() + (Dim == 2 ? s_zz * s_zz : 0.0);
-  const double q = std::sqrt(1.5 * ss);
   const double h = 3.0 * G + hardening;
-  if (q <= sy || !(h > 0.0)) return inc;
+  if (1.5 * ss <= sy * sy || !(h > 0.0)) return inc;  // q <= σ_y (sy >= 0): no square root while elastic
+  const double q = std::sqrt(1.5 * ss);
   const double dep = (q - sy) / h;
   const double scale = 1.0 - 3.0 * G * dep / q;
   s *= scale;
@@ -149,6 +167,25 @@ FRICTHERM_ALWAYS_INLINE J2Increment j2_deviatoric_update(const Mat<Dim>& L, doub
   inc.plastic_strain = dep;
   inc.plastic_work = (q - 3.0 * G * dep) * dep;  // = σ_y(ε̄p + Δε̄p) Δε̄p
   return inc;
+}
+
+/// The end of a step's update, shared by mie_gruneisen_update and its plane-strain scalar form: the
+/// specific energy by the trapezoidal pressure work −½(p_n + p_{n+1}) ΔJ/ρ0 plus the plastic work
+/// (J/ρ0) σ:Δε_p, solved in closed form since p = f(J) + γ0 ρ0 e is linear in e; returns p_{n+1} and,
+/// if asked, the wave speed of the new state (as mie_gruneisen_wave_speed). wp: σ:Δε_p per unit
+/// current volume. Divisions are few on purpose: the PBX stress update is bound by the divider.
+FRICTHERM_ALWAYS_INLINE double mie_gruneisen_energy_and_pressure(const MieGruneisenParams& m, double J, double J_old,
+                                                                 double p_old, double wp, double& energy,
+                                                                 double* wave_speed) {
+  double f = 0.0, df = 0.0;
+  mie_gruneisen_reference_part(m, J, f, df);
+  const double inv_density = 1.0 / m.density;  // hoisted out of particle loops over one material
+  const double dJ = J - J_old;
+  energy = (energy - (0.5 * (p_old + f) * dJ - wp * J) * inv_density) / (1.0 + 0.5 * m.gamma0 * dJ);
+  const double p = f + m.gamma0 * m.density * energy;
+  if (wave_speed)
+    *wave_speed = mie_gruneisen_wave_speed_from(m, inv_density, J, mie_gruneisen_sound_speed_squared(m, inv_density, J, df, p));
+  return p;
 }
 
 /// Status of one particle update.
@@ -177,7 +214,7 @@ FRICTHERM_ALWAYS_INLINE MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& 
   if (!(J > min_J)) return MieGruneisenStatus::beyond_hugoniot_limit;  // also J <= 0, NaN
   const double J_old = J / (Mat<Dim>::Identity() + dt * L).determinant();
   const double zz = Dim == 2 ? sigma_zz : 0.0;
-  const double p_old = -(sigma.trace() + zz) / 3.0;
+  const double p_old = -(sigma.trace() + zz) * (1.0 / 3.0);
   Mat<Dim> s = sigma;
   s.diagonal().array() += p_old;
   double s_zz = zz + p_old;
@@ -185,17 +222,7 @@ FRICTHERM_ALWAYS_INLINE MieGruneisenStatus mie_gruneisen_update(const Mat<Dim>& 
       j2_deviatoric_update<Dim>(L, dt, m.shear_modulus, m.yield_stress, m.hardening_modulus, plastic_strain, s, s_zz);
   plastic_strain += inc.plastic_strain;
   plastic_work = inc.plastic_work;
-  double f = 0.0, df = 0.0;
-  mie_gruneisen_reference_part(m, J, f, df);
-  const double dJ = J - J_old;
-  energy = (energy - 0.5 * (p_old + f) * dJ / m.density + inc.plastic_work * J / m.density) /
-           (1.0 + 0.5 * m.gamma0 * dJ);
-  const double p = f + m.gamma0 * m.density * energy;
-  if (wave_speed) {  // as mie_gruneisen_wave_speed(m, J, energy), from the parts computed here
-    const double c2 = J * J / m.density * (df + m.gamma0 * p);
-    const double c = c2 > 0.0 ? std::sqrt(c2) : 0.0;
-    *wave_speed = std::sqrt(c * c + 4.0 / 3.0 * m.shear_modulus * J / m.density);
-  }
+  const double p = mie_gruneisen_energy_and_pressure(m, J, J_old, p_old, inc.plastic_work, energy, wave_speed);
   sigma = s;
   sigma.diagonal().array() -= p;
   sigma_zz = Dim == 2 ? s_zz - p : 0.0;

@@ -56,7 +56,7 @@ FRICTHERM_ALWAYS_INLINE MieGruneisenStatus mie_gruneisen_update_plane_strain(
   if (!(J > min_J)) return MieGruneisenStatus::beyond_hugoniot_limit;
   const double J_old = J / det_A;
   const double zz = sigma_zz;
-  const double p_old = -(sigma(0, 0) + sigma(1, 1) + zz) / 3.0;
+  const double p_old = -(sigma(0, 0) + sigma(1, 1) + zz) * (1.0 / 3.0);
   double s00 = sigma(0, 0) + p_old, s01 = sigma(0, 1), s10 = sigma(1, 0), s11 = sigma(1, 1) + p_old;
   double s_zz = zz + p_old;
 
@@ -82,9 +82,9 @@ FRICTHERM_ALWAYS_INLINE MieGruneisenStatus mie_gruneisen_update_plane_strain(
   const double sy = m.yield_stress + m.hardening_modulus * plastic_strain;
   if (sy < std::numeric_limits<double>::infinity()) {
     const double ss = ((s00 * s00 + s01 * s01) + (s10 * s10 + s11 * s11)) + s_zz * s_zz;
-    const double q = std::sqrt(1.5 * ss);
     const double h = 3.0 * G + m.hardening_modulus;
-    if (!(q <= sy) && h > 0.0) {
+    if (!(1.5 * ss <= sy * sy) && h > 0.0) {
+      const double q = std::sqrt(1.5 * ss);
       dep = (q - sy) / h;
       const double scale = 1.0 - 3.0 * G * dep / q;
       s00 *= scale, s01 *= scale, s10 *= scale, s11 *= scale;
@@ -96,14 +96,7 @@ FRICTHERM_ALWAYS_INLINE MieGruneisenStatus mie_gruneisen_update_plane_strain(
   plastic_work = wp;
 
   // Pressure and energy (mie_gruneisen_update).
-  double f = 0.0, df = 0.0;
-  mie_gruneisen_reference_part(m, J, f, df);
-  const double dJ = J - J_old;
-  energy = (energy - 0.5 * (p_old + f) * dJ / m.density + wp * J / m.density) / (1.0 + 0.5 * m.gamma0 * dJ);
-  const double p = f + m.gamma0 * m.density * energy;
-  const double c2 = J * J / m.density * (df + m.gamma0 * p);
-  const double c = c2 > 0.0 ? std::sqrt(c2) : 0.0;
-  wave_speed = std::sqrt(c * c + 4.0 / 3.0 * m.shear_modulus * J / m.density);
+  const double p = mie_gruneisen_energy_and_pressure(m, J, J_old, p_old, wp, energy, &wave_speed);
   sigma(0, 0) = s00 - p;
   sigma(1, 0) = s10;
   sigma(0, 1) = s01;
