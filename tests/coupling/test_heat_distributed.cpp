@@ -13,7 +13,7 @@
 //       1e-12 of the stripe's 50 K amplitude of the serial Coupler's, the same sub-steps, heat
 //       content kept to 1e-14; once with every node an unknown, once with sliver nodes that are not
 //       (the lumped gradients G');
-//   (c) work on a node that is no thermal unknown is refused on every rank.
+//   (c) work on a node with no thermal unknown next to it is refused on every rank.
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
 #include "frictherm/coupling/coupler.hpp"
 #include "frictherm/coupling/decomposed_heat.hpp"
@@ -218,7 +218,7 @@ TEST_P(DecomposedConduction, EqualsTheSerialConduction) {
 INSTANTIATE_TEST_SUITE_P(Edges, DecomposedConduction, ::testing::Values(false, true),
                          [](const auto& p) { return std::string(p.param ? "slivers" : "off_grid_lines"); });
 
-// ---- (c) work on a node that is no unknown: refused on every rank ----
+// ---- (c) work on a node with no unknown next to it: refused on every rank ----
 TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
   const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
@@ -230,7 +230,8 @@ TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
   fc::DecomposedHeatOptions ho;
   ho.materials = {{true, 1100.0, 0.45}};
   fc::DecomposedHeat heat(split, ho);
-  // The owned node at DMDA index (0, 0) (the grid's ghost corner) holds no mass: work there on rank 0.
+  // The owned node at DMDA index (0, 0) (the grid's ghost corner) and its neighbours hold no mass: work
+  // there on rank 0 has nowhere to go.
   std::vector<double> joules(split.owned_local_nodes().size(), 0.0);
   const std::array<int, 4> box = split.owned_nodes();
   if (box[0] == 0 && box[2] == 0) joules[0] = 1.0;
