@@ -148,6 +148,9 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   kept_node_.clear();
   kept_S_.clear();
   kept_G_.clear();
+  kept_node_.reserve(st.node.size());  // at most every stencil entry is kept
+  kept_S_.reserve(st.node.size());
+  kept_G_.reserve(Dim * st.node.size());
   auto G = [this](std::size_t a) { return GMap(kept_G_.data() + Dim * a); };
   conductance_.assign(np, 0.0);
   local_.assign(2 * nl, 0.0);
@@ -163,7 +166,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
           s_kept += st.S[ua];
           kept_node_.push_back(i);
           kept_S_.push_back(st.S[ua]);
-          kept_G_.insert(kept_G_.end(), st.G[ua].data(), st.G[ua].data() + Dim);
+          for (int d = 0; d < Dim; ++d) kept_G_.push_back(st.G[ua][d]);
         } else {
           g_dropped += st.G[ua];
         }
