@@ -144,18 +144,19 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
 
   // Pass 2: each heat-holding particle's kept nodes (unknowns), the lumped gradients G' and the two
   // bounds of λ_max(M⁻¹K) of ExplicitConduction::keep (Gershgorin row sums and Cauchy–Schwarz).
-  kept_first_.assign(1, 0);
-  kept_node_.clear();
-  kept_S_.clear();
-  kept_G_.clear();
-  kept_node_.reserve(st.node.size());  // at most every stencil entry is kept
-  kept_S_.reserve(st.node.size());
-  kept_G_.reserve(Dim * st.node.size());
+  const std::size_t entries = st.node.size();  // at most every stencil entry is kept
+  kept_first_.resize(np + 1);
+  kept_first_[0] = 0;
+  kept_node_.resize(entries);
+  kept_S_.resize(entries);
+  kept_G_.resize(Dim * entries);
+  kept_norm_.resize(entries);
   auto G = [this](std::size_t a) { return GMap(kept_G_.data() + Dim * a); };
   conductance_.assign(np, 0.0);
   local_.assign(2 * nl, 0.0);
+  std::size_t kept = 0;
   for (std::size_t k = 0; k < np; ++k) {
-    const std::size_t begin = kept_node_.size();
+    const std::size_t begin = kept;
     if (capacity_[k] > 0.0) {
       double s_kept = 0.0;
       Vec g_dropped = Vec::Zero();
@@ -164,15 +165,16 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
         const int i = st.node[ua];
         if (is_unknown(local_M[static_cast<std::size_t>(i)])) {
           s_kept += st.S[ua];
-          kept_node_.push_back(i);
-          kept_S_.push_back(st.S[ua]);
-          for (int d = 0; d < Dim; ++d) kept_G_.push_back(st.G[ua][d]);
+          kept_node_[kept] = i;
+          kept_S_[kept] = st.S[ua];
+          G(kept) = st.G[ua];
+          ++kept;
         } else {
           g_dropped += st.G[ua];
         }
       }
       const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
-      const std::size_t end = kept_node_.size();
+      const std::size_t end = kept;
       if (m.conductivity > 0.0 && end > begin && s_kept > 0.0) {
         if (end - begin < static_cast<std::size_t>(st.first[k + 1] - st.first[k]))
           for (std::size_t a = begin; a < end; ++a) G(a) += (kept_S_[a] / s_kept) * g_dropped;  // lump
@@ -180,17 +182,18 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
         double gsum = 0.0, g2m = 0.0;
         for (std::size_t a = begin; a < end; ++a) {
           const double g = G(a).norm();
+          kept_norm_[a] = g;
           gsum += g;
           g2m += g * g / local_M[static_cast<std::size_t>(kept_node_[a])];
         }
         for (std::size_t a = begin; a < end; ++a) {
           const auto i = static_cast<std::size_t>(kept_node_[a]);
-          local_[2 * i] += conductance_[k] * G(a).norm() * gsum;
+          local_[2 * i] += conductance_[k] * kept_norm_[a] * gsum;
           local_[2 * i + 1] += conductance_[k] * g2m;
         }
       }
     }
-    kept_first_.push_back(static_cast<int>(kept_node_.size()));
+    kept_first_[k + 1] = static_cast<int>(kept);
   }
   std::vector<double> bounds;
   mpm.sum_to_owned(local_, 2, bounds);
@@ -336,7 +339,8 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
 }
 
 DecomposedSnapshot DecomposedHeat::snapshot() const {
-  mechanics::DecomposedLocalParticles P = local_particles();
+  mechanics::DecomposedLocalParticles P =
+      mpm3_ ? mpm3_->local_particle_data(true) : mpm2_->local_particle_data(true);  // with x_p, v_p
   DecomposedSnapshot s;
   s.id = std::move(P.id);
   s.position = std::move(P.position);
@@ -350,7 +354,7 @@ template <int Dim>
 void DecomposedHeat::hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker,
                                   const std::string& reference, double time) const {
   // This rank's particles as the serial tracker reads them (x_p, l_p, m_p, V_p, material, T_p).
-  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
+  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data(true);
   const std::vector<double> T = mpm.particle_scalar(scalar_);
   const std::vector<double> T0 = mpm.particle_scalar(mpm.particle_scalar_index(reference));
   mechanics::Particles<Dim> local;

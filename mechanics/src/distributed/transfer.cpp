@@ -65,7 +65,7 @@ void DecomposedMpm<Dim>::set_particle_scalar(int index, const std::vector<double
 }
 
 template <int Dim>
-DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
+DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data(bool kinematics) const {
   SwarmFields f(impl_->swarm);
   DecomposedLocalParticles out;
   const auto n = static_cast<std::size_t>(f.n);
@@ -73,9 +73,11 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
   out.mass.assign(f.mass, f.mass + n);
   out.volume.assign(f.volume, f.volume + n);
   out.material.assign(f.material, f.material + n);
-  out.position.assign(f.x, f.x + Dim * n);
-  out.velocity.assign(f.velocity, f.velocity + Dim * n);
-  out.half_size.assign(f.half_size, f.half_size + Dim * n);
+  if (kinematics) {
+    out.position.assign(f.x, f.x + Dim * n);
+    out.velocity.assign(f.velocity, f.velocity + Dim * n);
+    out.half_size.assign(f.half_size, f.half_size + Dim * n);
+  }
   return out;
 }
 
@@ -192,7 +194,7 @@ void DecomposedMpm<Dim>::owned_to_local(const std::vector<double>& owned, int co
   template std::vector<double> DecomposedMpm<D>::Impl::scalar_values() const;                          \
   template std::vector<double> DecomposedMpm<D>::particle_scalar(int) const;                           \
   template void DecomposedMpm<D>::set_particle_scalar(int, const std::vector<double>&);                \
-  template DecomposedLocalParticles DecomposedMpm<D>::local_particle_data() const;                     \
+  template DecomposedLocalParticles DecomposedMpm<D>::local_particle_data(bool) const;                     \
   template const DecomposedMpm<D>::Stencils& DecomposedMpm<D>::current_stencils();                     \
   template int DecomposedMpm<D>::local_node_count() const;                                             \
   template const std::vector<int>& DecomposedMpm<D>::owned_local_nodes() const;                        \

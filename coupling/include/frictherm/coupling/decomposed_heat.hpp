@@ -102,9 +102,10 @@ class DecomposedHeat {
   DecomposedHeatBooks books_;
   // Per window, this rank's heat-holding particles' kept nodes (unknowns), flat: particle k's entries
   // [kept_first_[k], kept_first_[k+1]) with local node, S_ip and the lumped G'_ip (Dim values per
-  // entry); V_p k_p per particle.
+  // entry; sized for every stencil entry, the first kept_first_.back() used) and |G'_ip|; V_p k_p per
+  // particle.
   std::vector<int> kept_first_, kept_node_;
-  std::vector<double> kept_S_, kept_G_, conductance_, capacity_;
+  std::vector<double> kept_S_, kept_G_, kept_norm_, conductance_, capacity_;
   std::vector<double> local_, owned_, local_T_, force_;  // scratch
 };
 

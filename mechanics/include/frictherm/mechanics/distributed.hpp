@@ -98,8 +98,8 @@ struct DecomposedLocalParticles {
   std::vector<double> mass;    // m_p (kg; kg per unit thickness in 2D)
   std::vector<double> volume;  // V_p (m³; m² per unit thickness in 2D)
   std::vector<int> material;
-  /// x_p, v_p and the uGIMP half-widths l_p, Dim values per particle (hot spots and output of a
-  /// decomposed run read them without gathering every particle).
+  /// With local_particle_data(true): x_p, v_p and the uGIMP half-widths l_p, Dim values per particle
+  /// (hot spots and output of a decomposed run read them without gathering every particle).
   std::vector<double> position, velocity, half_size;
 };
 
@@ -227,7 +227,7 @@ class DecomposedMpm {
   /// This rank's values of one particle scalar, in swarm order; set them (same size) back.
   std::vector<double> particle_scalar(int index) const;
   void set_particle_scalar(int index, const std::vector<double>& values);
-  DecomposedLocalParticles local_particle_data() const;
+  DecomposedLocalParticles local_particle_data(bool kinematics = false) const;
   /// S_ip and G_ip at the particles' current positions, evaluated once after each step (the serial
   /// Stencil, as the step evaluates them).
   const Stencils& current_stencils();
