@@ -9,12 +9,20 @@
 // each phase, and each rank's ghost nodes and communication per step (the two grid exchanges, the
 // per-material entries at multi-material nodes, the migrated particles) in bytes. 2D strong scaling:
 // the same --cells at 1, 2, 4 ranks; weak scaling (--weak): the grid grows with the ranks so that
-// every rank keeps the particles of --cells at one rank. Asserts nothing.
+// every rank keeps the particles of --cells at one rank. 3D heated sliding block (case heated3d, built
+// with the coupling's decomposed part): the same scene run twice, mechanics only and coupled (frictional
+// heat and matrix-free conduction every step, DecomposedHeat), strong and weak as block3d; prints both
+// times per step, their ratio and the heat windows' grid exchanges per step and rank in bytes.
+// Asserts nothing.
 //
-//   mpirun -n 4 mechanics_distributed_scaling [--cells 200] [--steps 100] [--weak] [--cases block,sliding,block3d]
-//                                             [--cells3d 24]
+//   mpirun -n 4 mechanics_distributed_scaling [--cells 200] [--steps 100] [--weak]
+//                                             [--cases block,sliding,block3d,heated3d] [--cells3d 24]
+//                                             [--repeat 3]   (heated3d: interleaved pairs, smallest kept)
 #include "cpu_time.hpp"
 #include <frictherm/mechanics/distributed.hpp>
+#ifdef FRICTHERM_BENCH_DECOMPOSED_HEAT
+#include <frictherm/coupling/decomposed_heat.hpp>
+#endif
 
 #include <sys/resource.h>
 
@@ -22,6 +30,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -194,11 +203,143 @@ void run_block3d(const std::string& which, int nx, int n, int steps, int rank, i
   measure<3>(which, label, grid, mats, opt, particles, dt, steps, rank, ranks, static_cast<std::size_t>(count));
 }
 
+#ifdef FRICTHERM_BENCH_DECOMPOSED_HEAT
+// 3D heated sliding block: nx × ny × nz cells of 1 mm; base [1, nx−1] × [1, ny−1] × [0, nz/2] mm fixed
+// at z_min, block [0.2 W, 0.6 W] × [1, ny−1] × [nz/2, 3nz/4] mm sliding along x at 10 m/s, pressed by
+// g = 2e4 m/s² along −z, Coulomb μ = 0.3 (specified normal), 2³ uGIMP particles per cell; thermal: base
+// C = 100 J/(kg K), k = 50 W/(m K), block C = 150, k = 20 (the tests' values). Timed: `steps` steps
+// after one untimed, mechanics only, then the same scene coupled (step + DecomposedHeat::after_step).
+struct HeatedTimes {
+  double wall = 0.0, cpu = 0.0;  // slowest rank's wall, this rank's CPU (s)
+};
+
+HeatedTimes time_heated3d(const fm::Grid<3>& grid, const std::vector<fm::Material>& mats,
+                          const fm::DecomposedMpm3D::Options& opt, const std::vector<fm::DecomposedMpm3D::Particle>& all,
+                          double dt, int steps, int rank, bool coupled, std::vector<double>* report) {
+  fm::DecomposedMpm3D split(MPI_COMM_WORLD, grid, mats, opt);
+  std::vector<fm::DecomposedMpm3D::Particle> mine = rank == 0 ? all : std::vector<fm::DecomposedMpm3D::Particle>{};
+  if (!coupled)
+    for (auto& p : mine) p.scalars.clear();  // no temperature field in the mechanics-only swarm
+  split.add_particles(mine);
+  mine.clear();
+  mine.shrink_to_fit();
+  frictherm::coupling::DecomposedHeatOptions ho;
+  ho.materials = {{true, 100.0, 50.0}, {true, 150.0, 20.0}};
+  std::unique_ptr<frictherm::coupling::DecomposedHeat> heat;
+  if (coupled) heat = std::make_unique<frictherm::coupling::DecomposedHeat>(split, ho);
+  split.step(dt);  // first step (set-up of the exchanges) not timed
+  if (heat) heat->after_step(dt);
+  const long exchanges0 = heat ? heat->books().exchanges : 0, substeps0 = heat ? heat->books().substeps : 0;
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double w0 = MPI_Wtime(), c0 = cpu_seconds();
+  for (int s = 0; s < steps; ++s) {
+    split.step(dt);
+    if (heat) heat->after_step(dt);
+  }
+  HeatedTimes t;
+  t.cpu = cpu_seconds() - c0;
+  MPI_Barrier(MPI_COMM_WORLD);
+  t.wall = MPI_Wtime() - w0;
+  MPI_Allreduce(MPI_IN_PLACE, &t.wall, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  if (report && heat) {
+    // Per step and rank: the heat windows' grid exchanges, each moving this rank's ghost nodes × the
+    // DMDA's 7 values × 8 B (what it receives; what it sends is alike).
+    const fm::DecomposedTraffic& tr = split.traffic();
+    const double per_step = static_cast<double>(heat->books().exchanges - exchanges0) / steps;
+    *report = {static_cast<double>(split.local_particles()), static_cast<double>(tr.ghost_nodes),
+               per_step * static_cast<double>(tr.ghost_nodes) * tr.values_per_node * 8.0,
+               static_cast<double>(heat->books().substeps - substeps0) / steps, per_step,
+               heat->books().work_received, heat->books().particle_energy_change};
+  }
+  return t;
+}
+
+void run_heated3d(const std::string& which, int nx, int ny, int nz, int steps, int repeat, int rank, int ranks) {
+  const double h = 1e-3, rho = 1000.0, v0 = 10.0, g = 2e4;
+  const fm::Grid<3> grid(V3::Zero(), V3::Constant(h), {nx, ny, nz});
+  const std::vector<fm::Material> mats{elastic("base", 2e7), elastic("block", 1.5e7)};
+  fm::DecomposedMpm3D::Options opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  opt.gravity = V3(0.0, 0.0, -g);
+  opt.fixed_faces = {fm::FixedFace{2, false, {{true, true, true}}}};
+  opt.contact = true;
+  opt.contact_options.default_pair.law = fm::FrictionLaw::coulomb(0.3);
+  opt.contact_options.default_pair.normal = fm::NormalMethod::specified;
+  opt.contact_options.default_pair.normal_vector = V3(0.0, 0.0, 1.0);
+  opt.contact_pairs = {fm::DecomposedContactPair{0, 1, opt.contact_options.default_pair}};
+  std::vector<fm::DecomposedMpm3D::Particle> all;
+  const double W = nx * h, s = h / 2.0;
+  auto box = [&](V3 lo, V3 hi, int material, double vx) {
+    int m[3];
+    for (int a = 0; a < 3; ++a) m[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / s));
+    for (int k = 0; k < m[2]; ++k)
+      for (int j = 0; j < m[1]; ++j)
+        for (int i = 0; i < m[0]; ++i) {
+          fm::DecomposedMpm3D::Particle p;
+          p.id = static_cast<std::int64_t>(all.size());
+          p.position = lo + s * V3(i + 0.5, j + 0.5, k + 0.5);
+          p.half_size = V3::Constant(s / 2.0);
+          p.volume = s * s * s;
+          p.mass = rho * p.volume;
+          p.velocity = V3(vx, 0.0, 0.0);
+          p.material = material;
+          p.scalars = {300.0};
+          all.push_back(p);
+        }
+  };
+  if (rank == 0) {
+    box(V3(h, h, 0.0), V3(W - h, (ny - 1) * h, (nz / 2) * h), 0, 0.0);
+    box(V3(std::round(0.2 * nx) * h, h, (nz / 2) * h), V3(std::round(0.6 * nx) * h, (ny - 1) * h, (3 * nz / 4) * h), 1, v0);
+  }
+  long long count = static_cast<long long>(all.size());
+  MPI_Bcast(&count, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::three_d) / rho);
+  const double dt = 0.5 * h / (c + 2.0 * v0);
+  fm::DecomposedMpm3D::Options coupled_opt = opt;
+  coupled_opt.particle_scalars = {"temperature"};
+  std::vector<double> report;
+  // `repeat` interleaved pairs; each figure is its smallest over them (other jobs on the machine only
+  // ever add time, and interleaving exposes both runs to the same load).
+  HeatedTimes mech{1e300, 0.0}, heat{1e300, 0.0};
+  double cpu[2] = {1e300, 1e300};
+  for (int r = 0; r < repeat; ++r) {
+    const HeatedTimes m = time_heated3d(grid, mats, opt, all, dt, steps, rank, false, nullptr);
+    const HeatedTimes cr = time_heated3d(grid, mats, coupled_opt, all, dt, steps, rank, true, &report);
+    double both[2] = {m.cpu, cr.cpu};
+    MPI_Allreduce(MPI_IN_PLACE, both, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    mech.wall = std::min(mech.wall, m.wall);
+    heat.wall = std::min(heat.wall, cr.wall);
+    cpu[0] = std::min(cpu[0], both[0]);
+    cpu[1] = std::min(cpu[1], both[1]);
+  }
+  std::vector<double> rows(report.size() * static_cast<std::size_t>(ranks));
+  MPI_Gather(report.data(), static_cast<int>(report.size()), MPI_DOUBLE, rows.data(), static_cast<int>(report.size()),
+             MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (rank != 0) return;
+  const double ps = static_cast<double>(count) * steps;
+  std::printf("heated3d %-6s 3D %d rank%s  %dx%dx%d cells  %lld particles  %d steps, smallest of %d interleaved pairs\n",
+              which.c_str(), ranks, ranks > 1 ? "s" : " ", nx, ny, nz, count, steps, repeat);
+  std::printf("  mechanics only: wall %.3e s/step  cpu %.3e s/step (all ranks)  %.2f M p-steps/s  %.2f M p-steps/cpu-s\n",
+              mech.wall / steps, cpu[0] / steps, ps / mech.wall / 1e6, ps / cpu[0] / 1e6);
+  std::printf("  coupled:        wall %.3e s/step  cpu %.3e s/step (all ranks)  %.2f M p-steps/s  %.2f M p-steps/cpu-s"
+              "  coupled/mechanics wall %.2f cpu %.2f\n",
+              heat.wall / steps, cpu[1] / steps, ps / heat.wall / 1e6, ps / cpu[1] / 1e6, heat.wall / mech.wall,
+              cpu[1] / cpu[0]);
+  std::printf("  heat: %.2f sub-steps and %.1f grid exchanges per step; work %.4e J, particles' heat %.4e J\n", rows[3],
+              rows[4], rows[5], rows[6]);
+  for (int r = 0; r < ranks; ++r) {
+    const double* a = &rows[report.size() * static_cast<std::size_t>(r)];
+    std::printf("  rank %d: %.0f particles, %.0f ghost nodes, heat exchanges %.1f kB per step\n", r, a[0], a[1], a[2] / 1e3);
+  }
+  std::fflush(stdout);
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
   fm::DecomposedPetscSession session(&argc, &argv);
-  int cells = 200, steps = 100, cells3d = 24;
+  int cells = 200, steps = 100, cells3d = 24, repeat = 3;
   bool weak = false;
   std::string cases = "block,sliding";
   for (int a = 1; a < argc; ++a) {
@@ -207,15 +348,16 @@ int main(int argc, char** argv) {
     else if (a + 1 < argc && k == "--cells") cells = std::atoi(argv[++a]);
     else if (a + 1 < argc && k == "--cells3d") cells3d = std::atoi(argv[++a]);
     else if (a + 1 < argc && k == "--steps") steps = std::atoi(argv[++a]);
+    else if (a + 1 < argc && k == "--repeat") repeat = std::atoi(argv[++a]);
     else if (a + 1 < argc && k == "--cases") cases = argv[++a];
     else {
-      std::fprintf(stderr, "unknown option %s (valid: --cells N, --cells3d N, --steps N, --weak, --cases "
-                   "block,sliding,block3d)\n", k.c_str());
+      std::fprintf(stderr, "unknown option %s (valid: --cells N, --cells3d N, --steps N, --repeat N, --weak, --cases "
+                   "block,sliding,block3d,heated3d)\n", k.c_str());
       return 2;
     }
   }
-  if (cells < 8 || cells3d < 6 || steps < 1) {
-    std::fprintf(stderr, "--cells must be at least 8, --cells3d at least 6 and --steps at least 1\n");
+  if (cells < 8 || cells3d < 6 || steps < 1 || repeat < 1) {
+    std::fprintf(stderr, "--cells must be at least 8, --cells3d at least 6, --steps and --repeat at least 1\n");
     return 2;
   }
   int rank = 0, ranks = 1;
@@ -238,8 +380,17 @@ int main(int argc, char** argv) {
       run_block3d("strong", cells3d, n3, steps, rank, ranks);
       if (ranks > 1) run_block3d("weak", (cells3d - 2) * ranks + 2, n3, steps, rank, ranks);
       else if (rank == 0) std::printf("weak     3D 1 rank: the strong run above\n");
+#ifdef FRICTHERM_BENCH_DECOMPOSED_HEAT
+    } else if (c == "heated3d") {
+      // Strong: cells3d × ⅔ cells3d × ½ cells3d on any rank count; weak: the x extent (cells3d − 2
+      // cells) times the ranks.
+      const int ny = std::max(6, 2 * cells3d / 3), nz = std::max(6, cells3d / 2);
+      run_heated3d("strong", cells3d, ny, nz, steps, repeat, rank, ranks);
+      if (ranks > 1) run_heated3d("weak", (cells3d - 2) * ranks + 2, ny, nz, steps, repeat, rank, ranks);
+      else if (rank == 0) std::printf("heated3d weak 1 rank: the strong run above\n");
+#endif
     } else if (rank == 0) {
-      std::fprintf(stderr, "unknown case '%s' (valid: block, sliding, block3d)\n", c.c_str());
+      std::fprintf(stderr, "unknown case '%s' (valid: block, sliding, block3d, heated3d)\n", c.c_str());
     }
     at = comma + 1;
   }

@@ -13,7 +13,10 @@
 //       1e-12 of the stripe's 50 K amplitude of the serial Coupler's, the same sub-steps, heat
 //       content kept to 1e-14; once with every node an unknown, once with sliver nodes that are not
 //       (the lumped gradients G');
-//   (c) work on a node that is no thermal unknown is refused on every rank.
+//   (c) work on a node with no thermal unknown next to it is refused on every rank;
+//   (d) work on sliver nodes that are not unknowns goes to their neighbouring unknowns as the serial
+//       Coupler's distribute_heat moves it: temperatures within 1e-12 of 50 K, the amounts relocated
+//       equal, the books closed.
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
 #include "frictherm/coupling/coupler.hpp"
 #include "frictherm/coupling/decomposed_heat.hpp"
@@ -27,6 +30,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -218,7 +222,7 @@ TEST_P(DecomposedConduction, EqualsTheSerialConduction) {
 INSTANTIATE_TEST_SUITE_P(Edges, DecomposedConduction, ::testing::Values(false, true),
                          [](const auto& p) { return std::string(p.param ? "slivers" : "off_grid_lines"); });
 
-// ---- (c) work on a node that is no unknown: refused on every rank ----
+// ---- (c) work on a node with no unknown next to it: refused on every rank ----
 TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
   const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
@@ -230,13 +234,79 @@ TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
   fc::DecomposedHeatOptions ho;
   ho.materials = {{true, 1100.0, 0.45}};
   fc::DecomposedHeat heat(split, ho);
-  // The owned node at DMDA index (0, 0) (the grid's ghost corner) holds no mass: work there on rank 0.
+  // The owned node at DMDA index (0, 0) (the grid's ghost corner) and its neighbours hold no mass: work
+  // there on rank 0 has nowhere to go.
   std::vector<double> joules(split.owned_local_nodes().size(), 0.0);
   const std::array<int, 4> box = split.owned_nodes();
   if (box[0] == 0 && box[2] == 0) joules[0] = 1.0;
   EXPECT_THROW(heat.window(joules, 1.0), std::runtime_error);
   fc::DecomposedHeatOptions missing;  // no thermal properties for material 0
   EXPECT_THROW(fc::DecomposedHeat(split, missing), std::invalid_argument);
+}
+
+// ---- (d) work on nodes that are not unknowns, relocated to their neighbouring unknowns ----
+TEST(DecomposedHeat, RelocatesWorkOffTheUnknownsAsTheSerialCoupler) {
+  // The sliver body of (b): 2 J on the sliver node at lattice (14, 0) (y = 0: not an unknown, its
+  // neighbours on y = 1 mm are; they straddle the x cut at lattice 14 | 15 of 2 and 4 ranks), 1.5 J on
+  // the sliver node (0, 7) (its neighbours straddle the y cut at 7 | 8 of 4 ranks) and 1 J on an
+  // unknown, in each of 3 windows of 1 s, with the serial Coupler given the same grid-node work (its
+  // distribute_heat moves the 3.5 J in proportion to M_i).
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
+  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
+  const std::vector<fc::ThermalProperties> thermal{{true, 1100.0, 0.45}};
+  fm::Particles<2> sp = striped_body(0, true);
+  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_options(thermal));
+  coupler.start(sp, 0.0);
+  fm::DecomposedOptions opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  opt.particle_scalars = {"temperature"};
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(decomposed(sp, true));
+  fc::DecomposedHeatOptions ho;
+  ho.materials = thermal;
+  fc::DecomposedHeat heat(split, ho);
+  const double content0 = heat.heat_content();
+  // DMDA index = serial lattice index + 1 = the serial node's index along each axis.
+  const int sliver[2] = {15, 1}, sliver2[2] = {1, 8}, inside[2] = {12, 7};
+  const auto& npd = grid.nodes_per_dim();
+  std::vector<double> serial_work(grid.node_count(), 0.0);
+  serial_work[static_cast<std::size_t>(sliver[1] * npd[0] + sliver[0])] = 2.0;
+  serial_work[static_cast<std::size_t>(sliver2[1] * npd[0] + sliver2[0])] = 1.5;
+  serial_work[static_cast<std::size_t>(inside[1] * npd[0] + inside[0])] = 1.0;
+  std::vector<double> joules(split.owned_local_nodes().size(), 0.0);
+  const std::array<int, 4> box = split.owned_nodes();
+  auto put = [&](const int* n, double w) {
+    if (n[0] >= box[0] && n[0] < box[1] && n[1] >= box[2] && n[1] < box[3])
+      joules[static_cast<std::size_t>((n[1] - box[2]) * (box[1] - box[0]) + n[0] - box[0])] = w;
+  };
+  put(sliver, 2.0);
+  put(sliver2, 1.5);
+  put(inside, 1.0);
+  const int windows = 3;
+  for (int k = 1; k <= windows; ++k) {
+    coupler.after_step(sp, serial_work, 1.0 * k);
+    heat.window(joules, 1.0);
+  }
+  bool same = true;
+  const double dT = temperature_difference(split.gather(), sp, same);
+  const fc::DecomposedHeatBooks& b = heat.books();
+  const double added = 4.5 * windows, content = heat.heat_content() - content0;
+  EXPECT_TRUE(same);
+  EXPECT_GT(b.dropped_nodes, 0L);
+  EXPECT_EQ(b.substeps, coupler.books().matrix_free_substeps);
+  EXPECT_EQ(coupler.books().heat_relocated, 3.5 * windows);
+  EXPECT_EQ(b.heat_relocated, 3.5 * windows);
+  // Round-off of reordered sums, as (b); the heat added is all there (1e-9 of the 13.5 J, against Σ m C T
+  // ≈ 1.1e5 J).
+  EXPECT_LE(dT / 50.0, 1e-12);
+  EXPECT_LE(std::fabs(b.heat_delivered - added) / added, 1e-14);
+  EXPECT_LE(std::fabs(b.nodal_energy_change - added) / added, 1e-12);
+  EXPECT_LE(std::fabs(content - added) / added, 1e-9);
+  if (comm_rank() == 0)
+    std::printf("[relocation] %d ranks, %d windows: %.1f J relocated (serial %.1f J), |dT| vs serial %.2e of 50 K; "
+                "books (/added): delivered %.2e, nodal %.2e, content %.2e\n",
+                comm_size(), windows, b.heat_relocated, coupler.books().heat_relocated, dT / 50.0,
+                (b.heat_delivered - added) / added, (b.nodal_energy_change - added) / added, (content - added) / added);
 }
 
 }  // namespace

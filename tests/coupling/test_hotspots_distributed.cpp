@@ -5,7 +5,8 @@
 // as a serial tracker given all particles (ids, members, peak, mean, size, centroid, excess energy:
 // exactly, since the gathered candidates come in the serial order), also after a second update in
 // which the discs grow and one more appears (tracking by overlap); the maximum temperature is the
-// global one.
+// global one. The same in 3D: a 16 × 6 × 6 lattice split into slabs along x, a hot ball centred on the
+// boundary of the first two slabs and one inside the last slab.
 #include <frictherm/coupling/distributed.hpp>
 
 #include "../mpi_ranks.hpp"
@@ -13,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -108,6 +110,71 @@ TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
       for (const fc::HotSpot& h : spots) std::cout << ' ' << h.particle_count << " (id " << h.id << ")";
       std::cout << '\n';
     }
+  }
+}
+
+// ---- 3D: a ball straddling the first slab boundary, one inside the last slab ----
+namespace {
+
+constexpr int kX3 = 16, kY3 = 6, kZ3 = 6;
+
+int first_slab3(int rank, int ranks) { return rank * kX3 / ranks; }
+
+void lattice3(int c0, int c1, int ranks, fm::Particles<3>& p, std::vector<std::int64_t>& ids) {
+  p = fm::Particles<3>{};
+  ids.clear();
+  const double boundary = first_slab3(1, ranks) * kSpacing;
+  for (int i = c0; i < c1; ++i)
+    for (int j = 0; j < kY3; ++j)
+      for (int k = 0; k < kZ3; ++k) {
+        const fm::Vec<3> x((i + 0.5) * kSpacing, (j + 0.5) * kSpacing, (k + 0.5) * kSpacing);
+        const bool hot = (x - fm::Vec<3>(boundary, 3e-3, 3e-3)).norm() < 2.1e-3 ||
+                         (x - fm::Vec<3>(15e-3, 3e-3, 3e-3)).norm() < 1.2e-3;
+        p.add(x, fm::Vec<3>::Constant(0.5 * kSpacing), 1e-6, kSpacing * kSpacing * kSpacing, 0, 0,
+              kT0 + (hot ? 60.0 + 0.1 * (x[0] + 2.0 * x[1] + 3.0 * x[2]) / kSpacing : 0.0));
+        ids.push_back((static_cast<std::int64_t>(i) * kY3 + j) * kZ3 + k);
+      }
+}
+
+}  // namespace
+
+TEST(HotSpotsAcrossRanks, StraddlingBallIn3DIsOneAndAllRanksAgreeWithSerial) {
+  const int rank = comm_rank(), ranks = comm_size();
+  ASSERT_GE(ranks, 2);
+  const std::vector<fc::ThermalProperties> materials = {{true, 1000.0, 0.5}};
+  fc::HotSpotOptions opt;
+  opt.threshold = 20.0;
+  fc::HotSpotTracker serial(3, opt), decomposed(3, opt);
+  const std::size_t total = static_cast<std::size_t>(kX3) * kY3 * kZ3;
+  fm::Particles<3> all, mine;
+  std::vector<std::int64_t> all_ids, my_ids;
+  lattice3(0, kX3, ranks, all, all_ids);
+  lattice3(first_slab3(rank, ranks), first_slab3(rank + 1, ranks), ranks, mine, my_ids);
+  // The swarm order of a decomposed run is not the id order: this rank's particles reversed.
+  std::vector<std::size_t> reverse(mine.size());
+  for (std::size_t k = 0; k < reverse.size(); ++k) reverse[k] = reverse.size() - 1 - k;
+  mine.permute(reverse);
+  std::reverse(my_ids.begin(), my_ids.end());
+  const std::vector<double> reference(mine.size(), kT0), all_reference(all.size(), kT0);
+  double max_serial = 0.0;
+  serial.update_from(serial.candidates(all, materials, max_serial, &all_ids, &all_reference), max_serial, total, 0.0);
+  fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, materials, total, 0.0);
+  const auto& spots = decomposed.hot_spots();
+  ASSERT_EQ(spots.size(), 2u);
+  expect_same(spots, serial.hot_spots());
+  EXPECT_EQ(decomposed.max_temperature(), max_serial);
+  const std::int64_t boundary_id = static_cast<std::int64_t>(first_slab3(1, ranks)) * kY3 * kZ3;
+  int straddling = 0;
+  for (const fc::HotSpot& h : spots) {
+    bool left = false, right = false;
+    for (std::size_t id : h.particles) (static_cast<std::int64_t>(id) < boundary_id ? left : right) = true;
+    if (left && right) ++straddling;
+  }
+  EXPECT_EQ(straddling, 1);
+  if (rank == 0) {
+    std::cout << "[hot spots 3D across " << ranks << " ranks] " << spots.size() << " hot spots, sizes";
+    for (const fc::HotSpot& h : spots) std::cout << ' ' << h.particle_count << " (id " << h.id << ")";
+    std::cout << '\n';
   }
 }
 

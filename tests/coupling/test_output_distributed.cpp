@@ -5,6 +5,7 @@
 // velocities padded to 3 components, temperatures, materials), including a snapshot after particles
 // changed rank and one rank was left empty (no grid for it); times are exact; an existing output is
 // refused on every rank without overwrite, and inconsistent temperature arrays make every rank throw.
+// In 2D (geometry XY) and 3D (geometry XYZ, what ParaView's Xdmf3 reader needs for 3-component points).
 #include <frictherm/coupling/distributed.hpp>
 
 #include "../mpi_ranks.hpp"
@@ -45,7 +46,7 @@ double v_of(std::int64_t id, int d) { return 0.5 * static_cast<double>(id) - d; 
 
 // Snapshot 0: rank r holds 3 + 2r particles (ids in rank order). Snapshot 1: every rank's first
 // particle goes to the next rank and the last rank gives all of its particles to rank 0.
-fc::DecomposedSnapshot particles(int snapshot, int rank, int ranks, std::int64_t& total) {
+fc::DecomposedSnapshot particles(int snapshot, int rank, int ranks, std::int64_t& total, int dim) {
   std::vector<std::vector<std::int64_t>> owned(static_cast<std::size_t>(ranks));
   std::int64_t id = 0;
   for (int r = 0; r < ranks; ++r)
@@ -65,8 +66,8 @@ fc::DecomposedSnapshot particles(int snapshot, int rank, int ranks, std::int64_t
   fc::DecomposedSnapshot s;
   for (std::int64_t i : owned[static_cast<std::size_t>(rank)]) {
     s.id.push_back(i);
-    for (int d = 0; d < 2; ++d) s.position.push_back(x_of(i, d, snapshot));
-    for (int d = 0; d < 2; ++d) s.velocity.push_back(v_of(i, d));
+    for (int d = 0; d < dim; ++d) s.position.push_back(x_of(i, d, snapshot));
+    for (int d = 0; d < dim; ++d) s.velocity.push_back(v_of(i, d));
     s.temperature.push_back(300.0 + static_cast<double>(i));
     s.material.push_back(static_cast<int>(i % 3));
   }
@@ -92,15 +93,17 @@ std::vector<T> read(const std::string& file, const std::string& path, hid_t type
 
 }  // namespace
 
-TEST(DecomposedOutput, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
-  const int rank = comm_rank(), ranks = comm_size();
+class DecomposedOutputDims : public ::testing::TestWithParam<int> {};
+
+TEST_P(DecomposedOutputDims, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
+  const int rank = comm_rank(), ranks = comm_size(), dim = GetParam();
   const std::string dir = scratch();
   const std::string base = dir + "/run";
   std::int64_t total = 0;
   const double times[2] = {0.0, 1.2345678901234567e-6};
   {
-    fc::DecomposedOutput out(MPI_COMM_WORLD, base, 2, false);
-    for (int s = 0; s < 2; ++s) out.write(10 * s, times[s], particles(s, rank, ranks, total));
+    fc::DecomposedOutput out(MPI_COMM_WORLD, base, dim, false);
+    for (int s = 0; s < 2; ++s) out.write(10 * s, times[s], particles(s, rank, ranks, total, dim));
   }
   MPI_Barrier(MPI_COMM_WORLD);
   if (rank == 0) {
@@ -125,13 +128,14 @@ TEST(DecomposedOutput, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
     EXPECT_EQ(grids["/snapshots/000000"].size(), static_cast<std::size_t>(ranks));
     EXPECT_EQ(grids["/snapshots/000001"].size(), static_cast<std::size_t>(ranks - 1));  // the empty rank has none
     EXPECT_NE(xml.find("<Time Value=\"1.2345678901234567e-06\"/>"), std::string::npos);
+    EXPECT_NE(xml.find(dim == 2 ? "GeometryType=\"XY\"" : "GeometryType=\"XYZ\""), std::string::npos);
     int s = 0;
     for (const auto& [group, parts] : grids) {
       std::vector<int> seen(static_cast<std::size_t>(total), 0);
       for (const auto& [file, n] : parts) {
         const std::string path = dir + "/" + file;
         const auto id = read<std::int64_t>(path, group + "/id", H5T_NATIVE_INT64, n);
-        const auto x = read<double>(path, group + "/position", H5T_NATIVE_DOUBLE, 2 * n);
+        const auto x = read<double>(path, group + "/position", H5T_NATIVE_DOUBLE, static_cast<std::size_t>(dim) * n);
         const auto v = read<double>(path, group + "/velocity", H5T_NATIVE_DOUBLE, 3 * n);
         const auto T = read<double>(path, group + "/temperature", H5T_NATIVE_DOUBLE, n);
         const auto m = read<int>(path, group + "/material", H5T_NATIVE_INT, n);
@@ -139,11 +143,13 @@ TEST(DecomposedOutput, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
           ASSERT_GE(id[k], 0);
           ASSERT_LT(id[k], total);
           ++seen[static_cast<std::size_t>(id[k])];
-          for (int d = 0; d < 2; ++d) {
-            EXPECT_EQ(x[2 * k + static_cast<std::size_t>(d)], x_of(id[k], d, s));
+          for (int d = 0; d < dim; ++d) {
+            EXPECT_EQ(x[static_cast<std::size_t>(dim) * k + static_cast<std::size_t>(d)], x_of(id[k], d, s));
             EXPECT_EQ(v[3 * k + static_cast<std::size_t>(d)], v_of(id[k], d));
           }
-          EXPECT_EQ(v[3 * k + 2], 0.0);
+          if (dim == 2) {
+            EXPECT_EQ(v[3 * k + 2], 0.0);
+          }
           EXPECT_EQ(T[k], 300.0 + static_cast<double>(id[k]));
           EXPECT_EQ(m[k], static_cast<int>(id[k] % 3));
         }
@@ -151,21 +157,24 @@ TEST(DecomposedOutput, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
       for (std::int64_t i = 0; i < total; ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], 1) << group << " id " << i;
       ++s;
     }
-    std::cout << "[decomposed output] " << ranks << " ranks, " << total << " particles: " << grids.size()
+    std::cout << "[decomposed output " << dim << "D] " << ranks << " ranks, " << total << " particles: " << grids.size()
               << " snapshots read back through " << base << ".xdmf\n";
   }
   // An existing output is refused on every rank without overwrite; with it, it is replaced.
-  EXPECT_THROW(fc::DecomposedOutput(MPI_COMM_WORLD, base, 2, false), std::runtime_error);
-  EXPECT_NO_THROW(fc::DecomposedOutput(MPI_COMM_WORLD, base, 2, true));
+  EXPECT_THROW(fc::DecomposedOutput(MPI_COMM_WORLD, base, dim, false), std::runtime_error);
+  EXPECT_NO_THROW(fc::DecomposedOutput(MPI_COMM_WORLD, base, dim, true));
   // Temperatures on some ranks only: every rank throws.
   {
-    fc::DecomposedOutput out(MPI_COMM_WORLD, base, 2, true);
-    fc::DecomposedSnapshot p = particles(0, rank, ranks, total);
+    fc::DecomposedOutput out(MPI_COMM_WORLD, base, dim, true);
+    fc::DecomposedSnapshot p = particles(0, rank, ranks, total, dim);
     if (rank == 1) p.temperature.clear();
     EXPECT_THROW(out.write(0, 0.0, p), std::runtime_error);
   }
   MPI_Barrier(MPI_COMM_WORLD);
   if (rank == 0 && !std::getenv("FRICTHERM_TEST_KEEP")) std::system(("rm -rf '" + dir + "'").c_str());
 }
+
+INSTANTIATE_TEST_SUITE_P(Dims, DecomposedOutputDims, ::testing::Values(2, 3),
+                         [](const auto& p) { return std::to_string(p.param) + "D"; });
 
 int main(int argc, char** argv) { return frictherm::test::run_tests_under_mpi(argc, argv); }

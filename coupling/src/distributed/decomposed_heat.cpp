@@ -1,10 +1,14 @@
 // Frictional heating and matrix-free explicit conduction on the decomposed mechanics
 // (frictherm/coupling/decomposed_heat.hpp): the serial ExplicitConduction window (explicit_conduction.cpp,
 // Nairn et al. 2018 eqs. 37–38) with its particle loops over this rank's particles and its nodal sums
-// completed at the owners by the mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal).
+// completed at the owners by the mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal). One
+// template on Dim for the 2D and 3D mechanics; G'_ip flat, Dim values per kept entry.
 #include <frictherm/coupling/decomposed_heat.hpp>
 
+#include <Eigen/Core>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -23,53 +27,81 @@ double sum_over(MPI_Comm comm, double x) {
 
 }  // namespace
 
-DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm2D& mpm, DecomposedHeatOptions options)
-    : mpm_(mpm), opt_(std::move(options)) {
+DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<2>& mpm, DecomposedHeatOptions options)
+    : mpm2_(&mpm), opt_(std::move(options)) {
+  check_materials(mpm);
+}
+
+DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<3>& mpm, DecomposedHeatOptions options)
+    : mpm3_(&mpm), opt_(std::move(options)) {
+  check_materials(mpm);
+}
+
+template <int Dim>
+void DecomposedHeat::check_materials(const mechanics::DecomposedMpm<Dim>& mpm) {
   if (!(opt_.fe_safety > 0.0 && opt_.fe_safety <= 1.0))
     throw std::invalid_argument("decomposed heat: fe_safety " + std::to_string(opt_.fe_safety) +
                                 " (expected a value in (0, 1])");
-  scalar_ = mpm_.particle_scalar_index(opt_.temperature);
+  scalar_ = mpm.particle_scalar_index(opt_.temperature);
   // Every rank checks its own particles' materials and all agree before any window.
   int bad = -1;
-  for (int m : mpm_.local_particle_data().material)
+  for (int m : mpm.local_particle_data().material)
     if (m < 0 || m >= static_cast<int>(opt_.materials.size())) bad = std::max(bad, m);
-  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, mpm_.communicator());
+  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, mpm.communicator());
   if (bad >= 0)
     throw std::invalid_argument("decomposed heat: material " + std::to_string(bad) +
                                 " has no thermal properties (expected " + std::to_string(opt_.materials.size()) +
                                 " entries in materials to cover it)");
 }
 
+MPI_Comm DecomposedHeat::communicator() const { return mpm3_ ? mpm3_->communicator() : mpm2_->communicator(); }
+
+mechanics::DecomposedLocalParticles DecomposedHeat::local_particles() const {
+  return mpm3_ ? mpm3_->local_particle_data() : mpm2_->local_particle_data();
+}
+
+std::vector<double> DecomposedHeat::temperatures() const {
+  return mpm3_ ? mpm3_->particle_scalar(scalar_) : mpm2_->particle_scalar(scalar_);
+}
+
 double DecomposedHeat::heat_content() const {
-  const mechanics::DecomposedLocalParticles P = mpm_.local_particle_data();
-  const std::vector<double> T = mpm_.particle_scalar(scalar_);
+  const mechanics::DecomposedLocalParticles P = local_particles();
+  const std::vector<double> T = temperatures();
   double e = 0.0;
   for (std::size_t k = 0; k < T.size(); ++k) {
     const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
     if (m.conducts) e += P.mass[k] * m.heat_capacity * T[k];
   }
-  return sum_over(mpm_.communicator(), e);
+  return sum_over(communicator(), e);
 }
 
 void DecomposedHeat::after_step(double dt) {
-  const std::vector<double>& work = mpm_.frictional_work(opt_.order);
+  const std::vector<double>& work = mpm3_ ? mpm3_->frictional_work(opt_.order) : mpm2_->frictional_work(opt_.order);
   double w = 0.0;
   for (double x : work) w += x;
-  books_.work_received += sum_over(mpm_.communicator(), w);
+  books_.work_received += sum_over(communicator(), w);
   window(work, dt);
 }
 
 void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
-  const MPI_Comm comm = mpm_.communicator();
-  const std::vector<int>& owned_local = mpm_.owned_local_nodes();
-  const std::size_t no = owned_local.size(), nl = static_cast<std::size_t>(mpm_.local_node_count());
+  if (mpm3_) window_on(*mpm3_, joules, dt);
+  else window_on(*mpm2_, joules, dt);
+}
+
+template <int Dim>
+void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double dt) {
+  using Vec = mechanics::Vec<Dim>;
+  using GMap = Eigen::Map<Vec>;
+  const MPI_Comm comm = mpm.communicator();
+  const std::vector<int>& owned_local = mpm.owned_local_nodes();
+  const std::size_t no = owned_local.size(), nl = static_cast<std::size_t>(mpm.local_node_count());
   if (joules.size() != no)
     throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
                                 std::to_string(no) + " owned nodes");
   if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
-  const mechanics::DecomposedStencils& st = mpm_.current_stencils();
-  const mechanics::DecomposedLocalParticles P = mpm_.local_particle_data();
-  std::vector<double> T = mpm_.particle_scalar(scalar_);
+  const typename mechanics::DecomposedMpm<Dim>::Stencils& st = mpm.current_stencils();
+  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
+  std::vector<double> T = mpm.particle_scalar(scalar_);
   const std::size_t np = T.size();
 
   // Pass 1: M_i and M_i T_i (eq. 38) on the ghosted box, completed at the owners.
@@ -89,7 +121,7 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
     }
   }
   std::vector<double> mass_temp;
-  mpm_.sum_to_owned(local_, 2, mass_temp);
+  mpm.sum_to_owned(local_, 2, mass_temp);
   // Unknowns: M_i > active_mass_fraction · max M (select_unknowns' rule, max over ranks).
   double sums[3] = {0.0, particle_capacity, 0.0};  // Σ M_i, Σ m C, max M
   for (std::size_t q = 0; q < no; ++q) sums[0] += mass_temp[2 * q], sums[2] = std::max(sums[2], mass_temp[2 * q]);
@@ -108,56 +140,63 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
     else if (M[q] > 0.0) ++dropped;
   }
   std::vector<double> local_M;
-  mpm_.owned_to_local(M, 1, local_M);  // the same values at every rank's ghosts: the same unknowns
+  mpm.owned_to_local(M, 1, local_M);  // the same values at every rank's ghosts: the same unknowns
 
   // Pass 2: each heat-holding particle's kept nodes (unknowns), the lumped gradients G' and the two
   // bounds of λ_max(M⁻¹K) of ExplicitConduction::keep (Gershgorin row sums and Cauchy–Schwarz).
-  kept_first_.assign(1, 0);
-  kept_node_.clear();
-  kept_S_.clear();
-  kept_G_.clear();
+  const std::size_t entries = st.node.size();  // at most every stencil entry is kept
+  kept_first_.resize(np + 1);
+  kept_first_[0] = 0;
+  kept_node_.resize(entries);
+  kept_S_.resize(entries);
+  kept_G_.resize(Dim * entries);
+  kept_norm_.resize(entries);
+  auto G = [this](std::size_t a) { return GMap(kept_G_.data() + Dim * a); };
   conductance_.assign(np, 0.0);
   local_.assign(2 * nl, 0.0);
+  std::size_t kept = 0;
   for (std::size_t k = 0; k < np; ++k) {
-    const std::size_t begin = kept_node_.size();
+    const std::size_t begin = kept;
     if (capacity_[k] > 0.0) {
       double s_kept = 0.0;
-      mechanics::Vec<2> g_dropped = mechanics::Vec<2>::Zero();
+      Vec g_dropped = Vec::Zero();
       for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
         const auto ua = static_cast<std::size_t>(a);
         const int i = st.node[ua];
         if (is_unknown(local_M[static_cast<std::size_t>(i)])) {
           s_kept += st.S[ua];
-          kept_node_.push_back(i);
-          kept_S_.push_back(st.S[ua]);
-          kept_G_.push_back(st.G[ua]);
+          kept_node_[kept] = i;
+          kept_S_[kept] = st.S[ua];
+          G(kept) = st.G[ua];
+          ++kept;
         } else {
           g_dropped += st.G[ua];
         }
       }
       const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
-      const std::size_t end = kept_node_.size();
+      const std::size_t end = kept;
       if (m.conductivity > 0.0 && end > begin && s_kept > 0.0) {
         if (end - begin < static_cast<std::size_t>(st.first[k + 1] - st.first[k]))
-          for (std::size_t a = begin; a < end; ++a) kept_G_[a] += (kept_S_[a] / s_kept) * g_dropped;  // lump
+          for (std::size_t a = begin; a < end; ++a) G(a) += (kept_S_[a] / s_kept) * g_dropped;  // lump
         conductance_[k] = P.volume[k] * m.conductivity;  // V_p k_p
         double gsum = 0.0, g2m = 0.0;
         for (std::size_t a = begin; a < end; ++a) {
-          const double g = kept_G_[a].norm();
+          const double g = G(a).norm();
+          kept_norm_[a] = g;
           gsum += g;
           g2m += g * g / local_M[static_cast<std::size_t>(kept_node_[a])];
         }
         for (std::size_t a = begin; a < end; ++a) {
           const auto i = static_cast<std::size_t>(kept_node_[a]);
-          local_[2 * i] += conductance_[k] * kept_G_[a].norm() * gsum;
+          local_[2 * i] += conductance_[k] * kept_norm_[a] * gsum;
           local_[2 * i + 1] += conductance_[k] * g2m;
         }
       }
     }
-    kept_first_.push_back(static_cast<int>(kept_node_.size()));
+    kept_first_[k + 1] = static_cast<int>(kept);
   }
   std::vector<double> bounds;
-  mpm_.sum_to_owned(local_, 2, bounds);
+  mpm.sum_to_owned(local_, 2, bounds);
   double lam[2] = {0.0, 0.0};  // Gershgorin, Rayleigh: maxima over the unknowns of all ranks
   for (std::size_t q = 0; q < no; ++q) {
     if (!is_unknown(M[q])) continue;
@@ -169,25 +208,86 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
   long n = 1;
   if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (opt_.fe_safety * 2.0 / lambda) - 1e-12)));
 
-  // The heat: q_i = W_i / Δt on the owned unknowns. Work on a node that is not an unknown is refused.
-  double off = 0.0, delivered = 0.0;
+  // The heat: q_i = W_i / Δt on the owned unknowns. Work on a node that is not an unknown goes, as the
+  // serial distribute_heat moves it, to the unknowns among its lattice neighbours (one node away along
+  // every axis, so inside this rank's ghosted box) in proportion to their M_i, the last share taking the
+  // remainder; the shares are completed at the owners by one more sum_to_owned. Work on a node with no
+  // unknown next to it (the serial code gives it to the nearest unknown anywhere) is refused.
+  const std::array<int, 2 * Dim> own = mpm.owned_nodes(), box = mpm.ghosted_nodes();
+  constexpr int neighbours = Dim == 2 ? 9 : 27;
+  double moved[3] = {0.0, 0.0, 0.0};  // |work| off the unknowns, the same signed, of it with no unknown next to it
+  std::vector<double> shares;         // on the ghosted box
+  for (std::size_t u = 0; u < no; ++u) {
+    const double w = joules[u];
+    if (w == 0.0 || is_unknown(M[u])) continue;
+    if (shares.empty()) shares.assign(nl, 0.0);
+    moved[0] += std::fabs(w);
+    moved[1] += w;
+    int idx[Dim];  // DMDA index of owned node u (x fastest over owned_nodes())
+    std::size_t rest = u;
+    for (int d = 0; d < Dim; ++d) {
+      const auto extent = static_cast<std::size_t>(own[2 * d + 1] - own[2 * d]);
+      idx[d] = own[2 * d] + static_cast<int>(rest % extent);
+      rest /= extent;
+    }
+    int cand[neighbours];
+    double weight[neighbours];
+    int count = 0;
+    double wsum = 0.0;
+    for (int c = 0; c < neighbours; ++c) {  // x fastest, as the serial loop
+      int r = c, l = 0, stride = 1;
+      bool inside = true;
+      for (int d = 0; d < Dim; ++d) {
+        const int j = idx[d] + r % 3 - 1;
+        r /= 3;
+        if (j < box[2 * d] || j >= box[2 * d + 1]) inside = false;  // the ghosted box ends only at the grid's end
+        l += (j - box[2 * d]) * stride;
+        stride *= box[2 * d + 1] - box[2 * d];
+      }
+      if (!inside || !is_unknown(local_M[static_cast<std::size_t>(l)])) continue;
+      cand[count] = l;
+      weight[count] = local_M[static_cast<std::size_t>(l)];
+      wsum += weight[count];
+      ++count;
+    }
+    if (count == 0) {
+      moved[2] += std::fabs(w);
+      continue;
+    }
+    double given = 0.0;
+    for (int c = 0; c + 1 < count; ++c) {
+      const double share = w * (weight[c] / wsum);
+      shares[static_cast<std::size_t>(cand[c])] += share;
+      given += share;
+    }
+    shares[static_cast<std::size_t>(cand[count - 1])] += w - given;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, moved, 3, MPI_DOUBLE, MPI_SUM, comm);
+  if (moved[2] > 0.0)
+    throw std::runtime_error("decomposed heat: " + std::to_string(moved[2]) +
+                             " J of work on nodes with no thermal unknown next to them (not relocated in a "
+                             "decomposed run)");
+  std::vector<double> relocated;
+  if (moved[0] > 0.0) {  // every rank takes part in the exchange
+    if (shares.empty()) shares.assign(nl, 0.0);
+    mpm.sum_to_owned(shares, 1, relocated);
+    books_.heat_relocated += moved[1];
+    ++books_.exchanges;
+  }
+  double delivered = 0.0;
   std::vector<double> q(no, 0.0);
   for (std::size_t u = 0; u < no; ++u) {
-    if (joules[u] == 0.0) continue;
-    if (is_unknown(M[u])) q[u] = joules[u] / dt, delivered += q[u];
-    else off += std::fabs(joules[u]);
+    if (!is_unknown(M[u])) continue;
+    const double w = relocated.empty() ? joules[u] : joules[u] + relocated[u];
+    if (w != 0.0) q[u] = w / dt, delivered += q[u];
   }
-  off = sum_over(comm, off);
-  if (off > 0.0)
-    throw std::runtime_error("decomposed heat: " + std::to_string(off) +
-                             " J of work on nodes that are not thermal unknowns (relocation is serial only)");
 
   // Forward-Euler sub-steps: ghost T_j from the owners, f_i = −Σ_p V_p k_p G'_ip·(∇T)_p summed at the owners.
   std::vector<double> Tn = T0;
   const double h = dt / static_cast<double>(n);
   std::vector<double> f;
   for (long s = 0; s < n; ++s) {
-    mpm_.owned_to_local(Tn, 1, local_T_);
+    mpm.owned_to_local(Tn, 1, local_T_);
     force_.assign(nl, 0.0);
     for (std::size_t k = 0; k < np; ++k) {
       if (conductance_[k] == 0.0) continue;
@@ -198,12 +298,12 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
         hi = std::max(hi, local_T_[static_cast<std::size_t>(kept_node_[a])]);
       }
       if (hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi))) continue;  // quiet
-      mechanics::Vec<2> grad = mechanics::Vec<2>::Zero();  // (∇T)_p, eq. 37
-      for (std::size_t a = b; a < e; ++a) grad += kept_G_[a] * local_T_[static_cast<std::size_t>(kept_node_[a])];
+      Vec grad = Vec::Zero();  // (∇T)_p, eq. 37
+      for (std::size_t a = b; a < e; ++a) grad += G(a) * local_T_[static_cast<std::size_t>(kept_node_[a])];
       grad *= conductance_[k];
-      for (std::size_t a = b; a < e; ++a) force_[static_cast<std::size_t>(kept_node_[a])] -= kept_G_[a].dot(grad);
+      for (std::size_t a = b; a < e; ++a) force_[static_cast<std::size_t>(kept_node_[a])] -= G(a).dot(grad);
     }
-    mpm_.sum_to_owned(force_, 1, f);
+    mpm.sum_to_owned(force_, 1, f);
     for (std::size_t u = 0; u < no; ++u)
       if (is_unknown(M[u])) Tn[u] += h * (f[u] + q[u]) / M[u];
   }
@@ -214,7 +314,7 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
   for (std::size_t u = 0; u < no; ++u)
     if (is_unknown(M[u])) dT[u] = Tn[u] - T0[u], nodal += M[u] * dT[u];
   std::vector<double> local_dT;
-  mpm_.owned_to_local(dT, 1, local_dT);
+  mpm.owned_to_local(dT, 1, local_dT);
   double particle = 0.0;
   for (std::size_t k = 0; k < np; ++k) {
     double change = 0.0;
@@ -224,7 +324,7 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
     T[k] = before + change;
     particle += capacity_[k] * (T[k] - before);
   }
-  mpm_.set_particle_scalar(scalar_, T);
+  mpm.set_particle_scalar(scalar_, T);
   double b[3] = {delivered * dt, nodal, particle};
   MPI_Allreduce(MPI_IN_PLACE, b, 3, MPI_DOUBLE, MPI_SUM, comm);
   books_.heat_delivered += b[0];
@@ -235,6 +335,41 @@ void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
   books_.dropped_nodes = d;
   ++books_.windows;
   books_.substeps += n;
+  books_.exchanges += 4 + 2 * n;  // M and Σ m C T, M back, the bounds, per sub-step T and f, ΔT
+}
+
+DecomposedSnapshot DecomposedHeat::snapshot() const {
+  mechanics::DecomposedLocalParticles P =
+      mpm3_ ? mpm3_->local_particle_data(true) : mpm2_->local_particle_data(true);  // with x_p, v_p
+  DecomposedSnapshot s;
+  s.id = std::move(P.id);
+  s.position = std::move(P.position);
+  s.velocity = std::move(P.velocity);
+  s.temperature = temperatures();
+  s.material = std::move(P.material);
+  return s;
+}
+
+template <int Dim>
+void DecomposedHeat::hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker,
+                                  const std::string& reference, double time) const {
+  // This rank's particles as the serial tracker reads them (x_p, l_p, m_p, V_p, material, T_p).
+  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data(true);
+  const std::vector<double> T = mpm.particle_scalar(scalar_);
+  const std::vector<double> T0 = mpm.particle_scalar(mpm.particle_scalar_index(reference));
+  mechanics::Particles<Dim> local;
+  local.reserve(T.size());
+  for (std::size_t k = 0; k < T.size(); ++k)
+    local.add(Eigen::Map<const mechanics::Vec<Dim>>(P.position.data() + Dim * k),
+              Eigen::Map<const mechanics::Vec<Dim>>(P.half_size.data() + Dim * k), P.mass[k], P.volume[k], P.material[k],
+              0, T[k]);
+  const auto count = static_cast<std::size_t>(mpm.global_particles());
+  update_hot_spots_across_ranks(mpm.communicator(), tracker, local, P.id, T0, opt_.materials, count, time);
+}
+
+void DecomposedHeat::update_hot_spots(HotSpotTracker& tracker, const std::string& reference, double time) const {
+  if (mpm3_) hot_spots_on(*mpm3_, tracker, reference, time);
+  else hot_spots_on(*mpm2_, tracker, reference, time);
 }
 
 }  // namespace frictherm::coupling

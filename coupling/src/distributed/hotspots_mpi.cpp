@@ -2,6 +2,7 @@
 // rank with MPI_Allgatherv, clustered and matched by the serial tracker.
 #include <frictherm/coupling/distributed.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -53,7 +54,11 @@ void update_hot_spots_across_ranks(MPI_Comm comm, HotSpotTracker& tracker, const
   const std::vector<HotCandidate> mine = tracker.candidates(local, materials, local_max, &global_ids, &reference_temperature);
   double max_temperature = -std::numeric_limits<double>::infinity();
   mpi_check(MPI_Allreduce(&local_max, &max_temperature, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
-  tracker.update_from(gather_hot_candidates(comm, mine), max_temperature, global_particle_count, time);
+  // In global-id order: the clustering's order (hence the hot spots' order, new ids and sums) is then
+  // that of a serial tracker given every particle by id, whatever the partition and swarm order.
+  std::vector<HotCandidate> all = gather_hot_candidates(comm, mine);
+  std::sort(all.begin(), all.end(), [](const HotCandidate& a, const HotCandidate& b) { return a.index < b.index; });
+  tracker.update_from(std::move(all), max_temperature, global_particle_count, time);
 }
 
 #define FRICTHERM_HOT_SPOTS_ACROSS_RANKS(D)                                                                           \

@@ -65,7 +65,7 @@ void DecomposedMpm<Dim>::set_particle_scalar(int index, const std::vector<double
 }
 
 template <int Dim>
-DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
+DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data(bool kinematics) const {
   SwarmFields f(impl_->swarm);
   DecomposedLocalParticles out;
   const auto n = static_cast<std::size_t>(f.n);
@@ -73,6 +73,11 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
   out.mass.assign(f.mass, f.mass + n);
   out.volume.assign(f.volume, f.volume + n);
   out.material.assign(f.material, f.material + n);
+  if (kinematics) {
+    out.position.assign(f.x, f.x + Dim * n);
+    out.velocity.assign(f.velocity, f.velocity + Dim * n);
+    out.half_size.assign(f.half_size, f.half_size + Dim * n);
+  }
   return out;
 }
 
@@ -115,6 +120,16 @@ int DecomposedMpm<Dim>::local_node_count() const {
 template <int Dim>
 const std::vector<int>& DecomposedMpm<Dim>::owned_local_nodes() const {
   return impl_->owned_local_int;
+}
+
+template <int Dim>
+std::array<int, 2 * Dim> DecomposedMpm<Dim>::ghosted_nodes() const {
+  std::array<int, 2 * Dim> r{};
+  for (std::size_t d = 0; d < static_cast<std::size_t>(Dim); ++d) {
+    r[2 * d] = static_cast<int>(impl_->box_start[d]);
+    r[2 * d + 1] = static_cast<int>(impl_->box_start[d] + impl_->box_size[d]);
+  }
+  return r;
 }
 
 namespace {
@@ -179,10 +194,11 @@ void DecomposedMpm<Dim>::owned_to_local(const std::vector<double>& owned, int co
   template std::vector<double> DecomposedMpm<D>::Impl::scalar_values() const;                          \
   template std::vector<double> DecomposedMpm<D>::particle_scalar(int) const;                           \
   template void DecomposedMpm<D>::set_particle_scalar(int, const std::vector<double>&);                \
-  template DecomposedLocalParticles DecomposedMpm<D>::local_particle_data() const;                     \
+  template DecomposedLocalParticles DecomposedMpm<D>::local_particle_data(bool) const;                     \
   template const DecomposedMpm<D>::Stencils& DecomposedMpm<D>::current_stencils();                     \
   template int DecomposedMpm<D>::local_node_count() const;                                             \
   template const std::vector<int>& DecomposedMpm<D>::owned_local_nodes() const;                        \
+  template std::array<int, 2 * D> DecomposedMpm<D>::ghosted_nodes() const;                              \
   template void DecomposedMpm<D>::sum_to_owned(const std::vector<double>&, int, std::vector<double>&); \
   template void DecomposedMpm<D>::owned_to_local(const std::vector<double>&, int, std::vector<double>&);
 FRICTHERM_INSTANTIATE_TRANSFER(2)

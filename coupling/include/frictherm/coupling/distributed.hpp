@@ -7,8 +7,10 @@
 // Hot spots across rank boundaries: each rank finds its hot particles (HotSpotTracker::candidates,
 // indexed by global particle id), the candidates of all ranks are gathered on every rank (one
 // MPI_Allgatherv of fixed-size records: only hot particles travel) and every rank clusters the same
-// list in the same order, so a hot spot straddling ranks is one hot spot with the same id, members
-// and measures on every rank, and the tracking from one update to the next works as in a serial run.
+// list sorted by global id, so a hot spot straddling ranks is one hot spot with the same id, members
+// and measures on every rank, those of a serial tracker given the particles in id order whatever the
+// partition, and the tracking from one update to the next works as in a serial run. 2D and 3D; a
+// decomposed run's own particles reach it through DecomposedHeat::update_hot_spots (decomposed_heat.hpp).
 #include <frictherm/coupling/hotspots.hpp>
 
 #include <mpi.h>

@@ -44,7 +44,7 @@
 // built per body, not per particle).
 // Contact is resolved at owned nodes only, after the one exchange that completes their sums, by the
 // serial module's node-local code (mechanics/src/contact_pair.hpp, templated on Dim).
-// For coupled physics (the coupling's decomposed heat conduction, 2D) the run also carries named
+// For coupled physics (the coupling's decomposed heat conduction, 2D and 3D) the run also carries named
 // per-particle scalars in the swarm and offers the step's maps without physics: the particles' current
 // stencils in local node numbering, local node values summed into their owners, owner values to the
 // ghosts (transfer.cpp).
@@ -98,6 +98,9 @@ struct DecomposedLocalParticles {
   std::vector<double> mass;    // m_p (kg; kg per unit thickness in 2D)
   std::vector<double> volume;  // V_p (m³; m² per unit thickness in 2D)
   std::vector<int> material;
+  /// With local_particle_data(true): x_p, v_p and the uGIMP half-widths l_p, Dim values per particle
+  /// (hot spots and output of a decomposed run read them without gathering every particle).
+  std::vector<double> position, velocity, half_size;
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).
@@ -224,7 +227,7 @@ class DecomposedMpm {
   /// This rank's values of one particle scalar, in swarm order; set them (same size) back.
   std::vector<double> particle_scalar(int index) const;
   void set_particle_scalar(int index, const std::vector<double>& values);
-  DecomposedLocalParticles local_particle_data() const;
+  DecomposedLocalParticles local_particle_data(bool kinematics = false) const;
   /// S_ip and G_ip at the particles' current positions, evaluated once after each step (the serial
   /// Stencil, as the step evaluates them).
   const Stencils& current_stencils();
@@ -232,6 +235,9 @@ class DecomposedMpm {
   /// owned_nodes()), its local node.
   int local_node_count() const;
   const std::vector<int>& owned_local_nodes() const;
+  /// The ghosted box in DMDA indices, [begin, end) per direction as owned_nodes(): the local
+  /// numbering is x fastest over it.
+  std::array<int, 2 * Dim> ghosted_nodes() const;
   /// Collective: values on the ghosted box (`components` per node, ≤ max_transfer_components) summed
   /// over every rank holding the node into its owner (DMLocalToGlobal, ADD_VALUES): `owned` gets,
   /// per owned node, the sum over ranks.
