@@ -73,6 +73,8 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
   out.mass.assign(f.mass, f.mass + n);
   out.volume.assign(f.volume, f.volume + n);
   out.material.assign(f.material, f.material + n);
+  out.position.assign(f.x, f.x + Dim * n);
+  out.velocity.assign(f.velocity, f.velocity + Dim * n);
   return out;
 }
 

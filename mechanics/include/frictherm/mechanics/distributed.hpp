@@ -98,6 +98,8 @@ struct DecomposedLocalParticles {
   std::vector<double> mass;    // m_p (kg; kg per unit thickness in 2D)
   std::vector<double> volume;  // V_p (m³; m² per unit thickness in 2D)
   std::vector<int> material;
+  std::vector<double> position;  // x_p, Dim per particle (m)
+  std::vector<double> velocity;  // v_p, Dim per particle (m/s)
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).

@@ -1,0 +1,209 @@
+// `mpirun -n 2 frictherm run SCENE` (issue 16, "the same command"; coupling/src/distributed_run/,
+// coupling/app/cli_run_mpi.cpp) against `frictherm run SCENE` on the same scene:
+//   * the 2D sliding block with frictional heating (tests/coupling/scenes/decomposed_sliding_block.json,
+//     the scene of test_heat_distributed.cpp): time, kinetic energy, momentum, first- and second-order
+//     frictional work, heat delivered and the largest temperature rise agree at every step within 1e-9
+//     of each column's largest magnitude (the sliding phase has no chaos: the decomposed step is the
+//     serial arithmetic, the sums only change order); the books summed over ranks close to 1e-9 of the
+//     work (work received = heat delivered = Σ_i M_i ΔT_i = Σ_p m_p C_p ΔT_p) and the work received
+//     equals the serial run's second-order work; the last snapshot, read from the rank files, holds
+//     every particle exactly once at the serial position and temperature;
+//   * a 3D sliding block without heat (decomposed_sliding_block_3d.json): the same series checks;
+//   * a scene the decomposed engine does not support (penalty contact, a neo-Hookean material) is
+//     refused with exit code 2 naming the scene key, before any file is written;
+//   * an existing output file (the series file or one rank's file) is refused without --force, left
+//     untouched, and replaced with it.
+// Skipped when mpirun is not installed. Labels verification;mpi.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "h5_test_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using frictherm::test::read_doubles;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result shell(const std::string& cmd) {
+  Result r;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
+std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
+
+std::string mpirun2() {
+  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n 2";  // 2 processes on any machine
+  if (geteuid() == 0) cmd += " --allow-run-as-root";                      // Open MPI refuses root otherwise
+  return cmd;
+}
+
+class CliMpirun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("frictherm_mpirun_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // Runs the scene serially and under mpirun -n 2 into serial.h5 and split.h5.
+  void run_both(const char* name) {
+    const Result s = shell(exe() + " run " + scene(name) + " -q --threads 1 -o '" + path("serial.h5") + "'");
+    ASSERT_EQ(s.code, 0) << s.output;
+    const Result d = shell(mpirun2() + " " + exe() + " run " + scene(name) + " -o '" + path("split.h5") + "'");
+    ASSERT_EQ(d.code, 0) << d.output;
+    EXPECT_THAT(d.output, HasSubstr("particles on 2 ranks"));
+    for (const char* f : {"split.h5", "split.xdmf", "split.rank0.h5", "split.rank1.h5"}) EXPECT_TRUE(fs::exists(path(f))) << f;
+  }
+
+  // Every row of `column` in both files within `tolerance` of the serial column's largest magnitude;
+  // returns the largest difference relative to that magnitude.
+  double expect_same_column(const std::string& column, double tolerance, double offset = 0.0) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), "/series/" + column);
+    const std::vector<double> b = read_doubles(path("split.h5"), "/series/" + column);
+    EXPECT_FALSE(a.empty()) << column;
+    EXPECT_EQ(a.size(), b.size()) << column;
+    double scale = 0.0, diff = 0.0;
+    for (double x : a) scale = std::max(scale, std::fabs(x - offset));
+    for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) diff = std::max(diff, std::fabs(a[k] - b[k]));
+    EXPECT_GT(scale, 0.0) << column;
+    EXPECT_LE(diff, tolerance * scale) << column;
+    std::printf("  %-22s max |serial - split| = %.3g of %.6g\n", column.c_str(), diff / scale, scale);
+    return diff / scale;
+  }
+
+  double meta(const std::string& file, const std::string& key) const {
+    const std::vector<double> v = read_doubles(path(file), "/meta/" + key);
+    return v.empty() ? std::nan("") : v[0];
+  }
+
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(CliMpirun, SlidingBlockWithHeatingEqualsTheSerialRun) {
+  run_both("decomposed_sliding_block.json");
+  if (HasFatalFailure()) return;
+  constexpr double kTol = 1e-9;
+  expect_same_column("time", kTol);
+  for (const char* c : {"kinetic_energy", "momentum_x", "momentum_y", "friction_work_first", "friction_work_second",
+                        "heat_delivered", "thermal_windows"})
+    expect_same_column(c, kTol);
+  expect_same_column("max_temperature", kTol, 300.0);  // relative to the largest rise (≈ 0.79 K)
+  // Books over both ranks (J), relative to the work received.
+  const double w = meta("split.h5", "work_received");
+  const std::vector<double> w2 = read_doubles(path("serial.h5"), "/series/friction_work_second");
+  ASSERT_FALSE(w2.empty());
+  EXPECT_GT(w, 0.1);
+  EXPECT_NEAR(w, w2.back(), kTol * w);
+  for (const char* k : {"heat_delivered", "nodal_energy_change", "particle_energy_change"})
+    EXPECT_NEAR(meta("split.h5", k), w, kTol * w) << k;
+  // The last snapshot over the rank files: every particle once, at the serial position and temperature.
+  const std::string snap = "/snapshots/000004/";
+  const std::vector<double> xs = read_doubles(path("serial.h5"), snap + "position");
+  const std::vector<double> Ts = read_doubles(path("serial.h5"), snap + "temperature");
+  const std::size_t n = Ts.size();
+  ASSERT_EQ(n, 512u);
+  std::vector<int> seen(n, 0);
+  double dx = 0.0, dT = 0.0;
+  for (const char* f : {"split.rank0.h5", "split.rank1.h5"}) {
+    const std::vector<double> id = read_doubles(path(f), snap + "id");
+    const std::vector<double> x = read_doubles(path(f), snap + "position");
+    const std::vector<double> T = read_doubles(path(f), snap + "temperature");
+    EXPECT_FALSE(id.empty()) << f << ": every rank holds particles of the split block scene";
+    ASSERT_EQ(x.size(), 2 * id.size());
+    ASSERT_EQ(T.size(), id.size());
+    for (std::size_t k = 0; k < id.size(); ++k) {
+      const auto i = static_cast<std::size_t>(id[k]);
+      ASSERT_LT(i, n);
+      ++seen[i];
+      dx = std::max({dx, std::fabs(x[2 * k] - xs[2 * i]), std::fabs(x[2 * k + 1] - xs[2 * i + 1])});
+      dT = std::max(dT, std::fabs(T[k] - Ts[i]));
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
+  EXPECT_LE(dx, kTol * 1e-3);  // of the 1 mm cell
+  EXPECT_LE(dT, kTol * 0.79);  // of the largest temperature rise
+  std::printf("  last snapshot: positions %.3g m, temperatures %.3g K from the serial run\n", dx, dT);
+}
+
+TEST_F(CliMpirun, ThreeDimensionalSlidingBlockEqualsTheSerialRun) {
+  run_both("decomposed_sliding_block_3d.json");
+  if (HasFatalFailure()) return;
+  for (const char* c : {"time", "kinetic_energy", "momentum_x", "momentum_y", "friction_work_first", "friction_work_second"})
+    expect_same_column(c, 1e-9);
+}
+
+TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"--set contact.method=penalty", "contact.method: \"penalty\" is not supported in a decomposed run"},
+      {"--set materials.block.type=neo_hookean", "materials.block.type: \"neo_hookean\" is not supported in a decomposed run"},
+      {"--set coupling.window=adaptive", "coupling.window: \"adaptive\""}};
+  for (const auto& [set, message] : cases) {
+    const Result r = shell(mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
+                           " -o '" + path("refused.h5") + "'");
+    EXPECT_EQ(r.code, 2) << set << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message)) << set;
+    EXPECT_THAT(r.output, HasSubstr("the serial run (without mpirun, or with -n 1) supports it")) << set;
+    EXPECT_TRUE(fs::is_empty(dir_)) << set << ": nothing may be written";
+  }
+  // The serial program runs the same penalty scene's validation (it is a valid scene).
+  const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") + " --set contact.method=penalty");
+  EXPECT_EQ(v.code, 0) << v.output;
+}
+
+TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
+  const std::string run = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+                          " -q --set run.end_time=2e-5 -o '" + path("out.h5") + "'";
+  for (const char* existing : {"out.h5", "out.rank1.h5", "out.xdmf"}) {
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(path(existing)) << "an earlier result";
+    const Result r = shell(run);
+    EXPECT_EQ(r.code, 2) << existing << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(std::string(existing) + "' exists; refusing to replace an existing result"));
+    std::ifstream in(path(existing));
+    std::stringstream kept;
+    kept << in.rdbuf();
+    EXPECT_EQ(kept.str(), "an earlier result") << existing;
+    for (const char* f : {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"})
+      if (std::string(f) != existing) {
+        EXPECT_FALSE(fs::exists(path(f))) << existing << " refused, yet " << f << " written";
+      }
+    const Result forced = shell(run + " --force");
+    EXPECT_EQ(forced.code, 0) << existing << ": " << forced.output;
+    EXPECT_FALSE(read_doubles(path("out.rank1.h5"), "/snapshots/000000/id").empty() &&
+                 read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
+    EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty()) << existing;
+  }
+}
