@@ -81,9 +81,9 @@ std::string thermal_refusal(const Scene& s) {
     return refuse("thermal.fixed_temperature", std::to_string(c.fixed_faces.size()) + " face(s)", "adiabatic faces");
   if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
   if (c.window.kind != WindowPolicy::Kind::every_step)
-    return refuse("coupling.window", quoted(to_string(c.window.kind)) + " (adaptive is the default)", "\"every_step\"");
+    return refuse("coupling.window", quoted(to_string(c.window.kind)) + " (the default is adaptive)", "\"every_step\"");
   if (c.reuse_distance != 0.0)
-    return refuse("coupling.reuse_distance", number(c.reuse_distance) + " (0.01 is the default)",
+    return refuse("coupling.reuse_distance", number(c.reuse_distance) + " (the default is 0.01)",
                   "0: the gather every window");
   if (c.plastic.enabled) return refuse("coupling.plastic_heating", "true", "false");
   if (t.continuation_duration > 0.0)
