@@ -12,7 +12,8 @@
 //   * a scene the decomposed engine does not support (penalty contact, a neo-Hookean material) is
 //     refused with exit code 2 naming the scene key, before any file is written;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
-//     untouched, and replaced with it.
+//     untouched, and replaced with it;
+//   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle.
 // Skipped when mpirun is not installed. Labels verification;mpi.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -206,4 +207,32 @@ TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
                  read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
     EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty()) << existing;
   }
+}
+
+namespace {
+// "step N" and "particle K" of "... failed: step N, t = ... s: particle K ..." ("" when absent).
+std::string failure_point(const std::string& output) {
+  const auto at = output.find("simulation failed: step ");
+  if (at == std::string::npos) return "";
+  const auto step_end = output.find(',', at);
+  const auto particle = output.find(": particle ", step_end);
+  if (step_end == std::string::npos || particle == std::string::npos) return "";
+  const auto particle_end = output.find(' ', particle + 11);
+  return output.substr(at + 19, step_end - at - 19) + " / " + output.substr(particle + 2, particle_end - particle - 2);
+}
+}  // namespace
+
+TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
+  const std::string throw_block = " --set 'bodies[1].velocity=[400,0]'";  // leaves the 26 mm grid within 40 steps
+  const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + throw_block + " -q -o '" +
+                         path("serial.h5") + "'");
+  const Result d = shell(mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") + throw_block +
+                         " -q -o '" + path("split.h5") + "'");
+  EXPECT_EQ(s.code, 1) << s.output;
+  EXPECT_EQ(d.code, 1) << d.output;
+  const std::string point = failure_point(s.output);
+  EXPECT_THAT(point, HasSubstr("particle ")) << s.output;
+  EXPECT_EQ(failure_point(d.output), point) << d.output;
+  EXPECT_THAT(d.output, HasSubstr("left the grid"));
+  EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty()) << "the series before the failure stay readable";
 }

@@ -67,14 +67,16 @@ class DecomposedRun {
     last_flush_ = Clock::now();
     try {
       loop(progress);
-    } catch (const mechanics::SimulationError& e) {  // the time step, agreed by every rank
+    } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
       r_.status = RunResult::Status::failed;
       r_.message = e.what();
       if (out_) out_->write_metadata("failure", r_.message);
     }
     progress.finish();
-    if (last_series_step_ != step_) series();
-    if (last_snapshot_step_ != step_) snapshot();
+    if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
+      if (last_series_step_ != step_) series();
+      if (last_snapshot_step_ != step_) snapshot();
+    }
     if (r_.status == RunResult::Status::interrupted) {
       r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " + std::to_string(step_) +
                    ", t = " + format_number(time_) + " s";
@@ -198,38 +200,59 @@ class DecomposedRun {
     return n;
   }
 
-  // Collective: the largest c_p + |v_p| over all ranks (the serial stable_time_step's, linear elastic:
-  // c_p the material's P-wave speed) and whether any rank caught SIGINT/SIGTERM, in one reduction.
+  // Collective, one reduction: the largest c_p + |v_p| over all ranks (the serial stable_time_step's,
+  // linear elastic: c_p the material's P-wave speed), whether any rank caught SIGINT/SIGTERM, and the
+  // lowest id of a particle with a non-finite state or outside the grid (the serial step's check),
+  // which becomes a SimulationError on every rank.
   void stable_time_step(double& dt, int& signal) const {
     const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data();
-    double v[2] = {0.0, static_cast<double>(detail::interrupt_signal())};
+    constexpr double none = -std::numeric_limits<double>::infinity();
+    double v[4] = {0.0, static_cast<double>(detail::interrupt_signal()), none, none};  // max of −id: lowest id
     for (std::size_t k = 0; k < p.mass.size(); ++k) {
-      const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k);
+      const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k), xk(p.position.data() + Dim * k);
       v[0] = std::max(v[0], wave_speed_[static_cast<std::size_t>(p.material[k])] + vk.norm());
+      if (!(vk.allFinite() && xk.allFinite()))
+        v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
+      else if (!grid_->contains(xk))
+        v[3] = std::max(v[3], -static_cast<double>(p.id[k]));
     }
-    MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_DOUBLE, MPI_MAX, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, comm_);
     signal = static_cast<int>(v[1]);
+    const std::string at = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: particle ";
+    if (v[2] > none)
+      throw mechanics::SimulationError(at + format_number(-v[2]) + " has a non-finite velocity or position (the step "
+                                            "blew up; try a smaller CFL factor)", step_, time_, static_cast<long>(-v[2]));
+    if (v[3] > none) {
+      std::string span;
+      for (int d = 0; d < Dim; ++d) span += (d ? ", " : "") + format_number(grid_->lo()[d]);
+      span += ") to (";
+      for (int d = 0; d < Dim; ++d) span += (d ? ", " : "") + format_number(grid_->hi()[d]);
+      throw mechanics::SimulationError(at + format_number(-v[3]) + " left the grid; grid spans (" + span + ") m", step_,
+                                       time_, static_cast<long>(-v[3]));
+    }
     const double cap = s_.options.max_time_step;
     dt = v[0] <= 0.0 ? cap : std::min(s_.options.cfl * grid_->min_cell_size() / v[0], cap);
   }
 
+  // The serial loop (runner.cpp) with one reduction per step: after each mechanics step, the next
+  // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
   void loop(detail::ProgressLine& progress) {
     const double T = s_.end_time, eps = 1e-10 * T;
     const double snap_dt = s_.output.snapshot_interval, series_dt = s_.output.series_interval;
     long snap_k = 1;
     double next_snap = std::min(snap_dt, T);
     double next_series = series_dt;
+    double stable = 0.0;
+    int signal = 0;
+    stable_time_step(stable, signal);
     while (time_ < T - eps) {
-      if (s_.max_steps > 0 && step_ >= s_.max_steps) {
-        r_.status = RunResult::Status::stopped_at_max_steps;
-        return;
-      }
-      double stable = 0.0;
-      int signal = 0;
-      stable_time_step(stable, signal);
       if (signal != 0) {
         r_.status = RunResult::Status::interrupted;
         r_.signal = signal;
+        return;
+      }
+      if (s_.max_steps > 0 && step_ >= s_.max_steps) {
+        r_.status = RunResult::Status::stopped_at_max_steps;
         return;
       }
       // As the serial loop: land on the next snapshot time, the last stretch in two similar steps.
@@ -247,6 +270,7 @@ class DecomposedRun {
       time_ += dt;
       last_dt_ = dt;
       ++step_;
+      stable_time_step(stable, signal);  // throws SimulationError on every rank for a broken state
       if (heat_) {
         const Clock::time_point h0 = Clock::now();
         heat_->after_step(dt);
@@ -264,6 +288,10 @@ class DecomposedRun {
         if (next_snap <= t + eps && next_snap < T) next_snap = std::min(static_cast<double>(++snap_k) * snap_dt, T);
       }
       progress.update(step_, t);
+    }
+    if (signal != 0) {  // caught during the last step: the run is complete, but say so as the serial run
+      r_.status = RunResult::Status::interrupted;
+      r_.signal = signal;
     }
   }
 
