@@ -71,9 +71,9 @@ const char* const kRunHelp =
     "--checkpoint-every), heat in 3D, other integrators and windows, fixed temperatures, reactions,\n"
     "plastic heating, the continuation. Output: OUT.h5 holds the series (time, step, dt, kinetic\n"
     "energy, momentum, frictional work, contact counts, heat delivered, thermal energy change,\n"
-    "max temperature, energy books) and metadata; each rank writes its particle snapshots to\n"
-    "OUT.rank<r>.h5, joined by OUT.xdmf; every one of these files is refused if it exists, unless\n"
-    "--force. No hot spots, grid fields or stresses in a decomposed run's output yet.\n";
+    "max temperature, hot spots, energy books), /hotspots and metadata; each rank writes its particle\n"
+    "snapshots to OUT.rank<r>.h5, joined by OUT.xdmf; every one of these files is refused if it\n"
+    "exists, unless --force. No grid fields or stresses in a decomposed run's snapshots yet.\n";
 
 const char* const kValidateHelp =
     "usage: frictherm validate SCENE [--set KEY=VALUE ...]\n"

@@ -2,6 +2,7 @@
 // P-wave speed plus the particle speed, the largest over all ranks; landing on every snapshot time and
 // on end_time), the engine's USL step and, in 2D, the heat hand-off and forward-Euler conduction of
 // DecomposedHeat every step; series on rank 0 (OUT.h5), particle snapshots per rank joined by OUT.xdmf.
+#include "distributed_run/decomposed_hotspots.hpp"
 #include "distributed_run/decomposed_setup.hpp"
 #include "run/run_signals.hpp"
 #include "run/runner_detail.hpp"
@@ -144,6 +145,8 @@ class DecomposedRun {
         } catch (const std::invalid_argument& e) {
           throw SceneError(std::string("thermal.materials: ") + e.what());
         }
+        hot_ = std::make_unique<detail::DecomposedHotSpots<Dim>>(s_, *mpm_);
+        hot_->update(*mpm_, 0.0);  // the initial hot spots, as the serial Coupler::start
       }
     }
   }
@@ -159,6 +162,7 @@ class DecomposedRun {
         out_ = std::make_unique<H5Output>(r_.output, Dim, options);
         write_start_metadata();
         out_->declare_series(series_names());
+        if (hot_) hot_->declare_table(*out_);
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -194,9 +198,11 @@ class DecomposedRun {
     for (int d = 0; d < Dim; ++d) n.emplace_back(axes[d]);
     if (s_.contact.enabled)
       n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
-    if (heat_)
-      n.insert(n.end(), {"heat_delivered", "thermal_energy_change", "max_temperature", "thermal_windows",
-                         "work_received", "nodal_energy_change"});
+    if (heat_) {
+      n.insert(n.end(), {"heat_delivered", "thermal_energy_change", "max_temperature"});
+      for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
+      n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
+    }
     return n;
   }
 
@@ -274,6 +280,7 @@ class DecomposedRun {
       if (heat_) {
         const Clock::time_point h0 = Clock::now();
         heat_->after_step(dt);
+        hot_->update(*mpm_, time_);  // after every window, as the serial coupler
         heating_seconds_ += seconds_since(h0);
       }
       const double t = time_;
@@ -316,11 +323,14 @@ class DecomposedRun {
     }
     if (heat_) {
       const DecomposedHeatBooks& b = heat_->books();
-      row.insert(row.end(), {b.heat_delivered, b.particle_energy_change, max_temperature(p),
-                             static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
+      // The highest temperature of the conducting particles over all ranks, from the last update.
+      row.insert(row.end(), {b.heat_delivered, b.particle_energy_change, hot_->tracker().max_temperature()});
+      hot_->extend_series_row(row);
+      row.insert(row.end(), {static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
     }
     if (out_) {
       out_->append_series(row);
+      if (hot_) hot_->append_table_rows(*out_, time_);
       if (seconds_since(last_flush_) >= o_.flush_interval) {
         out_->flush();
         last_flush_ = Clock::now();
@@ -328,19 +338,6 @@ class DecomposedRun {
     }
     last_series_step_ = step_;
     output_seconds_ += seconds_since(c0);
-  }
-
-  // Collective: the highest temperature of the conducting particles (as the serial hot-spot tracker's).
-  double max_temperature(const mechanics::DecomposedLocalParticles& p) const {
-    const std::vector<double> T = mpm_->particle_scalar(temperature_);
-    const std::vector<ThermalProperties>& mats = s_.thermal.coupler.materials;
-    double tmax = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < T.size(); ++k) {
-      const auto m = static_cast<std::size_t>(p.material[k]);
-      if (m < mats.size() && mats[m].conducts) tmax = std::max(tmax, T[k]);
-    }
-    MPI_Allreduce(MPI_IN_PLACE, &tmax, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    return tmax;
   }
 
   // Collective: every rank writes its particles; rank 0 rewrites OUT.xdmf.
@@ -401,6 +398,7 @@ class DecomposedRun {
       out_->write_metadata("nodal_energy_change", b.nodal_energy_change);
       out_->write_metadata("particle_energy_change", b.particle_energy_change);
       out_->write_metadata("max_capacity_residual", b.max_capacity_residual);
+      out_->write_metadata("hotspots_seen", hot_->tracker().ids_issued());
     }
     const char* status = r_.status == RunResult::Status::failed                 ? "failed"
                          : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
@@ -425,6 +423,7 @@ class DecomposedRun {
   std::unique_ptr<mechanics::Grid<Dim>> grid_;
   std::unique_ptr<Mpm> mpm_;
   std::unique_ptr<DecomposedHeat> heat_;  // 2D scenes with a `thermal` section
+  std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
   std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
   std::unique_ptr<DecomposedOutput> snapshots_out_;
   std::vector<double> wave_speed_;  // P-wave speed by material (m/s)

@@ -51,7 +51,7 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
     o.contact_options = scene.contact.options;
     for (const ContactPairSpec& p : scene.contact.pairs) o.contact_pairs.push_back({p.material_a, p.material_b, p.settings});
   }
-  o.particle_scalars = {"temperature"};
+  o.particle_scalars = {"temperature", "reference_temperature"};  // T_p and T0_p (hot spots' reference)
   return o;
 }
 
@@ -78,7 +78,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MP
         q.stress = p.stress[k];
         q.stress_zz = p.stress_zz[k];
         q.material = p.material[k];
-        q.scalars = {p.temperature[k]};
+        q.scalars = {p.temperature[k], p.temperature[k]};
       }
     } catch (const SceneError& e) {
       error = e.what();

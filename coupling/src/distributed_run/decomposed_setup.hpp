@@ -16,13 +16,13 @@ namespace frictherm::coupling::detail {
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene);
 
-/// The decomposed engine's options for a supported scene; the particles carry one scalar,
-/// "temperature" (K).
+/// The decomposed engine's options for a supported scene; the particles carry two scalars,
+/// "temperature" and "reference_temperature" (T_p and its initial value T0_p, K).
 template <int Dim>
 typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& scene);
 
 /// Collective: rank 0 builds the scene's particles (build_simulation) and returns them with id = serial
-/// index and the body temperature as their scalar; the other ranks return none. A SceneError on rank 0
+/// index and the body temperature as both scalars; the other ranks return none. A SceneError on rank 0
 /// is thrown on every rank.
 template <int Dim>
 std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MPI_Comm comm, const Scene& scene);

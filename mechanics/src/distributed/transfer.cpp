@@ -75,6 +75,7 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data() const {
   out.material.assign(f.material, f.material + n);
   out.position.assign(f.x, f.x + Dim * n);
   out.velocity.assign(f.velocity, f.velocity + Dim * n);
+  out.half_size.assign(f.half_size, f.half_size + Dim * n);
   return out;
 }
 

@@ -100,6 +100,7 @@ struct DecomposedLocalParticles {
   std::vector<int> material;
   std::vector<double> position;  // x_p, Dim per particle (m)
   std::vector<double> velocity;  // v_p, Dim per particle (m/s)
+  std::vector<double> half_size; // l_p, Dim per particle (m)
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).
