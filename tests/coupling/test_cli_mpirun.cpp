@@ -217,9 +217,9 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
 TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
   const std::string run = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
                           " -q --set run.end_time=2e-5 -o '" + path("out.h5") + "'";
+  const char* const files[] = {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"};
   for (const char* existing : {"out.h5", "out.rank1.h5", "out.xdmf"}) {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    for (const char* f : files) fs::remove(path(f));
     std::ofstream(path(existing)) << "an earlier result";
     const Result r = shell(run);
     EXPECT_EQ(r.code, 2) << existing << ": " << r.output;
@@ -228,16 +228,21 @@ TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
     std::stringstream kept;
     kept << in.rdbuf();
     EXPECT_EQ(kept.str(), "an earlier result") << existing;
-    for (const char* f : {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"})
+    for (const char* f : files)
       if (std::string(f) != existing) {
         EXPECT_FALSE(fs::exists(path(f))) << existing << " refused, yet " << f << " written";
       }
-    const Result forced = shell(run + " --force");
-    EXPECT_EQ(forced.code, 0) << existing << ": " << forced.output;
-    EXPECT_FALSE(read_doubles(path("out.rank1.h5"), "/snapshots/000000/id").empty() &&
-                 read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
-    EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty()) << existing;
   }
+  // With --force every file is replaced (here out.xdmf existed).
+  const Result forced = shell(run + " --force");
+  EXPECT_EQ(forced.code, 0) << forced.output;
+  EXPECT_FALSE(read_doubles(path("out.rank1.h5"), "/snapshots/000000/id").empty() &&
+               read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
+  EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty());
+  std::ifstream xdmf(path("out.xdmf"));
+  std::stringstream text;
+  text << xdmf.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("out.rank1.h5:/snapshots/000000/position"));
 }
 
 namespace {
