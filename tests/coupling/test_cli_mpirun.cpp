@@ -12,7 +12,7 @@
 //     peak, mean, centroid, size and excess energy within 1e-9);
 //   * a 3D sliding block without heat (decomposed_sliding_block_3d.json): the same series checks;
 //   * a scene the decomposed engine does not support (penalty contact, a neo-Hookean material) is
-//     refused with exit code 2 naming the scene key, before any file is written;
+//     refused with exit code 2 naming the scene key, before any file is written, and `validate` says so;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
 //     untouched, and replaced with it;
 //   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle.
@@ -209,9 +209,12 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
     EXPECT_THAT(r.output, HasSubstr("the serial run (without mpirun, or with -n 1) supports it")) << set;
     EXPECT_TRUE(fs::is_empty(dir_)) << set << ": nothing may be written";
   }
-  // The serial program runs the same penalty scene's validation (it is a valid scene).
+  // It is a valid scene: `validate` accepts it and says that it runs serially only, and why.
   const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") + " --set contact.method=penalty");
   EXPECT_EQ(v.code, 0) << v.output;
+  EXPECT_THAT(v.output, HasSubstr("serial only (contact.method: \"penalty\" is not supported in a decomposed run"));
+  const Result ok = shell(exe() + " validate " + scene("decomposed_sliding_block.json"));
+  EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it"));
 }
 
 TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {

@@ -14,6 +14,7 @@
 // linear, uGIMP and quadratic B-spline shapes, fixed grid faces, gravity, multimaterial contact with
 // any friction law and the position, displacement or velocity_only separation; in 2D frictional
 // heating with forward-Euler conduction every mechanics step (matrix-free, the gather every window).
+#include <frictherm/coupling/decomposed_support.hpp>  // decomposed_run_refusal
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
@@ -22,10 +23,6 @@
 #include <string>
 
 namespace frictherm::coupling {
-
-/// "" when the decomposed engine runs `scene`; otherwise why not: the first unsupported scene key with
-/// its value ("contact.method: \"penalty\" is not supported in a decomposed run ..."). Pure: no MPI.
-std::string decomposed_run_refusal(const Scene& scene);
 
 /// Runs a validated, supported scene over the ranks of `comm` (collective; PETSc initialised).
 /// Output: OUT.h5 (rank 0: the time series and metadata, as the serial file without snapshots),

@@ -1,7 +1,7 @@
-// Which scenes the decomposed engine runs (decomposed_run.hpp): every feature DecomposedMpm and
+// Which scenes the decomposed engine runs (decomposed_support.hpp): every feature DecomposedMpm and
 // DecomposedHeat implement, checked key by key before anything is built, so that a scene they do not
 // support is refused with the scene key, its value and the way out (the serial run).
-#include <frictherm/coupling/decomposed_run.hpp>
+#include <frictherm/coupling/decomposed_support.hpp>
 
 #include <cmath>
 #include <sstream>
