@@ -15,7 +15,8 @@
 //     refused with exit code 2 naming the scene key, before any file is written, and `validate` says so;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
 //     untouched, and replaced with it;
-//   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle.
+//   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle;
+//   * mpirun -n 1 is the serial program (its file layout and the same numbers).
 // Skipped when mpirun is not installed. Labels verification;mpi.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -60,11 +61,12 @@ Result shell(const std::string& cmd) {
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
 
-std::string mpirun2() {
-  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n 2";  // 2 processes on any machine
-  if (geteuid() == 0) cmd += " --allow-run-as-root";                      // Open MPI refuses root otherwise
+std::string mpirun(int ranks) {
+  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n " + std::to_string(ranks);  // on any machine
+  if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
   return cmd;
 }
+std::string mpirun2() { return mpirun(2); }
 
 class CliMpirun : public ::testing::Test {
  protected:
@@ -274,4 +276,20 @@ TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
   EXPECT_EQ(failure_point(d.output), point) << d.output;
   EXPECT_THAT(d.output, HasSubstr("left the grid"));
   EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty()) << "the series before the failure stay readable";
+}
+
+TEST_F(CliMpirun, OneRankRunsTheSerialProgram) {
+  // mpirun -n 1: today's serial program (one file with its snapshots, no rank files), the same numbers.
+  const std::string sc = scene("decomposed_sliding_block_3d.json") + " -q --set run.end_time=5e-5";
+  const Result s = shell(exe() + " run " + sc + " --threads 1 -o '" + path("serial.h5") + "'");
+  const Result d = shell(mpirun(1) + " " + exe() + " run " + sc + " --threads 1 -o '" + path("one.h5") + "'");
+  ASSERT_EQ(s.code, 0) << s.output;
+  ASSERT_EQ(d.code, 0) << d.output;
+  EXPECT_FALSE(fs::exists(path("one.rank0.h5")));
+  EXPECT_FALSE(read_doubles(path("one.h5"), "/snapshots/000000/position").empty());
+  for (const char* c : {"time", "kinetic_energy", "friction_work_second"}) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), std::string("/series/") + c);
+    EXPECT_FALSE(a.empty()) << c;
+    EXPECT_EQ(a, read_doubles(path("one.h5"), std::string("/series/") + c)) << c;
+  }
 }
