@@ -60,7 +60,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
                                    {{"--checkpoint-every"}, true, "checkpoint-every"},
                                    kForceOption, kSetOption});
   if (a.help) {
-    std::cout << kRunHelp;
+    if (launcher_info().rank <= 0) std::cout << kRunHelp;  // under mpirun: rank 0 only
     return kOk;
   }
   const std::string& path = single_positional("run", a, "SCENE");
