@@ -16,7 +16,8 @@
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
 //     untouched, and replaced with it;
 //   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle;
-//   * mpirun -n 1 is the serial program (its file layout and the same numbers).
+//   * mpirun -n 1 is the serial program (its file layout and the same numbers);
+//   * Ctrl-C to mpirun stops every rank after the same step with complete, readable files.
 // Skipped when mpirun is not installed. Labels verification;mpi.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -292,4 +293,33 @@ TEST_F(CliMpirun, OneRankRunsTheSerialProgram) {
     EXPECT_FALSE(a.empty()) << c;
     EXPECT_EQ(a, read_doubles(path("one.h5"), std::string("/series/") + c)) << c;
   }
+}
+
+TEST_F(CliMpirun, InterruptedRunStopsEveryRankAndKeepsItsFiles) {
+  // Ctrl-C to mpirun once the run writes (Open MPI's mpirun passes it on to the ranks as SIGTERM):
+  // every rank stops after the same step, the files are complete and readable, rank 0 says so.
+  const std::string out = path("x.h5");
+  const std::string cmd = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+                          " -q --set run.end_time=1 -o '" + out + "' > '" + path("log") + "' 2>&1 & pid=$!; " +
+                          "for i in $(seq 1 600); do ls '" + out + "'.*.part >/dev/null 2>&1 && break; sleep 0.1; done; " +
+                          "sleep 0.5; kill -INT $pid; wait $pid";
+  const Result r = shell(cmd);
+  std::ifstream in(path("log"));
+  std::stringstream log;
+  log << in.rdbuf();
+  EXPECT_NE(r.code, 0) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("interrupted by SIG"));
+  EXPECT_THAT(log.str(), HasSubstr("/meta/status = interrupted"));
+  const std::vector<double> t = read_doubles(out, "/series/time");
+  ASSERT_FALSE(t.empty()) << "the series file is renamed into place and readable";
+  EXPECT_LT(t.back(), 1.0) << "stopped before end_time";
+  // The last snapshot is at the interruption, on the ranks that hold particles, listed in the XDMF file.
+  std::ifstream xdmf(path("x.xdmf"));
+  std::stringstream text;
+  text << xdmf.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("x.rank0.h5:/snapshots/000001/position"));
+  EXPECT_FALSE(read_doubles(path("x.rank0.h5"), "/snapshots/000001/id").empty() &&
+               read_doubles(path("x.rank1.h5"), "/snapshots/000001/id").empty());
+  const Result csv = shell(exe() + " export-csv '" + out + "'");
+  EXPECT_EQ(csv.code, 0) << csv.output;
 }
