@@ -23,6 +23,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "cli_test_support.hpp"
 #include "h5_test_support.hpp"
 
 #include <algorithm>
@@ -34,31 +35,15 @@
 #include <string>
 #include <vector>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using frictherm::test::read_doubles;
+using frictherm::test::Result;
+using frictherm::test::shell;
 
 namespace {
-
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result shell(const std::string& cmd) {
-  Result r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
