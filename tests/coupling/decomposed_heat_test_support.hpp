@@ -30,6 +30,16 @@ inline coupling::CouplerOptions serial_coupler_options(const std::vector<couplin
   return opt;
 }
 
+/// The decomposed run's heat: the materials' thermal properties, the frictional work of `order`.
+inline coupling::DecomposedHeatOptions decomposed_heat_options(
+    const std::vector<coupling::ThermalProperties>& materials,
+    mechanics::HeatingOrder order = mechanics::HeatingOrder::second) {
+  coupling::DecomposedHeatOptions ho;
+  ho.materials = materials;
+  ho.order = order;
+  return ho;
+}
+
 /// Largest |T_p − T_p(serial)| over the gathered particles `a` (temperature their first scalar);
 /// `same` is cleared unless a holds every serial particle, by id, each with `scalars` scalars.
 template <class Particle, int Dim>

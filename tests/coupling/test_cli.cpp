@@ -24,21 +24,9 @@ namespace {
 Result frictherm(const std::string& args) { return shell(std::string("'") + FRICTHERM_EXE + "' " + args); }
 
 /// A fresh folder per test (tests may run in parallel).
-class Cli : public ::testing::Test {
+class Cli : public frictherm::test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_cli_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path(name)) << text;
-    return path(name);
-  }
-  fs::path dir_;
+  Cli() : ScratchDirTest("frictherm_cli_") {}
 };
 
 const char* const kTinyScene = R"({

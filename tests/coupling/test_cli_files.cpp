@@ -50,21 +50,9 @@ std::string status_of(const std::string& h5) {
   return s;
 }
 
-class Files : public ::testing::Test {
+class Files : public frictherm::test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_files_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path(name)) << text;
-    return path(name);
-  }
-  fs::path dir_;
+  Files() : ScratchDirTest("frictherm_files_") {}
 };
 
 const char* const kTinyScene = R"({

@@ -42,18 +42,13 @@ const char* const kTinyScene = R"({
   "output": {"snapshot_count": 4}
 })";
 
-class CliMpi : public ::testing::Test {
+class CliMpi : public frictherm::test::ScratchDirTest {
  protected:
+  CliMpi() : ScratchDirTest("frictherm_mpi_") {}
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_mpi_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    std::ofstream(path("tiny.json")) << kTinyScene;
+    ScratchDirTest::SetUp();
+    write("tiny.json", kTinyScene);
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
 };
 
 std::string serial_exe() { return std::string("'") + FRICTHERM_SERIAL_EXE + "'"; }

@@ -55,17 +55,13 @@ std::string mpirun(int ranks) {
 }
 std::string mpirun2() { return mpirun(2); }
 
-class CliMpirun : public ::testing::Test {
+class CliMpirun : public frictherm::test::ScratchDirTest {
  protected:
+  CliMpirun() : ScratchDirTest("frictherm_mpirun_") {}
   void SetUp() override {
     if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_mpirun_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    ScratchDirTest::SetUp();
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   // Runs the scene serially and under mpirun -n 2 into serial.h5 and split.h5.
   void run_both(const char* name) {
@@ -105,8 +101,6 @@ class CliMpirun : public ::testing::Test {
     const std::vector<double> v = read_doubles(path(file), "/meta/" + key);
     return v.empty() ? std::nan("") : v[0];
   }
-
-  fs::path dir_;
 };
 
 }  // namespace

@@ -43,6 +43,7 @@ using V2 = fm::Vec<2>;
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 using frictherm::test::decomposed;
+using frictherm::test::decomposed_heat_options;
 using frictherm::test::elastic;
 using frictherm::test::serial_coupler_options;
 using frictherm::test::temperature_difference;
@@ -72,10 +73,7 @@ TEST(DecomposedHeat, SlidingBlockEqualsTheSerialRunAndClosesItsBooks) {
   opt.particle_scalars = {"temperature"};
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
   split.add_particles(decomposed(sp, true));
-  fc::DecomposedHeatOptions ho;
-  ho.materials = thermal;
-  ho.order = fm::HeatingOrder::second;
-  fc::DecomposedHeat heat(split, ho);
+  fc::DecomposedHeat heat(split, decomposed_heat_options(thermal, fm::HeatingOrder::second));
   const double content0 = heat.heat_content();
 
   const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
@@ -134,7 +132,7 @@ struct StripedRun {
 
   explicit StripedRun(bool slivers)
       : sp(striped_body(0, slivers)), coupler(grid, fm::ShapeKind::ugimp, serial_coupler_options(thermal)),
-        split(MPI_COMM_WORLD, grid, mats, decomposed_options()), heat(started(), heat_options()),
+        split(MPI_COMM_WORLD, grid, mats, decomposed_options()), heat(started(), decomposed_heat_options(thermal)),
         content0(heat.heat_content()) {}
 
   static fm::DecomposedOptions decomposed_options() {
@@ -142,11 +140,6 @@ struct StripedRun {
     opt.shape = fm::ShapeKind::ugimp;
     opt.particle_scalars = {"temperature"};
     return opt;
-  }
-  fc::DecomposedHeatOptions heat_options() const {
-    fc::DecomposedHeatOptions ho;
-    ho.materials = thermal;
-    return ho;
   }
   // The serial coupler started and the particles handed to the decomposed run, before its heat is set up.
   fm::DecomposedMpm2D& started() {

@@ -106,10 +106,7 @@ TEST(DecomposedHeat3D, SlidingBlockEqualsTheSerialRunWithHotSpotsAndOutput) {
   std::vector<Mpm::Particle> given = frictherm::test::decomposed(sp, true);
   for (Mpm::Particle& p : given) p.scalars.push_back(kT0);
   split.add_particles(given);
-  fc::DecomposedHeatOptions ho;
-  ho.materials = thermal;
-  ho.order = fm::HeatingOrder::second;
-  fc::DecomposedHeat heat(split, ho);
+  fc::DecomposedHeat heat(split, frictherm::test::decomposed_heat_options(thermal, fm::HeatingOrder::second));
   const double content0 = heat.heat_content();
 
   const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::three_d) / rho);

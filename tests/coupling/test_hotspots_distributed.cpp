@@ -106,7 +106,6 @@ TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
   const int rank = comm_rank(), ranks = comm_size();
   ASSERT_GE(ranks, 2);
   Trackers trackers(2);
-  const std::vector<fc::ThermalProperties>& materials = trackers.materials;
   fc::HotSpotTracker &serial = trackers.serial, &decomposed = trackers.decomposed;
   const std::size_t total = static_cast<std::size_t>(kColumns) * kRows;
   for (int update = 0; update < 2; ++update) {
@@ -118,8 +117,8 @@ TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
     lattice(first_column(rank, ranks), first_column(rank + 1, ranks), update, ranks, mine, my_ids);
     const std::vector<double> reference(mine.size(), kT0), all_reference(all.size(), kT0);
     double max_serial = 0.0;
-    serial.update_from(serial.candidates(all, materials, max_serial, &all_ids, &all_reference), max_serial, total, time);
-    fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, materials, total, time);
+    serial.update_from(serial.candidates(all, trackers.materials, max_serial, &all_ids, &all_reference), max_serial, total, time);
+    fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, trackers.materials, total, time);
 
     const auto& spots = decomposed.hot_spots();
     ASSERT_EQ(spots.size(), update == 0 ? 2u : 3u);
@@ -162,7 +161,6 @@ TEST(HotSpotsAcrossRanks, StraddlingBallIn3DIsOneAndAllRanksAgreeWithSerial) {
   const int rank = comm_rank(), ranks = comm_size();
   ASSERT_GE(ranks, 2);
   Trackers trackers(3);
-  const std::vector<fc::ThermalProperties>& materials = trackers.materials;
   fc::HotSpotTracker &serial = trackers.serial, &decomposed = trackers.decomposed;
   const std::size_t total = static_cast<std::size_t>(kX3) * kY3 * kZ3;
   fm::Particles<3> all, mine;
@@ -176,8 +174,8 @@ TEST(HotSpotsAcrossRanks, StraddlingBallIn3DIsOneAndAllRanksAgreeWithSerial) {
   std::reverse(my_ids.begin(), my_ids.end());
   const std::vector<double> reference(mine.size(), kT0), all_reference(all.size(), kT0);
   double max_serial = 0.0;
-  serial.update_from(serial.candidates(all, materials, max_serial, &all_ids, &all_reference), max_serial, total, 0.0);
-  fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, materials, total, 0.0);
+  serial.update_from(serial.candidates(all, trackers.materials, max_serial, &all_ids, &all_reference), max_serial, total, 0.0);
+  fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, trackers.materials, total, 0.0);
   const auto& spots = decomposed.hot_spots();
   ASSERT_EQ(spots.size(), 2u);
   expect_same(spots, serial.hot_spots());
