@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "cli_test_support.hpp"
 #include "h5_test_support.hpp"
 
 #include <cstdio>
@@ -13,31 +14,15 @@
 #include <fstream>
 #include <string>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using frictherm::test::read_doubles;
+using frictherm::test::Result;
+using frictherm::test::shell;
 
 namespace {
-
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result shell(const std::string& cmd) {
-  Result r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 std::size_t count_of(const std::string& text, const std::string& what) {
   std::size_t n = 0;
@@ -57,18 +42,13 @@ const char* const kTinyScene = R"({
   "output": {"snapshot_count": 4}
 })";
 
-class CliMpi : public ::testing::Test {
+class CliMpi : public frictherm::test::ScratchDirTest {
  protected:
+  CliMpi() : ScratchDirTest("frictherm_mpi_") {}
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_mpi_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    std::ofstream(path("tiny.json")) << kTinyScene;
+    ScratchDirTest::SetUp();
+    write("tiny.json", kTinyScene);
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
 };
 
 std::string serial_exe() { return std::string("'") + FRICTHERM_SERIAL_EXE + "'"; }

@@ -23,6 +23,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "cli_test_support.hpp"
 #include "h5_test_support.hpp"
 
 #include <algorithm>
@@ -34,31 +35,15 @@
 #include <string>
 #include <vector>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using frictherm::test::read_doubles;
+using frictherm::test::Result;
+using frictherm::test::shell;
 
 namespace {
-
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result shell(const std::string& cmd) {
-  Result r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
@@ -70,17 +55,13 @@ std::string mpirun(int ranks) {
 }
 std::string mpirun2() { return mpirun(2); }
 
-class CliMpirun : public ::testing::Test {
+class CliMpirun : public frictherm::test::ScratchDirTest {
  protected:
+  CliMpirun() : ScratchDirTest("frictherm_mpirun_") {}
   void SetUp() override {
     if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_mpirun_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    ScratchDirTest::SetUp();
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   // Runs the scene serially and under mpirun -n 2 into serial.h5 and split.h5.
   void run_both(const char* name) {
@@ -120,8 +101,6 @@ class CliMpirun : public ::testing::Test {
     const std::vector<double> v = read_doubles(path(file), "/meta/" + key);
     return v.empty() ? std::nan("") : v[0];
   }
-
-  fs::path dir_;
 };
 
 }  // namespace

@@ -241,11 +241,9 @@ class DecomposedRun {
   // The serial loop (runner.cpp) with one reduction per step: after each mechanics step, the next
   // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
   void loop(detail::ProgressLine& progress) {
-    const double T = s_.end_time, eps = 1e-10 * T;
-    const double snap_dt = s_.output.snapshot_interval, series_dt = s_.output.series_interval;
-    long snap_k = 1;
-    double next_snap = std::min(snap_dt, T);
-    double next_series = series_dt;
+    const double T = s_.end_time;
+    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, 0.0);
+    const double eps = schedule.eps();
     double stable = 0.0;
     int signal = 0;
     stable_time_step(stable, signal);
@@ -260,7 +258,7 @@ class DecomposedRun {
         return;
       }
       // As the serial loop: land on the next snapshot time, the last stretch in two similar steps.
-      double limit = next_snap - time_;
+      double limit = schedule.next_snapshot() - time_;
       if (step_ == 0 || limit < 3.0 * last_dt_)
         if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
       const double dt = std::min(stable, limit);
@@ -280,16 +278,8 @@ class DecomposedRun {
         heating_seconds_ += seconds_since(h0);
       }
       const double t = time_;
-      if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {
-        series();
-        if (series_dt > 0.0) next_series = (std::floor(t / series_dt + 1e-9) + 1.0) * series_dt;
-      }
-      if (t >= next_snap - eps) {
-        snapshot();
-        snap_k = std::max(snap_k + 1, static_cast<long>(std::floor((t + eps) / snap_dt)) + 1);
-        next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
-        if (next_snap <= t + eps && next_snap < T) next_snap = std::min(static_cast<double>(++snap_k) * snap_dt, T);
-      }
+      if (schedule.series_due(t)) series();
+      if (schedule.snapshot_due(t)) snapshot();
       progress.update(step_, t);
     }
     if (signal != 0) {  // caught during the last step: the run is complete, but say so as the serial run

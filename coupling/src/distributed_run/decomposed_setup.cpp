@@ -1,20 +1,11 @@
 // A decomposed run's grid, options and particles from a scene (decomposed_setup.hpp).
 #include "distributed_run/decomposed_setup.hpp"
 
+#include "scene/scene_detail.hpp"
+
 #include <algorithm>
 
 namespace frictherm::coupling::detail {
-
-namespace {
-
-template <int Dim>
-mechanics::Vec<Dim> to_vec(const SceneVec& v) {
-  mechanics::Vec<Dim> out;
-  for (int d = 0; d < Dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
-  return out;
-}
-
-}  // namespace
 
 std::string agreed_error(MPI_Comm comm, const std::string& error) {
   int rank = 0, size = 1;
