@@ -33,6 +33,10 @@ inline constexpr const char* stress_zz = "frictherm_stress_zz";
 inline constexpr const char* deformation = "frictherm_F";
 inline constexpr const char* material = "frictherm_material";
 inline constexpr const char* initial_position = "frictherm_x0";  // displacement separation (N·9)
+inline constexpr const char* plastic_strain = "frictherm_plastic_strain";    // ε̄p (Mie-Grüneisen/J2)
+inline constexpr const char* internal_energy = "frictherm_internal_energy";  // e (J/kg)
+inline constexpr const char* plastic_work = "frictherm_plastic_work";        // J, since the start
+inline constexpr const char* wave_speed = "frictherm_wave_speed";            // c_p of the state (CFL step)
 inline constexpr const char* scalars = "frictherm_scalars";  // DecomposedOptions::particle_scalars, when any
 }  // namespace swarm_field
 
@@ -56,6 +60,7 @@ struct SwarmFields {
   long* id = nullptr;
   double *mass = nullptr, *volume = nullptr, *volume0 = nullptr, *velocity = nullptr, *half_size = nullptr;
   double *stress = nullptr, *stress_zz = nullptr, *F = nullptr, *x0 = nullptr;
+  double *plastic_strain = nullptr, *internal_energy = nullptr, *plastic_work = nullptr, *wave_speed = nullptr;
   PetscInt* material = nullptr;
 
   explicit SwarmFields(DM swarm);
@@ -75,6 +80,10 @@ struct SwarmFields {
     f(swarm_field::deformation, F);
     f(swarm_field::material, material);
     f(swarm_field::initial_position, x0);
+    f(swarm_field::plastic_strain, plastic_strain);
+    f(swarm_field::internal_energy, internal_energy);
+    f(swarm_field::plastic_work, plastic_work);
+    f(swarm_field::wave_speed, wave_speed);
   }
   SwarmFields(const SwarmFields&) = delete;
   SwarmFields& operator=(const SwarmFields&) = delete;
@@ -87,6 +96,14 @@ struct DecomposedMpm<Dim>::Impl {
   int rank = 0, size = 1;
   Grid<Dim> grid;
   std::vector<Material> materials;
+  // Per material, hoisted out of the stress update's particle loop: Lamé λ, shear modulus μ, the
+  // Mie-Grüneisen limit J (mie_gruneisen_min_J) and the linear-elastic wave speed.
+  std::vector<double> lambda, mu, min_J, c0;
+  bool has_mie_gruneisen = false;
+  long beyond = -1;  // stress_update: the id of a particle compressed past its Hugoniot's limit, or −1
+  /// The dilatational wave speed of a particle's state (as Simulation::stable_time_step before the
+  /// first stress update).
+  double initial_wave_speed(int material, double J, double energy) const;
   Options opt;
   int width = 1;                 // DMDA stencil width (stencil_reach)
   int fields = 1;                // velocity fields per node: 1, or one per material with contact

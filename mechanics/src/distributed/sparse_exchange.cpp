@@ -160,7 +160,18 @@ void DecomposedMpm<Dim>::Impl::fields_to_ghosts(double /*dt*/) {
               "PetscSFBcastEnd");
 }
 
+template <int Dim>
+long DecomposedMpm<Dim>::field_slots() const {
+  return static_cast<long>(impl_->field_values.size()) / impl_->per_field;
+}
+template <int Dim>
+long DecomposedMpm<Dim>::peak_field_slots() const {
+  return field_slots();
+}
+
 #define FRICTHERM_INSTANTIATE_SPARSE(D)                              \
+  template long DecomposedMpm<D>::field_slots() const;                \
+  template long DecomposedMpm<D>::peak_field_slots() const;           \
   template void DecomposedMpm<D>::Impl::setup_sparse_exchange();      \
   template void DecomposedMpm<D>::Impl::exchange_field_ranges(double); \
   template void DecomposedMpm<D>::Impl::fields_to_owners(double);     \

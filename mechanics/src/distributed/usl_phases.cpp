@@ -3,10 +3,13 @@
 // fields_to_ghosts, migrate) are phases of their own, the contact phases are in contact_phases.cpp
 // and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
 // Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted box, and its
-// linear_elastic_update<Dim> (material.hpp), so they compute what the serial Simulation<Dim>'s USL
+// constitutive updates (material.hpp, mie_gruneisen.hpp, plane_strain_update.hpp), so they compute what the serial Simulation<Dim>'s USL
 // step computes (mechanics/src/simulation_step.cpp, simulation_fields.cpp) on this rank's particles,
 // in 2D and 3D alike.
 #include "distributed/decomposed_state.hpp"
+
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/plane_strain_update.hpp>
 
 #include <mpi.h>
 
@@ -179,36 +182,88 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
-// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, hypoelastic σ (Jaumann).
+// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's
+// stress as the serial update_stress, by the same inline functions in the same order: hypoelastic
+// linear elastic (Jaumann), Neo-Hookean (Kakouris 2024 eq. 47) or Mie-Grüneisen pressure with J2
+// plasticity (mie_gruneisen.hpp; in 2D the plane-strain scalar form of plane_strain_update.hpp), which
+// also update ε̄p, e, the plastic work V σ:Δε_p and the wave speed of the CFL step. A particle
+// compressed past its Hugoniot's limit stops the run on every rank (one reduction, here).
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
   constexpr int velocity = Dof::velocity;
-  SwarmFields f(swarm);
-  const auto& st = stencils<Kernel>();
-  const PetscScalar* a = nullptr;
-  petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
-  const NodeIndexer<Dim> ix = local_indexer();
-  for (PetscInt k = 0; k < f.n; ++k) {
-    const Material& material = materials[static_cast<std::size_t>(f.material[k])];
-    const double lam = material.lame_lambda(), mu = material.shear_modulus();
-    const int field = field_of(f.material[k]);
-    Mat<Dim> L = Mat<Dim>::Zero();
-    st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double, const Vec<Dim>& G) {
-      const double* node = node_values(a, i, field);
-      L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node + velocity)) * G.transpose();
-    });
-    Eigen::Map<Mat<Dim>> F(f.F + Dim * Dim * k);
-    const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-    Mat<Dim> F_new;
-    F_new.noalias() = A * F;  // as the serial update_stress
-    F = F_new;
-    f.volume[k] = F.determinant() * f.volume0[k];
-    Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
-    linear_elastic_update<Dim>(L, dt, lam, mu, opt.analysis, sigma, f.stress_zz[k]);
-    Eigen::Map<Mat<Dim>>(f.stress + Dim * Dim * k) = sigma;
+  const Analysis an = opt.analysis;
+  beyond = -1;
+  {
+    SwarmFields f(swarm);
+    const auto& st = stencils<Kernel>();
+    const PetscScalar* a = nullptr;
+    petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+    const NodeIndexer<Dim> ix = local_indexer();
+    for (PetscInt k = 0; k < f.n; ++k) {
+      const std::size_t m = static_cast<std::size_t>(f.material[k]);
+      const Material& mat = materials[m];
+      const int field = field_of(f.material[k]);
+      const Stencil<Dim, Kernel>& sk = st[static_cast<std::size_t>(k)];
+      const bool mg = mat.kind == MaterialKind::mie_gruneisen;
+      if constexpr (Dim == 2) {
+        if (mg) {  // the serial 2D Mie-Grüneisen loop, on scalars
+          VelocityGradient2 L;
+          sk.for_each(ix, [&](int i, double, const Vec<2>& G) {
+            L.add(Vec<2>(Eigen::Map<const Vec<2>>(node_values(a, i, field) + velocity)), G);
+          });
+          Mat<2> F = Eigen::Map<const Mat<2>>(f.F + 4 * k);
+          const double det_A = deformation_update_2d(L, dt, F);
+          Eigen::Map<Mat<2>>(f.F + 4 * k) = F;
+          f.volume[k] = determinant_2d(F) * f.volume0[k];
+          Mat<2> sigma = Eigen::Map<const Mat<2>>(f.stress + 4 * k);
+          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+          if (mie_gruneisen_update_plane_strain(L, dt, f.volume[k] / f.volume0[k], det_A, mat.mie_gruneisen, min_J[m],
+                                                sigma, f.stress_zz[k], f.plastic_strain[k], f.internal_energy[k], wp,
+                                                f.wave_speed[k]) != MieGruneisenStatus::ok)
+            beyond = std::max(beyond, static_cast<long>(f.id[k]));
+          Eigen::Map<Mat<2>>(f.stress + 4 * k) = sigma;
+          f.plastic_work[k] += wp * f.volume[k];
+          continue;
+        }
+      }
+      Mat<Dim> L = Mat<Dim>::Zero();
+      sk.for_each(ix, [&](int i, double, const Vec<Dim>& G) {
+        L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, i, field) + velocity)) * G.transpose();
+      });
+      Eigen::Map<Mat<Dim>> F(f.F + Dim * Dim * k);
+      const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+      Mat<Dim> F_new;
+      F_new.noalias() = A * F;  // as the serial update_stress
+      F = F_new;
+      f.volume[k] = F.determinant() * f.volume0[k];
+      Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
+      if (mg) {
+        double wp = 0.0;
+        if (mie_gruneisen_update<Dim>(L, dt, f.volume[k] / f.volume0[k], mat.mie_gruneisen, min_J[m], sigma,
+                                      f.stress_zz[k], f.plastic_strain[k], f.internal_energy[k], wp,
+                                      &f.wave_speed[k]) != MieGruneisenStatus::ok)
+          beyond = std::max(beyond, static_cast<long>(f.id[k]));
+        f.plastic_work[k] += wp * f.volume[k];
+      } else if (mat.kind == MaterialKind::neo_hookean) {
+        const Mat<Dim> Fk = F;
+        neo_hookean_stress<Dim>(Fk, lambda[m], mu[m], sigma, f.stress_zz[k]);
+        f.wave_speed[k] = mat.wave_speed(an, f.volume[k] / f.volume0[k]);
+      } else {
+        linear_elastic_update<Dim>(L, dt, lambda[m], mu[m], an, sigma, f.stress_zz[k]);
+        f.wave_speed[k] = c0[m];
+      }
+      Eigen::Map<Mat<Dim>>(f.stress + Dim * Dim * k) = sigma;
+    }
+    petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
   }
-  petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
+  if (!has_mie_gruneisen) return;
+  long worst = beyond;
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_LONG, MPI_MAX, comm);
+  if (worst >= 0)
+    throw std::runtime_error("decomposed mechanics: step " + std::to_string(traffic.steps) + ": particle " +
+                             std::to_string(worst) +
+                             " is compressed past the limit of its Hugoniot (try a smaller CFL factor)");
 }
 
 template <int Dim>

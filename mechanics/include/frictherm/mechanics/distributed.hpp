@@ -60,6 +60,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -101,6 +102,8 @@ struct DecomposedLocalParticles {
   /// With local_particle_data(true): x_p, v_p and the uGIMP half-widths l_p, Dim values per particle
   /// (hot spots and output of a decomposed run read them without gathering every particle).
   std::vector<double> position, velocity, half_size;
+  /// Plastic work done on each particle since the start (J; 0 for non-plastic materials).
+  std::vector<double> plastic_work;
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).
@@ -140,6 +143,12 @@ class DecomposedMpm {
     Mat<Dim> stress = Mat<Dim>::Zero();
     double stress_zz = 0.0;  // 2D plane strain σ_zz; unused (0) in 3D
     int material = 0;        // index into the materials given to DecomposedMpm
+    /// Per-particle state of the Mie-Grüneisen/J2 materials (as Particles<Dim>): equivalent plastic
+    /// strain ε̄p, specific internal energy e (J/kg) and the plastic work done on the particle since
+    /// the start (J). Zero (and unchanged) for the other materials.
+    double plastic_strain = 0.0;
+    double internal_energy = 0.0;
+    double plastic_work = 0.0;
     /// Values of Options::particle_scalars, in that order (empty: zeros).
     std::vector<double> scalars;
   };
@@ -217,6 +226,17 @@ class DecomposedMpm {
   DecomposedContactStats contact_stats() const;
   /// Collective: every particle of every rank, sorted by id, on every rank.
   std::vector<Particle> gather() const;
+  /// Collective: the largest stable step over all ranks, C min(h) / max_p (c_p + |v_p|) (Nairn 2018
+  /// eq. 45 with the particle speed added, as Simulation::stable_time_step), c_p the dilatational wave
+  /// speed of the particle's state after the last stress update (before the first step: of its
+  /// initial state), capped at max_time_step (also when no particle moves or carries a wave).
+  double stable_time_step(double cfl, double max_time_step = std::numeric_limits<double>::infinity()) const;
+  /// Collective: plastic work done on all particles since the start (J; Mie-Grüneisen/J2 materials).
+  double total_plastic_work() const;
+  /// Velocity-field slots this rank stores (Σ over its fields of their boxes' nodes; see the header
+  /// comment) and the largest over the run's steps.
+  long field_slots() const;
+  long peak_field_slots() const;
 
   // ---- Transfers for coupled physics (transfer.cpp): the particle–grid maps of the step, without
   // any physics of their own, so that a caller (the coupling's decomposed heat conduction) can
