@@ -78,14 +78,11 @@ void DecomposedMpm<Dim>::Impl::find_contact_nodes(double /*dt*/) {
   work_second.assign(static_cast<std::size_t>(owned), 0.0);
   contact_nodes.clear();
   if (!opt.contact) return;
-  for (PetscInt q = 0; q < owned; ++q) {
-    const PetscInt l = owned_local[static_cast<std::size_t>(q)];
-    const std::size_t u = static_cast<std::size_t>(l);
-    if (!multi[u]) continue;
+  for (std::size_t g = 0; g < mt_q.size(); ++g) {
     int present = 0;
-    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl)
-      if (field_at(l, static_cast<int>(fl))[Dof::mass] > empty_node_mass) ++present;
-    if (present >= 2) contact_nodes.push_back({q, l});
+    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e)
+      if (mt_at(e)[Dof::mass] > empty_node_mass) ++present;
+    if (present >= 2) contact_nodes.push_back({static_cast<std::size_t>(mt_q[g]), g});
   }
 }
 
@@ -121,17 +118,16 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   thread_local std::vector<int> mats;
   thread_local std::vector<double*> values;
   thread_local std::vector<Vec<Dim>> dps;
-  for (const auto& [q, l] : contact_nodes) {
-    const std::size_t u = static_cast<std::size_t>(l);
+  for (const auto& [q, g] : contact_nodes) {
     double node_mass = 0.0;
-    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
-      const double m = field_at(l, static_cast<int>(fl))[mass];
+    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {
+      const double m = mt_at(e)[mass];
       if (m > empty_node_mass) node_mass += m;
     }
     sides.clear(), mats.clear(), values.clear();
     long guarded = 0;
-    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
-      double* v = field_at(l, static_cast<int>(fl));
+    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {  // in material order
+      double* v = mt_at(e);
       const double m = v[mass];
       if (!(m > empty_node_mass)) continue;
       if (m < co.min_mass_fraction * node_mass) {
@@ -147,7 +143,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
       sd.domain_gradient = Eigen::Map<const Vec<Dim>>(v + domain_gradient);
       sd.sliver = m < co.sliver_fraction * node_mass;
       sides.push_back(sd);
-      mats.push_back(static_cast<int>(fl));  // with contact, field = material
+      mats.push_back(mt_field[e]);  // with contact, field = material
       values.push_back(v);
     }
     if (updated) {
@@ -155,7 +151,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
       ++stats.contact_nodes;
       if (sides.size() > 2) ++stats.multi_nodes;
     }
-    const std::size_t uq = static_cast<std::size_t>(q);
+    const std::size_t uq = q;
     contact_detail::resolve_contact_node(
         sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
         [&](std::size_t j, const Vec<Dim>& dp) {

@@ -229,7 +229,7 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   // Traffic bookkeeping: ghost nodes of this rank and the bytes of one particle (every field).
   s.traffic.ghost_nodes = static_cast<long>(s.local_count() - s.owned_count());
   s.traffic.values_per_node = s.dof;
-  s.traffic.field_entry_bytes = s.per_field * static_cast<int>(sizeof(double));
+  s.traffic.field_entry_bytes = (s.per_field + 2) * static_cast<int>(sizeof(double));  // values, material, rank
   s.setup_fixed_faces();
   s.setup_sparse_exchange();
   int bytes = 0;

@@ -14,6 +14,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <climits>
 #include <stdexcept>
 #include <string>
 
@@ -43,9 +44,10 @@ template <int Dim, class Kernel>
 
 // Phase 1, local: per velocity field m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p,
 // f_i = Σ (S_ip m_p g − V_p σ_p G_ip) (Nairn 2018 eqs. 1–3) and, with contact, Σ S_ip m_p x_p (or
-// the displacement x_p − x_p^(0), eq. 9), Ω_i = Σ S_ip V_p and g_i = Σ G_ip V_p (eqs. 4–6), into the
-// per-field values of the ghosted box, as the serial map_to_grid; each node records the range of
-// fields reaching it. The stencils are kept for the later phases.
+// the displacement x_p − x_p^(0), eq. 9), Ω_i = Σ S_ip V_p and g_i = Σ G_ip V_p (eqs. 4–6), as the
+// serial map_to_grid: first every stencil and each field's box of nodes (laid out as the serial
+// layout_fields), then the scatter into the fields' slots; each node records the range of fields
+// reaching it. The stencils are kept for the later phases.
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
@@ -54,29 +56,42 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   SwarmFields f(swarm);
   auto& st = stencils<Kernel>();
   st.resize(static_cast<std::size_t>(f.n));
-  std::fill(field_values.begin(), field_values.end(), 0.0);
-  std::fill(field_lo.begin(), field_lo.end(), fields);
-  std::fill(field_hi.begin(), field_hi.end(), -1);
-  const NodeIndexer<Dim> ix = local_indexer();
-  const Vec<Dim> g = opt.gravity;
-  const bool contact = opt.contact;
-  const bool displacement = opt.contact_options.separation == SeparationMethod::displacement;
+  IVec<Dim> none_lo, none_hi;
+  none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
+  box_lo.assign(static_cast<std::size_t>(fields), none_lo);
+  box_hi.assign(static_cast<std::size_t>(fields), none_hi);
   for (PetscInt k = 0; k < f.n; ++k) {
     auto& s = st[static_cast<std::size_t>(k)];
     s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
     if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
+    const std::size_t field = static_cast<std::size_t>(field_of(f.material[k]));
+    const IVec<Dim> b = s.first_node();
+    for (int d = 0; d < Dim; ++d) {
+      box_lo[field][d] = std::min(box_lo[field][d], b[d]);
+      box_hi[field][d] = std::max(box_hi[field][d], b[d] + Kernel::K - 1);
+    }
+  }
+  layout_fields();
+  std::fill(field_lo.begin(), field_lo.end(), fields);
+  std::fill(field_hi.begin(), field_hi.end(), -1);
+  const Vec<Dim> g = opt.gravity;
+  const bool contact = opt.contact;
+  const bool displacement = opt.contact_options.separation == SeparationMethod::displacement;
+  for (PetscInt k = 0; k < f.n; ++k) {
+    const auto& s = st[static_cast<std::size_t>(k)];
     const int field = field_of(f.material[k]);
+    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field)].index;
     const double mp = f.mass[k], Vp = f.volume[k];
     const Vec<Dim> mv = mp * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
     const Mat<Dim> Vsig = Vp * Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
     const Vec<Dim> mg = mp * g;
     const Eigen::Map<const Vec<Dim>> xp(f.x + Dim * k), x0(f.x0 + Dim * k);
     const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(xp - x0) : Vec<Dim>(xp));
-    s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-      const std::size_t u = static_cast<std::size_t>(i);
+    s.for_each(ix, [&](int slot, double S, const Vec<Dim>& G) {
+      const std::size_t u = static_cast<std::size_t>(slot_node[static_cast<std::size_t>(slot)]);
       field_lo[u] = std::min<PetscInt>(field_lo[u], field);
       field_hi[u] = std::max<PetscInt>(field_hi[u], field);
-      double* node = field_at(i, field);
+      double* node = slot_values(static_cast<std::size_t>(slot));
       const Vec<Dim> fi = S * mg - Vsig * G;
       node[mass] += S * mp;
       for (int d = 0; d < Dim; ++d) {
@@ -93,20 +108,19 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   }
 }
 
-// Phase 2, exchange: each local node's m, p, f summed over the fields reaching it into the DMDA's
-// local vector (one field: its values exactly), and the ghost nodes' sums added into their owners.
+// Phase 2, exchange: each local node's m, p, f summed over its fields' slots (in field order; one
+// field: its values exactly) into the DMDA's local vector, and the ghost nodes' sums added into
+// their owners.
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::sum_to_owners(double /*dt*/) {
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(local, &a), "VecGetArray");
-  const PetscInt n = local_count();
-  for (PetscInt l = 0; l < n; ++l) {
-    double* node = a + dof * l;
-    std::fill(node, node + dof, 0.0);
-    for (PetscInt fl = field_lo[static_cast<std::size_t>(l)]; fl <= field_hi[static_cast<std::size_t>(l)]; ++fl) {
-      const double* v = field_at(l, static_cast<int>(fl));
-      for (int c = 0; c < dof; ++c) node[c] += v[c];
-    }
+  std::fill(a, a + dof * local_count(), 0.0);
+  const std::size_t slots = slot_node.size();
+  for (std::size_t sl = 0; sl < slots; ++sl) {
+    double* node = a + dof * slot_node[sl];
+    const double* v = slot_values(sl);
+    for (int c = 0; c < dof; ++c) node[c] += v[c];
   }
   petsc_check(VecRestoreArray(local, &a), "VecRestoreArray");
   petsc_check(VecZeroEntries(global), "VecZeroEntries");
@@ -167,12 +181,11 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const auto& st = stencils<Kernel>();
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
-  const NodeIndexer<Dim> ix = local_indexer();
   for (PetscInt k = 0; k < f.n; ++k) {
     Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
-    const int field = field_of(f.material[k]);
-    st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-      const double* node = node_values(a, i, field);
+    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
+    st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
+      const double* node = node_values(a, static_cast<std::size_t>(slot));
       acc += S * Eigen::Map<const Vec<Dim>>(node + acceleration);
       v += S * Eigen::Map<const Vec<Dim>>(node + velocity);
     });
@@ -199,18 +212,17 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
     const auto& st = stencils<Kernel>();
     const PetscScalar* a = nullptr;
     petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
-    const NodeIndexer<Dim> ix = local_indexer();
     for (PetscInt k = 0; k < f.n; ++k) {
       const std::size_t m = static_cast<std::size_t>(f.material[k]);
       const Material& mat = materials[m];
-      const int field = field_of(f.material[k]);
+      const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
       const Stencil<Dim, Kernel>& sk = st[static_cast<std::size_t>(k)];
       const bool mg = mat.kind == MaterialKind::mie_gruneisen;
       if constexpr (Dim == 2) {
         if (mg) {  // the serial 2D Mie-Grüneisen loop, on scalars
           VelocityGradient2 L;
-          sk.for_each(ix, [&](int i, double, const Vec<2>& G) {
-            L.add(Vec<2>(Eigen::Map<const Vec<2>>(node_values(a, i, field) + velocity)), G);
+          sk.for_each(ix, [&](int slot, double, const Vec<2>& G) {
+            L.add(Vec<2>(Eigen::Map<const Vec<2>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)), G);
           });
           Mat<2> F = Eigen::Map<const Mat<2>>(f.F + 4 * k);
           const double det_A = deformation_update_2d(L, dt, F);
@@ -228,8 +240,9 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
         }
       }
       Mat<Dim> L = Mat<Dim>::Zero();
-      sk.for_each(ix, [&](int i, double, const Vec<Dim>& G) {
-        L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, i, field) + velocity)) * G.transpose();
+      sk.for_each(ix, [&](int slot, double, const Vec<Dim>& G) {
+        L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)) *
+                       G.transpose();
       });
       Eigen::Map<Mat<Dim>> F(f.F + Dim * Dim * k);
       const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
