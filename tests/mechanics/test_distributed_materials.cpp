@@ -282,6 +282,73 @@ TEST(DecomposedMaterials, MieGruneisenIntoNeoHookean3DEqualsTheSerialRun) {
   print_storage("mg-nh 3D", split);
 }
 
+// ---- (c) storage with 50 materials: slots bounded by the particles ----
+TEST(DecomposedMaterials, FiftyGrainsStoreSlotsBoundedByTheirParticles) {
+  // 50 rectangular HMX grains (4 × 4 cells of 50 µm, 10 × 5 of them filling 40 × 20 cells; every
+  // grain its own material; yield stresses spread over 2.6–3.8e8 Pa) compressed by the field
+  // v = −150 m/s ((x − xc)/a, 0.5 (y − yc)/b): grain faces and corners (four materials at a node,
+  // the lumped virtual material of eqs. 39–40) in contact across the rank cuts, uGIMP, Coulomb
+  // μ = 0.3 with the average-volume-gradient normal (the grains are congruent: the maximum-gradient
+  // normal would tie, see (b)). 20 steps against the serial run; then the slots each rank stores.
+  const double h = 50e-6, v0 = 150.0;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {40, 20});
+  fm::SimulationOptions so;
+  so.shape = fm::ShapeKind::ugimp;
+  so.scheme = fm::UpdateScheme::usl;
+  so.cfl = 0.4;
+  fm::Simulation<2> serial(grid, so);
+  std::vector<fm::Material> mats;
+  for (int g = 0; g < 50; ++g) mats.push_back(hmx("grain" + std::to_string(g), 2.6e8 * (1.0 + 0.01 * g)));
+  for (const auto& m : mats) serial.add_material(m);
+  for (int g = 0; g < 50; ++g) {
+    const V2 lo(4.0 * h * (g % 10), 4.0 * h * (g / 10));
+    serial.add_body("grain" + std::to_string(g), *fm::make_box<2>(lo, lo + V2(4 * h, 4 * h), g), 2, V2::Zero());
+  }
+  fm::ContactOptions co;
+  co.default_pair.law = fm::FrictionLaw::coulomb(0.3);
+  co.default_pair.normal = fm::NormalMethod::average_volume_gradient;
+  serial.enable_contact(co);
+  serial.finalize();
+  const V2 centre(20 * h, 10 * h), half(20 * h, 10 * h);
+  for (std::size_t k = 0; k < serial.particles().size(); ++k) {
+    const V2 r = serial.particles().position[k] - centre;
+    serial.particles().velocity[k] = -v0 * V2(r[0] / half[0], 0.5 * r[1] / half[1]);
+  }
+  fm::DecomposedOptions opt;
+  opt.shape = so.shape;
+  opt.contact = true;
+  opt.contact_options = co;
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
+  const int steps = 20;
+  const RunResult r = run_both(serial, split, so.cfl, steps, 5);
+  const Difference& d = r.worst;
+  EXPECT_TRUE(d.same_ids);
+  EXPECT_GT(r.max_multi, 0L);  // nodes of three or more materials (grain corners)
+  EXPECT_GT(r.w_friction, 0.0);
+  EXPECT_LE(d.position / h, 1e-9);
+  EXPECT_LE(d.velocity / d.v_max, 1e-9);
+  EXPECT_LE(r.frictional / r.w_friction, 1e-9);
+  // Each local grain part is an axis-aligned rectangle of particles, so its field's box is the union
+  // of their stencils: at most K^Dim = 9 nodes per particle (uGIMP). Dense storage would need
+  // fields × ghosted-box nodes, 50 × (≥ 231 on 4 ranks), well above that bound.
+  const long slots = split.peak_field_slots(), particles = static_cast<long>(split.local_particles());
+  const long dense = static_cast<long>(split.velocity_fields()) * split.local_node_count();
+  EXPECT_LE(slots, 9 * particles);
+  EXPECT_GT(dense, 9 * particles);  // the bound tells the two storages apart on this case
+  long all[3] = {slots, particles, dense};
+  MPI_Allreduce(MPI_IN_PLACE, all, 3, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  if (comm_rank() == 0)
+    std::printf("[50 grains] %zu particles, %d steps: contact nodes up to %ld (three or more materials %ld), "
+                "W_friction %.6e J, W_plastic %.6e J; vs serial |dx|/h %.2e, |dv|/v_max %.2e, |dW|/W %.2e; field "
+                "slots over ranks %ld (%.2f per particle) against dense %ld (%.1f x)\n",
+                serial.particles().size(), steps, r.max_contact, r.max_multi, r.w_friction, r.w_plastic,
+                d.position / h, d.velocity / d.v_max, r.frictional / r.w_friction, all[0],
+                static_cast<double>(all[0]) / static_cast<double>(all[1]), all[2],
+                static_cast<double>(all[2]) / static_cast<double>(all[0]));
+  print_storage("50 grains", split);
+}
+
 // ---- (d) refusals ----
 TEST(DecomposedMaterials, RefusesWhatItDoesNotSupport) {
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {8, 8});
