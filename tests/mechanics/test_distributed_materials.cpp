@@ -11,7 +11,9 @@
 //       (uGIMP) = the serial Simulation<3> likewise;
 //   (c) storage: 50 grains, each its own material: the velocity-field slots each rank stores are
 //       bounded by its particles (K^Dim nodes per particle), not by materials × ghosted box;
-//   (d) what the decomposed step refuses (a rigid material, plane stress with Mie-Grüneisen).
+//   (a') the PBX scene's loading: the specimen between rigid boundary walls, a piston driving it
+//       (the serial rigid_boundary materials) = the serial run likewise;
+//   (d) what the decomposed step refuses (a rigid contact partner, plane stress with Mie-Grüneisen).
 // Tolerance 1e-9 of the case's scales (the figure): the measured differences are round-off
 // grown through contact decisions and plastic returns (printed).
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
@@ -282,6 +284,91 @@ TEST(DecomposedMaterials, MieGruneisenIntoNeoHookean3DEqualsTheSerialRun) {
   print_storage("mg-nh 3D", split);
 }
 
+// ---- (a') the PBX scene's loading: rigid boundary walls acting on the nodes they touch ----
+fm::Material wall(const std::string& name, double vx, double vy, bool x, bool y) {
+  fm::Material m;
+  m.name = name;
+  m.kind = fm::MaterialKind::rigid;
+  m.density = 1000.0;
+  m.rigid_boundary = true;
+  m.rigid_velocity = {fm::TimeFunction::constant(vx), fm::TimeFunction::constant(vy)};
+  m.rigid_controls = {{x, y, false}};
+  return m;
+}
+
+class DecomposedWalls : public ::testing::TestWithParam<bool> {};
+
+TEST_P(DecomposedWalls, PbxBetweenRigidWallsEqualsTheSerialRun) {
+  const bool contact = GetParam();
+  // As examples/pbx_compaction.json in small: a binder block [2h, 22h] × [2h, 16h] with 4 elliptical
+  // HMX grains (each its own material) between rigid boundary walls ("boundary": true: they drive
+  // the velocity components they prescribe at every node they touch): a bottom wall holding v_y = 0,
+  // side walls holding v_x = 0 and a piston driving v_y = −100 m/s from above; 24 × 20 cells of
+  // 50 µm, uGIMP, Coulomb μ = 0.3 between grains and binder (the parameter; without contact one
+  // shared field, where every rigid material is a boundary, as in the serial step). 150 steps.
+  const double h = 50e-6, v0 = 100.0;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {24, 20});
+  fm::SimulationOptions so;
+  so.shape = fm::ShapeKind::ugimp;
+  so.scheme = fm::UpdateScheme::usl;
+  so.cfl = 0.4;
+  fm::Simulation<2> serial(grid, so);
+  std::vector<fm::Material> mats{binder(), wall("bottom", 0.0, 0.0, false, true), wall("left", 0.0, 0.0, true, false),
+                                 wall("right", 0.0, 0.0, true, false), wall("piston", 0.0, -v0, false, true)};
+  for (int g = 0; g < 4; ++g) mats.push_back(hmx("grain" + std::to_string(g), 2.6e8));
+  for (const auto& m : mats) serial.add_material(m);
+  serial.add_body("bottom", *fm::make_box<2>(V2(1 * h, 1 * h), V2(23 * h, 2 * h), 1), 2, V2::Zero());
+  serial.add_body("left", *fm::make_box<2>(V2(1 * h, 2 * h), V2(2 * h, 17 * h), 2), 2, V2::Zero());
+  serial.add_body("right", *fm::make_box<2>(V2(22 * h, 2 * h), V2(23 * h, 17 * h), 3), 2, V2::Zero());
+  serial.add_body("piston", *fm::make_box<2>(V2(2 * h, 16 * h), V2(22 * h, 17 * h), 4), 2, V2(0.0, -v0));
+  for (int g = 0; g < 4; ++g) {
+    const V2 c(h * (2.0 + 5.0 * (g + 0.5)), h * (9.0 + 2.5 * ((g % 2) ? 1.0 : -1.0)));
+    serial.add_body("grain" + std::to_string(g), *fm::make_ellipse<2>(c, V2(2.1 * h, 1.4 * h), 0.5 * g, 5 + g), 2,
+                    V2::Zero());
+  }
+  serial.add_body("binder", *fm::make_box<2>(V2(2 * h, 2 * h), V2(22 * h, 16 * h), 0), 2, V2::Zero());
+  fm::ContactOptions co;
+  co.default_pair.law = fm::FrictionLaw::coulomb(0.3);
+  if (contact) serial.enable_contact(co);
+  serial.finalize();
+
+  fm::DecomposedOptions opt;
+  opt.shape = so.shape;
+  opt.contact = contact;
+  opt.contact_options = co;
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
+  const int steps = 150;
+  const RunResult r = run_both(serial, split, so.cfl, steps, 10);
+  const Difference& d = r.worst;
+  // The piston moved the specimen's top: the mean vertical velocity of the binder near it.
+  double vy = 0.0, m = 0.0;
+  for (std::size_t k = 0; k < serial.particles().size(); ++k)
+    if (serial.particles().material[k] == 0 && serial.particles().position[k][1] > 14 * h)
+      vy += serial.particles().mass[k] * serial.particles().velocity[k][1], m += serial.particles().mass[k];
+  vy /= m;
+  EXPECT_TRUE(d.same_ids);
+  EXPECT_LT(vy, -0.5 * v0);  // the top of the binder follows the piston
+  EXPECT_GT(r.w_plastic, 0.0);
+  EXPECT_LE(r.dt_difference, 1e-12);
+  EXPECT_LE(d.position / h, 1e-9);
+  EXPECT_LE(d.velocity / d.v_max, 1e-9);
+  EXPECT_LE(d.stress / d.s_max, 1e-9);
+  EXPECT_LE(r.plastic / r.w_plastic, 1e-9);
+  if (r.w_friction > 0.0) {
+    EXPECT_LE(r.frictional / r.w_friction, 1e-9);
+  }
+  if (comm_rank() == 0)
+    std::printf("[pbx walls, contact %d] %zu particles, %d steps to %.3e s: top binder v_y %.2f m/s, W_friction %.6e J, "
+                "W_plastic %.6e J, contact nodes up to %ld; vs serial |dx|/h %.2e, |dv|/v_max %.2e, "
+                "|dsigma|/sigma_max %.2e, |dW_friction|/W %.2e, |dW_plastic|/W %.2e, |d dt|/dt %.2e\n",
+                contact ? 1 : 0, serial.particles().size(), steps, serial.time(), vy, r.w_friction, r.w_plastic, r.max_contact,
+                d.position / h, d.velocity / d.v_max, d.stress / d.s_max,
+                r.w_friction > 0.0 ? r.frictional / r.w_friction : 0.0, r.plastic / r.w_plastic, r.dt_difference);
+}
+
+INSTANTIATE_TEST_SUITE_P(Contact, DecomposedWalls, ::testing::Bool());
+
 // ---- (c) storage with 50 materials: slots bounded by the particles ----
 TEST(DecomposedMaterials, FiftyGrainsStoreSlotsBoundedByTheirParticles) {
   // 50 rectangular HMX grains (4 × 4 cells of 50 µm, 10 × 5 of them filling 40 × 20 cells; every
@@ -362,11 +449,15 @@ TEST(DecomposedMaterials, RefusesWhatItDoesNotSupport) {
     }
     ADD_FAILURE() << "not refused: " << expect;
   };
-  fm::Material wall;
-  wall.name = "wall";
-  wall.kind = fm::MaterialKind::rigid;
-  wall.density = 1000.0;
-  refused({binder(), wall}, {}, "rigid");
+  fm::Material partner = wall("partner", 1.0, 0.0, true, true);
+  partner.rigid_boundary = false;  // a rigid contact partner (its own velocity field): serial only
+  partner.rigid_controls = {{true, true, true}};
+  fm::DecomposedOptions contact;
+  contact.contact = true;
+  refused({binder(), partner}, contact, "rigid_boundary = true");
+  fm::Material free_component = wall("free", 1.0, 0.0, true, false);
+  free_component.rigid_boundary = false;
+  refused({binder(), free_component}, {}, "boundary rigid material");
   fm::DecomposedOptions stress;
   stress.analysis = fm::Analysis::plane_stress;
   refused({binder()}, stress, "plane_strain");

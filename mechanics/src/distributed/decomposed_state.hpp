@@ -100,6 +100,17 @@ struct DecomposedMpm<Dim>::Impl {
   // Mie-Grüneisen limit J (mie_gruneisen_min_J) and the linear-elastic wave speed.
   std::vector<double> lambda, mu, min_J, c0;
   bool has_mie_gruneisen = false;
+  // Rigid materials (velocity boundary conditions on the nodes they touch, as the serial
+  // map_rigid_particles / apply_velocity_bc / update_grid): per axis d and local node, the largest
+  // rigid material prescribing component d whose particles' stencils reach the node with S > 0 (−1:
+  // none; the serial loop lets the last material win), completed at the owners in sum_to_owners;
+  // per owned node the driven components (bit d) and their prescribed velocity at the step's start.
+  bool has_rigid = false;
+  double time = 0.0;  // at the start of the step (the serial time_)
+  std::array<std::vector<PetscInt>, 3> driver, root_driver;
+  std::vector<std::uint8_t> drive_mask;
+  std::vector<Vec<Dim>> drive_velocity;
+  bool rigid(PetscInt material) const { return materials[static_cast<std::size_t>(material)].is_rigid(); }
   long beyond = -1;  // stress_update: the id of a particle compressed past its Hugoniot's limit, or −1
   /// The dilatational wave speed of a particle's state (as Simulation::stable_time_step before the
   /// first stress update).

@@ -106,10 +106,15 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   std::vector<Material> mats = materials;
   for (Material& material : mats) {
     const std::string where = "decomposed mechanics: material '" + material.name + "'";
-    if (material.kind == MaterialKind::rigid)
-      throw std::invalid_argument(where + " has kind 'rigid' (expected linear_elastic, neo_hookean or mie_gruneisen: "
-                                          "rigid materials are not decomposed yet)");
     if (!(material.density > 0.0)) throw std::invalid_argument(where + ": density must be > 0");
+    if (material.is_rigid()) {
+      if (!material.rigid_boundary && !(material.rigid_controls[0] && material.rigid_controls[1] && material.rigid_controls[2]))
+        throw std::invalid_argument(where + ": only a boundary rigid material may leave velocity components free");
+      if (options.contact && !material.rigid_boundary)
+        throw std::invalid_argument(where + ": a rigid material in contact must be a boundary one in a decomposed run "
+                                            "(expected rigid_boundary = true: rigid contact partners stay serial)");
+      continue;
+    }
     if (material.kind == MaterialKind::mie_gruneisen) {
       material.mie_gruneisen.density = material.density;
       validate(material.mie_gruneisen, options.analysis, "material '" + material.name + "'");
@@ -136,9 +141,10 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   s.grid = grid;
   s.materials = mats;
   for (const Material& m : mats) {
-    const bool mg = m.kind == MaterialKind::mie_gruneisen;
-    s.lambda.push_back(mg ? 0.0 : m.lame_lambda());
-    s.mu.push_back(mg ? 0.0 : m.shear_modulus());
+    const bool mg = m.kind == MaterialKind::mie_gruneisen, elastic = !mg && !m.is_rigid();
+    s.has_rigid = s.has_rigid || m.is_rigid();
+    s.lambda.push_back(elastic ? m.lame_lambda() : 0.0);
+    s.mu.push_back(elastic ? m.shear_modulus() : 0.0);
     s.min_J.push_back(mg ? mie_gruneisen_min_J(m.mie_gruneisen) : 0.0);
     s.c0.push_back(m.kind == MaterialKind::linear_elastic ? m.p_wave_speed(options.analysis) : 0.0);
     s.has_mie_gruneisen = s.has_mie_gruneisen || mg;
@@ -232,6 +238,11 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   s.traffic.field_entry_bytes = (s.per_field + 2) * static_cast<int>(sizeof(double));  // values, material, rank
   s.setup_fixed_faces();
   s.setup_sparse_exchange();
+  if (s.has_rigid) {
+    for (int d = 0; d < Dim; ++d) s.driver[static_cast<std::size_t>(d)].assign(static_cast<std::size_t>(s.local_count()), -1);
+    s.drive_mask.assign(static_cast<std::size_t>(s.owned_count()), 0);
+    s.drive_velocity.assign(static_cast<std::size_t>(s.owned_count()), Vec<Dim>::Zero());
+  }
   int bytes = 0;
   for (const char* name : {DMSwarmPICField_coor, DMSwarmField_pid, DMSwarmField_rank, DMSwarmPICField_cellid,
                            swarm_field::id, swarm_field::mass, swarm_field::volume, swarm_field::volume0,
@@ -504,6 +515,7 @@ std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() 
 template <int Dim>
 double DecomposedMpm<Dim>::Impl::initial_wave_speed(int material, double J, double energy) const {
   const Material& m = materials[static_cast<std::size_t>(material)];
+  if (m.is_rigid()) return -std::numeric_limits<double>::infinity();  // rigid_speed() counts them
   if (m.kind == MaterialKind::mie_gruneisen) return mie_gruneisen_wave_speed(m.mie_gruneisen, J, energy);
   if (m.kind == MaterialKind::neo_hookean) return m.wave_speed(opt.analysis, J);
   return c0[static_cast<std::size_t>(material)];
@@ -521,6 +533,8 @@ double DecomposedMpm<Dim>::stable_time_step(double cfl, double max_time_step) co
       cmax = std::max(cmax, f.wave_speed[k] + Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k).norm());
   }
   MPI_Allreduce(MPI_IN_PLACE, &cmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
+  for (const Material& m : s.materials)  // rigid bodies move material through the grid too
+    if (m.is_rigid()) cmax = std::max(cmax, m.rigid_velocity_at(s.time).norm());
   if (cmax <= 0.0) return max_time_step;
   return std::min(cfl * s.grid.min_cell_size() / cmax, max_time_step);
 }

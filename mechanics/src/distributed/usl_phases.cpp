@@ -60,10 +60,25 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
   box_lo.assign(static_cast<std::size_t>(fields), none_lo);
   box_hi.assign(static_cast<std::size_t>(fields), none_hi);
+  if (has_rigid)
+    for (int d = 0; d < Dim; ++d) std::fill(driver[static_cast<std::size_t>(d)].begin(), driver[static_cast<std::size_t>(d)].end(), -1);
+  const NodeIndexer<Dim> local_ix = local_indexer();
   for (PetscInt k = 0; k < f.n; ++k) {
     auto& s = st[static_cast<std::size_t>(k)];
     s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
     if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
+    if (rigid(f.material[k])) {  // the serial map_rigid_particles: nodes with S > 0, components it prescribes
+      const Material& m = materials[static_cast<std::size_t>(f.material[k])];
+      s.for_each(local_ix, [&](int l, double S, const Vec<Dim>&) {
+        if (S > 0.0)
+          for (int d = 0; d < Dim; ++d)
+            if (m.rigid_controls[static_cast<std::size_t>(d)]) {
+              PetscInt& w = driver[static_cast<std::size_t>(d)][static_cast<std::size_t>(l)];
+              w = std::max<PetscInt>(w, f.material[k]);
+            }
+      });
+      continue;  // no velocity field of its own
+    }
     const std::size_t field = static_cast<std::size_t>(field_of(f.material[k]));
     const IVec<Dim> b = s.first_node();
     for (int d = 0; d < Dim; ++d) {
@@ -78,6 +93,7 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   const bool contact = opt.contact;
   const bool displacement = opt.contact_options.separation == SeparationMethod::displacement;
   for (PetscInt k = 0; k < f.n; ++k) {
+    if (rigid(f.material[k])) continue;
     const auto& s = st[static_cast<std::size_t>(k)];
     const int field = field_of(f.material[k]);
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field)].index;
@@ -125,6 +141,27 @@ void DecomposedMpm<Dim>::Impl::sum_to_owners(double /*dt*/) {
   petsc_check(VecRestoreArray(local, &a), "VecRestoreArray");
   petsc_check(VecZeroEntries(global), "VecZeroEntries");
   petsc_check(DMLocalToGlobalBegin(da, local, ADD_VALUES, global), "DMLocalToGlobalBegin");
+  if (has_rigid) {  // the rigid materials driving each node, completed at the owner (the largest wins)
+    for (int d = 0; d < Dim; ++d) root_driver[static_cast<std::size_t>(d)] = driver[static_cast<std::size_t>(d)];
+    for (int d = 0; d < Dim; ++d)
+      petsc_check(PetscSFReduceBegin(node_sf, MPIU_INT, driver[static_cast<std::size_t>(d)].data(),
+                                     root_driver[static_cast<std::size_t>(d)].data(), MPI_MAX),
+                  "PetscSFReduceBegin");
+    for (int d = 0; d < Dim; ++d)
+      petsc_check(PetscSFReduceEnd(node_sf, MPIU_INT, driver[static_cast<std::size_t>(d)].data(),
+                                   root_driver[static_cast<std::size_t>(d)].data(), MPI_MAX),
+                  "PetscSFReduceEnd");
+    for (std::size_t q = 0; q < owned_local.size(); ++q) {
+      const std::size_t l = static_cast<std::size_t>(owned_local[q]);
+      drive_mask[q] = 0;
+      for (int d = 0; d < Dim; ++d) {
+        const PetscInt m = root_driver[static_cast<std::size_t>(d)][l];
+        if (m < 0) continue;
+        drive_mask[q] |= static_cast<std::uint8_t>(1u << d);
+        drive_velocity[q][d] = materials[static_cast<std::size_t>(m)].rigid_velocity_at(time)[d];
+      }
+    }
+  }
   petsc_check(DMLocalToGlobalEnd(da, local, ADD_VALUES, global), "DMLocalToGlobalEnd");
 }
 
@@ -137,6 +174,13 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   petsc_check(VecGetArray(global, &a), "VecGetArray");
   for_each_owned_field(a, [&](PetscInt q, double* node) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
+    if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0) {
+      // Driven components end the step at the rigid velocity: the change made a force, (m v − p)/dt,
+      // so that the particles' FLIP update receives it too (the serial apply_velocity_bc).
+      for (int d = 0; d < Dim; ++d)
+        if (driven & (1u << d))
+          node[force + d] = (node[Dof::mass] * drive_velocity[static_cast<std::size_t>(q)][d] - node[momentum + d]) / dt;
+    }
     for (int d = 0; d < Dim; ++d) {
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
       node[momentum + d] += node[force + d] * dt;
@@ -153,13 +197,16 @@ void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
   constexpr int velocity = Dof::velocity, acceleration = Dof::acceleration;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt, double* node) {
+  for_each_owned_field(a, [&](PetscInt q, double* node) {
     const double m = node[mass];
     for (int d = 0; d < Dim; ++d) {
       const double p = node[momentum + d], f = node[force + d];
       node[velocity + d] = m > empty_node_mass ? p / m : 0.0;
       node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
     }
+    if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0; driven && m > empty_node_mass)
+      for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial update_grid)
+        if (driven & (1u << d)) node[velocity + d] = drive_velocity[static_cast<std::size_t>(q)][d];
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
 }
@@ -182,6 +229,14 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
   for (PetscInt k = 0; k < f.n; ++k) {
+    if (rigid(f.material[k])) {  // the serial move_rigid_particles: v(t), x += ½ (v(t) + v(t + dt)) dt
+      const Material& m = materials[static_cast<std::size_t>(f.material[k])];
+      const Vec<Dim> v0 = m.rigid_velocity_at(time).template head<Dim>();
+      const Vec<Dim> dx = ((m.rigid_velocity_at(time + dt) + m.rigid_velocity_at(time)) * 0.5 * dt).template head<Dim>();
+      Eigen::Map<Vec<Dim>>(f.velocity + Dim * k) = v0;
+      Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dx;
+      continue;
+    }
     Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
     st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
@@ -215,6 +270,7 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
     for (PetscInt k = 0; k < f.n; ++k) {
       const std::size_t m = static_cast<std::size_t>(f.material[k]);
       const Material& mat = materials[m];
+      if (mat.is_rigid()) continue;
       const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
       const Stencil<Dim, Kernel>& sk = st[static_cast<std::size_t>(k)];
       const bool mg = mat.kind == MaterialKind::mie_gruneisen;
@@ -317,6 +373,7 @@ void DecomposedMpm<Dim>::step(double dt) {
       s.traffic.phase_seconds[p] += MPI_Wtime() - t0;
     }
   });
+  s.time += dt;
   ++s.traffic.steps;
 }
 
