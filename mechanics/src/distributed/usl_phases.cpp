@@ -45,9 +45,10 @@ template <int Dim, class Kernel>
 // Phase 1, local: per velocity field m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p,
 // f_i = Σ (S_ip m_p g − V_p σ_p G_ip) (Nairn 2018 eqs. 1–3) and, with contact, Σ S_ip m_p x_p (or
 // the displacement x_p − x_p^(0), eq. 9), Ω_i = Σ S_ip V_p and g_i = Σ G_ip V_p (eqs. 4–6), as the
-// serial map_to_grid: first every stencil and each field's box of nodes (laid out as the serial
-// layout_fields), then the scatter into the fields' slots; each node records the range of fields
-// reaching it. The stencils are kept for the later phases.
+// serial map_to_grid: with several fields first every stencil and each field's box of nodes (laid
+// out as the serial layout_fields), then the scatter into the fields' slots, each node recording the
+// range of fields reaching it; one field covers the ghosted box. The stencils are kept for the later
+// phases.
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
@@ -63,37 +64,51 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   if (has_rigid)
     for (int d = 0; d < Dim; ++d) std::fill(driver[static_cast<std::size_t>(d)].begin(), driver[static_cast<std::size_t>(d)].end(), -1);
   const NodeIndexer<Dim> local_ix = local_indexer();
-  for (PetscInt k = 0; k < f.n; ++k) {
+  // Evaluates particle k's stencil; a rigid particle marks the nodes it drives (the serial
+  // map_rigid_particles: nodes with S > 0, the components its material prescribes) and is skipped.
+  const auto evaluate = [&](PetscInt k) {
     auto& s = st[static_cast<std::size_t>(k)];
     s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
     if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
-    if (rigid(f.material[k])) {  // the serial map_rigid_particles: nodes with S > 0, components it prescribes
-      const Material& m = materials[static_cast<std::size_t>(f.material[k])];
-      s.for_each(local_ix, [&](int l, double S, const Vec<Dim>&) {
-        if (S > 0.0)
-          for (int d = 0; d < Dim; ++d)
-            if (m.rigid_controls[static_cast<std::size_t>(d)]) {
-              PetscInt& w = driver[static_cast<std::size_t>(d)][static_cast<std::size_t>(l)];
-              w = std::max<PetscInt>(w, f.material[k]);
-            }
-      });
-      continue;  // no velocity field of its own
-    }
-    const std::size_t field = static_cast<std::size_t>(field_of(f.material[k]));
-    const IVec<Dim> b = s.first_node();
+    if (!rigid(f.material[k])) return true;
+    const Material& m = materials[static_cast<std::size_t>(f.material[k])];
+    s.for_each(local_ix, [&](int l, double S, const Vec<Dim>&) {
+      if (S > 0.0)
+        for (int d = 0; d < Dim; ++d)
+          if (m.rigid_controls[static_cast<std::size_t>(d)]) {
+            PetscInt& w = driver[static_cast<std::size_t>(d)][static_cast<std::size_t>(l)];
+            w = std::max<PetscInt>(w, f.material[k]);
+          }
+    });
+    return false;
+  };
+  // One field (no contact): it covers the ghosted box and the stencils are evaluated in the scatter
+  // loop. Several: each field's box from its particles' stencils first.
+  const bool ranges = fields > 1;
+  if (!ranges) {
     for (int d = 0; d < Dim; ++d) {
-      box_lo[field][d] = std::min(box_lo[field][d], b[d]);
-      box_hi[field][d] = std::max(box_hi[field][d], b[d] + Kernel::K - 1);
+      box_lo[0][d] = static_cast<int>(box_start[static_cast<std::size_t>(d)]);
+      box_hi[0][d] = static_cast<int>(box_start[static_cast<std::size_t>(d)] + box_size[static_cast<std::size_t>(d)]) - 1;
     }
+  } else {
+    for (PetscInt k = 0; k < f.n; ++k) {
+      if (!evaluate(k)) continue;
+      const std::size_t field = static_cast<std::size_t>(field_of(f.material[k]));
+      const IVec<Dim> b = st[static_cast<std::size_t>(k)].first_node();
+      for (int d = 0; d < Dim; ++d) {
+        box_lo[field][d] = std::min(box_lo[field][d], b[d]);
+        box_hi[field][d] = std::max(box_hi[field][d], b[d] + Kernel::K - 1);
+      }
+    }
+    std::fill(field_lo.begin(), field_lo.end(), fields);
+    std::fill(field_hi.begin(), field_hi.end(), -1);
   }
   layout_fields();
-  std::fill(field_lo.begin(), field_lo.end(), fields);
-  std::fill(field_hi.begin(), field_hi.end(), -1);
   const Vec<Dim> g = opt.gravity;
   const bool contact = opt.contact;
   const bool displacement = opt.contact_options.separation == SeparationMethod::displacement;
   for (PetscInt k = 0; k < f.n; ++k) {
-    if (rigid(f.material[k])) continue;
+    if (ranges ? rigid(f.material[k]) : !evaluate(k)) continue;
     const auto& s = st[static_cast<std::size_t>(k)];
     const int field = field_of(f.material[k]);
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field)].index;
@@ -104,9 +119,11 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
     const Eigen::Map<const Vec<Dim>> xp(f.x + Dim * k), x0(f.x0 + Dim * k);
     const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(xp - x0) : Vec<Dim>(xp));
     s.for_each(ix, [&](int slot, double S, const Vec<Dim>& G) {
-      const std::size_t u = static_cast<std::size_t>(slot_node[static_cast<std::size_t>(slot)]);
-      field_lo[u] = std::min<PetscInt>(field_lo[u], field);
-      field_hi[u] = std::max<PetscInt>(field_hi[u], field);
+      if (ranges) {
+        const std::size_t u = static_cast<std::size_t>(slot_node[static_cast<std::size_t>(slot)]);
+        field_lo[u] = std::min<PetscInt>(field_lo[u], field);
+        field_hi[u] = std::max<PetscInt>(field_hi[u], field);
+      }
       double* node = slot_values(static_cast<std::size_t>(slot));
       const Vec<Dim> fi = S * mg - Vsig * G;
       node[mass] += S * mp;
