@@ -13,6 +13,7 @@
 //       bounded by its particles (K^Dim nodes per particle), not by materials × ghosted box;
 //   (a') the PBX scene's loading: the specimen between rigid boundary walls, a piston driving it
 //       (the serial rigid_boundary materials) = the serial run likewise;
+//   (e) a particle compressed past its Hugoniot's limit stops every rank (a collective error);
 //   (d) what the decomposed step refuses (a rigid contact partner, plane stress with Mie-Grüneisen).
 // Tolerance 1e-9 of the case's scales (the figure): the measured differences are round-off
 // grown through contact decisions and plastic returns (printed).
@@ -434,6 +435,57 @@ TEST(DecomposedMaterials, FiftyGrainsStoreSlotsBoundedByTheirParticles) {
                 static_cast<double>(all[0]) / static_cast<double>(all[1]), all[2],
                 static_cast<double>(all[2]) / static_cast<double>(all[0]));
   print_storage("50 grains", split);
+}
+
+// ---- (e) past the Hugoniot's limit: every rank stops ----
+TEST(DecomposedMaterials, CompressionPastTheHugoniotLimitStopsEveryRank) {
+  // A Mie-Grüneisen block whose Hugoniot ends at J = 0.9 (S1 = 10: 1 − S1 η = 0 at η = 0.1) squeezed
+  // by v = −2000 m/s (x − xc)/a along x (a = 6 cells of 50 µm; no contact, uGIMP) with a step of
+  // 20 ns, over twice its CFL step (factor 1): the first step compresses the interior by
+  // dt·2000/(6h) = 13 % > 10 %, so particles pass the limit and std::runtime_error is thrown on every
+  // rank (one collective decision: no rank is left waiting in a later collective). The Hugoniot
+  // pressure diverges at the limit, so a run within its CFL step is stopped by the material instead;
+  // the serial step (which never exceeds its CFL step) cannot be driven past it the same way.
+  const double h = 50e-6;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {16, 10});
+  fm::Material brittle = hmx("brittle", 2.6e8);
+  brittle.mie_gruneisen.S1 = 10.0;
+  std::vector<fm::DecomposedParticle> particles;
+  for (int j = 0; j < 12; ++j)
+    for (int i = 0; i < 24; ++i) {
+      fm::DecomposedParticle p;
+      p.id = static_cast<std::int64_t>(particles.size());
+      p.position = V2(2 * h + (i + 0.5) * h / 2, 2 * h + (j + 0.5) * h / 2);
+      p.volume = h * h / 4;
+      p.mass = brittle.density * p.volume;
+      p.half_size = V2(h / 4, h / 4);
+      p.velocity = V2(-2000.0 * (p.position[0] - 8 * h) / (6 * h), 0.0);
+      particles.push_back(p);
+    }
+  fm::DecomposedOptions opt;
+  opt.shape = fm::ShapeKind::ugimp;
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, {brittle}, opt);
+  split.add_particles(comm_rank() == 0 ? particles : std::vector<fm::DecomposedParticle>{});
+  const double dt = 20e-9, cfl_step = split.stable_time_step(1.0);
+  int stop = -1;
+  std::string message;
+  for (int s = 0; s < 5 && stop < 0; ++s) {
+    try {
+      split.step(dt);
+    } catch (const std::runtime_error& e) {
+      stop = s;
+      message = e.what();
+    }
+  }
+  int stops[2] = {stop, -stop};  // the same step on every rank: max = −min
+  MPI_Allreduce(MPI_IN_PLACE, stops, 2, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  EXPECT_GT(dt, 2.0 * cfl_step);
+  EXPECT_EQ(stop, 0);
+  EXPECT_EQ(stops[0], -stops[1]);
+  EXPECT_NE(message.find("Hugoniot"), std::string::npos) << message;
+  if (comm_rank() == 0)
+    std::printf("[hugoniot] dt %.1e s = %.1f CFL steps: stopped at step %d on every rank: %s\n", dt, dt / cfl_step,
+                stop, message.c_str());
 }
 
 // ---- (d) refusals ----

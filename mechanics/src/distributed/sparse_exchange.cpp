@@ -234,6 +234,8 @@ void DecomposedMpm<Dim>::Impl::fields_to_mt() {
       const PetscInt kk = it.node / (bx * by) + box_start[2];
       mt_q.push_back(((kk - owned_start[2]) * owned_size[1] + (jj - owned_start[1])) * owned_size[0] +
                      (ii - owned_start[0]));
+      if (owned_local[static_cast<std::size_t>(mt_q.back())] != it.node)
+        throw std::logic_error("decomposed mechanics: a multi-material node's owned index does not match its local node");
       mt_l.push_back(it.node);
       mt_first.push_back(mt_field.size());
     }
