@@ -20,7 +20,8 @@
 namespace frictherm::mechanics {
 
 // Checks the contact settings (the serial enable_contact / set_contact_pair rules plus what the
-// decomposed step does not support) and fills pair_table as the serial contact_pair(a, b) reads:
+// decomposed step does not support) and fills pair_settings / pair_index as the serial
+// set_contact_pair does, read as the serial contact_pair(a, b):
 // the default pair for pairs not set, an explicit pair (a, b) as given, (b, a) with the normal
 // reversed, a specified normal made unit.
 template <int Dim>
@@ -49,7 +50,8 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
                                   "'multimaterial'; penalty contact stays serial)");
   };
   multimaterial_only(co.default_pair, "default pair");
-  pair_table.assign(n * n, co.default_pair);
+  pair_settings.assign(1, co.default_pair);
+  pair_index.assign(opt.contact_pairs.empty() ? 0 : n * n, 0);
   for (const DecomposedContactPair& p : opt.contact_pairs) {
     const int a = p.material_a, b = p.material_b;
     const std::string pair = "pair (" + std::to_string(a) + ", " + std::to_string(b) + ")";
@@ -64,8 +66,10 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
     }
     ContactPairSettings flipped = s;  // seen from b: the normal points from b to a
     flipped.normal_vector = -s.normal_vector;
-    pair_table[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = s;
-    pair_table[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = flipped;
+    pair_settings.push_back(s);
+    pair_settings.push_back(flipped);
+    pair_index[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = static_cast<int>(pair_settings.size()) - 2;
+    pair_index[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = static_cast<int>(pair_settings.size()) - 1;
   }
 }
 
@@ -111,7 +115,8 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
                                   dt, updated};
   auto pair_of = [&](int x, int y) -> const ContactPairSettings& {
-    return pair_table[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)];
+    if (pair_index.empty()) return pair_settings[0];
+    return pair_settings[static_cast<std::size_t>(pair_index[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)])];
   };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
   thread_local std::vector<ContactSide<Dim>> sides;

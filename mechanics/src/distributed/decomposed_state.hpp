@@ -209,7 +209,10 @@ struct DecomposedMpm<Dim>::Impl {
   // Contact (contact_phases.cpp): settings per ordered material pair, the owned nodes where two or
   // more fields have mass (indices into the owned block), frictional work per owned node (last step)
   // and since the start on this rank, counters of the last step on this rank.
-  std::vector<ContactPairSettings> pair_table;  // materials², [a·n + b]
+  // As the serial pair_settings_ / pair_index_: [0] the default pair, then each explicit pair and its
+  // reverse; pair_index (materials², [a·n + b], 4 B each) only when pairs were given.
+  std::vector<ContactPairSettings> pair_settings;
+  std::vector<int> pair_index;
   std::vector<std::array<std::size_t, 2>> contact_nodes;  // (owned node q, group of mt_*)
   std::vector<double> work_first, work_second;
   double cumulative_first = 0.0, cumulative_second = 0.0;
@@ -256,7 +259,7 @@ struct DecomposedMpm<Dim>::Impl {
   int owner_of(const double* x) const;
 
   std::vector<double> scalar_values() const;  // transfer.cpp: every particle scalar, particle-major
-  void setup_contact();  // contact_phases.cpp: checks and pair_table
+  void setup_contact();  // contact_phases.cpp: checks, pair_settings and pair_index
   void setup_fixed_faces();
   void setup_sparse_exchange();  // sparse_exchange.cpp: node_sf, owned_local, field_unit
   void fields_to_mt();           // sparse_exchange.cpp: the owner's groups from its slots and the received entries
