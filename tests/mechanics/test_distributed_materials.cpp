@@ -12,7 +12,8 @@
 //   (c) storage: 50 grains, each its own material: the velocity-field slots each rank stores are
 //       bounded by its particles (K^Dim nodes per particle), not by materials × ghosted box;
 //   (a') the PBX scene's loading: the specimen between rigid boundary walls, a piston driving it
-//       (the serial rigid_boundary materials) = the serial run likewise;
+//       (the serial rigid_boundary materials) = the serial run likewise, and a one-particle wall
+//       beside a rank cut driving the first node the other rank owns;
 //   (e) a particle compressed past its Hugoniot's limit stops every rank (a collective error);
 //   (d) what the decomposed step refuses (a rigid contact partner, plane stress with Mie-Grüneisen).
 // Tolerance 1e-9 of the case's scales (the figure): the measured differences are round-off
@@ -369,6 +370,57 @@ TEST_P(DecomposedWalls, PbxBetweenRigidWallsEqualsTheSerialRun) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Contact, DecomposedWalls, ::testing::Bool());
+
+// A rigid wall one particle thick beside a rank cut: its particles live on the left rank and
+// their stencils reach the first node the right rank owns, where nothing of the right rank's drives
+// it: only the reduction of the drivers to the owner stops the block arriving from the right.
+TEST(DecomposedMaterials, RigidWallBesideARankCutDrivesTheOwnersNode) {
+  const double h = 1e-3;
+  const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {20, 12});
+  const fm::Material block = frictherm::test::elastic("block", 1e7, 0.3, 1000.0);
+  // The first x cut of the DMDA (index c: the right rank owns DMDA nodes ≥ c, lattice x = (c − 1) h).
+  int c = 1 << 20;
+  {
+    fm::DecomposedMpm2D probe(MPI_COMM_WORLD, grid, block, {});
+    const int begin = probe.owned_nodes()[0];
+    if (begin > 0) c = begin;
+    MPI_Allreduce(MPI_IN_PLACE, &c, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  }
+  if (comm_size() == 1) c = 12;  // (no cut: the comparison still runs)
+  fm::SimulationOptions so;
+  so.shape = fm::ShapeKind::ugimp;
+  so.scheme = fm::UpdateScheme::usl;
+  fm::Simulation<2> serial(grid, so);
+  const std::vector<fm::Material> mats{block, wall("wall", 0.0, 0.0, true, false)};
+  for (const auto& m : mats) serial.add_material(m);
+  const double xc = (c - 1) * h;  // the owner's first node
+  // The wall: one column at xc − 0.75 h (nearest node xc − h, left of the cut; its uGIMP stencil
+  // reaches xc with S > 0). The block: from xc on, moving left at 5 m/s.
+  serial.add_body("wall", *fm::make_box<2>(V2(xc - h, h), V2(xc - 0.5 * h, 11 * h), 1), 2, V2::Zero());
+  serial.add_body("block", *fm::make_box<2>(V2(xc, 3 * h), V2(xc + 5 * h, 9 * h), 0), 2, V2(-5.0, 0.0));
+  serial.finalize();
+  fm::DecomposedOptions opt;
+  opt.shape = so.shape;
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  split.add_particles(frictherm::test::decomposed(serial.particles()));
+  const double dt = 0.3 * h / (std::sqrt(block.p_wave_modulus(fm::Analysis::plane_strain) / block.density) + 5.0);
+  for (int s = 0; s < 100; ++s) {
+    serial.step(dt);
+    split.step(dt);
+  }
+  const Difference d = compare<2>(split.gather(), serial);
+  double x_min = 1.0;  // the block's leftmost particle: held at the wall
+  for (std::size_t k = 0; k < serial.particles().size(); ++k)
+    if (serial.particles().material[k] == 0) x_min = std::min(x_min, serial.particles().position[k][0]);
+  EXPECT_TRUE(d.same_ids);
+  EXPECT_GT(x_min, xc - 0.5 * h);  // (free, it would have moved 100 dt · 5 m/s = 1.3 h)
+  EXPECT_LE(d.position / h, 1e-9);
+  EXPECT_LE(d.velocity / 5.0, 1e-9);
+  if (comm_rank() == 0)
+    std::printf("[wall at a cut] cut at DMDA node %d; block's left edge %.3f h from the owner's first node; vs "
+                "serial |dx|/h %.2e, |dv|/5 m/s %.2e\n",
+                c, (x_min - xc) / h, d.position / h, d.velocity / 5.0);
+}
 
 // ---- (c) storage with 50 materials: slots bounded by the particles ----
 TEST(DecomposedMaterials, FiftyGrainsStoreSlotsBoundedByTheirParticles) {
