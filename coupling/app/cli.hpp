@@ -6,6 +6,10 @@
 #include <string>
 #include <vector>
 
+namespace frictherm::coupling {
+struct RunOptions;
+}
+
 namespace frictherm::cli {
 
 /// Exit codes of the program.
@@ -55,6 +59,11 @@ int positive_int(const std::string& command, const std::string& option, const st
 
 int ensemble_command(const std::vector<std::string>& args, const std::string& command_line);
 int run_command(const std::vector<std::string>& args, const std::string& command_line);
+/// `run` in one process: load SCENE with --set, run_scene, report (cli_commands.cpp).
+int serial_run_command(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt);
+/// `run` started as several processes by an MPI launcher (cli_run_mpi.cpp): the decomposed run when
+/// the program has it (MPI and PETSc), the serial run when MPI counts one process.
+int decomposed_run_command(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt);
 int resume_command(const std::vector<std::string>& args, const std::string& command_line);  // cli_resume.cpp
 int continue_command(const std::vector<std::string>& args, const std::string& command_line);  // cli_continue.cpp
 int validate_command(const std::vector<std::string>& args);

@@ -60,7 +60,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
                                    {{"--checkpoint-every"}, true, "checkpoint-every"},
                                    kForceOption, kSetOption});
   if (a.help) {
-    std::cout << kRunHelp;
+    if (launcher_info().rank <= 0) std::cout << kRunHelp;  // under mpirun: rank 0 only
     return kOk;
   }
   const std::string& path = single_positional("run", a, "SCENE");
@@ -78,6 +78,12 @@ int run_command(const std::vector<std::string>& args, const std::string& command
     if (end == v.c_str() || *end != '\0' || !(opt.checkpoint_wall_interval > 0.0) || !std::isfinite(opt.checkpoint_wall_interval))
       throw UsageError("run", "--checkpoint-every: expected wall-clock seconds > 0, got '" + v + "'");
   }
+  // Started as several processes by mpirun (and allowed by refuse_under_launcher): the decomposed run.
+  if (several_processes(launcher_info())) return decomposed_run_command(a, path, opt);
+  return serial_run_command(a, path, opt);
+}
+
+int serial_run_command(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt) {
   coupling::Scene scene;
   if (!load(path, a, scene)) return kUsage;
   coupling::RunResult r;

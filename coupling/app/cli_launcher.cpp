@@ -68,8 +68,15 @@ int refuse_under_launcher(const std::string& command) {
   if (!several_processes(info)) return kOk;
 #ifdef FRICTHERM_WITH_MPI
   if (command == "ensemble") return kOk;
+#ifdef FRICTHERM_DECOMPOSED_RUN
+  if (command == "run") return kOk;  // the decomposed run (cli_run_mpi.cpp)
+  const std::string why = "only 'frictherm run' (decomposed) and 'frictherm ensemble' share their work over MPI "
+                          "processes; every process would run '" + command +
+                          "' alone and write the same files. Run it without the launcher (threads: --threads)";
+#else
   const std::string why = "only 'frictherm ensemble' spreads its members over MPI processes; every process would run '" +
                           command + "' alone and write the same files. Run it without the launcher (threads: --threads)";
+#endif
 #else
   const std::string why = "this frictherm was built without MPI, so every process would run every member of '" +
                           command + "' and write the same files. Rebuild with MPI (Debian libopenmpi-dev, CMake "

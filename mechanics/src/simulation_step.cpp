@@ -224,6 +224,31 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
   });
 }
 
+// Each part of the thread partition clears the slots it scatters into (its own fields in the nodes,
+// its buffer for a field it shares) and scatters; after a barrier the shared fields' buffers are
+// summed into the nodes. One parallel region per phase.
+template <int Dim>
+template <class Scatter>
+void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter) {
+#pragma omp parallel num_threads(threads_)
+  {
+    for_each_part(partition_, [&](int t) {
+      clear_scatter_targets(t, which);
+      for (std::size_t m = 0; m < materials_.size(); ++m) {
+        const int f = field_of_material_[m];
+        if (f < 0 || (!include_rigid && materials_[m].is_rigid())) continue;
+        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        if (kb >= ke) continue;
+        scatter(scatter_target(t, f), fields_[static_cast<std::size_t>(f)].index, m, kb, ke);
+      }
+    });
+    if (!partition_.shared_fields.empty()) {
+#pragma omp barrier
+      sum_shared_fields(which);
+    }
+  }
+}
+
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:
 // m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p, f_i = Σ (−V_p σ_p G_ip + S_ip m_p g) (Nairn 2018 eqs. 1–3);
 // with contact also Σ S_ip m_p x_p (or the displacement x_p − x_p^(0)), Ω = Σ S_ip V_p and
@@ -236,78 +261,58 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
   const bool prepared = stencils_current_;  // by current_stencils() since the last step
-  // One region: each part of the thread partition clears the slots it scatters into (its own fields
-  // in the nodes, its buffer for a field it shares) and scatters; after a barrier the shared fields'
-  // buffers are summed into the nodes.
-  const Accumulated which{true, true, true, contact_};
-#pragma omp parallel num_threads(threads_)
-  {
-    for_each_part(partition_, [&](int t) {
-      clear_scatter_targets(t, which);
-      for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const int f = field_of_material_[m];
-        if (f < 0) continue;
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-        if (kb >= ke) continue;
-        NodalFields<Dim>& acc = scatter_target(t, f);
-        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-        const bool rigid = materials_[m].is_rigid();
-        if (!contact_) {
-          for (std::size_t k = kb; k < ke; ++k) {
-            if constexpr (!is_extended<Kernel>)
-              if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
-            const auto& s = st[k];  // EBS: a view of the precomputed entries
-            const double mp = p_.mass[k];
-            const Vec<Dim> mv = mp * p_.velocity[k];
-            const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
-            const Vec<Dim> mg = mp * g;
-            if (with_forces) {
-              s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-                acc.mass[i] += S * mp;
-                acc.momentum[i] += S * mv;
-                acc.force[i] += S * mg - Vsig * G;
-              });
-            } else {
-              s.for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-                acc.mass[i] += S * mp;
-                acc.momentum[i] += S * mv;
-              });
-            }
-          }
+  scatter_phase(Accumulated{true, true, true, contact_}, true,
+                [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t m, std::size_t kb, std::size_t ke) {
+    if (!contact_) {
+      for (std::size_t k = kb; k < ke; ++k) {
+        if constexpr (!is_extended<Kernel>)
+          if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
+        const auto& s = st[k];  // EBS: a view of the precomputed entries
+        const double mp = p_.mass[k];
+        const Vec<Dim> mv = mp * p_.velocity[k];
+        const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
+        const Vec<Dim> mg = mp * g;
+        if (with_forces) {
+          s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
+            acc.mass[i] += S * mp;
+            acc.momentum[i] += S * mv;
+            acc.force[i] += S * mg - Vsig * G;
+          });
         } else {
-          const bool forces = with_forces && !rigid;
-          // Plain pointers, held in registers: Eigen's vector stores may alias anything, so through the
-          // std::vectors every store would reload every array's address.
-          double* const mass = acc.mass.data();
-          double* const domain = acc.domain.data();
-          Vec<Dim>* const momentum = acc.momentum.data();
-          Vec<Dim>* const force = acc.force.data();
-          Vec<Dim>* const mass_position = acc.mass_position.data();
-          Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
-          decltype(auto) stk = indexable(st);
-          for (std::size_t k = kb; k < ke; ++k) {
-            const double mp = p_.mass[k], Vp = p_.volume[k];
-            const Vec<Dim> mv = mp * p_.velocity[k];
-            const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
-            const Mat<Dim> Vsig = Vp * p_.stress[k];
-            const Vec<Dim> mg = mp * g;
-            stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-              mass[i] += S * mp;
-              momentum[i] += S * mv;
-              if (forces) force[i] += S * mg - Vsig * G;
-              mass_position[i] += S * mx;
-              domain[i] += S * Vp;
-              domain_gradient[i] += Vp * G;
-            });
-          }
+          s.for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+            acc.mass[i] += S * mp;
+            acc.momentum[i] += S * mv;
+          });
         }
       }
-    });
-    if (!partition_.shared_fields.empty()) {
-#pragma omp barrier
-      sum_shared_fields(which);
+      return;
     }
-  }
+    const bool forces = with_forces && !materials_[m].is_rigid();
+    // Plain pointers, held in registers: Eigen's vector stores may alias anything, so through the
+    // std::vectors every store would reload every array's address.
+    double* const mass = acc.mass.data();
+    double* const domain = acc.domain.data();
+    Vec<Dim>* const momentum = acc.momentum.data();
+    Vec<Dim>* const force = acc.force.data();
+    Vec<Dim>* const mass_position = acc.mass_position.data();
+    Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
+    decltype(auto) stk = indexable(st);
+    for (std::size_t k = kb; k < ke; ++k) {
+      const double mp = p_.mass[k], Vp = p_.volume[k];
+      const Vec<Dim> mv = mp * p_.velocity[k];
+      const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
+      const Mat<Dim> Vsig = Vp * p_.stress[k];
+      const Vec<Dim> mg = mp * g;
+      stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
+        mass[i] += S * mp;
+        momentum[i] += S * mv;
+        if (forces) force[i] += S * mg - Vsig * G;
+        mass_position[i] += S * mx;
+        domain[i] += S * Vp;
+        domain_gradient[i] += Vp * G;
+      });
+    }
+  });
 }
 
 // USF: internal and body forces from the freshly updated stress.
@@ -316,29 +321,14 @@ template <class Kernel>
 void Simulation<Dim>::add_internal_forces() {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
-  const Accumulated which{false, false, true, false};
-#pragma omp parallel num_threads(threads_)
-  {
-    for_each_part(partition_, [&](int t) {
-      clear_scatter_targets(t, which);
-      for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const int f = field_of_material_[m];
-        if (f < 0 || materials_[m].is_rigid()) continue;
-        NodalFields<Dim>& acc = scatter_target(t, f);
-        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-        for (std::size_t k = kb; k < ke; ++k) {
-          const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
-          const Vec<Dim> mg = p_.mass[k] * g;
-          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
-        }
-      }
-    });
-    if (!partition_.shared_fields.empty()) {
-#pragma omp barrier
-      sum_shared_fields(which);
+  scatter_phase(Accumulated{false, false, true, false}, false,
+                [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
+    for (std::size_t k = kb; k < ke; ++k) {
+      const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
+      const Vec<Dim> mg = p_.mass[k] * g;
+      st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
     }
-  }
+  });
 }
 
 // Rigid materials without a velocity field of their own (all of them without contact, boundary ones
@@ -404,44 +394,44 @@ long Simulation<Dim>::update_particles(double dt) {
   decltype(auto) stk = indexable(st);
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
   for_each_part(partition_, [&](int t) {
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    const int f = field_of_material_[m];
-    if (f < 0 || materials_[m].is_rigid()) continue;
-    const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-    const long b = static_cast<long>(partition_.lo(t, material_begin_[m]));
-    const long e = static_cast<long>(partition_.hi(t, material_end_[m]));
-    for (long kk = b; kk < e; ++kk) {
-      const std::size_t k = static_cast<std::size_t>(kk);
-      Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
-      if (update == ParticleUpdate::flip) {
-        stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-          a += S * acceleration[i];
-          v += S * velocity[i];
-        });
-      } else {
-        stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-          a += S * acceleration[i];
-          v += S * velocity[i];
-          vf += S * filtered_v[i];
-        });
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+      const int f = field_of_material_[m];
+      if (f < 0 || materials_[m].is_rigid()) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+      const long b = static_cast<long>(partition_.lo(t, material_begin_[m]));
+      const long e = static_cast<long>(partition_.hi(t, material_end_[m]));
+      for (long kk = b; kk < e; ++kk) {
+        const std::size_t k = static_cast<std::size_t>(kk);
+        Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
+        if (update == ParticleUpdate::flip) {
+          stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+            a += S * acceleration[i];
+            v += S * velocity[i];
+          });
+        } else {
+          stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
+            a += S * acceleration[i];
+            v += S * velocity[i];
+            vf += S * filtered_v[i];
+          });
+        }
+        const Vec<Dim> v_old = p_.velocity[k];
+        if (update == ParticleUpdate::flip) {
+          work += p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt;
+          p_.velocity[k] += dt * a;
+          if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
+        } else if (update == ParticleUpdate::xpic) {
+          p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
+        } else {
+          p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
+          v = vf;
+        }
+        if (update != ParticleUpdate::flip) work += p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt;
+        p_.position[k] += dt * v;
+        const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
+        if (!ok) bad = std::min(bad, kk);
       }
-      const Vec<Dim> v_old = p_.velocity[k];
-      if (update == ParticleUpdate::flip) {
-        work += p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt;
-        p_.velocity[k] += dt * a;
-        if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
-      } else if (update == ParticleUpdate::xpic) {
-        p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
-      } else {
-        p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
-        v = vf;
-      }
-      if (update != ParticleUpdate::flip) work += p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt;
-      p_.position[k] += dt * v;
-      const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
-      if (!ok) bad = std::min(bad, kk);
     }
-  }
   });
   for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
   external_work_ += work;
@@ -454,28 +444,13 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::remap_momentum() {
   auto& st = stencils<Kernel>();
-  const Accumulated which{false, true, false, false};
-#pragma omp parallel num_threads(threads_)
-  {
-    for_each_part(partition_, [&](int t) {
-      clear_scatter_targets(t, which);
-      for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const int f = field_of_material_[m];
-        if (f < 0 || materials_[m].is_rigid()) continue;
-        NodalFields<Dim>& acc = scatter_target(t, f);
-        const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-        for (std::size_t k = kb; k < ke; ++k) {
-          const Vec<Dim> mv = p_.mass[k] * p_.velocity[k];
-          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
-        }
-      }
-    });
-    if (!partition_.shared_fields.empty()) {
-#pragma omp barrier
-      sum_shared_fields(which);
+  scatter_phase(Accumulated{false, true, false, false}, false,
+                [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
+    for (std::size_t k = kb; k < ke; ++k) {
+      const Vec<Dim> mv = p_.mass[k] * p_.velocity[k];
+      st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
     }
-  }
+  });
 }
 
 // Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
@@ -492,63 +467,63 @@ long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
   decltype(auto) stk = indexable(st);
 #pragma omp parallel num_threads(threads_) reduction(max : beyond)
   for_each_part(partition_, [&](int t) {
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    const Material& mat = materials_[m];
-    const int f = field_of_material_[m];
-    if (mat.is_rigid() || f < 0) continue;
-    const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-    const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
-    const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
-    const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
-    const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
-    if constexpr (Dim == 2) {
-      if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
-        // A local copy: no particle store can touch it, so the compiler hoists what depends on the
-        // material only (ρ0 C0², −2G/3, …) out of the loop.
-        const MieGruneisenParams params = mat.mie_gruneisen;
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-        for (std::size_t k = kb; k < ke; ++k) {
-          VelocityGradient2 L;
-          stk[k].for_each(ix, [&](int i, double, const Vec<2>& G) { L.add(vi[i], G); });
-          Mat<2>& F = p_.deformation_gradient[k];
-          const double det_A = deformation_update_2d(L, dt, F);
-          p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+      const Material& mat = materials_[m];
+      const int f = field_of_material_[m];
+      if (mat.is_rigid() || f < 0) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+      const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
+      const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
+      const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
+      const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
+      if constexpr (Dim == 2) {
+        if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
+          // A local copy: no particle store can touch it, so the compiler hoists what depends on the
+          // material only (ρ0 C0², −2G/3, …) out of the loop.
+          const MieGruneisenParams params = mat.mie_gruneisen;
+          const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+          for (std::size_t k = kb; k < ke; ++k) {
+            VelocityGradient2 L;
+            stk[k].for_each(ix, [&](int i, double, const Vec<2>& G) { L.add(vi[i], G); });
+            Mat<2>& F = p_.deformation_gradient[k];
+            const double det_A = deformation_update_2d(L, dt, F);
+            p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
+            double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+            if (mie_gruneisen_update_plane_strain(L, dt, p_.volume[k] / p_.initial_volume[k], det_A, params,
+                                                  min_J, p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
+                                                  p_.internal_energy[k], wp, wave_speed_[k]) != MieGruneisenStatus::ok)
+              beyond = std::max(beyond, static_cast<long>(k));
+            p_.plastic_work[k] += wp * p_.volume[k];
+          }
+          continue;
+        }
+      }
+      const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+      for (std::size_t k = kb; k < ke; ++k) {
+        Mat<Dim> L = Mat<Dim>::Zero();
+        stk[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += vi[i] * G.transpose(); });
+        Mat<Dim>& F = p_.deformation_gradient[k];
+        const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+        Mat<Dim> F_new;
+        F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
+        F = F_new;
+        p_.volume[k] = F.determinant() * p_.initial_volume[k];
+        if (mg) {
           double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-          if (mie_gruneisen_update_plane_strain(L, dt, p_.volume[k] / p_.initial_volume[k], det_A, params,
-                                                min_J, p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
-                                                p_.internal_energy[k], wp, wave_speed_[k]) != MieGruneisenStatus::ok)
+          if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J, p_.stress[k],
+                                        p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k], wp,
+                                        &wave_speed_[k]) != MieGruneisenStatus::ok)
             beyond = std::max(beyond, static_cast<long>(k));
           p_.plastic_work[k] += wp * p_.volume[k];
+        } else if (nh) {
+          neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
+          wave_speed_[k] = mat.wave_speed(an, p_.volume[k] / p_.initial_volume[k]);
+        } else {
+          linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
+          wave_speed_[k] = c0;
         }
-        continue;
       }
     }
-    const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-    for (std::size_t k = kb; k < ke; ++k) {
-      Mat<Dim> L = Mat<Dim>::Zero();
-      stk[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += vi[i] * G.transpose(); });
-      Mat<Dim>& F = p_.deformation_gradient[k];
-      const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-      Mat<Dim> F_new;
-      F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
-      F = F_new;
-      p_.volume[k] = F.determinant() * p_.initial_volume[k];
-      if (mg) {
-        double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-        if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J, p_.stress[k],
-                                      p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k], wp,
-                                      &wave_speed_[k]) != MieGruneisenStatus::ok)
-          beyond = std::max(beyond, static_cast<long>(k));
-        p_.plastic_work[k] += wp * p_.volume[k];
-      } else if (nh) {
-        neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
-        wave_speed_[k] = mat.wave_speed(an, p_.volume[k] / p_.initial_volume[k]);
-      } else {
-        linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
-        wave_speed_[k] = c0;
-      }
-    }
-  }
   });
   wave_speed_ready_ = true;
   return beyond;

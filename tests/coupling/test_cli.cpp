@@ -3,55 +3,30 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include "cli_test_support.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
+using frictherm::test::Result;
+using frictherm::test::shell;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result frictherm(const std::string& args) {
-  const std::string cmd = std::string("'") + FRICTHERM_EXE + "' " + args + " 2>&1";
-  Result r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+Result frictherm(const std::string& args) { return shell(std::string("'") + FRICTHERM_EXE + "' " + args); }
 
 /// A fresh folder per test (tests may run in parallel).
-class Cli : public ::testing::Test {
+class Cli : public frictherm::test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("frictherm_cli_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path(name)) << text;
-    return path(name);
-  }
-  fs::path dir_;
+  Cli() : ScratchDirTest("frictherm_cli_") {}
 };
 
 const char* const kTinyScene = R"({
@@ -91,8 +66,6 @@ int count_snapshots(const std::string& h5, bool& has_failure) {
   H5Fclose(f);
   return static_cast<int>(n);
 }
-
-}  // namespace
 
 TEST_F(Cli, HelpAndVersion) {
   for (const char* args : {"--help", "help", "run --help", "validate --help", "export-csv --help", "help run"}) {
@@ -221,3 +194,5 @@ TEST_F(Cli, EnsembleHelpStatesTheMemberLimit) {
   EXPECT_EQ(over.code, 2) << over.output;
   EXPECT_THAT(over.output, HasSubstr("integer in [1, 1024], got '1025'"));
 }
+
+}  // namespace

@@ -26,6 +26,7 @@
 
 #include "../decomposed_test_support.hpp"
 #include "../mpi_ranks.hpp"
+#include "decomposed_heat_test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -42,31 +43,13 @@ using V2 = fm::Vec<2>;
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 using frictherm::test::decomposed;
+using frictherm::test::decomposed_heat_options;
 using frictherm::test::elastic;
-using frictherm::test::mean_velocity_x;
+using frictherm::test::serial_coupler_options;
+using frictherm::test::temperature_difference;
 
 constexpr double kT0 = 300.0;  // K
 
-// Largest |T_p − T_p(serial)| over the gathered particles (by id), and whether the ids match.
-double temperature_difference(const std::vector<fm::DecomposedParticle>& a, const fm::Particles<2>& sp, bool& same) {
-  double d = 0.0;
-  same = same && a.size() == sp.position.size();
-  for (std::size_t k = 0; same && k < a.size(); ++k) {
-    same = a[k].id == static_cast<std::int64_t>(k) && a[k].scalars.size() == 1;
-    if (same) d = std::max(d, std::fabs(a[k].scalars[0] - sp.temperature[k]));
-  }
-  return d;
-}
-
-
-fc::CouplerOptions serial_options(const std::vector<fc::ThermalProperties>& materials) {
-  fc::CouplerOptions opt;
-  opt.materials = materials;
-  opt.integrator = "forward_euler";  // matrix-free for windows of ≤ 64 stable sub-steps
-  opt.window.kind = fc::WindowPolicy::Kind::every_step;
-  opt.reuse_distance = 0.0;  // gather every window
-  return opt;
-}
 
 // ---- (a) the sliding block with heating ----
 TEST(DecomposedHeat, SlidingBlockEqualsTheSerialRunAndClosesItsBooks) {
@@ -83,61 +66,29 @@ TEST(DecomposedHeat, SlidingBlockEqualsTheSerialRunAndClosesItsBooks) {
   fm::Particles<2>& sp = serial.particles();
   std::fill(sp.temperature.begin(), sp.temperature.end(), kT0);
   const std::vector<fc::ThermalProperties> thermal{{true, 100.0, 50.0}, {true, 150.0, 20.0}};
-  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_options(thermal));
+  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_coupler_options(thermal));
   coupler.start(sp, 0.0);
 
   fm::DecomposedOptions opt = scene.options;
   opt.particle_scalars = {"temperature"};
   fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
   split.add_particles(decomposed(sp, true));
-  fc::DecomposedHeatOptions ho;
-  ho.materials = thermal;
-  ho.order = fm::HeatingOrder::second;
-  fc::DecomposedHeat heat(split, ho);
+  fc::DecomposedHeat heat(split, decomposed_heat_options(thermal, fm::HeatingOrder::second));
   const double content0 = heat.heat_content();
 
   const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
   const double dt = 0.3 * h / (c + v0);
   const int steps = 200;
-  double dhist = 0.0, dw = 0.0, dT = 0.0, rise = 0.0, time = 0.0, w = 0.0, ws = 0.0;
-  bool same = true;
-  for (int s = 1; s <= steps; ++s) {
-    serial.step(dt);
-    time += dt;
-    coupler.after_step(sp, serial.frictional_work(fm::HeatingOrder::second), time);
-    split.step(dt);
-    heat.after_step(dt);
-    w = split.cumulative_frictional_work(fm::HeatingOrder::second);
-    ws = serial.cumulative_frictional_work(fm::HeatingOrder::second);
-    dw = std::max(dw, std::fabs(w - ws));
-    const auto a = split.gather();
-    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, blk) - mean_velocity_x(sp, blk)));
-    if (s % 20 == 0) dT = std::max(dT, temperature_difference(a, sp, same));
-  }
-  for (double T : sp.temperature) rise = std::max(rise, T - kT0);
+  // Temperatures compared every 20 steps and at the end.
+  const auto run = frictherm::test::run_heated_block(serial, coupler, split, heat, dt, steps, 20, blk, 1, kT0);
+  const double dhist = run.dhist, dw = run.dw, dT = run.dT, rise = run.rise, ws = run.ws, v_end = run.v_end;
   const fc::DecomposedHeatBooks& b = heat.books();
   const double content = heat.heat_content() - content0;
   const fc::EnergyBooks& sb = coupler.books();
-  const double v_end = mean_velocity_x(sp, blk);
 
-  EXPECT_TRUE(same);  // every particle kept, with its temperature
-  EXPECT_EQ(sb.matrix_free_windows, steps);  // the serial run took the matrix-free path every step
-  EXPECT_EQ(sb.heat_relocated, 0.0);         // as the decomposed run requires
-  EXPECT_EQ(b.windows, steps);
-  EXPECT_EQ(b.substeps, sb.matrix_free_substeps);
-  EXPECT_LT(v_end, v0 - 0.5);  // friction braked the block
-  EXPECT_GT(rise, 0.05);       // and heated the interface
-  // The 1e-9 of the case's own scales: v0, the final work, the largest temperature rise.
-  EXPECT_LE(dhist / v0, 1e-9);
-  EXPECT_LE(dw / ws, 1e-9);
-  EXPECT_LE(dT / rise, 1e-9);
-  EXPECT_LE(std::fabs(b.work_received - ws) / ws, 1e-9);
-  // Books over ranks: heat delivered = work received (no relocation), and conduction creates no heat.
-  EXPECT_LE(std::fabs(b.heat_delivered - b.work_received) / ws, 1e-9);
-  EXPECT_LE(std::fabs(b.nodal_energy_change - b.work_received) / ws, 1e-9);
-  EXPECT_LE(std::fabs(b.particle_energy_change - b.work_received) / ws, 1e-9);
-  EXPECT_LE(std::fabs(content - b.work_received) / ws, 1e-9);
-  EXPECT_LE(b.max_capacity_residual, 1e-12);  // Σ_i M_i = Σ_p m_p C_p (partition of unity)
+  frictherm::test::expect_heated_block_as_serial(run, b, sb, content, steps, v0);
+  EXPECT_EQ(sb.heat_relocated, 0.0);  // no work off the unknowns, as the decomposed run requires
+  EXPECT_GT(rise, 0.05);              // friction heated the interface
   if (comm_rank() == 0)
     std::printf("[heated sliding block] %d ranks, %d steps: block %.3f -> %.3f m/s, W2 %.6e J, max rise %.4f K, "
                 "%ld sub-steps, %ld dropped nodes at the end; max over steps |dv|/v0 %.2e, |dW2|/W2 %.2e, |dT|/rise %.2e; books (/W2): delivered "
@@ -166,27 +117,50 @@ fm::Particles<2> striped_body(int material, bool slivers = false) {
   return p;
 }
 
+// The striped body of material 0 (α = k / (ρ C) = 2.15e-7 m²/s: λ bound ≈ a few 1/s) on its 26 × 12
+// grid twice: the serial Coupler's particles and a decomposed run (uGIMP, the temperature carried by
+// the particles) with its DecomposedHeat, both started.
+struct StripedRun {
+  const fm::Grid<2> grid{V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12}};
+  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
+  const std::vector<fc::ThermalProperties> thermal{{true, 1100.0, 0.45}};
+  fm::Particles<2> sp;
+  fc::Coupler<2> coupler;
+  fm::DecomposedMpm2D split;
+  fc::DecomposedHeat heat;
+  const double content0;  // J
+
+  explicit StripedRun(bool slivers)
+      : sp(striped_body(0, slivers)), coupler(grid, fm::ShapeKind::ugimp, serial_coupler_options(thermal)),
+        split(MPI_COMM_WORLD, grid, mats, decomposed_options()), heat(started(), decomposed_heat_options(thermal)),
+        content0(heat.heat_content()) {}
+
+  static fm::DecomposedOptions decomposed_options() {
+    fm::DecomposedOptions opt;
+    opt.shape = fm::ShapeKind::ugimp;
+    opt.particle_scalars = {"temperature"};
+    return opt;
+  }
+  // The serial coupler started and the particles handed to the decomposed run, before its heat is set up.
+  fm::DecomposedMpm2D& started() {
+    coupler.start(sp, 0.0);
+    split.add_particles(decomposed(sp, true));
+    return split;
+  }
+};
+
 // ---- (b) conduction alone across rank boundaries ----
 class DecomposedConduction : public ::testing::TestWithParam<bool> {};
 
 TEST_P(DecomposedConduction, EqualsTheSerialConduction) {
   const bool slivers = GetParam();
-  const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
-  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
-  // α = k / (ρ C) = 2.15e-7 m²/s: λ bound ≈ a few 1/s; windows of 1 s take several sub-steps.
-  const std::vector<fc::ThermalProperties> thermal{{true, 1100.0, 0.45}};
-  fm::Particles<2> sp = striped_body(0, slivers);
-  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_options(thermal));
-  coupler.start(sp, 0.0);
-  fm::DecomposedOptions opt;
-  opt.shape = fm::ShapeKind::ugimp;
-  opt.particle_scalars = {"temperature"};
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(decomposed(sp, true));
-  fc::DecomposedHeatOptions ho;
-  ho.materials = thermal;
-  fc::DecomposedHeat heat(split, ho);
-  const double content0 = heat.heat_content();
+  StripedRun run(slivers);
+  fm::Particles<2>& sp = run.sp;
+  fc::Coupler<2>& coupler = run.coupler;
+  fm::DecomposedMpm2D& split = run.split;
+  fc::DecomposedHeat& heat = run.heat;
+  const double content0 = run.content0;
+  // Windows of 1 s take several sub-steps.
   const std::vector<double> none(split.owned_local_nodes().size(), 0.0);
   const double window = 1.0;  // s
   const int windows = 8;
@@ -195,7 +169,7 @@ TEST_P(DecomposedConduction, EqualsTheSerialConduction) {
     heat.window(none, window);
   }
   bool same = true;
-  const double dT = temperature_difference(split.gather(), sp, same);
+  const double dT = temperature_difference(split.gather(), sp, 1, same);
   const fm::Particles<2> start = striped_body(0, slivers);
   double change = 0.0;
   for (std::size_t k = 0; k < sp.size(); ++k) change = std::max(change, std::fabs(sp.temperature[k] - start.temperature[k]));
@@ -224,16 +198,9 @@ INSTANTIATE_TEST_SUITE_P(Edges, DecomposedConduction, ::testing::Values(false, t
 
 // ---- (c) work on a node with no unknown next to it: refused on every rank ----
 TEST(DecomposedHeat, RefusesWorkOffTheUnknowns) {
-  const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
-  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
-  fm::DecomposedOptions opt;
-  opt.shape = fm::ShapeKind::ugimp;
-  opt.particle_scalars = {"temperature"};
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(decomposed(striped_body(0), true));
-  fc::DecomposedHeatOptions ho;
-  ho.materials = {{true, 1100.0, 0.45}};
-  fc::DecomposedHeat heat(split, ho);
+  StripedRun run(false);  // the body of (b) with its edges off the grid lines
+  fm::DecomposedMpm2D& split = run.split;
+  fc::DecomposedHeat& heat = run.heat;
   // The owned node at DMDA index (0, 0) (the grid's ghost corner) and its neighbours hold no mass: work
   // there on rank 0 has nowhere to go.
   std::vector<double> joules(split.owned_local_nodes().size(), 0.0);
@@ -251,21 +218,13 @@ TEST(DecomposedHeat, RelocatesWorkOffTheUnknownsAsTheSerialCoupler) {
   // the sliver node (0, 7) (its neighbours straddle the y cut at 7 | 8 of 4 ranks) and 1 J on an
   // unknown, in each of 3 windows of 1 s, with the serial Coupler given the same grid-node work (its
   // distribute_heat moves the 3.5 J in proportion to M_i).
-  const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {26, 12});
-  const std::vector<fm::Material> mats{elastic("still", 1e7, 0.3, 1900.0)};
-  const std::vector<fc::ThermalProperties> thermal{{true, 1100.0, 0.45}};
-  fm::Particles<2> sp = striped_body(0, true);
-  fc::Coupler<2> coupler(grid, fm::ShapeKind::ugimp, serial_options(thermal));
-  coupler.start(sp, 0.0);
-  fm::DecomposedOptions opt;
-  opt.shape = fm::ShapeKind::ugimp;
-  opt.particle_scalars = {"temperature"};
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
-  split.add_particles(decomposed(sp, true));
-  fc::DecomposedHeatOptions ho;
-  ho.materials = thermal;
-  fc::DecomposedHeat heat(split, ho);
-  const double content0 = heat.heat_content();
+  StripedRun run(true);
+  const fm::Grid<2>& grid = run.grid;
+  fm::Particles<2>& sp = run.sp;
+  fc::Coupler<2>& coupler = run.coupler;
+  fm::DecomposedMpm2D& split = run.split;
+  fc::DecomposedHeat& heat = run.heat;
+  const double content0 = run.content0;
   // DMDA index = serial lattice index + 1 = the serial node's index along each axis.
   const int sliver[2] = {15, 1}, sliver2[2] = {1, 8}, inside[2] = {12, 7};
   const auto& npd = grid.nodes_per_dim();
@@ -288,7 +247,7 @@ TEST(DecomposedHeat, RelocatesWorkOffTheUnknownsAsTheSerialCoupler) {
     heat.window(joules, 1.0);
   }
   bool same = true;
-  const double dT = temperature_difference(split.gather(), sp, same);
+  const double dT = temperature_difference(split.gather(), sp, 1, same);
   const fc::DecomposedHeatBooks& b = heat.books();
   const double added = 4.5 * windows, content = heat.heat_content() - content0;
   EXPECT_TRUE(same);

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <string>
 
 namespace fc = frictherm::coupling;
 namespace fm = frictherm::mechanics;
@@ -69,15 +70,43 @@ void expect_same(const std::vector<fc::HotSpot>& a, const std::vector<fc::HotSpo
   }
 }
 
+// One conducting material and a serial and a decomposed tracker of hot spots 20 K above T0, in `dim`.
+struct Trackers {
+  const std::vector<fc::ThermalProperties> materials = {{true, 1000.0, 0.5}};
+  fc::HotSpotTracker serial, decomposed;
+  explicit Trackers(int dim) : serial(dim, options()), decomposed(dim, options()) {}
+  static fc::HotSpotOptions options() {
+    fc::HotSpotOptions opt;
+    opt.threshold = 20.0;
+    return opt;
+  }
+};
+
+// Hot spots holding particles on both sides of a slab boundary (ids below `boundary_id` on its left).
+int straddling(const std::vector<fc::HotSpot>& spots, std::int64_t boundary_id) {
+  int n = 0;
+  for (const fc::HotSpot& h : spots) {
+    bool left = false, right = false;
+    for (std::size_t id : h.particles) (static_cast<std::int64_t>(id) < boundary_id ? left : right) = true;
+    if (left && right) ++n;
+  }
+  return n;
+}
+
+// "<title> N hot spots, sizes n (id i) ..." on one line.
+void print_spots(const std::string& title, const std::vector<fc::HotSpot>& spots) {
+  std::cout << title << spots.size() << " hot spots, sizes";
+  for (const fc::HotSpot& h : spots) std::cout << ' ' << h.particle_count << " (id " << h.id << ")";
+  std::cout << '\n';
+}
+
 }  // namespace
 
 TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
   const int rank = comm_rank(), ranks = comm_size();
   ASSERT_GE(ranks, 2);
-  const std::vector<fc::ThermalProperties> materials = {{true, 1000.0, 0.5}};
-  fc::HotSpotOptions opt;
-  opt.threshold = 20.0;
-  fc::HotSpotTracker serial(2, opt), decomposed(2, opt);
+  Trackers trackers(2);
+  fc::HotSpotTracker &serial = trackers.serial, &decomposed = trackers.decomposed;
   const std::size_t total = static_cast<std::size_t>(kColumns) * kRows;
   for (int update = 0; update < 2; ++update) {
     SCOPED_TRACE(update);
@@ -88,28 +117,18 @@ TEST(HotSpotsAcrossRanks, StraddlingSpotIsOneAndAllRanksAgreeWithSerial) {
     lattice(first_column(rank, ranks), first_column(rank + 1, ranks), update, ranks, mine, my_ids);
     const std::vector<double> reference(mine.size(), kT0), all_reference(all.size(), kT0);
     double max_serial = 0.0;
-    serial.update_from(serial.candidates(all, materials, max_serial, &all_ids, &all_reference), max_serial, total, time);
-    fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, materials, total, time);
+    serial.update_from(serial.candidates(all, trackers.materials, max_serial, &all_ids, &all_reference), max_serial, total, time);
+    fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, trackers.materials, total, time);
 
     const auto& spots = decomposed.hot_spots();
     ASSERT_EQ(spots.size(), update == 0 ? 2u : 3u);
     expect_same(spots, serial.hot_spots());
     EXPECT_EQ(decomposed.max_temperature(), max_serial);
     // The disc on the boundary of slabs 0 and 1 holds particles of both.
-    const std::int64_t boundary_id = static_cast<std::int64_t>(first_column(1, ranks)) * kRows;
-    int straddling = 0;
-    for (const fc::HotSpot& h : spots) {
-      bool left = false, right = false;
-      for (std::size_t id : h.particles) (static_cast<std::int64_t>(id) < boundary_id ? left : right) = true;
-      if (left && right) ++straddling;
-    }
-    EXPECT_EQ(straddling, 1);
-    if (rank == 0) {
-      std::cout << "[hot spots across " << ranks << " ranks] update " << update << ": " << spots.size()
-                << " hot spots, sizes";
-      for (const fc::HotSpot& h : spots) std::cout << ' ' << h.particle_count << " (id " << h.id << ")";
-      std::cout << '\n';
-    }
+    EXPECT_EQ(straddling(spots, static_cast<std::int64_t>(first_column(1, ranks)) * kRows), 1);
+    if (rank == 0)
+      print_spots("[hot spots across " + std::to_string(ranks) + " ranks] update " + std::to_string(update) + ": ",
+                  spots);
   }
 }
 
@@ -141,10 +160,8 @@ void lattice3(int c0, int c1, int ranks, fm::Particles<3>& p, std::vector<std::i
 TEST(HotSpotsAcrossRanks, StraddlingBallIn3DIsOneAndAllRanksAgreeWithSerial) {
   const int rank = comm_rank(), ranks = comm_size();
   ASSERT_GE(ranks, 2);
-  const std::vector<fc::ThermalProperties> materials = {{true, 1000.0, 0.5}};
-  fc::HotSpotOptions opt;
-  opt.threshold = 20.0;
-  fc::HotSpotTracker serial(3, opt), decomposed(3, opt);
+  Trackers trackers(3);
+  fc::HotSpotTracker &serial = trackers.serial, &decomposed = trackers.decomposed;
   const std::size_t total = static_cast<std::size_t>(kX3) * kY3 * kZ3;
   fm::Particles<3> all, mine;
   std::vector<std::int64_t> all_ids, my_ids;
@@ -157,25 +174,14 @@ TEST(HotSpotsAcrossRanks, StraddlingBallIn3DIsOneAndAllRanksAgreeWithSerial) {
   std::reverse(my_ids.begin(), my_ids.end());
   const std::vector<double> reference(mine.size(), kT0), all_reference(all.size(), kT0);
   double max_serial = 0.0;
-  serial.update_from(serial.candidates(all, materials, max_serial, &all_ids, &all_reference), max_serial, total, 0.0);
-  fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, materials, total, 0.0);
+  serial.update_from(serial.candidates(all, trackers.materials, max_serial, &all_ids, &all_reference), max_serial, total, 0.0);
+  fc::update_hot_spots_across_ranks(MPI_COMM_WORLD, decomposed, mine, my_ids, reference, trackers.materials, total, 0.0);
   const auto& spots = decomposed.hot_spots();
   ASSERT_EQ(spots.size(), 2u);
   expect_same(spots, serial.hot_spots());
   EXPECT_EQ(decomposed.max_temperature(), max_serial);
-  const std::int64_t boundary_id = static_cast<std::int64_t>(first_slab3(1, ranks)) * kY3 * kZ3;
-  int straddling = 0;
-  for (const fc::HotSpot& h : spots) {
-    bool left = false, right = false;
-    for (std::size_t id : h.particles) (static_cast<std::int64_t>(id) < boundary_id ? left : right) = true;
-    if (left && right) ++straddling;
-  }
-  EXPECT_EQ(straddling, 1);
-  if (rank == 0) {
-    std::cout << "[hot spots 3D across " << ranks << " ranks] " << spots.size() << " hot spots, sizes";
-    for (const fc::HotSpot& h : spots) std::cout << ' ' << h.particle_count << " (id " << h.id << ")";
-    std::cout << '\n';
-  }
+  EXPECT_EQ(straddling(spots, static_cast<std::int64_t>(first_slab3(1, ranks)) * kY3 * kZ3), 1);
+  if (rank == 0) print_spots("[hot spots 3D across " + std::to_string(ranks) + " ranks] ", spots);
 }
 
 int main(int argc, char** argv) { return frictherm::test::run_tests_under_mpi(argc, argv); }

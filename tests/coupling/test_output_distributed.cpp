@@ -9,6 +9,7 @@
 #include <frictherm/coupling/distributed.hpp>
 
 #include "../mpi_ranks.hpp"
+#include "../mpi_scratch.hpp"
 #include "../mpi_test_main.hpp"
 
 #include <gtest/gtest.h>
@@ -26,20 +27,6 @@ using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 
 namespace {
-
-// A scratch folder made by rank 0 and known to all.
-std::string scratch() {
-  std::string dir;
-  if (comm_rank() == 0) {
-    char tmpl[] = "/tmp/frictherm_decomposed_XXXXXX";
-    dir = mkdtemp(tmpl);
-  }
-  int length = static_cast<int>(dir.size());
-  MPI_Bcast(&length, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  dir.resize(static_cast<std::size_t>(length));
-  MPI_Bcast(dir.data(), length, MPI_CHAR, 0, MPI_COMM_WORLD);
-  return dir;
-}
 
 double x_of(std::int64_t id, int d, int snapshot) { return 1e-3 * static_cast<double>(id) + 0.1 * d + 1e-4 * snapshot; }
 double v_of(std::int64_t id, int d) { return 0.5 * static_cast<double>(id) - d; }
@@ -97,7 +84,7 @@ class DecomposedOutputDims : public ::testing::TestWithParam<int> {};
 
 TEST_P(DecomposedOutputDims, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce) {
   const int rank = comm_rank(), ranks = comm_size(), dim = GetParam();
-  const std::string dir = scratch();
+  const std::string dir = frictherm::test::scratch_folder("/tmp/frictherm_decomposed_");
   const std::string base = dir + "/run";
   std::int64_t total = 0;
   const double times[2] = {0.0, 1.2345678901234567e-6};

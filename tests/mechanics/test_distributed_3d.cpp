@@ -365,38 +365,16 @@ TEST(Decomposed3D, SixFixedFacesEqualTheSerialSimulation) {
 class Decomposed3DSliding : public ::testing::TestWithParam<fm::ShapeKind> {};
 
 TEST_P(Decomposed3DSliding, EqualsTheSerialRunWithHeating) {
-  // Base 10 × 4 × 2 mm fixed at z_min (all components), block 4 × 4 × 2 mm on it sliding along x at
-  // 10 m/s (across the 2-rank cut near x = 6.5 mm), pressed by g = 2e4 m/s² along −z, Coulomb μ = 0.3
-  // with the specified normal (0, 0, 1) from base to block; 1 mm cells, 2³ particles per cell, USL;
-  // 12 × 6 × 5 cells; 150 steps (the block moves ~2.5 mm).
-  const double v0 = 10.0, g = 2e4, mu = 0.3;
-  const fm::Grid<3> grid(V3::Zero(), V3::Constant(h), {12, 6, 5});
-  const std::vector<fm::Material> mats{elastic("base", 2e7, 0.3, rho), elastic("block", 1.5e7, 0.25, rho)};
-  fm::SimulationOptions so;
-  so.shape = GetParam();
-  so.scheme = fm::UpdateScheme::usl;
-  so.gravity = V3(0.0, 0.0, -g);
-  fm::Simulation<3> serial(grid, so);
-  const int base = serial.add_material(mats[0]), blk = serial.add_material(mats[1]);
-  serial.add_body("base", *fm::make_box<3>(V3(1e-3, 1e-3, 0.0), V3(11e-3, 5e-3, 2e-3), base), 2, V3::Zero());
-  serial.add_body("block", *fm::make_box<3>(V3(2e-3, 1e-3, 2e-3), V3(6e-3, 5e-3, 4e-3), blk), 2, V3(v0, 0.0, 0.0));
-  const fm::FixedFace bottom{2, false, {{true, true, true}}};
-  serial.fix_face(bottom);
-  fm::ContactOptions co;
-  co.default_pair.law = fm::FrictionLaw::coulomb(mu);
-  co.default_pair.normal = fm::NormalMethod::specified;
-  co.default_pair.normal_vector = V3(0.0, 0.0, 1.0);
-  serial.enable_contact(co);
-  serial.set_contact_pair(base, blk, co.default_pair);
-  serial.finalize();
-  Mpm::Options opt;
-  opt.shape = so.shape;
-  opt.gravity = V3(0.0, 0.0, -g);
-  opt.fixed_faces = {bottom};
-  opt.contact = true;
-  opt.contact_options = co;
-  opt.contact_pairs = {fm::DecomposedContactPair{base, blk, co.default_pair}};
-  Mpm split(MPI_COMM_WORLD, grid, mats, opt);
+  // The 3D sliding block of decomposed_test_support.hpp (base 10 × 4 × 2 mm fixed at z_min, block
+  // 4 × 4 × 2 mm sliding along x at 10 m/s across the 2-rank cut, g = 2e4 m/s² along −z, Coulomb
+  // μ = 0.3, 12 × 6 × 5 cells of 1 mm, USL); 150 steps (the block moves ~2.5 mm).
+  frictherm::test::SlidingBlock3D scene(GetParam());
+  const double v0 = scene.v0;
+  const fm::Grid<3>& grid = scene.grid;
+  const std::vector<fm::Material>& mats = scene.materials;
+  fm::Simulation<3>& serial = *scene.serial;
+  const int blk = scene.block;
+  Mpm split(MPI_COMM_WORLD, grid, mats, scene.options);
   split.add_particles(frictherm::test::decomposed(serial.particles()));
 
   const double dt = 0.3 * h / (p_wave_speed(mats[0]) + v0);

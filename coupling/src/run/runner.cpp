@@ -201,14 +201,10 @@ class Run {
 
   void loop(detail::ProgressLine& progress) {
     const double T = s_.end_time;
-    const double eps = 1e-10 * T;
-    const double snap_dt = s_.output.snapshot_interval;
-    const double series_dt = s_.output.series_interval;
     // The next output times after the current one (t = 0, or a resumed checkpoint's time).
     const double t0 = sim_->time();
-    long snap_k = static_cast<long>(std::floor(t0 / snap_dt + 1e-9)) + 1;
-    double next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
-    double next_series = series_dt > 0.0 ? (std::floor(t0 / series_dt + 1e-9) + 1.0) * series_dt : 0.0;
+    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, t0);
+    const double eps = schedule.eps();
     if (s_.checkpoint_interval > 0.0)
       next_checkpoint_ = (std::floor(t0 / s_.checkpoint_interval + 1e-9) + 1.0) * s_.checkpoint_interval;
     while (sim_->time() < T - eps) {
@@ -218,7 +214,7 @@ class Run {
       }
       // Land exactly on the next snapshot time (or end_time); split the last stretch into two
       // similar steps rather than a full step and a sliver.
-      double limit = next_snap - sim_->time();
+      double limit = schedule.next_snapshot() - sim_->time();
       if (sim_->step_count() == 0 || limit < 3.0 * sim_->last_time_step()) {
         const double stable = sim_->stable_time_step();
         if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
@@ -237,23 +233,14 @@ class Run {
         const Clock::time_point c0 = Clock::now();
         const double solve0 = thermal_->solve_seconds();
         const double shape0 = sim_->phase_times().shape_functions;
-        thermal_->after_step(*sim_, sim_->frictional_work(thermal_->heating_order()), t >= next_snap - eps);
+        thermal_->after_step(*sim_, sim_->frictional_work(thermal_->heating_order()), schedule.snapshot_reached(t));
         // Less the next step's stencils the coupler had evaluated (current_stencils): timed as the
         // step's shape_functions phase.
         coupling_seconds_ += seconds_since(c0) - (sim_->phase_times().shape_functions - shape0);
         loading_solve_seconds_ += thermal_->solve_seconds() - solve0;
       }
-      if (series_dt <= 0.0 || t >= next_series - eps || t >= T - eps) {
-        series();
-        if (series_dt > 0.0) next_series = (std::floor(t / series_dt + 1e-9) + 1.0) * series_dt;
-      }
-      if (t >= next_snap - eps) {
-        snapshot();
-        // The next snapshot time after t, in closed form (validation bounds end_time / snap_dt).
-        snap_k = std::max(snap_k + 1, static_cast<long>(std::floor((t + eps) / snap_dt)) + 1);
-        next_snap = std::min(static_cast<double>(snap_k) * snap_dt, T);
-        if (next_snap <= t + eps && next_snap < T) next_snap = std::min(static_cast<double>(++snap_k) * snap_dt, T);
-      }
+      if (schedule.series_due(t)) series();
+      if (schedule.snapshot_due(t)) snapshot();
       if (checkpoints_ && (t >= next_checkpoint_ - eps || (o_.checkpoint_wall_interval > 0.0 &&
                                                             seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval))) {
         checkpoint();

@@ -1,9 +1,11 @@
 #pragma once
-// Private helpers of the run loop: what goes into the HDF5 file, and the progress line.
+// Private helpers of the run loop: what goes into the HDF5 file, when it is written, and the progress line.
 #include <frictherm/coupling/h5_output.hpp>
 #include <frictherm/coupling/runner.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -66,6 +68,47 @@ class ProgressLine {
   Clock::time_point start_, last_draw_;
   long last_step_ = 0;
   std::size_t width_ = 0;  // characters drawn last time
+};
+
+/// When a run loop (runner.cpp, distributed_run/decomposed_runner.cpp) writes: a series row every
+/// series_interval (every step when it is 0) and at end_time; a snapshot at every multiple of
+/// snapshot_interval and at end_time, the times the loop lands its steps on (next_snapshot()).
+/// Times within eps = 1e-10 end_time count as reached.
+class OutputSchedule {
+ public:
+  /// From time t0: 0, or a resumed checkpoint's time (the next output times are the ones after it).
+  OutputSchedule(double end_time, double snapshot_interval, double series_interval, double t0)
+      : end_(end_time), eps_(1e-10 * end_time), snap_dt_(snapshot_interval), series_dt_(series_interval),
+        snap_k_(static_cast<long>(std::floor(t0 / snap_dt_ + 1e-9)) + 1),
+        next_snap_(std::min(static_cast<double>(snap_k_) * snap_dt_, end_)),
+        next_series_(series_dt_ > 0.0 ? (std::floor(t0 / series_dt_ + 1e-9) + 1.0) * series_dt_ : 0.0) {}
+
+  double eps() const { return eps_; }
+  double next_snapshot() const { return next_snap_; }
+  bool snapshot_reached(double t) const { return t >= next_snap_ - eps_; }
+
+  /// Whether a series row is due at time t; if so the next series time moves past t.
+  bool series_due(double t) {
+    if (!(series_dt_ <= 0.0 || t >= next_series_ - eps_ || t >= end_ - eps_)) return false;
+    if (series_dt_ > 0.0) next_series_ = (std::floor(t / series_dt_ + 1e-9) + 1.0) * series_dt_;
+    return true;
+  }
+  /// Whether a snapshot is due at time t; if so the next snapshot time moves to the first multiple
+  /// of snapshot_interval after t, in closed form (validation bounds end_time / snapshot_interval),
+  /// or to end_time.
+  bool snapshot_due(double t) {
+    if (!snapshot_reached(t)) return false;
+    snap_k_ = std::max(snap_k_ + 1, static_cast<long>(std::floor((t + eps_) / snap_dt_)) + 1);
+    next_snap_ = std::min(static_cast<double>(snap_k_) * snap_dt_, end_);
+    if (next_snap_ <= t + eps_ && next_snap_ < end_)
+      next_snap_ = std::min(static_cast<double>(++snap_k_) * snap_dt_, end_);
+    return true;
+  }
+
+ private:
+  double end_, eps_, snap_dt_, series_dt_;
+  long snap_k_;
+  double next_snap_, next_series_;
 };
 
 /// "mm:ss", or "h:mm:ss" past an hour.

@@ -8,12 +8,7 @@ namespace frictherm::coupling {
 
 namespace {
 
-template <int Dim>
-mechanics::Vec<Dim> to_vec(const SceneVec& v) {
-  mechanics::Vec<Dim> out;
-  for (int d = 0; d < Dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
-  return out;
-}
+using detail::to_vec;
 
 template <int Dim>
 std::unique_ptr<mechanics::Region<Dim>> make_region(const ShapeSpec& s, int material) {

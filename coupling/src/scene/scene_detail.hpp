@@ -26,6 +26,13 @@ struct ParseContext {
 SceneVec read_vec(const JsonReader& value, int dim, const Range& range = Range::any());
 /// "(x, y)" or "(x, y, z)".
 std::string format_vec(const SceneVec& v, int dim);
+/// The first Dim components of a SceneVec (the serial scene build and the decomposed set-up).
+template <int Dim>
+mechanics::Vec<Dim> to_vec(const SceneVec& v) {
+  mechanics::Vec<Dim> out;
+  for (int d = 0; d < Dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
+  return out;
+}
 
 /// bodies: [...]
 void parse_bodies(const JsonReader& root, Scene& scene, ParseContext& ctx);

@@ -1,6 +1,7 @@
 // The human-readable summary `frictherm validate` prints.
 #include "scene/scene_detail.hpp"
 
+#include <frictherm/coupling/decomposed_support.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 
 #include <cmath>
@@ -114,6 +115,10 @@ void describe(const Scene& s, std::ostream& out) {
   const double snaps = std::ceil(s.end_time / s.output.snapshot_interval - 1e-9) + 1.0;
   row("output") << s.output.file << ": " << g(snaps) << " snapshots, series "
                 << (s.output.series_interval > 0.0 ? "every " + g(s.output.series_interval) + " s" : std::string("every step"))
+                << '\n';
+  const std::string refusal = decomposed_run_refusal(s);  // "KEY: VALUE is not supported ...; the serial run ..."
+  row("mpirun") << (refusal.empty() ? "mpirun -n K frictherm run decomposes it (docs/distributed_run.md)"
+                                     : "serial only (" + refusal.substr(0, refusal.find("; the serial run")) + ")")
                 << '\n';
 }
 

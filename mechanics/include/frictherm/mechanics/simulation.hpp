@@ -297,6 +297,10 @@ class Simulation {
   }
   void clear_scatter_targets(int tid, Accumulated which);  // inside a parallel region, before the scatter
   void sum_shared_fields(Accumulated which);  // inside a parallel region, after a barrier
+  /// One scatter phase (simulation_step.cpp): a parallel region in which each part of the partition
+  /// clears its targets and calls scatter(acc, index, m, k_begin, k_end) for each of its materials that
+  /// has a field (rigid ones only with include_rigid), then the shared fields are summed.
+  template <class Scatter> void scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter);
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead.
   void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;

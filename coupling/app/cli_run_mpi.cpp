@@ -1,0 +1,109 @@
+// `mpirun -n K frictherm run SCENE` (issue 16): the scene is loaded and validated on every rank as in
+// the serial program, checked against what the decomposed engine supports (a refusal names the scene
+// key; exit code 2, nothing written), then run by run_scene_decomposed. Only rank 0 speaks.
+#include "cli.hpp"
+
+#include <frictherm/coupling/runner.hpp>
+#include <frictherm/coupling/scene.hpp>
+
+#include <cstdio>
+#include <iostream>
+
+#ifdef FRICTHERM_DECOMPOSED_RUN
+#include <frictherm/coupling/decomposed_run.hpp>
+#include <frictherm/mechanics/distributed.hpp>
+
+#include <mpi.h>
+#endif
+
+namespace frictherm::cli {
+
+#ifdef FRICTHERM_DECOMPOSED_RUN
+namespace {
+
+// The outcome of a decomposed run on this rank, reported by rank 0.
+int report(const coupling::RunResult& r, const coupling::RunOptions& opt, int rank, int ranks) {
+  if (rank != 0) return r.exit_code();
+  if (r.status == coupling::RunResult::Status::failed) {
+    std::cerr << "frictherm: simulation failed: " << r.message << ". Kept: " << r.output << " (the time series) and "
+              << r.snapshots << " snapshots per rank.\n";
+    return kSimulationFailed;
+  }
+  if (r.status == coupling::RunResult::Status::interrupted) {
+    std::cerr << "frictherm: " << r.message << ". Kept in " << r.output << ": " << r.series_rows << " series rows and "
+              << r.snapshots << " snapshots (the last one at the interruption) in the rank files joined by the XDMF "
+              << "file; /meta/status = interrupted.\n";
+    return r.exit_code();
+  }
+  if (!opt.quiet) {
+    std::printf("wrote %s (series) and %zu snapshots over %d rank files joined by the XDMF file: %zu series rows; "
+                "%ld steps to t = %g s in %.2f s (%zu particles on %d ranks)\n",
+                r.output.c_str(), r.snapshots, ranks, r.series_rows, r.steps, r.time, r.wall_time, r.particles, ranks);
+    if (r.wall_time > 0.0 && r.steps > 0) {
+      std::printf("%.3g particle-steps/s; rank 0's wall time by phase:",
+                  static_cast<double>(r.particles) * r.steps / r.wall_time);
+      for (const auto& [name, seconds] : r.phase_seconds)
+        if (seconds > 0.0005 * r.wall_time) std::printf(" %s %.1f%%", name.c_str(), 100.0 * seconds / r.wall_time);
+      std::printf("\n");
+    }
+    std::fflush(stdout);
+  }
+  return kOk;
+}
+
+int run_decomposed(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt, int rank, int ranks) {
+  coupling::Scene scene;
+  try {  // every rank loads and validates the scene (deterministic: all agree); rank 0 reports
+    std::vector<coupling::SceneOverride> overrides;
+    if (a.lists.count("set"))
+      for (const auto& assignment : a.lists.at("set")) overrides.push_back(coupling::parse_override(assignment));
+    scene = coupling::load_scene(path, overrides);
+  } catch (const coupling::SceneError& e) {
+    if (rank == 0) std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    return kUsage;
+  }
+  if (const std::string why = coupling::decomposed_run_refusal(scene); !why.empty()) {
+    if (rank == 0) std::cerr << "frictherm: " << path << ": " << why << ".\n";
+    return kUsage;
+  }
+  if (opt.checkpoint_wall_interval > 0.0) {
+    if (rank == 0)
+      std::cerr << "frictherm run: --checkpoint-every is not supported in a decomposed run (no checkpoints); the "
+                   "serial run (without mpirun, or with -n 1) supports it\n";
+    return kUsage;
+  }
+  coupling::RunResult r;
+  try {
+    r = coupling::run_scene_decomposed(MPI_COMM_WORLD, scene, opt);
+  } catch (const coupling::SceneError& e) {  // agreed by every rank
+    if (rank == 0) std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    return kUsage;
+  } catch (const coupling::OutputError& e) {  // agreed by every rank
+    if (rank == 0) std::cerr << "frictherm: " << e.what() << '\n';
+    return kUsage;
+  } catch (const std::exception& e) {  // perhaps on this rank alone: end every rank rather than hang
+    std::cerr << "frictherm: rank " << rank << ": run of " << path << " failed: " << e.what() << '\n';
+    MPI_Abort(MPI_COMM_WORLD, kSimulationFailed);
+    return kSimulationFailed;
+  }
+  return report(r, opt, rank, ranks);
+}
+
+}  // namespace
+#endif
+
+int decomposed_run_command(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt) {
+#ifdef FRICTHERM_DECOMPOSED_RUN
+  // PETSc (and MPI) for the lifetime of the run; PETSc reads no options from the command line.
+  const mechanics::DecomposedPetscSession petsc(nullptr, nullptr);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  if (ranks == 1) return serial_run_command(a, path, opt);  // one process: today's program
+  return run_decomposed(a, path, opt, rank, ranks);
+#else
+  return serial_run_command(a, path, opt);  // not reached: refuse_under_launcher refused `run` before
+#endif
+}
+
+}  // namespace frictherm::cli

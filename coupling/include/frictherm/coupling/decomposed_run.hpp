@@ -1,0 +1,40 @@
+#pragma once
+// `mpirun -n K frictherm run SCENE.json` (issue 16, "the same command"): a scene run on the decomposed
+// engine (frictherm/mechanics/distributed.hpp: DMDA grid, DMSwarm particles, USL step with
+// multimaterial contact; frictherm/coupling/decomposed_heat.hpp: heat hand-off and forward-Euler
+// conduction every step; frictherm/coupling/distributed.hpp: per-rank output joined by XDMF).
+// Library target frictherm::coupling_run_mpi (coupling/src/distributed_run/), built when the
+// decomposed mechanics and coupling are; the frictherm program uses it when started as K > 1 processes.
+//
+//   if (std::string why = decomposed_run_refusal(scene); !why.empty()) → exit code 2, nothing written
+//   RunResult r = run_scene_decomposed(MPI_COMM_WORLD, scene, options);
+//
+// What a decomposed run supports (anything else is refused by decomposed_run_refusal, naming the
+// scene key and its value): 2D and 3D, linear-elastic materials, the USL update with FLIP, the
+// linear, uGIMP and quadratic B-spline shapes, fixed grid faces, gravity, multimaterial contact with
+// any friction law and the position, displacement or velocity_only separation; in 2D frictional
+// heating with forward-Euler conduction every mechanics step (matrix-free, the gather every window).
+#include <frictherm/coupling/decomposed_support.hpp>  // decomposed_run_refusal
+#include <frictherm/coupling/runner.hpp>
+#include <frictherm/coupling/scene.hpp>
+
+#include <mpi.h>
+
+#include <string>
+
+namespace frictherm::coupling {
+
+/// Runs a validated, supported scene over the ranks of `comm` (collective; PETSc initialised).
+/// Output: OUT.h5 (rank 0: the time series and metadata, as the serial file without snapshots),
+/// OUT.rank<r>.h5 (each rank's particle snapshots) and OUT.xdmf joining them. Same refusals as the
+/// serial run (OutputError on every rank for an existing file without overwrite, or an input file);
+/// SceneError on every rank when the particles cannot be built. options.handle_signals: SIGINT or
+/// SIGTERM on any rank ends the run after the current step on every rank. Checkpoints and the
+/// per-step observer are not supported (std::invalid_argument).
+RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options);
+
+/// The files a decomposed run writes for output `out` with `ranks` processes: out, the XDMF file
+/// and every rank file.
+std::vector<std::string> decomposed_output_files(const std::string& out, int ranks);
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,81 @@
+// Hot spots of a decomposed run (decomposed_hotspots.hpp).
+#include "distributed_run/decomposed_hotspots.hpp"
+
+#include <frictherm/coupling/distributed.hpp>
+
+#include <cmath>
+#include <limits>
+
+namespace frictherm::coupling::detail {
+
+template <int Dim>
+DecomposedHotSpots<Dim>::DecomposedHotSpots(const Scene& scene, const mechanics::DecomposedMpm<Dim>& mpm)
+    : materials_(scene.thermal.coupler.materials),
+      tracker_(Dim, scene.thermal.coupler.hotspots, scene.thermal.coupler.thickness),
+      temperature_(mpm.particle_scalar_index("temperature")),
+      reference_(mpm.particle_scalar_index("reference_temperature")),
+      particle_count_(static_cast<std::size_t>(mpm.global_particles())) {}
+
+template <int Dim>
+void DecomposedHotSpots<Dim>::update(const mechanics::DecomposedMpm<Dim>& mpm, double time) {
+  const mechanics::DecomposedLocalParticles p = mpm.local_particle_data(true);
+  const std::size_t n = p.mass.size();
+  // The fields HotSpotTracker::candidates reads: x_p, l_p, V_p, m_p, material, T_p.
+  local_.position.resize(n);
+  local_.half_size.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    local_.position[k] = Eigen::Map<const mechanics::Vec<Dim>>(p.position.data() + Dim * k);
+    local_.half_size[k] = Eigen::Map<const mechanics::Vec<Dim>>(p.half_size.data() + Dim * k);
+  }
+  local_.volume = p.volume;
+  local_.mass = p.mass;
+  local_.material.assign(p.material.begin(), p.material.end());
+  local_.temperature = mpm.particle_scalar(temperature_);
+  ids_ = p.id;
+  update_hot_spots_across_ranks<Dim>(mpm.communicator(), tracker_, local_, ids_, mpm.particle_scalar(reference_),
+                                     materials_, particle_count_, time);
+  ++updates_;
+}
+
+template <int Dim>
+std::vector<std::string> DecomposedHotSpots<Dim>::series_names() {
+  return {"hotspot_count", "hottest_hotspot_temperature", "hottest_hotspot_size", "hottest_hotspot_diameter"};
+}
+
+template <int Dim>
+void DecomposedHotSpots<Dim>::extend_series_row(std::vector<double>& row) const {
+  const HotSpot* hot = tracker_.hottest();
+  const double none = std::numeric_limits<double>::quiet_NaN();  // no hot spot: NaN, as the serial run
+  row.insert(row.end(), {static_cast<double>(tracker_.hot_spots().size()), hot ? hot->peak_temperature : none,
+                         hot ? hot->size : none, hot ? hot->equivalent_diameter : none});
+}
+
+template <int Dim>
+void DecomposedHotSpots<Dim>::declare_table(H5Output& out) const {
+  std::vector<std::string> c{"time", "id", "particle_count", "peak_temperature", "mean_temperature", "size",
+                             "equivalent_diameter"};
+  const char* axes[3] = {"centroid_x", "centroid_y", "centroid_z"};
+  for (int d = 0; d < Dim; ++d) c.emplace_back(axes[d]);
+  for (const char* name : {"birth_time", "duration", "excess_energy", "material_mask"}) c.emplace_back(name);
+  out.declare_table("hotspots", c);
+}
+
+template <int Dim>
+void DecomposedHotSpots<Dim>::append_table_rows(H5Output& out, double time) {
+  if (updates_ == updates_written_) return;
+  updates_written_ = updates_;
+  for (const HotSpot& h : tracker_.hot_spots()) {
+    std::vector<double> r{time, static_cast<double>(h.id), static_cast<double>(h.particle_count), h.peak_temperature,
+                          h.mean_temperature, h.size, h.equivalent_diameter};
+    for (int d = 0; d < Dim; ++d) r.push_back(h.centroid[static_cast<std::size_t>(d)]);
+    double mask = 0.0;  // bit m set: material id m present
+    for (int m : h.materials) mask += std::ldexp(1.0, m);
+    r.insert(r.end(), {h.birth_time, h.duration, h.excess_energy, mask});
+    out.append_table_row("hotspots", r);
+  }
+}
+
+template class DecomposedHotSpots<2>;
+template class DecomposedHotSpots<3>;
+
+}  // namespace frictherm::coupling::detail

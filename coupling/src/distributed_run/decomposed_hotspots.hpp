@@ -1,0 +1,47 @@
+#pragma once
+// Hot spots of a decomposed run (decomposed_hotspots.cpp): the serial run's tracker
+// (hotspots.hpp) fed with every rank's particles (update_hot_spots_across_ranks, distributed.hpp) after
+// every heat window, and its series columns and /hotspots rows written as the serial run writes them
+// (runner_thermal.cpp).
+#include <frictherm/coupling/h5_output.hpp>
+#include <frictherm/coupling/hotspots.hpp>
+#include <frictherm/coupling/scene.hpp>
+#include <frictherm/mechanics/distributed.hpp>
+
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling::detail {
+
+template <int Dim>
+class DecomposedHotSpots {
+ public:
+  /// The scene's coupling.hotspots settings; the particles carry the scalars `temperature` and
+  /// `reference_temperature` (T0_p, K).
+  DecomposedHotSpots(const Scene& scene, const mechanics::DecomposedMpm<Dim>& mpm);
+
+  /// Collective: finds and matches the hot spots of all ranks at `time` (every rank holds the result).
+  void update(const mechanics::DecomposedMpm<Dim>& mpm, double time);
+
+  /// Series columns after the thermal ones: hotspot_count, hottest_hotspot_temperature, _size, _diameter.
+  static std::vector<std::string> series_names();
+  void extend_series_row(std::vector<double>& row) const;
+  /// Rank 0: declares /hotspots (the serial columns) and appends the current hot spots once per update.
+  void declare_table(H5Output& out) const;
+  void append_table_rows(H5Output& out, double time);
+
+  const HotSpotTracker& tracker() const { return tracker_; }
+
+ private:
+  std::vector<ThermalProperties> materials_;
+  HotSpotTracker tracker_;
+  int temperature_ = 0, reference_ = 0;
+  std::size_t particle_count_ = 0;
+  long updates_ = 0, updates_written_ = -1;
+  mechanics::Particles<Dim> local_;  // scratch: this rank's particles as the tracker reads them
+  std::vector<std::int64_t> ids_;
+};
+
+}  // namespace frictherm::coupling::detail

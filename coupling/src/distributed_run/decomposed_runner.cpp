@@ -1,0 +1,437 @@
+// The decomposed run loop (decomposed_run.hpp): the serial run loop's time stepping (CFL from the
+// P-wave speed plus the particle speed, the largest over all ranks; landing on every snapshot time and
+// on end_time), the engine's USL step and the heat hand-off and forward-Euler conduction of
+// DecomposedHeat every step; series on rank 0 (OUT.h5), particle snapshots per rank joined by OUT.xdmf.
+#include "distributed_run/decomposed_hotspots.hpp"
+#include "distributed_run/decomposed_setup.hpp"
+#include "run/run_signals.hpp"
+#include "run/runner_detail.hpp"
+
+#include <frictherm/coupling/decomposed_heat.hpp>
+#include <frictherm/coupling/decomposed_run.hpp>
+#include <frictherm/coupling/distributed.hpp>
+#include <frictherm/coupling/h5_output.hpp>
+#include <frictherm/coupling/output_files.hpp>
+#include <frictherm/coupling/xdmf.hpp>
+#include <frictherm/mechanics/errors.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <memory>
+
+namespace frictherm::coupling {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+// OUT.xdmf without its extension: the base of DecomposedOutput's files (OUT.rank<r>.h5, OUT.xdmf).
+std::string output_base(const std::string& out) {
+  const std::string x = xdmf_path_for(out);
+  return x.substr(0, x.size() - 5);
+}
+
+template <int Dim>
+class DecomposedRun {
+ public:
+  using Mpm = mechanics::DecomposedMpm<Dim>;
+  DecomposedRun(MPI_Comm comm, const Scene& scene, const RunOptions& options) : comm_(comm), s_(scene), o_(options) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &size_);
+  }
+
+  RunResult execute() {
+    const Clock::time_point t0 = Clock::now();
+    if (!o_.resume_checkpoint.empty() || o_.checkpoint_wall_interval > 0.0 || o_.observer)
+      throw std::invalid_argument("a decomposed run has no checkpoints and no per-step observer");
+    const detail::InterruptGuard interrupt_guard(o_.handle_signals);
+    r_.output = o_.output.empty() ? s_.output.file : o_.output;
+    check_output_files();  // before anything is built: refusals cost nothing
+    build();
+    open_output();
+    series();
+    snapshot();
+    detail::ProgressLine progress(std::cerr, rank_ == 0 && show_progress(), s_.end_time);
+    last_flush_ = Clock::now();
+    try {
+      loop(progress);
+    } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
+      r_.status = RunResult::Status::failed;
+      r_.message = e.what();
+      if (out_) out_->write_metadata("failure", r_.message);
+    }
+    progress.finish();
+    if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
+      if (last_series_step_ != step_) series();
+      if (last_snapshot_step_ != step_) snapshot();
+    }
+    if (r_.status == RunResult::Status::interrupted) {
+      r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " + std::to_string(step_) +
+                   ", t = " + format_number(time_) + " s";
+      if (out_) out_->write_metadata("interruption", r_.message);
+    }
+    if (r_.status == RunResult::Status::stopped_at_max_steps && !o_.quiet && rank_ == 0)
+      (o_.log ? *o_.log : std::cerr) << "frictherm: note: stopped at run.max_steps = " << s_.max_steps << " (t = " << time_
+                                     << " s of end_time " << s_.end_time << " s)\n";
+    r_.steps = step_;
+    r_.time = time_;
+    r_.wall_time = seconds_since(t0);
+    record_phase_seconds();
+    r_.snapshots = static_cast<std::size_t>(snapshots_);
+    if (out_) finish_output();
+    snapshots_out_->close();
+    if (heat_ && rank_ == 0 && !o_.quiet) print_books(o_.log ? *o_.log : std::cerr);
+    return r_;
+  }
+
+ private:
+  bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
+
+  bool show_progress() const {
+    if (o_.quiet || o_.progress == RunOptions::Progress::never) return false;
+    return o_.progress == RunOptions::Progress::always || isatty(STDERR_FILENO) != 0;
+  }
+
+  // Rank 0 checks every file of every rank as the serial run checks its output (docs/robustness.md):
+  // never an input, an existing file only with --force / output.overwrite; all ranks agree.
+  void check_output_files() const {
+    std::string error;
+    if (rank_ == 0) {
+      try {
+        const std::vector<std::string> inputs = scene_input_files(s_);
+        for (const std::string& f : decomposed_output_files(r_.output, size_))
+          check_output_path(f, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    }
+    if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
+  }
+
+  void build() {
+    grid_ = std::make_unique<mechanics::Grid<Dim>>(detail::scene_grid<Dim>(s_));
+    try {
+      mpm_ = std::make_unique<Mpm>(comm_, *grid_, s_.materials, detail::decomposed_options<Dim>(s_));
+    } catch (const std::invalid_argument& e) {  // thrown on every rank alike: all hold the same scene
+      throw SceneError(e.what());
+    }
+    mpm_->add_particles(detail::scene_particles<Dim>(comm_, s_));
+    r_.particles = static_cast<std::size_t>(mpm_->global_particles());
+    for (const mechanics::Material& m : s_.materials) wave_speed_.push_back(m.p_wave_speed(s_.options.analysis));
+    temperature_ = mpm_->particle_scalar_index("temperature");
+    if (s_.thermal.enabled) {
+      const CouplerOptions& c = s_.thermal.coupler;
+      DecomposedHeatOptions h;
+      h.materials = c.materials;
+      h.assembly = c.assembly;
+      h.fe_safety = c.integrator_options.fe_safety;
+      h.order = s_.thermal.heating_order;
+      try {
+        heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
+      } catch (const std::invalid_argument& e) {
+        throw SceneError(std::string("thermal.materials: ") + e.what());
+      }
+      hot_ = std::make_unique<detail::DecomposedHotSpots<Dim>>(s_, *mpm_);
+      hot_->update(*mpm_, 0.0);  // the initial hot spots, as the serial Coupler::start
+    }
+  }
+
+  void open_output() {
+    std::string error;
+    if (rank_ == 0) {
+      try {
+        H5OutputOptions options;
+        options.write_xdmf = false;  // OUT.xdmf joins the rank files (DecomposedOutput)
+        options.via_temporary = true;
+        options.replace_existing = overwrite();
+        out_ = std::make_unique<H5Output>(r_.output, Dim, options);
+        write_start_metadata();
+        out_->declare_series(series_names());
+        if (hot_) hot_->declare_table(*out_);
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    }
+    if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
+    try {
+      snapshots_out_ = std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+  }
+
+  void write_start_metadata() {
+    out_->write_metadata("scene", s_.text);
+    out_->write_metadata("scene_file", s_.source);
+    out_->write_metadata("version", FRICTHERM_VERSION);
+    out_->write_metadata("command_line", o_.command_line);
+    out_->write_metadata("status", "running");
+    out_->write_metadata("dimension", Dim);
+    out_->write_metadata("engine", "decomposed");
+    out_->write_metadata("ranks", size_);
+    std::string grid;
+    for (int p : mpm_->processes()) grid += (grid.empty() ? "" : " x ") + std::to_string(p);
+    out_->write_metadata("process_grid", grid);
+    out_->write_metadata("particle_count", r_.particles);
+    out_->write_metadata("snapshots", xdmf_path_for(r_.output));
+  }
+
+  // The serial run's column names where the quantity is the same (runner_output.cpp, runner_thermal.cpp).
+  std::vector<std::string> series_names() const {
+    std::vector<std::string> n{"time", "step", "dt", "kinetic_energy"};
+    const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
+    for (int d = 0; d < Dim; ++d) n.emplace_back(axes[d]);
+    if (s_.contact.enabled)
+      n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
+    if (heat_) {
+      n.insert(n.end(), {"heat_delivered", "thermal_energy_change", "max_temperature"});
+      for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
+      n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
+    }
+    return n;
+  }
+
+  // Collective, one reduction: the largest c_p + |v_p| over all ranks (the serial stable_time_step's,
+  // linear elastic: c_p the material's P-wave speed), whether any rank caught SIGINT/SIGTERM, and the
+  // lowest id of a particle with a non-finite state or outside the grid (the serial step's check),
+  // which becomes a SimulationError on every rank.
+  void stable_time_step(double& dt, int& signal) const {
+    const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
+    constexpr double none = -std::numeric_limits<double>::infinity();
+    double v[4] = {0.0, static_cast<double>(detail::interrupt_signal()), none, none};  // max of −id: lowest id
+    for (std::size_t k = 0; k < p.mass.size(); ++k) {
+      const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k), xk(p.position.data() + Dim * k);
+      v[0] = std::max(v[0], wave_speed_[static_cast<std::size_t>(p.material[k])] + vk.norm());
+      if (!(vk.allFinite() && xk.allFinite()))
+        v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
+      else if (!grid_->contains(xk))
+        v[3] = std::max(v[3], -static_cast<double>(p.id[k]));
+    }
+    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, comm_);
+    signal = static_cast<int>(v[1]);
+    const std::string at = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: particle ";
+    if (v[2] > none)
+      throw mechanics::SimulationError(at + format_number(-v[2]) + " has a non-finite velocity or position (the step "
+                                            "blew up; try a smaller CFL factor)", step_, time_, static_cast<long>(-v[2]));
+    if (v[3] > none) {
+      std::string span;
+      for (int d = 0; d < Dim; ++d) span += (d ? ", " : "") + format_number(grid_->lo()[d]);
+      span += ") to (";
+      for (int d = 0; d < Dim; ++d) span += (d ? ", " : "") + format_number(grid_->hi()[d]);
+      throw mechanics::SimulationError(at + format_number(-v[3]) + " left the grid; grid spans (" + span + ") m", step_,
+                                       time_, static_cast<long>(-v[3]));
+    }
+    const double cap = s_.options.max_time_step;
+    dt = v[0] <= 0.0 ? cap : std::min(s_.options.cfl * grid_->min_cell_size() / v[0], cap);
+  }
+
+  // The serial loop (runner.cpp) with one reduction per step: after each mechanics step, the next
+  // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
+  void loop(detail::ProgressLine& progress) {
+    const double T = s_.end_time;
+    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, 0.0);
+    const double eps = schedule.eps();
+    double stable = 0.0;
+    int signal = 0;
+    stable_time_step(stable, signal);
+    while (time_ < T - eps) {
+      if (signal != 0) {
+        r_.status = RunResult::Status::interrupted;
+        r_.signal = signal;
+        return;
+      }
+      if (s_.max_steps > 0 && step_ >= s_.max_steps) {
+        r_.status = RunResult::Status::stopped_at_max_steps;
+        return;
+      }
+      // As the serial loop: land on the next snapshot time, the last stretch in two similar steps.
+      double limit = schedule.next_snapshot() - time_;
+      if (step_ == 0 || limit < 3.0 * last_dt_)
+        if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
+      const double dt = std::min(stable, limit);
+      if (!(dt > 0.0) || !std::isfinite(dt) || !(time_ + dt > time_))
+        throw mechanics::SimulationError("step " + std::to_string(step_) + ", t = " + format_number(time_) +
+                                             " s: the time step " + format_number(dt) + " s does not advance the time",
+                                         step_, time_, -1);
+      mpm_->step(dt);  // times its own phases (DecomposedTraffic::phase_seconds)
+      time_ += dt;
+      last_dt_ = dt;
+      ++step_;
+      stable_time_step(stable, signal);  // throws SimulationError on every rank for a broken state
+      if (heat_) {
+        const Clock::time_point h0 = Clock::now();
+        heat_->after_step(dt);
+        hot_->update(*mpm_, time_);  // after every window, as the serial coupler
+        heating_seconds_ += seconds_since(h0);
+      }
+      const double t = time_;
+      if (schedule.series_due(t)) series();
+      if (schedule.snapshot_due(t)) snapshot();
+      progress.update(step_, t);
+    }
+    if (signal != 0) {  // caught during the last step: the run is complete, but say so as the serial run
+      r_.status = RunResult::Status::interrupted;
+      r_.signal = signal;
+    }
+  }
+
+  // Collective: one row; rank 0 appends it.
+  void series() {
+    const Clock::time_point c0 = Clock::now();
+    const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
+    double ke = 0.0;
+    for (std::size_t k = 0; k < p.mass.size(); ++k) {
+      const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k);
+      ke += 0.5 * p.mass[k] * vk.squaredNorm();
+    }
+    MPI_Allreduce(MPI_IN_PLACE, &ke, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    const mechanics::Vec<Dim> P = mpm_->total_momentum();
+    std::vector<double> row{time_, static_cast<double>(step_), last_dt_, ke};
+    for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+    if (s_.contact.enabled) {
+      const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
+      const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);
+      const mechanics::DecomposedContactStats cs = mpm_->contact_stats();
+      row.insert(row.end(), {w1, w2, static_cast<double>(cs.contact_nodes), static_cast<double>(cs.sliding_nodes)});
+    }
+    if (heat_) {
+      const DecomposedHeatBooks& b = heat_->books();
+      // The highest temperature of the conducting particles over all ranks, from the last update.
+      row.insert(row.end(), {b.heat_delivered, b.particle_energy_change, hot_->tracker().max_temperature()});
+      hot_->extend_series_row(row);
+      row.insert(row.end(), {static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
+    }
+    if (out_) {
+      out_->append_series(row);
+      if (hot_) hot_->append_table_rows(*out_, time_);
+      if (seconds_since(last_flush_) >= o_.flush_interval) {
+        out_->flush();
+        last_flush_ = Clock::now();
+      }
+    }
+    last_series_step_ = step_;
+    output_seconds_ += seconds_since(c0);
+  }
+
+  // Collective: every rank writes its particles; rank 0 rewrites OUT.xdmf.
+  void snapshot() {
+    const Clock::time_point c0 = Clock::now();
+    const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
+    DecomposedSnapshot snap;
+    snap.id = p.id;
+    snap.position = p.position;
+    snap.velocity = p.velocity;
+    snap.material = p.material;
+    snap.temperature = mpm_->particle_scalar(temperature_);
+    snapshots_out_->write(step_, time_, snap);
+    ++snapshots_;
+    last_snapshot_step_ = step_;
+    output_seconds_ += seconds_since(c0);
+  }
+
+  void record_phase_seconds() {
+    const mechanics::DecomposedTraffic& tr = mpm_->traffic();
+    auto& ph = r_.phase_seconds;
+    ph.clear();
+    for (std::size_t i = 0; i < tr.phase_seconds.size(); ++i) ph.emplace_back(Mpm::phase_names()[i], tr.phase_seconds[i]);
+    ph.emplace_back("heating", heating_seconds_);
+    ph.emplace_back("output", output_seconds_);
+    double accounted = 0.0;
+    for (const auto& x : ph) accounted += x.second;
+    ph.emplace_back("other", r_.wall_time - accounted);
+  }
+
+  // The energy books summed over ranks (J) and how well they close (relative to the work received).
+  void print_books(std::ostream& log) const {
+    const DecomposedHeatBooks& b = heat_->books();
+    const double w = b.work_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "frictherm: energy books over %d ranks: frictional work received %.9g J, heat delivered %.9g J, "
+                  "nodal energy change %.9g J, particle energy change %.9g J (largest difference %.2g of the work)\n",
+                  size_, w, b.heat_delivered, b.nodal_energy_change, b.particle_energy_change,
+                  std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
+                            std::fabs(b.particle_energy_change - w)}) / scale);
+    log << line;
+  }
+
+  // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5.
+  void finish_output() {
+    r_.series_rows = out_->series_rows();
+    for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
+    if (heat_) {
+      const DecomposedHeatBooks& b = heat_->books();
+      out_->write_metadata("thermal_integrator", "forward_euler (decomposed, matrix-free)");
+      out_->write_metadata("thermal_window_policy", "every_step");
+      out_->write_metadata("heating_order", mechanics::to_string(s_.thermal.heating_order));
+      out_->write_metadata("thermal_windows", b.windows);
+      out_->write_metadata("thermal_matrix_free_substeps", b.substeps);
+      out_->write_metadata("work_received", b.work_received);
+      out_->write_metadata("heat_delivered", b.heat_delivered);
+      out_->write_metadata("nodal_energy_change", b.nodal_energy_change);
+      out_->write_metadata("particle_energy_change", b.particle_energy_change);
+      out_->write_metadata("max_capacity_residual", b.max_capacity_residual);
+      out_->write_metadata("hotspots_seen", hot_->tracker().ids_issued());
+    }
+    const char* status = r_.status == RunResult::Status::failed                 ? "failed"
+                         : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
+                         : r_.status == RunResult::Status::interrupted          ? "interrupted"
+                                                                                : "completed";
+    out_->write_metadata("status", status);
+    out_->write_metadata("steps", r_.steps);
+    out_->write_metadata("final_time", r_.time);
+    out_->write_metadata("wall_time", r_.wall_time);
+    try {
+      out_->close();
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+  }
+
+  MPI_Comm comm_;
+  const Scene& s_;
+  const RunOptions& o_;
+  int rank_ = 0, size_ = 1;
+  RunResult r_;
+  std::unique_ptr<mechanics::Grid<Dim>> grid_;
+  std::unique_ptr<Mpm> mpm_;
+  std::unique_ptr<DecomposedHeat> heat_;  // scenes with a `thermal` section
+  std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
+  std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
+  std::unique_ptr<DecomposedOutput> snapshots_out_;
+  std::vector<double> wave_speed_;  // P-wave speed by material (m/s)
+  int temperature_ = 0;
+  double time_ = 0.0, last_dt_ = 0.0;
+  long step_ = 0, snapshots_ = 0;
+  long last_series_step_ = -1, last_snapshot_step_ = -1;
+  double heating_seconds_ = 0.0, output_seconds_ = 0.0;
+  Clock::time_point last_flush_ = Clock::now();
+};
+
+}  // namespace
+
+std::vector<std::string> decomposed_output_files(const std::string& out, int ranks) {
+  std::vector<std::string> files{out, xdmf_path_for(out)};
+  for (int r = 0; r < ranks; ++r) files.push_back(DecomposedOutput::rank_file(output_base(out), r));
+  return files;
+}
+
+RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options) {
+  if (scene.dimension == 2) return DecomposedRun<2>(comm, scene, options).execute();
+  return DecomposedRun<3>(comm, scene, options).execute();
+}
+
+}  // namespace frictherm::coupling

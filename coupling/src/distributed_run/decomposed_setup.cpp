@@ -1,0 +1,91 @@
+// A decomposed run's grid, options and particles from a scene (decomposed_setup.hpp).
+#include "distributed_run/decomposed_setup.hpp"
+
+#include "scene/scene_detail.hpp"
+
+#include <algorithm>
+
+namespace frictherm::coupling::detail {
+
+std::string agreed_error(MPI_Comm comm, const std::string& error) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const int mine = error.empty() ? size : rank;
+  int first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return "";
+  int length = rank == first ? static_cast<int>(error.size()) : 0;
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  std::string text = rank == first ? error : std::string(static_cast<std::size_t>(length), ' ');
+  MPI_Bcast(text.data(), length, MPI_CHAR, first, comm);
+  return text;
+}
+
+template <int Dim>
+mechanics::Grid<Dim> scene_grid(const Scene& scene) {
+  mechanics::IVec<Dim> cells{};
+  for (int d = 0; d < Dim; ++d) cells[static_cast<std::size_t>(d)] = scene.cells[static_cast<std::size_t>(d)];
+  return mechanics::Grid<Dim>(to_vec<Dim>(scene.grid_lo), to_vec<Dim>(scene.cell_size), cells);
+}
+
+template <int Dim>
+typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& scene) {
+  typename mechanics::DecomposedMpm<Dim>::Options o;
+  o.shape = scene.options.shape;
+  o.analysis = scene.options.analysis;
+  o.thickness = scene.options.thickness;
+  for (int d = 0; d < Dim; ++d) o.gravity[d] = scene.options.gravity[d];
+  o.fixed_faces = scene.fixed_faces;
+  o.contact = scene.contact.enabled;
+  if (o.contact) {
+    o.contact_options = scene.contact.options;
+    for (const ContactPairSpec& p : scene.contact.pairs) o.contact_pairs.push_back({p.material_a, p.material_b, p.settings});
+  }
+  o.particle_scalars = {"temperature", "reference_temperature"};  // T_p and T0_p (hot spots' reference)
+  return o;
+}
+
+template <int Dim>
+std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MPI_Comm comm, const Scene& scene) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> all;
+  std::string error;
+  if (rank == 0) {
+    try {
+      // The serial run's own particles, in its order (finalized: grouped by material).
+      const auto sim = build_simulation<Dim>(scene);
+      const mechanics::Particles<Dim>& p = sim->particles();
+      all.resize(p.size());
+      for (std::size_t k = 0; k < all.size(); ++k) {
+        auto& q = all[k];
+        q.id = static_cast<std::int64_t>(k);
+        q.mass = p.mass[k];
+        q.volume = p.volume[k];
+        q.position = p.position[k];
+        q.velocity = p.velocity[k];
+        q.half_size = p.half_size[k];
+        q.stress = p.stress[k];
+        q.stress_zz = p.stress_zz[k];
+        q.material = p.material[k];
+        q.scalars = {p.temperature[k], p.temperature[k]};
+      }
+    } catch (const SceneError& e) {
+      error = e.what();
+      if (error.empty()) error = "the particles could not be built";
+    }
+  }
+  if (const std::string why = agreed_error(comm, error); !why.empty()) throw SceneError(why);
+  return all;
+}
+
+#define FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(D)                                                         \
+  template mechanics::Grid<D> scene_grid<D>(const Scene&);                                                \
+  template mechanics::DecomposedMpm<D>::Options decomposed_options<D>(const Scene&);                      \
+  template std::vector<mechanics::DecomposedMpm<D>::Particle> scene_particles<D>(MPI_Comm, const Scene&);
+FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(2)
+FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
+#undef FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP
+
+}  // namespace frictherm::coupling::detail

@@ -1,0 +1,103 @@
+// Which scenes the decomposed engine runs (decomposed_support.hpp): every feature DecomposedMpm and
+// DecomposedHeat implement, checked key by key before anything is built, so that a scene they do not
+// support is refused with the scene key, its value and the way out (the serial run).
+#include <frictherm/coupling/decomposed_support.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+namespace frictherm::coupling {
+
+namespace {
+
+std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+std::string number(double v) {
+  std::ostringstream o;
+  o.precision(9);
+  o << v;
+  return o.str();
+}
+
+// "KEY: VALUE is not supported in a decomposed run (expected ...); the serial run (without mpirun,
+// or mpirun -n 1) supports it".
+std::string refuse(const std::string& key, const std::string& value, const std::string& expected) {
+  return key + ": " + value + " is not supported in a decomposed run (expected " + expected +
+         "); the serial run (without mpirun, or with -n 1) supports it";
+}
+
+std::string mechanics_refusal(const Scene& s) {
+  const mechanics::SimulationOptions& o = s.options;
+  if (o.shape == mechanics::ShapeKind::extended_bspline)
+    return refuse("solver.shape_function", quoted("extended_bspline"), "\"linear\", \"ugimp\" or \"quadratic_bspline\"");
+  if (o.scheme != mechanics::UpdateScheme::usl)
+    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\"");
+  if (o.particle_update != mechanics::ParticleUpdate::flip)
+    return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
+  if (std::isfinite(o.pic_relaxation_time))
+    return refuse("solver.pic_relaxation_time", number(o.pic_relaxation_time), "no PIC blend: remove the key");
+  if (o.damping_rate > 0.0) return refuse("solver.damping", "rate " + number(o.damping_rate), "no damping: remove the key");
+  for (const mechanics::Material& m : s.materials)
+    if (m.kind != mechanics::MaterialKind::linear_elastic)
+      return refuse("materials." + m.name + ".type", quoted(mechanics::to_string(m.kind)), "\"linear_elastic\"");
+  if (!s.point_loads.empty())
+    return refuse("loads.point", std::to_string(s.point_loads.size()) + " point load(s)", "no point loads");
+  if (!s.tractions.empty())
+    return refuse("loads.traction", std::to_string(s.tractions.size()) + " traction(s)", "no tractions");
+  if (s.checkpoint_interval > 0.0)
+    return refuse("run.checkpoint_interval", number(s.checkpoint_interval), "no checkpoints: remove the key");
+  return "";
+}
+
+std::string contact_refusal(const Scene& s) {
+  if (!s.contact.enabled) return "";
+  const mechanics::ContactOptions& c = s.contact.options;
+  if (c.default_pair.method == mechanics::ContactMethod::penalty)
+    return refuse("contact.method", quoted("penalty"), "\"multimaterial\"");
+  for (std::size_t i = 0; i < s.contact.pairs.size(); ++i)
+    if (s.contact.pairs[i].settings.method == mechanics::ContactMethod::penalty)
+      return refuse("contact.pairs[" + std::to_string(i) + "].method", quoted("penalty"), "\"multimaterial\"");
+  if (c.separation == mechanics::SeparationMethod::extent)
+    return refuse("contact.separation", quoted("extent"), "\"position\", \"displacement\" or \"velocity_only\"");
+  if (c.regularized()) return refuse("contact.regularization", "an object", "no regularisation: remove the key");
+  return "";
+}
+
+std::string thermal_refusal(const Scene& s) {
+  const ThermalSceneSpec& t = s.thermal;
+  if (!t.enabled) return "";
+  const CouplerOptions& c = t.coupler;
+  if (c.integrator != "forward_euler")
+    return refuse("thermal.integrator", quoted(c.integrator), "\"forward_euler\"");
+  const thermal::IntegratorOptions& io = c.integrator_options;
+  if (io.fe_stability_policy != "substep")
+    return refuse("thermal.forward_euler.stability", quoted(io.fe_stability_policy), "\"substep\"");
+  if (io.fe_limit_estimate != "gershgorin")
+    return refuse("thermal.forward_euler.limit_estimate", quoted(io.fe_limit_estimate), "\"gershgorin\"");
+  if (io.fe_max_dt > 0.0) return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
+  if (!c.fixed_faces.empty())
+    return refuse("thermal.fixed_temperature", std::to_string(c.fixed_faces.size()) + " face(s)", "adiabatic faces");
+  if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
+  if (c.window.kind != WindowPolicy::Kind::every_step)
+    return refuse("coupling.window", quoted(to_string(c.window.kind)) + " (the default is adaptive)", "\"every_step\"");
+  if (c.reuse_distance != 0.0)
+    return refuse("coupling.reuse_distance", number(c.reuse_distance) + " (the default is 0.01)",
+                  "0: the gather every window");
+  if (c.plastic.enabled) return refuse("coupling.plastic_heating", "true", "false");
+  if (t.continuation_duration > 0.0)
+    return refuse("coupling.continuation", "duration " + number(t.continuation_duration), "no continuation");
+  if (std::isfinite(c.subgrid_relaxation_time))
+    return refuse("coupling.subgrid_relaxation_time", number(c.subgrid_relaxation_time), "no key");
+  return "";
+}
+
+}  // namespace
+
+std::string decomposed_run_refusal(const Scene& scene) {
+  for (const std::string& why : {mechanics_refusal(scene), contact_refusal(scene), thermal_refusal(scene)})
+    if (!why.empty()) return why;
+  return "";
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,59 @@
+#pragma once
+// Shared by the tests of the frictherm program (test_cli*.cpp, test_cli_mpi.cpp, test_cli_mpirun.cpp):
+// a shell command's exit code and everything it printed, and a fresh folder per test.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace frictherm::test {
+
+struct Result {
+  int code = -1;       // the exit code; -1 when the command could not start or ended by a signal
+  std::string output;  // stdout and stderr together
+};
+
+/// Runs `cmd` with /bin/sh, its stderr joined to its stdout.
+inline Result shell(const std::string& cmd) {
+  Result r;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+/// A fixture with a fresh folder per test, <temp>/<prefix><test name>_<pid> (tests may run in
+/// parallel), removed after the test.
+class ScratchDirTest : public ::testing::Test {
+ protected:
+  explicit ScratchDirTest(std::string prefix) : prefix_(std::move(prefix)) {}
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() / (prefix_ + info->name() + "_" + std::to_string(getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  /// Writes `text` to the file `name` of the folder; returns its path.
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  std::filesystem::path dir_;
+
+ private:
+  std::string prefix_;
+};
+
+}  // namespace frictherm::test

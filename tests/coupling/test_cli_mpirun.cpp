@@ -1,0 +1,325 @@
+// `mpirun -n 2 frictherm run SCENE` (issue 16, "the same command"; coupling/src/distributed_run/,
+// coupling/app/cli_run_mpi.cpp) against `frictherm run SCENE` on the same scene:
+//   * the 2D sliding block with frictional heating (tests/coupling/scenes/decomposed_sliding_block.json,
+//     the scene of test_heat_distributed.cpp): time, kinetic energy, momentum, first- and second-order
+//     frictional work, heat delivered and the largest temperature rise agree at every step within 1e-9
+//     of each column's largest magnitude (the sliding phase has no chaos: the decomposed step is the
+//     serial arithmetic, the sums only change order); the books summed over ranks close to 1e-9 of the
+//     work (work received = heat delivered = Σ_i M_i ΔT_i = Σ_p m_p C_p ΔT_p) and the work received
+//     equals the serial run's second-order work; the last snapshot, read from the rank files, holds
+//     every particle exactly once at the serial position and temperature; the hot spots above a 0.3 K
+//     rise, tracked across the ranks, are the serial run's (count, ids, members, birth times exactly;
+//     peak, mean, centroid, size and excess energy within 1e-9);
+//   * a 3D sliding block without heat (decomposed_sliding_block_3d.json): the same series checks;
+//   * the 3D block with heating (decomposed_heated_block_3d.json): series, hot-spot counts, books;
+//   * a scene the decomposed engine does not support (penalty contact, a neo-Hookean material) is
+//     refused with exit code 2 naming the scene key, before any file is written, and `validate` says so;
+//   * an existing output file (the series file or one rank's file) is refused without --force, left
+//     untouched, and replaced with it;
+//   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle;
+//   * mpirun -n 1 is the serial program (its file layout and the same numbers);
+//   * Ctrl-C to mpirun stops every rank after the same step with complete, readable files.
+// Skipped when mpirun is not installed. Labels verification;mpi.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "cli_test_support.hpp"
+#include "h5_test_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using frictherm::test::read_doubles;
+using frictherm::test::Result;
+using frictherm::test::shell;
+
+namespace {
+
+std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
+std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
+
+std::string mpirun(int ranks) {
+  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n " + std::to_string(ranks);  // on any machine
+  if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
+  return cmd;
+}
+std::string mpirun2() { return mpirun(2); }
+
+class CliMpirun : public frictherm::test::ScratchDirTest {
+ protected:
+  CliMpirun() : ScratchDirTest("frictherm_mpirun_") {}
+  void SetUp() override {
+    if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
+    ScratchDirTest::SetUp();
+  }
+
+  // Runs the scene serially and under mpirun -n 2 into serial.h5 and split.h5.
+  void run_both(const char* name) {
+    const Result s = shell(exe() + " run " + scene(name) + " -q --threads 1 -o '" + path("serial.h5") + "'");
+    ASSERT_EQ(s.code, 0) << s.output;
+    const Result d = shell(mpirun2() + " " + exe() + " run " + scene(name) + " -o '" + path("split.h5") + "'");
+    ASSERT_EQ(d.code, 0) << d.output;
+    EXPECT_THAT(d.output, HasSubstr("particles on 2 ranks"));
+    for (const char* f : {"split.h5", "split.xdmf", "split.rank0.h5", "split.rank1.h5"}) EXPECT_TRUE(fs::exists(path(f))) << f;
+  }
+
+  // Every row of `column` in both files within `tolerance` of the serial column's largest magnitude;
+  // returns the largest difference relative to that magnitude.
+  double expect_same_column(const std::string& column, double tolerance, double offset = 0.0) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), "/series/" + column);
+    const std::vector<double> b = read_doubles(path("split.h5"), "/series/" + column);
+    EXPECT_FALSE(a.empty()) << column;
+    EXPECT_EQ(a.size(), b.size()) << column;
+    double scale = 0.0, diff = 0.0;
+    for (double x : a)
+      if (!std::isnan(x)) scale = std::max(scale, std::fabs(x - offset));
+    long nan_mismatch = 0;  // NaN (no hot spot) in one file only
+    for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
+      if (std::isnan(a[k]) || std::isnan(b[k]))
+        nan_mismatch += std::isnan(a[k]) != std::isnan(b[k]);
+      else
+        diff = std::max(diff, std::fabs(a[k] - b[k]));
+    }
+    EXPECT_EQ(nan_mismatch, 0) << column;
+    EXPECT_GT(scale, 0.0) << column;
+    EXPECT_LE(diff, tolerance * scale) << column;
+    std::printf("  %-22s max |serial - split| = %.3g of %.6g\n", column.c_str(), diff / scale, scale);
+    return diff / scale;
+  }
+
+  double meta(const std::string& file, const std::string& key) const {
+    const std::vector<double> v = read_doubles(path(file), "/meta/" + key);
+    return v.empty() ? std::nan("") : v[0];
+  }
+};
+
+}  // namespace
+
+TEST_F(CliMpirun, SlidingBlockWithHeatingEqualsTheSerialRun) {
+  run_both("decomposed_sliding_block.json");
+  if (HasFatalFailure()) return;
+  constexpr double kTol = 1e-9;
+  expect_same_column("time", kTol);
+  for (const char* c : {"kinetic_energy", "momentum_x", "momentum_y", "friction_work_first", "friction_work_second",
+                        "heat_delivered", "thermal_windows"})
+    expect_same_column(c, kTol);
+  expect_same_column("max_temperature", kTol, 300.0);  // relative to the largest rise (≈ 0.79 K)
+  // Hot spots above a 0.3 K rise, tracked across the ranks: the series columns and the /hotspots table.
+  expect_same_column("hotspot_count", 0.0);
+  expect_same_column("hottest_hotspot_temperature", kTol, 300.0);
+  expect_same_column("hottest_hotspot_size", kTol);
+  for (const char* c : {"time", "id", "particle_count", "birth_time"}) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), std::string("/hotspots/") + c);
+    EXPECT_FALSE(a.empty()) << c << ": the scene makes hot spots";
+    EXPECT_EQ(a, read_doubles(path("split.h5"), std::string("/hotspots/") + c)) << c;
+  }
+  for (const char* c : {"peak_temperature", "mean_temperature", "centroid_x", "centroid_y", "excess_energy"}) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), std::string("/hotspots/") + c);
+    const std::vector<double> b = read_doubles(path("split.h5"), std::string("/hotspots/") + c);
+    ASSERT_EQ(a.size(), b.size()) << c;
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      scale = std::max(scale, std::fabs(a[k] - (std::string(c).find("temperature") != std::string::npos ? 300.0 : 0.0)));
+      diff = std::max(diff, std::fabs(a[k] - b[k]));
+    }
+    EXPECT_LE(diff, kTol * scale) << c;
+    std::printf("  /hotspots/%-18s max |serial - split| = %.3g of %.6g (%zu rows)\n", c, diff / scale, scale, a.size());
+  }
+  // Books over both ranks (J), relative to the work received.
+  const double w = meta("split.h5", "work_received");
+  const std::vector<double> w2 = read_doubles(path("serial.h5"), "/series/friction_work_second");
+  ASSERT_FALSE(w2.empty());
+  EXPECT_GT(w, 0.1);
+  EXPECT_NEAR(w, w2.back(), kTol * w);
+  for (const char* k : {"heat_delivered", "nodal_energy_change", "particle_energy_change"})
+    EXPECT_NEAR(meta("split.h5", k), w, kTol * w) << k;
+  // The last snapshot over the rank files: every particle once, at the serial position and temperature.
+  const std::string snap = "/snapshots/000004/";
+  const std::vector<double> xs = read_doubles(path("serial.h5"), snap + "position");
+  const std::vector<double> Ts = read_doubles(path("serial.h5"), snap + "temperature");
+  const std::size_t n = Ts.size();
+  ASSERT_EQ(n, 512u);
+  std::vector<int> seen(n, 0);
+  double dx = 0.0, dT = 0.0;
+  for (const char* f : {"split.rank0.h5", "split.rank1.h5"}) {
+    const std::vector<double> id = read_doubles(path(f), snap + "id");
+    const std::vector<double> x = read_doubles(path(f), snap + "position");
+    const std::vector<double> T = read_doubles(path(f), snap + "temperature");
+    EXPECT_FALSE(id.empty()) << f << ": every rank holds particles of the split block scene";
+    ASSERT_EQ(x.size(), 2 * id.size());
+    ASSERT_EQ(T.size(), id.size());
+    for (std::size_t k = 0; k < id.size(); ++k) {
+      const auto i = static_cast<std::size_t>(id[k]);
+      ASSERT_LT(i, n);
+      ++seen[i];
+      dx = std::max({dx, std::fabs(x[2 * k] - xs[2 * i]), std::fabs(x[2 * k + 1] - xs[2 * i + 1])});
+      dT = std::max(dT, std::fabs(T[k] - Ts[i]));
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n));
+  EXPECT_LE(dx, kTol * 1e-3);  // of the 1 mm cell
+  EXPECT_LE(dT, kTol * 0.79);  // of the largest temperature rise
+  std::printf("  last snapshot: positions %.3g m, temperatures %.3g K from the serial run\n", dx, dT);
+}
+
+TEST_F(CliMpirun, ThreeDimensionalSlidingBlockEqualsTheSerialRun) {
+  run_both("decomposed_sliding_block_3d.json");
+  if (HasFatalFailure()) return;
+  for (const char* c : {"time", "kinetic_energy", "momentum_x", "momentum_y", "friction_work_first", "friction_work_second"})
+    expect_same_column(c, 1e-9);
+}
+
+// The 3D block with frictional heating and conduction every step: the series, the hot spots and
+// the books as the 2D case (the interface warms by a fraction of a kelvin).
+TEST_F(CliMpirun, ThreeDimensionalHeatedSlidingBlockEqualsTheSerialRun) {
+  run_both("decomposed_heated_block_3d.json");
+  if (HasFatalFailure()) return;
+  constexpr double kTol = 1e-9;
+  for (const char* c : {"time", "kinetic_energy", "momentum_x", "momentum_y", "friction_work_first",
+                        "friction_work_second", "heat_delivered", "thermal_windows"})
+    expect_same_column(c, kTol);
+  expect_same_column("max_temperature", kTol, 300.0);  // relative to the largest rise
+  expect_same_column("hotspot_count", 0.0);
+  const double w = meta("split.h5", "work_received");
+  const std::vector<double> w2 = read_doubles(path("serial.h5"), "/series/friction_work_second");
+  ASSERT_FALSE(w2.empty());
+  EXPECT_GT(w, 0.0);
+  EXPECT_NEAR(w, w2.back(), kTol * w);
+  for (const char* k : {"heat_delivered", "nodal_energy_change", "particle_energy_change"})
+    EXPECT_NEAR(meta("split.h5", k), w, kTol * w) << k;
+}
+
+TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"--set contact.method=penalty", "contact.method: \"penalty\" is not supported in a decomposed run"},
+      {"--set materials.block.type=neo_hookean", "materials.block.type: \"neo_hookean\" is not supported in a decomposed run"},
+      {"--set coupling.window=adaptive", "coupling.window: \"adaptive\""}};
+  for (const auto& [set, message] : cases) {
+    const Result r = shell(mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
+                           " -o '" + path("refused.h5") + "'");
+    EXPECT_EQ(r.code, 2) << set << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message)) << set;
+    EXPECT_THAT(r.output, HasSubstr("the serial run (without mpirun, or with -n 1) supports it")) << set;
+    EXPECT_TRUE(fs::is_empty(dir_)) << set << ": nothing may be written";
+  }
+  // It is a valid scene: `validate` accepts it and says that it runs serially only, and why.
+  const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") + " --set contact.method=penalty");
+  EXPECT_EQ(v.code, 0) << v.output;
+  EXPECT_THAT(v.output, HasSubstr("serial only (contact.method: \"penalty\" is not supported in a decomposed run"));
+  const Result ok = shell(exe() + " validate " + scene("decomposed_sliding_block.json"));
+  EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it"));
+}
+
+TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
+  const std::string run = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+                          " -q --set run.end_time=2e-5 -o '" + path("out.h5") + "'";
+  const char* const files[] = {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"};
+  for (const char* existing : {"out.h5", "out.rank1.h5", "out.xdmf"}) {
+    for (const char* f : files) fs::remove(path(f));
+    std::ofstream(path(existing)) << "an earlier result";
+    const Result r = shell(run);
+    EXPECT_EQ(r.code, 2) << existing << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(std::string(existing) + "' exists; refusing to replace an existing result"));
+    std::ifstream in(path(existing));
+    std::stringstream kept;
+    kept << in.rdbuf();
+    EXPECT_EQ(kept.str(), "an earlier result") << existing;
+    for (const char* f : files)
+      if (std::string(f) != existing) {
+        EXPECT_FALSE(fs::exists(path(f))) << existing << " refused, yet " << f << " written";
+      }
+  }
+  // With --force every file is replaced (here out.xdmf existed).
+  const Result forced = shell(run + " --force");
+  EXPECT_EQ(forced.code, 0) << forced.output;
+  EXPECT_FALSE(read_doubles(path("out.rank1.h5"), "/snapshots/000000/id").empty() &&
+               read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
+  EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty());
+  std::ifstream xdmf(path("out.xdmf"));
+  std::stringstream text;
+  text << xdmf.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("out.rank1.h5:/snapshots/000000/position"));
+}
+
+namespace {
+// "step N" and "particle K" of "... failed: step N, t = ... s: particle K ..." ("" when absent).
+std::string failure_point(const std::string& output) {
+  const auto at = output.find("simulation failed: step ");
+  if (at == std::string::npos) return "";
+  const auto step_end = output.find(',', at);
+  const auto particle = output.find(": particle ", step_end);
+  if (step_end == std::string::npos || particle == std::string::npos) return "";
+  const auto particle_end = output.find(' ', particle + 11);
+  return output.substr(at + 19, step_end - at - 19) + " / " + output.substr(particle + 2, particle_end - particle - 2);
+}
+}  // namespace
+
+TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
+  const std::string throw_block = " --set 'bodies[1].velocity=[400,0]'";  // leaves the 26 mm grid within 40 steps
+  const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + throw_block + " -q -o '" +
+                         path("serial.h5") + "'");
+  const Result d = shell(mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") + throw_block +
+                         " -q -o '" + path("split.h5") + "'");
+  EXPECT_EQ(s.code, 1) << s.output;
+  EXPECT_EQ(d.code, 1) << d.output;
+  const std::string point = failure_point(s.output);
+  EXPECT_THAT(point, HasSubstr("particle ")) << s.output;
+  EXPECT_EQ(failure_point(d.output), point) << d.output;
+  EXPECT_THAT(d.output, HasSubstr("left the grid"));
+  EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty()) << "the series before the failure stay readable";
+}
+
+TEST_F(CliMpirun, OneRankRunsTheSerialProgram) {
+  // mpirun -n 1: today's serial program (one file with its snapshots, no rank files), the same numbers.
+  const std::string sc = scene("decomposed_sliding_block_3d.json") + " -q --set run.end_time=5e-5";
+  const Result s = shell(exe() + " run " + sc + " --threads 1 -o '" + path("serial.h5") + "'");
+  const Result d = shell(mpirun(1) + " " + exe() + " run " + sc + " --threads 1 -o '" + path("one.h5") + "'");
+  ASSERT_EQ(s.code, 0) << s.output;
+  ASSERT_EQ(d.code, 0) << d.output;
+  EXPECT_FALSE(fs::exists(path("one.rank0.h5")));
+  EXPECT_FALSE(read_doubles(path("one.h5"), "/snapshots/000000/position").empty());
+  for (const char* c : {"time", "kinetic_energy", "friction_work_second"}) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), std::string("/series/") + c);
+    EXPECT_FALSE(a.empty()) << c;
+    EXPECT_EQ(a, read_doubles(path("one.h5"), std::string("/series/") + c)) << c;
+  }
+}
+
+TEST_F(CliMpirun, InterruptedRunStopsEveryRankAndKeepsItsFiles) {
+  // Ctrl-C to mpirun once the run writes (Open MPI's mpirun passes it on to the ranks as SIGTERM):
+  // every rank stops after the same step, the files are complete and readable, rank 0 says so.
+  const std::string out = path("x.h5");
+  const std::string cmd = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+                          " -q --set run.end_time=1 -o '" + out + "' > '" + path("log") + "' 2>&1 & pid=$!; " +
+                          "for i in $(seq 1 600); do ls '" + out + "'.*.part >/dev/null 2>&1 && break; sleep 0.1; done; " +
+                          "sleep 0.5; kill -INT $pid; wait $pid";
+  const Result r = shell(cmd);
+  std::ifstream in(path("log"));
+  std::stringstream log;
+  log << in.rdbuf();
+  EXPECT_NE(r.code, 0) << log.str();
+  EXPECT_THAT(log.str(), HasSubstr("interrupted by SIG"));
+  EXPECT_THAT(log.str(), HasSubstr("/meta/status = interrupted"));
+  const std::vector<double> t = read_doubles(out, "/series/time");
+  ASSERT_FALSE(t.empty()) << "the series file is renamed into place and readable";
+  EXPECT_LT(t.back(), 1.0) << "stopped before end_time";
+  // The last snapshot is at the interruption, on the ranks that hold particles, listed in the XDMF file.
+  std::ifstream xdmf(path("x.xdmf"));
+  std::stringstream text;
+  text << xdmf.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("x.rank0.h5:/snapshots/000001/position"));
+  EXPECT_FALSE(read_doubles(path("x.rank0.h5"), "/snapshots/000001/id").empty() &&
+               read_doubles(path("x.rank1.h5"), "/snapshots/000001/id").empty());
+  const Result csv = shell(exe() + " export-csv '" + out + "'");
+  EXPECT_EQ(csv.code, 0) << csv.output;
+}
