@@ -15,7 +15,7 @@
 // velocity conditions on the nodes their particles touch (the serial rigid_boundary materials; every
 // rigid material without contact), prescribing the components they control; a rigid contact partner
 // (rigid_boundary = false with contact) stays serial. stable_time_step() is the serial CFL step over
-// all ranks.
+// all ranks. docs/distributed_pbx.md: these pieces, their tests and the many-materials benchmark.
 //
 //   particle_to_grid       local: stencils; rigid particles mark the nodes they drive; per velocity
 //                          field m_i, p_i, f_i (N·1–3) and, with contact, Σ S m x (or the displacement
