@@ -88,9 +88,10 @@ TEST(DecomposedMechanics, StencilWidthIsTheKernelsReachBeyondTheNearestNode) {
   EXPECT_EQ(fm::stencil_reach(fm::ShapeKind::quadratic_bspline), 1);
   EXPECT_THROW(fm::stencil_reach(fm::ShapeKind::extended_bspline), std::invalid_argument);
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {8, 8});
-  fm::Material plastic = elastic(1e6, 0.3, 1000.0);
-  plastic.kind = fm::MaterialKind::neo_hookean;
-  EXPECT_THROW(fm::DecomposedMpm2D(MPI_COMM_WORLD, grid, plastic, {}), std::invalid_argument);
+  fm::Material rigid = elastic(1e6, 0.3, 1000.0);  // (materials: test_distributed_materials.cpp)
+  rigid.kind = fm::MaterialKind::rigid;
+  rigid.rigid_controls = {{true, false, false}};  // a free component needs a boundary rigid material
+  EXPECT_THROW(fm::DecomposedMpm2D(MPI_COMM_WORLD, grid, rigid, {}), std::invalid_argument);
 }
 
 // ---- (a) an isolated body crossing rank boundaries: particles kept, momentum conserved ----

@@ -20,7 +20,8 @@
 namespace frictherm::mechanics {
 
 // Checks the contact settings (the serial enable_contact / set_contact_pair rules plus what the
-// decomposed step does not support) and fills pair_table as the serial contact_pair(a, b) reads:
+// decomposed step does not support) and fills pair_settings / pair_index as the serial
+// set_contact_pair does, read as the serial contact_pair(a, b):
 // the default pair for pairs not set, an explicit pair (a, b) as given, (b, a) with the normal
 // reversed, a specified normal made unit.
 template <int Dim>
@@ -49,7 +50,8 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
                                   "'multimaterial'; penalty contact stays serial)");
   };
   multimaterial_only(co.default_pair, "default pair");
-  pair_table.assign(n * n, co.default_pair);
+  pair_settings.assign(1, co.default_pair);
+  pair_index.assign(opt.contact_pairs.empty() ? 0 : n * n, 0);
   for (const DecomposedContactPair& p : opt.contact_pairs) {
     const int a = p.material_a, b = p.material_b;
     const std::string pair = "pair (" + std::to_string(a) + ", " + std::to_string(b) + ")";
@@ -64,8 +66,10 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
     }
     ContactPairSettings flipped = s;  // seen from b: the normal points from b to a
     flipped.normal_vector = -s.normal_vector;
-    pair_table[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = s;
-    pair_table[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = flipped;
+    pair_settings.push_back(s);
+    pair_settings.push_back(flipped);
+    pair_index[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)] = static_cast<int>(pair_settings.size()) - 2;
+    pair_index[static_cast<std::size_t>(b) * n + static_cast<std::size_t>(a)] = static_cast<int>(pair_settings.size()) - 1;
   }
 }
 
@@ -78,14 +82,11 @@ void DecomposedMpm<Dim>::Impl::find_contact_nodes(double /*dt*/) {
   work_second.assign(static_cast<std::size_t>(owned), 0.0);
   contact_nodes.clear();
   if (!opt.contact) return;
-  for (PetscInt q = 0; q < owned; ++q) {
-    const PetscInt l = owned_local[static_cast<std::size_t>(q)];
-    const std::size_t u = static_cast<std::size_t>(l);
-    if (!multi[u]) continue;
+  for (std::size_t g = 0; g < mt_q.size(); ++g) {
     int present = 0;
-    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl)
-      if (field_at(l, static_cast<int>(fl))[Dof::mass] > empty_node_mass) ++present;
-    if (present >= 2) contact_nodes.push_back({q, l});
+    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e)
+      if (mt_at(e)[Dof::mass] > empty_node_mass) ++present;
+    if (present >= 2) contact_nodes.push_back({static_cast<std::size_t>(mt_q[g]), g});
   }
 }
 
@@ -114,24 +115,24 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
                                   dt, updated};
   auto pair_of = [&](int x, int y) -> const ContactPairSettings& {
-    return pair_table[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)];
+    if (pair_index.empty()) return pair_settings[0];
+    return pair_settings[static_cast<std::size_t>(pair_index[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)])];
   };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
   thread_local std::vector<ContactSide<Dim>> sides;
   thread_local std::vector<int> mats;
   thread_local std::vector<double*> values;
   thread_local std::vector<Vec<Dim>> dps;
-  for (const auto& [q, l] : contact_nodes) {
-    const std::size_t u = static_cast<std::size_t>(l);
+  for (const auto& [q, g] : contact_nodes) {
     double node_mass = 0.0;
-    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
-      const double m = field_at(l, static_cast<int>(fl))[mass];
+    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {
+      const double m = mt_at(e)[mass];
       if (m > empty_node_mass) node_mass += m;
     }
     sides.clear(), mats.clear(), values.clear();
     long guarded = 0;
-    for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) {
-      double* v = field_at(l, static_cast<int>(fl));
+    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {  // in material order
+      double* v = mt_at(e);
       const double m = v[mass];
       if (!(m > empty_node_mass)) continue;
       if (m < co.min_mass_fraction * node_mass) {
@@ -147,7 +148,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
       sd.domain_gradient = Eigen::Map<const Vec<Dim>>(v + domain_gradient);
       sd.sliver = m < co.sliver_fraction * node_mass;
       sides.push_back(sd);
-      mats.push_back(static_cast<int>(fl));  // with contact, field = material
+      mats.push_back(mt_field[e]);  // with contact, field = material
       values.push_back(v);
     }
     if (updated) {
@@ -155,7 +156,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
       ++stats.contact_nodes;
       if (sides.size() > 2) ++stats.multi_nodes;
     }
-    const std::size_t uq = static_cast<std::size_t>(q);
+    const std::size_t uq = q;
     contact_detail::resolve_contact_node(
         sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
         [&](std::size_t j, const Vec<Dim>& dp) {

@@ -33,6 +33,10 @@ inline constexpr const char* stress_zz = "frictherm_stress_zz";
 inline constexpr const char* deformation = "frictherm_F";
 inline constexpr const char* material = "frictherm_material";
 inline constexpr const char* initial_position = "frictherm_x0";  // displacement separation (N·9)
+inline constexpr const char* plastic_strain = "frictherm_plastic_strain";    // ε̄p (Mie-Grüneisen/J2)
+inline constexpr const char* internal_energy = "frictherm_internal_energy";  // e (J/kg)
+inline constexpr const char* plastic_work = "frictherm_plastic_work";        // J, since the start
+inline constexpr const char* wave_speed = "frictherm_wave_speed";            // c_p of the state (CFL step)
 inline constexpr const char* scalars = "frictherm_scalars";  // DecomposedOptions::particle_scalars, when any
 }  // namespace swarm_field
 
@@ -56,6 +60,7 @@ struct SwarmFields {
   long* id = nullptr;
   double *mass = nullptr, *volume = nullptr, *volume0 = nullptr, *velocity = nullptr, *half_size = nullptr;
   double *stress = nullptr, *stress_zz = nullptr, *F = nullptr, *x0 = nullptr;
+  double *plastic_strain = nullptr, *internal_energy = nullptr, *plastic_work = nullptr, *wave_speed = nullptr;
   PetscInt* material = nullptr;
 
   explicit SwarmFields(DM swarm);
@@ -75,6 +80,10 @@ struct SwarmFields {
     f(swarm_field::deformation, F);
     f(swarm_field::material, material);
     f(swarm_field::initial_position, x0);
+    f(swarm_field::plastic_strain, plastic_strain);
+    f(swarm_field::internal_energy, internal_energy);
+    f(swarm_field::plastic_work, plastic_work);
+    f(swarm_field::wave_speed, wave_speed);
   }
   SwarmFields(const SwarmFields&) = delete;
   SwarmFields& operator=(const SwarmFields&) = delete;
@@ -87,45 +96,99 @@ struct DecomposedMpm<Dim>::Impl {
   int rank = 0, size = 1;
   Grid<Dim> grid;
   std::vector<Material> materials;
+  // Per material, hoisted out of the stress update's particle loop: Lamé λ, shear modulus μ, the
+  // Mie-Grüneisen limit J (mie_gruneisen_min_J) and the linear-elastic wave speed.
+  std::vector<double> lambda, mu, min_J, c0;
+  bool has_mie_gruneisen = false;
+  // Rigid materials (velocity boundary conditions on the nodes they touch, as the serial
+  // map_rigid_particles / apply_velocity_bc / update_grid): per axis d and local node, the largest
+  // rigid material prescribing component d whose particles' stencils reach the node with S > 0 (−1:
+  // none; the serial loop lets the last material win), completed at the owners in sum_to_owners;
+  // per owned node the driven components (bit d) and their prescribed velocity at the step's start.
+  bool has_rigid = false;
+  double time = 0.0;  // at the start of the step (the serial time_)
+  std::array<std::vector<PetscInt>, 3> driver, root_driver;
+  std::vector<std::uint8_t> drive_mask;
+  std::vector<Vec<Dim>> drive_velocity;
+  bool rigid(PetscInt material) const { return materials[static_cast<std::size_t>(material)].is_rigid(); }
+  long beyond = -1;  // stress_update: the id of a particle compressed past its Hugoniot's limit, or −1
+  /// The dilatational wave speed of a particle's state (as Simulation::stable_time_step before the
+  /// first stress update).
+  double initial_wave_speed(int material, double J, double energy) const;
   Options opt;
   int width = 1;                 // DMDA stencil width (stencil_reach)
   int fields = 1;                // velocity fields per node: 1, or one per material with contact
   int per_field = Dof::without_contact;  // values per field (Dof::with_contact with contact)
   static constexpr int dof = Dof::without_contact;  // DMDA values per node: m, p, f over all fields
   int field_of(PetscInt material) const { return opt.contact ? static_cast<int>(material) : 0; }
-  // Per-field values of the ghosted box (sparse_exchange.cpp), [(l·fields + field)·per_field + value]
-  // for local node l; field_lo / field_hi: the smallest and largest field whose particles' stencils
-  // reach node l (fields / −1 when none), at owned nodes over all ranks after exchange_field_ranges;
-  // multi: 1 where they differ (two or more fields reach the node on some rank), at every local node.
+  // Per-field storage (field_storage.cpp), as the serial layout_fields: field f covers the box of
+  // local nodes its local particles' stencils reach, stored contiguously from boxes[f].first; slot
+  // s holds per_field values at field_values[s·per_field] and lies at local node slot_node[s]. So
+  // memory and per-step work scale with the particles, not with fields × ghosted box.
+  struct FieldBox {
+    IVec<Dim> lo{}, extent{};   // first node (DMDA indices) and nodes per direction
+    std::size_t first = 0, count = 0;
+    NodeIndexer<Dim> index;     // DMDA node -> slot
+  };
+  std::vector<FieldBox> boxes;
+  std::vector<IVec<Dim>> box_lo, box_hi;  // scratch of particle_to_grid: per field, nodes reached
   std::vector<double> field_values;
+  std::vector<PetscInt> slot_node;
+  long peak_slots = 0;
+  double* slot_values(std::size_t slot) { return field_values.data() + slot * static_cast<std::size_t>(per_field); }
+  void layout_fields();  // boxes, slot_node, field_values (zeroed) from box_lo / box_hi
+  // field_lo / field_hi: the smallest and largest field whose particles' stencils reach local node l
+  // (fields / −1 when none), at owned nodes over all ranks after exchange_field_ranges; multi: 1 where
+  // they differ (two or more fields reach the node on some rank), at every local node.
   std::vector<PetscInt> field_lo, field_hi, multi, root_lo, root_hi;
+  std::vector<std::uint8_t> owned_flag;          // per local node: 1 if this rank owns it
+  std::vector<PetscInt> ghost_of_local;          // per local node: its index in ghost_local, or −1
   std::vector<PetscInt> owned_local;             // owned node q (x fastest) -> local node l
   PetscSF node_sf = nullptr;                     // leaves: this rank's ghost nodes; roots: owners' local nodes
   std::vector<PetscInt> ghost_local;             // leaves of node_sf (local node ids)
   std::vector<PetscSFNode> ghost_remote;         // their owners (rank, owner's local node id)
-  PetscSF entry_sf = nullptr;                    // this step's (ghost node, field) entries at multi nodes
-  MPI_Datatype field_unit = MPI_DATATYPE_NULL;   // per_field doubles
-  std::vector<PetscInt> entry_local;             // scratch of the entry graph
+  // The complete per-field values at the owned multi-material nodes (fields_to_owners): group g is
+  // owned node mt_q[g] (local node mt_l[g]) with entries [mt_first[g], mt_first[g + 1]) in field
+  // order, entry e of field mt_field[e] with per_field values at mt_values[e·per_field].
+  std::vector<PetscInt> mt_q, mt_l;
+  std::vector<std::size_t> mt_first;
+  std::vector<int> mt_field;
+  std::vector<double> mt_values;
+  std::vector<std::array<std::size_t, 2>> mt_own;  // (own slot, entry): written back after the step's grid phases
+  std::vector<std::size_t> mt_recv_entry;          // per received entry: its group entry
+  double* mt_at(std::size_t e) { return mt_values.data() + e * static_cast<std::size_t>(per_field); }
+  // The entry exchange: leaves are this rank's (ghost node, field) entries at multi-material nodes
+  // (send_slot: their slots), roots the owners' received entries; a unit is per_field values, the
+  // field and the sending rank.
+  PetscSF entry_sf = nullptr;
+  MPI_Datatype field_unit = MPI_DATATYPE_NULL;   // per_field + 2 doubles
+  int unit_size() const { return per_field + 2; }
+  std::vector<std::size_t> send_slot;
+  std::vector<int> send_field;
+  std::vector<PetscInt> send_jth;  // the entry's place among this rank's entries at its node
+  bool all_zero(const double* v) const {
+    for (int c = 0; c < per_field; ++c)
+      if (v[c] != 0.0) return false;
+    return true;
+  }
+  std::vector<double> send_buf, recv_buf;
+  std::vector<PetscInt> leaf_count, leaf_offset, root_count, entry_base;  // per local node
   std::vector<PetscSFNode> entry_remote;
-  double* field_at(PetscInt l, int field) { return field_values.data() + (l * fields + field) * per_field; }
-  /// visit(q, values) for every field at owned node q: the per-field values at a multi-material node,
-  /// else the DMDA's total (`total`: the global vector's array; one field).
+  /// visit(q, values) for every field at owned node q: the total of the DMDA (`total`: the global
+  /// vector's array) at a single-material node, each field's complete values at a multi-material one.
   template <class Visit>
   void for_each_owned_field(PetscScalar* total, Visit&& visit) {
     const PetscInt owned = owned_count();
-    for (PetscInt q = 0; q < owned; ++q) {
-      const PetscInt l = owned_local[static_cast<std::size_t>(q)];
-      const std::size_t u = static_cast<std::size_t>(l);
-      if (multi[u])
-        for (PetscInt fl = field_lo[u]; fl <= field_hi[u]; ++fl) visit(q, field_at(l, static_cast<int>(fl)));
-      else
-        visit(q, total + dof * q);
-    }
+    for (PetscInt q = 0; q < owned; ++q)
+      if (!multi[static_cast<std::size_t>(owned_local[static_cast<std::size_t>(q)])]) visit(q, total + dof * q);
+    for (std::size_t g = 0; g < mt_q.size(); ++g)
+      for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) visit(mt_q[g], mt_at(e));
   }
-  /// A particle's field at local node l after the exchanges: per-field values at a multi-material
-  /// node, else the DMDA's ghosted total `local_total`.
-  const double* node_values(const PetscScalar* local_total, PetscInt l, int field) {
-    return multi[static_cast<std::size_t>(l)] ? field_at(l, field) : local_total + dof * l;
+  /// The values a particle reads at its field's slot after the exchanges: its field's at a
+  /// multi-material node, else the DMDA's ghosted total `local_total`.
+  const double* node_values(const PetscScalar* local_total, std::size_t slot) {
+    const PetscInt l = slot_node[slot];
+    return multi[static_cast<std::size_t>(l)] ? slot_values(slot) : local_total + dof * l;
   }
   DM da = nullptr, swarm = nullptr;
   ::Vec local = nullptr, global = nullptr;  // PETSc vectors (mechanics::Vec is the Eigen one)
@@ -146,8 +209,11 @@ struct DecomposedMpm<Dim>::Impl {
   // Contact (contact_phases.cpp): settings per ordered material pair, the owned nodes where two or
   // more fields have mass (indices into the owned block), frictional work per owned node (last step)
   // and since the start on this rank, counters of the last step on this rank.
-  std::vector<ContactPairSettings> pair_table;  // materials², [a·n + b]
-  std::vector<std::array<PetscInt, 2>> contact_nodes;  // (owned node q, local node l)
+  // As the serial pair_settings_ / pair_index_: [0] the default pair, then each explicit pair and its
+  // reverse; pair_index (materials², [a·n + b], 4 B each) only when pairs were given.
+  std::vector<ContactPairSettings> pair_settings;
+  std::vector<int> pair_index;
+  std::vector<std::array<std::size_t, 2>> contact_nodes;  // (owned node q, group of mt_*)
   std::vector<double> work_first, work_second;
   double cumulative_first = 0.0, cumulative_second = 0.0;
   DecomposedContactStats stats;
@@ -193,9 +259,10 @@ struct DecomposedMpm<Dim>::Impl {
   int owner_of(const double* x) const;
 
   std::vector<double> scalar_values() const;  // transfer.cpp: every particle scalar, particle-major
-  void setup_contact();  // contact_phases.cpp: checks and pair_table
+  void setup_contact();  // contact_phases.cpp: checks, pair_settings and pair_index
   void setup_fixed_faces();
   void setup_sparse_exchange();  // sparse_exchange.cpp: node_sf, owned_local, field_unit
+  void fields_to_mt();           // sparse_exchange.cpp: the owner's groups from its slots and the received entries
 
   // The phases (usl_phases.cpp, contact_phases.cpp) and the migration (decomposition.cpp).
   template <class Kernel>

@@ -3,6 +3,8 @@
 // fixed faces, reductions and the gather by global id.
 #include "distributed/decomposed_state.hpp"
 
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+
 // PETSc 3.18 has no public setter of the swarm's migration type (DMSwarmSetMigrateType came in
 // 3.19); the private header gives the field. Needed because the PIC default (DMSWARM_MIGRATE_
 // DMCELLNSCATTER, DMLocatePoints on the DMDA) counts the cell straddling two ranks on both and can
@@ -100,10 +102,30 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   if (materials.empty()) throw std::invalid_argument("decomposed mechanics: no material given");
-  for (const Material& material : materials)
-    if (material.kind != MaterialKind::linear_elastic)
-      throw std::invalid_argument("decomposed mechanics: material '" + material.name + "' has kind '" +
-                                  to_string(material.kind) + "' (expected linear_elastic)");
+  // The serial add_material's checks (a Mie-Grüneisen material's EOS density is its density).
+  std::vector<Material> mats = materials;
+  for (Material& material : mats) {
+    const std::string where = "decomposed mechanics: material '" + material.name + "'";
+    if (!(material.density > 0.0)) throw std::invalid_argument(where + ": density must be > 0");
+    if (material.is_rigid()) {
+      if (!material.rigid_boundary && !(material.rigid_controls[0] && material.rigid_controls[1] && material.rigid_controls[2]))
+        throw std::invalid_argument(where + ": only a boundary rigid material may leave velocity components free");
+      if (options.contact && !material.rigid_boundary)
+        throw std::invalid_argument(where + ": a rigid material in contact must be a boundary one in a decomposed run "
+                                            "(expected rigid_boundary = true: rigid contact partners stay serial)");
+      continue;
+    }
+    if (material.kind == MaterialKind::mie_gruneisen) {
+      material.mie_gruneisen.density = material.density;
+      validate(material.mie_gruneisen, options.analysis, "material '" + material.name + "'");
+      continue;
+    }
+    if (!(material.youngs_modulus > 0.0)) throw std::invalid_argument(where + ": E must be > 0");
+    if (!(material.poisson_ratio > -1.0 && material.poisson_ratio < 0.5))
+      throw std::invalid_argument(where + ": Poisson ratio must be in (-1, 0.5)");
+    if (material.kind == MaterialKind::neo_hookean && options.analysis == Analysis::plane_stress)
+      throw std::invalid_argument(where + ": neo_hookean needs plane_strain or 3D (expected analysis plane_strain)");
+  }
   for (const FixedFace& face : options.fixed_faces)
     if (face.axis < 0 || face.axis >= Dim)
       throw std::invalid_argument("decomposed mechanics: fixed face axis " + std::to_string(face.axis) +
@@ -117,7 +139,16 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   MPI_Comm_rank(comm, &s.rank);
   MPI_Comm_size(comm, &s.size);
   s.grid = grid;
-  s.materials = materials;
+  s.materials = mats;
+  for (const Material& m : mats) {
+    const bool mg = m.kind == MaterialKind::mie_gruneisen, elastic = !mg && !m.is_rigid();
+    s.has_rigid = s.has_rigid || m.is_rigid();
+    s.lambda.push_back(elastic ? m.lame_lambda() : 0.0);
+    s.mu.push_back(elastic ? m.shear_modulus() : 0.0);
+    s.min_J.push_back(mg ? mie_gruneisen_min_J(m.mie_gruneisen) : 0.0);
+    s.c0.push_back(m.kind == MaterialKind::linear_elastic ? m.p_wave_speed(options.analysis) : 0.0);
+    s.has_mie_gruneisen = s.has_mie_gruneisen || mg;
+  }
   s.opt = options;
   s.setup_contact();  // checks the contact settings before any collective PETSc call
   s.fields = options.contact ? static_cast<int>(materials.size()) : 1;
@@ -186,6 +217,10 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   reg(swarm_field::deformation, Dim * Dim, PETSC_DOUBLE);
   reg(swarm_field::material, 1, PETSC_INT);
   reg(swarm_field::initial_position, Dim, PETSC_DOUBLE);
+  reg(swarm_field::plastic_strain, 1, PETSC_DOUBLE);
+  reg(swarm_field::internal_energy, 1, PETSC_DOUBLE);
+  reg(swarm_field::plastic_work, 1, PETSC_DOUBLE);
+  reg(swarm_field::wave_speed, 1, PETSC_DOUBLE);
   s.scalars = static_cast<int>(options.particle_scalars.size());
   if (s.scalars > 0) reg(swarm_field::scalars, s.scalars, PETSC_DOUBLE);
   petsc_check(DMSwarmFinalizeFieldRegister(s.swarm), "DMSwarmFinalizeFieldRegister");
@@ -200,15 +235,21 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   // Traffic bookkeeping: ghost nodes of this rank and the bytes of one particle (every field).
   s.traffic.ghost_nodes = static_cast<long>(s.local_count() - s.owned_count());
   s.traffic.values_per_node = s.dof;
-  s.traffic.field_entry_bytes = s.per_field * static_cast<int>(sizeof(double));
+  s.traffic.field_entry_bytes = (s.per_field + 2) * static_cast<int>(sizeof(double));  // values, material, rank
   s.setup_fixed_faces();
   s.setup_sparse_exchange();
+  if (s.has_rigid) {
+    for (int d = 0; d < Dim; ++d) s.driver[static_cast<std::size_t>(d)].assign(static_cast<std::size_t>(s.local_count()), -1);
+    s.drive_mask.assign(static_cast<std::size_t>(s.owned_count()), 0);
+    s.drive_velocity.assign(static_cast<std::size_t>(s.owned_count()), Vec<Dim>::Zero());
+  }
   int bytes = 0;
   for (const char* name : {DMSwarmPICField_coor, DMSwarmField_pid, DMSwarmField_rank, DMSwarmPICField_cellid,
                            swarm_field::id, swarm_field::mass, swarm_field::volume, swarm_field::volume0,
                            swarm_field::velocity, swarm_field::half_size, swarm_field::stress,
                            swarm_field::stress_zz, swarm_field::deformation, swarm_field::material,
-                           swarm_field::initial_position}) {
+                           swarm_field::initial_position, swarm_field::plastic_strain,
+                           swarm_field::internal_energy, swarm_field::plastic_work, swarm_field::wave_speed}) {
     PetscInt bs = 0;
     PetscDataType type;
     void* ptr = nullptr;
@@ -267,6 +308,10 @@ void DecomposedMpm<Dim>::add_particles(const std::vector<Particle>& particles) {
       f.stress_zz[k] = p.stress_zz;
       f.material[k] = static_cast<PetscInt>(p.material);
       Eigen::Map<Mat<Dim>>(f.F + Dim * Dim * k) = Mat<Dim>::Identity();
+      f.plastic_strain[k] = p.plastic_strain;
+      f.internal_energy[k] = p.internal_energy;
+      f.plastic_work[k] = p.plastic_work;
+      f.wave_speed[k] = s.initial_wave_speed(p.material, 1.0, p.internal_energy);  // V = V0 here
     }
   }
   if (s.scalars > 0) {
@@ -416,9 +461,9 @@ double DecomposedMpm<Dim>::total_momentum_scale() const {
 template <int Dim>
 std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() const {
   constexpr int D = Dim, DD = Dim * Dim;
-  // Doubles per particle: mass, volume, x, v, l_p, σ, σ_zz, material, the scalars.
+  // Doubles per particle: mass, volume, x, v, l_p, σ, σ_zz, material, ε̄p, e, plastic work, the scalars.
   constexpr int at_x = 2, at_v = at_x + D, at_l = at_v + D, at_s = at_l + D, at_zz = at_s + DD, at_mat = at_zz + 1;
-  constexpr int at_scalars = at_mat + 1;  // 14 in 2D, 22 in 3D
+  constexpr int at_state = at_mat + 1, at_scalars = at_state + 3;  // 17 in 2D, 25 in 3D
   const int ns = impl_->scalars;
   const int per = at_scalars + ns;
   const std::vector<double> sc = ns > 0 ? impl_->scalar_values() : std::vector<double>{};
@@ -434,6 +479,7 @@ std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() 
     for (int c = 0; c < DD; ++c) v[at_s + c] = f.stress[DD * k + c];
     v[at_zz] = f.stress_zz[k];
     v[at_mat] = static_cast<double>(f.material[k]);
+    v[at_state] = f.plastic_strain[k], v[at_state + 1] = f.internal_energy[k], v[at_state + 2] = f.plastic_work[k];
     for (int c = 0; c < ns; ++c) v[at_scalars + c] = sc[static_cast<std::size_t>(k * ns + c)];
   }
   const int ranks = impl_->size;
@@ -459,10 +505,47 @@ std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() 
     p.stress = Eigen::Map<const Mat<Dim>>(v + at_s);
     p.stress_zz = v[at_zz];
     p.material = static_cast<int>(v[at_mat]);
+    p.plastic_strain = v[at_state], p.internal_energy = v[at_state + 1], p.plastic_work = v[at_state + 2];
     p.scalars.assign(v + at_scalars, v + at_scalars + ns);
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
+}
+
+template <int Dim>
+double DecomposedMpm<Dim>::Impl::initial_wave_speed(int material, double J, double energy) const {
+  const Material& m = materials[static_cast<std::size_t>(material)];
+  if (m.is_rigid()) return -std::numeric_limits<double>::infinity();  // rigid_speed() counts them
+  if (m.kind == MaterialKind::mie_gruneisen) return mie_gruneisen_wave_speed(m.mie_gruneisen, J, energy);
+  if (m.kind == MaterialKind::neo_hookean) return m.wave_speed(opt.analysis, J);
+  return c0[static_cast<std::size_t>(material)];
+}
+
+// Simulation::stable_time_step over the ranks: the largest c_p + |v_p| of every rank (MPI_MAX), so
+// every rank takes the same step, the smallest of the ranks' own limits.
+template <int Dim>
+double DecomposedMpm<Dim>::stable_time_step(double cfl, double max_time_step) const {
+  const Impl& s = *impl_;
+  double cmax = 0.0;
+  {
+    SwarmFields f(s.swarm);
+    for (PetscInt k = 0; k < f.n; ++k)
+      cmax = std::max(cmax, f.wave_speed[k] + Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k).norm());
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &cmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
+  for (const Material& m : s.materials)  // rigid bodies move material through the grid too
+    if (m.is_rigid()) cmax = std::max(cmax, m.rigid_velocity_at(s.time).norm());
+  if (cmax <= 0.0) return max_time_step;
+  return std::min(cfl * s.grid.min_cell_size() / cmax, max_time_step);
+}
+
+template <int Dim>
+double DecomposedMpm<Dim>::total_plastic_work() const {
+  SwarmFields f(impl_->swarm);
+  double w = 0.0;
+  for (PetscInt k = 0; k < f.n; ++k) w += f.plastic_work[k];
+  MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
 }
 
 // Every member defined in this file, for both dimensions (the other files instantiate theirs).

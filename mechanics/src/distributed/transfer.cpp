@@ -73,6 +73,7 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data(bool kinematics
   out.mass.assign(f.mass, f.mass + n);
   out.volume.assign(f.volume, f.volume + n);
   out.material.assign(f.material, f.material + n);
+  out.plastic_work.assign(f.plastic_work, f.plastic_work + n);
   if (kinematics) {
     out.position.assign(f.x, f.x + Dim * n);
     out.velocity.assign(f.velocity, f.velocity + Dim * n);

@@ -3,14 +3,18 @@
 // fields_to_ghosts, migrate) are phases of their own, the contact phases are in contact_phases.cpp
 // and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
 // Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted box, and its
-// linear_elastic_update<Dim> (material.hpp), so they compute what the serial Simulation<Dim>'s USL
+// constitutive updates (material.hpp, mie_gruneisen.hpp, plane_strain_update.hpp), so they compute what the serial Simulation<Dim>'s USL
 // step computes (mechanics/src/simulation_step.cpp, simulation_fields.cpp) on this rank's particles,
 // in 2D and 3D alike.
 #include "distributed/decomposed_state.hpp"
 
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/plane_strain_update.hpp>
+
 #include <mpi.h>
 
 #include <algorithm>
+#include <climits>
 #include <stdexcept>
 #include <string>
 
@@ -40,9 +44,11 @@ template <int Dim, class Kernel>
 
 // Phase 1, local: per velocity field m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p,
 // f_i = Σ (S_ip m_p g − V_p σ_p G_ip) (Nairn 2018 eqs. 1–3) and, with contact, Σ S_ip m_p x_p (or
-// the displacement x_p − x_p^(0), eq. 9), Ω_i = Σ S_ip V_p and g_i = Σ G_ip V_p (eqs. 4–6), into the
-// per-field values of the ghosted box, as the serial map_to_grid; each node records the range of
-// fields reaching it. The stencils are kept for the later phases.
+// the displacement x_p − x_p^(0), eq. 9), Ω_i = Σ S_ip V_p and g_i = Σ G_ip V_p (eqs. 4–6), as the
+// serial map_to_grid: with several fields first every stencil and each field's box of nodes (laid
+// out as the serial layout_fields), then the scatter into the fields' slots, each node recording the
+// range of fields reaching it; one field covers the ghosted box. The stencils are kept for the later
+// phases.
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
@@ -51,29 +57,74 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   SwarmFields f(swarm);
   auto& st = stencils<Kernel>();
   st.resize(static_cast<std::size_t>(f.n));
-  std::fill(field_values.begin(), field_values.end(), 0.0);
-  std::fill(field_lo.begin(), field_lo.end(), fields);
-  std::fill(field_hi.begin(), field_hi.end(), -1);
-  const NodeIndexer<Dim> ix = local_indexer();
+  IVec<Dim> none_lo, none_hi;
+  none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
+  box_lo.assign(static_cast<std::size_t>(fields), none_lo);
+  box_hi.assign(static_cast<std::size_t>(fields), none_hi);
+  if (has_rigid)
+    for (int d = 0; d < Dim; ++d) std::fill(driver[static_cast<std::size_t>(d)].begin(), driver[static_cast<std::size_t>(d)].end(), -1);
+  const NodeIndexer<Dim> local_ix = local_indexer();
+  // Evaluates particle k's stencil; a rigid particle marks the nodes it drives (the serial
+  // map_rigid_particles: nodes with S > 0, the components its material prescribes) and is skipped.
+  const auto evaluate = [&](PetscInt k) {
+    auto& s = st[static_cast<std::size_t>(k)];
+    s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
+    if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
+    if (!rigid(f.material[k])) return true;
+    const Material& m = materials[static_cast<std::size_t>(f.material[k])];
+    s.for_each(local_ix, [&](int l, double S, const Vec<Dim>&) {
+      if (S > 0.0)
+        for (int d = 0; d < Dim; ++d)
+          if (m.rigid_controls[static_cast<std::size_t>(d)]) {
+            PetscInt& w = driver[static_cast<std::size_t>(d)][static_cast<std::size_t>(l)];
+            w = std::max<PetscInt>(w, f.material[k]);
+          }
+    });
+    return false;
+  };
+  // One field (no contact): it covers the ghosted box and the stencils are evaluated in the scatter
+  // loop. Several: each field's box from its particles' stencils first.
+  const bool ranges = fields > 1;
+  if (!ranges) {
+    for (int d = 0; d < Dim; ++d) {
+      box_lo[0][d] = static_cast<int>(box_start[static_cast<std::size_t>(d)]);
+      box_hi[0][d] = static_cast<int>(box_start[static_cast<std::size_t>(d)] + box_size[static_cast<std::size_t>(d)]) - 1;
+    }
+  } else {
+    for (PetscInt k = 0; k < f.n; ++k) {
+      if (!evaluate(k)) continue;
+      const std::size_t field = static_cast<std::size_t>(field_of(f.material[k]));
+      const IVec<Dim> b = st[static_cast<std::size_t>(k)].first_node();
+      for (int d = 0; d < Dim; ++d) {
+        box_lo[field][d] = std::min(box_lo[field][d], b[d]);
+        box_hi[field][d] = std::max(box_hi[field][d], b[d] + Kernel::K - 1);
+      }
+    }
+    std::fill(field_lo.begin(), field_lo.end(), fields);
+    std::fill(field_hi.begin(), field_hi.end(), -1);
+  }
+  layout_fields();
   const Vec<Dim> g = opt.gravity;
   const bool contact = opt.contact;
   const bool displacement = opt.contact_options.separation == SeparationMethod::displacement;
   for (PetscInt k = 0; k < f.n; ++k) {
-    auto& s = st[static_cast<std::size_t>(k)];
-    s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
-    if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
+    if (ranges ? rigid(f.material[k]) : !evaluate(k)) continue;
+    const auto& s = st[static_cast<std::size_t>(k)];
     const int field = field_of(f.material[k]);
+    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field)].index;
     const double mp = f.mass[k], Vp = f.volume[k];
     const Vec<Dim> mv = mp * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
     const Mat<Dim> Vsig = Vp * Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
     const Vec<Dim> mg = mp * g;
     const Eigen::Map<const Vec<Dim>> xp(f.x + Dim * k), x0(f.x0 + Dim * k);
     const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(xp - x0) : Vec<Dim>(xp));
-    s.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-      const std::size_t u = static_cast<std::size_t>(i);
-      field_lo[u] = std::min<PetscInt>(field_lo[u], field);
-      field_hi[u] = std::max<PetscInt>(field_hi[u], field);
-      double* node = field_at(i, field);
+    s.for_each(ix, [&](int slot, double S, const Vec<Dim>& G) {
+      if (ranges) {
+        const std::size_t u = static_cast<std::size_t>(slot_node[static_cast<std::size_t>(slot)]);
+        field_lo[u] = std::min<PetscInt>(field_lo[u], field);
+        field_hi[u] = std::max<PetscInt>(field_hi[u], field);
+      }
+      double* node = slot_values(static_cast<std::size_t>(slot));
       const Vec<Dim> fi = S * mg - Vsig * G;
       node[mass] += S * mp;
       for (int d = 0; d < Dim; ++d) {
@@ -90,24 +141,44 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   }
 }
 
-// Phase 2, exchange: each local node's m, p, f summed over the fields reaching it into the DMDA's
-// local vector (one field: its values exactly), and the ghost nodes' sums added into their owners.
+// Phase 2, exchange: each local node's m, p, f summed over its fields' slots (in field order; one
+// field: its values exactly) into the DMDA's local vector, and the ghost nodes' sums added into
+// their owners.
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::sum_to_owners(double /*dt*/) {
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(local, &a), "VecGetArray");
-  const PetscInt n = local_count();
-  for (PetscInt l = 0; l < n; ++l) {
-    double* node = a + dof * l;
-    std::fill(node, node + dof, 0.0);
-    for (PetscInt fl = field_lo[static_cast<std::size_t>(l)]; fl <= field_hi[static_cast<std::size_t>(l)]; ++fl) {
-      const double* v = field_at(l, static_cast<int>(fl));
-      for (int c = 0; c < dof; ++c) node[c] += v[c];
-    }
+  std::fill(a, a + dof * local_count(), 0.0);
+  const std::size_t slots = slot_node.size();
+  for (std::size_t sl = 0; sl < slots; ++sl) {
+    double* node = a + dof * slot_node[sl];
+    const double* v = slot_values(sl);
+    for (int c = 0; c < dof; ++c) node[c] += v[c];
   }
   petsc_check(VecRestoreArray(local, &a), "VecRestoreArray");
   petsc_check(VecZeroEntries(global), "VecZeroEntries");
   petsc_check(DMLocalToGlobalBegin(da, local, ADD_VALUES, global), "DMLocalToGlobalBegin");
+  if (has_rigid) {  // the rigid materials driving each node, completed at the owner (the largest wins)
+    for (int d = 0; d < Dim; ++d) root_driver[static_cast<std::size_t>(d)] = driver[static_cast<std::size_t>(d)];
+    for (int d = 0; d < Dim; ++d)
+      petsc_check(PetscSFReduceBegin(node_sf, MPIU_INT, driver[static_cast<std::size_t>(d)].data(),
+                                     root_driver[static_cast<std::size_t>(d)].data(), MPI_MAX),
+                  "PetscSFReduceBegin");
+    for (int d = 0; d < Dim; ++d)
+      petsc_check(PetscSFReduceEnd(node_sf, MPIU_INT, driver[static_cast<std::size_t>(d)].data(),
+                                   root_driver[static_cast<std::size_t>(d)].data(), MPI_MAX),
+                  "PetscSFReduceEnd");
+    for (std::size_t q = 0; q < owned_local.size(); ++q) {
+      const std::size_t l = static_cast<std::size_t>(owned_local[q]);
+      drive_mask[q] = 0;
+      for (int d = 0; d < Dim; ++d) {
+        const PetscInt m = root_driver[static_cast<std::size_t>(d)][l];
+        if (m < 0) continue;
+        drive_mask[q] |= static_cast<std::uint8_t>(1u << d);
+        drive_velocity[q][d] = materials[static_cast<std::size_t>(m)].rigid_velocity_at(time)[d];
+      }
+    }
+  }
   petsc_check(DMLocalToGlobalEnd(da, local, ADD_VALUES, global), "DMLocalToGlobalEnd");
 }
 
@@ -120,6 +191,13 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   petsc_check(VecGetArray(global, &a), "VecGetArray");
   for_each_owned_field(a, [&](PetscInt q, double* node) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
+    if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0) {
+      // Driven components end the step at the rigid velocity: the change made a force, (m v − p)/dt,
+      // so that the particles' FLIP update receives it too (the serial apply_velocity_bc).
+      for (int d = 0; d < Dim; ++d)
+        if (driven & (1u << d))
+          node[force + d] = (node[Dof::mass] * drive_velocity[static_cast<std::size_t>(q)][d] - node[momentum + d]) / dt;
+    }
     for (int d = 0; d < Dim; ++d) {
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
       node[momentum + d] += node[force + d] * dt;
@@ -136,13 +214,16 @@ void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
   constexpr int velocity = Dof::velocity, acceleration = Dof::acceleration;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt, double* node) {
+  for_each_owned_field(a, [&](PetscInt q, double* node) {
     const double m = node[mass];
     for (int d = 0; d < Dim; ++d) {
       const double p = node[momentum + d], f = node[force + d];
       node[velocity + d] = m > empty_node_mass ? p / m : 0.0;
       node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
     }
+    if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0; driven && m > empty_node_mass)
+      for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial update_grid)
+        if (driven & (1u << d)) node[velocity + d] = drive_velocity[static_cast<std::size_t>(q)][d];
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
 }
@@ -164,12 +245,19 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const auto& st = stencils<Kernel>();
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
-  const NodeIndexer<Dim> ix = local_indexer();
   for (PetscInt k = 0; k < f.n; ++k) {
+    if (rigid(f.material[k])) {  // the serial move_rigid_particles: v(t), x += ½ (v(t) + v(t + dt)) dt
+      const Material& m = materials[static_cast<std::size_t>(f.material[k])];
+      const Vec<Dim> v0 = m.rigid_velocity_at(time).template head<Dim>();
+      const Vec<Dim> dx = ((m.rigid_velocity_at(time + dt) + m.rigid_velocity_at(time)) * 0.5 * dt).template head<Dim>();
+      Eigen::Map<Vec<Dim>>(f.velocity + Dim * k) = v0;
+      Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dx;
+      continue;
+    }
     Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
-    const int field = field_of(f.material[k]);
-    st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-      const double* node = node_values(a, i, field);
+    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
+    st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
+      const double* node = node_values(a, static_cast<std::size_t>(slot));
       acc += S * Eigen::Map<const Vec<Dim>>(node + acceleration);
       v += S * Eigen::Map<const Vec<Dim>>(node + velocity);
     });
@@ -179,36 +267,89 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
-// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, hypoelastic σ (Jaumann).
+// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's
+// stress as the serial update_stress, by the same inline functions in the same order: hypoelastic
+// linear elastic (Jaumann), Neo-Hookean (Kakouris 2024 eq. 47) or Mie-Grüneisen pressure with J2
+// plasticity (mie_gruneisen.hpp; in 2D the plane-strain scalar form of plane_strain_update.hpp), which
+// also update ε̄p, e, the plastic work V σ:Δε_p and the wave speed of the CFL step. A particle
+// compressed past its Hugoniot's limit stops the run on every rank (one reduction, here).
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
   constexpr int velocity = Dof::velocity;
-  SwarmFields f(swarm);
-  const auto& st = stencils<Kernel>();
-  const PetscScalar* a = nullptr;
-  petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
-  const NodeIndexer<Dim> ix = local_indexer();
-  for (PetscInt k = 0; k < f.n; ++k) {
-    const Material& material = materials[static_cast<std::size_t>(f.material[k])];
-    const double lam = material.lame_lambda(), mu = material.shear_modulus();
-    const int field = field_of(f.material[k]);
-    Mat<Dim> L = Mat<Dim>::Zero();
-    st[static_cast<std::size_t>(k)].for_each(ix, [&](int i, double, const Vec<Dim>& G) {
-      const double* node = node_values(a, i, field);
-      L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node + velocity)) * G.transpose();
-    });
-    Eigen::Map<Mat<Dim>> F(f.F + Dim * Dim * k);
-    const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-    Mat<Dim> F_new;
-    F_new.noalias() = A * F;  // as the serial update_stress
-    F = F_new;
-    f.volume[k] = F.determinant() * f.volume0[k];
-    Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
-    linear_elastic_update<Dim>(L, dt, lam, mu, opt.analysis, sigma, f.stress_zz[k]);
-    Eigen::Map<Mat<Dim>>(f.stress + Dim * Dim * k) = sigma;
+  const Analysis an = opt.analysis;
+  beyond = -1;
+  {
+    SwarmFields f(swarm);
+    const auto& st = stencils<Kernel>();
+    const PetscScalar* a = nullptr;
+    petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+    for (PetscInt k = 0; k < f.n; ++k) {
+      const std::size_t m = static_cast<std::size_t>(f.material[k]);
+      const Material& mat = materials[m];
+      if (mat.is_rigid()) continue;
+      const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
+      const Stencil<Dim, Kernel>& sk = st[static_cast<std::size_t>(k)];
+      const bool mg = mat.kind == MaterialKind::mie_gruneisen;
+      if constexpr (Dim == 2) {
+        if (mg) {  // the serial 2D Mie-Grüneisen loop, on scalars
+          VelocityGradient2 L;
+          sk.for_each(ix, [&](int slot, double, const Vec<2>& G) {
+            L.add(Vec<2>(Eigen::Map<const Vec<2>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)), G);
+          });
+          Mat<2> F = Eigen::Map<const Mat<2>>(f.F + 4 * k);
+          const double det_A = deformation_update_2d(L, dt, F);
+          Eigen::Map<Mat<2>>(f.F + 4 * k) = F;
+          f.volume[k] = determinant_2d(F) * f.volume0[k];
+          Mat<2> sigma = Eigen::Map<const Mat<2>>(f.stress + 4 * k);
+          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+          if (mie_gruneisen_update_plane_strain(L, dt, f.volume[k] / f.volume0[k], det_A, mat.mie_gruneisen, min_J[m],
+                                                sigma, f.stress_zz[k], f.plastic_strain[k], f.internal_energy[k], wp,
+                                                f.wave_speed[k]) != MieGruneisenStatus::ok)
+            beyond = std::max(beyond, static_cast<long>(f.id[k]));
+          Eigen::Map<Mat<2>>(f.stress + 4 * k) = sigma;
+          f.plastic_work[k] += wp * f.volume[k];
+          continue;
+        }
+      }
+      Mat<Dim> L = Mat<Dim>::Zero();
+      sk.for_each(ix, [&](int slot, double, const Vec<Dim>& G) {
+        L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)) *
+                       G.transpose();
+      });
+      Eigen::Map<Mat<Dim>> F(f.F + Dim * Dim * k);
+      const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+      Mat<Dim> F_new;
+      F_new.noalias() = A * F;  // as the serial update_stress
+      F = F_new;
+      f.volume[k] = F.determinant() * f.volume0[k];
+      Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
+      if (mg) {
+        double wp = 0.0;
+        if (mie_gruneisen_update<Dim>(L, dt, f.volume[k] / f.volume0[k], mat.mie_gruneisen, min_J[m], sigma,
+                                      f.stress_zz[k], f.plastic_strain[k], f.internal_energy[k], wp,
+                                      &f.wave_speed[k]) != MieGruneisenStatus::ok)
+          beyond = std::max(beyond, static_cast<long>(f.id[k]));
+        f.plastic_work[k] += wp * f.volume[k];
+      } else if (mat.kind == MaterialKind::neo_hookean) {
+        const Mat<Dim> Fk = F;
+        neo_hookean_stress<Dim>(Fk, lambda[m], mu[m], sigma, f.stress_zz[k]);
+        f.wave_speed[k] = mat.wave_speed(an, f.volume[k] / f.volume0[k]);
+      } else {
+        linear_elastic_update<Dim>(L, dt, lambda[m], mu[m], an, sigma, f.stress_zz[k]);
+        f.wave_speed[k] = c0[m];
+      }
+      Eigen::Map<Mat<Dim>>(f.stress + Dim * Dim * k) = sigma;
+    }
+    petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
   }
-  petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
+  if (!has_mie_gruneisen) return;
+  long worst = beyond;
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_LONG, MPI_MAX, comm);
+  if (worst >= 0)
+    throw std::runtime_error("decomposed mechanics: step " + std::to_string(traffic.steps) + ": particle " +
+                             std::to_string(worst) +
+                             " is compressed past the limit of its Hugoniot (try a smaller CFL factor)");
 }
 
 template <int Dim>
@@ -249,6 +390,7 @@ void DecomposedMpm<Dim>::step(double dt) {
       s.traffic.phase_seconds[p] += MPI_Wtime() - t0;
     }
   });
+  s.time += dt;
   ++s.traffic.steps;
 }
 

@@ -2,39 +2,50 @@
 // Decomposed MPM on PETSc, 2D and 3D (issue 16, "Beyond one machine"): the structured grid as a DMDA
 // (DMDACreate2d / DMDACreate3d) whose points are the grid's nodes (the serial Grid<Dim>'s nodes, its
 // ghost layer included), particles in a DMSwarm of type DMSWARM_PIC with the DMDA as cell DM, and one
-// explicit USL step of linear-elastic materials with optional multimaterial contact and frictional
-// heating (Nairn, Bardenhagen & Smith 2018), fixed grid faces (the 4 faces in 2D, the 6 in 3D) and
-// gravity, written as a list of named phases in which the exchanges are phases of their own
-// (docs/distributed.md). DecomposedMpm<Dim> is instantiated for Dim = 2 and 3; DecomposedMpm2D,
-// DecomposedParticle, DecomposedOptions and DecomposedStencils name the 2D ones.
+// explicit USL step with optional multimaterial contact and frictional heating (Nairn, Bardenhagen &
+// Smith 2018), fixed grid faces, rigid boundary materials and gravity, written as a list of named
+// phases in which the exchanges are phases of their own (docs/distributed.md). DecomposedMpm<Dim> is
+// instantiated for Dim = 2 and 3; DecomposedMpm2D, DecomposedParticle, DecomposedOptions and
+// DecomposedStencils name the 2D ones.
 //
-//   particle_to_grid       local: per velocity field m_i, p_i, f_i (N·1–3) and, with contact,
-//                          Σ S m x (or the displacement form), Ω_i, g_i (N·4–6, 9)
+// Materials: linear elastic (hypoelastic, Jaumann), Neo-Hookean (Kakouris 2024 eq. 47) and the PBX
+// materials, Mie-Grüneisen pressure with elastic shear and J2 plasticity (mie_gruneisen.hpp; 2D plane
+// strain through plane_strain_update.hpp), by the serial step's own inline functions; the swarm
+// carries their state (ε̄p, e, plastic work, wave speed) with the particles. Rigid materials act as
+// velocity conditions on the nodes their particles touch (the serial rigid_boundary materials; every
+// rigid material without contact), prescribing the components they control; a rigid contact partner
+// (rigid_boundary = false with contact) stays serial. stable_time_step() is the serial CFL step over
+// all ranks. docs/distributed_pbx.md: these pieces, their tests and the many-materials benchmark.
+//
+//   particle_to_grid       local: stencils; rigid particles mark the nodes they drive; per velocity
+//                          field m_i, p_i, f_i (N·1–3) and, with contact, Σ S m x (or the displacement
+//                          form), Ω_i, g_i (N·4–6, 9), into the field's box of slots
 //   sum_to_owners          exchange: every node's m, p, f summed over its fields into the DMDA,
-//                          DMLocalToGlobal(ADD_VALUES) into the owners
+//                          DMLocalToGlobal(ADD_VALUES) into the owners; the rigid drivers to the owners
 //   exchange_field_ranges  exchange (PetscSF): which materials reach each node, completed at the
 //                          owner; the multi-material flag back to every rank holding the node
-//   fields_to_owners       exchange (PetscSF): per-material sums at multi-material ghost nodes into the owner
+//   fields_to_owners       exchange (PetscSF): per-material sums at multi-material ghost nodes placed
+//                          at the owner (fetch-and-add), summed there per material
 //   find_contact_nodes     owned nodes where two or more fields have mass
 //   contact_extrapolated   contact on the extrapolated momenta (N·7–18), node-local
-//   momentum_update        owned nodes: fixed faces (p, f components zeroed), p_i += f_i dt
+//   momentum_update        owned nodes: rigid drive (f = (m v_rigid − p)/dt), fixed faces (p, f
+//                          components zeroed), p_i += f_i dt
 //   contact_updated        contact on p^{n+1} with consistent forces (N·19) and frictional work (N·27, 34, 36, 40)
-//   nodal_velocities       owned nodes: v_i = p_i/m_i, a_i = f_i/m_i
+//   nodal_velocities       owned nodes: v_i = p_i/m_i, a_i = f_i/m_i; driven components v = v_rigid
 //   ghost_velocities       exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get the totals' v_i, a_i
 //   fields_to_ghosts       exchange (PetscSF): per-material v_i, a_i back to the ranks that sent the sums
-//   grid_to_particle       FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i (the particle's own field)
-//   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, hypoelastic σ
-//                          (material.hpp's linear_elastic_update<Dim>)
+//   grid_to_particle       FLIP: v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i (the particle's own field);
+//                          rigid particles move with their prescribed velocity
+//   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, the material's stress
 //   migrate                exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
 //
-// Velocity fields: without contact every material shares one field (as the serial Simulation);
-// with contact each material has its own. A node that one material reaches (on every rank) needs no
-// per-material data: the DMDA's total is that material's field. Only at shared nodes that two or
-// more materials reach do per-material values travel, as (node, material) entries over a PetscSF
-// rebuilt each step (mechanics/src/distributed/sparse_exchange.cpp). Each rank still stores every
-// field densely over its ghosted box (materials × (2 + 4·Dim) doubles per node): fine for a few
-// materials, not for a PBX with hundreds of grains (per-material boxes, as the serial step has, are
-// the next step; docs/distributed.md).
+// Velocity fields: without contact every deformable material shares one field (as the serial
+// Simulation); with contact each material has its own. Each rank stores each field over the box of
+// local nodes its local particles' stencils reach (the serial layout_fields), so memory and work
+// scale with the particles (field_slots()), not with materials × ghosted box. A node that one material
+// reaches (on every rank) needs no per-material data: the DMDA's total is that material's field. Only
+// at shared nodes that two or more materials reach do per-material values travel, as (node, material)
+// entries over a PetscSF rebuilt each step (mechanics/src/distributed/sparse_exchange.cpp).
 //
 // Ownership: a particle belongs to the rank that owns the grid node nearest to it (the node's dual
 // cell [x_n − h/2, x_n + h/2) along every axis). With that rule the stencil of the linear, uGIMP
@@ -60,6 +71,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -101,6 +113,8 @@ struct DecomposedLocalParticles {
   /// With local_particle_data(true): x_p, v_p and the uGIMP half-widths l_p, Dim values per particle
   /// (hot spots and output of a decomposed run read them without gathering every particle).
   std::vector<double> position, velocity, half_size;
+  /// Plastic work done on each particle since the start (J; 0 for non-plastic materials).
+  std::vector<double> plastic_work;
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).
@@ -140,6 +154,12 @@ class DecomposedMpm {
     Mat<Dim> stress = Mat<Dim>::Zero();
     double stress_zz = 0.0;  // 2D plane strain σ_zz; unused (0) in 3D
     int material = 0;        // index into the materials given to DecomposedMpm
+    /// Per-particle state of the Mie-Grüneisen/J2 materials (as Particles<Dim>): equivalent plastic
+    /// strain ε̄p, specific internal energy e (J/kg) and the plastic work done on the particle since
+    /// the start (J). Zero (and unchanged) for the other materials.
+    double plastic_strain = 0.0;
+    double internal_energy = 0.0;
+    double plastic_work = 0.0;
     /// Values of Options::particle_scalars, in that order (empty: zeros).
     std::vector<double> scalars;
   };
@@ -174,9 +194,9 @@ class DecomposedMpm {
   };
 
   /// Collective over comm. The grid is the serial Grid<Dim> (nodes −1 … cells+1 per direction);
-  /// PETSc must be initialised. Throws std::invalid_argument for a material other than
-  /// linear_elastic, for the extended B-spline, an analysis that does not fit Dim and for
-  /// unsupported contact settings.
+  /// PETSc must be initialised. Throws std::invalid_argument for a material the serial
+  /// add_material refuses, a rigid contact partner (rigid_boundary = false with contact), the
+  /// extended B-spline, an analysis that does not fit Dim and unsupported contact settings.
   DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const std::vector<Material>& materials, const Options& options);
   /// One material.
   DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const Material& material, const Options& options);
@@ -188,7 +208,8 @@ class DecomposedMpm {
   /// migrated to their owners. Every particle must lie inside the grid's physical region.
   void add_particles(const std::vector<Particle>& particles);
 
-  /// One USL step of size dt (collective): the phases listed above, in that order.
+  /// One USL step of size dt (collective): the phases listed above, in that order. Throws
+  /// std::runtime_error on every rank when a particle is compressed past its Hugoniot's limit.
   void step(double dt);
   static const std::array<const char*, 14>& phase_names();
 
@@ -217,6 +238,17 @@ class DecomposedMpm {
   DecomposedContactStats contact_stats() const;
   /// Collective: every particle of every rank, sorted by id, on every rank.
   std::vector<Particle> gather() const;
+  /// Collective: the largest stable step over all ranks, C min(h) / max_p (c_p + |v_p|) (Nairn 2018
+  /// eq. 45 with the particle speed added, as Simulation::stable_time_step), c_p the dilatational wave
+  /// speed of the particle's state after the last stress update (before the first step: of its
+  /// initial state), capped at max_time_step (also when no particle moves or carries a wave).
+  double stable_time_step(double cfl, double max_time_step = std::numeric_limits<double>::infinity()) const;
+  /// Collective: plastic work done on all particles since the start (J; Mie-Grüneisen/J2 materials).
+  double total_plastic_work() const;
+  /// Velocity-field slots this rank stores (Σ over its fields of their boxes' nodes; see the header
+  /// comment) and the largest over the run's steps.
+  long field_slots() const;
+  long peak_field_slots() const;
 
   // ---- Transfers for coupled physics (transfer.cpp): the particle–grid maps of the step, without
   // any physics of their own, so that a caller (the coupling's decomposed heat conduction) can
