@@ -123,10 +123,10 @@ def scene(seed, count):
 
 HEADER = """// 3D PBX-like compaction (issue 16), written by examples/pbx_3d_generate.py --seed {seed} --grains {count}
 // (edit the script, not this file). SI units. An 80 um cube of {n} axis-aligned ellipsoidal HMX grains
-// ({pct:.0f} % by volume, semi-axes 8-16 um, at least 1 um apart, placed by seeded random sequential
-// addition), every grain its own material (hmx_1, hmx_2, ...) so that friction acts between grains and
-// between grains and binder, in a binder box (listed after the grains: a body skips the points earlier
-// bodies took). Table 1 properties of Nairn, Bardenhagen & Smith (2018), as examples/pbx_compaction.json
+// ({n} of the {count} drawn fitted; {pct:.0f} % by volume, semi-axes 8-16 um, at least 1 um apart, placed
+// largest first by seeded random sequential addition), every grain its own material (hmx_1, hmx_2,
+// ...) so that friction acts between grains and between grains and binder, in a binder box (listed after the
+// grains: a body skips the points earlier bodies took). Table 1 properties of Nairn, Bardenhagen & Smith (2018), as examples/pbx_compaction.json
 // and examples/materials/pbx_table1.json: Mie-Gruneisen pressure with elastic shear, HMX with J2
 // plasticity. Five rigid boundary walls hold the cube (x and y walls fix their normal velocity, the
 // floor its z velocity); a rigid piston on top moves down at {v} m/s (1.6 % of the HMX C0) for {t} ns:
