@@ -125,9 +125,10 @@ HEADER = """// 3D PBX-like compaction (issue 16), written by examples/pbx_3d_gen
 // (edit the script, not this file). SI units. An 80 um cube of {n} axis-aligned ellipsoidal HMX grains
 // ({n} of the {count} drawn fitted; {pct:.0f} % by volume, semi-axes 8-16 um, at least 1 um apart, placed
 // largest first by seeded random sequential addition), every grain its own material (hmx_1, hmx_2,
-// ...) so that friction acts between grains and between grains and binder, in a binder box (listed after the
-// grains: a body skips the points earlier bodies took). Table 1 properties of Nairn, Bardenhagen & Smith (2018), as examples/pbx_compaction.json
-// and examples/materials/pbx_table1.json: Mie-Gruneisen pressure with elastic shear, HMX with J2
+// ...) so that friction acts between grains and between grains and binder, in a binder box
+// (listed after the grains: a body skips the points earlier bodies took). Table 1 properties of
+// Nairn, Bardenhagen & Smith (2018), as examples/pbx_compaction.json and
+// examples/materials/pbx_table1.json: Mie-Gruneisen pressure with elastic shear, HMX with J2
 // plasticity. Five rigid boundary walls hold the cube (x and y walls fix their normal velocity, the
 // floor its z velocity); a rigid piston on top moves down at {v} m/s (1.6 % of the HMX C0) for {t} ns:
 // 15 um, a 19 % strain. 4 um cells with 2 x 2 x 2 uGIMP particles each (2 um particles), multimaterial
