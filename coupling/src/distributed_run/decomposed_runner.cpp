@@ -1,7 +1,8 @@
-// The decomposed run loop (decomposed_run.hpp): the serial run loop's time stepping (CFL from the
-// P-wave speed plus the particle speed, the largest over all ranks; landing on every snapshot time and
-// on end_time), the engine's USL step and the heat hand-off and forward-Euler conduction of
-// DecomposedHeat every step; series on rank 0 (OUT.h5), particle snapshots per rank joined by OUT.xdmf.
+// The decomposed run loop (decomposed_run.hpp): the serial run loop's time stepping (CFL from each
+// particle's dilatational wave speed plus its speed, DecomposedMpm::stable_time_step, the largest over
+// all ranks; landing on every snapshot time and on end_time), the engine's USL step and the heat
+// hand-off and forward-Euler conduction of DecomposedHeat every step; series on rank 0 (OUT.h5),
+// particle snapshots per rank joined by OUT.xdmf.
 #include "distributed_run/decomposed_hotspots.hpp"
 #include "distributed_run/decomposed_setup.hpp"
 #include "run/run_signals.hpp"
@@ -90,6 +91,7 @@ class DecomposedRun {
     r_.time = time_;
     r_.wall_time = seconds_since(t0);
     record_phase_seconds();
+    record_traffic();
     r_.snapshots = static_cast<std::size_t>(snapshots_);
     if (out_) finish_output();
     snapshots_out_->close();
@@ -130,7 +132,6 @@ class DecomposedRun {
     }
     mpm_->add_particles(detail::scene_particles<Dim>(comm_, s_));
     r_.particles = static_cast<std::size_t>(mpm_->global_particles());
-    for (const mechanics::Material& m : s_.materials) wave_speed_.push_back(m.p_wave_speed(s_.options.analysis));
     temperature_ = mpm_->particle_scalar_index("temperature");
     if (s_.thermal.enabled) {
       const CouplerOptions& c = s_.thermal.coupler;
@@ -204,41 +205,40 @@ class DecomposedRun {
     return n;
   }
 
-  // Collective, one reduction: the largest c_p + |v_p| over all ranks (the serial stable_time_step's,
-  // linear elastic: c_p the material's P-wave speed), whether any rank caught SIGINT/SIGTERM, and the
-  // lowest id of a particle with a non-finite state or outside the grid (the serial step's check),
-  // which becomes a SimulationError on every rank.
+  // Collective: one reduction for whether any rank caught SIGINT/SIGTERM and the lowest id of a
+  // particle with a non-finite state or outside the grid (the serial step's check), which becomes a
+  // SimulationError on every rank; then the engine's stable step, C min(h) / max_p (c_p + |v_p|) over
+  // all ranks with c_p of each particle's state (Mie-Grüneisen: its current wave speed), as the serial
+  // Simulation::stable_time_step.
   void stable_time_step(double& dt, int& signal) const {
     const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
     constexpr double none = -std::numeric_limits<double>::infinity();
-    double v[4] = {0.0, static_cast<double>(detail::interrupt_signal()), none, none};  // max of −id: lowest id
+    double v[3] = {static_cast<double>(detail::interrupt_signal()), none, none};  // max of −id: lowest id
     for (std::size_t k = 0; k < p.mass.size(); ++k) {
       const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k), xk(p.position.data() + Dim * k);
-      v[0] = std::max(v[0], wave_speed_[static_cast<std::size_t>(p.material[k])] + vk.norm());
       if (!(vk.allFinite() && xk.allFinite()))
-        v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
+        v[1] = std::max(v[1], -static_cast<double>(p.id[k]));
       else if (!grid_->contains(xk))
-        v[3] = std::max(v[3], -static_cast<double>(p.id[k]));
+        v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
     }
-    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, comm_);
-    signal = static_cast<int>(v[1]);
+    MPI_Allreduce(MPI_IN_PLACE, v, 3, MPI_DOUBLE, MPI_MAX, comm_);
+    signal = static_cast<int>(v[0]);
     const std::string at = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: particle ";
-    if (v[2] > none)
-      throw mechanics::SimulationError(at + format_number(-v[2]) + " has a non-finite velocity or position (the step "
-                                            "blew up; try a smaller CFL factor)", step_, time_, static_cast<long>(-v[2]));
-    if (v[3] > none) {
+    if (v[1] > none)
+      throw mechanics::SimulationError(at + format_number(-v[1]) + " has a non-finite velocity or position (the step "
+                                            "blew up; try a smaller CFL factor)", step_, time_, static_cast<long>(-v[1]));
+    if (v[2] > none) {
       std::string span;
       for (int d = 0; d < Dim; ++d) span += (d ? ", " : "") + format_number(grid_->lo()[d]);
       span += ") to (";
       for (int d = 0; d < Dim; ++d) span += (d ? ", " : "") + format_number(grid_->hi()[d]);
-      throw mechanics::SimulationError(at + format_number(-v[3]) + " left the grid; grid spans (" + span + ") m", step_,
-                                       time_, static_cast<long>(-v[3]));
+      throw mechanics::SimulationError(at + format_number(-v[2]) + " left the grid; grid spans (" + span + ") m", step_,
+                                       time_, static_cast<long>(-v[2]));
     }
-    const double cap = s_.options.max_time_step;
-    dt = v[0] <= 0.0 ? cap : std::min(s_.options.cfl * grid_->min_cell_size() / v[0], cap);
+    dt = mpm_->stable_time_step(s_.options.cfl, s_.options.max_time_step);
   }
 
-  // The serial loop (runner.cpp) with one reduction per step: after each mechanics step, the next
+  // The serial loop (runner.cpp) with two reductions per step: after each mechanics step, the next
   // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
   void loop(detail::ProgressLine& progress) {
     const double T = s_.end_time;
@@ -292,15 +292,18 @@ class DecomposedRun {
   void series() {
     const Clock::time_point c0 = Clock::now();
     const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
-    double ke = 0.0;
+    // Kinetic energy and momentum of the deformable particles, as Simulation::kinetic_energy and
+    // linear_momentum (a rigid wall's prescribed motion is not part of the body's).
+    double sums[1 + Dim] = {};
     for (std::size_t k = 0; k < p.mass.size(); ++k) {
+      if (s_.materials[static_cast<std::size_t>(p.material[k])].is_rigid()) continue;
       const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k);
-      ke += 0.5 * p.mass[k] * vk.squaredNorm();
+      sums[0] += 0.5 * p.mass[k] * vk.squaredNorm();
+      for (int d = 0; d < Dim; ++d) sums[1 + d] += p.mass[k] * vk[d];
     }
-    MPI_Allreduce(MPI_IN_PLACE, &ke, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    const mechanics::Vec<Dim> P = mpm_->total_momentum();
-    std::vector<double> row{time_, static_cast<double>(step_), last_dt_, ke};
-    for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+    MPI_Allreduce(MPI_IN_PLACE, sums, 1 + Dim, MPI_DOUBLE, MPI_SUM, comm_);
+    std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0]};
+    for (int d = 0; d < Dim; ++d) row.push_back(sums[1 + d]);
     if (s_.contact.enabled) {
       const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
       const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);
@@ -352,6 +355,38 @@ class DecomposedRun {
     double accounted = 0.0;
     for (const auto& x : ph) accounted += x.second;
     ph.emplace_back("other", r_.wall_time - accounted);
+  }
+
+  // Collective: the engine's traffic counters (DecomposedTraffic) per rank, their mean and largest over
+  // the ranks, as metadata of OUT.h5 (traffic_*_mean, traffic_*_max) and one log line on rank 0: ghost
+  // nodes (a grid exchange sends ghost_nodes × values_per_node doubles), particles migrated per step,
+  // per-field contact entries per step, bytes per migrated particle and per field entry.
+  void record_traffic() {
+    const mechanics::DecomposedTraffic& t = mpm_->traffic();
+    const double steps = std::max(1L, t.steps);
+    const char* names[] = {"ghost_nodes", "grid_exchange_bytes", "migrated_particles_per_step",
+                           "migration_bytes_per_step", "field_entries_per_step", "field_bytes_per_step",
+                           "local_particles"};
+    double mine[7] = {static_cast<double>(t.ghost_nodes),
+                      static_cast<double>(t.ghost_nodes) * t.values_per_node * sizeof(double),
+                      (t.particles_sent + t.particles_received) / steps,
+                      (t.particles_sent + t.particles_received) * static_cast<double>(t.particle_bytes) / steps,
+                      2.0 * t.field_entries_sent / steps,  // sent to the owners and received back
+                      2.0 * t.field_entries_sent * static_cast<double>(t.field_entry_bytes) / steps,
+                      static_cast<double>(mpm_->local_particles())};
+    double sum[7], max[7];
+    MPI_Reduce(mine, sum, 7, MPI_DOUBLE, MPI_SUM, 0, comm_);
+    MPI_Reduce(mine, max, 7, MPI_DOUBLE, MPI_MAX, 0, comm_);
+    if (rank_ != 0) return;
+    std::string line = "frictherm: traffic per rank (mean / largest):";
+    for (int i = 0; i < 7; ++i) {
+      if (out_) {
+        out_->write_metadata(std::string("traffic_") + names[i] + "_mean", sum[i] / size_);
+        out_->write_metadata(std::string("traffic_") + names[i] + "_max", max[i]);
+      }
+      line += std::string(i ? ", " : " ") + names[i] + " " + format_number(sum[i] / size_) + " / " + format_number(max[i]);
+    }
+    if (!o_.quiet) (o_.log ? *o_.log : std::cerr) << line << "\n";
   }
 
   // The energy books summed over ranks (J) and how well they close (relative to the work received).
@@ -412,7 +447,6 @@ class DecomposedRun {
   std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
   std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
   std::unique_ptr<DecomposedOutput> snapshots_out_;
-  std::vector<double> wave_speed_;  // P-wave speed by material (m/s)
   int temperature_ = 0;
   double time_ = 0.0, last_dt_ = 0.0;
   long step_ = 0, snapshots_ = 0;

@@ -69,6 +69,9 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MP
         q.stress = p.stress[k];
         q.stress_zz = p.stress_zz[k];
         q.material = p.material[k];
+        q.plastic_strain = p.plastic_strain[k];  // the Mie-Grüneisen/J2 state (zeros for other materials)
+        q.internal_energy = p.internal_energy[k];
+        q.plastic_work = p.plastic_work[k];
         q.scalars = {p.temperature[k], p.temperature[k]};
       }
     } catch (const SceneError& e) {

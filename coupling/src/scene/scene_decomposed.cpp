@@ -38,9 +38,12 @@ std::string mechanics_refusal(const Scene& s) {
   if (std::isfinite(o.pic_relaxation_time))
     return refuse("solver.pic_relaxation_time", number(o.pic_relaxation_time), "no PIC blend: remove the key");
   if (o.damping_rate > 0.0) return refuse("solver.damping", "rate " + number(o.damping_rate), "no damping: remove the key");
+  // Every material kind runs decomposed (DecomposedMpm: linear elastic, neo-Hookean, Mie-Grüneisen/J2,
+  // rigid; docs/distributed_pbx.md), but a rigid material in contact must be a boundary wall: the
+  // engine's rule, rigid contact partners stay serial.
   for (const mechanics::Material& m : s.materials)
-    if (m.kind != mechanics::MaterialKind::linear_elastic)
-      return refuse("materials." + m.name + ".type", quoted(mechanics::to_string(m.kind)), "\"linear_elastic\"");
+    if (m.is_rigid() && s.contact.enabled && !m.rigid_boundary)
+      return refuse("materials." + m.name + ".boundary", "false (a rigid contact partner)", "true: a rigid wall");
   if (!s.point_loads.empty())
     return refuse("loads.point", std::to_string(s.point_loads.size()) + " point load(s)", "no point loads");
   if (!s.tractions.empty())
