@@ -1,13 +1,19 @@
 #pragma once
 // Shared by the decomposed-run tests (tests/mechanics/test_distributed*.cpp,
-// tests/coupling/test_heat_distributed*.cpp): a linear-elastic material, serial particles handed to
-// the decomposed run, and the serial sliding blocks (2D, 3D) they compare with.
+// tests/coupling/test_heat_distributed*.cpp): a linear-elastic material, the serial options and the
+// matching decomposed ones, serial particles handed to the decomposed run, the serial sliding blocks
+// (2D, 3D) they compare with and the checks of that comparison.
 #include "frictherm/mechanics/distributed.hpp"
 #include "frictherm/mechanics/geometry.hpp"
 #include "frictherm/mechanics/simulation.hpp"
 
 #include "mpi_ranks.hpp"
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <memory>
 #include <vector>
 
@@ -21,6 +27,29 @@ inline mechanics::Material elastic(const char* name, double E, double nu, double
   m.poisson_ratio = nu;
   m.density = rho;
   return m;
+}
+
+/// The serial run's options of the decomposed comparisons: the kernel `shape`, the USL scheme and,
+/// where given, the CFL number `cfl` (the default otherwise).
+inline mechanics::SimulationOptions usl_options(mechanics::ShapeKind shape, double cfl = mechanics::SimulationOptions{}.cfl) {
+  mechanics::SimulationOptions so;
+  so.shape = shape;
+  so.scheme = mechanics::UpdateScheme::usl;
+  so.cfl = cfl;
+  return so;
+}
+
+/// The decomposed run's options matching a serial run with contact: its shape and (with `contact`)
+/// its contact options `co`.
+template <int Dim>
+typename mechanics::DecomposedMpm<Dim>::Options matching_options(const mechanics::SimulationOptions& so,
+                                                                 const mechanics::ContactOptions& co,
+                                                                 bool contact = true) {
+  typename mechanics::DecomposedMpm<Dim>::Options opt;
+  opt.shape = so.shape;
+  opt.contact = contact;
+  opt.contact_options = co;
+  return opt;
 }
 
 /// Serial particles as decomposed particles (id = serial index; with `temperature` the temperature
@@ -126,5 +155,63 @@ struct SlidingBlock3D : SlidingBlockOf<3> {
       : SlidingBlockOf<3>(shape, {12, 6, 5}, mechanics::Vec<3>(1e-3, 1e-3, 0.0), mechanics::Vec<3>(11e-3, 5e-3, 2e-3),
                           mechanics::Vec<3>(2e-3, 1e-3, 2e-3), mechanics::Vec<3>(6e-3, 5e-3, 4e-3)) {}
 };
+
+/// The worst differences of a decomposed sliding block from the serial run over its steps: positions,
+/// velocities, the block's mean x-velocity (the history), the first- and second-order cumulative
+/// frictional work, and the books (each step's nodal work over all ranks against the cumulative
+/// work's increment); with what the serial run did: |step taken − dt|, the final works W1, W2, the
+/// block's final mean x-velocity, and the fewest contact and sliding nodes after the first 5 steps.
+struct SlidingDifferences {
+  double taken = 0.0, dx = 0.0, dv = 0.0, dhist = 0.0, dw1 = 0.0, dw2 = 0.0, books = 0.0;
+  double ws1 = 0.0, ws2 = 0.0, v_end = 0.0;
+  long min_contact = 1L << 40, min_sliding = 1L << 40;
+  bool same_ids = true;
+
+  /// Records step `s`: the decomposed run's contact statistics `st`, and its gathered particles `a`
+  /// against the serial ones `sp` (`ids`: the same particles; `d_position`, `d_velocity`: the largest
+  /// differences) with the mean x-velocity of material `block`.
+  template <class Particle, int Dim>
+  void record(int s, const mechanics::DecomposedContactStats& st, const std::vector<Particle>& a,
+              const mechanics::Particles<Dim>& sp, int block, bool ids, double d_position, double d_velocity) {
+    if (s >= 5) min_contact = std::min(min_contact, st.contact_nodes), min_sliding = std::min(min_sliding, st.sliding_nodes);
+    same_ids = same_ids && ids;
+    dx = std::max(dx, d_position);
+    dv = std::max(dv, d_velocity);
+    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, block) - mean_velocity_x(sp, block)));
+  }
+};
+
+/// The sliding block slid and was braked by friction over the whole run (contact and sliding at every
+/// step after the first few, the block slowed by more than 0.5 m/s, the books the comparisons rest on
+/// not empty), and the decomposed run equals the serial one: every particle kept, positions within
+/// 1e-9 of the cell size h, velocities and the history within 1e-9 of v0, the work within 1e-9 of its
+/// final value (the tolerance) and the books closed to round-off (1e-12 of W1).
+inline void expect_sliding_block_equals_serial(const SlidingDifferences& s, double h, double v0) {
+  EXPECT_EQ(s.taken, 0.0);  // the serial step took dt (below its CFL limit)
+  EXPECT_TRUE(s.same_ids);  // every particle kept, with its material and mass
+  EXPECT_GT(s.min_contact, 0L);
+  EXPECT_GT(s.min_sliding, 0L);
+  EXPECT_LT(s.v_end, v0 - 0.5);
+  EXPECT_GT(s.ws1, 0.0);
+  EXPECT_GT(s.ws2, 0.0);
+  EXPECT_LE(s.dx / h, 1e-9);
+  EXPECT_LE(s.dv / v0, 1e-9);
+  EXPECT_LE(s.dhist / v0, 1e-9);
+  EXPECT_LE(s.dw1 / s.ws1, 1e-9);
+  EXPECT_LE(s.dw2 / s.ws2, 1e-9);
+  EXPECT_LE(s.books / s.ws1, 1e-12);
+}
+
+/// Rank 0 prints the sliding block's run and its differences from the serial one, tagged `tag`, for
+/// the kernel named `kernel`.
+inline void print_sliding_block(const char* tag, const char* kernel, int steps, double h, double v0,
+                                const SlidingDifferences& s) {
+  if (comm_rank() != 0) return;
+  std::printf("[%s] %s, %d steps: block %.3f -> %.3f m/s, W1 %.6e J, W2 %.6e J; max over steps |dx|/h %.2e, "
+              "|dv|/v0 %.2e, history %.2e, |dW1|/W1 %.2e, |dW2|/W2 %.2e, books %.2e; contact nodes >= %ld, "
+              "sliding >= %ld\n",
+              tag, kernel, steps, v0, s.v_end, s.ws1, s.ws2, s.dx / h, s.dv / v0, s.dhist / v0, s.dw1 / s.ws1,
+              s.dw2 / s.ws2, s.books / s.ws1, s.min_contact, s.min_sliding);
+}
 
 }  // namespace frictherm::test

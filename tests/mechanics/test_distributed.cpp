@@ -293,9 +293,7 @@ INSTANTIATE_TEST_SUITE_P(Kernels, DecomposedEqualsOneRank,
 TEST(DecomposedMechanics, EqualsTheSerialSimulation) {
   const double h = 1e-3, rho = 1000.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {28, 16});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
+  fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp);
   so.gravity = fm::Vec<3>(0.0, -200.0, 0.0);
   fm::Simulation<2> serial(grid, so);
   const fm::Material mat = elastic(1e6, 0.3, rho);

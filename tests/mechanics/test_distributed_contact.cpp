@@ -110,43 +110,28 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
   const double c = std::sqrt(mats[0].p_wave_modulus(fm::Analysis::plane_strain) / rho);
   const double dt = 0.3 * h / (c + v0);
   const int steps = 200;
-  double taken = 0.0, dx = 0.0, dv = 0.0, dhist = 0.0, dw1 = 0.0, dw2 = 0.0, books = 0.0;
-  long min_contact = 1L << 40, min_sliding = 1L << 40;
-  bool same_ids = true;
-  double w1 = 0.0, w2 = 0.0, ws1 = 0.0, ws2 = 0.0;
+  frictherm::test::SlidingDifferences diff;
+  double w1 = 0.0, w2 = 0.0;
   for (int s = 0; s < steps; ++s) {
-    taken = std::max(taken, std::fabs(serial.step(dt) - dt));
+    diff.taken = std::max(diff.taken, std::fabs(serial.step(dt) - dt));
     split.step(dt);
     const double before1 = w1, before2 = w2;
     w1 = split.cumulative_frictional_work(fm::HeatingOrder::first);
     w2 = split.cumulative_frictional_work(fm::HeatingOrder::second);
-    ws1 = serial.cumulative_frictional_work(fm::HeatingOrder::first);
-    ws2 = serial.cumulative_frictional_work(fm::HeatingOrder::second);
-    dw1 = std::max(dw1, std::fabs(w1 - ws1));
-    dw2 = std::max(dw2, std::fabs(w2 - ws2));
+    diff.ws1 = serial.cumulative_frictional_work(fm::HeatingOrder::first);
+    diff.ws2 = serial.cumulative_frictional_work(fm::HeatingOrder::second);
+    diff.dw1 = std::max(diff.dw1, std::fabs(w1 - diff.ws1));
+    diff.dw2 = std::max(diff.dw2, std::fabs(w2 - diff.ws2));
     // The step's work per owned node, summed over ranks: the cumulative work's increment.
-    books = std::max({books, std::fabs(owned_sum(split.frictional_work(fm::HeatingOrder::first)) - (w1 - before1)),
-                      std::fabs(owned_sum(split.frictional_work(fm::HeatingOrder::second)) - (w2 - before2))});
+    diff.books = std::max({diff.books, std::fabs(owned_sum(split.frictional_work(fm::HeatingOrder::first)) - (w1 - before1)),
+                           std::fabs(owned_sum(split.frictional_work(fm::HeatingOrder::second)) - (w2 - before2))});
     const fm::DecomposedContactStats st = split.contact_stats();
-    if (s >= 5) min_contact = std::min(min_contact, st.contact_nodes), min_sliding = std::min(min_sliding, st.sliding_nodes);
     const auto a = split.gather();
     const Difference d = compare(a, serial);
-    same_ids = same_ids && d.same_ids;
-    dx = std::max(dx, d.position);
-    dv = std::max(dv, d.velocity);
-    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, blk) - mean_velocity_x(serial.particles(), blk)));
+    diff.record(s, st, a, serial.particles(), blk, d.same_ids, d.position, d.velocity);
   }
-  const double v_end = mean_velocity_x(serial.particles(), blk);
-  EXPECT_EQ(taken, 0.0);  // the serial step took dt (below its CFL limit)
-  EXPECT_TRUE(same_ids);  // every particle kept, with its material and mass
+  diff.v_end = mean_velocity_x(serial.particles(), blk);
   EXPECT_EQ(split.global_particles(), static_cast<long long>(serial.particles().size()));
-  // The block slid and was braked by friction over the whole run (contact and sliding at every step
-  // after the first few); the books the comparisons rest on are not empty.
-  EXPECT_GT(min_contact, 0L);
-  EXPECT_GT(min_sliding, 0L);
-  EXPECT_LT(v_end, v0 - 0.5);
-  EXPECT_GT(ws1, 0.0);
-  EXPECT_GT(ws2, 0.0);
   long sent = split.traffic().particles_sent;
   MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
   const long entries = field_entries(split);
@@ -154,20 +139,9 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
     EXPECT_GT(sent, 0L);     // block particles crossed rank boundaries
     EXPECT_GT(entries, 0L);  // and the contact surface: per-material sums travelled over the star forest
   }
-  // Round-off grows in the contact decisions and the stress; 1e-9 of the case's scales (the issue's
-  // tolerance): positions against the cell size, velocities against v0, work against its final value.
-  EXPECT_LE(dx / h, 1e-9);
-  EXPECT_LE(dv / v0, 1e-9);
-  EXPECT_LE(dhist / v0, 1e-9);
-  EXPECT_LE(dw1 / ws1, 1e-9);
-  EXPECT_LE(dw2 / ws2, 1e-9);
-  EXPECT_LE(books / ws1, 1e-12);
-  if (comm_rank() == 0)
-    std::printf("[sliding block] %s, %d steps: block %.3f -> %.3f m/s, work W1 %.6e J W2 %.6e J; max over steps "
-                "|dx|/h %.2e, |dv|/v0 %.2e, history %.2e, |dW1|/W1 %.2e, |dW2|/W2 %.2e, books %.2e; contact nodes "
-                ">= %ld, sliding >= %ld\n",
-                fm::to_string(GetParam()), steps, v0, v_end, ws1, ws2, dx / h, dv / v0, dhist / v0, dw1 / ws1,
-                dw2 / ws2, books / ws1, min_contact, min_sliding);
+  // Round-off grows in the contact decisions and the stress: 1e-9 of the case's scales.
+  frictherm::test::expect_sliding_block_equals_serial(diff, h, v0);
+  frictherm::test::print_sliding_block("sliding block", fm::to_string(GetParam()), steps, h, v0, diff);
   print_phases(fm::to_string(GetParam()), split);
 }
 
@@ -182,9 +156,7 @@ TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
   // puts the contact nodes on both ranks; no velocity condition, no gravity.
   const double h = 1e-3, rho = 1000.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {28, 18});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
+  const fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp);
   fm::Simulation<2> serial(grid, so);
   const std::vector<fm::Material> mats{elastic("left", 1e7, 0.3, rho), elastic("right", 2e7, 0.3, 1500.0)};
   const int a = serial.add_material(mats[0]), b = serial.add_material(mats[1]);
@@ -195,11 +167,7 @@ TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
   serial.enable_contact(co);
   serial.finalize();
 
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.contact = true;
-  opt.contact_options = co;
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, frictherm::test::matching_options<2>(so, co));
   split.add_particles(frictherm::test::decomposed(serial.particles()));
   const V2 p0 = split.total_momentum();
   const double scale = split.total_momentum_scale();
@@ -256,9 +224,7 @@ TEST(DecomposedContact, ThreeMaterialsMeetingAtNodesEqualTheSerialRun) {
   // x = 15 mm, where the 2-rank split runs. The serial ContactConservation case at 1 mm cells.
   const double h = 1e-3, rho = 1000.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {30, 24});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
+  const fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp);
   fm::Simulation<2> serial(grid, so);
   const std::vector<fm::Material> mats{elastic("A", 1e7, 0.3, rho), elastic("B", 1.5e7, 0.3, rho),
                                        elastic("C", 2e7, 0.2, rho)};
@@ -272,11 +238,7 @@ TEST(DecomposedContact, ThreeMaterialsMeetingAtNodesEqualTheSerialRun) {
   serial.enable_contact(co);
   serial.finalize();
 
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.contact = true;
-  opt.contact_options = co;
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, frictherm::test::matching_options<2>(so, co));
   split.add_particles(frictherm::test::decomposed(serial.particles()));
   double c = 0.0;
   for (const auto& m : mats) c = std::max(c, std::sqrt(m.p_wave_modulus(fm::Analysis::plane_strain) / rho));
@@ -324,9 +286,7 @@ TEST(DecomposedContact, UpperFixedFacesEqualTheSerialRun) {
   // particles reach the faces' nodes from the first step. Quadratic B-spline, 150 steps.
   const double h = 1e-3, rho = 1000.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {20, 14});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::quadratic_bspline;
-  so.scheme = fm::UpdateScheme::usl;
+  fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::quadratic_bspline);
   so.gravity = fm::Vec<3>(3e4, 3e4, 0.0);
   fm::Simulation<2> serial(grid, so);
   const fm::Material mat = elastic("block", 1e7, 0.3, rho);

@@ -140,6 +140,32 @@ RunResult run_both(fm::Simulation<Dim>& serial, fm::DecomposedMpm<Dim>& split, d
   return r;
 }
 
+// The case did what it is for (bodies in contact, sliding heat and plastic work) and the decomposed
+// run equals the serial one: the same particles, the CFL step over all ranks to round-off, and
+// positions (against the cell size h), velocities, stresses, each particle's plastic work and the
+// frictional and plastic work to 1e-9 of the case's scales.
+void expect_contact_case_equals_serial(const RunResult& r, double h) {
+  const Difference& d = r.worst;
+  EXPECT_TRUE(d.same_ids);
+  EXPECT_GT(r.max_contact, 0L);
+  EXPECT_GT(r.w_friction, 0.0);
+  EXPECT_GT(r.w_plastic, 0.0);
+  EXPECT_LE(r.dt_difference, 1e-12);
+  EXPECT_LE(d.position / h, 1e-9);
+  EXPECT_LE(d.velocity / d.v_max, 1e-9);
+  EXPECT_LE(d.stress / d.s_max, 1e-9);
+  EXPECT_LE(d.plastic / d.plastic_max, 1e-9);
+  EXPECT_LE(r.frictional / r.w_friction, 1e-9);
+  EXPECT_LE(r.plastic / r.w_plastic, 1e-9);
+}
+
+// Sets each serial particle's velocity to v(x − centre) (the decomposed run takes the serial particles).
+template <class Field>
+void set_velocity_field(fm::Simulation<2>& serial, const V2& centre, Field v) {
+  for (std::size_t k = 0; k < serial.particles().size(); ++k)
+    serial.particles().velocity[k] = v(V2(serial.particles().position[k] - centre));
+}
+
 template <int Dim>
 void print_storage(const char* label, const fm::DecomposedMpm<Dim>& run) {
   long slots = run.peak_field_slots(), particles = static_cast<long>(run.local_particles());
@@ -165,10 +191,7 @@ TEST(DecomposedMaterials, PbxGrainsInBinderEqualTheSerialRun) {
   // every pair, the default maximum-volume-gradient normal).
   const double h = 50e-6, v0 = 150.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {30, 20});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
-  so.cfl = 0.4;
+  const fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp, 0.4);
   fm::Simulation<2> serial(grid, so);
   std::vector<fm::Material> mats{binder()};
   for (int g = 0; g < 8; ++g) mats.push_back(hmx("grain" + std::to_string(g), 2.6e8 * (1.0 + 0.05 * g)));
@@ -183,39 +206,21 @@ TEST(DecomposedMaterials, PbxGrainsInBinderEqualTheSerialRun) {
   co.default_pair.law = fm::FrictionLaw::coulomb(0.3);
   serial.enable_contact(co);
   serial.finalize();
-  const V2 centre(15 * h, 10 * h), half(13 * h, 8 * h);
-  for (std::size_t k = 0; k < serial.particles().size(); ++k) {
-    const V2 r = serial.particles().position[k] - centre;
-    serial.particles().velocity[k] = v0 * V2(-r[0] / half[0], -0.3 * r[1] / half[1] + 0.3 * r[0] / half[0]);
-  }
+  const V2 half(13 * h, 8 * h);
+  set_velocity_field(serial, V2(15 * h, 10 * h),
+                     [&](const V2& r) -> V2 { return v0 * V2(-r[0] / half[0], -0.3 * r[1] / half[1] + 0.3 * r[0] / half[0]); });
 
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.contact = true;
-  opt.contact_options = co;
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, frictherm::test::matching_options<2>(so, co));
   split.add_particles(frictherm::test::decomposed(serial.particles()));
   const int steps = 120;
   const RunResult r = run_both(serial, split, so.cfl, steps, 10);
   const Difference& d = r.worst;
   const long entries = entries_sent(split);
-  EXPECT_TRUE(d.same_ids);
   EXPECT_EQ(split.global_particles(), static_cast<long long>(serial.particles().size()));
-  // The specimen did what the case is for: grains in contact (nodes of three materials too), sliding
-  // heat and plastic work.
-  EXPECT_GT(r.max_contact, 0L);
-  EXPECT_GT(r.w_friction, 0.0);
-  EXPECT_GT(r.w_plastic, 0.0);
   if (comm_size() > 1) {
     EXPECT_GT(entries, 0L);  // per-material sums crossed the rank cuts
   }
-  EXPECT_LE(r.dt_difference, 1e-12);             // the CFL step over all ranks = the serial one
-  EXPECT_LE(d.position / h, 1e-9);
-  EXPECT_LE(d.velocity / d.v_max, 1e-9);
-  EXPECT_LE(d.stress / d.s_max, 1e-9);
-  EXPECT_LE(d.plastic / d.plastic_max, 1e-9);
-  EXPECT_LE(r.frictional / r.w_friction, 1e-9);
-  EXPECT_LE(r.plastic / r.w_plastic, 1e-9);
+  expect_contact_case_equals_serial(r, h);
   if (comm_rank() == 0)
     std::printf("[pbx 2D] %zu particles, %zu materials, %d steps to %.3e s: W_friction %.6e J, W_plastic %.6e J, "
                 "contact nodes up to %ld (three or more materials %ld), %ld per-material entries sent; vs serial "
@@ -238,11 +243,8 @@ TEST(DecomposedMaterials, MieGruneisenIntoNeoHookean3DEqualsTheSerialRun) {
   // 2e-2 of v_max apart after 80 steps on 2 ranks, linear-elastic bodies alike; 6e-15 with this one).
   const double h = 1e-3;
   const fm::Grid<3> grid(V3::Zero(), V3(h, h, h), {8, 6, 6});
-  fm::SimulationOptions so;
+  fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp, 0.4);
   so.analysis = fm::Analysis::three_d;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
-  so.cfl = 0.4;
   fm::Simulation<3> serial(grid, so);
   fm::Material nh = frictherm::test::elastic("rubbery", 5e9, 0.3, 1200.0);
   nh.kind = fm::MaterialKind::neo_hookean;
@@ -256,26 +258,12 @@ TEST(DecomposedMaterials, MieGruneisenIntoNeoHookean3DEqualsTheSerialRun) {
   serial.enable_contact(co);
   serial.finalize();
 
-  fm::DecomposedMpm3D::Options opt;
-  opt.shape = so.shape;
-  opt.contact = true;
-  opt.contact_options = co;
-  fm::DecomposedMpm3D split(MPI_COMM_WORLD, grid, mats, opt);
+  fm::DecomposedMpm3D split(MPI_COMM_WORLD, grid, mats, frictherm::test::matching_options<3>(so, co));
   split.add_particles(frictherm::test::decomposed(serial.particles()));
   const int steps = 80;
   const RunResult r = run_both(serial, split, so.cfl, steps, 10);
   const Difference& d = r.worst;
-  EXPECT_TRUE(d.same_ids);
-  EXPECT_GT(r.max_contact, 0L);
-  EXPECT_GT(r.w_friction, 0.0);
-  EXPECT_GT(r.w_plastic, 0.0);
-  EXPECT_LE(r.dt_difference, 1e-12);
-  EXPECT_LE(d.position / h, 1e-9);
-  EXPECT_LE(d.velocity / d.v_max, 1e-9);
-  EXPECT_LE(d.stress / d.s_max, 1e-9);
-  EXPECT_LE(d.plastic / d.plastic_max, 1e-9);
-  EXPECT_LE(r.frictional / r.w_friction, 1e-9);
-  EXPECT_LE(r.plastic / r.w_plastic, 1e-9);
+  expect_contact_case_equals_serial(r, h);
   if (comm_rank() == 0)
     std::printf("[mg-nh 3D] %zu particles, %d steps to %.3e s: W_friction %.6e J, W_plastic %.6e J, contact nodes "
                 "up to %ld; vs serial |dx|/h %.2e, |dv|/v_max %.2e, |dsigma|/sigma_max %.2e, |dWp_p|/max %.2e, "
@@ -310,10 +298,7 @@ TEST_P(DecomposedWalls, PbxBetweenRigidWallsEqualsTheSerialRun) {
   // shared field, where every rigid material is a boundary, as in the serial step). 150 steps.
   const double h = 50e-6, v0 = 100.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {24, 20});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
-  so.cfl = 0.4;
+  const fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp, 0.4);
   fm::Simulation<2> serial(grid, so);
   std::vector<fm::Material> mats{binder(), wall("bottom", 0.0, 0.0, false, true), wall("left", 0.0, 0.0, true, false),
                                  wall("right", 0.0, 0.0, true, false), wall("piston", 0.0, -v0, false, true)};
@@ -334,11 +319,7 @@ TEST_P(DecomposedWalls, PbxBetweenRigidWallsEqualsTheSerialRun) {
   if (contact) serial.enable_contact(co);
   serial.finalize();
 
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.contact = contact;
-  opt.contact_options = co;
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, frictherm::test::matching_options<2>(so, co, contact));
   split.add_particles(frictherm::test::decomposed(serial.particles()));
   const int steps = 150;
   const RunResult r = run_both(serial, split, so.cfl, steps, 10);
@@ -387,9 +368,7 @@ TEST(DecomposedMaterials, RigidWallBesideARankCutDrivesTheOwnersNode) {
     MPI_Allreduce(MPI_IN_PLACE, &c, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   }
   if (comm_size() == 1) c = 12;  // (no cut: the comparison still runs)
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
+  const fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp);
   fm::Simulation<2> serial(grid, so);
   const std::vector<fm::Material> mats{block, wall("wall", 0.0, 0.0, true, false)};
   for (const auto& m : mats) serial.add_material(m);
@@ -432,10 +411,7 @@ TEST(DecomposedMaterials, FiftyGrainsStoreSlotsBoundedByTheirParticles) {
   // normal would tie, see (b)). 20 steps against the serial run; then the slots each rank stores.
   const double h = 50e-6, v0 = 150.0;
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(h, h), {40, 20});
-  fm::SimulationOptions so;
-  so.shape = fm::ShapeKind::ugimp;
-  so.scheme = fm::UpdateScheme::usl;
-  so.cfl = 0.4;
+  const fm::SimulationOptions so = frictherm::test::usl_options(fm::ShapeKind::ugimp, 0.4);
   fm::Simulation<2> serial(grid, so);
   std::vector<fm::Material> mats;
   for (int g = 0; g < 50; ++g) mats.push_back(hmx("grain" + std::to_string(g), 2.6e8 * (1.0 + 0.01 * g)));
@@ -449,16 +425,10 @@ TEST(DecomposedMaterials, FiftyGrainsStoreSlotsBoundedByTheirParticles) {
   co.default_pair.normal = fm::NormalMethod::average_volume_gradient;
   serial.enable_contact(co);
   serial.finalize();
-  const V2 centre(20 * h, 10 * h), half(20 * h, 10 * h);
-  for (std::size_t k = 0; k < serial.particles().size(); ++k) {
-    const V2 r = serial.particles().position[k] - centre;
-    serial.particles().velocity[k] = -v0 * V2(r[0] / half[0], 0.5 * r[1] / half[1]);
-  }
-  fm::DecomposedOptions opt;
-  opt.shape = so.shape;
-  opt.contact = true;
-  opt.contact_options = co;
-  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, opt);
+  const V2 half(20 * h, 10 * h);
+  set_velocity_field(serial, V2(20 * h, 10 * h),
+                     [&](const V2& r) -> V2 { return -v0 * V2(r[0] / half[0], 0.5 * r[1] / half[1]); });
+  fm::DecomposedMpm2D split(MPI_COMM_WORLD, grid, mats, frictherm::test::matching_options<2>(so, co));
   split.add_particles(frictherm::test::decomposed(serial.particles()));
   const int steps = 20;
   const RunResult r = run_both(serial, split, so.cfl, steps, 5);
