@@ -15,6 +15,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace frictherm::test {
@@ -156,28 +158,66 @@ struct SlidingBlock3D : SlidingBlockOf<3> {
                           mechanics::Vec<3>(2e-3, 1e-3, 2e-3), mechanics::Vec<3>(6e-3, 5e-3, 4e-3)) {}
 };
 
+/// Expects the decomposed run of `materials` with options `o` on `grid` to be refused with an
+/// std::invalid_argument naming `expect` (the scene key or the expected value).
+template <int Dim>
+void expect_refused(const mechanics::Grid<Dim>& grid, const std::vector<mechanics::Material>& materials,
+                    const typename mechanics::DecomposedMpm<Dim>::Options& o, const char* expect) {
+  try {
+    mechanics::DecomposedMpm<Dim> run(MPI_COMM_WORLD, grid, materials, o);
+  } catch (const std::invalid_argument& e) {
+    const bool named = std::string(e.what()).find(expect) != std::string::npos;
+    EXPECT_TRUE(named) << e.what();
+    return;
+  }
+  ADD_FAILURE() << "not refused: " << expect;
+}
+
 /// The worst differences of a decomposed sliding block from the serial run over its steps: positions,
 /// velocities, the block's mean x-velocity (the history), the first- and second-order cumulative
 /// frictional work, and the books (each step's nodal work over all ranks against the cumulative
 /// work's increment); with what the serial run did: |step taken − dt|, the final works W1, W2, the
 /// block's final mean x-velocity, and the fewest contact and sliding nodes after the first 5 steps.
+/// (Collective: every rank steps.)
 struct SlidingDifferences {
   double taken = 0.0, dx = 0.0, dv = 0.0, dhist = 0.0, dw1 = 0.0, dw2 = 0.0, books = 0.0;
   double ws1 = 0.0, ws2 = 0.0, v_end = 0.0;
   long min_contact = 1L << 40, min_sliding = 1L << 40;
   bool same_ids = true;
 
-  /// Records step `s`: the decomposed run's contact statistics `st`, and its gathered particles `a`
-  /// against the serial ones `sp` (`ids`: the same particles; `d_position`, `d_velocity`: the largest
-  /// differences) with the mean x-velocity of material `block`.
-  template <class Particle, int Dim>
-  void record(int s, const mechanics::DecomposedContactStats& st, const std::vector<Particle>& a,
-              const mechanics::Particles<Dim>& sp, int block, bool ids, double d_position, double d_velocity) {
+  double w1 = 0.0, w2 = 0.0;  // the decomposed run's cumulative work (first, second order)
+
+  /// Step `s`: steps the serial run and the decomposed one `split` by `dt`, and records the step's
+  /// work and books, the decomposed run's contact statistics, and its gathered particles against the
+  /// serial ones: `compare(gathered)` gives their largest differences (`same_ids`, `position`,
+  /// `velocity`); the history is the mean x-velocity of material `block`.
+  template <int Dim, class Compare>
+  void step(int s, mechanics::Simulation<Dim>& serial, mechanics::DecomposedMpm<Dim>& split, double dt, int block,
+            Compare compare) {
+    taken = std::max(taken, std::fabs(serial.step(dt) - dt));
+    split.step(dt);
+    const double before1 = w1, before2 = w2;
+    w1 = split.cumulative_frictional_work(mechanics::HeatingOrder::first);
+    w2 = split.cumulative_frictional_work(mechanics::HeatingOrder::second);
+    ws1 = serial.cumulative_frictional_work(mechanics::HeatingOrder::first);
+    ws2 = serial.cumulative_frictional_work(mechanics::HeatingOrder::second);
+    dw1 = std::max(dw1, std::fabs(w1 - ws1));
+    dw2 = std::max(dw2, std::fabs(w2 - ws2));
+    // The step's work per owned node summed over ranks is the cumulative work's increment.
+    double step_work[2] = {0.0, 0.0};
+    for (double w : split.frictional_work(mechanics::HeatingOrder::first)) step_work[0] += w;
+    for (double w : split.frictional_work(mechanics::HeatingOrder::second)) step_work[1] += w;
+    MPI_Allreduce(MPI_IN_PLACE, step_work, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    books = std::max({books, std::fabs(step_work[0] - (w1 - before1)), std::fabs(step_work[1] - (w2 - before2))});
+    const mechanics::DecomposedContactStats st = split.contact_stats();
     if (s >= 5) min_contact = std::min(min_contact, st.contact_nodes), min_sliding = std::min(min_sliding, st.sliding_nodes);
-    same_ids = same_ids && ids;
-    dx = std::max(dx, d_position);
-    dv = std::max(dv, d_velocity);
-    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, block) - mean_velocity_x(sp, block)));
+    const auto a = split.gather();
+    const auto d = compare(a);
+    same_ids = same_ids && d.same_ids;
+    dx = std::max(dx, d.position);
+    dv = std::max(dv, d.velocity);
+    dhist = std::max(dhist, std::fabs(mean_velocity_x(a, block) - mean_velocity_x(serial.particles(), block)));
+    v_end = mean_velocity_x(serial.particles(), block);
   }
 };
 

@@ -376,30 +376,8 @@ TEST_P(Decomposed3DSliding, EqualsTheSerialRunWithHeating) {
   const double dt = 0.3 * h / (p_wave_speed(mats[0]) + v0);
   const int steps = 150;
   frictherm::test::SlidingDifferences diff;
-  double w1 = 0.0, w2 = 0.0;
-  for (int s = 0; s < steps; ++s) {
-    diff.taken = std::max(diff.taken, std::fabs(serial.step(dt) - dt));
-    split.step(dt);
-    const double before1 = w1, before2 = w2;
-    w1 = split.cumulative_frictional_work(fm::HeatingOrder::first);
-    w2 = split.cumulative_frictional_work(fm::HeatingOrder::second);
-    diff.ws1 = serial.cumulative_frictional_work(fm::HeatingOrder::first);
-    diff.ws2 = serial.cumulative_frictional_work(fm::HeatingOrder::second);
-    diff.dw1 = std::max(diff.dw1, std::fabs(w1 - diff.ws1));
-    diff.dw2 = std::max(diff.dw2, std::fabs(w2 - diff.ws2));
-    // The step's work per owned node summed over ranks is the cumulative work's increment.
-    double step_work[2] = {0.0, 0.0};
-    for (double w : split.frictional_work(fm::HeatingOrder::first)) step_work[0] += w;
-    for (double w : split.frictional_work(fm::HeatingOrder::second)) step_work[1] += w;
-    MPI_Allreduce(MPI_IN_PLACE, step_work, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-    diff.books =
-        std::max({diff.books, std::fabs(step_work[0] - (w1 - before1)), std::fabs(step_work[1] - (w2 - before2))});
-    const fm::DecomposedContactStats st = split.contact_stats();
-    const auto a = split.gather();
-    const Difference d = compare(a, serial.particles());
-    diff.record(s, st, a, serial.particles(), blk, d.same_ids, d.position, d.velocity);
-  }
-  diff.v_end = frictherm::test::mean_velocity_x(serial.particles(), blk);
+  for (int s = 0; s < steps; ++s)
+    diff.step(s, serial, split, dt, blk, [&](const auto& a) { return compare(a, serial.particles()); });
   const long sent = sum_over_ranks(split.traffic().particles_sent);
   const long entries = sum_over_ranks(split.traffic().field_entries_sent);
   if (comm_size() > 1) {

@@ -37,7 +37,6 @@ using V2 = fm::Vec<2>;
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 using frictherm::test::elastic;
-using frictherm::test::mean_velocity_x;
 
 // Largest differences of the decomposed particles (gathered, by id) from the serial ones.
 struct Difference {
@@ -54,13 +53,6 @@ Difference compare(const std::vector<fm::DecomposedParticle>& a, const fm::Simul
     d.velocity = std::max(d.velocity, (a[k].velocity - sp.velocity[k]).norm());
   }
   return d;
-}
-
-double owned_sum(const std::vector<double>& w) {
-  double s = 0.0;
-  for (double x : w) s += x;
-  MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  return s;
 }
 
 // Per-material entries sent over the star forest, over all ranks and steps (the sparse exchange).
@@ -111,26 +103,8 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
   const double dt = 0.3 * h / (c + v0);
   const int steps = 200;
   frictherm::test::SlidingDifferences diff;
-  double w1 = 0.0, w2 = 0.0;
-  for (int s = 0; s < steps; ++s) {
-    diff.taken = std::max(diff.taken, std::fabs(serial.step(dt) - dt));
-    split.step(dt);
-    const double before1 = w1, before2 = w2;
-    w1 = split.cumulative_frictional_work(fm::HeatingOrder::first);
-    w2 = split.cumulative_frictional_work(fm::HeatingOrder::second);
-    diff.ws1 = serial.cumulative_frictional_work(fm::HeatingOrder::first);
-    diff.ws2 = serial.cumulative_frictional_work(fm::HeatingOrder::second);
-    diff.dw1 = std::max(diff.dw1, std::fabs(w1 - diff.ws1));
-    diff.dw2 = std::max(diff.dw2, std::fabs(w2 - diff.ws2));
-    // The step's work per owned node, summed over ranks: the cumulative work's increment.
-    diff.books = std::max({diff.books, std::fabs(owned_sum(split.frictional_work(fm::HeatingOrder::first)) - (w1 - before1)),
-                           std::fabs(owned_sum(split.frictional_work(fm::HeatingOrder::second)) - (w2 - before2))});
-    const fm::DecomposedContactStats st = split.contact_stats();
-    const auto a = split.gather();
-    const Difference d = compare(a, serial);
-    diff.record(s, st, a, serial.particles(), blk, d.same_ids, d.position, d.velocity);
-  }
-  diff.v_end = mean_velocity_x(serial.particles(), blk);
+  for (int s = 0; s < steps; ++s)
+    diff.step(s, serial, split, dt, blk, [&](const auto& a) { return compare(a, serial); });
   EXPECT_EQ(split.global_particles(), static_cast<long long>(serial.particles().size()));
   long sent = split.traffic().particles_sent;
   MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
@@ -327,14 +301,7 @@ TEST(DecomposedContact, RefusesWhatItDoesNotSupport) {
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {8, 8});
   const std::vector<fm::Material> mats{elastic("a", 1e6, 0.3, 1000.0), elastic("b", 1e6, 0.3, 1000.0)};
   auto refused = [&](const fm::DecomposedOptions& o, const char* expect) {
-    try {
-      fm::DecomposedMpm2D run(MPI_COMM_WORLD, grid, mats, o);
-    } catch (const std::invalid_argument& e) {
-      const bool named = std::string(e.what()).find(expect) != std::string::npos;
-      EXPECT_TRUE(named) << e.what();
-      return;
-    }
-    ADD_FAILURE() << "not refused: " << expect;
+    frictherm::test::expect_refused<2>(grid, mats, o, expect);
   };
   fm::DecomposedOptions o;
   o.contact = true;
