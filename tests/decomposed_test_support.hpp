@@ -73,6 +73,33 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> decomposed(const m
   return comm_rank() == 0 ? all : decltype(all){};
 }
 
+/// Largest differences of the gathered decomposed particles `a` (by id) from the serial run's (position,
+/// velocity, stress with σ_zz, each particle's plastic work), and the serial scales they are measured
+/// against; `same_ids`: the same particles, with their materials and masses.
+struct SerialDifference {
+  double position = 0.0, velocity = 0.0, stress = 0.0, plastic = 0.0;
+  double v_max = 0.0, s_max = 0.0, plastic_max = 0.0;
+  bool same_ids = true;
+};
+template <int Dim>
+SerialDifference compare_with_serial(const std::vector<typename mechanics::DecomposedMpm<Dim>::Particle>& a,
+                                     const mechanics::Simulation<Dim>& serial) {
+  const auto& sp = serial.particles();
+  SerialDifference d;
+  d.same_ids = a.size() == sp.position.size();
+  for (std::size_t k = 0; d.same_ids && k < a.size(); ++k) {
+    d.same_ids = a[k].id == static_cast<std::int64_t>(k) && a[k].material == sp.material[k] && a[k].mass == sp.mass[k];
+    d.position = std::max(d.position, (a[k].position - sp.position[k]).norm());
+    d.velocity = std::max(d.velocity, (a[k].velocity - sp.velocity[k]).norm());
+    d.stress = std::max({d.stress, (a[k].stress - sp.stress[k]).norm(), std::fabs(a[k].stress_zz - sp.stress_zz[k])});
+    d.plastic = std::max(d.plastic, std::fabs(a[k].plastic_work - sp.plastic_work[k]));
+    d.v_max = std::max(d.v_max, sp.velocity[k].norm());
+    d.s_max = std::max(d.s_max, sp.stress[k].norm());
+    d.plastic_max = std::max(d.plastic_max, sp.plastic_work[k]);
+  }
+  return d;
+}
+
 /// Mass-weighted mean x-velocity of one material's particles (gathered decomposed ones, serial ones).
 template <class Particle>
 double mean_velocity_x(const std::vector<Particle>& a, int material) {

@@ -38,22 +38,7 @@ using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
 using frictherm::test::elastic;
 
-// Largest differences of the decomposed particles (gathered, by id) from the serial ones.
-struct Difference {
-  double position = 0.0, velocity = 0.0;
-  bool same_ids = true;
-};
-Difference compare(const std::vector<fm::DecomposedParticle>& a, const fm::Simulation<2>& serial) {
-  const auto& sp = serial.particles();
-  Difference d;
-  d.same_ids = a.size() == sp.position.size();
-  for (std::size_t k = 0; d.same_ids && k < a.size(); ++k) {
-    d.same_ids = a[k].id == static_cast<std::int64_t>(k) && a[k].material == sp.material[k] && a[k].mass == sp.mass[k];
-    d.position = std::max(d.position, (a[k].position - sp.position[k]).norm());
-    d.velocity = std::max(d.velocity, (a[k].velocity - sp.velocity[k]).norm());
-  }
-  return d;
-}
+using Difference = frictherm::test::SerialDifference;
 
 // Per-material entries sent over the star forest, over all ranks and steps (the sparse exchange).
 long field_entries(const fm::DecomposedMpm2D& run) {
@@ -104,7 +89,7 @@ TEST_P(DecomposedSlidingBlock, EqualsTheSerialRunWithHeating) {
   const int steps = 200;
   frictherm::test::SlidingDifferences diff;
   for (int s = 0; s < steps; ++s)
-    diff.step(s, serial, split, dt, blk, [&](const auto& a) { return compare(a, serial); });
+    diff.step(s, serial, split, dt, blk, [&](const auto& a) { return frictherm::test::compare_with_serial<2>(a, serial); });
   EXPECT_EQ(split.global_particles(), static_cast<long long>(serial.particles().size()));
   long sent = split.traffic().particles_sent;
   MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
@@ -159,7 +144,7 @@ TEST(DecomposedContact, IsolatedImpactConservesMomentumAndEqualsSerial) {
     max_contact = std::max(max_contact, st.contact_nodes);
     max_sliding = std::max(max_sliding, st.sliding_nodes);
     if (s % 10 == 9) {
-      const Difference d = compare(split.gather(), serial);
+      const Difference d = frictherm::test::compare_with_serial<2>(split.gather(), serial);
       same_ids = same_ids && d.same_ids;
       dx = std::max(dx, d.position), dv = std::max(dv, d.velocity);
     }
@@ -229,7 +214,7 @@ TEST(DecomposedContact, ThreeMaterialsMeetingAtNodesEqualTheSerialRun) {
     dw = std::max(dw, std::fabs(split.cumulative_frictional_work(fm::HeatingOrder::second) -
                                 serial.cumulative_frictional_work(fm::HeatingOrder::second)));
     if (s % 10 == 9) {
-      const Difference d = compare(split.gather(), serial);
+      const Difference d = frictherm::test::compare_with_serial<2>(split.gather(), serial);
       same_ids = same_ids && d.same_ids;
       dx = std::max(dx, d.position), dv = std::max(dv, d.velocity);
     }
@@ -281,7 +266,7 @@ TEST(DecomposedContact, UpperFixedFacesEqualTheSerialRun) {
     serial.step(dt);
     split.step(dt);
   }
-  const Difference d = compare(split.gather(), serial);
+  const Difference d = frictherm::test::compare_with_serial<2>(split.gather(), serial);
   double smax = 0.0, vmax = 0.0;
   for (std::size_t k = 0; k < serial.particles().size(); ++k) {
     smax = std::max(smax, serial.particles().stress[k].norm());

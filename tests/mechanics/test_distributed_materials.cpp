@@ -66,30 +66,7 @@ long sum_over_ranks(long x) {
   return x;
 }
 
-// Largest differences of the gathered decomposed particles (by id) from the serial ones, and the
-// scales they are measured against.
-struct Difference {
-  double position = 0.0, velocity = 0.0, stress = 0.0, plastic = 0.0;
-  double v_max = 0.0, s_max = 0.0, plastic_max = 0.0;
-  bool same_ids = true;
-};
-template <int Dim>
-Difference compare(const std::vector<typename fm::DecomposedMpm<Dim>::Particle>& a, const fm::Simulation<Dim>& serial) {
-  const auto& sp = serial.particles();
-  Difference d;
-  d.same_ids = a.size() == sp.position.size();
-  for (std::size_t k = 0; d.same_ids && k < a.size(); ++k) {
-    d.same_ids = a[k].id == static_cast<std::int64_t>(k) && a[k].material == sp.material[k] && a[k].mass == sp.mass[k];
-    d.position = std::max(d.position, (a[k].position - sp.position[k]).norm());
-    d.velocity = std::max(d.velocity, (a[k].velocity - sp.velocity[k]).norm());
-    d.stress = std::max({d.stress, (a[k].stress - sp.stress[k]).norm(), std::fabs(a[k].stress_zz - sp.stress_zz[k])});
-    d.plastic = std::max(d.plastic, std::fabs(a[k].plastic_work - sp.plastic_work[k]));
-    d.v_max = std::max(d.v_max, sp.velocity[k].norm());
-    d.s_max = std::max(d.s_max, sp.stress[k].norm());
-    d.plastic_max = std::max(d.plastic_max, sp.plastic_work[k]);
-  }
-  return d;
-}
+using Difference = frictherm::test::SerialDifference;
 
 template <int Dim>
 double serial_plastic_work(const fm::Simulation<Dim>& s) {
@@ -128,7 +105,7 @@ RunResult run_both(fm::Simulation<Dim>& serial, fm::DecomposedMpm<Dim>& split, d
     r.frictional = std::max(r.frictional, std::fabs(wf - r.w_friction));
     r.plastic = std::max(r.plastic, std::fabs(wp - r.w_plastic));
     if (s % check_every == check_every - 1 || s == steps - 1) {
-      const Difference d = compare<Dim>(split.gather(), serial);
+      const Difference d = frictherm::test::compare_with_serial<Dim>(split.gather(), serial);
       Difference& w = r.worst;
       w.same_ids = w.same_ids && d.same_ids;
       w.position = std::max(w.position, d.position), w.velocity = std::max(w.velocity, d.velocity);
@@ -387,7 +364,7 @@ TEST(DecomposedMaterials, RigidWallBesideARankCutDrivesTheOwnersNode) {
     serial.step(dt);
     split.step(dt);
   }
-  const Difference d = compare<2>(split.gather(), serial);
+  const Difference d = frictherm::test::compare_with_serial<2>(split.gather(), serial);
   double x_min = 1.0;  // the block's leftmost particle: held at the wall
   for (std::size_t k = 0; k < serial.particles().size(); ++k)
     if (serial.particles().material[k] == 0) x_min = std::min(x_min, serial.particles().position[k][0]);
