@@ -132,17 +132,9 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
     for (int d = 0; d < Dim; ++d) extent[d] = hi[m][d] - lo[m][d] + 1;
     changed = changed || F.lo != lo[m] || F.extent != extent;
     F.lo = lo[m];
-    std::size_t count = 1;
-    int shift = static_cast<int>(total);
-    for (int d = 0; d < Dim; ++d) {
-      F.extent[d] = hi[m][d] - lo[m][d] + 1;
-      F.index.stride[d] = static_cast<int>(count);
-      shift -= F.lo[d] * F.index.stride[d];
-      count *= static_cast<std::size_t>(F.extent[d]);
-    }
-    F.index.shift = shift;
-    F.count = count;
-    total += count;
+    F.extent = extent;
+    F.index = box_indexer<Dim>(F.lo, F.extent, total, F.count);
+    total += F.count;
   }
   if (nodes_.mass.size() != total) {
     nodes_.resize(total, true);

@@ -22,18 +22,12 @@ void DecomposedMpm<Dim>::Impl::layout_fields() {
       B.index = NodeIndexer<Dim>{};
       continue;
     }
-    std::size_t count = 1;
-    int shift = static_cast<int>(total);
     for (int d = 0; d < Dim; ++d) {
       B.lo[d] = box_lo[f][d];
       B.extent[d] = box_hi[f][d] - box_lo[f][d] + 1;
-      B.index.stride[d] = static_cast<int>(count);
-      shift -= B.lo[d] * B.index.stride[d];
-      count *= static_cast<std::size_t>(B.extent[d]);
     }
-    B.index.shift = shift;
-    B.count = count;
-    total += count;
+    B.index = box_indexer<Dim>(B.lo, B.extent, total, B.count);
+    total += B.count;
   }
   slot_node.resize(total);
   for (const FieldBox& B : boxes) {

@@ -30,6 +30,22 @@ struct NodeIndexer {
   int shift = 0;
 };
 
+/// The indexer of a box of nodes [lo, lo + extent) stored contiguously (x fastest) from slot
+/// `first`: slot = first + Σ (L_d − lo_d) stride_d. Returns it and sets `count` to the box's nodes.
+template <int Dim>
+NodeIndexer<Dim> box_indexer(const IVec<Dim>& lo, const IVec<Dim>& extent, std::size_t first, std::size_t& count) {
+  NodeIndexer<Dim> ix;
+  count = 1;
+  int shift = static_cast<int>(first);
+  for (int d = 0; d < Dim; ++d) {
+    ix.stride[d] = static_cast<int>(count);
+    shift -= lo[d] * ix.stride[d];
+    count *= static_cast<std::size_t>(extent[d]);
+  }
+  ix.shift = shift;
+  return ix;
+}
+
 /// ⌊s⌋ as an int for s within int range: truncation corrected for negative s. Cheaper than
 /// static_cast<int>(std::floor(s)) on baseline x86-64 (no SSE4.1 rounding instruction), same result.
 inline int floor_to_int(double s) {
