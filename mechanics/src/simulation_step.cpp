@@ -6,9 +6,9 @@
 // extended B-spline the weights are precomputed per step (simulation_ebs.cpp) and the same loops
 // read them.
 #include <frictherm/mechanics/errors.hpp>
-#include <frictherm/mechanics/mie_gruneisen.hpp>
-#include <frictherm/mechanics/plane_strain_update.hpp>
 #include <frictherm/mechanics/simulation.hpp>
+
+#include "stencil_access.hpp"
 
 #include <omp.h>
 
@@ -19,24 +19,16 @@
 
 namespace frictherm::mechanics {
 
+using step_detail::indexable;
+using step_detail::is_extended;
+
 namespace {
-template <class Kernel>
-constexpr bool is_extended = std::is_same_v<Kernel, ExtendedBSplineKernel>;
-
-// The step's stencils for hot loops: a plain pointer to an array of Stencil (kept in a register, see
-// map_to_grid), or the precomputed EBS entries themselves.
-template <class T>
-const T* indexable(const std::vector<T>& v) { return v.data(); }
-
 // The parts of the thread partition this thread runs: its own, or (if the runtime gave the region
 // fewer threads than asked for) every omp_get_num_threads()-th one.
 template <class Fn>
 void for_each_part(const ThreadPartition& partition, Fn&& fn) {
   for (int t = omp_get_thread_num(); t < partition.threads; t += omp_get_num_threads()) fn(t);
 }
-template <int D>
-const PrecomputedStencils<D>& indexable(const PrecomputedStencils<D>& p) { return p; }
-
 }  // namespace
 
 template <int Dim>
@@ -119,7 +111,7 @@ void Simulation<Dim>::step_with(double dt) {
   if (usf) {
     velocity_from_momentum();
     lap_.to(pt.grid_update);
-    throw_beyond_hugoniot(update_stress<Kernel>(nodes_.velocity, dt));
+    throw_beyond_hugoniot(particle_pass<false, true>(dt, stencils<Kernel>()).beyond);
     lap_.to(pt.stress_update);
     add_internal_forces<Kernel>();
     lap_.to(pt.particle_to_grid);
@@ -133,15 +125,22 @@ void Simulation<Dim>::step_with(double dt) {
   update_grid(dt);         // velocity conditions act on the penalty forces too
   lap_.to(pt.grid_update, nested_phase_);  // less its contact pass (resolve_contact times itself)
   if (opt_.particle_update != ParticleUpdate::flip) filter_grid_velocity(stencils<Kernel>());  // XPIC/FMPM
-  const long bad = update_particles<Kernel>(dt);
-  if (opt_.scheme == UpdateScheme::usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
+  // USL: the stress update from the same nodal velocities in the same pass over the stencils (timed
+  // as stress_update); USF and MUSL: the grid-to-particle update alone.
+  const bool usl = opt_.scheme == UpdateScheme::usl;
+  const ParticlePassResult pass = usl ? particle_pass<true, true>(dt, stencils<Kernel>())
+                                      : particle_pass<true, false>(dt, stencils<Kernel>());
+  lap_.to(usl ? pt.stress_update : pt.grid_to_particle);
+  if (usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
   move_rigid_particles(dt, t);
   stencils_current_ = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
   lap_.to(pt.grid_to_particle);
   time_ += dt;
   ++step_;
-  check_particle(bad, dt);
-  if (opt_.scheme == UpdateScheme::musl) {
+  check_particle(pass.bad, dt);
+  if (usl) {
+    throw_beyond_hugoniot(pass.beyond);
+  } else if (opt_.scheme == UpdateScheme::musl) {
     remap_momentum<Kernel>();
     lap_.to(pt.particle_to_grid);
     if (contact_) resolve_contact(ContactPass::remapped, dt);
@@ -149,10 +148,7 @@ void Simulation<Dim>::step_with(double dt) {
     velocity_from_momentum();
     move_boundary_points(dt, t);  // MUSL: with the remapped velocity, as the stress update
     lap_.to(pt.grid_update);
-    throw_beyond_hugoniot(update_stress<Kernel>(nodes_.velocity, dt));
-    lap_.to(pt.stress_update);
-  } else if (opt_.scheme == UpdateScheme::usl) {
-    throw_beyond_hugoniot(update_stress<Kernel>(nodes_.velocity, dt));
+    throw_beyond_hugoniot(particle_pass<false, true>(dt, stencils<Kernel>()).beyond);
     lap_.to(pt.stress_update);
   }
 }
@@ -188,7 +184,7 @@ void Simulation<Dim>::evaluate_stencils() {
     hi.assign(nm, none_hi);
     for_each_part(partition_, [&](int t) {
       for (std::size_t m = 0; m < nm; ++m) {
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        const std::size_t kb = partition_.even_lo(t, material_begin_[m]), ke = partition_.even_hi(t, material_end_[m]);
         for (std::size_t k = kb; k < ke; ++k) {
           stk[k].evaluate(grid, position[k], half_size[k]);
           const IVec<Dim> f = stk[k].first_node();
@@ -373,71 +369,6 @@ void Simulation<Dim>::map_external_loads(double t) {
   }
 }
 
-// Grid-to-particle (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1}; with a PIC relaxation time
-// τ, v_p ← (1 − α) v_p + α Σ S_ip v_i^{n+1}, α = 1 − e^(−dt/τ), which damps the particle velocity modes
-// the grid cannot see at a rate independent of the time step. Returns the first
-// particle with a non-finite state or outside the grid, or -1.
-template <int Dim>
-template <class Kernel>
-long Simulation<Dim>::update_particles(double dt) {
-  auto& st = stencils<Kernel>();
-  long bad = std::numeric_limits<long>::max();  // min-reduction identity
-  double work = 0.0;
-  const Vec<Dim> g = opt_.gravity.template head<Dim>();
-  const double pic = std::isfinite(opt_.pic_relaxation_time) ? -std::expm1(-dt / opt_.pic_relaxation_time) : 0.0;
-  const ParticleUpdate update = opt_.particle_update;
-  const std::vector<Vec<Dim>>& filtered = transfer_.filtered;  // v* of XPIC/FMPM (transfer.hpp)
-  // Plain pointers (see map_to_grid): the particle stores below would otherwise reload them.
-  const Vec<Dim>* const acceleration = nodes_.acceleration.data();
-  const Vec<Dim>* const velocity = nodes_.velocity.data();
-  const Vec<Dim>* const filtered_v = filtered.data();
-  decltype(auto) stk = indexable(st);
-#pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(+ : work)
-  for_each_part(partition_, [&](int t) {
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const int f = field_of_material_[m];
-      if (f < 0 || materials_[m].is_rigid()) continue;
-      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-      const long b = static_cast<long>(partition_.lo(t, material_begin_[m]));
-      const long e = static_cast<long>(partition_.hi(t, material_end_[m]));
-      for (long kk = b; kk < e; ++kk) {
-        const std::size_t k = static_cast<std::size_t>(kk);
-        Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
-        if (update == ParticleUpdate::flip) {
-          stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-            a += S * acceleration[i];
-            v += S * velocity[i];
-          });
-        } else {
-          stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) {
-            a += S * acceleration[i];
-            v += S * velocity[i];
-            vf += S * filtered_v[i];
-          });
-        }
-        const Vec<Dim> v_old = p_.velocity[k];
-        if (update == ParticleUpdate::flip) {
-          work += p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt;
-          p_.velocity[k] += dt * a;
-          if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
-        } else if (update == ParticleUpdate::xpic) {
-          p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
-        } else {
-          p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
-          v = vf;
-        }
-        if (update != ParticleUpdate::flip) work += p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt;
-        p_.position[k] += dt * v;
-        const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
-        if (!ok) bad = std::min(bad, kk);
-      }
-    }
-  });
-  for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
-  external_work_ += work;
-  return bad == std::numeric_limits<long>::max() ? -1 : bad;
-}
-
 // MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p (step_with
 // then resolves contact again on the remapped momenta).
 template <int Dim>
@@ -452,83 +383,6 @@ void Simulation<Dim>::remap_momentum() {
     }
   });
 }
-
-// Velocity gradient L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's stress.
-// Returns the first particle compressed past its Hugoniot's limit, or -1 (throw_beyond_hugoniot reports it).
-template <int Dim>
-template <class Kernel>
-long Simulation<Dim>::update_stress(const std::vector<Vec<Dim>>& v, double dt) {
-  auto& st = stencils<Kernel>();
-  const Analysis an = opt_.analysis;
-  if (wave_speed_.size() != p_.size())
-    wave_speed_.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
-  long beyond = -1;  // a particle compressed past the Hugoniot's limit
-  const Vec<Dim>* const vi = v.data();  // plain pointers (see map_to_grid)
-  decltype(auto) stk = indexable(st);
-#pragma omp parallel num_threads(threads_) reduction(max : beyond)
-  for_each_part(partition_, [&](int t) {
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const Material& mat = materials_[m];
-      const int f = field_of_material_[m];
-      if (mat.is_rigid() || f < 0) continue;
-      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-      const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
-      const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
-      const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
-      const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
-      if constexpr (Dim == 2) {
-        if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
-          // A local copy: no particle store can touch it, so the compiler hoists what depends on the
-          // material only (ρ0 C0², −2G/3, …) out of the loop.
-          const MieGruneisenParams params = mat.mie_gruneisen;
-          const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-          for (std::size_t k = kb; k < ke; ++k) {
-            VelocityGradient2 L;
-            stk[k].for_each(ix, [&](int i, double, const Vec<2>& G) { L.add(vi[i], G); });
-            Mat<2>& F = p_.deformation_gradient[k];
-            const double det_A = deformation_update_2d(L, dt, F);
-            p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
-            double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-            if (mie_gruneisen_update_plane_strain(L, dt, p_.volume[k] / p_.initial_volume[k], det_A, params,
-                                                  min_J, p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
-                                                  p_.internal_energy[k], wp, wave_speed_[k]) != MieGruneisenStatus::ok)
-              beyond = std::max(beyond, static_cast<long>(k));
-            p_.plastic_work[k] += wp * p_.volume[k];
-          }
-          continue;
-        }
-      }
-      const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
-      for (std::size_t k = kb; k < ke; ++k) {
-        Mat<Dim> L = Mat<Dim>::Zero();
-        stk[k].for_each(ix, [&](int i, double, const Vec<Dim>& G) { L.noalias() += vi[i] * G.transpose(); });
-        Mat<Dim>& F = p_.deformation_gradient[k];
-        const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-        Mat<Dim> F_new;
-        F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
-        F = F_new;
-        p_.volume[k] = F.determinant() * p_.initial_volume[k];
-        if (mg) {
-          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-          if (mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J, p_.stress[k],
-                                        p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k], wp,
-                                        &wave_speed_[k]) != MieGruneisenStatus::ok)
-            beyond = std::max(beyond, static_cast<long>(k));
-          p_.plastic_work[k] += wp * p_.volume[k];
-        } else if (nh) {
-          neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
-          wave_speed_[k] = mat.wave_speed(an, p_.volume[k] / p_.initial_volume[k]);
-        } else {
-          linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
-          wave_speed_[k] = c0;
-        }
-      }
-    }
-  });
-  wave_speed_ready_ = true;
-  return beyond;
-}
-
 
 #define FRICTHERM_INSTANTIATE_STEP(D) \
   template double Simulation<D>::step(double); \

@@ -38,6 +38,9 @@ void ThreadPartition::build(int thread_count, const std::vector<std::size_t>& ma
     else if (to_end < to_begin && static_cast<double>(to_end) <= tolerance) split = material_end[m];
     begin[static_cast<std::size_t>(t)] = std::max(split, begin[static_cast<std::size_t>(t) - 1]);
   }
+  even_begin.resize(static_cast<std::size_t>(threads) + 1);
+  for (int t = 0; t <= threads; ++t)
+    even_begin[static_cast<std::size_t>(t)] = particle_count * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
   first_thread.assign(fields, 0);
   last_thread.assign(fields, 0);
   std::vector<char> seen(fields, 0);

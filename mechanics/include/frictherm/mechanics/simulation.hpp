@@ -275,9 +275,14 @@ class Simulation {
   template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);
   template <class Kernel> void map_external_loads(double t);
   template <class Kernel> void remap_momentum();
-  template <class Kernel> long update_stress(const std::vector<Vec<Dim>>& nodal_velocity, double dt);
+  /// The particle loops after the grid update (simulation_particle_pass.cpp): grid-to-particle
+  /// (Kinematics), stress update from nodes_.velocity (Stress), or both in one pass (USL).
+  struct ParticlePassResult {
+    long bad = -1;     // the first particle with a non-finite state or outside the grid (check_particle)
+    long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
+  };
+  template <bool Kinematics, bool Stress, class Stencils> ParticlePassResult particle_pass(double dt, const Stencils& st);
   void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
-  template <class Kernel> long update_particles(double dt);
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
   template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
   void prepare_extended_stencils();  // EBS: rebuild per field, lay out the fields, flatten the weights

@@ -11,8 +11,10 @@ struct StepPhaseTimes {
   double particle_to_grid = 0.0;  // s: mass, momentum, forces, MUSL remap, external loads
   double contact = 0.0;           // s: contact nodes, multimaterial passes (with the frictional work), penalty
   double grid_update = 0.0;       // s: momentum update, velocity conditions, nodal velocities
-  double grid_to_particle = 0.0;  // s: particle velocities and positions, rigid bodies
-  double stress_update = 0.0;     // s: velocity gradient, deformation gradient, constitutive update
+  double grid_to_particle = 0.0;  // s: particle velocities and positions (USF, MUSL), rigid bodies
+  // s: velocity gradient, deformation gradient, constitutive update; USL: together with the particle
+  // velocities and positions (one pass over the stencils, simulation_particle_pass.cpp)
+  double stress_update = 0.0;
   double total() const {
     return time_step + shape_functions + particle_to_grid + contact + grid_update + grid_to_particle + stress_update;
   }

@@ -19,6 +19,9 @@ struct ThreadPartition {
   std::vector<int> first_thread;    // per field: the lowest thread holding its particles (0 if none)
   std::vector<int> last_thread;     // per field: the highest
   std::vector<int> shared_fields;   // fields with first_thread < last_thread
+  // An even split over every particle (rigid ones and those without a field too), for loops that
+  // scatter nothing and visit every particle (the stencils): thread t takes [even_begin[t], even_begin[t+1]).
+  std::vector<std::size_t> even_begin;
   std::size_t particles = 0;
 
   /// Balanced over the particles of materials that have a velocity field (field_of_material >= 0;
@@ -35,6 +38,15 @@ struct ThreadPartition {
   std::size_t lo(int t, std::size_t b) const { return b > begin[static_cast<std::size_t>(t)] ? b : begin[static_cast<std::size_t>(t)]; }
   std::size_t hi(int t, std::size_t e) const {
     const std::size_t x = begin[static_cast<std::size_t>(t) + 1];
+    return e < x ? e : x;
+  }
+  /// The same for the even split.
+  std::size_t even_lo(int t, std::size_t b) const {
+    const std::size_t x = even_begin[static_cast<std::size_t>(t)];
+    return b > x ? b : x;
+  }
+  std::size_t even_hi(int t, std::size_t e) const {
+    const std::size_t x = even_begin[static_cast<std::size_t>(t) + 1];
     return e < x ? e : x;
   }
 };

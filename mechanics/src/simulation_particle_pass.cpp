@@ -1,0 +1,188 @@
+// The particle loops after the grid update: grid-to-particle (FLIP, PIC blend, XPIC/FMPM) and the
+// stress update (velocity gradient, deformation gradient, constitutive law). One pass serves either
+// or both: USL runs both in one pass over the stencils (simulation_step.cpp), which reads each
+// particle's stencil and its nodes' velocities once and costs one parallel region instead of two.
+// Particle by particle the arithmetic is that of the separate loops, so the results are the same.
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/plane_strain_update.hpp>
+#include <frictherm/mechanics/simulation.hpp>
+
+#include "stencil_access.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace frictherm::mechanics {
+
+namespace {
+// The parts of the thread partition this thread runs (see simulation_step.cpp).
+template <class Fn>
+void for_each_part(const ThreadPartition& partition, Fn&& fn) {
+  for (int t = omp_get_thread_num(); t < partition.threads; t += omp_get_num_threads()) fn(t);
+}
+
+// Σ_i v_i ⊗ G_ip into a velocity gradient: the scalar 2D form of the PBX path, or an Eigen matrix.
+FRICTHERM_ALWAYS_INLINE void add_gradient(VelocityGradient2& L, const Vec<2>& v, const Vec<2>& G) { L.add(v, G); }
+template <int Dim>
+FRICTHERM_ALWAYS_INLINE void add_gradient(Mat<Dim>& L, const Vec<Dim>& v, const Vec<Dim>& G) {
+  L.noalias() += v * G.transpose();
+}
+}  // namespace
+
+// Grid-to-particle (Kinematics; FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1}; with a PIC
+// relaxation time τ, v_p ← (1 − α) v_p + α Σ S_ip v_i^{n+1}, α = 1 − e^(−dt/τ), which damps the particle
+// velocity modes the grid cannot see at a rate independent of the time step; XPIC/FMPM from the
+// filtered velocity. Stress update (Stress): L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0,
+// then the material's stress. Returns the first particle with a non-finite state or outside the grid
+// and the first compressed past its Hugoniot's limit (−1: none).
+template <int Dim>
+template <bool Kinematics, bool Stress, class Stencils>
+typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(double dt, const Stencils& st) {
+  long bad = std::numeric_limits<long>::max();  // min-reduction identity
+  long beyond = -1;                              // max-reduction identity
+  double work = 0.0;
+  const Vec<Dim> g = opt_.gravity.template head<Dim>();
+  const double pic = std::isfinite(opt_.pic_relaxation_time) ? -std::expm1(-dt / opt_.pic_relaxation_time) : 0.0;
+  const ParticleUpdate update = opt_.particle_update;
+  const bool flip = update == ParticleUpdate::flip;
+  const Analysis an = opt_.analysis;
+  if (Stress && wave_speed_.size() != p_.size())
+    wave_speed_.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
+  // Plain pointers (see map_to_grid): the particle stores below would otherwise reload them.
+  const Vec<Dim>* const acceleration = nodes_.acceleration.data();
+  const Vec<Dim>* const velocity = nodes_.velocity.data();
+  const Vec<Dim>* const filtered_v = transfer_.filtered.data();  // v* of XPIC/FMPM (transfer.hpp)
+  decltype(auto) stk = step_detail::indexable(st);
+
+#pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
+  for_each_part(partition_, [&](int t) {
+    // One material's particles [kb, ke): gather from the nodes, then the kinematic and stress updates;
+    // `stress(k, L)` is the material's constitutive update (false: beyond the Hugoniot's limit).
+    // Defined in the parallel region: it adds to this thread's copies of bad, beyond and work.
+    auto run = [&](const NodeIndexer<Dim>& ix, std::size_t kb, std::size_t ke, auto gradient_zero, auto&& stress) {
+      using Gradient = decltype(gradient_zero);
+      for (std::size_t k = kb; k < ke; ++k) {
+        Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
+        Gradient L = gradient_zero;
+        if (!Kinematics || flip) {
+          stk[k].for_each(ix, [&](int i, [[maybe_unused]] double S, [[maybe_unused]] const Vec<Dim>& G) {
+            if constexpr (Kinematics) {
+              a += S * acceleration[i];
+              v += S * velocity[i];
+            }
+            if constexpr (Stress) add_gradient(L, velocity[i], G);
+          });
+        } else {
+          stk[k].for_each(ix, [&](int i, double S, [[maybe_unused]] const Vec<Dim>& G) {
+            a += S * acceleration[i];
+            v += S * velocity[i];
+            vf += S * filtered_v[i];
+            if constexpr (Stress) add_gradient(L, velocity[i], G);
+          });
+        }
+        if constexpr (Kinematics) {
+          const Vec<Dim> v_old = p_.velocity[k];
+          if (flip) {
+            work += p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt;
+            p_.velocity[k] += dt * a;
+            if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
+          } else if (update == ParticleUpdate::xpic) {
+            p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
+          } else {
+            p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
+            v = vf;
+          }
+          if (!flip) work += p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt;
+          p_.position[k] += dt * v;
+          const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
+          if (!ok) bad = std::min(bad, static_cast<long>(k));
+        }
+        if constexpr (Stress)
+          if (!stress(k, L)) beyond = std::max(beyond, static_cast<long>(k));
+      }
+    };
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+      const Material& mat = materials_[m];
+      const int f = field_of_material_[m];
+      if (f < 0 || mat.is_rigid()) continue;
+      const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
+      const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+      if (kb >= ke) continue;
+      if constexpr (!Stress) {
+        run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [](std::size_t, const Mat<Dim>&) { return true; });
+        continue;
+      }
+      const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
+      const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
+      const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
+      const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
+      if constexpr (Dim == 2) {
+        if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
+          // A local copy: no particle store can touch it, so the compiler hoists what depends on the
+          // material only (ρ0 C0², −2G/3, …) out of the loop.
+          const MieGruneisenParams params = mat.mie_gruneisen;
+          run(ix, kb, ke, VelocityGradient2{}, [&](std::size_t k, const VelocityGradient2& L) {
+            Mat<2>& F = p_.deformation_gradient[k];
+            const double det_A = deformation_update_2d(L, dt, F);
+            p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
+            double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+            const MieGruneisenStatus status = mie_gruneisen_update_plane_strain(
+                L, dt, p_.volume[k] / p_.initial_volume[k], det_A, params, min_J, p_.stress[k], p_.stress_zz[k],
+                p_.plastic_strain[k], p_.internal_energy[k], wp, wave_speed_[k]);
+            p_.plastic_work[k] += wp * p_.volume[k];
+            return status == MieGruneisenStatus::ok;
+          });
+          continue;
+        }
+      }
+      run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [&](std::size_t k, const Mat<Dim>& L) {
+        Mat<Dim>& F = p_.deformation_gradient[k];
+        const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+        Mat<Dim> F_new;
+        F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
+        F = F_new;
+        p_.volume[k] = F.determinant() * p_.initial_volume[k];
+        bool ok = true;
+        if (mg) {
+          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+          ok = mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J,
+                                         p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k],
+                                         wp, &wave_speed_[k]) == MieGruneisenStatus::ok;
+          p_.plastic_work[k] += wp * p_.volume[k];
+        } else if (nh) {
+          neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
+          wave_speed_[k] = mat.wave_speed(an, p_.volume[k] / p_.initial_volume[k]);
+        } else {
+          linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
+          wave_speed_[k] = c0;
+        }
+        return ok;
+      });
+    }
+  });
+  if constexpr (Kinematics) {
+    for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
+    external_work_ += work;
+  }
+  if constexpr (Stress) wave_speed_ready_ = true;
+  return {bad == std::numeric_limits<long>::max() ? -1 : bad, beyond};
+}
+
+#define FRICTHERM_INSTANTIATE_PASS_FOR(D, ...)                                                          \
+  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<true, false, __VA_ARGS__>(double, const __VA_ARGS__&); \
+  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<false, true, __VA_ARGS__>(double, const __VA_ARGS__&); \
+  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<true, true, __VA_ARGS__>(double, const __VA_ARGS__&);
+#define FRICTHERM_INSTANTIATE_PASS(D)                                          \
+  FRICTHERM_INSTANTIATE_PASS_FOR(D, std::vector<Stencil<D, LinearKernel>>)     \
+  FRICTHERM_INSTANTIATE_PASS_FOR(D, std::vector<Stencil<D, UGIMPKernel>>)      \
+  FRICTHERM_INSTANTIATE_PASS_FOR(D, std::vector<Stencil<D, QuadraticBSplineKernel>>) \
+  FRICTHERM_INSTANTIATE_PASS_FOR(D, PrecomputedStencils<D>)
+FRICTHERM_INSTANTIATE_PASS(2)
+FRICTHERM_INSTANTIATE_PASS(3)
+#undef FRICTHERM_INSTANTIATE_PASS
+#undef FRICTHERM_INSTANTIATE_PASS_FOR
+
+}  // namespace frictherm::mechanics
