@@ -162,6 +162,10 @@ TEST_P(DecomposedOutputDims, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce)
       for (std::int64_t i = 0; i < total; ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], 1) << group << " id " << i;
       ++s;
     }
+    // The empty rank's group holds the same datasets with 0 rows (temperature included).
+    const std::string empty = fc::DecomposedOutput::rank_file(base, ranks - 1);
+    EXPECT_TRUE(read<double>(empty, "/snapshots/000001/temperature", H5T_NATIVE_DOUBLE, 0).empty());
+    EXPECT_EQ(read_time(empty, "/snapshots/000001"), times[1]);
     std::cout << "[decomposed output " << dim << "D] " << ranks << " ranks, " << total << " particles: " << grids.size()
               << " snapshots read back through " << base << ".xdmf\n";
   }

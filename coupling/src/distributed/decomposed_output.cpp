@@ -156,7 +156,8 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
       write_dataset(g.get(), file, "position", H5T_NATIVE_DOUBLE, s.position.data(), n, dim);
       const std::vector<double> v = padded(s.velocity, n, dim_);
       write_dataset(g.get(), file, "velocity", H5T_NATIVE_DOUBLE, v.data(), n, 3);
-      if (!s.temperature.empty()) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
+      // Every rank's group holds the same datasets (a rank without particles: 0 rows).
+      if (any_temperature) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
       write_dataset(g.get(), file, "material", H5T_NATIVE_INT, s.material.data(), n, 1);
       h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
     } catch (const std::exception& e) {
