@@ -78,6 +78,19 @@ std::vector<T> read(const std::string& file, const std::string& path, hid_t type
   return out;
 }
 
+// A scalar double attribute of an HDF5 group (the snapshot's `time`).
+double read_time(const std::string& file, const std::string& group) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0) << file;
+  const hid_t a = H5Aopen_by_name(f, group.c_str(), "time", H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(a, 0) << file << ":" << group << " time";
+  double t = -1.0;
+  H5Aread(a, H5T_NATIVE_DOUBLE, &t);
+  H5Aclose(a);
+  H5Fclose(f);
+  return t;
+}
+
 }  // namespace
 
 class DecomposedOutputDims : public ::testing::TestWithParam<int> {};
@@ -115,6 +128,10 @@ TEST_P(DecomposedOutputDims, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce)
     EXPECT_EQ(grids["/snapshots/000000"].size(), static_cast<std::size_t>(ranks));
     EXPECT_EQ(grids["/snapshots/000001"].size(), static_cast<std::size_t>(ranks - 1));  // the empty rank has none
     EXPECT_NE(xml.find("<Time Value=\"1.2345678901234567e-06\"/>"), std::string::npos);
+    // The global ids as a 64-bit attribute (ParaView colours and selects by them across ranks).
+    EXPECT_NE(xml.find("<Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n"
+                       "          <DataItem Dimensions=\"3\" NumberType=\"Int\" Precision=\"8\""),
+              std::string::npos);
     EXPECT_NE(xml.find(dim == 2 ? "GeometryType=\"XY\"" : "GeometryType=\"XYZ\""), std::string::npos);
     int s = 0;
     for (const auto& [group, parts] : grids) {
@@ -126,6 +143,7 @@ TEST_P(DecomposedOutputDims, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce)
         const auto v = read<double>(path, group + "/velocity", H5T_NATIVE_DOUBLE, 3 * n);
         const auto T = read<double>(path, group + "/temperature", H5T_NATIVE_DOUBLE, n);
         const auto m = read<int>(path, group + "/material", H5T_NATIVE_INT, n);
+        EXPECT_EQ(read_time(path, group), times[s]) << path << ":" << group;  // as the serial file's snapshots
         for (std::size_t k = 0; k < n; ++k) {
           ASSERT_GE(id[k], 0);
           ASSERT_LT(id[k], total);
@@ -144,6 +162,10 @@ TEST_P(DecomposedOutputDims, XdmfJoinsEveryRanksFileAndEveryParticleAppearsOnce)
       for (std::int64_t i = 0; i < total; ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], 1) << group << " id " << i;
       ++s;
     }
+    // The empty rank's group holds the same datasets with 0 rows (temperature included).
+    const std::string empty = fc::DecomposedOutput::rank_file(base, ranks - 1);
+    EXPECT_TRUE(read<double>(empty, "/snapshots/000001/temperature", H5T_NATIVE_DOUBLE, 0).empty());
+    EXPECT_EQ(read_time(empty, "/snapshots/000001"), times[1]);
     std::cout << "[decomposed output " << dim << "D] " << ranks << " ranks, " << total << " particles: " << grids.size()
               << " snapshots read back through " << base << ".xdmf\n";
   }

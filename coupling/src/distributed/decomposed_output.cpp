@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -53,6 +54,15 @@ void write_dataset(hid_t group, const std::string& file, const std::string& name
                                   file, "cannot create dataset " + name),
                      H5Dclose};
   if (rows > 0) h5::check(H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, "cannot write " + name);
+}
+
+// A scalar attribute of the snapshot group (the serial file's `step` and `time`, docs/output.md).
+void write_attribute(hid_t group, const std::string& file, const char* name, hid_t type, const void* value) {
+  const h5::Handle space{h5::check_id(H5Screate(H5S_SCALAR), file, "cannot create a dataspace"), H5Sclose};
+  const h5::Handle a{h5::check_id(H5Acreate2(group, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), file,
+                                  std::string("cannot create attribute ") + name),
+                     H5Aclose};
+  h5::check(H5Awrite(a.get(), type, value), file, std::string("cannot write attribute ") + name);
 }
 
 // n × dim values padded to n × 3 (ParaView's vectors).
@@ -136,6 +146,9 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
       const h5::Handle g{h5::check_id(H5Gcreate2(file_, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
                                       "cannot create " + path),
                          H5Gclose};
+      const std::int64_t step64 = step;
+      write_attribute(g.get(), file, "step", H5T_NATIVE_INT64, &step64);
+      write_attribute(g.get(), file, "time", H5T_NATIVE_DOUBLE, &time);
       std::vector<int> connectivity(n);
       for (std::size_t k = 0; k < n; ++k) connectivity[k] = static_cast<int>(k);
       write_dataset(g.get(), file, "connectivity", H5T_NATIVE_INT, connectivity.data(), n, 1);
@@ -143,7 +156,8 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
       write_dataset(g.get(), file, "position", H5T_NATIVE_DOUBLE, s.position.data(), n, dim);
       const std::vector<double> v = padded(s.velocity, n, dim_);
       write_dataset(g.get(), file, "velocity", H5T_NATIVE_DOUBLE, v.data(), n, 3);
-      if (!s.temperature.empty()) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
+      // Every rank's group holds the same datasets (a rank without particles: 0 rows).
+      if (any_temperature) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
       write_dataset(g.get(), file, "material", H5T_NATIVE_INT, s.material.data(), n, 1);
       h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
     } catch (const std::exception& e) {
@@ -160,9 +174,10 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
   if (rank_ == 0) {
     try {
       std::string xml = "    <Grid Name=\"" + index + "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+      // The shortest text that reads back to the same double (as every rank's grid's time).
       char time_text[32];
-      std::snprintf(time_text, sizeof time_text, "%.17g", time);
-      xml += "      <Time Value=\"" + std::string(time_text) + "\"/>\n";
+      const auto printed = std::to_chars(time_text, time_text + sizeof time_text, time);
+      xml += "      <Time Value=\"" + std::string(time_text, printed.ptr) + "\"/>\n";
       for (int r = 0; r < size_; ++r) {
         if (counts[static_cast<std::size_t>(r)] == 0) continue;
         XdmfGrid grid;
@@ -172,7 +187,9 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
         grid.step = step;
         grid.time = time;
         grid.points = static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
-        grid.fields = {{"position", dim_, false}, {"velocity", 3, false}, {"material", 1, true}};
+        // The global id (int64: Int Precision 8) so ParaView can colour, select and threshold by the
+        // serial particle index across ranks.
+        grid.fields = {{"position", dim_, false}, {"id", 1, true, 8}, {"velocity", 3, false}, {"material", 1, true}};
         if (any_temperature) grid.fields.push_back({"temperature", 1, false});
         std::string g = xdmf_grid_xml(grid, base_name(rank_file(r)), dim_);
         // Indented one level deeper: inside this snapshot's spatial collection.

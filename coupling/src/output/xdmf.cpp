@@ -25,10 +25,13 @@ std::string dims_text(std::size_t n, int components) {
   return s;
 }
 
-void data_item(std::string& out, const std::string& indent, const std::string& dims, bool integer,
+// integer_bytes: 0 for float64, otherwise the integer's width (4 or 8: VTK reads Int Precision 8 as
+// a 64-bit array, e.g. the particle ids of a decomposed run).
+void data_item(std::string& out, const std::string& indent, const std::string& dims, int integer_bytes,
                const std::string& h5_file, const std::string& h5_path) {
-  out += indent + "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" +
-         (integer ? "Int\" Precision=\"4\"" : "Float\" Precision=\"8\"") + " Format=\"HDF\">" +
+  const std::string type = integer_bytes == 0 ? "Float\" Precision=\"8\""
+                                              : "Int\" Precision=\"" + std::to_string(integer_bytes) + "\"";
+  out += indent + "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" + type + " Format=\"HDF\">" +
          xml_escape(h5_file) + ":" + xml_escape(h5_path) + "</DataItem>\n";
 }
 
@@ -78,17 +81,20 @@ std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name,
   out += in3 + "<Information Name=\"step\" Value=\"" + std::to_string(grid.step) + "\"/>\n";
   out += in3 + "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" + n +
          "\" NodesPerElement=\"1\">\n";
-  data_item(out, in4, n, true, h5_file_name, grid.connectivity);
+  data_item(out, in4, n, 4, h5_file_name, grid.connectivity);
   out += in3 + "</Topology>\n";
   out += in3 + "<Geometry GeometryType=\"" + (dim == 2 ? "XY" : "XYZ") + "\">\n";
-  data_item(out, in4, dims_text(grid.points, dim), false, h5_file_name,
+  data_item(out, in4, dims_text(grid.points, dim), 0, h5_file_name,
             grid.h5_group + "/position");
   out += in3 + "</Geometry>\n";
   for (const auto& f : grid.fields) {
     if (&f == position) continue;
     out += in3 + "<Attribute Name=\"" + xml_escape(f.name) + "\" AttributeType=\"" +
            xdmf_attribute_type(f.components) + "\" Center=\"Node\">\n";
-    data_item(out, in4, dims_text(grid.points, f.components), f.integer, h5_file_name,
+    if (f.integer && f.bytes != 0 && f.bytes != 4 && f.bytes != 8)
+      throw std::invalid_argument("XDMF: field " + f.name + " has integers of " + std::to_string(f.bytes) +
+                                  " bytes (expected 4 or 8)");
+    data_item(out, in4, dims_text(grid.points, f.components), f.integer ? (f.bytes == 0 ? 4 : f.bytes) : 0, h5_file_name,
               grid.h5_group + "/" + f.name);
     out += in3 + "</Attribute>\n";
   }

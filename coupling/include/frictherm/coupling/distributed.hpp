@@ -47,7 +47,9 @@ struct DecomposedSnapshot {
 /// BASE.rank<r>.h5, written by that rank alone with the serial HDF5 library, and one XDMF file,
 /// BASE.xdmf, written by rank 0, that joins them: per snapshot a spatial collection of the ranks'
 /// grids inside one temporal collection, which ParaView (Xdmf3ReaderS) opens as one data set per
-/// time. Vectors are written with 3 components in 2D too (ParaView's vector filters need 3). The
+/// time (one block per rank with particles; the global ids as a 64-bit attribute; tests/coupling/
+/// vtk_decomposed.py opens it with ParaView's reader). Vectors are written with 3 components in 2D
+/// too (ParaView's vector filters need 3). The
 /// XDMF is rewritten atomically after each snapshot and each rank file flushed, so a run stopped at
 /// any point leaves readable files of what it wrote. Every call is collective; a failure on one rank
 /// (e.g. a file that exists without `overwrite`) makes every rank throw.

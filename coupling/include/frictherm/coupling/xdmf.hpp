@@ -13,7 +13,8 @@ namespace frictherm::coupling {
 struct XdmfField {
   std::string name;     // dataset name inside the snapshot group
   int components = 1;   // columns of the (n, components) dataset; 1 for an (n) dataset
-  bool integer = false; // int32 rather than float64
+  bool integer = false; // an integer rather than float64
+  int bytes = 0;         // the integer's width in bytes (4 or 8); 0 means 4 (int32). Floats are 8.
 };
 
 struct XdmfGrid {
