@@ -6,6 +6,7 @@
 #include <Eigen/SparseCore>
 #include <petscmat.h>
 
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -52,32 +53,66 @@ void DecomposedAssembledSolve::advance(MPI_Comm comm, const UnknownNumbering& id
   petsc_check(MatCreateAIJ(comm, n, n, N, N, columns, nullptr, columns, nullptr, &K.A), "MatCreateAIJ");
   petsc_check(MatSetOption(K.A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
 
-  // K_ij += V_p k_p G'_ip·G'_jp for each particle's kept nodes (all unknowns), one dense block per
-  // particle; rows owned elsewhere are sent to their owners at assembly and added there.
+  // K_ij += V_p k_p G'_ip·G'_jp for each particle's kept nodes (all unknowns), summed first on this rank
+  // per row i of its ghosted box in slots indexed by the lattice offset of j from i (each component in
+  // [−2, 2]: 5^dim slots), in particle order as the serial assembly; then one MatSetValues per row.
   const std::vector<int>& first = *kept.first;
   const std::vector<int>& node = *kept.node;
   const std::vector<double>& G = *kept.G;
   const std::vector<double>& c = *kept.conductance;
-  std::vector<PetscInt> rows;
-  std::vector<double> block;
+  const std::size_t nl = ids.local_id.size();
+  const int slots = dim == 2 ? 25 : 125;
+  std::vector<int> row_of(nl, -1), row_node;  // compact rows: the local nodes that are unknowns
+  for (std::size_t l = 0; l < nl; ++l)
+    if (ids.local_id[l] >= 0.0) row_of[l] = static_cast<int>(row_node.size()), row_node.push_back(static_cast<int>(l));
+  std::vector<double> acc(row_node.size() * static_cast<std::size_t>(slots), 0.0);
+  const std::array<int, 3>& ext = kept.box;
+  auto lattice = [&](int l, int* x) {
+    for (int d = 0; d < dim; ++d) x[d] = l % ext[static_cast<std::size_t>(d)], l /= ext[static_cast<std::size_t>(d)];
+  };
+  auto row_at = [&](int l) {
+    return &acc[static_cast<std::size_t>(row_of[static_cast<std::size_t>(l)]) * static_cast<std::size_t>(slots)];
+  };
+  int xyz[27][3];  // at most 27 nodes per stencil (3 per axis)
   for (std::size_t k = 0; k + 1 < first.size(); ++k) {
     if (c[k] == 0.0) continue;
     const int b = first[k], m = first[k + 1] - b;
-    if (m == 0) continue;
-    rows.resize(static_cast<std::size_t>(m));
-    block.resize(static_cast<std::size_t>(m) * static_cast<std::size_t>(m));
-    for (int a = 0; a < m; ++a)
-      rows[static_cast<std::size_t>(a)] = static_cast<PetscInt>(ids.local_id[static_cast<std::size_t>(node[static_cast<std::size_t>(b + a)])]);
+    if (m > 27) throw std::logic_error("decomposed heat: a stencil of more than 27 nodes");
+    for (int a = 0; a < m; ++a) lattice(node[static_cast<std::size_t>(b + a)], xyz[a]);
+    // K is symmetric: each product once, into row a at the offset of e and into row e at the mirrored
+    // offset (slots − 1 − slot); every (row, slot) still gets one term per particle, in particle order.
     for (int a = 0; a < m; ++a) {
       const double* ga = &G[static_cast<std::size_t>(dim) * static_cast<std::size_t>(b + a)];
-      for (int e = 0; e < m; ++e) {
+      double* r = row_at(node[static_cast<std::size_t>(b + a)]);
+      for (int e = a; e < m; ++e) {
         const double* ge = &G[static_cast<std::size_t>(dim) * static_cast<std::size_t>(b + e)];
         double dot = 0.0;
         for (int d = 0; d < dim; ++d) dot += ga[d] * ge[d];
-        block[static_cast<std::size_t>(a * m + e)] = c[k] * dot;
+        int slot = 0;
+        for (int d = dim - 1; d >= 0; --d) slot = 5 * slot + (xyz[e][d] - xyz[a][d] + 2);
+        const double kae = c[k] * dot;
+        r[slot] += kae;
+        if (e != a) row_at(node[static_cast<std::size_t>(b + e)])[slots - 1 - slot] += kae;
       }
     }
-    petsc_check(MatSetValues(K.A, m, rows.data(), m, rows.data(), block.data(), ADD_VALUES), "MatSetValues");
+  }
+  std::vector<PetscInt> row_cols(static_cast<std::size_t>(slots));
+  std::vector<double> row_vals(static_cast<std::size_t>(slots));
+  std::size_t stride[3] = {1, static_cast<std::size_t>(ext[0]), static_cast<std::size_t>(ext[0]) * static_cast<std::size_t>(ext[1])};
+  for (std::size_t r = 0; r < row_node.size(); ++r) {
+    const double* a = &acc[r * static_cast<std::size_t>(slots)];
+    PetscInt count = 0;
+    for (int sl = 0; sl < slots; ++sl) {
+      if (a[sl] == 0.0) continue;
+      long j = row_node[r];
+      for (int d = 0, rem = sl; d < dim; ++d, rem /= 5) j += static_cast<long>(rem % 5 - 2) * static_cast<long>(stride[d]);
+      row_cols[static_cast<std::size_t>(count)] = static_cast<PetscInt>(ids.local_id[static_cast<std::size_t>(j)]);
+      row_vals[static_cast<std::size_t>(count)] = a[sl];
+      ++count;
+    }
+    if (count == 0) continue;
+    const auto row = static_cast<PetscInt>(ids.local_id[static_cast<std::size_t>(row_node[r])]);
+    petsc_check(MatSetValues(K.A, 1, &row, count, row_cols.data(), row_vals.data(), ADD_VALUES), "MatSetValues");
   }
   petsc_check(MatAssemblyBegin(K.A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   petsc_check(MatAssemblyEnd(K.A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");

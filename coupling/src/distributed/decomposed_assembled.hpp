@@ -3,8 +3,9 @@
 //
 //   K_ij = Σ_p V_p k_p G'_ip · G'_jp          thermal_assembly.hpp (conduction term of eq. 37)
 //
-// summed over every rank's particles into a PETSc MPIAIJ matrix (MatSetValues, ADD_VALUES: a
-// particle's products on rows another rank owns travel to that owner at MatAssemblyEnd), the
+// summed over this rank's particles row by row on its ghosted box (slots by lattice offset, as the serial
+// assembly), then into a PETSc MPIAIJ matrix (MatSetValues, ADD_VALUES: the rows of nodes another rank
+// owns travel to that owner at MatAssemblyEnd and are added there), the
 // diagonal then set to minus the off-diagonal row sum (K·1 = 0 exactly, as the serial assembly), and
 // M dT/dt = −K T + q integrated over the window by a thermal::DistributedIntegrator of the serial
 // name (distributed.hpp: N_Vector_Parallel, the Krylov path preconditioned by a PETSc PC).
@@ -14,6 +15,7 @@
 
 #include <mpi.h>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +27,7 @@ namespace frictherm::coupling {
 /// G[dim·a]); conductance[k] = V_p k_p (0: the particle conducts nothing).
 struct KeptEntries {
   int dim = 2;
+  std::array<int, 3> box{1, 1, 1};  // the ghosted box's nodes per direction (local numbering x fastest)
   const std::vector<int>* first = nullptr;
   const std::vector<int>* node = nullptr;
   const std::vector<double>* G = nullptr;

@@ -456,7 +456,8 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   } else {
     // Assembled: K's rows at their owners, the distributed integrator over [t0, t0 + Δt].
     number_unknowns(mpm);
-    KeptEntries entries_of{Dim, &kept_first_, &kept_node_, &kept_G_, &conductance_};
+    KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
+    for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
     assembled_->advance(comm, *ids_, entries_of, M, q, Tn, t0, t0 + dt);
     ++books_.assembled_windows;
     books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
