@@ -13,7 +13,8 @@
 //   * the same block with cvode_bdf (PCG) and the serial default window (adaptive, 0.1 K) on 2 and 4
 //     ranks, and with the hypre (BoomerAMG) preconditioner on 4: the mechanics series within 1e-12, the
 //     temperatures (series and last snapshot) within 0.1 (rtol T_max + atol), the CVODE Newton
-//     iteration's stopping test, the same thermal step count (Jacobi); books: heat delivered = work
+//     iteration's stopping test, the same thermal step count (Jacobi); the same with a window every 7
+//     steps (every_n_steps) on 2 ranks; books: heat delivered = work
 //     received to 1e-12, Σ M ΔT = Σ m C ΔT_p = heat delivered to the round-off of the heat content;
 //   * a 3D sliding block without heat (decomposed_sliding_block_3d.json): the same series checks;
 //   * the 3D block with heating (decomposed_heated_block_3d.json): series, hot-spot counts, books;
@@ -221,7 +222,7 @@ class CliMpirun : public frictherm::test::ScratchDirTest {
       expect_same_column(c, 1e-12);
     const double windows = meta("split.h5", "thermal_windows"), steps = meta("split.h5", "steps");
     EXPECT_GT(windows, 1.0);
-    EXPECT_LT(windows, steps) << "adaptive windows span several steps";
+    EXPECT_LT(windows, steps) << "the windows span several steps";
     EXPECT_EQ(meta("split.h5", "thermal_assembled_windows"), windows);
     EXPECT_EQ(meta("serial.h5", "thermal_windows"), windows);
     if (same_steps) {
@@ -305,6 +306,14 @@ TEST_F(CliMpirun, HeatedBlockWithCvodeAndAdaptiveWindowsEqualsTheSerialRun) {
     if (HasFatalFailure()) return;
     expect_cvode_run_as_serial(ranks, 1e-6, 1e-6, 150.0, true);  // the block's C = 150 J/(kg K) is the larger
   }
+}
+
+// A window every 7 steps (coupling.window every_n_steps) with cvode_bdf on 2 ranks: the same checks.
+TEST_F(CliMpirun, HeatedBlockWithEveryNStepsWindowsEqualsTheSerialRun) {
+  run_both("decomposed_sliding_block.json",
+           std::string(kCvodeAdaptive) + " --set 'coupling.window={\"policy\":\"every_n_steps\",\"steps\":7}'", 2);
+  if (HasFatalFailure()) return;
+  expect_cvode_run_as_serial(2, 1e-6, 1e-6, 150.0, true);
 }
 
 // The same with BoomerAMG (thermal.preconditioner "hypre") preconditioning the decomposed Krylov solves,
