@@ -1,15 +1,19 @@
-// Frictional heating and matrix-free explicit conduction on the decomposed mechanics
-// (frictherm/coupling/decomposed_heat.hpp): the serial ExplicitConduction window (explicit_conduction.cpp,
-// Nairn et al. 2018 eqs. 37–38) with its particle loops over this rank's particles and its nodal sums
-// completed at the owners by the mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal). One
-// template on Dim for the 2D and 3D mechanics; G'_ip flat, Dim values per kept entry.
+// Frictional heating and conduction on the decomposed mechanics (frictherm/coupling/decomposed_heat.hpp):
+// the serial Coupler's windows (coupler.cpp) with the matrix-free ExplicitConduction window
+// (explicit_conduction.cpp, Nairn et al. 2018 eqs. 37–38) or the assembled one (decomposed_assembled.cpp),
+// their particle loops over this rank's particles and their nodal sums completed at the owners by the
+// mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal). One template on Dim for the 2D and 3D
+// mechanics; G'_ip flat, Dim values per kept entry.
 #include <frictherm/coupling/decomposed_heat.hpp>
+
+#include "distributed/decomposed_assembled.hpp"
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -25,6 +29,35 @@ double sum_over(MPI_Comm comm, double x) {
   return x;
 }
 
+// The lattice neighbours (one node away along every axis, x fastest as the serial loops) of owned node u
+// inside the ghosted box `box` that satisfy `take` (given their local node): their local nodes in cand.
+// The ghosted box ends only at the grid's end, so it holds every neighbour of an owned node.
+template <int Dim, class Take>
+int lattice_neighbours(const std::array<int, 2 * Dim>& own, const std::array<int, 2 * Dim>& box, std::size_t u,
+                       Take&& take, int* cand) {
+  constexpr int neighbours = Dim == 2 ? 9 : 27;
+  int idx[Dim];  // DMDA index of owned node u (x fastest over owned_nodes())
+  for (int d = 0; d < Dim; ++d) {
+    const auto extent = static_cast<std::size_t>(own[2 * d + 1] - own[2 * d]);
+    idx[d] = own[2 * d] + static_cast<int>(u % extent);
+    u /= extent;
+  }
+  int count = 0;
+  for (int c = 0; c < neighbours; ++c) {
+    int r = c, l = 0, stride = 1;
+    bool inside = true;
+    for (int d = 0; d < Dim; ++d) {
+      const int j = idx[d] + r % 3 - 1;
+      r /= 3;
+      if (j < box[2 * d] || j >= box[2 * d + 1]) inside = false;
+      l += (j - box[2 * d]) * stride;
+      stride *= box[2 * d + 1] - box[2 * d];
+    }
+    if (inside && take(l)) cand[count++] = l;
+  }
+  return count;
+}
+
 }  // namespace
 
 DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<2>& mpm, DecomposedHeatOptions options)
@@ -37,11 +70,26 @@ DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<3>& mpm, DecomposedHeatO
   check_materials(mpm);
 }
 
+DecomposedHeat::~DecomposedHeat() = default;
+
 template <int Dim>
-void DecomposedHeat::check_materials(const mechanics::DecomposedMpm<Dim>& mpm) {
+void DecomposedHeat::check_materials(mechanics::DecomposedMpm<Dim>& mpm) {
   if (!(opt_.fe_safety > 0.0 && opt_.fe_safety <= 1.0))
     throw std::invalid_argument("decomposed heat: fe_safety " + std::to_string(opt_.fe_safety) +
                                 " (expected a value in (0, 1])");
+  const WindowPolicy& w = opt_.window;  // the serial Coupler's checks
+  if (w.kind == WindowPolicy::Kind::every_n_steps && w.steps < 1)
+    throw std::invalid_argument("decomposed heat: every_n_steps needs steps >= 1");
+  if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
+    throw std::invalid_argument("decomposed heat: adaptive windows need max_temperature_rise > 0");
+  if (!(w.max_duration > 0.0)) throw std::invalid_argument("decomposed heat: max_duration must be > 0");
+  if (opt_.matrix_free_max_substeps < 0)
+    throw std::invalid_argument("decomposed heat: matrix_free_max_substeps must be >= 0");
+  thermal::IntegratorOptions io = opt_.integrator_options;
+  io.fe_safety = opt_.fe_safety;
+  // The same on every rank (all hold the same options): a bad name throws everywhere.
+  assembled_ = std::make_unique<DecomposedAssembledSolve>(opt_.integrator == "auto" ? "cvode_bdf" : opt_.integrator, io,
+                                                          opt_.preconditioner);
   scalar_ = mpm.particle_scalar_index(opt_.temperature);
   // Every rank checks its own particles' materials and all agree before any window.
   int bad = -1;
@@ -52,6 +100,8 @@ void DecomposedHeat::check_materials(const mechanics::DecomposedMpm<Dim>& mpm) {
     throw std::invalid_argument("decomposed heat: material " + std::to_string(bad) +
                                 " has no thermal properties (expected " + std::to_string(opt_.materials.size()) +
                                 " entries in materials to cover it)");
+  pending_.assign(mpm.owned_local_nodes().size(), 0.0);
+  if (w.kind == WindowPolicy::Kind::adaptive) gather_mass(mpm);  // the first estimate's M (Coupler::start)
 }
 
 MPI_Comm DecomposedHeat::communicator() const { return mpm3_ ? mpm3_->communicator() : mpm2_->communicator(); }
@@ -75,36 +125,95 @@ double DecomposedHeat::heat_content() const {
   return sum_over(communicator(), e);
 }
 
-void DecomposedHeat::after_step(double dt) {
+double DecomposedHeat::pending_heat() const {
+  double w = 0.0;
+  for (double x : pending_) w += x;
+  return sum_over(communicator(), w);
+}
+
+thermal::IntegratorStats DecomposedHeat::integrator_stats() const { return assembled_->stats(); }
+
+// The serial Coupler::after_step: the step's work joins the pending heat; the policy closes the window.
+bool DecomposedHeat::after_step(double dt, bool must_close) {
   const std::vector<double>& work = mpm3_ ? mpm3_->frictional_work(opt_.order) : mpm2_->frictional_work(opt_.order);
   double w = 0.0;
   for (double x : work) w += x;
   books_.work_received += sum_over(communicator(), w);
-  window(work, dt);
+  for (std::size_t u = 0; u < work.size(); ++u) pending_[u] += work[u];
+  time_ += dt;
+  ++books_.steps;
+  ++window_steps_;
+  const WindowPolicy& p = opt_.window;
+  bool close = must_close;
+  switch (p.kind) {
+    case WindowPolicy::Kind::every_step: close = true; break;
+    case WindowPolicy::Kind::every_n_steps: close = close || window_steps_ >= p.steps; break;
+    case WindowPolicy::Kind::adaptive: {
+      double rise = mpm3_ ? rise_of_step(*mpm3_, work) : rise_of_step(*mpm2_, work);
+      MPI_Allreduce(MPI_IN_PLACE, &rise, 1, MPI_DOUBLE, MPI_MAX, communicator());
+      max_rise_ = std::max(max_rise_, rise);
+      close = close || max_rise_ >= p.max_temperature_rise || time_ - window_start_ >= p.max_duration * (1.0 - 1e-12) ||
+              (p.max_steps > 0 && window_steps_ >= p.max_steps);
+      break;
+    }
+  }
+  return close ? close_window() : false;
+}
+
+bool DecomposedHeat::close_window() {
+  const double dt = time_ - window_start_;
+  if (!(dt > 0.0)) return false;  // nothing to integrate; pending heat stays for the next window
+  if (mpm3_) window_on(*mpm3_, pending_, window_start_, dt);
+  else window_on(*mpm2_, pending_, window_start_, dt);
+  std::fill(pending_.begin(), pending_.end(), 0.0);
+  books_.min_window = books_.windows == 1 ? dt : std::min(books_.min_window, dt);
+  books_.max_window = std::max(books_.max_window, dt);
+  window_start_ = time_;
+  window_steps_ = 0;
+  max_rise_ = 0.0;
+  return true;
 }
 
 void DecomposedHeat::window(const std::vector<double>& joules, double dt) {
-  if (mpm3_) window_on(*mpm3_, joules, dt);
-  else window_on(*mpm2_, joules, dt);
+  if (mpm3_) window_on(*mpm3_, joules, time_, dt);
+  else window_on(*mpm2_, joules, time_, dt);
+  time_ += dt;
+  window_start_ = time_;
 }
 
+// Coupler::mass_estimate on the last gather: M_i of an unknown; else the Σ M_j of the unknowns next to it
+// (its heat would go to them); else the smallest unknown M_j of all ranks.
 template <int Dim>
-void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double dt) {
-  using Vec = mechanics::Vec<Dim>;
-  using GMap = Eigen::Map<Vec>;
+double DecomposedHeat::mass_estimate(const mechanics::DecomposedMpm<Dim>& mpm, std::size_t u) const {
+  if (is_unknown(M_[u])) return M_[u];
+  int cand[Dim == 2 ? 9 : 27];
+  const int count = lattice_neighbours<Dim>(
+      mpm.owned_nodes(), mpm.ghosted_nodes(), u,
+      [this](int l) { return is_unknown(local_M_[static_cast<std::size_t>(l)]); }, cand);
+  double m = 0.0;
+  for (int c = 0; c < count; ++c) m += local_M_[static_cast<std::size_t>(cand[c])];
+  return m > 0.0 ? m : min_unknown_mass_;
+}
+
+// This rank's largest |W_i| / M_i estimate over the nodes the step's work reached (Coupler::after_step).
+template <int Dim>
+double DecomposedHeat::rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& work) const {
+  double rise = 0.0;
+  for (std::size_t u = 0; u < work.size(); ++u)
+    if (work[u] != 0.0) rise = std::max(rise, std::fabs(pending_[u]) / mass_estimate(mpm, u));
+  return rise;
+}
+
+// Pass 1: M_i and M_i T_i (eq. 38) on the ghosted box, completed at the owners; the unknowns
+// (select_unknowns' rule, max over ranks), T_i on them, M_i on the ghosted box.
+template <int Dim>
+void DecomposedHeat::gather_mass(mechanics::DecomposedMpm<Dim>& mpm) {
   const MPI_Comm comm = mpm.communicator();
-  const std::vector<int>& owned_local = mpm.owned_local_nodes();
-  const std::size_t no = owned_local.size(), nl = static_cast<std::size_t>(mpm.local_node_count());
-  if (joules.size() != no)
-    throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
-                                std::to_string(no) + " owned nodes");
-  if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
+  const std::size_t no = mpm.owned_local_nodes().size(), nl = static_cast<std::size_t>(mpm.local_node_count());
   const typename mechanics::DecomposedMpm<Dim>::Stencils& st = mpm.current_stencils();
   const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
-  std::vector<double> T = mpm.particle_scalar(scalar_);
+  const std::vector<double> T = mpm.particle_scalar(scalar_);
   const std::size_t np = T.size();
-
-  // Pass 1: M_i and M_i T_i (eq. 38) on the ghosted box, completed at the owners.
   capacity_.assign(np, 0.0);
   local_.assign(2 * nl, 0.0);
   double particle_capacity = 0.0;
@@ -122,7 +231,6 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   }
   std::vector<double> mass_temp;
   mpm.sum_to_owned(local_, 2, mass_temp);
-  // Unknowns: M_i > active_mass_fraction · max M (select_unknowns' rule, max over ranks).
   double sums[3] = {0.0, particle_capacity, 0.0};  // Σ M_i, Σ m C, max M
   for (std::size_t q = 0; q < no; ++q) sums[0] += mass_temp[2 * q], sums[2] = std::max(sums[2], mass_temp[2 * q]);
   double reduced[2] = {sums[0], sums[1]};
@@ -130,17 +238,63 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   MPI_Allreduce(MPI_IN_PLACE, &sums[2], 1, MPI_DOUBLE, MPI_MAX, comm);
   if (!(reduced[1] > 0.0)) throw std::invalid_argument("decomposed heat: no particle of a material with thermal properties");
   books_.max_capacity_residual = std::max(books_.max_capacity_residual, std::fabs(reduced[0] - reduced[1]) / reduced[1]);
-  const double threshold = opt_.assembly.active_mass_fraction * sums[2];
-  auto is_unknown = [threshold](double M) { return M > threshold && M > 0.0; };
-  std::vector<double> M(no), T0(no, 0.0);
-  long dropped = 0;
+  threshold_ = opt_.assembly.active_mass_fraction * sums[2];
+  M_.assign(no, 0.0);
+  T0_.assign(no, 0.0);
+  double least[2] = {std::numeric_limits<double>::infinity(), 0.0};  // smallest unknown M, nodes dropped
   for (std::size_t q = 0; q < no; ++q) {
-    M[q] = mass_temp[2 * q];
-    if (is_unknown(M[q])) T0[q] = mass_temp[2 * q + 1] / M[q];
-    else if (M[q] > 0.0) ++dropped;
+    M_[q] = mass_temp[2 * q];
+    if (is_unknown(M_[q])) T0_[q] = mass_temp[2 * q + 1] / M_[q], least[0] = std::min(least[0], M_[q]);
+    else if (M_[q] > 0.0) least[1] += 1.0;
   }
-  std::vector<double> local_M;
-  mpm.owned_to_local(M, 1, local_M);  // the same values at every rank's ghosts: the same unknowns
+  MPI_Allreduce(MPI_IN_PLACE, &least[0], 1, MPI_DOUBLE, MPI_MIN, comm);
+  MPI_Allreduce(MPI_IN_PLACE, &least[1], 1, MPI_DOUBLE, MPI_SUM, comm);
+  min_unknown_mass_ = least[0];
+  books_.dropped_nodes = static_cast<long>(least[1]);
+  mpm.owned_to_local(M_, 1, local_M_);  // the same values at every rank's ghosts: the same unknowns
+}
+
+// The unknowns' global ids: this rank's owned unknowns in owned-node order after those of the lower
+// ranks (the row ranges DistributedProblem needs), and the owners' ids on the ghosted box.
+template <int Dim>
+void DecomposedHeat::number_unknowns(mechanics::DecomposedMpm<Dim>& mpm) {
+  if (!ids_) ids_ = std::make_unique<UnknownNumbering>();
+  UnknownNumbering& n = *ids_;
+  const MPI_Comm comm = mpm.communicator();
+  n.count = 0;
+  for (double M : M_) n.count += is_unknown(M) ? 1 : 0;
+  long first = 0;
+  MPI_Exscan(&n.count, &first, 1, MPI_LONG, MPI_SUM, comm);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  n.first = rank == 0 ? 0 : first;  // MPI_Exscan leaves rank 0's result undefined
+  MPI_Allreduce(&n.count, &n.global, 1, MPI_LONG, MPI_SUM, comm);
+  n.owned_id.assign(M_.size(), -1);
+  std::vector<double> id(M_.size(), -1.0);
+  long next = n.first;
+  for (std::size_t u = 0; u < M_.size(); ++u)
+    if (is_unknown(M_[u])) n.owned_id[u] = next, id[u] = static_cast<double>(next), ++next;
+  mpm.owned_to_local(id, 1, n.local_id);
+}
+
+template <int Dim>
+void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0,
+                               double dt) {
+  using Vec = mechanics::Vec<Dim>;
+  using GMap = Eigen::Map<Vec>;
+  const MPI_Comm comm = mpm.communicator();
+  const std::size_t no = mpm.owned_local_nodes().size(), nl = static_cast<std::size_t>(mpm.local_node_count());
+  if (joules.size() != no)
+    throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
+                                std::to_string(no) + " owned nodes");
+  if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
+  gather_mass(mpm);  // pass 1: M_, T0_, local_M_, capacity_
+  const typename mechanics::DecomposedMpm<Dim>::Stencils& st = mpm.current_stencils();
+  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
+  std::vector<double> T = mpm.particle_scalar(scalar_);
+  const std::size_t np = T.size();
+  const std::vector<double>& M = M_;
+  auto unknown = [this](double m) { return is_unknown(m); };
 
   // Pass 2: each heat-holding particle's kept nodes (unknowns), the lumped gradients G' and the two
   // bounds of λ_max(M⁻¹K) of ExplicitConduction::keep (Gershgorin row sums and Cauchy–Schwarz).
@@ -163,7 +317,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
       for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
         const auto ua = static_cast<std::size_t>(a);
         const int i = st.node[ua];
-        if (is_unknown(local_M[static_cast<std::size_t>(i)])) {
+        if (unknown(local_M_[static_cast<std::size_t>(i)])) {
           s_kept += st.S[ua];
           kept_node_[kept] = i;
           kept_S_[kept] = st.S[ua];
@@ -184,7 +338,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
           const double g = G(a).norm();
           kept_norm_[a] = g;
           gsum += g;
-          g2m += g * g / local_M[static_cast<std::size_t>(kept_node_[a])];
+          g2m += g * g / local_M_[static_cast<std::size_t>(kept_node_[a])];
         }
         for (std::size_t a = begin; a < end; ++a) {
           const auto i = static_cast<std::size_t>(kept_node_[a]);
@@ -199,14 +353,26 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   mpm.sum_to_owned(local_, 2, bounds);
   double lam[2] = {0.0, 0.0};  // Gershgorin, Rayleigh: maxima over the unknowns of all ranks
   for (std::size_t q = 0; q < no; ++q) {
-    if (!is_unknown(M[q])) continue;
+    if (!unknown(M[q])) continue;
     lam[0] = std::max(lam[0], bounds[2 * q] / M[q]);
     lam[1] = std::max(lam[1], bounds[2 * q + 1]);
   }
   MPI_Allreduce(MPI_IN_PLACE, lam, 2, MPI_DOUBLE, MPI_MAX, comm);
   const double lambda = std::min(lam[0], lam[1]);
+
+  // The serial Coupler's choice (close_window, matrix_free_window): matrix-free forward Euler for
+  // "forward_euler" and "auto" when the window needs at most matrix_free_max_substeps stable sub-steps
+  // (skipped without looking when the last bound puts it beyond twice that), else the assembled path.
+  const bool fe = opt_.integrator == "forward_euler" || opt_.integrator == "auto";
+  const auto limit = static_cast<double>(opt_.matrix_free_max_substeps);
+  bool matrix_free = fe && opt_.matrix_free_max_substeps > 0 &&
+                     !(last_lambda_ > 0.0 && dt / (opt_.fe_safety * 2.0 / last_lambda_) > 2.0 * limit);
   long n = 1;
-  if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (opt_.fe_safety * 2.0 / lambda) - 1e-12)));
+  if (matrix_free) {
+    last_lambda_ = lambda;
+    if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (opt_.fe_safety * 2.0 / lambda) - 1e-12)));
+    matrix_free = n <= opt_.matrix_free_max_substeps;
+  }
 
   // The heat: q_i = W_i / Δt on the owned unknowns. Work on a node that is not an unknown goes, as the
   // serial distribute_heat moves it, to the unknowns among its lattice neighbours (one node away along
@@ -214,49 +380,26 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   // remainder; the shares are completed at the owners by one more sum_to_owned. Work on a node with no
   // unknown next to it (the serial code gives it to the nearest unknown anywhere) is refused.
   const std::array<int, 2 * Dim> own = mpm.owned_nodes(), box = mpm.ghosted_nodes();
-  constexpr int neighbours = Dim == 2 ? 9 : 27;
   double moved[3] = {0.0, 0.0, 0.0};  // |work| off the unknowns, the same signed, of it with no unknown next to it
   std::vector<double> shares;         // on the ghosted box
   for (std::size_t u = 0; u < no; ++u) {
     const double w = joules[u];
-    if (w == 0.0 || is_unknown(M[u])) continue;
+    if (w == 0.0 || unknown(M[u])) continue;
     if (shares.empty()) shares.assign(nl, 0.0);
     moved[0] += std::fabs(w);
     moved[1] += w;
-    int idx[Dim];  // DMDA index of owned node u (x fastest over owned_nodes())
-    std::size_t rest = u;
-    for (int d = 0; d < Dim; ++d) {
-      const auto extent = static_cast<std::size_t>(own[2 * d + 1] - own[2 * d]);
-      idx[d] = own[2 * d] + static_cast<int>(rest % extent);
-      rest /= extent;
-    }
-    int cand[neighbours];
-    double weight[neighbours];
-    int count = 0;
-    double wsum = 0.0;
-    for (int c = 0; c < neighbours; ++c) {  // x fastest, as the serial loop
-      int r = c, l = 0, stride = 1;
-      bool inside = true;
-      for (int d = 0; d < Dim; ++d) {
-        const int j = idx[d] + r % 3 - 1;
-        r /= 3;
-        if (j < box[2 * d] || j >= box[2 * d + 1]) inside = false;  // the ghosted box ends only at the grid's end
-        l += (j - box[2 * d]) * stride;
-        stride *= box[2 * d + 1] - box[2 * d];
-      }
-      if (!inside || !is_unknown(local_M[static_cast<std::size_t>(l)])) continue;
-      cand[count] = l;
-      weight[count] = local_M[static_cast<std::size_t>(l)];
-      wsum += weight[count];
-      ++count;
-    }
+    int cand[Dim == 2 ? 9 : 27];
+    const int count = lattice_neighbours<Dim>(
+        own, box, u, [&](int l) { return unknown(local_M_[static_cast<std::size_t>(l)]); }, cand);
     if (count == 0) {
       moved[2] += std::fabs(w);
       continue;
     }
+    double wsum = 0.0;
+    for (int c = 0; c < count; ++c) wsum += local_M_[static_cast<std::size_t>(cand[c])];
     double given = 0.0;
     for (int c = 0; c + 1 < count; ++c) {
-      const double share = w * (weight[c] / wsum);
+      const double share = w * (local_M_[static_cast<std::size_t>(cand[c])] / wsum);
       shares[static_cast<std::size_t>(cand[c])] += share;
       given += share;
     }
@@ -277,42 +420,54 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   double delivered = 0.0;
   std::vector<double> q(no, 0.0);
   for (std::size_t u = 0; u < no; ++u) {
-    if (!is_unknown(M[u])) continue;
+    if (!unknown(M[u])) continue;
     const double w = relocated.empty() ? joules[u] : joules[u] + relocated[u];
     if (w != 0.0) q[u] = w / dt, delivered += q[u];
   }
 
-  // Forward-Euler sub-steps: ghost T_j from the owners, f_i = −Σ_p V_p k_p G'_ip·(∇T)_p summed at the owners.
-  std::vector<double> Tn = T0;
-  const double h = dt / static_cast<double>(n);
-  std::vector<double> f;
-  for (long s = 0; s < n; ++s) {
-    mpm.owned_to_local(Tn, 1, local_T_);
-    force_.assign(nl, 0.0);
-    for (std::size_t k = 0; k < np; ++k) {
-      if (conductance_[k] == 0.0) continue;
-      const auto b = static_cast<std::size_t>(kept_first_[k]), e = static_cast<std::size_t>(kept_first_[k + 1]);
-      double lo = local_T_[static_cast<std::size_t>(kept_node_[b])], hi = lo;
-      for (std::size_t a = b + 1; a < e; ++a) {
-        lo = std::min(lo, local_T_[static_cast<std::size_t>(kept_node_[a])]);
-        hi = std::max(hi, local_T_[static_cast<std::size_t>(kept_node_[a])]);
+  std::vector<double> Tn = T0_;
+  if (matrix_free) {
+    // Forward-Euler sub-steps: ghost T_j from the owners, f_i = −Σ_p V_p k_p G'_ip·(∇T)_p summed at the owners.
+    const double h = dt / static_cast<double>(n);
+    std::vector<double> f;
+    for (long s = 0; s < n; ++s) {
+      mpm.owned_to_local(Tn, 1, local_T_);
+      force_.assign(nl, 0.0);
+      for (std::size_t k = 0; k < np; ++k) {
+        if (conductance_[k] == 0.0) continue;
+        const auto b = static_cast<std::size_t>(kept_first_[k]), e = static_cast<std::size_t>(kept_first_[k + 1]);
+        double lo = local_T_[static_cast<std::size_t>(kept_node_[b])], hi = lo;
+        for (std::size_t a = b + 1; a < e; ++a) {
+          lo = std::min(lo, local_T_[static_cast<std::size_t>(kept_node_[a])]);
+          hi = std::max(hi, local_T_[static_cast<std::size_t>(kept_node_[a])]);
+        }
+        if (hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi))) continue;  // quiet
+        Vec grad = Vec::Zero();  // (∇T)_p, eq. 37
+        for (std::size_t a = b; a < e; ++a) grad += G(a) * local_T_[static_cast<std::size_t>(kept_node_[a])];
+        grad *= conductance_[k];
+        for (std::size_t a = b; a < e; ++a) force_[static_cast<std::size_t>(kept_node_[a])] -= G(a).dot(grad);
       }
-      if (hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi))) continue;  // quiet
-      Vec grad = Vec::Zero();  // (∇T)_p, eq. 37
-      for (std::size_t a = b; a < e; ++a) grad += G(a) * local_T_[static_cast<std::size_t>(kept_node_[a])];
-      grad *= conductance_[k];
-      for (std::size_t a = b; a < e; ++a) force_[static_cast<std::size_t>(kept_node_[a])] -= G(a).dot(grad);
+      mpm.sum_to_owned(force_, 1, f);
+      for (std::size_t u = 0; u < no; ++u)
+        if (unknown(M[u])) Tn[u] += h * (f[u] + q[u]) / M[u];
     }
-    mpm.sum_to_owned(force_, 1, f);
-    for (std::size_t u = 0; u < no; ++u)
-      if (is_unknown(M[u])) Tn[u] += h * (f[u] + q[u]) / M[u];
+    books_.substeps += n;
+    books_.exchanges += 4 + 2 * n;  // M and Σ m C T, M back, the bounds, per sub-step T and f, ΔT
+  } else {
+    // Assembled: K's rows at their owners, the distributed integrator over [t0, t0 + Δt].
+    number_unknowns(mpm);
+    KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
+    for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
+    assembled_->advance(comm, *ids_, entries_of, M, q, Tn, t0, t0 + dt);
+    ++books_.assembled_windows;
+    books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
   }
 
   // Back to the particles incrementally (design §4): T_p += Σ_i S_ip ΔT_i over its unknowns.
   std::vector<double> dT(no, 0.0);
   double nodal = 0.0;
   for (std::size_t u = 0; u < no; ++u)
-    if (is_unknown(M[u])) dT[u] = Tn[u] - T0[u], nodal += M[u] * dT[u];
+    if (unknown(M[u])) dT[u] = Tn[u] - T0_[u], nodal += M[u] * dT[u];
   std::vector<double> local_dT;
   mpm.owned_to_local(dT, 1, local_dT);
   double particle = 0.0;
@@ -330,12 +485,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   books_.heat_delivered += b[0];
   books_.nodal_energy_change += b[1];
   books_.particle_energy_change += b[2];
-  long d = dropped;
-  MPI_Allreduce(MPI_IN_PLACE, &d, 1, MPI_LONG, MPI_SUM, comm);
-  books_.dropped_nodes = d;
   ++books_.windows;
-  books_.substeps += n;
-  books_.exchanges += 4 + 2 * n;  // M and Σ m C T, M back, the bounds, per sub-step T and f, ΔT
 }
 
 DecomposedSnapshot DecomposedHeat::snapshot() const {

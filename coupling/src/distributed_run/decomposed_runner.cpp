@@ -1,8 +1,9 @@
 // The decomposed run loop (decomposed_run.hpp): the serial run loop's time stepping (CFL from each
 // particle's dilatational wave speed plus its speed, DecomposedMpm::stable_time_step, the largest over
 // all ranks; landing on every snapshot time and on end_time), the engine's USL step and the heat
-// hand-off and forward-Euler conduction of DecomposedHeat every step; series on rank 0 (OUT.h5),
-// particle snapshots per rank joined by OUT.xdmf.
+// hand-off of DecomposedHeat every step, its windows closed by the scene's policy and at every snapshot
+// time (as the serial ThermalRun::after_step); series on rank 0 (OUT.h5), particle snapshots per rank
+// joined by OUT.xdmf.
 #include "distributed_run/decomposed_hotspots.hpp"
 #include "distributed_run/decomposed_setup.hpp"
 #include "run/run_signals.hpp"
@@ -93,6 +94,7 @@ class DecomposedRun {
     record_phase_seconds();
     record_traffic();
     r_.snapshots = static_cast<std::size_t>(snapshots_);
+    if (heat_) pending_heat_ = heat_->pending_heat();  // collective
     if (out_) finish_output();
     snapshots_out_->close();
     if (heat_ && rank_ == 0 && !o_.quiet) print_books(o_.log ? *o_.log : std::cerr);
@@ -140,6 +142,11 @@ class DecomposedRun {
       h.assembly = c.assembly;
       h.fe_safety = c.integrator_options.fe_safety;
       h.order = s_.thermal.heating_order;
+      h.integrator = c.integrator;
+      h.integrator_options = c.integrator_options;
+      h.preconditioner = s_.thermal.preconditioner;
+      h.matrix_free_max_substeps = c.matrix_free_max_substeps;
+      h.window = c.window;
       try {
         heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
       } catch (const std::invalid_argument& e) {
@@ -271,13 +278,19 @@ class DecomposedRun {
       last_dt_ = dt;
       ++step_;
       stable_time_step(stable, signal);  // throws SimulationError on every rank for a broken state
+      const double t = time_;
       if (heat_) {
         const Clock::time_point h0 = Clock::now();
-        heat_->after_step(dt);
-        hot_->update(*mpm_, time_);  // after every window, as the serial coupler
+        try {
+          // The serial run closes the window at every snapshot time and at the end (runner.cpp).
+          if (heat_->after_step(dt, schedule.snapshot_reached(t))) hot_->update(*mpm_, time_);  // after every window
+        } catch (const thermal::SolverError& e) {  // on every rank (the integrator's agreement)
+          throw mechanics::SimulationError(std::string("thermal solver failed: ") + e.what(), step_, time_, -1);
+        } catch (const thermal::StabilityError& e) {
+          throw mechanics::SimulationError(std::string("thermal integration unstable: ") + e.what(), step_, time_, -1);
+        }
         heating_seconds_ += seconds_since(h0);
       }
-      const double t = time_;
       if (schedule.series_due(t)) series();
       if (schedule.snapshot_due(t)) snapshot();
       progress.update(step_, t);
@@ -409,13 +422,28 @@ class DecomposedRun {
     for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
     if (heat_) {
       const DecomposedHeatBooks& b = heat_->books();
-      out_->write_metadata("thermal_integrator", "forward_euler (decomposed, matrix-free)");
-      out_->write_metadata("thermal_window_policy", "every_step");
+      const CouplerOptions& c = s_.thermal.coupler;
+      out_->write_metadata("thermal_integrator", c.integrator);
+      out_->write_metadata("thermal_rtol", c.integrator_options.rtol);
+      out_->write_metadata("thermal_atol", c.integrator_options.atol);
+      out_->write_metadata("thermal_preconditioner", s_.thermal.preconditioner);
+      out_->write_metadata("thermal_window_policy", to_string(c.window.kind));
       out_->write_metadata("heating_order", mechanics::to_string(s_.thermal.heating_order));
       out_->write_metadata("thermal_windows", b.windows);
+      out_->write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
       out_->write_metadata("thermal_matrix_free_substeps", b.substeps);
+      out_->write_metadata("thermal_assembled_windows", b.assembled_windows);
+      out_->write_metadata("thermal_min_window", b.min_window);
+      out_->write_metadata("thermal_max_window", b.max_window);
+      const thermal::IntegratorStats st = heat_->integrator_stats();  // global counts
+      out_->write_metadata("thermal_steps", st.steps);
+      out_->write_metadata("thermal_rhs_evals", st.rhs_evals);
+      out_->write_metadata("thermal_linear_iters", st.linear_iters);
+      out_->write_metadata("thermal_error_test_failures", st.error_test_failures);
+      out_->write_metadata("thermal_wall_time", st.wall_seconds);
       out_->write_metadata("work_received", b.work_received);
       out_->write_metadata("heat_delivered", b.heat_delivered);
+      out_->write_metadata("heat_pending", pending_heat_);
       out_->write_metadata("nodal_energy_change", b.nodal_energy_change);
       out_->write_metadata("particle_energy_change", b.particle_energy_change);
       out_->write_metadata("max_capacity_residual", b.max_capacity_residual);
@@ -452,6 +480,7 @@ class DecomposedRun {
   long step_ = 0, snapshots_ = 0;
   long last_series_step_ = -1, last_snapshot_step_ = -1;
   double heating_seconds_ = 0.0, output_seconds_ = 0.0;
+  double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
   Clock::time_point last_flush_ = Clock::now();
 };
 

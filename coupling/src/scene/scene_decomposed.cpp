@@ -71,22 +71,28 @@ std::string thermal_refusal(const Scene& s) {
   const ThermalSceneSpec& t = s.thermal;
   if (!t.enabled) return "";
   const CouplerOptions& c = t.coupler;
-  if (c.integrator != "forward_euler")
-    return refuse("thermal.integrator", quoted(c.integrator), "\"forward_euler\"");
+  // Every integrator name runs (DecomposedHeat: matrix-free forward Euler, or the distributed integrator
+  // of that name on the assembled rows); the Krylov path only, no sparse direct solver.
   const thermal::IntegratorOptions& io = c.integrator_options;
-  if (io.fe_stability_policy != "substep")
+  if (io.linear_solver == "klu")
+    return refuse("thermal.linear_solver", quoted("klu"), "\"pcg\" (the default of a decomposed run) or no key");
+  // Matrix-free windows: the serial "substep" policy with the Gershgorin estimate, no cap on the step.
+  const bool matrix_free = (c.integrator == "forward_euler" || c.integrator == "auto") && c.matrix_free_max_substeps > 0;
+  const bool forward_euler = c.integrator == "forward_euler" || c.integrator == "auto";
+  if (forward_euler && io.fe_stability_policy != "substep")
     return refuse("thermal.forward_euler.stability", quoted(io.fe_stability_policy), "\"substep\"");
-  if (io.fe_limit_estimate != "gershgorin")
+  if (forward_euler && io.fe_limit_estimate != "gershgorin")
     return refuse("thermal.forward_euler.limit_estimate", quoted(io.fe_limit_estimate), "\"gershgorin\"");
-  if (io.fe_max_dt > 0.0) return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
+  if (forward_euler && io.fe_max_dt > 0.0)
+    return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
   if (!c.fixed_faces.empty())
     return refuse("thermal.fixed_temperature", std::to_string(c.fixed_faces.size()) + " face(s)", "adiabatic faces");
   if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
-  if (c.window.kind != WindowPolicy::Kind::every_step)
-    return refuse("coupling.window", quoted(to_string(c.window.kind)) + " (the default is adaptive)", "\"every_step\"");
-  if (c.reuse_distance != 0.0)
+  // Every window policy runs (every_step, every_n_steps, adaptive: DecomposedHeat::after_step). Matrix-free
+  // windows gather every window: the serial reuse of the last gather is not decomposed.
+  if (matrix_free && c.reuse_distance != 0.0)
     return refuse("coupling.reuse_distance", number(c.reuse_distance) + " (the default is 0.01)",
-                  "0: the gather every window");
+                  "0: the gather every window, or an integrator other than forward_euler and auto");
   if (c.plastic.enabled) return refuse("coupling.plastic_heating", "true", "false");
   if (t.continuation_duration > 0.0)
     return refuse("coupling.continuation", "duration " + number(t.continuation_duration), "no continuation");

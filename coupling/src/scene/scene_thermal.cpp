@@ -31,6 +31,13 @@ void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
     o.linear_solver = ls->as_choice(allowed);
   }
   o.krylov_maxl = static_cast<int>(t.integer("krylov_maxl", o.krylov_maxl, 1, 100000));
+  // The PETSc preconditioner of a decomposed run's Krylov solve (thermal::DistributedOptions; the serial
+  // run's PCG is Jacobi-preconditioned and its KLU needs none: they do not read it).
+  if (const auto pc = t.find("preconditioner")) {
+    if (c.integrator == "forward_euler" || c.integrator == "arkode_erk")
+      pc->fail("not used by the explicit integrator " + c.integrator + " (remove it)");
+    spec.preconditioner = pc->as_choice({"jacobi", "bjacobi", "hypre"});
+  }
   o.reinit_every_window = t.find("reinit_every_window") ? t.at("reinit_every_window").as_bool() : false;
   if (const auto fe = t.find("forward_euler")) {
     if (!explicit_allowed) fe->fail("only for \"integrator\": \"forward_euler\" or \"auto\"");

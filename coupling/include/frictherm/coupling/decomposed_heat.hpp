@@ -1,50 +1,77 @@
 #pragma once
-// Frictional heating and matrix-free explicit conduction in a decomposed run (issue 16): the serial
-// matrix-free window (explicit_conduction.hpp, Nairn et al. 2018 eqs. 37–38) on the decomposed
-// mechanics' grid and particles (frictherm/mechanics/distributed.hpp), one window per mechanics step
-// (the serial "every_step" policy, gathered every window: reuse_distance 0).
+// Frictional heating and conduction in a decomposed run (issue 16): the serial Coupler's window
+// (coupler.hpp) on the decomposed mechanics' grid and particles (frictherm/mechanics/distributed.hpp).
 //
 //   M_i = Σ_p m_p C_v,p S_ip,  T_i = Σ_p m_p C_v,p T_p S_ip / M_i       eq. 38, summed over ranks
 //   unknowns: M_i > active_mass_fraction · max_j M_j (max over ranks); a particle's gradient on the
 //   other nodes is lumped onto its unknowns in proportion to S_ip (G', as thermal_assembly.hpp)
-//   (∇T)_p = Σ_j G'_jp T_j                                              eq. 37, ghost T_j from owners
-//   f_i = −Σ_p V_p k_p G'_ip · (∇T)_p                                   summed over ranks
-//   T_i ← T_i + h (f_i + q_i) / M_i,  q_i = W_i / Δt,  h = Δt / n       forward Euler on owned unknowns
-//   n from the bounds of λ_max(M⁻¹K) of the serial code, maxima over ranks (MPI_Allreduce)
-//   T_p += Σ_i S_ip ΔT_i                                                design §4, ghost ΔT_i from owners
+//   q_i = W_i / Δt over the window (W_i its frictional work at owned nodes, Δt its length)
+//
+// then one of the serial Coupler's two paths, chosen by its rule (Coupler::matrix_free_allowed):
+//
+//   * matrix-free forward Euler (integrator "forward_euler" or "auto", at most
+//     matrix_free_max_substeps stable sub-steps; the serial ExplicitConduction, Nairn et al. 2018
+//     eqs. 37–38): (∇T)_p = Σ_j G'_jp T_j with ghost T_j from the owners, f_i = −Σ_p V_p k_p G'_ip·(∇T)_p
+//     summed over ranks, T_i ← T_i + h (f_i + q_i) / M_i, h = Δt / n, n from the bounds of
+//     λ_max(M⁻¹K) of the serial code (maxima over ranks);
+//   * assembled (every other window; decomposed_assembled.cpp): K_ij = Σ_p V_p k_p G'_ip·G'_jp summed
+//     at the owners of the rows (a PETSc matrix, ADD_VALUES), M dT/dt = −K T + q integrated by the
+//     thermal::DistributedIntegrator of the scene's name ("auto": cvode_bdf) on N_Vector_Parallel,
+//     the Krylov path preconditioned by a PETSc PC (jacobi, bjacobi, hypre BoomerAMG);
+//
+// and T_p += Σ_i S_ip ΔT_i (design §4, ghost ΔT_i from the owners). Windows as the serial Coupler:
+// every step, every n steps, or adaptive (closed when the pending heat would raise some node by more
+// than max_temperature_rise, estimated as W_i / M_i with M of the last window: Coupler::mass_estimate
+// over the node's lattice neighbours; or after max_duration / max_steps), and by the caller.
 //
 // W_i is the mechanics step's frictional work at owned nodes (N·27, 34/36, 40; second order by
 // default). The particles' temperatures live in the swarm as the particle scalar named in the options
 // (they migrate with the particles). Every call is collective.
 //
 // 2D and 3D: one class for DecomposedMpm<2> and DecomposedMpm<3> (the constructor taken fixes dim());
-// the window is one template on Dim (decomposed_heat.cpp) with G'_ip stored flat, Dim per entry, so
-// the 3D run is the serial ExplicitConduction<3> window as the 2D run is ExplicitConduction<2>'s.
+// the window is one template on Dim (decomposed_heat.cpp) with G'_ip stored flat, Dim per entry.
 // It also hands the run's particles to the hot-spot tracker (update_hot_spots_across_ranks) and to
 // the per-rank output (DecomposedOutput) without gathering them (frictherm/coupling/distributed.hpp).
 //
 // Work that lands on a node that is not an unknown goes to the unknowns among its lattice neighbours in
 // proportion to M_i (the serial distribute_heat); with no unknown next to it (the serial code then
-// takes the nearest unknown anywhere) it is refused with std::runtime_error on every rank.
-// Differences from the serial Coupler: that refusal; fixed-temperature faces, plastic and reaction
-// heat, the sub-grid relaxation and the assembled / implicit paths are absent
-// (docs/distributed_coupling.md).
+// takes the nearest unknown anywhere) it is refused with std::runtime_error on every rank. The
+// adaptive estimate of such a node takes the smallest unknown M_i of all ranks (the serial one the
+// nearest unknown's). Differences from the serial Coupler: that refusal; fixed-temperature faces,
+// plastic and reaction heat, the sub-grid relaxation, the reuse of matrix-free gathers, the KLU
+// solver and the continuation are absent (docs/distributed_coupling.md, docs/distributed_run.md).
+#include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/distributed.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace frictherm::coupling {
 
+class DecomposedAssembledSolve;  // decomposed_assembled.hpp (internal)
+struct UnknownNumbering;
+
 struct DecomposedHeatOptions {
   std::vector<ThermalProperties> materials;  // by the mechanics' material index
   AssemblyOptions assembly;                  // active_mass_fraction of the unknowns
-  double fe_safety = 0.9;                    // h ≤ fe_safety · 2 / λ bound (thermal::IntegratorOptions)
+  double fe_safety = 0.9;                    // h ≤ fe_safety · 2 / λ bound (both paths; thermal::IntegratorOptions)
   mechanics::HeatingOrder order = mechanics::HeatingOrder::second;
   std::string temperature = "temperature";   // the particle scalar holding T_p (K)
+  /// "forward_euler" (default), "auto" (CouplerOptions::integrator: matrix-free forward Euler for a
+  /// window of at most matrix_free_max_substeps stable steps, cvode_bdf beyond) or another
+  /// thermal::make_distributed_integrator name (cvode_bdf, cvode_adams, arkode_erk, arkode_dirk).
+  std::string integrator = "forward_euler";
+  /// rtol, atol, max_steps, krylov_maxl and linear_solver ("pcg", the default of the implicit
+  /// integrators, or "gmres"; cvode_adams also "fixed_point", its default) of the assembled path;
+  /// fe_safety above replaces theirs.
+  thermal::IntegratorOptions integrator_options;
+  std::string preconditioner = "jacobi";  // of the Krylov path: "jacobi", "bjacobi" or "hypre"
+  long matrix_free_max_substeps = 64;     // CouplerOptions::matrix_free_max_substeps (0: never matrix-free)
+  WindowPolicy window;                    // every_step (default), every_n_steps, adaptive
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -56,23 +83,37 @@ struct DecomposedHeatBooks {
   double particle_energy_change = 0.0;  // Σ over windows of Σ_p m_p C_v,p ΔT_p
   double max_capacity_residual = 0.0;   // worst |Σ_i M_i − Σ_p m_p C_v,p| / Σ_p m_p C_v,p
   long windows = 0;
-  long substeps = 0;
+  long substeps = 0;                    // matrix-free forward-Euler sub-steps
+  long assembled_windows = 0;           // windows integrated by the distributed integrator
+  long steps = 0;                       // mechanics steps seen (after_step)
+  double min_window = 0.0, max_window = 0.0;  // s (0 before the first window)
   long dropped_nodes = 0;               // last window: nodes with mass that are not unknowns
   long exchanges = 0;                   // grid exchanges (sum_to_owned, owned_to_local): 4 + 2 n per window (+1 relocating)
 };
 
 class DecomposedHeat {
  public:
-  /// The mechanics must carry the particle scalar options.temperature. Throws std::invalid_argument
-  /// (every rank) for a mechanics material without thermal properties or a bad fe_safety.
+  /// The mechanics must carry the particle scalar options.temperature and hold its particles (the
+  /// adaptive window's first estimate reads their M_i, as Coupler::start). Throws
+  /// std::invalid_argument (every rank) for a mechanics material without thermal properties, a bad
+  /// fe_safety, window, integrator name, option or preconditioner.
   DecomposedHeat(mechanics::DecomposedMpm<2>& mpm, DecomposedHeatOptions options);
   DecomposedHeat(mechanics::DecomposedMpm<3>& mpm, DecomposedHeatOptions options);
+  ~DecomposedHeat();
 
   int dim() const { return mpm3_ ? 3 : 2; }
-  /// After a mechanics step of dt seconds: its frictional work is the heat of one window of dt.
-  void after_step(double dt);
-  /// One window of `dt` seconds with `joules` on the owned nodes (x fastest over owned_nodes()).
+  /// After a mechanics step of dt seconds: adds its frictional work to the pending heat and closes the
+  /// window when the policy says so or `must_close` (a snapshot time, the end). True if one closed.
+  bool after_step(double dt, bool must_close = false);
+  /// Closes the open window (a no-op when it has no length). True if it closed.
+  bool close_window();
+  /// One window of `dt` seconds with `joules` on the owned nodes (x fastest over owned_nodes()), the
+  /// pending heat left alone.
   void window(const std::vector<double>& joules, double dt);
+  /// Σ of the pending work over ranks (J).
+  double pending_heat() const;
+  /// The distributed integrator's global counts (zero before the first assembled window).
+  thermal::IntegratorStats integrator_stats() const;
 
   const DecomposedHeatBooks& books() const { return books_; }
   /// Σ_p m_p C_v,p T_p over all ranks (J).
@@ -86,8 +127,14 @@ class DecomposedHeat {
   void update_hot_spots(HotSpotTracker& tracker, const std::string& reference, double time) const;
 
  private:
-  template <int Dim> void check_materials(const mechanics::DecomposedMpm<Dim>& mpm);
-  template <int Dim> void window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double dt);
+  template <int Dim> void check_materials(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim>
+  void window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0, double dt);
+  template <int Dim> void gather_mass(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> double mass_estimate(const mechanics::DecomposedMpm<Dim>& mpm, std::size_t owned) const;
+  template <int Dim> double rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& work) const;
+  template <int Dim> void number_unknowns(mechanics::DecomposedMpm<Dim>& mpm);
+  bool is_unknown(double M) const { return M > threshold_ && M > 0.0; }
   template <int Dim>
   void hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker, const std::string& reference,
                     double time) const;
@@ -107,6 +154,17 @@ class DecomposedHeat {
   std::vector<int> kept_first_, kept_node_;
   std::vector<double> kept_S_, kept_G_, kept_norm_, conductance_, capacity_;
   std::vector<double> local_, owned_, local_T_, force_;  // scratch
+  // The last gather: M_i and T_i (eq. 38) per owned node, M_i on the ghosted box, the unknowns'
+  // threshold and smallest M_i over all ranks; the unknowns' global numbering of assembled windows.
+  std::vector<double> M_, T0_, local_M_;
+  double threshold_ = 0.0, min_unknown_mass_ = 0.0;
+  std::unique_ptr<UnknownNumbering> ids_;
+  // The window: pending work per owned node, times (s), steps, the adaptive estimate (K).
+  std::vector<double> pending_;
+  double time_ = 0.0, window_start_ = 0.0, max_rise_ = 0.0;
+  long window_steps_ = 0;
+  double last_lambda_ = 0.0;  // λ bound of the last matrix-free decision (Coupler::last_lambda_bound_)
+  std::unique_ptr<DecomposedAssembledSolve> assembled_;  // the distributed integrator (assembled path)
 };
 
 }  // namespace frictherm::coupling

@@ -1,0 +1,70 @@
+// The assembled window of a decomposed run (issue 16 item 2; decomposed_heat.hpp): the serial
+// Coupler's assembled path (coupler.cpp, thermal_assembly.cpp) over the ranks. Internal header.
+//
+//   K_ij = Σ_p V_p k_p G'_ip · G'_jp          thermal_assembly.hpp (conduction term of eq. 37)
+//
+// summed over this rank's particles row by row on its ghosted box (slots by lattice offset, as the serial
+// assembly), then into a PETSc MPIAIJ matrix (MatSetValues, ADD_VALUES: the rows of nodes another rank
+// owns travel to that owner at MatAssemblyEnd and are added there), the
+// diagonal then set to minus the off-diagonal row sum (K·1 = 0 exactly, as the serial assembly), and
+// M dT/dt = −K T + q integrated over the window by a thermal::DistributedIntegrator of the serial
+// name (distributed.hpp: N_Vector_Parallel, the Krylov path preconditioned by a PETSc PC).
+#pragma once
+
+#include <frictherm/thermal/distributed.hpp>
+
+#include <mpi.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling {
+
+/// A window's particle–unknown entries on this rank (DecomposedHeat's pass 2): particle k has the
+/// entries [first[k], first[k+1]) with local node node[a] and lumped gradient G'_ip (dim values at
+/// G[dim·a]); conductance[k] = V_p k_p (0: the particle conducts nothing).
+struct KeptEntries {
+  int dim = 2;
+  std::array<int, 3> box{1, 1, 1};  // the ghosted box's nodes per direction (local numbering x fastest)
+  const std::vector<int>* first = nullptr;
+  const std::vector<int>* node = nullptr;
+  const std::vector<double>* G = nullptr;
+  const std::vector<double>* conductance = nullptr;
+};
+
+/// The unknowns' global numbering: this rank owns [first, first + count) of `global` unknowns, in
+/// owned-node order; `owned_id[u]` is the global id of owned node u (−1: not an unknown), `local_id`
+/// the same on the rank's ghosted box (the owners' ids, as doubles: exact below 2^53).
+struct UnknownNumbering {
+  long global = 0, first = 0, count = 0;
+  std::vector<long> owned_id;
+  std::vector<double> local_id;
+};
+
+class DecomposedAssembledSolve {
+ public:
+  /// `name`: thermal::make_distributed_integrator's (the serial names); throws std::invalid_argument
+  /// for a bad name, option or preconditioner.
+  DecomposedAssembledSolve(const std::string& name, const thermal::IntegratorOptions& options,
+                           const std::string& preconditioner);
+  ~DecomposedAssembledSolve();
+
+  /// Collective. Assembles K from `kept`, then integrates M dT/dt = −K T + q from t0 to t1 on the
+  /// unknowns: M, q and T are per owned node (read and written on the unknowns only). Throws
+  /// thermal::SolverError / StabilityError (every rank) when the integrator fails.
+  void advance(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept, const std::vector<double>& M,
+               const std::vector<double>& q, std::vector<double>& T, double t0, double t1);
+
+  const thermal::IntegratorStats& stats() const { return integrator_->stats(); }
+  std::string name() const { return integrator_->name(); }
+  /// Stored entries of K's owned rows in the last window (this rank).
+  long last_entries() const { return entries_; }
+
+ private:
+  std::unique_ptr<thermal::DistributedIntegrator> integrator_;
+  long entries_ = 0;
+};
+
+}  // namespace frictherm::coupling
