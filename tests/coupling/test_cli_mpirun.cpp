@@ -354,8 +354,8 @@ TEST_F(CliMpirun, ThreeDimensionalHeatedBlockWithCvodeEqualsTheSerialRun) {
 }
 
 // The PBX specimen of Nairn et al. 2018 (examples/pbx_compaction.json) with the overrides that make it
-// decomposable (no reaction, no sub-grid relaxation, no continuation, no PIC blend; its cvode_bdf with
-// PCG at rtol 1e-8 and its adaptive windows run as they are), for 0.2 us of compaction (about 360 steps
+// decomposable (no reaction, no sub-grid relaxation, no continuation; its FLIP/PIC blend, its cvode_bdf
+// with PCG at rtol 1e-8 and its adaptive windows run as they are), for 0.2 us of compaction (about 360 steps
 // at the Mie-Grüneisen CFL step: the piston has moved 0.6 nm, the grains touch the walls and each other,
 // no chaos yet): the time steps (each particle's current wave speed counts, as in the serial run),
 // kinetic energy and momentum of the deformable particles, frictional work and heat delivered agree
@@ -364,7 +364,7 @@ TEST_F(CliMpirun, ThreeDimensionalHeatedBlockWithCvodeEqualsTheSerialRun) {
 TEST_F(CliMpirun, PbxCompactionEqualsTheSerialRun) {
   const std::string sets =
       " --set thermal.reaction=null --set coupling.subgrid_relaxation_time=null --set coupling.continuation=null"
-      " --set solver.pic_relaxation_time=null --set run.end_time=2e-7 --set output.series_interval=null"
+      " --set run.end_time=2e-7 --set output.series_interval=null"
       " --set output.snapshot_count=1";
   const std::string pbx = std::string("'") + FRICTHERM_SOURCE_DIR + "/examples/pbx_compaction.json'" + sets;
   const Result s = shell(exe() + " run " + pbx + " -q --threads 1 -o '" + path("serial.h5") + "'");

@@ -36,6 +36,7 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.analysis = scene.options.analysis;
   o.thickness = scene.options.thickness;
   for (int d = 0; d < Dim; ++d) o.gravity[d] = scene.options.gravity[d];
+  o.pic_relaxation_time = scene.options.pic_relaxation_time;
   o.fixed_faces = scene.fixed_faces;
   o.contact = scene.contact.enabled;
   if (o.contact) {

@@ -35,8 +35,6 @@ std::string mechanics_refusal(const Scene& s) {
     return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\"");
   if (o.particle_update != mechanics::ParticleUpdate::flip)
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
-  if (std::isfinite(o.pic_relaxation_time))
-    return refuse("solver.pic_relaxation_time", number(o.pic_relaxation_time), "no PIC blend: remove the key");
   if (o.damping_rate > 0.0) return refuse("solver.damping", "rate " + number(o.damping_rate), "no damping: remove the key");
   // Every material kind runs decomposed (DecomposedMpm: linear elastic, neo-Hookean, Mie-Grüneisen/J2,
   // rigid; docs/distributed_pbx.md), but a rigid material in contact must be a boundary wall: the

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -236,7 +237,7 @@ void DecomposedMpm<Dim>::Impl::ghost_velocities(double /*dt*/) {
 }
 
 // Phase 12, local (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
-// field, start-of-step stencils.
+// field, start-of-step stencils; with a PIC relaxation time the serial FLIP/PIC blend.
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
@@ -245,6 +246,8 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const auto& st = stencils<Kernel>();
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+  // The serial update_particles' FLIP/PIC blend: α = 1 − e^(−dt/τ).
+  const double pic = std::isfinite(opt.pic_relaxation_time) ? -std::expm1(-dt / opt.pic_relaxation_time) : 0.0;
   for (PetscInt k = 0; k < f.n; ++k) {
     if (rigid(f.material[k])) {  // the serial move_rigid_particles: v(t), x += ½ (v(t) + v(t + dt)) dt
       const Material& m = materials[static_cast<std::size_t>(f.material[k])];
@@ -261,7 +264,9 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
       acc += S * Eigen::Map<const Vec<Dim>>(node + acceleration);
       v += S * Eigen::Map<const Vec<Dim>>(node + velocity);
     });
-    Eigen::Map<Vec<Dim>>(f.velocity + Dim * k) += dt * acc;
+    Eigen::Map<Vec<Dim>> vp(f.velocity + Dim * k);
+    vp += dt * acc;
+    if (pic > 0.0) vp = (1.0 - pic) * vp + pic * v;  // FLIP/PIC blend
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");

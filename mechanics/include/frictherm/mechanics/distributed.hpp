@@ -170,6 +170,9 @@ class DecomposedMpm {
     Analysis analysis = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
     double thickness = 1.0;               // 2D out-of-plane thickness (m), as SimulationOptions::thickness; unused in 3D
     Vec<Dim> gravity = Vec<Dim>::Zero();  // body force per unit mass (m/s²)
+    /// FLIP/PIC blend time τ (s), as SimulationOptions::pic_relaxation_time: after the FLIP update
+    /// v_p ← (1 − α) v_p + α Σ S_ip v_i, α = 1 − e^(−dt/τ); infinity: pure FLIP.
+    double pic_relaxation_time = std::numeric_limits<double>::infinity();
     std::vector<FixedFace> fixed_faces;   // grid faces with velocity components fixed to 0 (Simulation::fix_face)
     /// Multimaterial contact (one velocity field per material), as Simulation::enable_contact and
     /// set_contact_pair. Supported: multimaterial pairs with any friction law, separation position,
