@@ -20,9 +20,10 @@
 //   * the 3D block with heating (decomposed_heated_block_3d.json): series, hot-spot counts, books;
 //   * the 2D PBX compaction example (examples/pbx_compaction.json: Mie-Grüneisen/J2 HMX grains, each
 //     its own material, in a Mie-Grüneisen binder, rigid boundary walls and a piston, Coulomb contact,
-//     second-order heating, its cvode_bdf and adaptive windows) made decomposable by --set (no PIC
-//     blend and its sub-grid relaxation run; no reaction, no continuation) and cut to 0.2 us: the series within
-//     1e-9, the temperatures within the CVODE bound above, the books closed;
+//     second-order heating, its cvode_bdf and adaptive windows, its PIC blend and sub-grid relaxation)
+//     made decomposable by --set (no reaction, no continuation) and cut to 0.2 us: the series within
+//     1e-9, the temperatures (largest, every particle's at the end) within the CVODE bound above, the
+//     books closed;
 //   * plastic heating without friction (decomposed_plastic_impact.json: a Mie-Grüneisen/J2 block
 //     impact) on 2 and 4 ranks: the series within 1e-9, the plastic heat books within 1e-9 of the heat;
 //   * the 3D PBX-like scene (examples/pbx_3d.json) for 40 steps: the series within 1e-9, the books,
