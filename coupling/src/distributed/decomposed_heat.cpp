@@ -91,6 +91,16 @@ void DecomposedHeat::check_materials(mechanics::DecomposedMpm<Dim>& mpm) {
   assembled_ = std::make_unique<DecomposedAssembledSolve>(opt_.integrator == "auto" ? "cvode_bdf" : opt_.integrator, io,
                                                           opt_.preconditioner);
   scalar_ = mpm.particle_scalar_index(opt_.temperature);
+  if (!(opt_.subgrid_relaxation_time > 0.0))
+    throw std::invalid_argument("decomposed heat: subgrid_relaxation_time " +
+                                std::to_string(opt_.subgrid_relaxation_time) + " s (expected > 0, or infinite: none)");
+  if (opt_.plastic.enabled) {  // the serial PlasticHeatSource's check
+    for (std::size_t m = 0; m < opt_.plastic.taylor_quinney.size(); ++m)
+      if (!(opt_.plastic.taylor_quinney[m] >= 0.0 && opt_.plastic.taylor_quinney[m] <= 1.0))
+        throw std::invalid_argument("decomposed heat: Taylor-Quinney fraction of material " + std::to_string(m) + " is " +
+                                    std::to_string(opt_.plastic.taylor_quinney[m]) + " (expected a value in [0, 1])");
+    heated_scalar_ = mpm.particle_scalar_index(opt_.plastic_work_heated);
+  }
   // Every rank checks its own particles' materials and all agree before any window.
   int bad = -1;
   for (int m : mpm.local_particle_data().material)
@@ -133,13 +143,22 @@ double DecomposedHeat::pending_heat() const {
 
 thermal::IntegratorStats DecomposedHeat::integrator_stats() const { return assembled_->stats(); }
 
-// The serial Coupler::after_step: the step's work joins the pending heat; the policy closes the window.
+// The serial Coupler::after_step: the step's frictional work, then its plastic heat, join the pending
+// heat; the policy closes the window.
 bool DecomposedHeat::after_step(double dt, bool must_close) {
   const std::vector<double>& work = mpm3_ ? mpm3_->frictional_work(opt_.order) : mpm2_->frictional_work(opt_.order);
-  double w = 0.0;
-  for (double x : work) w += x;
-  books_.work_received += sum_over(communicator(), w);
+  double sums[3] = {0.0, 0.0, 0.0};  // frictional work, plastic work Δw_p, plastic heat (J)
+  for (double x : work) sums[0] += x;
   for (std::size_t u = 0; u < work.size(); ++u) pending_[u] += work[u];
+  if (heated_scalar_ >= 0) {
+    if (mpm3_) collect_plastic(*mpm3_, sums + 1);
+    else collect_plastic(*mpm2_, sums + 1);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, communicator());
+  books_.work_received += sums[0];
+  books_.plastic_work_received += sums[1];
+  books_.plastic_heat_received += sums[2];
+  pending_plastic_ += sums[2];
   time_ += dt;
   ++books_.steps;
   ++window_steps_;
@@ -166,6 +185,8 @@ bool DecomposedHeat::close_window() {
   if (mpm3_) window_on(*mpm3_, pending_, window_start_, dt);
   else window_on(*mpm2_, pending_, window_start_, dt);
   std::fill(pending_.begin(), pending_.end(), 0.0);
+  books_.plastic_heat_delivered += pending_plastic_;
+  pending_plastic_ = 0.0;
   books_.min_window = books_.windows == 1 ? dt : std::min(books_.min_window, dt);
   books_.max_window = std::max(books_.max_window, dt);
   window_start_ = time_;
@@ -195,12 +216,16 @@ double DecomposedHeat::mass_estimate(const mechanics::DecomposedMpm<Dim>& mpm, s
   return m > 0.0 ? m : min_unknown_mass_;
 }
 
-// This rank's largest |W_i| / M_i estimate over the nodes the step's work reached (Coupler::after_step).
+// This rank's largest |W_i| / M_i estimate over the nodes the step's work reached and, with plastic heat
+// pending (it can sit on any node), over every node holding heat (Coupler::after_step).
 template <int Dim>
 double DecomposedHeat::rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& work) const {
   double rise = 0.0;
   for (std::size_t u = 0; u < work.size(); ++u)
     if (work[u] != 0.0) rise = std::max(rise, std::fabs(pending_[u]) / mass_estimate(mpm, u));
+  if (pending_plastic_ != 0.0)
+    for (std::size_t u = 0; u < pending_.size(); ++u)
+      if (pending_[u] != 0.0) rise = std::max(rise, std::fabs(pending_[u]) / mass_estimate(mpm, u));
   return rise;
 }
 
@@ -463,24 +488,11 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
     books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
   }
 
-  // Back to the particles incrementally (design §4): T_p += Σ_i S_ip ΔT_i over its unknowns.
-  std::vector<double> dT(no, 0.0);
-  double nodal = 0.0;
-  for (std::size_t u = 0; u < no; ++u)
-    if (unknown(M[u])) dT[u] = Tn[u] - T0_[u], nodal += M[u] * dT[u];
-  std::vector<double> local_dT;
-  mpm.owned_to_local(dT, 1, local_dT);
-  double particle = 0.0;
-  for (std::size_t k = 0; k < np; ++k) {
-    double change = 0.0;
-    for (int a = kept_first_[k]; a < kept_first_[k + 1]; ++a)
-      change += kept_S_[static_cast<std::size_t>(a)] * local_dT[static_cast<std::size_t>(kept_node_[static_cast<std::size_t>(a)])];
-    const double before = T[k];
-    T[k] = before + change;
-    particle += capacity_[k] * (T[k] - before);
-  }
+  // Back to the particles incrementally (design §4), with the sub-grid relaxation (decomposed_sources.cpp).
+  double changes[2];
+  map_back(mpm, Tn, dt, T, changes);
   mpm.set_particle_scalar(scalar_, T);
-  double b[3] = {delivered * dt, nodal, particle};
+  double b[3] = {delivered * dt, changes[0], changes[1]};
   MPI_Allreduce(MPI_IN_PLACE, b, 3, MPI_DOUBLE, MPI_SUM, comm);
   books_.heat_delivered += b[0];
   books_.nodal_energy_change += b[1];

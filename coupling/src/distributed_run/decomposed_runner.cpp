@@ -147,6 +147,8 @@ class DecomposedRun {
       h.preconditioner = s_.thermal.preconditioner;
       h.matrix_free_max_substeps = c.matrix_free_max_substeps;
       h.window = c.window;
+      h.plastic = c.plastic;
+      h.subgrid_relaxation_time = c.subgrid_relaxation_time;
       try {
         heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
       } catch (const std::invalid_argument& e) {
@@ -208,6 +210,7 @@ class DecomposedRun {
       n.insert(n.end(), {"heat_delivered", "thermal_energy_change", "max_temperature"});
       for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
       n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
+      if (s_.thermal.coupler.plastic.enabled) n.insert(n.end(), {"plastic_work", "plastic_heat"});
     }
     return n;
   }
@@ -329,6 +332,7 @@ class DecomposedRun {
       row.insert(row.end(), {b.heat_delivered, b.particle_energy_change, hot_->tracker().max_temperature()});
       hot_->extend_series_row(row);
       row.insert(row.end(), {static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
+      if (s_.thermal.coupler.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
     }
     if (out_) {
       out_->append_series(row);
@@ -402,15 +406,18 @@ class DecomposedRun {
     if (!o_.quiet) (o_.log ? *o_.log : std::cerr) << line << "\n";
   }
 
-  // The energy books summed over ranks (J) and how well they close (relative to the work received).
+  // The energy books summed over ranks (J) and how well they close (relative to the heat received:
+  // frictional work plus plastic heat).
   void print_books(std::ostream& log) const {
     const DecomposedHeatBooks& b = heat_->books();
-    const double w = b.work_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
-    char line[512];
+    const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
+    char line[640];
     std::snprintf(line, sizeof line,
-                  "frictherm: energy books over %d ranks: frictional work received %.9g J, heat delivered %.9g J, "
-                  "nodal energy change %.9g J, particle energy change %.9g J (largest difference %.2g of the work)\n",
-                  size_, w, b.heat_delivered, b.nodal_energy_change, b.particle_energy_change,
+                  "frictherm: energy books over %d ranks: frictional work received %.9g J, plastic heat received %.9g J, "
+                  "heat delivered %.9g J, nodal energy change %.9g J, particle energy change %.9g J (largest "
+                  "difference %.2g of the heat received)\n",
+                  size_, b.work_received, b.plastic_heat_received, b.heat_delivered, b.nodal_energy_change,
+                  b.particle_energy_change,
                   std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
                             std::fabs(b.particle_energy_change - w)}) / scale);
     log << line;
@@ -442,6 +449,10 @@ class DecomposedRun {
       out_->write_metadata("thermal_error_test_failures", st.error_test_failures);
       out_->write_metadata("thermal_wall_time", st.wall_seconds);
       out_->write_metadata("work_received", b.work_received);
+      out_->write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
+      out_->write_metadata("plastic_work_received", b.plastic_work_received);
+      out_->write_metadata("plastic_heat_received", b.plastic_heat_received);
+      out_->write_metadata("plastic_heat_delivered", b.plastic_heat_delivered);
       out_->write_metadata("heat_delivered", b.heat_delivered);
       out_->write_metadata("heat_pending", pending_heat_);
       out_->write_metadata("nodal_energy_change", b.nodal_energy_change);

@@ -22,6 +22,8 @@ std::string agreed_error(MPI_Comm comm, const std::string& error) {
   return text;
 }
 
+bool plastic_heating(const Scene& scene) { return scene.thermal.enabled && scene.thermal.coupler.plastic.enabled; }
+
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene) {
   mechanics::IVec<Dim> cells{};
@@ -44,6 +46,8 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
     for (const ContactPairSpec& p : scene.contact.pairs) o.contact_pairs.push_back({p.material_a, p.material_b, p.settings});
   }
   o.particle_scalars = {"temperature", "reference_temperature"};  // T_p and T0_p (hot spots' reference)
+  // The plastic work already handed to the heat (DecomposedHeatOptions::plastic_work_heated).
+  if (plastic_heating(scene)) o.particle_scalars.emplace_back("plastic_work_heated");
   return o;
 }
 
@@ -74,6 +78,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MP
         q.internal_energy = p.internal_energy[k];
         q.plastic_work = p.plastic_work[k];
         q.scalars = {p.temperature[k], p.temperature[k]};
+        if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
       }
     } catch (const SceneError& e) {
       error = e.what();

@@ -16,13 +16,18 @@ namespace frictherm::coupling::detail {
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene);
 
+/// Whether the scene heats with plastic work (thermal on, coupling.plastic_heating).
+bool plastic_heating(const Scene& scene);
+
 /// The decomposed engine's options for a supported scene; the particles carry two scalars,
-/// "temperature" and "reference_temperature" (T_p and its initial value T0_p, K).
+/// "temperature" and "reference_temperature" (T_p and its initial value T0_p, K), and with plastic
+/// heating a third, "plastic_work_heated" (J: the plastic work already handed to the heat).
 template <int Dim>
 typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& scene);
 
 /// Collective: rank 0 builds the scene's particles (build_simulation) and returns them with id = serial
-/// index and the body temperature as both scalars; the other ranks return none. A SceneError on rank 0
+/// index, the body temperature as the first two scalars and w_p as the third (plastic heating); the
+/// other ranks return none. A SceneError on rank 0
 /// is thrown on every rank.
 template <int Dim>
 std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MPI_Comm comm, const Scene& scene);

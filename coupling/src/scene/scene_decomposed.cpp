@@ -3,7 +3,6 @@
 // support is refused with the scene key, its value and the way out (the serial run).
 #include <frictherm/coupling/decomposed_support.hpp>
 
-#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -91,11 +90,9 @@ std::string thermal_refusal(const Scene& s) {
   if (matrix_free && c.reuse_distance != 0.0)
     return refuse("coupling.reuse_distance", number(c.reuse_distance) + " (the default is 0.01)",
                   "0: the gather every window, or an integrator other than forward_euler and auto");
-  if (c.plastic.enabled) return refuse("coupling.plastic_heating", "true", "false");
+  // Plastic heating and the sub-grid relaxation run (DecomposedHeat, decomposed_sources.cpp).
   if (t.continuation_duration > 0.0)
     return refuse("coupling.continuation", "duration " + number(t.continuation_duration), "no continuation");
-  if (std::isfinite(c.subgrid_relaxation_time))
-    return refuse("coupling.subgrid_relaxation_time", number(c.subgrid_relaxation_time), "no key");
   return "";
 }
 

@@ -37,15 +37,17 @@
 // proportion to M_i (the serial distribute_heat); with no unknown next to it (the serial code then
 // takes the nearest unknown anywhere) it is refused with std::runtime_error on every rank. The
 // adaptive estimate of such a node takes the smallest unknown M_i of all ranks (the serial one the
-// nearest unknown's). Differences from the serial Coupler: that refusal; fixed-temperature faces,
-// plastic and reaction heat, the sub-grid relaxation, the reuse of matrix-free gathers, the KLU
-// solver and the continuation are absent (docs/distributed_coupling.md, docs/distributed_run.md).
+// nearest unknown's). Plastic heat and the sub-grid relaxation as the serial Coupler
+// (decomposed_sources.cpp). Differences from the serial Coupler: that refusal; fixed-temperature faces,
+// reaction heat, the reuse of matrix-free gathers, the KLU solver and the continuation are absent
+// (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/distributed.hpp>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +74,14 @@ struct DecomposedHeatOptions {
   std::string preconditioner = "jacobi";  // of the Krylov path: "jacobi", "bjacobi" or "hypre"
   long matrix_free_max_substeps = 64;     // CouplerOptions::matrix_free_max_substeps (0: never matrix-free)
   WindowPolicy window;                    // every_step (default), every_n_steps, adaptive
+  /// Plastic heating (CouplerOptions::plastic): after every step β Δw_p S_ip on the nodes joins the
+  /// pending heat (decomposed_sources.cpp); Δw_p against the particle scalar named below, which
+  /// carries the plastic work already handed over with the particles (its initial value: w_p).
+  PlasticHeatingOptions plastic;
+  std::string plastic_work_heated = "plastic_work_heated";
+  /// CouplerOptions::subgrid_relaxation_time τ (s; infinite: none): the map back blends
+  /// β = 1 − e^{−Δt/τ} of Σ_i S_ip T_i / Σ_i S_ip (the kept unknowns' end temperatures) into T_p.
+  double subgrid_relaxation_time = std::numeric_limits<double>::infinity();
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -82,13 +92,16 @@ struct DecomposedHeatBooks {
   double nodal_energy_change = 0.0;     // Σ over windows of Σ_i M_i ΔT_i
   double particle_energy_change = 0.0;  // Σ over windows of Σ_p m_p C_v,p ΔT_p
   double max_capacity_residual = 0.0;   // worst |Σ_i M_i − Σ_p m_p C_v,p| / Σ_p m_p C_v,p
+  double plastic_work_received = 0.0;   // Σ over steps of Δw_p of the particles with β > 0
+  double plastic_heat_received = 0.0;   // Σ over steps of Σ_i β Δw_p S_ip (part of the pending heat)
+  double plastic_heat_delivered = 0.0;  // of it, handed to closed windows
   long windows = 0;
   long substeps = 0;                    // matrix-free forward-Euler sub-steps
   long assembled_windows = 0;           // windows integrated by the distributed integrator
   long steps = 0;                       // mechanics steps seen (after_step)
   double min_window = 0.0, max_window = 0.0;  // s (0 before the first window)
   long dropped_nodes = 0;               // last window: nodes with mass that are not unknowns
-  long exchanges = 0;                   // grid exchanges (sum_to_owned, owned_to_local): 4 + 2 n per window (+1 relocating)
+  long exchanges = 0;                   // grid exchanges (sum_to_owned, owned_to_local): 4 + 2 n per window (+1 relocating, +1 per step with plastic heating)
 };
 
 class DecomposedHeat {
@@ -134,6 +147,13 @@ class DecomposedHeat {
   template <int Dim> double mass_estimate(const mechanics::DecomposedMpm<Dim>& mpm, std::size_t owned) const;
   template <int Dim> double rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& work) const;
   template <int Dim> void number_unknowns(mechanics::DecomposedMpm<Dim>& mpm);
+  // decomposed_sources.cpp: the step's plastic heat onto pending_ (this rank's Δw_p and heat in
+  // `sums`), and the map back T_p += Σ_i S_ip ΔT_i with the sub-grid relaxation (energy changes in
+  // `changes`: Σ_i M_i ΔT_i and Σ_p m_p C_v,p ΔT_p of this rank).
+  template <int Dim> void collect_plastic(mechanics::DecomposedMpm<Dim>& mpm, double sums[2]);
+  template <int Dim>
+  void map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& Tn, double dt, std::vector<double>& T,
+                double changes[2]);
   bool is_unknown(double M) const { return M > threshold_ && M > 0.0; }
   template <int Dim>
   void hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker, const std::string& reference,
@@ -145,7 +165,7 @@ class DecomposedHeat {
   mechanics::DecomposedMpm<2>* mpm2_ = nullptr;  // one of the two
   mechanics::DecomposedMpm<3>* mpm3_ = nullptr;
   DecomposedHeatOptions opt_;
-  int scalar_ = 0;
+  int scalar_ = 0, heated_scalar_ = -1;  // T_p; the plastic work handed over (-1: no plastic heating)
   DecomposedHeatBooks books_;
   // Per window, this rank's heat-holding particles' kept nodes (unknowns), flat: particle k's entries
   // [kept_first_[k], kept_first_[k+1]) with local node, S_ip and the lumped G'_ip (Dim values per
@@ -161,6 +181,7 @@ class DecomposedHeat {
   std::unique_ptr<UnknownNumbering> ids_;
   // The window: pending work per owned node, times (s), steps, the adaptive estimate (K).
   std::vector<double> pending_;
+  double pending_plastic_ = 0.0;  // of it, plastic heat (J, over ranks)
   double time_ = 0.0, window_start_ = 0.0, max_rise_ = 0.0;
   long window_steps_ = 0;
   double last_lambda_ = 0.0;  // λ bound of the last matrix-free decision (Coupler::last_lambda_bound_)
