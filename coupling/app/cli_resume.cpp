@@ -3,6 +3,7 @@
 #include "cli.hpp"
 #include "cli_resume.hpp"
 
+#include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/result_append.hpp>
 #include <frictherm/coupling/runner.hpp>
@@ -53,6 +54,9 @@ void remove_quietly(const std::string& path) {
 }  // namespace
 
 ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
+  if (const int ranks = coupling::checkpoint_ranks(q.checkpoint); ranks > 0)
+    throw coupling::OutputError(q.checkpoint + " was written by a decomposed run on " + std::to_string(ranks) +
+                                " ranks: resume it with mpirun -n " + std::to_string(ranks) + " frictherm resume " + q.run);
   ResumeOutcome out;
   coupling::RunOptions opt;
   opt.threads = q.threads;
@@ -144,6 +148,7 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
     if (end == v.c_str() || *end != '\0' || !(q.checkpoint_wall_interval > 0.0) || !std::isfinite(q.checkpoint_wall_interval))
       throw UsageError("resume", "--checkpoint-every: expected wall-clock seconds > 0, got '" + v + "'");
   }
+  if (several_processes(launcher_info())) return decomposed_resume_command(q);  // mpirun -n K (K > 1)
   return run_from_checkpoint(q, "resume", [&q] {
     if (!exists(q.checkpoint)) throw coupling::OutputError("no checkpoint " + q.checkpoint + " to resume " + q.run + " from");
     q.scene = coupling::checkpoint_scene(q.checkpoint);

@@ -3,9 +3,13 @@
 // all ranks; landing on every snapshot time and on end_time), the engine's USL step and the heat
 // hand-off of DecomposedHeat every step, its windows closed by the scene's policy and at every snapshot
 // time (as the serial ThermalRun::after_step); series on rank 0 (OUT.h5), particle snapshots per rank
-// joined by OUT.xdmf.
+// joined by OUT.xdmf. Checkpoints (decomposed_checkpoint.hpp) at run.checkpoint_interval, every
+// --checkpoint-every wall seconds, at the end and on SIGINT/SIGTERM; a resumed run restores them and
+// rewrites OUT.h5 with the checkpoint's series rows, keeping the rank files' snapshots up to it.
+#include "distributed_run/decomposed_checkpoint.hpp"
 #include "distributed_run/decomposed_hotspots.hpp"
 #include "distributed_run/decomposed_setup.hpp"
+#include "run/checkpoint_io.hpp"
 #include "run/run_signals.hpp"
 #include "run/runner_detail.hpp"
 
@@ -57,17 +61,22 @@ class DecomposedRun {
 
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
-    if (!o_.resume_checkpoint.empty() || o_.checkpoint_wall_interval > 0.0 || o_.observer)
-      throw std::invalid_argument("a decomposed run has no checkpoints and no per-step observer");
+    if (o_.observer) throw std::invalid_argument("a decomposed run has no per-step observer");
     const detail::InterruptGuard interrupt_guard(o_.handle_signals);
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
-    check_output_files();  // before anything is built: refusals cost nothing
+    resuming_ = !o_.resume_checkpoint.empty();
+    checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
+    checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
+    if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
     build();
+    if (resuming_) restore();
     open_output();
-    series();
-    snapshot();
+    if (!resuming_) {  // a resumed run's output has the checkpoint's rows and snapshots already
+      series();
+      snapshot();
+    }
     detail::ProgressLine progress(std::cerr, rank_ == 0 && show_progress(), s_.end_time);
-    last_flush_ = Clock::now();
+    last_flush_ = last_checkpoint_ = Clock::now();
     try {
       loop(progress);
     } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
@@ -77,6 +86,9 @@ class DecomposedRun {
     }
     progress.finish();
     if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
+      // At the end, a stop at run.max_steps or an interruption: before the off-schedule row and
+      // snapshot below, which an uninterrupted run does not have (a resume drops them).
+      if (checkpoints_) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     }
@@ -164,18 +176,21 @@ class DecomposedRun {
         H5OutputOptions options;
         options.write_xdmf = false;  // OUT.xdmf joins the rank files (DecomposedOutput)
         options.via_temporary = true;
-        options.replace_existing = overwrite();
+        options.replace_existing = overwrite() || resuming_;  // a resume rewrites OUT.h5 (checkpoint's rows first)
         out_ = std::make_unique<H5Output>(r_.output, Dim, options);
         write_start_metadata();
         out_->declare_series(series_names());
         if (hot_) hot_->declare_table(*out_);
+        if (resuming_) rewrite_rows();
       } catch (const std::exception& e) {
         error = e.what();
       }
     }
     if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
     try {
-      snapshots_out_ = std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
+      snapshots_out_ = resuming_ ? std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, snapshots_,
+                                                                      split_grids(xdmf_grids_))
+                                 : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
     } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
@@ -217,10 +232,12 @@ class DecomposedRun {
   // SimulationError on every rank; then the engine's stable step, C min(h) / max_p (c_p + |v_p|) over
   // all ranks with c_p of each particle's state (Mie-Grüneisen: its current wave speed), as the serial
   // Simulation::stable_time_step.
-  void stable_time_step(double& dt, int& signal) const {
+  void stable_time_step(double& dt, int& signal, bool& checkpoint_due) const {
     const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
     constexpr double none = -std::numeric_limits<double>::infinity();
-    double v[3] = {static_cast<double>(detail::interrupt_signal()), none, none};  // max of −id: lowest id
+    // max of −id: lowest id; the last: whether --checkpoint-every's wall interval has passed on some rank
+    const bool wall = o_.checkpoint_wall_interval > 0.0 && seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval;
+    double v[4] = {static_cast<double>(detail::interrupt_signal()), none, none, wall ? 1.0 : 0.0};
     for (std::size_t k = 0; k < p.mass.size(); ++k) {
       const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k), xk(p.position.data() + Dim * k);
       if (!(vk.allFinite() && xk.allFinite()))
@@ -228,8 +245,9 @@ class DecomposedRun {
       else if (!grid_->contains(xk))
         v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
     }
-    MPI_Allreduce(MPI_IN_PLACE, v, 3, MPI_DOUBLE, MPI_MAX, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, comm_);
     signal = static_cast<int>(v[0]);
+    checkpoint_due = v[3] > 0.0;
     const std::string at = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: particle ";
     if (v[1] > none)
       throw mechanics::SimulationError(at + format_number(-v[1]) + " has a non-finite velocity or position (the step "
@@ -249,11 +267,14 @@ class DecomposedRun {
   // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
   void loop(detail::ProgressLine& progress) {
     const double T = s_.end_time;
-    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, 0.0);
+    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, time_);
     const double eps = schedule.eps();
+    const double ci = s_.checkpoint_interval;  // the next multiple after the start (as the serial loop)
+    double next_checkpoint = ci > 0.0 ? (std::floor(time_ / ci + 1e-9) + 1.0) * ci : std::numeric_limits<double>::infinity();
     double stable = 0.0;
     int signal = 0;
-    stable_time_step(stable, signal);
+    bool wall_due = false;
+    stable_time_step(stable, signal, wall_due);
     while (time_ < T - eps) {
       if (signal != 0) {
         r_.status = RunResult::Status::interrupted;
@@ -277,7 +298,7 @@ class DecomposedRun {
       time_ += dt;
       last_dt_ = dt;
       ++step_;
-      stable_time_step(stable, signal);  // throws SimulationError on every rank for a broken state
+      stable_time_step(stable, signal, wall_due);  // throws SimulationError on every rank for a broken state
       const double t = time_;
       if (heat_) {
         const Clock::time_point h0 = Clock::now();
@@ -293,6 +314,10 @@ class DecomposedRun {
       }
       if (schedule.series_due(t)) series();
       if (schedule.snapshot_due(t)) snapshot();
+      if (checkpoints_ && t < T - eps && (t >= next_checkpoint - eps || wall_due)) {  // the end: after the loop
+        checkpoint();
+        if (ci > 0.0) next_checkpoint = (std::floor(t / ci + 1e-9) + 1.0) * ci;
+      }
       progress.update(step_, t);
     }
     if (signal != 0) {  // caught during the last step: the run is complete, but say so as the serial run
@@ -332,6 +357,8 @@ class DecomposedRun {
     }
     if (out_) {
       out_->append_series(row);
+      series_rows_.insert(series_rows_.end(), row.begin(), row.end());  // for checkpoints
+      series_columns_ = static_cast<long>(row.size());
       if (hot_) hot_->append_table_rows(*out_, time_);
       if (seconds_since(last_flush_) >= o_.flush_interval) {
         out_->flush();
@@ -454,6 +481,11 @@ class DecomposedRun {
                          : r_.status == RunResult::Status::interrupted          ? "interrupted"
                                                                                 : "completed";
     out_->write_metadata("status", status);
+    if (checkpoints_written_ > 0) {
+      out_->write_metadata("checkpoints_written", checkpoints_written_);
+      out_->write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, this process's checkpoints
+    }
+    if (resuming_) out_->write_metadata("resumed_from", o_.resume_checkpoint);
     out_->write_metadata("steps", r_.steps);
     out_->write_metadata("final_time", r_.time);
     out_->write_metadata("wall_time", r_.wall_time);
@@ -482,6 +514,104 @@ class DecomposedRun {
   double heating_seconds_ = 0.0, output_seconds_ = 0.0;
   double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
   Clock::time_point last_flush_ = Clock::now();
+  // Checkpoints: whether this run writes them, where, the generation of the last one, the clock of
+  // --checkpoint-every; rank 0: every series row so far (flat) and OUT.xdmf's grids (from a resume).
+  bool checkpoints_ = false, resuming_ = false;
+  std::string checkpoint_file_;
+  long generation_ = 0, checkpoints_written_ = 0;
+  double checkpoint_seconds_ = 0.0;
+  Clock::time_point last_checkpoint_ = Clock::now();
+  std::vector<double> series_rows_;
+  long series_columns_ = 0;
+  std::string xdmf_grids_;
+  typename Mpm::CheckpointState restored_;
+
+  static constexpr char kGridSeparator = '\x1e';
+  static std::vector<std::string> split_grids(const std::string& joined) {
+    std::vector<std::string> grids;
+    for (std::size_t a = 0, b; a < joined.size(); a = b + 1) {
+      b = joined.find(kGridSeparator, a);
+      if (b == std::string::npos) b = joined.size();
+      grids.push_back(joined.substr(a, b - a));
+    }
+    return grids;
+  }
+
+  // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's.
+  void checkpoint() {
+    const Clock::time_point c0 = Clock::now();
+    CheckpointMarks m;
+    m.step = step_;
+    m.time = time_;
+    m.series_rows = series_columns_ > 0 ? static_cast<long>(series_rows_.size()) / series_columns_ : 0;
+    m.snapshots = snapshots_;
+    if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
+    xdmf_grids_.clear();
+    for (const std::string& g : snapshots_out_->xdmf_grids()) xdmf_grids_ += (xdmf_grids_.empty() ? "" : std::string(1, kGridSeparator)) + g;
+    try {
+      detail::write_decomposed_checkpoint(
+          comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
+          [&](const ckpt::Writer& w) { visit_global_state(w); });
+    } catch (const std::runtime_error& e) {  // on every rank; the previous checkpoint is whole
+      throw OutputError(e.what());
+    }
+    last_checkpoint_ = Clock::now();
+    ++checkpoints_written_;
+    checkpoint_seconds_ += seconds_since(c0);
+  }
+
+  // Collective: the state of o_.resume_checkpoint (every rank's own file and the global one).
+  void restore() {
+    try {
+      generation_ = detail::read_decomposed_checkpoint(
+          comm_, o_.resume_checkpoint, Dim, [&](const ckpt::Reader& r) { visit_rank_state(r); },
+          [&](const ckpt::Reader& r) { visit_global_state(r); });
+      mpm_->restore_checkpoint_state(restored_);
+    } catch (const std::exception& e) {  // read errors agreed by every rank; a bad state on every rank alike
+      throw OutputError(e.what());
+    }
+    restored_ = {};
+  }
+
+  // This rank: its particles (every swarm field, in swarm order), the mechanics' books and the heat.
+  template <class V> void visit_rank_state(const V& v) {
+    typename Mpm::CheckpointState st = mpm_->checkpoint_state();  // reading: the names and a template
+    for (auto& [name, values] : st.reals) v(("mechanics/" + name).c_str(), values);
+    for (auto& [name, values] : st.integers) v(("mechanics/" + name).c_str(), values);
+    v("mechanics/time", st.time);
+    v("mechanics/cumulative_work_first", st.cumulative_first);
+    v("mechanics/cumulative_work_second", st.cumulative_second);
+    v("mechanics/empty_node_mass", st.empty_node_mass);
+    v("mechanics/work_first", st.work_first);
+    v("mechanics/work_second", st.work_second);
+    v("mechanics/contact_stats", st.stats);
+    if constexpr (V::reading) restored_ = std::move(st);
+    if (heat_) heat_->visit_state(v);
+  }
+
+  // The same on every rank (rank 0 writes it): the run loop, the output so far, the hot spots.
+  template <class V> void visit_global_state(const V& v) {
+    v("run/time", time_);
+    v("run/step", step_);
+    v("run/last_dt", last_dt_);
+    v("run/snapshots", snapshots_);
+    v("run/last_series_step", last_series_step_);
+    v("run/last_snapshot_step", last_snapshot_step_);
+    v("output/series_rows", series_rows_);
+    v("output/series_columns", series_columns_);
+    v("output/xdmf_grids", xdmf_grids_);
+    if (hot_) hot_->visit_state(v);
+  }
+
+  // Rank 0, resuming: the checkpoint's series and /hotspots rows into the new OUT.h5.
+  void rewrite_rows() {
+    const auto c = static_cast<std::size_t>(series_columns_);
+    for (std::size_t a = 0; c > 0 && a + c <= series_rows_.size(); a += c)
+      out_->append_series(std::vector<double>(series_rows_.begin() + static_cast<long>(a),
+                                              series_rows_.begin() + static_cast<long>(a + c)));
+    if (hot_) hot_->rewrite_table_rows(*out_);
+    out_->write_metadata("resumed_at_step", step_);
+  }
 };
 
 }  // namespace

@@ -1,0 +1,45 @@
+#pragma once
+// Checkpoints of a decomposed run (docs/checkpoints.md, "Decomposed runs"): one HDF5 file per rank
+// and one global file, written collectively and committed atomically.
+//
+//   OUT.h5.checkpoint                 rank 0 writes it, every rank reads it: the serial checkpoint's
+//                                     root attributes (format, dimension) plus `ranks` (K) and
+//                                     `generation` (g), the scene text, source and --set overrides
+//                                     (checkpoint_scene), /marks (checkpoint_marks) and the global
+//                                     state the caller writes (run loop, series rows, hot spots)
+//   OUT.h5.checkpoint.<g>.rank<r>     rank r's state (particles in swarm order, heat per owned node)
+//
+// Writing generation g: every rank writes its file of generation g; once all succeeded (one
+// reduction), rank 0 writes the global file to OUT.h5.checkpoint.<pid>.tmp and renames it over the
+// previous one (the commit: until then the global file names generation g − 1, whose rank files are
+// untouched); then every rank removes its file of generation g − 1. A kill at any moment leaves a
+// global file whose rank files are all whole.
+#include <frictherm/coupling/checkpoint.hpp>
+#include <frictherm/coupling/scene.hpp>
+
+#include <mpi.h>
+
+#include <functional>
+#include <string>
+
+namespace frictherm::coupling::detail {
+
+/// Rank r's file of generation g beside the global checkpoint `path`.
+std::string decomposed_rank_checkpoint(const std::string& path, long generation, int rank);
+
+/// Collective: writes generation `generation` (> 0) as described above; `rank_part` on every rank
+/// into its file, `global_part` on rank 0 into the global file (names relative to the file's root).
+/// Throws std::runtime_error on every rank if any rank failed; the previous checkpoint stays whole.
+void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const Scene& scene, int dim, long generation,
+                                 const CheckpointMarks& marks,
+                                 const std::function<void(const ckpt::Writer&)>& rank_part,
+                                 const std::function<void(const ckpt::Writer&)>& global_part);
+
+/// Collective: checks the global file (format, dimension, ranks = the communicator's size), reads it
+/// on every rank with `global_part` and this rank's file with `rank_part`; returns the generation.
+/// Throws std::runtime_error on every rank if any rank failed.
+long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+                                const std::function<void(const ckpt::Reader&)>& rank_part,
+                                const std::function<void(const ckpt::Reader&)>& global_part);
+
+}  // namespace frictherm::coupling::detail
