@@ -78,6 +78,24 @@ void agree(MPI_Comm comm, const std::string& error) {
 
 }  // namespace
 
+constexpr char kGridSeparator = '\x1e';
+
+std::string join_grids(const std::vector<std::string>& grids) {
+  std::string joined;
+  for (const std::string& g : grids) joined += (joined.empty() ? "" : std::string(1, kGridSeparator)) + g;
+  return joined;
+}
+
+std::vector<std::string> split_grids(const std::string& joined) {
+  std::vector<std::string> grids;
+  for (std::size_t a = 0, b; a < joined.size(); a = b + 1) {
+    b = joined.find(kGridSeparator, a);
+    if (b == std::string::npos) b = joined.size();
+    grids.push_back(joined.substr(a, b - a));
+  }
+  return grids;
+}
+
 std::string decomposed_rank_checkpoint(const std::string& path, long generation, int rank) {
   return path + "." + std::to_string(generation) + ".rank" + std::to_string(rank);
 }
@@ -130,6 +148,28 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
   agree(comm, error);
   // 3. The previous generation is no longer named: every rank removes its file.
   if (generation > 1) std::remove(decomposed_rank_checkpoint(path, generation - 1, rank).c_str());
+}
+
+long committed_generation(MPI_Comm comm, const std::string& path) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  long generation = 0;
+  if (rank == 0 && ::access(path.c_str(), F_OK) == 0) {
+    const h5detail::Quiet quiet;
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f >= 0) {
+      if (H5Aexists(f, "generation") > 0) {
+        try {
+          generation = read_int_attribute(f, path, "generation");
+        } catch (const std::exception&) {
+          generation = 0;
+        }
+      }
+      H5Fclose(f);
+    }
+  }
+  MPI_Bcast(&generation, 1, MPI_LONG, 0, comm);
+  return generation;
 }
 
 long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,

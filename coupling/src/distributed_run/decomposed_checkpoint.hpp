@@ -21,6 +21,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace frictherm::coupling::detail {
 
@@ -41,5 +42,15 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
 long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
                                 const std::function<void(const ckpt::Reader&)>& rank_part,
                                 const std::function<void(const ckpt::Reader&)>& global_part);
+
+/// Collective: the generation the global file at `path` names (rank 0 reads it), 0 if there is none or
+/// it is not a decomposed checkpoint. A new run starts after it, so that it never rewrites the rank
+/// files a committed checkpoint names (a run replacing an earlier one's output with --force).
+long committed_generation(MPI_Comm comm, const std::string& path);
+
+/// OUT.xdmf's per-snapshot text (DecomposedOutput::xdmf_grids) as one string of the global file and
+/// back (separated by the ASCII record separator, which XML text does not hold).
+std::string join_grids(const std::vector<std::string>& grids);
+std::vector<std::string> split_grids(const std::string& joined);
 
 }  // namespace frictherm::coupling::detail

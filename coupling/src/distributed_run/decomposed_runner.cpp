@@ -68,6 +68,7 @@ class DecomposedRun {
     checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
     checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
     if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
+    if (checkpoints_ && !resuming_) generation_ = detail::committed_generation(comm_, checkpoint_file_);
     build();
     if (resuming_) restore();
     open_output();
@@ -189,7 +190,7 @@ class DecomposedRun {
     if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
     try {
       snapshots_out_ = resuming_ ? std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, snapshots_,
-                                                                      split_grids(xdmf_grids_))
+                                                                      detail::split_grids(xdmf_grids_))
                                  : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
     } catch (const std::exception& e) {
       throw OutputError(e.what());
@@ -526,17 +527,6 @@ class DecomposedRun {
   std::string xdmf_grids_;
   typename Mpm::CheckpointState restored_;
 
-  static constexpr char kGridSeparator = '\x1e';
-  static std::vector<std::string> split_grids(const std::string& joined) {
-    std::vector<std::string> grids;
-    for (std::size_t a = 0, b; a < joined.size(); a = b + 1) {
-      b = joined.find(kGridSeparator, a);
-      if (b == std::string::npos) b = joined.size();
-      grids.push_back(joined.substr(a, b - a));
-    }
-    return grids;
-  }
-
   // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's.
   void checkpoint() {
     const Clock::time_point c0 = Clock::now();
@@ -546,8 +536,7 @@ class DecomposedRun {
     m.series_rows = series_columns_ > 0 ? static_cast<long>(series_rows_.size()) / series_columns_ : 0;
     m.snapshots = snapshots_;
     if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
-    xdmf_grids_.clear();
-    for (const std::string& g : snapshots_out_->xdmf_grids()) xdmf_grids_ += (xdmf_grids_.empty() ? "" : std::string(1, kGridSeparator)) + g;
+    xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
     try {
       detail::write_decomposed_checkpoint(
           comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
