@@ -110,7 +110,7 @@ class DecomposedRun {
     if (heat_) pending_heat_ = heat_->pending_heat();  // collective
     if (out_) finish_output();
     snapshots_out_->close();
-    if (heat_ && rank_ == 0 && !o_.quiet) print_books(o_.log ? *o_.log : std::cerr);
+    if (heat_ && rank_ == 0 && !o_.quiet) detail::print_decomposed_books(o_.log ? *o_.log : std::cerr, heat_->books(), size_);
     return r_;
   }
 
@@ -430,20 +430,6 @@ class DecomposedRun {
     if (!o_.quiet) (o_.log ? *o_.log : std::cerr) << line << "\n";
   }
 
-  // The energy books summed over ranks (J) and how well they close (relative to the work received).
-  void print_books(std::ostream& log) const {
-    const DecomposedHeatBooks& b = heat_->books();
-    const double w = b.work_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
-    char line[512];
-    std::snprintf(line, sizeof line,
-                  "frictherm: energy books over %d ranks: frictional work received %.9g J, heat delivered %.9g J, "
-                  "nodal energy change %.9g J, particle energy change %.9g J (largest difference %.2g of the work)\n",
-                  size_, w, b.heat_delivered, b.nodal_energy_change, b.particle_energy_change,
-                  std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
-                            std::fabs(b.particle_energy_change - w)}) / scale);
-    log << line;
-  }
-
   // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5.
   void finish_output() {
     r_.series_rows = out_->series_rows();
@@ -551,14 +537,20 @@ class DecomposedRun {
 
   // Collective: the state of o_.resume_checkpoint (every rank's own file and the global one).
   void restore() {
-    try {
+    try {  // read errors are agreed by every rank
       generation_ = detail::read_decomposed_checkpoint(
           comm_, o_.resume_checkpoint, Dim, [&](const ckpt::Reader& r) { visit_rank_state(r); },
           [&](const ckpt::Reader& r) { visit_global_state(r); });
-      mpm_->restore_checkpoint_state(restored_);
-    } catch (const std::exception& e) {  // read errors agreed by every rank; a bad state on every rank alike
+    } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
+    std::string error;
+    try {
+      mpm_->restore_checkpoint_state(restored_);
+    } catch (const std::exception& e) {
+      error = o_.resume_checkpoint + ": " + e.what();
+    }
+    if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
     restored_ = {};
   }
 

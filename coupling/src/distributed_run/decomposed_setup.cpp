@@ -1,9 +1,12 @@
-// A decomposed run's grid, options and particles from a scene (decomposed_setup.hpp).
+// A decomposed run's grid, options and particles from a scene, agreed errors and the books' log line
+// (decomposed_setup.hpp).
 #include "distributed_run/decomposed_setup.hpp"
 
 #include "scene/scene_detail.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 namespace frictherm::coupling::detail {
 
@@ -91,5 +94,17 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MP
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(2)
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
 #undef FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP
+
+void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {
+  const double w = b.work_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "frictherm: energy books over %d ranks: frictional work received %.9g J, heat delivered %.9g J, "
+                "nodal energy change %.9g J, particle energy change %.9g J (largest difference %.2g of the work)\n",
+                ranks, w, b.heat_delivered, b.nodal_energy_change, b.particle_energy_change,
+                std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
+                          std::fabs(b.particle_energy_change - w)}) / scale);
+  log << line;
+}
 
 }  // namespace frictherm::coupling::detail
