@@ -78,7 +78,7 @@ const char* const kRunHelp =
     "exists, unless --force. No grid fields or stresses in a decomposed run's snapshots yet.\n"
     "Checkpoints (run.checkpoint_interval, --checkpoint-every, at the end and on Ctrl-C) are one file\n"
     "per rank, OUT.h5.checkpoint.<g>.rank<r>, named by OUT.h5.checkpoint; `mpirun -n K frictherm\n"
-    "resume OUT.h5` goes on from them on the same K (another K is refused), bit-for-bit.\n";
+    "resume OUT.h5` goes on from them: bit-for-bit on the same K, redistributed on another K.\n";
 
 const char* const kValidateHelp =
     "usage: frictherm validate SCENE [--set KEY=VALUE ...]\n"

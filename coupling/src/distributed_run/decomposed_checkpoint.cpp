@@ -172,6 +172,36 @@ long committed_generation(MPI_Comm comm, const std::string& path) {
   return generation;
 }
 
+namespace {
+
+// Opens the global file and checks it (format, a decomposed run's, dimension); `ranks` and
+// `generation` from its attributes.
+Handle open_global(const std::string& path, int dim, long& ranks, long& generation) {
+  Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
+  if (read_int_attribute(f.get(), path, "format") != kFormat)
+    throw std::runtime_error("checkpoint '" + path + "': written by another frictherm version (format)");
+  if (H5Aexists(f.get(), "ranks") <= 0)
+    throw std::runtime_error("checkpoint '" + path + "' was written by a serial run: resume it without mpirun");
+  if (read_int_attribute(f.get(), path, "dimension") != dim)
+    throw std::runtime_error("checkpoint '" + path + "': of another dimension than the scene");
+  ranks = read_int_attribute(f.get(), path, "ranks");
+  generation = read_int_attribute(f.get(), path, "generation");
+  return f;
+}
+
+// Opens rank r's file of the generation and checks its attributes.
+Handle open_rank_file(const std::string& path, long generation, int r) {
+  const std::string file = decomposed_rank_checkpoint(path, generation, r);
+  Handle g{check_id(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), file,
+                    "cannot open the rank's checkpoint (named by '" + path + "')"),
+           H5Fclose};
+  if (read_int_attribute(g.get(), file, "generation") != generation || read_int_attribute(g.get(), file, "rank") != r)
+    throw std::runtime_error("checkpoint '" + file + "': of another generation or rank than its name says");
+  return g;
+}
+
+}  // namespace
+
 long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
                                 const std::function<void(const ckpt::Reader&)>& rank_part,
                                 const std::function<void(const ckpt::Reader&)>& global_part) {
@@ -179,31 +209,37 @@ long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   std::string error;
-  long generation = 0;
+  long generation = 0, ranks = 0;
   try {
     const h5detail::Quiet quiet;
-    const Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"),
-                   H5Fclose};
-    if (read_int_attribute(f.get(), path, "format") != kFormat)
-      throw std::runtime_error("checkpoint '" + path + "': written by another frictherm version (format)");
-    if (H5Aexists(f.get(), "ranks") <= 0)
-      throw std::runtime_error("checkpoint '" + path + "' was written by a serial run: resume it without mpirun");
-    const long ranks = read_int_attribute(f.get(), path, "ranks");
+    const Handle f = open_global(path, dim, ranks, generation);
     if (ranks != size)
       throw std::runtime_error("checkpoint '" + path + "' was written by " + std::to_string(ranks) +
                                " ranks, resumed on " + std::to_string(size) + ": run mpirun -n " +
                                std::to_string(ranks));
-    if (read_int_attribute(f.get(), path, "dimension") != dim)
-      throw std::runtime_error("checkpoint '" + path + "': of another dimension than the scene");
-    generation = read_int_attribute(f.get(), path, "generation");
     global_part(ckpt::Reader{f.get(), path, 0});
-    const std::string file = decomposed_rank_checkpoint(path, generation, rank);
-    const Handle g{check_id(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), file,
-                            "cannot open the rank's checkpoint (named by '" + path + "')"),
-                   H5Fclose};
-    if (read_int_attribute(g.get(), file, "generation") != generation || read_int_attribute(g.get(), file, "rank") != rank)
-      throw std::runtime_error("checkpoint '" + file + "': of another generation or rank than its name says");
-    rank_part(ckpt::Reader{g.get(), file, 0});
+    const Handle g = open_rank_file(path, generation, rank);
+    rank_part(ckpt::Reader{g.get(), decomposed_rank_checkpoint(path, generation, rank), 0});
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  agree(comm, error);
+  return generation;
+}
+
+long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+                                   const std::function<void(const ckpt::Reader&, int)>& file_part,
+                                   const std::function<void(const ckpt::Reader&)>& global_part) {
+  std::string error;
+  long generation = 0, ranks = 0;
+  try {
+    const h5detail::Quiet quiet;
+    const Handle f = open_global(path, dim, ranks, generation);
+    global_part(ckpt::Reader{f.get(), path, 0});
+    for (int j = 0; j < static_cast<int>(ranks); ++j) {
+      const Handle g = open_rank_file(path, generation, j);
+      file_part(ckpt::Reader{g.get(), decomposed_rank_checkpoint(path, generation, j), 0}, j);
+    }
   } catch (const std::exception& e) {
     error = e.what();
   }

@@ -43,6 +43,14 @@ long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
                                 const std::function<void(const ckpt::Reader&)>& rank_part,
                                 const std::function<void(const ckpt::Reader&)>& global_part);
 
+/// Collective, for a checkpoint written by another number of ranks: reads the global file on every
+/// rank with `global_part`, then every rank file j of the checkpoint with `file_part(reader, j)` (each
+/// rank takes what it needs: some files' particles, the heat of its owned nodes). Returns the
+/// generation; throws std::runtime_error on every rank if any rank failed.
+long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+                                   const std::function<void(const ckpt::Reader&, int)>& file_part,
+                                   const std::function<void(const ckpt::Reader&)>& global_part);
+
 /// Collective: the generation the global file at `path` names (rank 0 reads it), 0 if there is none or
 /// it is not a decomposed checkpoint. A new run starts after it, so that it never rewrites the rank
 /// files a committed checkpoint names (a run replacing an earlier one's output with --force).

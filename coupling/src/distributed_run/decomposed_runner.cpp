@@ -8,6 +8,7 @@
 // rewrites OUT.h5 with the checkpoint's series rows, keeping the rank files' snapshots up to it.
 #include "distributed_run/decomposed_checkpoint.hpp"
 #include "distributed_run/decomposed_hotspots.hpp"
+#include "distributed_run/decomposed_redistribute.hpp"
 #include "distributed_run/decomposed_setup.hpp"
 #include "run/checkpoint_io.hpp"
 #include "run/run_signals.hpp"
@@ -190,7 +191,8 @@ class DecomposedRun {
     if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
     try {
       snapshots_out_ = resuming_ ? std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, snapshots_,
-                                                                      detail::split_grids(xdmf_grids_))
+                                                                      detail::split_grids(xdmf_grids_),
+                                                                      redistributed_from_ > 0)
                                  : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
     } catch (const std::exception& e) {
       throw OutputError(e.what());
@@ -473,6 +475,7 @@ class DecomposedRun {
       out_->write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, this process's checkpoints
     }
     if (resuming_) out_->write_metadata("resumed_from", o_.resume_checkpoint);
+    if (redistributed_from_ > 0) out_->write_metadata("resumed_from_ranks", redistributed_from_);
     out_->write_metadata("steps", r_.steps);
     out_->write_metadata("final_time", r_.time);
     out_->write_metadata("wall_time", r_.wall_time);
@@ -512,6 +515,7 @@ class DecomposedRun {
   long series_columns_ = 0;
   std::string xdmf_grids_;
   typename Mpm::CheckpointState restored_;
+  int redistributed_from_ = 0;  // ranks of a checkpoint resumed on another number of ranks
 
   // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's.
   void checkpoint() {
@@ -530,13 +534,21 @@ class DecomposedRun {
     } catch (const std::runtime_error& e) {  // on every rank; the previous checkpoint is whole
       throw OutputError(e.what());
     }
+    if (rank_ == 0 && redistributed_from_ > size_ && checkpoints_written_ == 0)  // the resumed generation's
+      for (int j = size_; j < redistributed_from_; ++j)                          // files of ranks gone
+        std::remove(detail::decomposed_rank_checkpoint(checkpoint_file_, generation_ - 1, j).c_str());
     last_checkpoint_ = Clock::now();
     ++checkpoints_written_;
     checkpoint_seconds_ += seconds_since(c0);
   }
 
-  // Collective: the state of o_.resume_checkpoint (every rank's own file and the global one).
+  // Collective: the state of o_.resume_checkpoint (every rank's own file and the global one; of
+  // another rank count: decomposed_redistribute.hpp).
   void restore() {
+    if (const int old = checkpoint_ranks(o_.resume_checkpoint); old > 0 && old != size_) {
+      redistribute(old);
+      return;
+    }
     try {  // read errors are agreed by every rank
       generation_ = detail::read_decomposed_checkpoint(
           comm_, o_.resume_checkpoint, Dim, [&](const ckpt::Reader& r) { visit_rank_state(r); },
@@ -566,6 +578,9 @@ class DecomposedRun {
     v("mechanics/work_first", st.work_first);
     v("mechanics/work_second", st.work_second);
     v("mechanics/contact_stats", st.stats);
+    std::vector<long> owned;  // this rank's owned nodes (DMDA indices, [begin, end) per axis): redistribution
+    if constexpr (!V::reading) for (int b : mpm_->owned_nodes()) owned.push_back(b);
+    v("mechanics/owned_nodes", owned);
     if constexpr (V::reading) restored_ = std::move(st);
     if (heat_) heat_->visit_state(v);
   }
@@ -582,6 +597,25 @@ class DecomposedRun {
     v("output/series_columns", series_columns_);
     v("output/xdmf_grids", xdmf_grids_);
     if (hot_) hot_->visit_state(v);
+  }
+
+  // Collective: a checkpoint of `old` ranks: rank r takes the particles of the files j ≡ r (mod K),
+  // which then migrate to their owners, and the heat of its owned nodes from the files owning them.
+  void redistribute(int old) {
+    detail::Redistribution<Dim> re(*mpm_, heat_ != nullptr);
+    try {
+      generation_ = detail::read_redistributed_checkpoint(
+          comm_, o_.resume_checkpoint, Dim,
+          [&](const ckpt::Reader& r, int j) {
+            re.take(r, j, j % size_ == rank_);
+            if (heat_ && j == 0) heat_->visit_state(r);  // books and window: the same in every file
+          },
+          [&](const ckpt::Reader& r) { visit_global_state(r); });
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+    re.finish(heat_.get());
+    redistributed_from_ = old;
   }
 
   // Rank 0, resuming: the checkpoint's series and /hotspots rows into the new OUT.h5.

@@ -74,7 +74,7 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
 }
 
 template <int Dim>
-void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c) {
+void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool migrate) {
   Impl& s = *impl_;
   auto integers = [&](const std::string& name) -> const std::vector<std::int64_t>& {
     for (const auto& [n, v] : c.integers)
@@ -89,7 +89,7 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c) {
                                 " materials for " + std::to_string(n) + " ids");
   // The last step's work per owned node (empty before the first step with contact).
   const auto owned = static_cast<std::size_t>(s.owned_count());
-  if (c.stats.size() != 4 || (!c.work_first.empty() && c.work_first.size() != owned) ||
+  if (c.stats.size() != 4 || (!c.work_first.empty() && c.work_first.size() != owned && !migrate) ||
       c.work_second.size() != c.work_first.size())
     throw std::invalid_argument("decomposed mechanics: checkpoint state of another decomposition (owned nodes or "
                                 "contact counters differ)");
@@ -141,11 +141,16 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c) {
   s.work_second = c.work_second;
   s.stats = DecomposedContactStats{c.stats[0], c.stats[1], c.stats[2], c.stats[3]};
   s.current_valid = false;
+  if (migrate) {
+    const long sent = s.traffic.particles_sent, received = s.traffic.particles_received;
+    s.migrate(0.0);
+    s.traffic.particles_sent = sent, s.traffic.particles_received = received;  // not a step
+  }
 }
 
 #define FRICTHERM_INSTANTIATE_CHECKPOINT(D)                                                                \
   template DecomposedMpm<D>::CheckpointState DecomposedMpm<D>::checkpoint_state() const;                  \
-  template void DecomposedMpm<D>::restore_checkpoint_state(const CheckpointState&);
+  template void DecomposedMpm<D>::restore_checkpoint_state(const CheckpointState&, bool);
 FRICTHERM_INSTANTIATE_CHECKPOINT(2)
 FRICTHERM_INSTANTIATE_CHECKPOINT(3)
 #undef FRICTHERM_INSTANTIATE_CHECKPOINT

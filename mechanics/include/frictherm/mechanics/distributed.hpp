@@ -300,8 +300,9 @@ class DecomposedMpm {
   CheckpointState checkpoint_state() const;
   /// This rank alone: replaces its particles and books by `state` (no migration: the particles stay
   /// in the given order on this rank). Throws std::invalid_argument for arrays of the wrong size
-  /// or a missing field.
-  void restore_checkpoint_state(const CheckpointState& state);
+  /// or a missing field. With `migrate` (collective; a checkpoint of another rank count, each rank
+  /// given some of its particles): every particle then goes to its owner, as after add_particles.
+  void restore_checkpoint_state(const CheckpointState& state, bool migrate = false);
 
  private:
   struct Impl;
