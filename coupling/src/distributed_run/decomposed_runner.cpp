@@ -106,7 +106,8 @@ class DecomposedRun {
     r_.time = time_;
     r_.wall_time = seconds_since(t0);
     record_phase_seconds();
-    record_traffic();
+    detail::record_decomposed_traffic(comm_, mpm_->traffic(), mpm_->local_particles(), out_.get(),
+                                      o_.quiet ? nullptr : (o_.log ? o_.log : &std::cerr));
     r_.snapshots = static_cast<std::size_t>(snapshots_);
     if (heat_) pending_heat_ = heat_->pending_heat();  // collective
     if (out_) finish_output();
@@ -398,38 +399,6 @@ class DecomposedRun {
     double accounted = 0.0;
     for (const auto& x : ph) accounted += x.second;
     ph.emplace_back("other", r_.wall_time - accounted);
-  }
-
-  // Collective: the engine's traffic counters (DecomposedTraffic) per rank, their mean and largest over
-  // the ranks, as metadata of OUT.h5 (traffic_*_mean, traffic_*_max) and one log line on rank 0: ghost
-  // nodes (a grid exchange sends ghost_nodes × values_per_node doubles), particles migrated per step,
-  // per-field contact entries per step, bytes per migrated particle and per field entry.
-  void record_traffic() {
-    const mechanics::DecomposedTraffic& t = mpm_->traffic();
-    const double steps = std::max(1L, t.steps);
-    const char* names[] = {"ghost_nodes", "grid_exchange_bytes", "migrated_particles_per_step",
-                           "migration_bytes_per_step", "field_entries_per_step", "field_bytes_per_step",
-                           "local_particles"};
-    double mine[7] = {static_cast<double>(t.ghost_nodes),
-                      static_cast<double>(t.ghost_nodes) * t.values_per_node * sizeof(double),
-                      (t.particles_sent + t.particles_received) / steps,
-                      (t.particles_sent + t.particles_received) * static_cast<double>(t.particle_bytes) / steps,
-                      2.0 * t.field_entries_sent / steps,  // sent to the owners and received back
-                      2.0 * t.field_entries_sent * static_cast<double>(t.field_entry_bytes) / steps,
-                      static_cast<double>(mpm_->local_particles())};
-    double sum[7], max[7];
-    MPI_Reduce(mine, sum, 7, MPI_DOUBLE, MPI_SUM, 0, comm_);
-    MPI_Reduce(mine, max, 7, MPI_DOUBLE, MPI_MAX, 0, comm_);
-    if (rank_ != 0) return;
-    std::string line = "frictherm: traffic per rank (mean / largest):";
-    for (int i = 0; i < 7; ++i) {
-      if (out_) {
-        out_->write_metadata(std::string("traffic_") + names[i] + "_mean", sum[i] / size_);
-        out_->write_metadata(std::string("traffic_") + names[i] + "_max", max[i]);
-      }
-      line += std::string(i ? ", " : " ") + names[i] + " " + format_number(sum[i] / size_) + " / " + format_number(max[i]);
-    }
-    if (!o_.quiet) (o_.log ? *o_.log : std::cerr) << line << "\n";
   }
 
   // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5.

@@ -1,5 +1,5 @@
-// A decomposed run's grid, options and particles from a scene, agreed errors and the books' log line
-// (decomposed_setup.hpp).
+// A decomposed run's grid, options and particles from a scene, agreed errors, the books' log line and
+// the traffic record (decomposed_setup.hpp).
 #include "distributed_run/decomposed_setup.hpp"
 
 #include "scene/scene_detail.hpp"
@@ -105,6 +105,42 @@ void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int
                 std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
                           std::fabs(b.particle_energy_change - w)}) / scale);
   log << line;
+}
+
+void record_decomposed_traffic(MPI_Comm comm, const mechanics::DecomposedTraffic& t, std::size_t local_particles,
+                               H5Output* out, std::ostream* log) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const double steps = std::max(1L, t.steps);
+  const char* names[] = {"ghost_nodes", "grid_exchange_bytes", "migrated_particles_per_step",
+                         "migration_bytes_per_step", "field_entries_per_step", "field_bytes_per_step",
+                         "local_particles"};
+  double mine[7] = {static_cast<double>(t.ghost_nodes),
+                    static_cast<double>(t.ghost_nodes) * t.values_per_node * sizeof(double),
+                    (t.particles_sent + t.particles_received) / steps,
+                    (t.particles_sent + t.particles_received) * static_cast<double>(t.particle_bytes) / steps,
+                    2.0 * t.field_entries_sent / steps,  // sent to the owners and received back
+                    2.0 * t.field_entries_sent * static_cast<double>(t.field_entry_bytes) / steps,
+                    static_cast<double>(local_particles)};
+  double sum[7], max[7];
+  MPI_Reduce(mine, sum, 7, MPI_DOUBLE, MPI_SUM, 0, comm);
+  MPI_Reduce(mine, max, 7, MPI_DOUBLE, MPI_MAX, 0, comm);
+  if (rank != 0) return;
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return std::string(buf);
+  };
+  std::string line = "frictherm: traffic per rank (mean / largest):";
+  for (int i = 0; i < 7; ++i) {
+    if (out) {
+      out->write_metadata(std::string("traffic_") + names[i] + "_mean", sum[i] / size);
+      out->write_metadata(std::string("traffic_") + names[i] + "_max", max[i]);
+    }
+    line += std::string(i ? ", " : " ") + names[i] + " " + number(sum[i] / size) + " / " + number(max[i]);
+  }
+  if (log) *log << line << "\n";
 }
 
 }  // namespace frictherm::coupling::detail
