@@ -69,14 +69,17 @@ const char* const kRunHelp =
     "(thermal.preconditioner jacobi, bjacobi, hypre) and coupling.subgrid_relaxation_time.\n"
     "Refused before any step, naming the scene key (exit code 2; the serial run supports them):\n"
     "penalty contact, extent separation, regularisation, extended B-splines, USF/MUSL, XPIC/FMPM,\n"
-    "damping, rigid contact partners, point loads, tractions, checkpoints (run.checkpoint_interval,\n"
-    "--checkpoint-every), thermal.linear_solver klu, the thermal.forward_euler options,\n"
-    "coupling.reuse_distance > 0 with forward Euler, fixed temperatures, reactions, the\n"
-    "continuation. Output: OUT.h5 holds the series (time, step, dt, kinetic energy, momentum,\n"
-    "frictional work, contact counts, heat delivered, thermal energy change, max temperature, hot\n"
-    "spots, energy books, plastic work and heat), /hotspots and metadata; each rank writes its particle\n"
+    "damping, rigid contact partners, point loads, tractions, thermal.linear_solver klu, the\n"
+    "thermal.forward_euler options, coupling.reuse_distance > 0 with forward Euler, fixed\n"
+    "temperatures, reactions, the continuation. Output: OUT.h5 holds the series (time, step, dt,\n"
+    "kinetic energy, momentum, frictional work, contact counts, heat delivered, thermal energy\n"
+    "change, max temperature, hot spots, energy books, plastic work and heat), /hotspots and\n"
+    "metadata; each rank writes its particle\n"
     "snapshots to OUT.rank<r>.h5, joined by OUT.xdmf; every one of these files is refused if it\n"
-    "exists, unless --force. No grid fields or stresses in a decomposed run's snapshots yet.\n";
+    "exists, unless --force. No grid fields or stresses in a decomposed run's snapshots yet.\n"
+    "Checkpoints (run.checkpoint_interval, --checkpoint-every, at the end and on Ctrl-C) are one file\n"
+    "per rank, OUT.h5.checkpoint.<g>.rank<r>, named by OUT.h5.checkpoint; `mpirun -n K frictherm\n"
+    "resume OUT.h5` goes on from them: bit-for-bit on the same K, redistributed on another K.\n";
 
 const char* const kValidateHelp =
     "usage: frictherm validate SCENE [--set KEY=VALUE ...]\n"

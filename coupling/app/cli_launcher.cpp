@@ -69,8 +69,8 @@ int refuse_under_launcher(const std::string& command) {
 #ifdef FRICTHERM_WITH_MPI
   if (command == "ensemble") return kOk;
 #ifdef FRICTHERM_DECOMPOSED_RUN
-  if (command == "run") return kOk;  // the decomposed run (cli_run_mpi.cpp)
-  const std::string why = "only 'frictherm run' (decomposed) and 'frictherm ensemble' share their work over MPI "
+  if (command == "run" || command == "resume") return kOk;  // the decomposed run (cli_run_mpi.cpp)
+  const std::string why = "only 'frictherm run' and 'frictherm resume' (decomposed) and 'frictherm ensemble' share their work over MPI "
                           "processes; every process would run '" + command +
                           "' alone and write the same files. Run it without the launcher (threads: --threads)";
 #else

@@ -3,6 +3,7 @@
 #include "cli.hpp"
 #include "cli_resume.hpp"
 
+#include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/result_append.hpp>
 #include <frictherm/coupling/runner.hpp>
@@ -35,6 +36,12 @@ const char* const kResumeHelp =
     "only when complete. Without RUN.h5 (a killed run leaves only RUN.h5.<pid>.part) the continuation\n"
     "is written alone, starting at the checkpoint's state.\n"
     "\n"
+    "A decomposed run's checkpoint (mpirun -n K frictherm run) is resumed with mpirun -n K frictherm\n"
+    "resume RUN.h5, in place: RUN.h5 is rewritten from the checkpoint's series rows, each rank file\n"
+    "keeps its snapshots up to it; on the same K bit-for-bit as an uninterrupted run, on another K the\n"
+    "particles are redistributed (round-off of reordered sums). -o and resuming it without mpirun are\n"
+    "refused (exit code 2).\n"
+    "\n"
     "  -o, --output FILE     write the appended result to FILE instead (RUN.h5 is left as it is)\n"
     "  -f, --force           replace FILE if it exists (else refused)\n"
     "  -t, --threads N       OpenMP threads (1 thread repeats an interrupted 1-thread run bit-for-bit)\n"
@@ -53,6 +60,9 @@ void remove_quietly(const std::string& path) {
 }  // namespace
 
 ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
+  if (const int ranks = coupling::checkpoint_ranks(q.checkpoint); ranks > 0)
+    throw coupling::OutputError(q.checkpoint + " was written by a decomposed run on " + std::to_string(ranks) +
+                                " ranks: resume it with mpirun -n " + std::to_string(ranks) + " frictherm resume " + q.run);
   ResumeOutcome out;
   coupling::RunOptions opt;
   opt.threads = q.threads;
@@ -144,6 +154,7 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
     if (end == v.c_str() || *end != '\0' || !(q.checkpoint_wall_interval > 0.0) || !std::isfinite(q.checkpoint_wall_interval))
       throw UsageError("resume", "--checkpoint-every: expected wall-clock seconds > 0, got '" + v + "'");
   }
+  if (several_processes(launcher_info())) return decomposed_resume_command(q);  // mpirun -n K (K > 1)
   return run_from_checkpoint(q, "resume", [&q] {
     if (!exists(q.checkpoint)) throw coupling::OutputError("no checkpoint " + q.checkpoint + " to resume " + q.run + " from");
     q.scene = coupling::checkpoint_scene(q.checkpoint);

@@ -38,4 +38,8 @@ int report_resumed(const char* command, const ResumeOutcome& outcome, bool quiet
 /// `command` is "resume" or "continue".
 int run_from_checkpoint(ResumeRequest& request, const char* command, const std::function<void()>& prepare);
 
+/// `mpirun -n K frictherm resume RUN.h5` (cli_run_mpi.cpp): a decomposed run's checkpoint resumed on
+/// the same K ranks, in place (no -o); a serial checkpoint or another K is refused (kUsage).
+int decomposed_resume_command(const ResumeRequest& request);
+
 }  // namespace frictherm::cli

@@ -2,11 +2,16 @@
 // the serial program, checked against what the decomposed engine supports (a refusal names the scene
 // key; exit code 2, nothing written), then run by run_scene_decomposed. Only rank 0 speaks.
 #include "cli.hpp"
+#include "cli_resume.hpp"
+
+#include <frictherm/coupling/checkpoint.hpp>
+#include <frictherm/coupling/output_files.hpp>
 
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #ifdef FRICTHERM_DECOMPOSED_RUN
@@ -33,6 +38,8 @@ int report(const coupling::RunResult& r, const coupling::RunOptions& opt, int ra
     std::cerr << "frictherm: " << r.message << ". Kept in " << r.output << ": " << r.series_rows << " series rows and "
               << r.snapshots << " snapshots (the last one at the interruption) in the rank files joined by the XDMF "
               << "file; /meta/status = interrupted.\n";
+    if (std::filesystem::exists(coupling::checkpoint_path(r.output)))
+      std::cerr << "frictherm: resume with: mpirun -n " << ranks << " frictherm resume " << r.output << '\n';
     return r.exit_code();
   }
   if (!opt.quiet) {
@@ -51,6 +58,9 @@ int report(const coupling::RunResult& r, const coupling::RunOptions& opt, int ra
   return kOk;
 }
 
+int run_and_report(const coupling::Scene& scene, const std::string& path, const coupling::RunOptions& opt, int rank,
+                   int ranks);
+
 int run_decomposed(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt, int rank, int ranks) {
   coupling::Scene scene;
   try {  // every rank loads and validates the scene (deterministic: all agree); rank 0 reports
@@ -66,12 +76,11 @@ int run_decomposed(const ParsedArgs& a, const std::string& path, const coupling:
     if (rank == 0) std::cerr << "frictherm: " << path << ": " << why << ".\n";
     return kUsage;
   }
-  if (opt.checkpoint_wall_interval > 0.0) {
-    if (rank == 0)
-      std::cerr << "frictherm run: --checkpoint-every is not supported in a decomposed run (no checkpoints); the "
-                   "serial run (without mpirun, or with -n 1) supports it\n";
-    return kUsage;
-  }
+  return run_and_report(scene, path, opt, rank, ranks);
+}
+
+int run_and_report(const coupling::Scene& scene, const std::string& path, const coupling::RunOptions& opt, int rank,
+                   int ranks) {
   coupling::RunResult r;
   try {
     r = coupling::run_scene_decomposed(MPI_COMM_WORLD, scene, opt);
@@ -103,6 +112,49 @@ int decomposed_run_command(const ParsedArgs& a, const std::string& path, const c
   return run_decomposed(a, path, opt, rank, ranks);
 #else
   return serial_run_command(a, path, opt);  // not reached: refuse_under_launcher refused `run` before
+#endif
+}
+
+int decomposed_resume_command(const ResumeRequest& q) {
+#ifdef FRICTHERM_DECOMPOSED_RUN
+  const mechanics::DecomposedPetscSession petsc(nullptr, nullptr);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  auto refuse = [&](const std::string& why) {
+    if (rank == 0) std::cerr << "frictherm resume: " << why << '\n';
+    return kUsage;
+  };
+  if (!std::filesystem::exists(q.checkpoint)) return refuse("no checkpoint " + q.checkpoint + " to resume " + q.run + " from");
+  int written = 0;
+  coupling::Scene scene;
+  try {  // every rank reads the global file (read-only); all agree
+    written = coupling::checkpoint_ranks(q.checkpoint);
+    scene = coupling::checkpoint_scene(q.checkpoint);
+  } catch (const std::exception& e) {
+    return refuse(q.checkpoint + ": " + e.what());
+  }
+  if (written == 0)
+    return refuse(q.checkpoint + " was written by a serial run: resume it without mpirun (frictherm resume " + q.run + ")");
+  if (written != ranks && rank == 0 && !q.quiet)  // the particles migrate to the new decomposition
+    std::cerr << "frictherm resume: note: " << q.checkpoint << " was written by " << written << " ranks, resumed on "
+              << ranks << ": the particles are redistributed (results agree to round-off, not bit-for-bit)\n";
+  if (q.output != q.run && !coupling::same_file(q.output, q.run))
+    return refuse("-o " + q.output + ": a decomposed run resumes in place (its rank files go on); leave out -o");
+  if (const std::string why = coupling::decomposed_run_refusal(scene); !why.empty()) return refuse(why);
+  coupling::RunOptions opt;
+  opt.threads = q.threads;
+  opt.checkpoint_wall_interval = q.checkpoint_wall_interval;
+  opt.quiet = q.quiet;
+  opt.command_line = q.command_line;
+  opt.handle_signals = true;
+  opt.resume_checkpoint = q.checkpoint;
+  opt.output = q.run;
+  opt.overwrite = true;
+  return run_and_report(scene, q.checkpoint, opt, rank, ranks);
+#else
+  (void)q;
+  return kUsage;  // not reached: refuse_under_launcher refused `resume` before
 #endif
 }
 

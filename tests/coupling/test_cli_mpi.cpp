@@ -98,8 +98,9 @@ TEST_F(CliMpi, MpiBuildRefusesCommandsThatDoNotShareWork) {
 #ifndef FRICTHERM_TEST_MPI
   GTEST_SKIP() << "frictherm was built without MPI";
 #endif
-  // `run` shares its work too when the decomposed engine is built (test_cli_mpirun.cpp runs it).
-  for (const char* cmd : {"resume", "microstructure", "export-csv"}) {
+  // `run` and `resume` share their work too when the decomposed engine is built (test_cli_mpirun.cpp,
+  // test_cli_mpirun_checkpoint.cpp run them).
+  for (const char* cmd : {"continue", "microstructure", "export-csv"}) {
     const Result r = shell(std::string("env PMI_SIZE=2 PMI_RANK=0 ") + mpi_exe() + " " + cmd + " '" + path("tiny.json") + "'");
     EXPECT_EQ(r.code, 2) << cmd << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr(std::string("every process would run '") + cmd + "' alone and write the same files"));

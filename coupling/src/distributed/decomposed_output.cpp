@@ -112,6 +112,52 @@ DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, boo
   }
 }
 
+DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, long kept, std::vector<std::string> grids,
+                                   bool create_missing)
+    : comm_(comm), dim_(dim), base_(std::move(base)), xdmf_path_(base_ + ".xdmf"), grids_(std::move(grids)),
+      snapshots_(kept) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+  std::string error;
+  const std::string file = rank_file(rank_);
+  try {
+    const h5::Quiet quiet;
+    const bool missing = ::access(file.c_str(), F_OK) != 0;
+    if (missing && !create_missing)
+      throw std::runtime_error("'" + file + "' is missing (the run's snapshots of rank " + std::to_string(rank_) + ")");
+    if (missing) {
+      file_ = h5::check_id(H5Fcreate(file.c_str(), H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT), file, "cannot create the file");
+      h5::Handle{h5::check_id(H5Gcreate2(file_, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
+                              "cannot create /snapshots"),
+                 H5Gclose};
+    } else {
+      file_ = h5::check_id(H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), file, "cannot open the file");
+    }
+    const h5::Handle g{h5::check_id(H5Gopen2(file_, "snapshots", H5P_DEFAULT), file, "cannot open /snapshots"), H5Gclose};
+    H5G_info_t info;
+    h5::check(H5Gget_info(g.get(), &info), file, "cannot list /snapshots");
+    const hsize_t n = info.nlinks;
+    if (static_cast<long>(n) < kept && !missing)
+      throw std::runtime_error("'" + file + "' holds " + std::to_string(n) + " snapshots, the checkpoint " +
+                               std::to_string(kept));
+    for (long k = missing ? static_cast<long>(n) : kept; k < static_cast<long>(n); ++k) {  // snapshots are numbered 0, 1, ... in order
+      char b[16];
+      std::snprintf(b, sizeof b, "%06ld", k);
+      h5::check(H5Ldelete(g.get(), b, H5P_DEFAULT), file, std::string("cannot remove snapshot ") + b);
+    }
+    h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
+    if (rank_ == 0) write_text_atomically(xdmf_path_, xdmf_document(grids_));
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  try {
+    agree(comm_, error);
+  } catch (...) {
+    close();
+    throw;
+  }
+}
+
 DecomposedOutput::~DecomposedOutput() { close(); }
 
 void DecomposedOutput::close() {

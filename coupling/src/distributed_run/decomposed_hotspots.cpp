@@ -72,7 +72,16 @@ void DecomposedHotSpots<Dim>::append_table_rows(H5Output& out, double time) {
     for (int m : h.materials) mask += std::ldexp(1.0, m);
     r.insert(r.end(), {h.birth_time, h.duration, h.excess_energy, mask});
     out.append_table_row("hotspots", r);
+    table_rows_.insert(table_rows_.end(), r.begin(), r.end());
   }
+}
+
+template <int Dim>
+void DecomposedHotSpots<Dim>::rewrite_table_rows(H5Output& out) const {
+  constexpr std::size_t columns = 11 + Dim;
+  for (std::size_t a = 0; a + columns <= table_rows_.size(); a += columns)
+    out.append_table_row("hotspots", std::vector<double>(table_rows_.begin() + static_cast<long>(a),
+                                                          table_rows_.begin() + static_cast<long>(a + columns)));
 }
 
 template class DecomposedHotSpots<2>;

@@ -33,6 +33,16 @@ class DecomposedHotSpots {
   void append_table_rows(H5Output& out, double time);
 
   const HotSpotTracker& tracker() const { return tracker_; }
+  /// Checkpoints: the tracker's state (the same on every rank) and the update counters of /hotspots.
+  template <class V> void visit_state(V&& v) {
+    tracker_.visit_state(v);
+    v("hotspots/updates", updates_);
+    v("hotspots/updates_written", updates_written_);
+    v("hotspots/table_rows", table_rows_);
+  }
+  /// Rank 0, resuming: the /hotspots rows written up to the checkpoint, appended again.
+  void rewrite_table_rows(H5Output& out) const;
+  long table_rows() const { return static_cast<long>(table_rows_.size() / (11 + Dim)); }
 
  private:
   std::vector<ThermalProperties> materials_;
@@ -42,6 +52,7 @@ class DecomposedHotSpots {
   long updates_ = 0, updates_written_ = -1;
   mechanics::Particles<Dim> local_;  // scratch: this rank's particles as the tracker reads them
   std::vector<std::int64_t> ids_;
+  std::vector<double> table_rows_;  // rank 0: every /hotspots row so far (11 + Dim columns), for checkpoints
 };
 
 }  // namespace frictherm::coupling::detail

@@ -3,9 +3,14 @@
 // all ranks; landing on every snapshot time and on end_time), the engine's USL step and the heat
 // hand-off of DecomposedHeat every step, its windows closed by the scene's policy and at every snapshot
 // time (as the serial ThermalRun::after_step); series on rank 0 (OUT.h5), particle snapshots per rank
-// joined by OUT.xdmf.
+// joined by OUT.xdmf. Checkpoints (decomposed_checkpoint.hpp) at run.checkpoint_interval, every
+// --checkpoint-every wall seconds, at the end and on SIGINT/SIGTERM; a resumed run restores them and
+// rewrites OUT.h5 with the checkpoint's series rows, keeping the rank files' snapshots up to it.
+#include "distributed_run/decomposed_checkpoint.hpp"
 #include "distributed_run/decomposed_hotspots.hpp"
+#include "distributed_run/decomposed_redistribute.hpp"
 #include "distributed_run/decomposed_setup.hpp"
+#include "run/checkpoint_io.hpp"
 #include "run/run_signals.hpp"
 #include "run/runner_detail.hpp"
 
@@ -57,17 +62,23 @@ class DecomposedRun {
 
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
-    if (!o_.resume_checkpoint.empty() || o_.checkpoint_wall_interval > 0.0 || o_.observer)
-      throw std::invalid_argument("a decomposed run has no checkpoints and no per-step observer");
+    if (o_.observer) throw std::invalid_argument("a decomposed run has no per-step observer");
     const detail::InterruptGuard interrupt_guard(o_.handle_signals);
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
-    check_output_files();  // before anything is built: refusals cost nothing
+    resuming_ = !o_.resume_checkpoint.empty();
+    checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
+    checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
+    if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
+    if (checkpoints_ && !resuming_) generation_ = detail::committed_generation(comm_, checkpoint_file_);
     build();
+    if (resuming_) restore();
     open_output();
-    series();
-    snapshot();
+    if (!resuming_) {  // a resumed run's output has the checkpoint's rows and snapshots already
+      series();
+      snapshot();
+    }
     detail::ProgressLine progress(std::cerr, rank_ == 0 && show_progress(), s_.end_time);
-    last_flush_ = Clock::now();
+    last_flush_ = last_checkpoint_ = Clock::now();
     try {
       loop(progress);
     } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
@@ -77,6 +88,9 @@ class DecomposedRun {
     }
     progress.finish();
     if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
+      // At the end, a stop at run.max_steps or an interruption: before the off-schedule row and
+      // snapshot below, which an uninterrupted run does not have (a resume drops them).
+      if (checkpoints_) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     }
@@ -92,12 +106,13 @@ class DecomposedRun {
     r_.time = time_;
     r_.wall_time = seconds_since(t0);
     record_phase_seconds();
-    record_traffic();
+    detail::record_decomposed_traffic(comm_, mpm_->traffic(), mpm_->local_particles(), out_.get(),
+                                      o_.quiet ? nullptr : (o_.log ? o_.log : &std::cerr));
     r_.snapshots = static_cast<std::size_t>(snapshots_);
     if (heat_) pending_heat_ = heat_->pending_heat();  // collective
     if (out_) finish_output();
     snapshots_out_->close();
-    if (heat_ && rank_ == 0 && !o_.quiet) print_books(o_.log ? *o_.log : std::cerr);
+    if (heat_ && rank_ == 0 && !o_.quiet) detail::print_decomposed_books(o_.log ? *o_.log : std::cerr, heat_->books(), size_);
     return r_;
   }
 
@@ -166,18 +181,22 @@ class DecomposedRun {
         H5OutputOptions options;
         options.write_xdmf = false;  // OUT.xdmf joins the rank files (DecomposedOutput)
         options.via_temporary = true;
-        options.replace_existing = overwrite();
+        options.replace_existing = overwrite() || resuming_;  // a resume rewrites OUT.h5 (checkpoint's rows first)
         out_ = std::make_unique<H5Output>(r_.output, Dim, options);
         write_start_metadata();
         out_->declare_series(series_names());
         if (hot_) hot_->declare_table(*out_);
+        if (resuming_) rewrite_rows();
       } catch (const std::exception& e) {
         error = e.what();
       }
     }
     if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
     try {
-      snapshots_out_ = std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
+      snapshots_out_ = resuming_ ? std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, snapshots_,
+                                                                      detail::split_grids(xdmf_grids_),
+                                                                      redistributed_from_ > 0)
+                                 : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
     } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
@@ -220,10 +239,12 @@ class DecomposedRun {
   // SimulationError on every rank; then the engine's stable step, C min(h) / max_p (c_p + |v_p|) over
   // all ranks with c_p of each particle's state (Mie-Grüneisen: its current wave speed), as the serial
   // Simulation::stable_time_step.
-  void stable_time_step(double& dt, int& signal) const {
+  void stable_time_step(double& dt, int& signal, bool& checkpoint_due) const {
     const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
     constexpr double none = -std::numeric_limits<double>::infinity();
-    double v[3] = {static_cast<double>(detail::interrupt_signal()), none, none};  // max of −id: lowest id
+    // max of −id: lowest id; the last: whether --checkpoint-every's wall interval has passed on some rank
+    const bool wall = o_.checkpoint_wall_interval > 0.0 && seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval;
+    double v[4] = {static_cast<double>(detail::interrupt_signal()), none, none, wall ? 1.0 : 0.0};
     for (std::size_t k = 0; k < p.mass.size(); ++k) {
       const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k), xk(p.position.data() + Dim * k);
       if (!(vk.allFinite() && xk.allFinite()))
@@ -231,8 +252,9 @@ class DecomposedRun {
       else if (!grid_->contains(xk))
         v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
     }
-    MPI_Allreduce(MPI_IN_PLACE, v, 3, MPI_DOUBLE, MPI_MAX, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, comm_);
     signal = static_cast<int>(v[0]);
+    checkpoint_due = v[3] > 0.0;
     const std::string at = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: particle ";
     if (v[1] > none)
       throw mechanics::SimulationError(at + format_number(-v[1]) + " has a non-finite velocity or position (the step "
@@ -252,11 +274,14 @@ class DecomposedRun {
   // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
   void loop(detail::ProgressLine& progress) {
     const double T = s_.end_time;
-    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, 0.0);
+    detail::OutputSchedule schedule(T, s_.output.snapshot_interval, s_.output.series_interval, time_);
     const double eps = schedule.eps();
+    const double ci = s_.checkpoint_interval;  // the next multiple after the start (as the serial loop)
+    double next_checkpoint = ci > 0.0 ? (std::floor(time_ / ci + 1e-9) + 1.0) * ci : std::numeric_limits<double>::infinity();
     double stable = 0.0;
     int signal = 0;
-    stable_time_step(stable, signal);
+    bool wall_due = false;
+    stable_time_step(stable, signal, wall_due);
     while (time_ < T - eps) {
       if (signal != 0) {
         r_.status = RunResult::Status::interrupted;
@@ -280,7 +305,7 @@ class DecomposedRun {
       time_ += dt;
       last_dt_ = dt;
       ++step_;
-      stable_time_step(stable, signal);  // throws SimulationError on every rank for a broken state
+      stable_time_step(stable, signal, wall_due);  // throws SimulationError on every rank for a broken state
       const double t = time_;
       if (heat_) {
         const Clock::time_point h0 = Clock::now();
@@ -296,6 +321,10 @@ class DecomposedRun {
       }
       if (schedule.series_due(t)) series();
       if (schedule.snapshot_due(t)) snapshot();
+      if (checkpoints_ && t < T - eps && (t >= next_checkpoint - eps || wall_due)) {  // the end: after the loop
+        checkpoint();
+        if (ci > 0.0) next_checkpoint = (std::floor(t / ci + 1e-9) + 1.0) * ci;
+      }
       progress.update(step_, t);
     }
     if (signal != 0) {  // caught during the last step: the run is complete, but say so as the serial run
@@ -336,6 +365,8 @@ class DecomposedRun {
     }
     if (out_) {
       out_->append_series(row);
+      series_rows_.insert(series_rows_.end(), row.begin(), row.end());  // for checkpoints
+      series_columns_ = static_cast<long>(row.size());
       if (hot_) hot_->append_table_rows(*out_, time_);
       if (seconds_since(last_flush_) >= o_.flush_interval) {
         out_->flush();
@@ -374,138 +405,3 @@ class DecomposedRun {
     ph.emplace_back("other", r_.wall_time - accounted);
   }
 
-  // Collective: the engine's traffic counters (DecomposedTraffic) per rank, their mean and largest over
-  // the ranks, as metadata of OUT.h5 (traffic_*_mean, traffic_*_max) and one log line on rank 0: ghost
-  // nodes (a grid exchange sends ghost_nodes × values_per_node doubles), particles migrated per step,
-  // per-field contact entries per step, bytes per migrated particle and per field entry.
-  void record_traffic() {
-    const mechanics::DecomposedTraffic& t = mpm_->traffic();
-    const double steps = std::max(1L, t.steps);
-    const char* names[] = {"ghost_nodes", "grid_exchange_bytes", "migrated_particles_per_step",
-                           "migration_bytes_per_step", "field_entries_per_step", "field_bytes_per_step",
-                           "local_particles"};
-    double mine[7] = {static_cast<double>(t.ghost_nodes),
-                      static_cast<double>(t.ghost_nodes) * t.values_per_node * sizeof(double),
-                      (t.particles_sent + t.particles_received) / steps,
-                      (t.particles_sent + t.particles_received) * static_cast<double>(t.particle_bytes) / steps,
-                      2.0 * t.field_entries_sent / steps,  // sent to the owners and received back
-                      2.0 * t.field_entries_sent * static_cast<double>(t.field_entry_bytes) / steps,
-                      static_cast<double>(mpm_->local_particles())};
-    double sum[7], max[7];
-    MPI_Reduce(mine, sum, 7, MPI_DOUBLE, MPI_SUM, 0, comm_);
-    MPI_Reduce(mine, max, 7, MPI_DOUBLE, MPI_MAX, 0, comm_);
-    if (rank_ != 0) return;
-    std::string line = "frictherm: traffic per rank (mean / largest):";
-    for (int i = 0; i < 7; ++i) {
-      if (out_) {
-        out_->write_metadata(std::string("traffic_") + names[i] + "_mean", sum[i] / size_);
-        out_->write_metadata(std::string("traffic_") + names[i] + "_max", max[i]);
-      }
-      line += std::string(i ? ", " : " ") + names[i] + " " + format_number(sum[i] / size_) + " / " + format_number(max[i]);
-    }
-    if (!o_.quiet) (o_.log ? *o_.log : std::cerr) << line << "\n";
-  }
-
-  // The energy books summed over ranks (J) and how well they close (relative to the heat received:
-  // frictional work plus plastic heat).
-  void print_books(std::ostream& log) const {
-    const DecomposedHeatBooks& b = heat_->books();
-    const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
-    char line[640];
-    std::snprintf(line, sizeof line,
-                  "frictherm: energy books over %d ranks: frictional work received %.9g J, plastic heat received %.9g J, "
-                  "heat delivered %.9g J, nodal energy change %.9g J, particle energy change %.9g J (largest "
-                  "difference %.2g of the heat received)\n",
-                  size_, b.work_received, b.plastic_heat_received, b.heat_delivered, b.nodal_energy_change,
-                  b.particle_energy_change,
-                  std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
-                            std::fabs(b.particle_energy_change - w)}) / scale);
-    log << line;
-  }
-
-  // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5.
-  void finish_output() {
-    r_.series_rows = out_->series_rows();
-    for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
-    if (heat_) {
-      const DecomposedHeatBooks& b = heat_->books();
-      const CouplerOptions& c = s_.thermal.coupler;
-      out_->write_metadata("thermal_integrator", c.integrator);
-      out_->write_metadata("thermal_rtol", c.integrator_options.rtol);
-      out_->write_metadata("thermal_atol", c.integrator_options.atol);
-      out_->write_metadata("thermal_preconditioner", s_.thermal.preconditioner);
-      out_->write_metadata("thermal_window_policy", to_string(c.window.kind));
-      out_->write_metadata("heating_order", mechanics::to_string(s_.thermal.heating_order));
-      out_->write_metadata("thermal_windows", b.windows);
-      out_->write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
-      out_->write_metadata("thermal_matrix_free_substeps", b.substeps);
-      out_->write_metadata("thermal_assembled_windows", b.assembled_windows);
-      out_->write_metadata("thermal_min_window", b.min_window);
-      out_->write_metadata("thermal_max_window", b.max_window);
-      const thermal::IntegratorStats st = heat_->integrator_stats();  // global counts
-      out_->write_metadata("thermal_steps", st.steps);
-      out_->write_metadata("thermal_rhs_evals", st.rhs_evals);
-      out_->write_metadata("thermal_linear_iters", st.linear_iters);
-      out_->write_metadata("thermal_error_test_failures", st.error_test_failures);
-      out_->write_metadata("thermal_wall_time", st.wall_seconds);
-      out_->write_metadata("work_received", b.work_received);
-      out_->write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
-      out_->write_metadata("plastic_work_received", b.plastic_work_received);
-      out_->write_metadata("plastic_heat_received", b.plastic_heat_received);
-      out_->write_metadata("plastic_heat_delivered", b.plastic_heat_delivered);
-      out_->write_metadata("heat_delivered", b.heat_delivered);
-      out_->write_metadata("heat_pending", pending_heat_);
-      out_->write_metadata("nodal_energy_change", b.nodal_energy_change);
-      out_->write_metadata("particle_energy_change", b.particle_energy_change);
-      out_->write_metadata("max_capacity_residual", b.max_capacity_residual);
-      out_->write_metadata("hotspots_seen", hot_->tracker().ids_issued());
-    }
-    const char* status = r_.status == RunResult::Status::failed                 ? "failed"
-                         : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
-                         : r_.status == RunResult::Status::interrupted          ? "interrupted"
-                                                                                : "completed";
-    out_->write_metadata("status", status);
-    out_->write_metadata("steps", r_.steps);
-    out_->write_metadata("final_time", r_.time);
-    out_->write_metadata("wall_time", r_.wall_time);
-    try {
-      out_->close();
-    } catch (const std::exception& e) {
-      throw OutputError(e.what());
-    }
-  }
-
-  MPI_Comm comm_;
-  const Scene& s_;
-  const RunOptions& o_;
-  int rank_ = 0, size_ = 1;
-  RunResult r_;
-  std::unique_ptr<mechanics::Grid<Dim>> grid_;
-  std::unique_ptr<Mpm> mpm_;
-  std::unique_ptr<DecomposedHeat> heat_;  // scenes with a `thermal` section
-  std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
-  std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
-  std::unique_ptr<DecomposedOutput> snapshots_out_;
-  int temperature_ = 0;
-  double time_ = 0.0, last_dt_ = 0.0;
-  long step_ = 0, snapshots_ = 0;
-  long last_series_step_ = -1, last_snapshot_step_ = -1;
-  double heating_seconds_ = 0.0, output_seconds_ = 0.0;
-  double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
-  Clock::time_point last_flush_ = Clock::now();
-};
-
-}  // namespace
-
-std::vector<std::string> decomposed_output_files(const std::string& out, int ranks) {
-  std::vector<std::string> files{out, xdmf_path_for(out)};
-  for (int r = 0; r < ranks; ++r) files.push_back(DecomposedOutput::rank_file(output_base(out), r));
-  return files;
-}
-
-RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options) {
-  if (scene.dimension == 2) return DecomposedRun<2>(comm, scene, options).execute();
-  return DecomposedRun<3>(comm, scene, options).execute();
-}
-
-}  // namespace frictherm::coupling

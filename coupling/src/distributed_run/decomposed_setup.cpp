@@ -1,9 +1,12 @@
-// A decomposed run's grid, options and particles from a scene (decomposed_setup.hpp).
+// A decomposed run's grid, options and particles from a scene, agreed errors, the books' log line and
+// the traffic record (decomposed_setup.hpp).
 #include "distributed_run/decomposed_setup.hpp"
 
 #include "scene/scene_detail.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 namespace frictherm::coupling::detail {
 
@@ -96,5 +99,56 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MP
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(2)
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
 #undef FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP
+
+void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {
+  // Relative to the heat received: frictional work plus plastic heat.
+  const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
+  char line[640];
+  std::snprintf(line, sizeof line,
+                "frictherm: energy books over %d ranks: frictional work received %.9g J, plastic heat received %.9g J, "
+                "heat delivered %.9g J, nodal energy change %.9g J, particle energy change %.9g J (largest "
+                "difference %.2g of the heat received)\n",
+                ranks, b.work_received, b.plastic_heat_received, b.heat_delivered, b.nodal_energy_change,
+                b.particle_energy_change,
+                std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
+                          std::fabs(b.particle_energy_change - w)}) / scale);
+  log << line;
+}
+
+void record_decomposed_traffic(MPI_Comm comm, const mechanics::DecomposedTraffic& t, std::size_t local_particles,
+                               H5Output* out, std::ostream* log) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const double steps = std::max(1L, t.steps);
+  const char* names[] = {"ghost_nodes", "grid_exchange_bytes", "migrated_particles_per_step",
+                         "migration_bytes_per_step", "field_entries_per_step", "field_bytes_per_step",
+                         "local_particles"};
+  double mine[7] = {static_cast<double>(t.ghost_nodes),
+                    static_cast<double>(t.ghost_nodes) * t.values_per_node * sizeof(double),
+                    (t.particles_sent + t.particles_received) / steps,
+                    (t.particles_sent + t.particles_received) * static_cast<double>(t.particle_bytes) / steps,
+                    2.0 * t.field_entries_sent / steps,  // sent to the owners and received back
+                    2.0 * t.field_entries_sent * static_cast<double>(t.field_entry_bytes) / steps,
+                    static_cast<double>(local_particles)};
+  double sum[7], max[7];
+  MPI_Reduce(mine, sum, 7, MPI_DOUBLE, MPI_SUM, 0, comm);
+  MPI_Reduce(mine, max, 7, MPI_DOUBLE, MPI_MAX, 0, comm);
+  if (rank != 0) return;
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return std::string(buf);
+  };
+  std::string line = "frictherm: traffic per rank (mean / largest):";
+  for (int i = 0; i < 7; ++i) {
+    if (out) {
+      out->write_metadata(std::string("traffic_") + names[i] + "_mean", sum[i] / size);
+      out->write_metadata(std::string("traffic_") + names[i] + "_max", max[i]);
+    }
+    line += std::string(i ? ", " : " ") + names[i] + " " + number(sum[i] / size) + " / " + number(max[i]);
+  }
+  if (log) *log << line << "\n";
+}
 
 }  // namespace frictherm::coupling::detail

@@ -186,6 +186,13 @@ std::string joined_overrides(const std::vector<SceneOverride>& list) {
 
 std::string checkpoint_path(const std::string& result_path) { return result_path + ".checkpoint"; }
 
+int checkpoint_ranks(const std::string& path) {
+  const h5detail::Quiet quiet;
+  const Handle f = open_checkpoint(path, 0);
+  if (H5Aexists(f.get(), "ranks") <= 0) return 0;
+  return read_int_attribute(f.get(), path, "ranks");
+}
+
 template <int Dim>
 void write_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, const Scene& scene,
                       const CheckpointMarks& marks, const std::function<void(const ckpt::Writer&)>& extra) {

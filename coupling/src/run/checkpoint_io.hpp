@@ -64,6 +64,9 @@ struct Writer {
     const std::int32_t b = x ? 1 : 0;
     write_array(group, file, name, H5T_NATIVE_INT32, &b, 1, 1);
   }
+  void operator()(const char* name, std::string& text) const {  // bytes
+    write_array(group, file, name, H5T_NATIVE_CHAR, text.data(), text.size(), 1);
+  }
 };
 
 struct Reader {
@@ -97,6 +100,14 @@ struct Reader {
     std::int32_t b = 0;
     scalar(name, H5T_NATIVE_INT32, b);
     x = b != 0;
+  }
+  void operator()(const char* name, std::string& text) const {
+    hsize_t n = 0;
+    const h5detail::Handle d = open_array(group, file, name, 1, n);
+    text.assign(n, '\0');
+    if (n > 0)
+      h5detail::check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), file,
+                      "cannot read '" + std::string(name) + "'");
   }
 };
 

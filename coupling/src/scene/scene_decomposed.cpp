@@ -45,8 +45,6 @@ std::string mechanics_refusal(const Scene& s) {
     return refuse("loads.point", std::to_string(s.point_loads.size()) + " point load(s)", "no point loads");
   if (!s.tractions.empty())
     return refuse("loads.traction", std::to_string(s.tractions.size()) + " traction(s)", "no tractions");
-  if (s.checkpoint_interval > 0.0)
-    return refuse("run.checkpoint_interval", number(s.checkpoint_interval), "no checkpoints: remove the key");
   return "";
 }
 

@@ -49,6 +49,10 @@ template <int Dim>
 void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
                      const std::function<void(const ckpt::Reader&)>& extra = {});
 
+/// The number of ranks of the decomposed run that wrote the checkpoint (its root attribute `ranks`;
+/// docs/checkpoints.md, "Decomposed runs"), 0 for a serial run's checkpoint.
+int checkpoint_ranks(const std::string& path);
+
 /// The output marks stored in a checkpoint.
 CheckpointMarks checkpoint_marks(const std::string& path);
 

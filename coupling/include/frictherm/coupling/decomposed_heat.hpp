@@ -50,6 +50,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -138,6 +139,39 @@ class DecomposedHeat {
   /// (update_hot_spots_across_ranks), T_p from the swarm and T0_p from the particle scalar named
   /// `reference` (carried with the particles, as T_p is).
   void update_hot_spots(HotSpotTracker& tracker, const std::string& reference, double time) const;
+
+  /// Checkpoints (decomposed_checkpoint.cpp): v(name, member) for this rank's state that the next
+  /// windows read, as Coupler::visit_state: the books (sums over ranks, the same on every rank), the
+  /// pending work per owned node, the window's times, steps and adaptive estimate, and the last
+  /// gather (M_i, T_i, M_i on the ghosted box, threshold, smallest unknown M_i) the adaptive estimate
+  /// reads. The assembled path's integrator starts afresh every window: only its counters (metadata)
+  /// are not restored.
+  template <class V> void visit_state(V&& v) {
+    DecomposedHeatBooks& b = books_;
+    for (auto [name, x] : {std::pair<const char*, double*>{"books/work_received", &b.work_received},
+                           {"books/heat_delivered", &b.heat_delivered}, {"books/heat_relocated", &b.heat_relocated},
+                           {"books/nodal_energy_change", &b.nodal_energy_change},
+                           {"books/particle_energy_change", &b.particle_energy_change},
+                           {"books/max_capacity_residual", &b.max_capacity_residual},
+                           {"books/min_window", &b.min_window}, {"books/max_window", &b.max_window},
+                           {"books/plastic_work_received", &b.plastic_work_received},
+                           {"books/plastic_heat_received", &b.plastic_heat_received},
+                           {"books/plastic_heat_delivered", &b.plastic_heat_delivered},
+                           {"window/pending_plastic", &pending_plastic_},
+                           {"window/time", &time_}, {"window/start", &window_start_}, {"window/max_rise", &max_rise_},
+                           {"window/last_lambda", &last_lambda_}, {"gather/threshold", &threshold_},
+                           {"gather/min_unknown_mass", &min_unknown_mass_}})
+      v(name, *x);
+    for (auto [name, x] : {std::pair<const char*, long*>{"books/windows", &b.windows}, {"books/substeps", &b.substeps},
+                           {"books/assembled_windows", &b.assembled_windows}, {"books/steps", &b.steps},
+                           {"books/dropped_nodes", &b.dropped_nodes}, {"books/exchanges", &b.exchanges},
+                           {"window/steps", &window_steps_}})
+      v(name, *x);
+    v("window/pending", pending_);
+    v("gather/M", M_);
+    v("gather/T", T0_);
+    v("gather/local_M", local_M_);
+  }
 
  private:
   template <int Dim> void check_materials(mechanics::DecomposedMpm<Dim>& mpm);

@@ -29,8 +29,12 @@ namespace frictherm::coupling {
 /// OUT.rank<r>.h5 (each rank's particle snapshots) and OUT.xdmf joining them. Same refusals as the
 /// serial run (OutputError on every rank for an existing file without overwrite, or an input file);
 /// SceneError on every rank when the particles cannot be built. options.handle_signals: SIGINT or
-/// SIGTERM on any rank ends the run after the current step on every rank. Checkpoints and the
-/// per-step observer are not supported (std::invalid_argument).
+/// SIGTERM on any rank ends the run after the current step on every rank. Checkpoints as the serial
+/// run's options say (scene.checkpoint_interval, options.checkpoint_wall_interval, at the end and on a
+/// signal; options.checkpoint_file, else OUT.h5.checkpoint) and options.resume_checkpoint (by the
+/// same number of ranks bit-for-bit, by another redistributed; the output goes on in place):
+/// docs/checkpoints.md, "Decomposed runs".
+/// The per-step observer is not supported (std::invalid_argument).
 RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options);
 
 /// The files a decomposed run writes for output `out` with `ranks` processes: out, the XDMF file

@@ -56,6 +56,15 @@ struct DecomposedSnapshot {
 class DecomposedOutput {
  public:
   DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite);
+  /// Resuming a checkpointed run: opens the existing rank files (each rank its own), removes their
+  /// snapshots from number `kept` on (written after the checkpoint) and goes on after the kept ones;
+  /// `grids` (rank 0) is xdmf_grids() at the checkpoint, and OUT.xdmf is rewritten from it.
+  /// `create_missing` (a checkpoint of fewer ranks): a rank without a file starts one.
+  DecomposedOutput(MPI_Comm comm, std::string base, int dim, long kept, std::vector<std::string> grids,
+                   bool create_missing = false);
+  /// Rank 0: the XDMF text of every snapshot so far (checkpoints store it); snapshots written.
+  const std::vector<std::string>& xdmf_grids() const { return grids_; }
+  long snapshots() const { return snapshots_; }
   ~DecomposedOutput();
   DecomposedOutput(const DecomposedOutput&) = delete;
   DecomposedOutput& operator=(const DecomposedOutput&) = delete;

@@ -75,6 +75,7 @@
 #include <memory>
 #include <string>
 #include <vector>
+#include <utility>
 
 namespace frictherm::mechanics {
 
@@ -281,6 +282,27 @@ class DecomposedMpm {
   /// Collective: owned node values to every rank holding the node (DMGlobalToLocal, INSERT_VALUES):
   /// `local` gets the owners' values on the whole ghosted box.
   void owned_to_local(const std::vector<double>& owned, int components, std::vector<double>& local);
+
+  // ---- Checkpoints (checkpoint_state.cpp; the coupling's decomposed checkpoints) ----
+  /// Everything of this rank that the next step reads besides the scene: every registered swarm
+  /// field of every local particle in swarm order (PETSc's DMSwarmPIC_coor as "coor", the particle
+  /// scalars as "scalars"; integer fields as int64), the step's start time, the frictional work books
+  /// (this rank's part), the last step's work per owned node and contact counters, and the empty-node
+  /// mass threshold. Restored on the same rank of a decomposition built from the same scene and rank
+  /// count, the run steps on bit-for-bit (same particles in the same swarm order).
+  struct CheckpointState {
+    std::vector<std::pair<std::string, std::vector<double>>> reals;          // name, n × components
+    std::vector<std::pair<std::string, std::vector<std::int64_t>>> integers;  // id, material
+    double time = 0.0, cumulative_first = 0.0, cumulative_second = 0.0, empty_node_mass = 0.0;
+    std::vector<double> work_first, work_second;
+    std::vector<long> stats;  // contact_nodes, multi_nodes, sliding_nodes, guarded (this rank)
+  };
+  CheckpointState checkpoint_state() const;
+  /// This rank alone: replaces its particles and books by `state` (no migration: the particles stay
+  /// in the given order on this rank). Throws std::invalid_argument for arrays of the wrong size
+  /// or a missing field. With `migrate` (collective; a checkpoint of another rank count, each rank
+  /// given some of its particles): every particle then goes to its owner, as after add_particles.
+  void restore_checkpoint_state(const CheckpointState& state, bool migrate = false);
 
  private:
   struct Impl;

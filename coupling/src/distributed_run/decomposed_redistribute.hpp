@@ -1,0 +1,132 @@
+#pragma once
+// Resuming a decomposed checkpoint on another number of ranks (docs/checkpoints.md, "Decomposed
+// runs"): rank r of K' takes the particles of the checkpoint's rank files j ≡ r (mod K'), every swarm
+// field as written, then the swarm migrates each particle to its owner in the new decomposition; the
+// mechanics' cumulative work books of file j go with its particles (their sum over ranks is kept);
+// the heat's per-node state (pending work, M_i and T_i of the last gather) is copied node by node from
+// the file whose rank owned the node (DMDA indices are the same for every K), M_i on the ghosted box
+// from the new owners. The particles' order on a rank and the ranks' sums then differ from an
+// uninterrupted K'-rank run: results agree to the round-off of reordered sums, not bit-for-bit.
+#include "run/checkpoint_io.hpp"
+
+#include <frictherm/coupling/decomposed_heat.hpp>
+#include <frictherm/mechanics/distributed.hpp>
+
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace frictherm::coupling::detail {
+
+template <int Dim>
+class Redistribution {
+ public:
+  using Mpm = mechanics::DecomposedMpm<Dim>;
+  Redistribution(Mpm& mpm, bool heat) : mpm_(mpm), heat_(heat), mine_(mpm.owned_nodes()) {
+    acc_ = mpm.checkpoint_state();  // the field names; emptied
+    for (auto& r : acc_.reals) r.second.clear();
+    for (auto& r : acc_.integers) r.second.clear();
+    acc_.cumulative_first = acc_.cumulative_second = 0.0;
+    acc_.work_first.clear();
+    acc_.work_second.clear();
+    acc_.stats.assign(4, 0);
+    std::size_t n = 1;
+    for (int d = 0; d < Dim; ++d) n *= static_cast<std::size_t>(mine_[2 * d + 1] - mine_[2 * d]);
+    pending_.assign(n, 0.0);
+    M_.assign(n, 0.0);
+    T_.assign(n, 0.0);
+  }
+
+  /// Rank file j of the checkpoint: its particles and books when `particles`, its nodes' heat.
+  void take(const ckpt::Reader& r, int j, bool particles) {
+    std::vector<long> box;
+    r("mechanics/owned_nodes", box);
+    if (box.size() != 2 * Dim) throw std::runtime_error("rank file " + std::to_string(j) + ": no owned node range");
+    r("mechanics/time", acc_.time);
+    r("mechanics/empty_node_mass", acc_.empty_node_mass);
+    if (particles) {
+      for (auto& [name, values] : acc_.reals) {
+        std::vector<double> v;
+        r(("mechanics/" + name).c_str(), v);
+        values.insert(values.end(), v.begin(), v.end());
+      }
+      for (auto& [name, values] : acc_.integers) {
+        std::vector<long> v;
+        r(("mechanics/" + name).c_str(), v);
+        values.insert(values.end(), v.begin(), v.end());
+      }
+      double w = 0.0;
+      r("mechanics/cumulative_work_first", w);
+      acc_.cumulative_first += w;
+      r("mechanics/cumulative_work_second", w);
+      acc_.cumulative_second += w;
+      std::vector<long> stats;
+      r("mechanics/contact_stats", stats);
+      for (std::size_t k = 0; k < 4 && k < stats.size(); ++k) acc_.stats[k] += stats[k];
+    }
+    if (!heat_) return;
+    std::vector<double> pending, M, T;
+    r("window/pending", pending);
+    r("gather/M", M);
+    r("gather/T", T);
+    copy_nodes(box, pending, pending_);
+    copy_nodes(box, M, M_);
+    copy_nodes(box, T, T_);
+  }
+
+  /// Collective: the particles into the swarm (migrated) and the per-node heat into `heat`.
+  void finish(DecomposedHeat* heat) {
+    mpm_.restore_checkpoint_state(acc_, true);
+    if (!heat) return;
+    std::vector<double> local_M;
+    mpm_.owned_to_local(M_, 1, local_M);
+    Assign a{pending_, M_, T_, local_M};
+    heat->visit_state(a);
+  }
+
+ private:
+  // The values of file j's owned box (x fastest) at the nodes this rank owns.
+  void copy_nodes(const std::vector<long>& box, const std::vector<double>& from, std::vector<double>& to) const {
+    std::array<long, 3> lo{0, 0, 0}, hi{1, 1, 1}, blo{0, 0, 0}, bn{1, 1, 1}, mlo{0, 0, 0}, mn{1, 1, 1};
+    std::size_t count = 1;
+    for (int d = 0; d < Dim; ++d) {
+      blo[d] = box[2 * d], bn[d] = box[2 * d + 1] - box[2 * d];
+      mlo[d] = mine_[2 * d], mn[d] = mine_[2 * d + 1] - mine_[2 * d];
+      lo[d] = std::max(blo[d], mlo[d]), hi[d] = std::min(box[2 * d + 1], static_cast<long>(mine_[2 * d + 1]));
+      count *= static_cast<std::size_t>(bn[d]);
+    }
+    if (from.size() != count) throw std::runtime_error("checkpoint: per-node heat of the wrong size");
+    for (long k = lo[2]; k < hi[2]; ++k)
+      for (long j = lo[1]; j < hi[1]; ++j)
+        for (long i = lo[0]; i < hi[0]; ++i)
+          to[static_cast<std::size_t>(((k - mlo[2]) * mn[1] + (j - mlo[1])) * mn[0] + (i - mlo[0]))] =
+              from[static_cast<std::size_t>(((k - blo[2]) * bn[1] + (j - blo[1])) * bn[0] + (i - blo[0]))];
+  }
+
+  // A visitor of DecomposedHeat::visit_state that sets only the per-node arrays.
+  struct Assign {
+    static constexpr bool reading = true;
+    const std::vector<double>& pending;
+    const std::vector<double>& M;
+    const std::vector<double>& T;
+    const std::vector<double>& local_M;
+    void operator()(const char* name, std::vector<double>& v) const {
+      const std::string n(name);
+      if (n == "window/pending") v = pending;
+      else if (n == "gather/M") v = M;
+      else if (n == "gather/T") v = T;
+      else if (n == "gather/local_M") v = local_M;
+    }
+    void operator()(const char*, double&) const {}
+    void operator()(const char*, long&) const {}
+  };
+
+  Mpm& mpm_;
+  bool heat_;
+  std::array<int, 2 * Dim> mine_;
+  typename Mpm::CheckpointState acc_;
+  std::vector<double> pending_, M_, T_;
+};
+
+}  // namespace frictherm::coupling::detail

@@ -1,0 +1,227 @@
+// Checkpoints and resume of decomposed runs (docs/checkpoints.md, "Decomposed runs";
+// coupling/src/distributed_run/decomposed_checkpoint.cpp, coupling/app/cli_run_mpi.cpp), on the 2D
+// heated sliding block of test_cli_mpirun.cpp (tests/coupling/scenes/decomposed_sliding_block.json)
+// run to 10 ms or 3 ms (the block stops on the base by friction after ~1.7 ms), under mpirun -n 2:
+//   * Ctrl-C to mpirun after the first checkpoint, then `mpirun -n 2 frictherm resume OUT.h5`: every
+//     series column, the /hotspots table, the energy books and every snapshot of every rank file equal
+//     an uninterrupted run's bit-for-bit (each rank restores its particles in their swarm order, so
+//     every sum runs in the same order), and the books close;
+//   * the same 2-rank checkpoint resumed on 3 ranks (the particles redistributed by the swarm's
+//     migration, the heat per node copied from its old owner): the series within 1e-9 of each column's
+//     largest magnitude (temperatures: of the largest rise) of the uninterrupted 2-rank run, as
+//     test_cli_mpirun's decomposed-against-serial bound (the same arithmetic, sums over particles and
+//     ranks in another order), the books closed to 1e-9; resumed without mpirun it is refused (exit
+//     code 2) naming the rank count, and the checkpoint is left alone;
+//   * the ranks killed with SIGKILL at random moments of a run that checkpoints every 20 us (~7 steps,
+//     150 checkpoints in all, a sizeable part of its time spent writing them): the checkpoint left
+//     always resumes to the uninterrupted run's result.
+// Skipped when mpirun is not installed. Labels verification;mpi.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "cli_test_support.hpp"
+#include "h5_test_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using frictherm::test::read_doubles;
+using frictherm::test::Result;
+using frictherm::test::shell;
+
+namespace {
+
+std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
+
+std::string mpirun(int ranks) {
+  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n " + std::to_string(ranks);
+  if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
+  return cmd;
+}
+
+// The block slides until friction stops it (~1.7 ms) and rests: ~330 steps per ms.
+std::string scene_args(const std::string& checkpoint_interval, const std::string& end_time) {
+  return std::string(" '") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/decomposed_sliding_block.json' -q" +
+         " --set run.end_time=" + end_time + " --set run.checkpoint_interval=" + checkpoint_interval;
+}
+
+class CliMpirunCheckpoint : public frictherm::test::ScratchDirTest {
+ protected:
+  CliMpirunCheckpoint() : ScratchDirTest("frictherm_mpirun_ckpt_") {}
+  void SetUp() override {
+    if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
+    ScratchDirTest::SetUp();
+  }
+
+  std::string text(const std::string& name) const {
+    std::ifstream in(path(name));
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  // The uninterrupted run into full.h5.
+  void run_full(const std::string& interval, const std::string& end_time) {
+    const Result r =
+        shell(mpirun(2) + " " + exe() + " run" + scene_args(interval, end_time) + " -o '" + path("full.h5") + "'");
+    ASSERT_EQ(r.code, 0) << r.output;
+  }
+
+  // Starts the run into part.h5 in the background, waits for its first checkpoint, then `stop` ($pid:
+  // mpirun's) after `delay` seconds; returns the run's log.
+  std::string run_and_stop(const std::string& interval, const std::string& end_time, const std::string& stop,
+                           double delay) {
+    const std::string out = path("part.h5");
+    const std::string cmd = mpirun(2) + " " + exe() + " run" + scene_args(interval, end_time) + " -o '" + out + "' > '" +
+                            path("log") + "' 2>&1 & pid=$!; " + "for i in $(seq 1 1200); do [ -e '" + out +
+                            ".checkpoint' ] && break; sleep 0.02; done; sleep " + std::to_string(delay) + "; " + stop +
+                            "; wait $pid; exit 0";
+    shell(cmd);
+    return text("log");
+  }
+
+  // part.h5 (resumed) against full.h5: every series column, the /hotspots table and the books
+  // bit-for-bit; every snapshot of both rank files too.
+  void expect_equal_results() {
+    for (const char* c : {"time", "step", "dt", "kinetic_energy", "momentum_x", "momentum_y", "friction_work_first",
+                          "friction_work_second", "contact_nodes", "sliding_nodes", "heat_delivered",
+                          "thermal_energy_change", "max_temperature", "hotspot_count", "hottest_hotspot_temperature",
+                          "thermal_windows", "work_received", "nodal_energy_change"}) {
+      const std::vector<double> a = read_doubles(path("full.h5"), std::string("/series/") + c);
+      ASSERT_GT(a.size(), 10u) << c;
+      const std::vector<double> b = read_doubles(path("part.h5"), std::string("/series/") + c);
+      ASSERT_EQ(a.size(), b.size()) << c;
+      for (std::size_t k = 0; k < a.size(); ++k)  // NaN (no hot spot) in both, or the same double
+        EXPECT_TRUE(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k]))) << c << " row " << k;
+    }
+    for (const char* c : {"time", "id", "particle_count", "peak_temperature", "centroid_x", "excess_energy"}) {
+      const std::vector<double> a = read_doubles(path("full.h5"), std::string("/hotspots/") + c);
+      EXPECT_FALSE(a.empty()) << c << ": the block makes hot spots";
+      EXPECT_EQ(a, read_doubles(path("part.h5"), std::string("/hotspots/") + c)) << c;
+    }
+    for (const char* k : {"work_received", "heat_delivered", "nodal_energy_change", "particle_energy_change", "steps",
+                           "final_time", "thermal_windows"})
+      EXPECT_EQ(read_doubles(path("full.h5"), std::string("/meta/") + k),
+                read_doubles(path("part.h5"), std::string("/meta/") + k)) << k;
+    // The books close (forward Euler: to the round-off of the sums, 1e-9 of the work as test_cli_mpirun).
+    const double w = read_doubles(path("part.h5"), "/meta/work_received").at(0);
+    EXPECT_GT(w, 0.1);
+    for (const char* k : {"heat_delivered", "nodal_energy_change", "particle_energy_change"})
+      EXPECT_NEAR(read_doubles(path("part.h5"), std::string("/meta/") + k).at(0), w, 1e-9 * w) << k;
+    for (int r = 0; r < 2; ++r)
+      for (int s = 0; s <= 4; ++s) {
+        char snap[32];
+        std::snprintf(snap, sizeof snap, "/snapshots/%06d/", s);
+        const std::string rank = ".rank" + std::to_string(r) + ".h5";
+        for (const char* f : {"id", "position", "velocity", "temperature"})
+          EXPECT_EQ(read_doubles(path("full" + rank), snap + std::string(f)),
+                    read_doubles(path("part" + rank), snap + std::string(f)))
+              << rank << snap << f;
+      }
+    char absent[32];
+    std::snprintf(absent, sizeof absent, "/snapshots/%06d/id", 5);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // the dataset is absent: no HDF5 error stack
+    EXPECT_TRUE(read_doubles(path("part.rank0.h5"), absent).empty()) << "the snapshot at the interruption is dropped";
+    EXPECT_EQ(text("full.xdmf").size(), text("part.xdmf").size());
+  }
+};
+
+TEST_F(CliMpirunCheckpoint, InterruptedAndResumedRunEqualsTheUninterruptedRun) {
+  // 10 ms (~3300 steps, a few seconds): Ctrl-C to mpirun (passed on to the ranks as SIGTERM) just after
+  // the first checkpoint (t = 0.2 ms) lands well before the end.
+  run_full("2e-4", "1e-2");
+  if (HasFatalFailure()) return;
+  const std::string log = run_and_stop("2e-4", "1e-2", "kill -INT $pid", 0.0);
+  ASSERT_THAT(log, HasSubstr("interrupted by SIG")) << "the run must be stopped before its end";
+  EXPECT_THAT(log, HasSubstr("resume with: mpirun -n 2 frictherm resume"));
+  const std::vector<double> t = read_doubles(path("part.h5"), "/series/time");
+  ASSERT_FALSE(t.empty());
+  EXPECT_LT(t.back(), 1e-2);
+  std::printf("  interrupted at t = %.6g s after %zu series rows\n", t.back(), t.size());
+
+  // Without mpirun: refused, exit code 2 naming the rank count, nothing written.
+  const auto before = fs::last_write_time(path("part.h5.checkpoint"));
+  const Result serial = shell(exe() + " resume '" + path("part.h5") + "'");
+  EXPECT_EQ(serial.code, 2) << serial.output;
+  EXPECT_THAT(serial.output, HasSubstr("written by a decomposed run on 2 ranks: resume it with mpirun -n 2"));
+  EXPECT_EQ(fs::last_write_time(path("part.h5.checkpoint")), before);
+
+  // A copy resumed on 3 ranks: the particles migrate to the new owners.
+  fs::create_directory(path("three"));
+  for (const auto& e : fs::directory_iterator(path("")))
+    if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
+      fs::copy_file(e.path(), path("three/" + e.path().filename().string()));
+  const Result three = shell(mpirun(3) + " " + exe() + " resume '" + path("three/part.h5") + "'");
+  ASSERT_EQ(three.code, 0) << three.output;
+  EXPECT_THAT(three.output, HasSubstr("written by 2 ranks, resumed on 3: the particles are redistributed"));
+  EXPECT_EQ(read_doubles(path("three/part.h5"), "/meta/resumed_from_ranks"), std::vector<double>{2.0});
+  for (const char* c : {"time", "kinetic_energy", "momentum_x", "momentum_y", "friction_work_first",
+                        "friction_work_second", "heat_delivered", "max_temperature", "hottest_hotspot_temperature"}) {
+    const bool temperature = std::string(c).find("temperature") != std::string::npos;
+    const std::vector<double> a = read_doubles(path("full.h5"), std::string("/series/") + c);
+    const std::vector<double> b = read_doubles(path("three/part.h5"), std::string("/series/") + c);
+    ASSERT_EQ(a.size(), b.size()) << c;
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      if (std::isnan(a[k]) || std::isnan(b[k])) {
+        EXPECT_EQ(std::isnan(a[k]), std::isnan(b[k])) << c << " row " << k;
+        continue;
+      }
+      scale = std::max(scale, std::fabs(a[k] - (temperature ? 300.0 : 0.0)));
+      diff = std::max(diff, std::fabs(a[k] - b[k]));
+    }
+    EXPECT_LE(diff, 1e-9 * scale) << c;
+    std::printf("  3 ranks from the 2-rank checkpoint: %-28s max |difference| %.3g of %.6g\n", c, diff / scale, scale);
+  }
+  const double w3 = read_doubles(path("three/part.h5"), "/meta/work_received").at(0);
+  for (const char* k : {"heat_delivered", "nodal_energy_change", "particle_energy_change"})
+    EXPECT_NEAR(read_doubles(path("three/part.h5"), std::string("/meta/") + k).at(0), w3, 1e-9 * w3) << k;
+  EXPECT_TRUE(fs::exists(path("three/part.rank2.h5")));
+
+  const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + path("part.h5") + "'");
+  ASSERT_EQ(resumed.code, 0) << resumed.output;
+  expect_equal_results();
+}
+
+TEST_F(CliMpirunCheckpoint, KilledRanksLeaveACheckpointThatResumesToTheUninterruptedRun) {
+  run_full("2e-5", "3e-3");
+  if (HasFatalFailure()) return;
+  std::mt19937 random(20261126);
+  std::uniform_real_distribution<double> delay(0.0, 0.5);
+  int inside = 0;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    for (const auto& e : fs::directory_iterator(path("")))
+      if (e.path().filename().string().rfind("part.", 0) == 0) fs::remove(e.path());
+    // SIGKILL to both ranks (mpirun's children), then to mpirun.
+    run_and_stop("2e-5", "3e-3", "pkill -KILL -P $pid; kill -KILL $pid", delay(random));
+    ASSERT_TRUE(fs::exists(path("part.h5.checkpoint")));
+    // A kill inside a write leaves a temporary or a rank file of a generation the global file does
+    // not name yet: count the attempts that did.
+    int rank_files = 0;
+    bool tmp = false;
+    for (const auto& e : fs::directory_iterator(path(""))) {
+      const std::string n = e.path().filename().string();
+      if (n.rfind("part.h5.checkpoint.", 0) == 0 && n.find(".rank") != std::string::npos) ++rank_files;
+      if (n.rfind("part.h5.checkpoint.", 0) == 0 && n.size() > 4 && n.substr(n.size() - 4) == ".tmp") tmp = true;
+    }
+    if (tmp || rank_files > 2) ++inside;
+    const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + path("part.h5") + "'");
+    ASSERT_EQ(resumed.code, 0) << resumed.output;
+    expect_equal_results();
+    if (HasFatalFailure()) return;
+  }
+  std::printf("  %d of 3 kills landed inside a checkpoint write\n", inside);
+}
+
+}  // namespace
