@@ -405,3 +405,218 @@ class DecomposedRun {
     ph.emplace_back("other", r_.wall_time - accounted);
   }
 
+  // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5.
+  void finish_output() {
+    r_.series_rows = out_->series_rows();
+    for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
+    if (heat_) {
+      const DecomposedHeatBooks& b = heat_->books();
+      const CouplerOptions& c = s_.thermal.coupler;
+      out_->write_metadata("thermal_integrator", c.integrator);
+      out_->write_metadata("thermal_rtol", c.integrator_options.rtol);
+      out_->write_metadata("thermal_atol", c.integrator_options.atol);
+      out_->write_metadata("thermal_preconditioner", s_.thermal.preconditioner);
+      out_->write_metadata("thermal_window_policy", to_string(c.window.kind));
+      out_->write_metadata("heating_order", mechanics::to_string(s_.thermal.heating_order));
+      out_->write_metadata("thermal_windows", b.windows);
+      out_->write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
+      out_->write_metadata("thermal_matrix_free_substeps", b.substeps);
+      out_->write_metadata("thermal_assembled_windows", b.assembled_windows);
+      out_->write_metadata("thermal_min_window", b.min_window);
+      out_->write_metadata("thermal_max_window", b.max_window);
+      const thermal::IntegratorStats st = heat_->integrator_stats();  // global counts
+      out_->write_metadata("thermal_steps", st.steps);
+      out_->write_metadata("thermal_rhs_evals", st.rhs_evals);
+      out_->write_metadata("thermal_linear_iters", st.linear_iters);
+      out_->write_metadata("thermal_error_test_failures", st.error_test_failures);
+      out_->write_metadata("thermal_wall_time", st.wall_seconds);
+      out_->write_metadata("work_received", b.work_received);
+      out_->write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
+      out_->write_metadata("plastic_work_received", b.plastic_work_received);
+      out_->write_metadata("plastic_heat_received", b.plastic_heat_received);
+      out_->write_metadata("plastic_heat_delivered", b.plastic_heat_delivered);
+      out_->write_metadata("heat_delivered", b.heat_delivered);
+      out_->write_metadata("heat_pending", pending_heat_);
+      out_->write_metadata("nodal_energy_change", b.nodal_energy_change);
+      out_->write_metadata("particle_energy_change", b.particle_energy_change);
+      out_->write_metadata("max_capacity_residual", b.max_capacity_residual);
+      out_->write_metadata("hotspots_seen", hot_->tracker().ids_issued());
+    }
+    const char* status = r_.status == RunResult::Status::failed                 ? "failed"
+                         : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
+                         : r_.status == RunResult::Status::interrupted          ? "interrupted"
+                                                                                : "completed";
+    out_->write_metadata("status", status);
+    if (checkpoints_written_ > 0) {
+      out_->write_metadata("checkpoints_written", checkpoints_written_);
+      out_->write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, this process's checkpoints
+    }
+    if (resuming_) out_->write_metadata("resumed_from", o_.resume_checkpoint);
+    if (redistributed_from_ > 0) out_->write_metadata("resumed_from_ranks", redistributed_from_);
+    out_->write_metadata("steps", r_.steps);
+    out_->write_metadata("final_time", r_.time);
+    out_->write_metadata("wall_time", r_.wall_time);
+    try {
+      out_->close();
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+  }
+
+  MPI_Comm comm_;
+  const Scene& s_;
+  const RunOptions& o_;
+  int rank_ = 0, size_ = 1;
+  RunResult r_;
+  std::unique_ptr<mechanics::Grid<Dim>> grid_;
+  std::unique_ptr<Mpm> mpm_;
+  std::unique_ptr<DecomposedHeat> heat_;  // scenes with a `thermal` section
+  std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
+  std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
+  std::unique_ptr<DecomposedOutput> snapshots_out_;
+  int temperature_ = 0;
+  double time_ = 0.0, last_dt_ = 0.0;
+  long step_ = 0, snapshots_ = 0;
+  long last_series_step_ = -1, last_snapshot_step_ = -1;
+  double heating_seconds_ = 0.0, output_seconds_ = 0.0;
+  double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
+  Clock::time_point last_flush_ = Clock::now();
+  // Checkpoints: whether this run writes them, where, the generation of the last one, the clock of
+  // --checkpoint-every; rank 0: every series row so far (flat) and OUT.xdmf's grids (from a resume).
+  bool checkpoints_ = false, resuming_ = false;
+  std::string checkpoint_file_;
+  long generation_ = 0, checkpoints_written_ = 0;
+  double checkpoint_seconds_ = 0.0;
+  Clock::time_point last_checkpoint_ = Clock::now();
+  std::vector<double> series_rows_;
+  long series_columns_ = 0;
+  std::string xdmf_grids_;
+  typename Mpm::CheckpointState restored_;
+  int redistributed_from_ = 0;  // ranks of a checkpoint resumed on another number of ranks
+
+  // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's.
+  void checkpoint() {
+    const Clock::time_point c0 = Clock::now();
+    CheckpointMarks m;
+    m.step = step_;
+    m.time = time_;
+    m.series_rows = series_columns_ > 0 ? static_cast<long>(series_rows_.size()) / series_columns_ : 0;
+    m.snapshots = snapshots_;
+    if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
+    xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
+    try {
+      detail::write_decomposed_checkpoint(
+          comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
+          [&](const ckpt::Writer& w) { visit_global_state(w); });
+    } catch (const std::runtime_error& e) {  // on every rank; the previous checkpoint is whole
+      throw OutputError(e.what());
+    }
+    if (rank_ == 0 && redistributed_from_ > size_ && checkpoints_written_ == 0)  // the resumed generation's
+      for (int j = size_; j < redistributed_from_; ++j)                          // files of ranks gone
+        std::remove(detail::decomposed_rank_checkpoint(checkpoint_file_, generation_ - 1, j).c_str());
+    last_checkpoint_ = Clock::now();
+    ++checkpoints_written_;
+    checkpoint_seconds_ += seconds_since(c0);
+  }
+
+  // Collective: the state of o_.resume_checkpoint (every rank's own file and the global one; of
+  // another rank count: decomposed_redistribute.hpp).
+  void restore() {
+    if (const int old = checkpoint_ranks(o_.resume_checkpoint); old > 0 && old != size_) {
+      redistribute(old);
+      return;
+    }
+    try {  // read errors are agreed by every rank
+      generation_ = detail::read_decomposed_checkpoint(
+          comm_, o_.resume_checkpoint, Dim, [&](const ckpt::Reader& r) { visit_rank_state(r); },
+          [&](const ckpt::Reader& r) { visit_global_state(r); });
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+    std::string error;
+    try {
+      mpm_->restore_checkpoint_state(restored_);
+    } catch (const std::exception& e) {
+      error = o_.resume_checkpoint + ": " + e.what();
+    }
+    if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
+    restored_ = {};
+  }
+
+  // This rank: its particles (every swarm field, in swarm order), the mechanics' books and the heat.
+  template <class V> void visit_rank_state(const V& v) {
+    typename Mpm::CheckpointState st = mpm_->checkpoint_state();  // reading: the names and a template
+    for (auto& [name, values] : st.reals) v(("mechanics/" + name).c_str(), values);
+    for (auto& [name, values] : st.integers) v(("mechanics/" + name).c_str(), values);
+    v("mechanics/time", st.time);
+    v("mechanics/cumulative_work_first", st.cumulative_first);
+    v("mechanics/cumulative_work_second", st.cumulative_second);
+    v("mechanics/empty_node_mass", st.empty_node_mass);
+    v("mechanics/work_first", st.work_first);
+    v("mechanics/work_second", st.work_second);
+    v("mechanics/contact_stats", st.stats);
+    std::vector<long> owned;  // this rank's owned nodes (DMDA indices, [begin, end) per axis): redistribution
+    if constexpr (!V::reading) for (int b : mpm_->owned_nodes()) owned.push_back(b);
+    v("mechanics/owned_nodes", owned);
+    if constexpr (V::reading) restored_ = std::move(st);
+    if (heat_) heat_->visit_state(v);
+  }
+
+  // The same on every rank (rank 0 writes it): the run loop, the output so far, the hot spots.
+  template <class V> void visit_global_state(const V& v) {
+    v("run/time", time_);
+    v("run/step", step_);
+    v("run/last_dt", last_dt_);
+    v("run/snapshots", snapshots_);
+    v("run/last_series_step", last_series_step_);
+    v("run/last_snapshot_step", last_snapshot_step_);
+    v("output/series_rows", series_rows_);
+    v("output/series_columns", series_columns_);
+    v("output/xdmf_grids", xdmf_grids_);
+    if (hot_) hot_->visit_state(v);
+  }
+
+  // Collective: a checkpoint of `old` ranks: rank r takes the particles of the files j ≡ r (mod K),
+  // which then migrate to their owners, and the heat of its owned nodes from the files owning them.
+  void redistribute(int old) {
+    detail::Redistribution<Dim> re(*mpm_, heat_ != nullptr);
+    try {
+      generation_ = detail::read_redistributed_checkpoint(
+          comm_, o_.resume_checkpoint, Dim,
+          [&](const ckpt::Reader& r, int j) {
+            re.take(r, j, j % size_ == rank_);
+            if (heat_ && j == 0) heat_->visit_state(r);  // books and window: the same in every file
+          },
+          [&](const ckpt::Reader& r) { visit_global_state(r); });
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
+    re.finish(heat_.get());
+    redistributed_from_ = old;
+  }
+
+  // Rank 0, resuming: the checkpoint's series and /hotspots rows into the new OUT.h5.
+  void rewrite_rows() {
+    const auto c = static_cast<std::size_t>(series_columns_);
+    for (std::size_t a = 0; c > 0 && a + c <= series_rows_.size(); a += c)
+      out_->append_series(std::vector<double>(series_rows_.begin() + static_cast<long>(a),
+                                              series_rows_.begin() + static_cast<long>(a + c)));
+    if (hot_) hot_->rewrite_table_rows(*out_);
+    out_->write_metadata("resumed_at_step", step_);
+  }
+};
+
+}  // namespace
+
+std::vector<std::string> decomposed_output_files(const std::string& out, int ranks) {
+  std::vector<std::string> files{out, xdmf_path_for(out)};
+  for (int r = 0; r < ranks; ++r) files.push_back(DecomposedOutput::rank_file(output_base(out), r));
+  return files;
+}
+
+RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options) {
+  if (scene.dimension == 2) return DecomposedRun<2>(comm, scene, options).execute();
+  return DecomposedRun<3>(comm, scene, options).execute();
+}
+
+}  // namespace frictherm::coupling
