@@ -50,8 +50,9 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
         st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
           if (!(S > 0.0)) return;
           const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(slot)]);
-          const auto [begin, c] = contact_run(node);  // the node's run (find_contact_nodes)
+          const int c = node_field_count_[node];
           if (c < 2) return;
+          const int begin = node_entry_cursor_[node] - c;  // the node's run (find_contact_nodes)
           for (int q = begin; q < begin + c; ++q) {
             const std::size_t qu = static_cast<std::size_t>(q);
             const Vec<Dim>& n = entry_normal_[qu];

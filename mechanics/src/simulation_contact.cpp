@@ -14,15 +14,8 @@
 namespace frictherm::mechanics {
 
 using contact_detail::PairContext;
-// Lists (node, slot, field) for every node where two or more fields have mass, grouped by node in
-// order of first appearance; within a node the slots come in slot order, i.e. material order (fields
-// are laid out in material order). No comparison sort, O(slots), the slots shared among the threads:
-//   1. each thread counts, per node, its slots with mass (its own count array, zero between calls);
-//   2. one thread walks the slots with mass in order and gives each node seen first, if two or more
-//      fields have mass there (the threads' counts summed), a run of entries, split among the threads
-//      in thread order;
-//   3. each thread fills its part of the runs and clears its counts.
-// The result does not depend on the thread count.
+// Lists (node, slot) for every node where two or more fields have mass, grouped by node; within a
+// node the slots come in material order because fields are laid out in material order.
 template <int Dim>
 void Simulation<Dim>::find_contact_nodes() {
   if (!any_multimaterial_) {  // every present pair uses penalty contact
@@ -30,71 +23,51 @@ void Simulation<Dim>::find_contact_nodes() {
     contact_groups_.assign(1, 0);
     return;
   }
+  // Counting sort by node, O(slots) (no comparison sort): count the fields with mass at each node,
+  // give each node with two or more a run of entries in order of first appearance, fill the runs in
+  // field order (slots are laid out in field order). Only the slots with mass are visited after the
+  // first pass. The counts and cursors are reset slot by slot, or over the grid when that is shorter.
   const double mmin = empty_node_mass_;
   const std::size_t total = nodes_.mass.size();
-  const std::size_t node_count = node_seen_.size();
-  const int threads = total >= 4096 ? threads_ : 1;  // below that the fork costs more than the pass
-  if (static_cast<int>(contact_node_scratch_.size()) < threads) contact_node_scratch_.resize(static_cast<std::size_t>(threads));
-  for (ContactNodeScratch& sc : contact_node_scratch_)
-    if (sc.count.size() != node_count) sc.count.assign(node_count, 0), sc.cursor.assign(node_count, 0);
-  const std::uint64_t generation = ++contact_generation_;
-  const double* const mass = nodes_.mass.data();
-  const int* const slot_node = slot_node_.data();
-  int team = 1;
-#pragma omp parallel num_threads(threads)
-  {
-    const int t = omp_get_thread_num(), n = omp_get_num_threads();
-#pragma omp single
-    team = n;
-    ContactNodeScratch& own = contact_node_scratch_[static_cast<std::size_t>(t)];
-    own.occupied.clear();
-    const std::size_t sb = total * static_cast<std::size_t>(t) / static_cast<std::size_t>(n);
-    const std::size_t se = total * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(n);
-    for (std::size_t s = sb; s < se; ++s)  // 1.
-      if (mass[s] > mmin) {
-        ++own.count[static_cast<std::size_t>(slot_node[s])];
-        own.occupied.push_back(static_cast<int>(s));
-      }
-#pragma omp barrier
-#pragma omp single
-    {  // 2.
-      int entries = 0;
-      contact_groups_.clear();
-      for (int u = 0; u < team; ++u)
-        for (const int s : contact_node_scratch_[static_cast<std::size_t>(u)].occupied) {
-          const std::size_t node = static_cast<std::size_t>(slot_node[s]);
-          if (node_seen_[node] == generation) continue;
-          node_seen_[node] = generation;
-          int c = 0;
-          for (int w = 0; w < team; ++w) c += contact_node_scratch_[static_cast<std::size_t>(w)].count[node];
-          if (c < 2) {
-            node_entry_begin_[node] = -1;
-            continue;
-          }
-          node_entry_begin_[node] = entries;
-          node_entry_count_[node] = static_cast<std::uint16_t>(c);
-          contact_groups_.push_back(static_cast<std::size_t>(entries));
-          for (int w = 0, run = entries; w < team; ++w) {
-            ContactNodeScratch& sw = contact_node_scratch_[static_cast<std::size_t>(w)];
-            sw.cursor[node] = run;
-            run += sw.count[node];
-          }
-          entries += c;
-        }
-      contact_entries_.resize(static_cast<std::size_t>(entries));
-      contact_groups_.push_back(static_cast<std::size_t>(entries));
+  if (total >= node_field_count_.size()) {
+    std::fill(node_field_count_.begin(), node_field_count_.end(), 0);
+    std::fill(node_entry_cursor_.begin(), node_entry_cursor_.end(), -1);
+  } else {
+    for (std::size_t s = 0; s < total; ++s) {
+      const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
+      node_field_count_[node] = 0;
+      node_entry_cursor_[node] = -1;
     }
-    // 3. The field of slot s: fields are laid out in order, so f only advances.
-    std::size_t f = 0;
-    for (const int s : own.occupied) {
-      const std::size_t su = static_cast<std::size_t>(s);
-      while (su >= fields_[f].first + fields_[f].count) ++f;
-      const std::size_t node = static_cast<std::size_t>(slot_node[su]);
-      if (node_entry_begin_[node] >= 0)
-        contact_entries_[static_cast<std::size_t>(own.cursor[node]++)] = {static_cast<int>(node), s, static_cast<int>(f)};
-    }
-    for (const int s : own.occupied) own.count[static_cast<std::size_t>(slot_node[s])] = 0;
   }
+  occupied_slots_.clear();
+  for (std::size_t s = 0; s < total; ++s)
+    if (nodes_.mass[s] > mmin) {
+      ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
+      occupied_slots_.push_back(static_cast<int>(s));
+    }
+  int entries = 0;
+  for (const int s : occupied_slots_) {
+    const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(s)]);
+    if (node_field_count_[node] >= 2 && node_entry_cursor_[node] < 0) {
+      node_entry_cursor_[node] = entries;
+      entries += node_field_count_[node];
+    }
+  }
+  contact_entries_.resize(static_cast<std::size_t>(entries));
+  std::size_t f = 0;  // the field of slot s: fields are laid out in order, so f only advances
+  for (const int s : occupied_slots_) {
+    const std::size_t su = static_cast<std::size_t>(s);
+    while (su >= fields_[f].first + fields_[f].count) ++f;
+    const int node = slot_node_[su];
+    if (node_field_count_[static_cast<std::size_t>(node)] >= 2)
+      contact_entries_[static_cast<std::size_t>(node_entry_cursor_[static_cast<std::size_t>(node)]++)] = {
+          node, s, static_cast<int>(f)};
+  }
+  // Node groups of contact_entries_: the start of each contact node's run, then the end.
+  contact_groups_.clear();
+  for (std::size_t e = 0; e < contact_entries_.size(); ++e)
+    if (e == 0 || contact_entries_[e].node != contact_entries_[e - 1].node) contact_groups_.push_back(e);
+  contact_groups_.push_back(contact_entries_.size());
 }
 
 template <int Dim>

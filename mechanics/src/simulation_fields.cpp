@@ -98,11 +98,8 @@ void Simulation<Dim>::init_fields() {
     slot_node_valid_ = false;
     box_lo_.assign(nm, IVec<Dim>{});
     box_hi_.assign(nm, IVec<Dim>{});
-    contact_generation_ = 0;
-    node_seen_.assign(grid_.node_count(), 0);
-    node_entry_begin_.assign(grid_.node_count(), -1);
-    node_entry_count_.assign(grid_.node_count(), 0);
-    contact_node_scratch_.clear();
+    node_field_count_.assign(grid_.node_count(), 0);
+    node_entry_cursor_.assign(grid_.node_count(), -1);
     pair_work_first_.assign(nm * nm, 0.0);
     pair_work_second_.assign(nm * nm, 0.0);
   }

@@ -346,6 +346,7 @@ class Simulation {
   std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
   std::vector<int> slot_node_;
   bool slot_node_valid_ = false;
+  std::vector<int> occupied_slots_;  // find_contact_nodes: slots with mass, in slot order  // slot_node_ matches the per-material layout of fields_ (layout_fields)
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
   bool contact_ = false;
@@ -367,24 +368,8 @@ class Simulation {
   // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
   // in contact on the previous step starts again from σ).
   std::vector<double> lagged_normal_traction_, lagged_normal_step_;
-  // find_contact_nodes (simulation_contact.cpp), per grid node: the call that last saw it with mass
-  // (contact_generation_ then), its run of contact_entries_ (begin, −1: one field only) and length.
-  std::uint64_t contact_generation_ = 0;
-  std::vector<std::uint64_t> node_seen_;
-  std::vector<int> node_entry_begin_;
-  std::vector<std::uint16_t> node_entry_count_;
-  struct ContactNodeScratch {      // per thread of find_contact_nodes
-    std::vector<std::uint16_t> count;  // per grid node: this thread's slots with mass there (0 between calls)
-    std::vector<int> cursor;           // per contact node: this thread's next entry of the node's run
-    std::vector<int> occupied;         // this thread's slots with mass, in slot order
-  };
-  std::vector<ContactNodeScratch> contact_node_scratch_;
-  /// This step's contact entries at a grid node: [begin, begin + count), count 0 unless two or more
-  /// fields have mass there.
-  std::pair<int, int> contact_run(std::size_t node) const {
-    if (node_seen_[node] != contact_generation_ || node_entry_begin_[node] < 0) return {0, 0};
-    return {node_entry_begin_[node], node_entry_count_[node]};
-  }
+  std::vector<std::uint16_t> node_field_count_;  // per grid node: fields with mass (find_contact_nodes)
+  std::vector<int> node_entry_cursor_;           // per grid node: next entry of its run, −1: none
   // Extent separation, per contact entry: the normal from its material to its partners, and the
   // largest extents of its own particle domains along it and of its partners' along its reverse.
   std::vector<Vec<Dim>> entry_normal_;
