@@ -40,22 +40,6 @@ void write_text(hid_t f, const std::string& file, const char* name, const std::s
   ckpt::write_array(f, file, name, H5T_NATIVE_CHAR, text.data(), text.size(), 1);
 }
 
-// /marks as the serial checkpoint writes them (checkpoint_marks reads them).
-void write_marks(const ckpt::Writer& w, hid_t f, const std::string& file, CheckpointMarks m) {
-  w("marks/step", m.step);
-  w("marks/time", m.time);
-  w("marks/series_rows", m.series_rows);
-  w("marks/snapshots", m.snapshots);
-  w("marks/end_of_loading", m.end_of_loading);
-  std::string names;
-  std::vector<long> rows;
-  for (const auto& [name, n] : m.table_rows) {
-    names += name + "\n";
-    rows.push_back(n);
-  }
-  write_text(f, file, "marks/table_names", names);
-  w("marks/table_rows", rows);
-}
 
 // Creates `file`, calls `fill` with a writer at its root, flushes; removes the file on failure.
 void write_file(const std::string& file, const std::function<void(hid_t, const ckpt::Writer&)>& fill) {
@@ -134,7 +118,7 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
         std::string overrides;  // one "path=value" per line, as the serial checkpoint
         for (const SceneOverride& o : scene.overrides) overrides += o.path + "=" + o.value + "\n";
         write_text(f, tmp, "scene_overrides", overrides);
-        write_marks(w, f, tmp, marks);
+        ckpt::write_marks(w, f, tmp, marks);  // as the serial checkpoint
         global_part(w);
       });
       if (std::rename(tmp.c_str(), path.c_str()) != 0) {

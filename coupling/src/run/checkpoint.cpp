@@ -123,21 +123,6 @@ std::string read_text(const std::string& path, const char* name) {
   return read_text(f.get(), path, name);
 }
 
-void write_marks(const ckpt::Writer& w, hid_t f, const std::string& file, CheckpointMarks m) {
-  w("marks/step", m.step);
-  w("marks/time", m.time);
-  w("marks/series_rows", m.series_rows);
-  w("marks/snapshots", m.snapshots);
-  w("marks/end_of_loading", m.end_of_loading);
-  std::string names;
-  std::vector<long> rows;
-  for (const auto& [name, n] : m.table_rows) {
-    names += name + "\n";
-    rows.push_back(n);
-  }
-  write_text(f, file, "marks/table_names", names);
-  w("marks/table_rows", rows);
-}
 
 template <int Dim>
 void write_file(const std::string& path, mechanics::Simulation<Dim>& sim, const std::string& scene_text,
@@ -162,7 +147,7 @@ void write_file(const std::string& path, mechanics::Simulation<Dim>& sim, const 
       sim.visit_state(ckpt::Writer{g.get(), tmp});
     }
     const ckpt::Writer root{f.get(), tmp};
-    write_marks(root, f.get(), tmp, marks);
+    ckpt::write_marks(root, f.get(), tmp, marks);
     if (extra) extra(root);
     check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush the checkpoint");
   } catch (...) {
@@ -284,5 +269,21 @@ Scene checkpoint_scene(const std::string& path, const std::vector<SceneOverride>
 FRICTHERM_INSTANTIATE_CHECKPOINT(2)
 FRICTHERM_INSTANTIATE_CHECKPOINT(3)
 #undef FRICTHERM_INSTANTIATE_CHECKPOINT
+
+void ckpt::write_marks(const Writer& w, hid_t f, const std::string& file, CheckpointMarks m) {
+  w("marks/step", m.step);
+  w("marks/time", m.time);
+  w("marks/series_rows", m.series_rows);
+  w("marks/snapshots", m.snapshots);
+  w("marks/end_of_loading", m.end_of_loading);
+  std::string names;
+  std::vector<long> rows;
+  for (const auto& [name, n] : m.table_rows) {
+    names += name + "\n";
+    rows.push_back(n);
+  }
+  write_text(f, file, "marks/table_names", names);
+  w("marks/table_rows", rows);
+}
 
 }  // namespace frictherm::coupling

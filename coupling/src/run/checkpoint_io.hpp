@@ -112,3 +112,12 @@ struct Reader {
 };
 
 }  // namespace frictherm::coupling::ckpt
+
+namespace frictherm::coupling {
+struct CheckpointMarks;
+namespace ckpt {
+/// The run's marks under /marks of the checkpoint `f` (`w` writes at its root), as checkpoint_marks
+/// reads them: serial and decomposed checkpoints (checkpoint.cpp).
+void write_marks(const Writer& w, hid_t f, const std::string& file, CheckpointMarks m);
+}  // namespace ckpt
+}  // namespace frictherm::coupling
