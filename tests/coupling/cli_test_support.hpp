@@ -32,6 +32,14 @@ inline Result shell(const std::string& cmd) {
   return r;
 }
 
+/// `mpirun` with `ranks` processes on any machine (oversubscribed: 4 ranks on 2 cores; as root Open
+/// MPI wants --allow-run-as-root), one OpenMP thread each.
+inline std::string mpirun_command(int ranks) {
+  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n " + std::to_string(ranks);
+  if (geteuid() == 0) cmd += " --allow-run-as-root";
+  return cmd;
+}
+
 /// A fixture with a fresh folder per test, <temp>/<prefix><test name>_<pid> (tests may run in
 /// parallel), removed after the test.
 class ScratchDirTest : public ::testing::Test {

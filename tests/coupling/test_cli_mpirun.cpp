@@ -65,11 +65,7 @@ namespace {
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
 
-std::string mpirun(int ranks) {
-  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n " + std::to_string(ranks);  // on any machine
-  if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
-  return cmd;
-}
+std::string mpirun(int ranks) { return frictherm::test::mpirun_command(ranks); }
 std::string mpirun2() { return mpirun(2); }
 
 class CliMpirun : public frictherm::test::ScratchDirTest {

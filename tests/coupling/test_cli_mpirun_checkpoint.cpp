@@ -44,11 +44,7 @@ namespace {
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 
-std::string mpirun(int ranks) {
-  std::string cmd = "env OMP_NUM_THREADS=1 mpirun --oversubscribe -n " + std::to_string(ranks);
-  if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
-  return cmd;
-}
+std::string mpirun(int ranks) { return frictherm::test::mpirun_command(ranks); }
 
 // The block slides until friction stops it (~1.7 ms) and rests: ~330 steps per ms.
 std::string scene_args(const std::string& checkpoint_interval, const std::string& end_time) {
