@@ -9,6 +9,9 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
+#include <string>
+
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace frictherm::coupling;
@@ -34,7 +37,8 @@ EnsembleOptions options(const fs::path& dir) {
 }  // namespace
 
 TEST(Ensemble, AggregateMatchesMemberFiles) {
-  const fs::path dir = fs::temp_directory_path() / "frictherm_test_ensemble";
+  // Per process: two test runs at once (two build folders) must not share it.
+  const fs::path dir = fs::temp_directory_path() / ("frictherm_test_ensemble_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   EnsembleOptions o = options(dir);

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -205,7 +206,8 @@ TEST(SceneSchema, EditDistanceAndNearestKey) {
 }
 
 TEST(SceneSchema, ValidateSuggestsTheNearestKey) {
-  const fs::path dir = fs::temp_directory_path() / "frictherm_test_scene_schema";
+  // Per process: two test runs at once (two build folders) must not share it.
+  const fs::path dir = fs::temp_directory_path() / ("frictherm_test_scene_schema_" + std::to_string(getpid()));
   fs::create_directories(dir);
   const std::string scene = (dir / "typo.json").string();
   std::ifstream src(fs::path(FRICTHERM_SOURCE_DIR) / "examples" / "bar_vibration.json");
