@@ -59,11 +59,7 @@ void remove_quietly(const std::string& path) {
 
 }  // namespace
 
-ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
-  if (const int ranks = coupling::checkpoint_ranks(q.checkpoint); ranks > 0)
-    throw coupling::OutputError(q.checkpoint + " was written by a decomposed run on " + std::to_string(ranks) +
-                                " ranks: resume it with mpirun -n " + std::to_string(ranks) + " frictherm resume " + q.run);
-  ResumeOutcome out;
+coupling::RunOptions resume_run_options(const ResumeRequest& q) {
   coupling::RunOptions opt;
   opt.threads = q.threads;
   opt.checkpoint_wall_interval = q.checkpoint_wall_interval;
@@ -71,6 +67,15 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
   opt.command_line = q.command_line;
   opt.handle_signals = true;
   opt.resume_checkpoint = q.checkpoint;
+  return opt;
+}
+
+ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
+  if (const int ranks = coupling::checkpoint_ranks(q.checkpoint); ranks > 0)
+    throw coupling::OutputError(q.checkpoint + " was written by a decomposed run on " + std::to_string(ranks) +
+                                " ranks: resume it with mpirun -n " + std::to_string(ranks) + " frictherm resume " + q.run);
+  ResumeOutcome out;
+  coupling::RunOptions opt = resume_run_options(q);
   opt.checkpoint_file = coupling::checkpoint_path(q.output);
   const bool in_place = coupling::same_file(q.run, q.output);
   if (!in_place) coupling::check_output_path(q.output, {q.run, q.checkpoint}, q.force, "--force");

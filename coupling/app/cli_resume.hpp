@@ -28,6 +28,9 @@ struct ResumeOutcome {
 /// Runs the scene from the checkpoint and appends the output to `run` (result_append.hpp) into
 /// `output`; without `run` writes `output` alone. Throws OutputError when `output` is refused,
 /// SceneError / std::runtime_error as run_scene and append_result do.
+/// The run options every resume starts from: threads, wall-clock checkpoints, quiet, command line,
+/// signals handled, resuming from request.checkpoint.
+coupling::RunOptions resume_run_options(const ResumeRequest& request);
 ResumeOutcome resume_from_checkpoint(const ResumeRequest& request);
 
 /// The exit code and message of a resumed run ("resumed" / "continued").

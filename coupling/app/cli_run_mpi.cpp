@@ -142,13 +142,7 @@ int decomposed_resume_command(const ResumeRequest& q) {
   if (q.output != q.run && !coupling::same_file(q.output, q.run))
     return refuse("-o " + q.output + ": a decomposed run resumes in place (its rank files go on); leave out -o");
   if (const std::string why = coupling::decomposed_run_refusal(scene); !why.empty()) return refuse(why);
-  coupling::RunOptions opt;
-  opt.threads = q.threads;
-  opt.checkpoint_wall_interval = q.checkpoint_wall_interval;
-  opt.quiet = q.quiet;
-  opt.command_line = q.command_line;
-  opt.handle_signals = true;
-  opt.resume_checkpoint = q.checkpoint;
+  coupling::RunOptions opt = resume_run_options(q);
   opt.output = q.run;
   opt.overwrite = true;
   return run_and_report(scene, q.checkpoint, opt, rank, ranks);

@@ -64,4 +64,14 @@ class ScratchDirTest : public ::testing::Test {
   std::string prefix_;
 };
 
+/// A scratch folder per test for tests that launch mpirun; skipped where mpirun is not installed.
+class MpirunScratchTest : public ScratchDirTest {
+ protected:
+  using ScratchDirTest::ScratchDirTest;
+  void SetUp() override {
+    if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
+    ScratchDirTest::SetUp();
+  }
+};
+
 }  // namespace frictherm::test

@@ -59,22 +59,17 @@ using ::testing::HasSubstr;
 using frictherm::test::read_doubles;
 using frictherm::test::Result;
 using frictherm::test::shell;
+constexpr auto mpirun = frictherm::test::mpirun_command;
 
 namespace {
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
 
-std::string mpirun(int ranks) { return frictherm::test::mpirun_command(ranks); }
-std::string mpirun2() { return mpirun(2); }
 
-class CliMpirun : public frictherm::test::ScratchDirTest {
+class CliMpirun : public frictherm::test::MpirunScratchTest {
  protected:
-  CliMpirun() : ScratchDirTest("frictherm_mpirun_") {}
-  void SetUp() override {
-    if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
-    ScratchDirTest::SetUp();
-  }
+  CliMpirun() : MpirunScratchTest("frictherm_mpirun_") {}
 
   // Runs the scene (with `sets`: --set options) serially into serial.h5 (once: kept if it exists) and under
   // mpirun -n `ranks` into split.h5 (replaced).
@@ -369,7 +364,7 @@ TEST_F(CliMpirun, PbxCompactionEqualsTheSerialRun) {
   const std::string pbx = std::string("'") + FRICTHERM_SOURCE_DIR + "/examples/pbx_compaction.json'" + sets;
   const Result s = shell(exe() + " run " + pbx + " -q --threads 1 -o '" + path("serial.h5") + "'");
   ASSERT_EQ(s.code, 0) << s.output;
-  const Result d = shell(mpirun2() + " " + exe() + " run " + pbx + " -o '" + path("split.h5") + "'");
+  const Result d = shell(mpirun(2) + " " + exe() + " run " + pbx + " -o '" + path("split.h5") + "'");
   ASSERT_EQ(d.code, 0) << d.output;
   EXPECT_THAT(d.output, HasSubstr("particles on 2 ranks"));
   constexpr double kTol = 1e-9;
@@ -404,7 +399,7 @@ TEST_F(CliMpirun, Pbx3dSceneEqualsTheSerialRun) {
                           " --set run.max_steps=40 --set output.series_interval=null --set output.snapshot_count=1";
   const Result s = shell(exe() + " run " + pbx + " -q --threads 1 -o '" + path("serial.h5") + "'");
   ASSERT_EQ(s.code, 0) << s.output;
-  const Result d = shell(mpirun2() + " " + exe() + " run " + pbx + " -q -o '" + path("split.h5") + "'");
+  const Result d = shell(mpirun(2) + " " + exe() + " run " + pbx + " -q -o '" + path("split.h5") + "'");
   ASSERT_EQ(d.code, 0) << d.output;
   constexpr double kTol = 1e-9;
   EXPECT_EQ(read_doubles(path("serial.h5"), "/series/time").size(), 41u) << "a row every step";
@@ -485,7 +480,7 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
       {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
        "thermal.linear_solver: \"klu\" is not supported in a decomposed run"}};
   for (const auto& [set, message] : cases) {
-    const Result r = shell(mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
+    const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
                            " -o '" + path("refused.h5") + "'");
     EXPECT_EQ(r.code, 2) << set << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr(message)) << set;
@@ -501,7 +496,7 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
 }
 
 TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
-  const std::string run = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+  const std::string run = mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
                           " -q --set run.end_time=2e-5 -o '" + path("out.h5") + "'";
   const char* const files[] = {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"};
   for (const char* existing : {"out.h5", "out.rank1.h5", "out.xdmf"}) {
@@ -548,7 +543,7 @@ TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
   const std::string throw_block = " --set 'bodies[1].velocity=[400,0]'";  // leaves the 26 mm grid within 40 steps
   const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + throw_block + " -q -o '" +
                          path("serial.h5") + "'");
-  const Result d = shell(mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") + throw_block +
+  const Result d = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + throw_block +
                          " -q -o '" + path("split.h5") + "'");
   EXPECT_EQ(s.code, 1) << s.output;
   EXPECT_EQ(d.code, 1) << d.output;
@@ -579,7 +574,7 @@ TEST_F(CliMpirun, InterruptedRunStopsEveryRankAndKeepsItsFiles) {
   // Ctrl-C to mpirun once the run writes (Open MPI's mpirun passes it on to the ranks as SIGTERM):
   // every rank stops after the same step, the files are complete and readable, rank 0 says so.
   const std::string out = path("x.h5");
-  const std::string cmd = mpirun2() + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+  const std::string cmd = mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
                           " -q --set run.end_time=1 -o '" + out + "' > '" + path("log") + "' 2>&1 & pid=$!; " +
                           "for i in $(seq 1 600); do ls '" + out + "'.*.part >/dev/null 2>&1 && break; sleep 0.1; done; " +
                           "sleep 0.5; kill -INT $pid; wait $pid";

@@ -39,12 +39,12 @@ using ::testing::HasSubstr;
 using frictherm::test::read_doubles;
 using frictherm::test::Result;
 using frictherm::test::shell;
+constexpr auto mpirun = frictherm::test::mpirun_command;
 
 namespace {
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 
-std::string mpirun(int ranks) { return frictherm::test::mpirun_command(ranks); }
 
 // The block slides until friction stops it (~1.7 ms) and rests: ~330 steps per ms.
 std::string scene_args(const std::string& checkpoint_interval, const std::string& end_time) {
@@ -52,13 +52,9 @@ std::string scene_args(const std::string& checkpoint_interval, const std::string
          " --set run.end_time=" + end_time + " --set run.checkpoint_interval=" + checkpoint_interval;
 }
 
-class CliMpirunCheckpoint : public frictherm::test::ScratchDirTest {
+class CliMpirunCheckpoint : public frictherm::test::MpirunScratchTest {
  protected:
-  CliMpirunCheckpoint() : ScratchDirTest("frictherm_mpirun_ckpt_") {}
-  void SetUp() override {
-    if (shell("command -v mpirun").code != 0) GTEST_SKIP() << "mpirun is not installed (Debian: openmpi-bin)";
-    ScratchDirTest::SetUp();
-  }
+  CliMpirunCheckpoint() : MpirunScratchTest("frictherm_mpirun_ckpt_") {}
 
   std::string text(const std::string& name) const {
     std::ifstream in(path(name));

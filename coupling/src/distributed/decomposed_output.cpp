@@ -81,6 +81,15 @@ std::string DecomposedOutput::rank_file(const std::string& base, int rank) {
 
 std::string DecomposedOutput::rank_file(int rank) const { return rank_file(base_, rank); }
 
+void DecomposedOutput::agree_or_close(const std::string& error) {
+  try {
+    agree(comm_, error);
+  } catch (...) {
+    close();
+    throw;
+  }
+}
+
 DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite)
     : comm_(comm), dim_(dim), base_(std::move(base)), xdmf_path_(base_ + ".xdmf") {
   MPI_Comm_rank(comm_, &rank_);
@@ -104,12 +113,7 @@ DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, boo
       error = e.what();
     }
   }
-  try {
-    agree(comm_, error);
-  } catch (...) {
-    close();
-    throw;
-  }
+  agree_or_close(error);
 }
 
 DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, long kept, std::vector<std::string> grids,
@@ -150,12 +154,7 @@ DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, lon
   } catch (const std::exception& e) {
     error = e.what();
   }
-  try {
-    agree(comm_, error);
-  } catch (...) {
-    close();
-    throw;
-  }
+  agree_or_close(error);
 }
 
 DecomposedOutput::~DecomposedOutput() { close(); }

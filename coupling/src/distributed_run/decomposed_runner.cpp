@@ -409,39 +409,8 @@ class DecomposedRun {
   void finish_output() {
     r_.series_rows = out_->series_rows();
     for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
-    if (heat_) {
-      const DecomposedHeatBooks& b = heat_->books();
-      const CouplerOptions& c = s_.thermal.coupler;
-      out_->write_metadata("thermal_integrator", c.integrator);
-      out_->write_metadata("thermal_rtol", c.integrator_options.rtol);
-      out_->write_metadata("thermal_atol", c.integrator_options.atol);
-      out_->write_metadata("thermal_preconditioner", s_.thermal.preconditioner);
-      out_->write_metadata("thermal_window_policy", to_string(c.window.kind));
-      out_->write_metadata("heating_order", mechanics::to_string(s_.thermal.heating_order));
-      out_->write_metadata("thermal_windows", b.windows);
-      out_->write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
-      out_->write_metadata("thermal_matrix_free_substeps", b.substeps);
-      out_->write_metadata("thermal_assembled_windows", b.assembled_windows);
-      out_->write_metadata("thermal_min_window", b.min_window);
-      out_->write_metadata("thermal_max_window", b.max_window);
-      const thermal::IntegratorStats st = heat_->integrator_stats();  // global counts
-      out_->write_metadata("thermal_steps", st.steps);
-      out_->write_metadata("thermal_rhs_evals", st.rhs_evals);
-      out_->write_metadata("thermal_linear_iters", st.linear_iters);
-      out_->write_metadata("thermal_error_test_failures", st.error_test_failures);
-      out_->write_metadata("thermal_wall_time", st.wall_seconds);
-      out_->write_metadata("work_received", b.work_received);
-      out_->write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
-      out_->write_metadata("plastic_work_received", b.plastic_work_received);
-      out_->write_metadata("plastic_heat_received", b.plastic_heat_received);
-      out_->write_metadata("plastic_heat_delivered", b.plastic_heat_delivered);
-      out_->write_metadata("heat_delivered", b.heat_delivered);
-      out_->write_metadata("heat_pending", pending_heat_);
-      out_->write_metadata("nodal_energy_change", b.nodal_energy_change);
-      out_->write_metadata("particle_energy_change", b.particle_energy_change);
-      out_->write_metadata("max_capacity_residual", b.max_capacity_residual);
-      out_->write_metadata("hotspots_seen", hot_->tracker().ids_issued());
-    }
+    if (heat_)
+      detail::write_decomposed_heat_metadata(*out_, s_, *heat_, pending_heat_, hot_->tracker().ids_issued());
     const char* status = r_.status == RunResult::Status::failed                 ? "failed"
                          : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
                          : r_.status == RunResult::Status::interrupted          ? "interrupted"

@@ -100,6 +100,41 @@ FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(2)
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
 #undef FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP
 
+void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const DecomposedHeat& heat, double pending,
+                                    long hotspots_seen) {
+  const DecomposedHeatBooks& b = heat.books();
+  const CouplerOptions& c = scene.thermal.coupler;
+  out.write_metadata("thermal_integrator", c.integrator);
+  out.write_metadata("thermal_rtol", c.integrator_options.rtol);
+  out.write_metadata("thermal_atol", c.integrator_options.atol);
+  out.write_metadata("thermal_preconditioner", scene.thermal.preconditioner);
+  out.write_metadata("thermal_window_policy", to_string(c.window.kind));
+  out.write_metadata("heating_order", mechanics::to_string(scene.thermal.heating_order));
+  out.write_metadata("thermal_windows", b.windows);
+  out.write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
+  out.write_metadata("thermal_matrix_free_substeps", b.substeps);
+  out.write_metadata("thermal_assembled_windows", b.assembled_windows);
+  out.write_metadata("thermal_min_window", b.min_window);
+  out.write_metadata("thermal_max_window", b.max_window);
+  const thermal::IntegratorStats st = heat.integrator_stats();  // global counts
+  out.write_metadata("thermal_steps", st.steps);
+  out.write_metadata("thermal_rhs_evals", st.rhs_evals);
+  out.write_metadata("thermal_linear_iters", st.linear_iters);
+  out.write_metadata("thermal_error_test_failures", st.error_test_failures);
+  out.write_metadata("thermal_wall_time", st.wall_seconds);
+  out.write_metadata("work_received", b.work_received);
+  out.write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
+  out.write_metadata("plastic_work_received", b.plastic_work_received);
+  out.write_metadata("plastic_heat_received", b.plastic_heat_received);
+  out.write_metadata("plastic_heat_delivered", b.plastic_heat_delivered);
+  out.write_metadata("heat_delivered", b.heat_delivered);
+  out.write_metadata("heat_pending", pending);
+  out.write_metadata("nodal_energy_change", b.nodal_energy_change);
+  out.write_metadata("particle_energy_change", b.particle_energy_change);
+  out.write_metadata("max_capacity_residual", b.max_capacity_residual);
+  out.write_metadata("hotspots_seen", hotspots_seen);
+}
+
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {
   // Relative to the heat received: frictional work plus plastic heat.
   const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;

@@ -43,6 +43,11 @@ std::string agreed_error(MPI_Comm comm, const std::string& error);
 /// the heat received: frictional work plus plastic heat).
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& books, int ranks);
 
+/// Rank 0: the heat's settings, window and integrator counts (global) and energy books (over ranks)
+/// as metadata of OUT.h5; `pending` the work of a window left open (J), `hotspots_seen` the tracker's ids.
+void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const DecomposedHeat& heat, double pending,
+                                    long hotspots_seen);
+
 /// Collective: the engine's traffic counters per rank, their mean and largest over the ranks, as
 /// metadata of OUT.h5 (`out`, rank 0: traffic_*_mean, traffic_*_max) and one line on rank 0's `log`
 /// (none: quiet): ghost nodes (a grid exchange sends ghost_nodes × values_per_node doubles), particles

@@ -78,6 +78,8 @@ class DecomposedOutput {
   static std::string rank_file(const std::string& base, int rank);
 
  private:
+  /// The constructors' end: every rank learns whether any failed; on failure the files are closed.
+  void agree_or_close(const std::string& error);
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1, dim_ = 2;
   std::string base_, xdmf_path_;
