@@ -93,7 +93,10 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   contact_thread_work_.resize(static_cast<std::size_t>(threads));
   for (auto& t : contact_thread_work_) {
     t.stats = ContactStats{};
-    if (heat) t.pair_first.assign(nm * nm, 0.0), t.pair_second.assign(nm * nm, 0.0);
+    if (heat && t.marked.size() != nm * nm) {
+      t.pair_first.assign(nm * nm, 0.0), t.pair_second.assign(nm * nm, 0.0), t.marked.assign(nm * nm, 0);
+      t.touched.clear();
+    }
   }
 
 #pragma omp parallel num_threads(threads)
@@ -117,8 +120,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       work_first_[static_cast<std::size_t>(node)] += w1;
       work_second_[static_cast<std::size_t>(node)] += w2;
       const std::size_t k = static_cast<std::size_t>(std::min(ma, mb)) * nm + static_cast<std::size_t>(std::max(ma, mb));
-      acc.pair_first[k] += w1;
-      acc.pair_second[k] += w2;
+      acc.add(k, w1, w2);
     };
     ContactStats& stats = acc.stats;
     auto pair_of = [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); };
@@ -141,13 +143,17 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
           [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); }, stats.sliding_nodes);
     }
   }
-  for (const auto& t : contact_thread_work_) {
+  for (auto& t : contact_thread_work_) {
     if (!heat) continue;
     contact_stats_.contact_nodes += t.stats.contact_nodes;
     contact_stats_.multi_nodes += t.stats.multi_nodes;
     contact_stats_.sliding_nodes += t.stats.sliding_nodes;
     contact_stats_.guarded += t.stats.guarded;
-    for (std::size_t k = 0; k < nm * nm; ++k) pair_work_first_[k] += t.pair_first[k], pair_work_second_[k] += t.pair_second[k];
+    for (const std::size_t k : t.touched) {  // (the others add zero)
+      pair_work_first_[k] += t.pair_first[k], pair_work_second_[k] += t.pair_second[k];
+      t.pair_first[k] = t.pair_second[k] = 0.0, t.marked[k] = 0;
+    }
+    t.touched.clear();
   }
 }
 

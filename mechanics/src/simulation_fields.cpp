@@ -22,6 +22,19 @@ void NodalFields<Dim>::resize(std::size_t n, bool with_contact) {
 }
 
 template <int Dim>
+void NodalFields<Dim>::resize_slots(std::size_t n, bool with_contact) {
+  mass.resize(n);
+  momentum.resize(n);
+  force.resize(n);
+  velocity.resize(n);
+  acceleration.resize(n);
+  const std::size_t nc = with_contact ? n : 0;
+  mass_position.resize(nc);
+  domain.resize(nc);
+  domain_gradient.resize(nc);
+}
+
+template <int Dim>
 void Simulation<Dim>::enable_contact(const ContactOptions& options) {
   if (finalized_) throw std::logic_error("contact must be enabled before the simulation is finalized");
   if (!(options.position_correction >= 0.0 && options.position_correction < 2.0))
@@ -137,8 +150,8 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
     total += F.count;
   }
   if (nodes_.mass.size() != total) {
-    nodes_.resize(total, true);
-    for (auto& t : thread_nodes_) t.resize(total, true);
+    nodes_.resize_slots(total, true);
+    for (auto& t : thread_nodes_) t.resize_slots(total, true);
   }
   if (!changed && slot_node_.size() == total && slot_node_valid_) return;
   slot_node_valid_ = true;
@@ -297,25 +310,22 @@ void Simulation<Dim>::update_grid(double dt) {
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
   if (contact_) resolve_contact(ContactPass::updated, dt);
-#pragma omp parallel for num_threads(threads_) schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    const double m = nodes_.mass[i];
-    if (m > mmin) {
-      nodes_.velocity[i] = nodes_.momentum[i] / m;
-      nodes_.acceleration[i] = nodes_.force[i] / m;
-    } else {
-      nodes_.velocity[i].setZero();
-      nodes_.acceleration[i].setZero();
-    }
-  }
-  // Rigid nodes keep the prescribed velocity (the force was zeroed consistently, so only the
-  // velocity needs resetting when the prescribed velocity changes).
+  // Nodes driven by a rigid boundary material keep its prescribed velocity components (the force was
+  // zeroed consistently, so only the velocity needs resetting when the prescribed velocity changes).
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t s = 0; s < n; ++s) {
-    const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
-    if (const std::uint8_t driven = rigid_mask_[i]; driven && nodes_.mass[s] > mmin)
-      for (int d = 0; d < Dim; ++d)
-        if (driven & (1u << d)) nodes_.velocity[s][d] = rigid_velocity_[i][d];
+    const double m = nodes_.mass[s];
+    if (m > mmin) {
+      nodes_.velocity[s] = nodes_.momentum[s] / m;
+      nodes_.acceleration[s] = nodes_.force[s] / m;
+      const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
+      if (const std::uint8_t driven = rigid_mask_[i])
+        for (int d = 0; d < Dim; ++d)
+          if (driven & (1u << d)) nodes_.velocity[s][d] = rigid_velocity_[i][d];
+    } else {
+      nodes_.velocity[s].setZero();
+      nodes_.acceleration[s].setZero();
+    }
   }
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
@@ -323,15 +333,20 @@ void Simulation<Dim>::update_grid(double dt) {
 }
 
 template <int Dim>
+typename Simulation<Dim>::RigidMotion Simulation<Dim>::rigid_motion(std::size_t m, double t, double dt) const {
+  const Material& mat = materials_[m];
+  return {mat.rigid_velocity_at(t).template head<Dim>(),
+          ((mat.rigid_velocity_at(t + dt) + mat.rigid_velocity_at(t)) * 0.5 * dt).template head<Dim>()};
+}
+
+template <int Dim>
 void Simulation<Dim>::move_rigid_particles(double dt, double t) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid()) continue;
-    const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
-    const Vec<Dim> dx = ((materials_[m].rigid_velocity_at(t + dt) + materials_[m].rigid_velocity_at(t)) * 0.5 * dt)
-                            .template head<Dim>();
+    const RigidMotion r = rigid_motion(m, t, dt);
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-      p_.velocity[k] = v;
-      p_.position[k] += dx;
+      p_.velocity[k] = r.velocity;
+      p_.position[k] += r.displacement;
     }
   }
 }
@@ -399,6 +414,7 @@ template struct NodalFields<3>;
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::update_grid(double);                                                           \
   template void Simulation<D>::move_rigid_particles(double, double);                                          \
+  template Simulation<D>::RigidMotion Simulation<D>::rigid_motion(std::size_t, double, double) const;         \
   template void Simulation<D>::check_particle(long, double) const;                                            \
   template void Simulation<D>::throw_beyond_hugoniot(long) const;
 FRICTHERM_INSTANTIATE_FIELDS(2)

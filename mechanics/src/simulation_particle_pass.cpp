@@ -3,6 +3,9 @@
 // or both: USL runs both in one pass over the stencils (simulation_step.cpp), which reads each
 // particle's stencil and its nodes' velocities once and costs one parallel region instead of two.
 // Particle by particle the arithmetic is that of the separate loops, so the results are the same.
+// With `refresh` (USL with contact) the pass also evaluates each moved particle's stencil for the next
+// step while its position is at hand, and moves the rigid materials' particles and evaluates theirs:
+// the start of the next step and the heat hand-off after it need not pass over the particles again.
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/plane_strain_update.hpp>
 #include <frictherm/mechanics/simulation.hpp>
@@ -12,6 +15,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <limits>
 
@@ -40,7 +44,7 @@ FRICTHERM_ALWAYS_INLINE void add_gradient(Mat<Dim>& L, const Vec<Dim>& v, const 
 // and the first compressed past its Hugoniot's limit (−1: none).
 template <int Dim>
 template <bool Kinematics, bool Stress, class Stencils>
-typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(double dt, const Stencils& st) {
+typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(double dt, Stencils& st, bool refresh) {
   long bad = std::numeric_limits<long>::max();  // min-reduction identity
   long beyond = -1;                              // max-reduction identity
   double work = 0.0;
@@ -56,14 +60,42 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   const Vec<Dim>* const velocity = nodes_.velocity.data();
   const Vec<Dim>* const filtered_v = transfer_.filtered.data();  // v* of XPIC/FMPM (transfer.hpp)
   decltype(auto) stk = step_detail::indexable(st);
+  // The next step's stencils (refresh): Stencil arrays only; EBS builds its weights per step.
+  constexpr bool refreshable = Kinematics && !std::is_same_v<Stencils, PrecomputedStencils<Dim>>;
+  refresh = refresh && refreshable;
+  const std::size_t nm = materials_.size();
+  if (refresh) {
+    rigid_motion_.resize(nm);
+    for (std::size_t m = 0; m < nm; ++m) {
+      box_lo_[m].fill(INT_MAX), box_hi_[m].fill(INT_MIN);
+      if (materials_[m].is_rigid()) rigid_motion_[m] = rigid_motion(m, time_, dt);
+    }
+  }
+  const Grid<Dim> grid = grid_;  // a local copy (see evaluate_stencils)
+  [[maybe_unused]] const auto next_stencils = [&] {
+    if constexpr (refreshable) return st.data();
+    else return nullptr;
+  }();
 
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
+  {
+  thread_local step_detail::StencilBoxes<Dim> boxes;
+  if (refresh) boxes.reset(nm);
   for_each_part(partition_, [&](int t) {
+    std::size_t m = 0;  // the material of the particles run() is given
+    // Particle k at its new position: its stencil for the next step, and its material's box.
+    [[maybe_unused]] auto refresh_stencil = [&](std::size_t k, IVec<Dim>& lo, IVec<Dim>& hi) {
+      if constexpr (refreshable) {
+        next_stencils[k].evaluate(grid, p_.position[k], p_.half_size[k]);
+        boxes.extend(next_stencils[k], lo, hi);
+      }
+    };
     // One material's particles [kb, ke): gather from the nodes, then the kinematic and stress updates;
     // `stress(k, L)` is the material's constitutive update (false: beyond the Hugoniot's limit).
     // Defined in the parallel region: it adds to this thread's copies of bad, beyond and work.
     auto run = [&](const NodeIndexer<Dim>& ix, std::size_t kb, std::size_t ke, auto gradient_zero, auto&& stress) {
       using Gradient = decltype(gradient_zero);
+      IVec<Dim> lo = step_detail::StencilBoxes<Dim>::none_lo(), hi = step_detail::StencilBoxes<Dim>::none_hi();
       for (std::size_t k = kb; k < ke; ++k) {
         Vec<Dim> a = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
         Gradient L = gradient_zero;
@@ -99,15 +131,32 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           p_.position[k] += dt * v;
           const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
           if (!ok) bad = std::min(bad, static_cast<long>(k));
+          else if (refresh) refresh_stencil(k, lo, hi);  // (a bad particle stops the run: check_particle)
         }
         if constexpr (Stress)
           if (!stress(k, L)) beyond = std::max(beyond, static_cast<long>(k));
       }
+      if (refresh)
+        for (int d = 0; d < Dim; ++d) boxes.lo[m][d] = std::min(boxes.lo[m][d], lo[d]), boxes.hi[m][d] = std::max(boxes.hi[m][d], hi[d]);
     };
-    for (std::size_t m = 0; m < materials_.size(); ++m) {
+    for (m = 0; m < nm; ++m) {
       const Material& mat = materials_[m];
       const int f = field_of_material_[m];
-      if (f < 0 || mat.is_rigid()) continue;
+      if (f < 0 || mat.is_rigid()) {
+        // Not updated by this pass: with refresh, this part's even share of them moved (rigid) and their
+        // stencils evaluated.
+        if (!refresh) continue;
+        const std::size_t b = material_begin_[m], n = material_end_[m] - b, T = static_cast<std::size_t>(partition_.threads);
+        const std::size_t tt = static_cast<std::size_t>(t);
+        for (std::size_t k = b + n * tt / T; k < b + n * (tt + 1) / T; ++k) {
+          if (mat.is_rigid()) {
+            p_.velocity[k] = rigid_motion_[m].velocity;
+            p_.position[k] += rigid_motion_[m].displacement;
+          }
+          refresh_stencil(k, boxes.lo[m], boxes.hi[m]);
+        }
+        continue;
+      }
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
       const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
       if (kb >= ke) continue;
@@ -163,6 +212,11 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
       });
     }
   });
+  if (refresh) {
+#pragma omp critical(frictherm_stencil_boxes)
+    boxes.merge_into(box_lo_, box_hi_);
+  }
+  }  // omp parallel
   if constexpr (Kinematics) {
     for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
     external_work_ += work;
@@ -172,9 +226,9 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
 }
 
 #define FRICTHERM_INSTANTIATE_PASS_FOR(D, ...)                                                          \
-  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<true, false, __VA_ARGS__>(double, const __VA_ARGS__&); \
-  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<false, true, __VA_ARGS__>(double, const __VA_ARGS__&); \
-  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<true, true, __VA_ARGS__>(double, const __VA_ARGS__&);
+  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<true, false, __VA_ARGS__>(double, __VA_ARGS__&, bool); \
+  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<false, true, __VA_ARGS__>(double, __VA_ARGS__&, bool); \
+  template Simulation<D>::ParticlePassResult Simulation<D>::particle_pass<true, true, __VA_ARGS__>(double, __VA_ARGS__&, bool);
 #define FRICTHERM_INSTANTIATE_PASS(D)                                          \
   FRICTHERM_INSTANTIATE_PASS_FOR(D, std::vector<Stencil<D, LinearKernel>>)     \
   FRICTHERM_INSTANTIATE_PASS_FOR(D, std::vector<Stencil<D, UGIMPKernel>>)      \

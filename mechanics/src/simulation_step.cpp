@@ -126,18 +126,22 @@ void Simulation<Dim>::step_with(double dt) {
   lap_.to(pt.grid_update, nested_phase_);  // less its contact pass (resolve_contact times itself)
   if (opt_.particle_update != ParticleUpdate::flip) filter_grid_velocity(stencils<Kernel>());  // XPIC/FMPM
   // USL: the stress update from the same nodal velocities in the same pass over the stencils (timed
-  // as stress_update); USF and MUSL: the grid-to-particle update alone.
+  // as stress_update); USF and MUSL: the grid-to-particle update alone. USL with contact also evaluates
+  // the next step's stencils and boxes in that pass (and moves the rigid particles): nothing after it
+  // in the step needs this step's stencils.
   const bool usl = opt_.scheme == UpdateScheme::usl;
-  const ParticlePassResult pass = usl ? particle_pass<true, true>(dt, stencils<Kernel>())
+  const bool refresh = usl && contact_ && !is_extended<Kernel>;
+  const ParticlePassResult pass = usl ? particle_pass<true, true>(dt, stencils<Kernel>(), refresh)
                                       : particle_pass<true, false>(dt, stencils<Kernel>());
   lap_.to(usl ? pt.stress_update : pt.grid_to_particle);
   if (usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
-  move_rigid_particles(dt, t);
+  if (!refresh) move_rigid_particles(dt, t);
   stencils_current_ = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
   lap_.to(pt.grid_to_particle);
   time_ += dt;
   ++step_;
   check_particle(pass.bad, dt);
+  stencils_current_ = refresh;  // every particle inside the grid: the pass evaluated every stencil
   if (usl) {
     throw_beyond_hugoniot(pass.beyond);
   } else if (opt_.scheme == UpdateScheme::musl) {
@@ -177,30 +181,19 @@ void Simulation<Dim>::evaluate_stencils() {
   // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
 #pragma omp parallel num_threads(threads_)
   {
-    thread_local std::vector<IVec<Dim>> lo, hi;
-    IVec<Dim> none_lo, none_hi;
-    none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
-    lo.assign(nm, none_lo);
-    hi.assign(nm, none_hi);
+    thread_local step_detail::StencilBoxes<Dim> boxes;
+    boxes.reset(nm);
     for_each_part(partition_, [&](int t) {
       for (std::size_t m = 0; m < nm; ++m) {
         const std::size_t kb = partition_.even_lo(t, material_begin_[m]), ke = partition_.even_hi(t, material_end_[m]);
         for (std::size_t k = kb; k < ke; ++k) {
           stk[k].evaluate(grid, position[k], half_size[k]);
-          const IVec<Dim> f = stk[k].first_node();
-          for (int d = 0; d < Dim; ++d) {
-            lo[m][d] = std::min(lo[m][d], f[d]);
-            hi[m][d] = std::max(hi[m][d], f[d] + Kernel::K - 1);
-          }
+          boxes.extend(stk[k], boxes.lo[m], boxes.hi[m]);
         }
       }
     });
 #pragma omp critical(frictherm_stencil_boxes)
-    for (std::size_t m = 0; m < nm; ++m)
-      for (int d = 0; d < Dim; ++d) {
-        box_lo_[m][d] = std::min(box_lo_[m][d], lo[m][d]);
-        box_hi_[m][d] = std::max(box_hi_[m][d], hi[m][d]);
-      }
+    boxes.merge_into(box_lo_, box_hi_);
   }
 }
 

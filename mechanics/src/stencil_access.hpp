@@ -3,6 +3,8 @@
 // stencils as the hot loops index them.
 #include <frictherm/mechanics/shape_functions.hpp>
 
+#include <algorithm>
+#include <climits>
 #include <type_traits>
 #include <vector>
 
@@ -18,5 +20,42 @@ template <class T>
 const T* indexable(const std::vector<T>& v) { return v.data(); }
 template <int D>
 const PrecomputedStencils<D>& indexable(const PrecomputedStencils<D>& p) { return p; }
+
+// One thread's boxes of nodes reached by each material's particles (lattice indices counted from the
+// ghost node, as Stencil::first_node), while it evaluates stencils; merged into the step's boxes under
+// a critical section by the caller (the boxes lay out the velocity fields: layout_fields).
+template <int Dim>
+struct StencilBoxes {
+  std::vector<IVec<Dim>> lo, hi;
+  static IVec<Dim> none_lo() {
+    IVec<Dim> b;
+    b.fill(INT_MAX);
+    return b;
+  }
+  static IVec<Dim> none_hi() {
+    IVec<Dim> b;
+    b.fill(INT_MIN);
+    return b;
+  }
+  void reset(std::size_t materials) {
+    lo.assign(materials, none_lo());
+    hi.assign(materials, none_hi());
+  }
+  template <class Kernel>
+  FRICTHERM_ALWAYS_INLINE static void extend(const Stencil<Dim, Kernel>& s, IVec<Dim>& box_lo, IVec<Dim>& box_hi) {
+    const IVec<Dim> f = s.first_node();
+    for (int d = 0; d < Dim; ++d) {
+      box_lo[d] = std::min(box_lo[d], f[d]);
+      box_hi[d] = std::max(box_hi[d], f[d] + Kernel::K - 1);
+    }
+  }
+  void merge_into(std::vector<IVec<Dim>>& box_lo, std::vector<IVec<Dim>>& box_hi) const {
+    for (std::size_t m = 0; m < lo.size(); ++m)
+      for (int d = 0; d < Dim; ++d) {
+        box_lo[m][d] = std::min(box_lo[m][d], lo[m][d]);
+        box_hi[m][d] = std::max(box_hi[m][d], hi[m][d]);
+      }
+  }
+};
 
 }  // namespace frictherm::mechanics::step_detail

@@ -49,6 +49,10 @@ void OdeSystem::build(const Problem& problem, bool symmetric) {
   // reaction's T–λ entries.
   const SparseMatrix& k = problem.conductance();
   const Eigen::VectorXd& ha = problem.convection_coefficients();
+  if (problem.dirichlet_nodes().empty() && !consume_ && copy_conductance_pattern(k, ha)) {
+    finish_build(n, nr);
+    return;
+  }
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(static_cast<std::size_t>(k.nonZeros() + n + 3 * nr));
   for (Index i = 0; i < n; ++i) {
@@ -71,6 +75,39 @@ void OdeSystem::build(const Problem& problem, bool symmetric) {
   jac_.resize(ns, ns);
   jac_.setFromTriplets(trip.begin(), trip.end());
   jac_.makeCompressed();
+  finish_build(n, nr);
+}
+
+// Without fixed nodes or a consumed reaction J has K's pattern: J = −diag(fscale) (K + diag(hA))
+// diag(1/s) written over a copy of K (no triplet list, no sort: a window's build in a coupled run).
+// The diagonal gets the convection term first and K's second, as setFromTriplets sums them, so J is
+// bit-identical to the general build. False (nothing done) if K is not compressed with sorted
+// columns and a stored diagonal in every row.
+bool OdeSystem::copy_conductance_pattern(const SparseMatrix& k, const Eigen::VectorXd& ha) {
+  if (!k.isCompressed()) return false;
+  const Index n = k.rows();
+  const auto* outer = k.outerIndexPtr();
+  const auto* inner = k.innerIndexPtr();
+  for (Index i = 0; i < n; ++i) {
+    bool diagonal = false;
+    for (auto e = outer[i]; e < outer[i + 1]; ++e) {
+      if (e > outer[i] && inner[e] <= inner[e - 1]) return false;
+      diagonal = diagonal || inner[e] == i;
+    }
+    if (!diagonal) return false;
+  }
+  jac_ = k;
+  double* value = jac_.valuePtr();
+  for (Index i = 0; i < n; ++i)
+    for (auto e = outer[i]; e < outer[i + 1]; ++e) {
+      const Index j = inner[e];
+      const double kij = -fscale_[i] * value[e] / s_[j];
+      value[e] = j == i ? -fscale_[i] * ha[i] / s_[i] + kij : kij;
+    }
+  return true;
+}
+
+void OdeSystem::finish_build(Index n, Index nr) {
   jdiag_ = jac_.diagonal();
   const auto nrs = static_cast<std::size_t>(nr);
   pos_tt_.assign(nrs, 0);

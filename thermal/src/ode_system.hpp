@@ -64,6 +64,8 @@ class OdeSystem {
  private:
   // Reaction Jacobian entries at y into d_tt_ … d_ll_ (cached on the reacting entries of y).
   void reaction_blocks(N_Vector y);
+  bool copy_conductance_pattern(const SparseMatrix& k, const Eigen::VectorXd& ha);  // build's fast path
+  void finish_build(Index n, Index nr);  // after jac_: its diagonal and the reaction entries' positions
 
   const Problem* problem_ = nullptr;
   bool symmetric_ = false;

@@ -110,7 +110,8 @@ struct RunResult {
   int signal = 0;            // interrupted: the signal that stopped the run (SIGINT, SIGTERM)
   /// Wall time (s) by phase, in this order: the mechanics step's phases (time_step, shape_functions,
   /// particle_to_grid, contact, grid_update, grid_to_particle, stress_update; with USL the particle
-  /// velocities and positions are updated in the stress update's pass and timed there), heating (the coupler
+  /// velocities and positions are updated in the stress update's pass and timed there, and with USL and
+  /// contact also the next step's stencils and the rigid particles' motion), heating (the coupler
   /// outside the integrator: work accumulated, heat mapped, temperatures back, hot spots),
   /// thermal_solve (the integrator during loading), continuation (thermal-only phase), output
   /// (series and snapshots) and other (the rest of wall_time: set-up, progress, metadata).

@@ -83,6 +83,10 @@ struct NodalFields {
   std::vector<double> domain;
   std::vector<Vec<Dim>> domain_gradient;
   void resize(std::size_t n, bool with_contact = false);
+  /// To n slots without clearing the ones kept (a layout change of the step: the step's scatter
+  /// clears every slot of a field before adding to it and update_grid sets every velocity and
+  /// acceleration, so no slot is read before it is written).
+  void resize_slots(std::size_t n, bool with_contact);
 };
 
 /// One velocity field: the nodes of a box of the grid, stored in slots first .. first + count − 1.
@@ -281,7 +285,10 @@ class Simulation {
     long bad = -1;     // the first particle with a non-finite state or outside the grid (check_particle)
     long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
   };
-  template <bool Kinematics, bool Stress, class Stencils> ParticlePassResult particle_pass(double dt, const Stencils& st);
+  /// `refresh` (grid-to-particle with Stencil arrays): also the next step's stencils at the moved
+  /// positions, the rigid materials moved (move_rigid_particles) and box_lo_/box_hi_, in the same pass.
+  template <bool Kinematics, bool Stress, class Stencils>
+  ParticlePassResult particle_pass(double dt, Stencils& st, bool refresh = false);
   void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
   template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
@@ -326,6 +333,10 @@ class Simulation {
   void compute_contact_normals();                                // extent separation: entry_normal_
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
+  struct RigidMotion {
+    Vec<Dim> velocity, displacement;  // at t, and over [t, t + dt] (trapezoid)
+  };
+  RigidMotion rigid_motion(std::size_t material, double t, double dt) const;
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
   void setup_penalty();                          // finalize(): penalty pairs and boundary points
   void apply_penalty_forces();                   // step: detection, forces into nodes_.force, heat
@@ -348,6 +359,7 @@ class Simulation {
   bool slot_node_valid_ = false;
   std::vector<int> occupied_slots_;  // find_contact_nodes: slots with mass, in slot order  // slot_node_ matches the per-material layout of fields_ (layout_fields)
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
+  std::vector<RigidMotion> rigid_motion_;  // per material, for particle_pass(refresh)
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
   bool contact_ = false;
   ContactOptions contact_opt_;
@@ -361,7 +373,16 @@ class Simulation {
   std::vector<std::size_t> contact_groups_;     // start of each node's entries, then the end
   struct ContactThreadWork {                    // per-thread contact stats and pair books of one pass
     ContactStats stats;
+    // Material pair k = min·nm + max: the pass's work, zero outside `touched` (the pairs it added
+    // to, marked in `marked`), so a pass clears and sums only those, not all nm² pairs of a PBX.
     std::vector<double> pair_first, pair_second;
+    std::vector<std::uint8_t> marked;
+    std::vector<std::size_t> touched;
+    void add(std::size_t k, double w1, double w2) {
+      if (!marked[k]) marked[k] = 1, touched.push_back(k);
+      pair_first[k] += w1;
+      pair_second[k] += w2;
+    }
   };
   std::vector<ContactThreadWork> contact_thread_work_;
   // Normal-stress regularisation (ContactOptions::regularized): per grid node the lagged normal

@@ -7,7 +7,9 @@ namespace frictherm::mechanics {
 
 struct StepPhaseTimes {
   double time_step = 0.0;         // s: stable time step (CFL over the particles)
-  double shape_functions = 0.0;   // s: stencils, EBS rebuild, field layout, rigid-driven nodes
+  // s: stencils, EBS rebuild, field layout, rigid-driven nodes (USL with contact: the stencils are
+  // evaluated in the previous step's stress-update pass and timed there)
+  double shape_functions = 0.0;
   double particle_to_grid = 0.0;  // s: mass, momentum, forces, MUSL remap, external loads
   double contact = 0.0;           // s: contact nodes, multimaterial passes (with the frictional work), penalty
   double grid_update = 0.0;       // s: momentum update, velocity conditions, nodal velocities
