@@ -18,8 +18,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <optional>
 
 namespace frictherm::coupling {
 
@@ -48,8 +50,13 @@ class Run {
     sim_ = build_simulation<Dim>(s_);
     if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;
-    // No count given: not more threads than idle cores or than the particles pay for (thread_policy.hpp).
-    omp_set_num_threads(threads > 0 ? threads : default_thread_count(sim_->particles().size()));
+    // No count given: not more threads than idle cores or than the particles pay for, and with
+    // spinning waits fewer while another process holds a core (thread_policy.hpp).
+    const std::size_t particles = sim_->particles().size();
+    omp_set_num_threads(threads > 0 ? threads : default_thread_count(particles));
+    const int stepping = std::min(omp_get_max_threads(), static_cast<int>(particles / 2000));  // as Simulation::step
+    if (threads <= 0 && std::getenv("OMP_NUM_THREADS") == nullptr && waiting_threads_spin() && stepping >= 2)
+      governor_.emplace(stepping);
     r_.particles = sim_->particles().size();
     check_checkpoints();
     if (!o_.resume_checkpoint.empty()) restore();
@@ -220,7 +227,10 @@ class Run {
         if (limit > stable && limit < 2.0 * stable) limit *= 0.5;
       }
       const double t_before = sim_->time();
+      if (governor_) governor_->step_started();
       sim_->step(limit);
+      if (governor_)
+        if (const std::string note = governor_->step_finished(); !note.empty()) progress.message(o_.log ? *o_.log : std::cerr, note);
       const double t = sim_->time();
       if (!(t > t_before))  // a step too small for the clock (1e-300 s at t = 1): never loop without advancing
         throw mechanics::SimulationError("step " + std::to_string(sim_->step_count()) + ", t = " + format_number(t) +
@@ -349,6 +359,7 @@ class Run {
   long last_series_step_ = -1;
   long last_snapshot_step_ = -1;
   double coupling_seconds_ = 0.0;       // in thermal_->after_step (heating and solve)
+  std::optional<ThreadGovernor> governor_;  // default thread count with spinning waits
   double loading_solve_seconds_ = 0.0;  // of which inside the integrator
   double continuation_seconds_ = 0.0;
   detail::SeriesMemory series_memory_;  // the previous series row, for the contact_heat_rate columns

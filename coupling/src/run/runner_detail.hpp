@@ -57,6 +57,8 @@ class ProgressLine {
   ProgressLine& operator=(const ProgressLine&) = delete;
   /// Cheap when nothing is drawn (one clock read).
   void update(long step, double time);
+  /// Writes a line to log (erasing the progress line first when log is its stream).
+  void message(std::ostream& log, const std::string& line);
   /// Erases the line (once).
   void finish();
 

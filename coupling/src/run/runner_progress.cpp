@@ -43,6 +43,14 @@ void ProgressLine::update(long step, double time) {
   last_step_ = step;
 }
 
+void ProgressLine::message(std::ostream& log, const std::string& line) {
+  if (enabled_ && width_ > 0 && &log == &out_) {
+    out_ << '\r' << std::string(width_, ' ') << '\r';
+    width_ = 0;
+  }
+  log << line << '\n' << std::flush;
+}
+
 void ProgressLine::finish() {
   if (!enabled_) return;
   if (width_ > 0) out_ << '\r' << std::string(width_, ' ') << '\r' << std::flush;
