@@ -90,7 +90,7 @@ int refuse_under_launcher(const std::string& command) {
 
 void prepare_process(char** argv) {
 #ifndef FRICTHERM_WITH_MPI  // under MPI the launcher owns the process: set OMP_WAIT_POLICY yourself
-  coupling::ensure_passive_wait(argv);  // threads sleep at barriers (docs/coupling.md)
+  coupling::ensure_passive_wait(argv);  // threads sleep at barriers (docs/performance.md, "Threads")
 #else
   (void)argv;
 #endif

@@ -1,5 +1,5 @@
 #pragma once
-// Thread policy for runs on shared machines (issue 13, docs/coupling.md "Threads"):
+// Thread policy for runs on shared machines (issue 13, docs/performance.md "Threads"):
 //
 //   int main(int argc, char** argv) {
 //     frictherm::coupling::ensure_passive_wait(argv);   // first thing: may re-execute the program
