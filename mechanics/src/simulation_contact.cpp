@@ -14,62 +14,6 @@
 namespace frictherm::mechanics {
 
 using contact_detail::PairContext;
-// Lists (node, slot) for every node where two or more fields have mass, grouped by node; within a
-// node the slots come in material order because fields are laid out in material order.
-template <int Dim>
-void Simulation<Dim>::find_contact_nodes() {
-  if (!any_multimaterial_) {  // every present pair uses penalty contact
-    contact_entries_.clear();
-    contact_groups_.assign(1, 0);
-    return;
-  }
-  // Counting sort by node, O(slots) (no comparison sort): count the fields with mass at each node,
-  // give each node with two or more a run of entries in order of first appearance, fill the runs in
-  // field order (slots are laid out in field order). Only the slots with mass are visited after the
-  // first pass. The counts and cursors are reset slot by slot, or over the grid when that is shorter.
-  const double mmin = empty_node_mass_;
-  const std::size_t total = nodes_.mass.size();
-  if (total >= node_field_count_.size()) {
-    std::fill(node_field_count_.begin(), node_field_count_.end(), 0);
-    std::fill(node_entry_cursor_.begin(), node_entry_cursor_.end(), -1);
-  } else {
-    for (std::size_t s = 0; s < total; ++s) {
-      const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
-      node_field_count_[node] = 0;
-      node_entry_cursor_[node] = -1;
-    }
-  }
-  occupied_slots_.clear();
-  for (std::size_t s = 0; s < total; ++s)
-    if (nodes_.mass[s] > mmin) {
-      ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
-      occupied_slots_.push_back(static_cast<int>(s));
-    }
-  int entries = 0;
-  for (const int s : occupied_slots_) {
-    const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(s)]);
-    if (node_field_count_[node] >= 2 && node_entry_cursor_[node] < 0) {
-      node_entry_cursor_[node] = entries;
-      entries += node_field_count_[node];
-    }
-  }
-  contact_entries_.resize(static_cast<std::size_t>(entries));
-  std::size_t f = 0;  // the field of slot s: fields are laid out in order, so f only advances
-  for (const int s : occupied_slots_) {
-    const std::size_t su = static_cast<std::size_t>(s);
-    while (su >= fields_[f].first + fields_[f].count) ++f;
-    const int node = slot_node_[su];
-    if (node_field_count_[static_cast<std::size_t>(node)] >= 2)
-      contact_entries_[static_cast<std::size_t>(node_entry_cursor_[static_cast<std::size_t>(node)]++)] = {
-          node, s, static_cast<int>(f)};
-  }
-  // Node groups of contact_entries_: the start of each contact node's run, then the end.
-  contact_groups_.clear();
-  for (std::size_t e = 0; e < contact_entries_.size(); ++e)
-    if (e == 0 || contact_entries_[e].node != contact_entries_[e - 1].node) contact_groups_.push_back(e);
-  contact_groups_.push_back(contact_entries_.size());
-}
-
 template <int Dim>
 void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const NestedPhase timed(phase_times_.contact, nested_phase_);  // called inside other phases
@@ -261,7 +205,6 @@ double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order, int a, in
 }
 
 #define FRICTHERM_INSTANTIATE_CONTACT(D)                                              \
-  template void Simulation<D>::find_contact_nodes();                                  \
   template void Simulation<D>::resolve_contact(ContactPass, double);                  \
   template void Simulation<D>::compute_contact_normals();                             \
   template int Simulation<D>::gather_contact_sides(std::size_t, double, std::vector<ContactSide<D>>&,      \

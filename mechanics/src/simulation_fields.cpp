@@ -344,10 +344,7 @@ void Simulation<Dim>::move_rigid_particles(double dt, double t) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid()) continue;
     const RigidMotion r = rigid_motion(m, t, dt);
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-      p_.velocity[k] = r.velocity;
-      p_.position[k] += r.displacement;
-    }
+    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) r.move(p_.velocity[k], p_.position[k]);
   }
 }
 

@@ -66,10 +66,9 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   const std::size_t nm = materials_.size();
   if (refresh) {
     rigid_motion_.resize(nm);
-    for (std::size_t m = 0; m < nm; ++m) {
-      box_lo_[m].fill(INT_MAX), box_hi_[m].fill(INT_MIN);
+    step_detail::StencilBoxes<Dim>::clear(box_lo_, box_hi_);
+    for (std::size_t m = 0; m < nm; ++m)
       if (materials_[m].is_rigid()) rigid_motion_[m] = rigid_motion(m, time_, dt);
-    }
   }
   const Grid<Dim> grid = grid_;  // a local copy (see evaluate_stencils)
   [[maybe_unused]] const auto next_stencils = [&] {
@@ -136,8 +135,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         if constexpr (Stress)
           if (!stress(k, L)) beyond = std::max(beyond, static_cast<long>(k));
       }
-      if (refresh)
-        for (int d = 0; d < Dim; ++d) boxes.lo[m][d] = std::min(boxes.lo[m][d], lo[d]), boxes.hi[m][d] = std::max(boxes.hi[m][d], hi[d]);
+      if (refresh) boxes.merge(m, lo, hi);
     };
     for (m = 0; m < nm; ++m) {
       const Material& mat = materials_[m];
@@ -149,10 +147,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         const std::size_t b = material_begin_[m], n = material_end_[m] - b, T = static_cast<std::size_t>(partition_.threads);
         const std::size_t tt = static_cast<std::size_t>(t);
         for (std::size_t k = b + n * tt / T; k < b + n * (tt + 1) / T; ++k) {
-          if (mat.is_rigid()) {
-            p_.velocity[k] = rigid_motion_[m].velocity;
-            p_.position[k] += rigid_motion_[m].displacement;
-          }
+          if (mat.is_rigid()) rigid_motion_[m].move(p_.velocity[k], p_.position[k]);
           refresh_stencil(k, boxes.lo[m], boxes.hi[m]);
         }
         continue;

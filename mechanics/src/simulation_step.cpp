@@ -176,7 +176,7 @@ void Simulation<Dim>::evaluate_stencils() {
   }
   const std::size_t nm = materials_.size();
   update_partition();
-  for (std::size_t m = 0; m < nm; ++m) box_lo_[m].fill(INT_MAX), box_hi_[m].fill(INT_MIN);
+  step_detail::StencilBoxes<Dim>::clear(box_lo_, box_hi_);
   // One parallel region for all materials (a grain is a few hundred particles: a region per
   // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
 #pragma omp parallel num_threads(threads_)
@@ -332,12 +332,10 @@ void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* 
     std::uint8_t bits = 0;
     for (int d = 0; d < Dim; ++d)
       if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
+    Stencil<Dim, Kernel> own;
     for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
-      Stencil<Dim, Kernel> s;
-      if (evaluated)
-        s = evaluated[k];
-      else
-        s.evaluate(grid_, p_.position[k], p_.half_size[k]);
+      if (!evaluated) own.evaluate(grid_, p_.position[k], p_.half_size[k]);
+      const Stencil<Dim, Kernel>& s = evaluated ? evaluated[k] : own;
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
         if (S > 0.0) {
           rigid_mask_[static_cast<std::size_t>(i)] |= bits;

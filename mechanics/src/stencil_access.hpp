@@ -49,12 +49,20 @@ struct StencilBoxes {
       box_hi[d] = std::max(box_hi[d], f[d] + Kernel::K - 1);
     }
   }
+  /// Material m's box grown to hold [add_lo, add_hi].
+  void merge(std::size_t m, const IVec<Dim>& add_lo, const IVec<Dim>& add_hi) { merge(lo[m], hi[m], add_lo, add_hi); }
+  static void merge(IVec<Dim>& box_lo, IVec<Dim>& box_hi, const IVec<Dim>& add_lo, const IVec<Dim>& add_hi) {
+    for (int d = 0; d < Dim; ++d) {
+      box_lo[d] = std::min(box_lo[d], add_lo[d]);
+      box_hi[d] = std::max(box_hi[d], add_hi[d]);
+    }
+  }
   void merge_into(std::vector<IVec<Dim>>& box_lo, std::vector<IVec<Dim>>& box_hi) const {
-    for (std::size_t m = 0; m < lo.size(); ++m)
-      for (int d = 0; d < Dim; ++d) {
-        box_lo[m][d] = std::min(box_lo[m][d], lo[m][d]);
-        box_hi[m][d] = std::max(box_hi[m][d], hi[m][d]);
-      }
+    for (std::size_t m = 0; m < lo.size(); ++m) merge(box_lo[m], box_hi[m], lo[m], hi[m]);
+  }
+  /// Every material's box emptied (the step's boxes, before the threads' boxes are merged into them).
+  static void clear(std::vector<IVec<Dim>>& box_lo, std::vector<IVec<Dim>>& box_hi) {
+    for (std::size_t m = 0; m < box_lo.size(); ++m) box_lo[m] = none_lo(), box_hi[m] = none_hi();
   }
 };
 

@@ -50,6 +50,32 @@ TEST(ThermalProblem, RejectsSizeMismatchAsymmetryAndNegativeDiagonal) {
   EXPECT_NE(message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); }).find("< 0"), std::string::npos);
 }
 
+// The symmetry sweep (one pass with a cursor per row) against every kind of one-sided entry: an upper
+// entry without its mirror, a lower one without its mirror (first and last in its row), and a mirror
+// pair that differs; a symmetric matrix with the same pattern passes.
+TEST(ThermalProblem, SymmetrySweepFindsEveryOneSidedEntry) {
+  const auto g = make_grid_1d(6, 0.0, 1.0, Material{});
+  Eigen::MatrixXd sym = Eigen::MatrixXd(g.k);
+  sym(0, 4) = sym(4, 0) = -0.25;  // a symmetric far pair: passes
+  sym(0, 0) += 0.25, sym(4, 4) += 0.25;
+  EXPECT_NO_THROW(ft::Problem(g.mass, dense_to_sparse(sym)));
+  const struct {
+    int r, c;
+  } one_sided[] = {{0, 3}, {3, 0}, {5, 1}, {1, 5}, {2, 5}, {5, 2}};
+  for (const auto& e : one_sided) {
+    Eigen::MatrixXd a = sym;
+    a(e.r, e.c) = -0.5;  // its mirror stays 0
+    const std::string msg = message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); });
+    EXPECT_NE(msg.find("not symmetric"), std::string::npos) << e.r << "," << e.c << ": " << msg;
+    EXPECT_NE(msg.find("0.5"), std::string::npos) << msg;  // the difference named
+  }
+  Eigen::MatrixXd a = sym;
+  a(4, 0) = -0.25 * (1.0 + 1e-9);  // a mirror pair that differs by more than 1e-12 of max |K|
+  EXPECT_NE(message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); }).find("not symmetric"), std::string::npos);
+  a(4, 0) = -0.25 * (1.0 + 1e-14);  // within the tolerance
+  EXPECT_NO_THROW(ft::Problem(g.mass, dense_to_sparse(a)));
+}
+
 TEST(ThermalProblem, RejectsBadNodesSourcesAndStates) {
   auto p = make_grid_1d(4, 0.0, 1.0, Material{}).problem();
   EXPECT_THROW(p.set_dirichlet(4, 1.0), std::invalid_argument);

@@ -68,7 +68,8 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
 
 template <int Dim>
 void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
-  system_ = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly, step_stencils());
+  NodalThermalSystem assembled = assemble_thermal(grid_, p, shape_, opt_.materials, opt_.assembly, step_stencils());
+  system_.swap(assembled);
   system_assembled_ = true;
   system_gathered_ = false;
   system_changed();

@@ -13,8 +13,17 @@ void HeatAccumulator::add(const std::vector<double>& nodal_work) {
   if (nodal_work.size() != work_.size())
     throw std::invalid_argument("HeatAccumulator: " + std::to_string(nodal_work.size()) +
                                 " nodal work values for a grid of " + std::to_string(work_.size()) + " nodes");
-  for (std::size_t i = 0; i < nodal_work.size(); ++i)
-    if (nodal_work[i] != 0.0) add(i, nodal_work[i]);
+  // add(i, w) for every non-zero entry, in node order, with its checks hoisted (a step's pass over
+  // the whole grid: most entries are zero).
+  if (is_touched_.size() != work_.size()) is_touched_.assign(work_.size(), 0);
+  for (std::size_t i = 0; i < nodal_work.size(); ++i) {
+    const double joules = nodal_work[i];
+    if (joules == 0.0) continue;
+    if (!std::isfinite(joules)) throw std::invalid_argument("HeatAccumulator: non-finite work on node " + std::to_string(i));
+    if (!is_touched_[i]) is_touched_[i] = 1, touched_.push_back(i);
+    work_[i] += joules;
+    total_ += joules;
+  }
 }
 
 void HeatAccumulator::add(std::size_t node, double joules) {

@@ -2,7 +2,12 @@
 // the incremental particle update T_p += Σ_i S_ip ΔT_i (design §4).
 #include <frictherm/coupling/thermal_assembly.hpp>
 
+#include "conductance_rows.hpp"
+
+#include <omp.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -80,35 +85,10 @@ struct StencilCache {
   }
 };
 
-/// K's sparsity pattern of the last assembly (per dimension and kernel, per thread): the unknowns, the
-/// CSR arrays and the row slot of every stored entry (the diagonal at the centre slot). A new assembly
-/// with the same unknowns and the same slots holding non-zero products has the same pattern: only
-/// the values are written (same numbers, same order as a fresh build).
-template <int Dim, class Kernel>
-struct ConductancePattern {
-  std::vector<int> grid_node;
-  std::vector<int> slot;  // by stored entry, CSR order
-  thermal::SparseMatrix matrix;
-
-  static ConductancePattern& local() {
-    thread_local ConductancePattern pattern;
-    return pattern;
-  }
-  /// True if `rows` (n rows of `slots` products) gives this pattern for these unknowns.
-  bool matches(const std::vector<int>& unknowns, const std::vector<double>& rows, int slots, int centre) const {
-    if (unknowns != grid_node || matrix.rows() != static_cast<Eigen::Index>(unknowns.size())) return false;
-    const auto* outer = matrix.outerIndexPtr();
-    for (std::size_t u = 0; u < unknowns.size(); ++u) {
-      const double* r = &rows[u * static_cast<std::size_t>(slots)];
-      int count = 0;
-      for (int s = 0; s < slots; ++s) count += s != centre && r[s] != 0.0;
-      if (count + 1 != outer[u + 1] - outer[u]) return false;
-      for (auto e = outer[u]; e < outer[u + 1]; ++e)
-        if (slot[static_cast<std::size_t>(e)] != centre && r[slot[static_cast<std::size_t>(e)]] == 0.0) return false;
-    }
-    return true;
-  }
-};
+using assembly_detail::assembly_threads;
+using assembly_detail::conductance_from_rows;
+using assembly_detail::ConductancePattern;
+using assembly_detail::NodeRange;
 
 template <int Dim, class Kernel>
 NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
@@ -117,29 +97,69 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   using Nodes = NodeList<Dim, Kernel>;
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
   const std::size_t n_nodes = grid.node_count();
+  const std::size_t np = p.size();
   NodalThermalSystem sys;
-  sys.grid_mass.assign(n_nodes, 0.0);
-  thread_local std::vector<double> mct;
-  mct.assign(n_nodes, 0.0);
-  StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
-  cache.reset(grid, p.size());
-  for (auto& l : cache.lists) l.count = 0;  // entries of non-conducting particles stay invalid
-
-  // Pass 1: M_i and M_i T_i (eq. 38).
-  for (std::size_t k = 0; k < p.size(); ++k) {
+  // Every particle's material checked (and the total heat capacity summed in particle order) before
+  // the threaded passes, which must not throw.
+  for (std::size_t k = 0; k < np; ++k) {
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
-    if (!m.conducts) continue;
-    const double mc = p.mass[k] * m.heat_capacity;
-    sys.particle_heat_capacity += mc;
-    const Nodes& nl = cache.fill(grid, p, k, step_stencils);
-    for (int a = 0; a < nl.count; ++a) {
-      const auto i = static_cast<std::size_t>(nl.node[a]);
-      sys.grid_mass[i] += mc * nl.S[a];
-      mct[i] += mc * p.temperature[k] * nl.S[a];
-    }
+    if (m.conducts) sys.particle_heat_capacity += p.mass[k] * m.heat_capacity;
   }
   if (!(sys.particle_heat_capacity > 0.0))
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
+  auto props = [&](std::size_t k) -> const ThermalProperties& { return materials[static_cast<std::size_t>(p.material[k])]; };
+  sys.grid_mass.resize(n_nodes);
+  // Buffers kept between windows (no fresh pages every window), per calling thread; the passes'
+  // threads reach them through these references (a thread_local named inside an OpenMP region would
+  // be each thread's own).
+  thread_local std::vector<double> mct_buffer, rows_buffer;
+  thread_local std::vector<std::array<int, 2>> reach_buffer;
+  std::vector<double>& mct = mct_buffer;
+  std::vector<double>& rows = rows_buffer;
+  // Per particle the lowest and highest node it reaches ({n_nodes, -1} if it does not conduct): a
+  // thread skips the particles outside its range of nodes without reading their node lists.
+  std::vector<std::array<int, 2>>& reach_of = reach_buffer;
+  mct.resize(n_nodes);
+  reach_of.resize(np);
+  // The calling thread's cache, shared by the passes' threads (each writes its own particles' lists).
+  StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
+  cache.reset(grid, np);
+  const int threads = assembly_threads(np);
+  int span_lo = static_cast<int>(n_nodes), span_hi = -1;  // the nodes the particles reach
+
+  // Pass 1: M_i and M_i T_i (eq. 38). The node lists filled in parallel; then each thread sums into
+  // its own range of nodes, in particle order (the sums of one thread are those of a serial pass).
+#pragma omp parallel num_threads(threads)
+  {
+    const NodeRange r = NodeRange::of_thread(0, static_cast<int>(n_nodes));  // cleared by this thread
+    std::fill(sys.grid_mass.begin() + r.lo, sys.grid_mass.begin() + r.hi, 0.0);
+    std::fill(mct.begin() + r.lo, mct.begin() + r.hi, 0.0);
+#pragma omp for schedule(static) reduction(min : span_lo) reduction(max : span_hi)
+    for (std::size_t k = 0; k < np; ++k) {
+      std::array<int, 2>& reach = reach_of[k];
+      reach = {static_cast<int>(n_nodes), -1};
+      if (!props(k).conducts) {
+        cache.lists[k].count = 0;  // no valid entry: not a node list of this assembly
+        continue;
+      }
+      const Nodes& nl = cache.fill(grid, p, k, step_stencils);
+      for (int a = 0; a < nl.count; ++a) reach[0] = std::min(reach[0], nl.node[a]), reach[1] = std::max(reach[1], nl.node[a]);
+      span_lo = std::min(span_lo, reach[0]), span_hi = std::max(span_hi, reach[1]);
+    }
+    // (the loop's end is a barrier: every node is cleared before any thread adds)
+    const NodeRange mine = NodeRange::of_thread(span_lo, span_hi + 1);
+    for (std::size_t k = 0; k < np; ++k) {
+      if (!mine.meets(reach_of[k])) continue;
+      const Nodes& nl = cache.lists[k];
+      const double mc = p.mass[k] * props(k).heat_capacity;
+      for (int a = 0; a < nl.count; ++a) {
+        const int i = nl.node[a];
+        if (!mine.holds(i)) continue;
+        sys.grid_mass[static_cast<std::size_t>(i)] += mc * nl.S[a];
+        mct[static_cast<std::size_t>(i)] += mc * p.temperature[k] * nl.S[a];
+      }
+    }
+  }
 
   // Unknowns: nodes carrying more than a tiny fraction of the largest nodal heat capacity.
   sys.select_unknowns(mct, opt.active_mass_fraction);
@@ -147,17 +167,17 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 
   // Pass 2: K_ij = Σ_p V_p k_p G'_ip·G'_jp, accumulated per unknown row in slots indexed by the lattice
   // offset of j from i (each component in [-(K-1), K-1]).
-  constexpr int kw = 2 * Kernel::K - 1;
-  constexpr int slots = Dim == 2 ? kw * kw : kw * kw * kw;
-  thread_local std::vector<double> rows;  // kept between windows: no fresh pages every window
-  rows.assign(static_cast<std::size_t>(n) * slots, 0.0);
+  constexpr int kw = ConductancePattern<Dim, Kernel>::kw;
+  constexpr int slots = ConductancePattern<Dim, Kernel>::slots;
+  rows.resize(static_cast<std::size_t>(n) * slots);
   // The slot of node j in row i from the flat index difference j - i through a table (no
   // node_lattice divisions per particle); the lattice is decoded instead if two offsets share a
   // difference (fewer than kw nodes along an axis).
   const auto& stride = grid.strides();
   int reach = 0;
   for (int d = 0; d < Dim; ++d) reach += (Kernel::K - 1) * stride[d];
-  thread_local std::vector<int> slot_of;
+  thread_local std::vector<int> slot_of_buffer;
+  std::vector<int>& slot_of = slot_of_buffer;
   slot_of.assign(static_cast<std::size_t>(2 * reach + 1), -1);
   bool use_table = true;
   for (int sl = 0; sl < slots; ++sl) {
@@ -170,12 +190,22 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     use_table = use_table && e < 0;
     e = sl;
   }
+  // Each thread adds into its own range of rows, in particle order, so every (row, slot) entry gets
+  // the same terms in the same order as in a serial pass: K is the same for every thread count.
+#pragma omp parallel num_threads(threads)
+  {
+  const NodeRange mine = NodeRange::of_thread(0, static_cast<int>(n));  // rows
+  std::fill(rows.begin() + static_cast<std::ptrdiff_t>(mine.lo) * slots, rows.begin() + static_cast<std::ptrdiff_t>(mine.hi) * slots, 0.0);
+  // The grid nodes of these rows: a particle reaching none of them is skipped before its lumping.
+  const NodeRange nodes = mine.lo < mine.hi ? NodeRange{sys.grid_node[static_cast<std::size_t>(mine.lo)],
+                                                        sys.grid_node[static_cast<std::size_t>(mine.hi - 1)] + 1}
+                                            : NodeRange{0, 0};
   mechanics::Vec<Dim> Gk[Nodes::capacity];
   mechanics::IVec<Dim> lat[Nodes::capacity];
   int row[Nodes::capacity], gnode[Nodes::capacity];
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
-    if (!m.conducts || !(m.conductivity > 0.0)) continue;
+  for (std::size_t k = 0; k < np; ++k) {
+    const ThermalProperties& m = props(k);
+    if (!nodes.meets(reach_of[k]) || !(m.conductivity > 0.0)) continue;  // (meets: it conducts)
     Nodes nl = cache.lists[k];  // filled by pass 1 (a copy: the lumping below reorders S)
     double s_kept = 0.0;
     mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
@@ -202,8 +232,11 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     // offset (slots - 1 - slot). Every (row, slot) entry still gets the same single term per particle,
     // in particle order, so the sums are bit-identical to the full double loop.
     for (int a = 0; a < kept; ++a) {
+      const bool own_a = mine.holds(row[a]);
       double* r = &rows[static_cast<std::size_t>(row[a]) * slots];
       for (int b = a; b < kept; ++b) {
+        const bool own_b = b != a && mine.holds(row[b]);
+        if (!own_a && !own_b) continue;
         int slot = 0;
         if (use_table) {
           slot = slot_of[static_cast<std::size_t>(gnode[b] - gnode[a] + reach)];
@@ -212,84 +245,16 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
             slot += (lat[b][static_cast<std::size_t>(d)] - lat[a][static_cast<std::size_t>(d)] + Kernel::K - 1) * scale;
         }
         const double kab = c * Gk[a].dot(Gk[b]);
-        r[slot] += kab;
-        if (b != a) rows[static_cast<std::size_t>(row[b]) * slots + static_cast<std::size_t>(slots - 1 - slot)] += kab;
+        if (own_a) r[slot] += kab;
+        if (own_b) rows[static_cast<std::size_t>(row[b]) * slots + static_cast<std::size_t>(slots - 1 - slot)] += kab;
       }
     }
   }
+  }  // omp parallel
 
-  // CSR with the diagonal set to minus the off-diagonal row sum, so K·1 = 0 to the round-off of
-  // that sum (the products above give it only approximately, and exact zero row sums make the
-  // conduction part conserve Σ M_i T_i exactly). Rows are written in place (Eigen's sorted
-  // startVec/insertBack fill): no triplet list, no temporary column-major copy.
-  constexpr int centre = (slots - 1) / 2;
-  ConductancePattern<Dim, Kernel>& pattern = ConductancePattern<Dim, Kernel>::local();
-  if (pattern.matches(sys.grid_node, rows, slots, centre)) {  // same layout: refill the values
-    sys.conductance = pattern.matrix;
-    double* value = sys.conductance.valuePtr();
-    const auto* outer = sys.conductance.outerIndexPtr();
-    for (Eigen::Index u = 0; u < n; ++u) {
-      const double* r = &rows[static_cast<std::size_t>(u) * slots];
-      double off_sum = 0.0;  // in slot order, as the fresh build sums it
-      for (int s = 0; s < slots; ++s)
-        if (s != centre && r[s] != 0.0) off_sum += r[s];
-      for (auto e = outer[u]; e < outer[u + 1]; ++e) {
-        const int sl = pattern.slot[static_cast<std::size_t>(e)];
-        value[e] = sl == centre ? -off_sum : r[sl];
-      }
-    }
-    return sys;
-  }
-  std::size_t nnz = 0;
-  for (double v : rows) nnz += v != 0.0;
-  sys.conductance.resize(n, n);
-  sys.conductance.reserve(static_cast<Eigen::Index>(nnz) + n);
-  pattern.slot.clear();
-  pattern.slot.reserve(nnz + static_cast<std::size_t>(n));
-  int col[slots], slot_at[slots];
-  double val[slots];
-  for (Eigen::Index u = 0; u < n; ++u) {
-    const double* r = &rows[static_cast<std::size_t>(u) * slots];
-    const int node = sys.grid_node[static_cast<std::size_t>(u)];
-    double off_sum = 0.0;
-    int count = 0;
-    for (int s = 0; s < slots; ++s) {
-      if (s == centre || r[s] == 0.0) continue;
-      int rem = s, j = node;
-      for (int d = 0; d < Dim; ++d) {
-        j += (rem % kw - (Kernel::K - 1)) * stride[d];
-        rem /= kw;
-      }
-      col[count] = sys.unknown[static_cast<std::size_t>(j)];
-      slot_at[count] = s;
-      val[count++] = r[s];
-      off_sum += r[s];
-    }
-    // Ascending columns: the slot order is the lattice order, in which unknown numbers increase
-    // (they follow the flat node index) unless an axis has fewer than kw nodes; then sort. The
-    // diagonal goes where its column falls.
-    for (int a = 1; a < count; ++a)
-      for (int b = a; b > 0 && col[b - 1] > col[b]; --b) {
-        std::swap(col[b - 1], col[b]);
-        std::swap(slot_at[b - 1], slot_at[b]);
-        std::swap(val[b - 1], val[b]);
-      }
-    sys.conductance.startVec(u);
-    bool diagonal = false;
-    for (int a = 0; a < count; ++a) {
-      if (!diagonal && col[a] > u) {
-        sys.conductance.insertBack(u, u) = -off_sum;
-        pattern.slot.push_back(centre);
-        diagonal = true;
-      }
-      sys.conductance.insertBack(u, col[a]) = val[a];
-      pattern.slot.push_back(slot_at[a]);
-    }
-    if (!diagonal) sys.conductance.insertBack(u, u) = -off_sum, pattern.slot.push_back(centre);
-  }
-  sys.conductance.finalize();
-  pattern.grid_node = sys.grid_node;
-  pattern.matrix = sys.conductance;
+  // K in CSR, the diagonal minus the off-diagonal row sum (conductance_rows.hpp).
+  conductance_from_rows<Dim, Kernel>(rows, sys.grid_node, sys.unknown, stride, threads,
+                                     ConductancePattern<Dim, Kernel>::local(), sys.conductance);
   return sys;
 }
 
@@ -299,10 +264,13 @@ void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>
                      const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end,
                      const mechanics::StencilView<Dim>& view) {
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
-  NodeList<Dim, Kernel> fresh;
-  const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();
+  const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();  // the calling thread's
+  for (std::size_t k = 0; k < p.size(); ++k) thermal_properties_of(materials, p.material[k]);  // throws here
+  // Each particle's temperature from its own nodes: the particles shared between threads.
+#pragma omp parallel for num_threads(assembly_threads(p.size())) schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!thermal_properties_of(materials, p.material[k]).conducts) continue;
+    if (!materials[static_cast<std::size_t>(p.material[k])].conducts) continue;
+    NodeList<Dim, Kernel> fresh;
     const NodeList<Dim, Kernel>* cached = cache.find(grid, p, k);  // the assembly's, when still exact
     if (!cached) fresh.fill(grid, p, k, step_stencils);
     const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -50,6 +51,14 @@ struct NodalThermalSystem {
   double max_mass = 0.0;                // max_i M_i (J/K)
 
   std::size_t size() const { return grid_node.size(); }
+  /// Exchanges the contents with `other` (Eigen 3.4's SparseMatrix has no move: assigning a returned
+  /// system would copy K).
+  void swap(NodalThermalSystem& other) noexcept {
+    grid_node.swap(other.grid_node), unknown.swap(other.unknown), grid_mass.swap(other.grid_mass);
+    mass.swap(other.mass), temperature.swap(other.temperature), conductance.swap(other.conductance);
+    std::swap(particle_heat_capacity, other.particle_heat_capacity), std::swap(dropped_mass, other.dropped_mass);
+    std::swap(max_mass, other.max_mass);
+  }
   /// From grid_mass and Σ_p m_p C_v,p T_p S_ip per node (mct): the unknowns (nodes carrying more than
   /// active_mass_fraction of the largest nodal heat capacity), their M and their T (eq. 38); sets
   /// max_mass and dropped_mass.

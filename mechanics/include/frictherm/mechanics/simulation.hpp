@@ -335,6 +335,10 @@ class Simulation {
   void move_rigid_particles(double dt, double t);
   struct RigidMotion {
     Vec<Dim> velocity, displacement;  // at t, and over [t, t + dt] (trapezoid)
+    void move(Vec<Dim>& particle_velocity, Vec<Dim>& particle_position) const {
+      particle_velocity = velocity;
+      particle_position += displacement;
+    }
   };
   RigidMotion rigid_motion(std::size_t material, double t, double dt) const;
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
@@ -356,8 +360,15 @@ class Simulation {
   std::vector<VelocityField<Dim>> fields_;
   std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
   std::vector<int> slot_node_;
-  bool slot_node_valid_ = false;
-  std::vector<int> occupied_slots_;  // find_contact_nodes: slots with mass, in slot order  // slot_node_ matches the per-material layout of fields_ (layout_fields)
+  bool slot_node_valid_ = false;  // slot_node_ matches the per-material layout of fields_ (layout_fields)
+  // One thread's share of find_contact_nodes (a range of grid nodes), per field: its slots
+  // [slot_begin, slot_end), the end of those with mass in `occupied`, the entries and nodes of the
+  // contact nodes that first have mass in that field, and where they go in contact_entries_/_groups_.
+  struct ContactNodeListing {
+    std::vector<int> occupied;
+    std::vector<std::size_t> slot_begin, slot_end, field_end, entries, groups, entry_base, group_base;
+  };
+  std::vector<ContactNodeListing> contact_node_listing_;
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
   std::vector<RigidMotion> rigid_motion_;  // per material, for particle_pass(refresh)
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
