@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -315,5 +316,64 @@ TEST(ThermalAssembly, RefilledConductanceEqualsFreshBuild) {
     fc::assemble_thermal(other_grid, small, shape, mats);
     expect_identical(after_refill, fc::assemble_thermal(grid, moved, shape, mats));
     EXPECT_NE(refilled.conductance.nonZeros(), 0);
+  }
+}
+
+namespace {
+
+// ~6000 particles (enough for the assembly to use two threads: one per 2000), jittered off the
+// lattice, of two conducting materials and a rigid strip without thermal properties, on 40 x 30 cells.
+fm::Particles<2> large_block(double shift) {
+  fm::Particles<2> p;
+  auto T = [](const fm::Vec<2>& x) { return 300.0 + 2e3 * x[0] + 20.0 * std::cos(500.0 * x[1]); };
+  fill_box<2>(p, {3e-3, 3e-3}, {33e-3, 23e-3}, 1e-3, 3, 1190.0, 1, T, 2e-3);
+  fill_box<2>(p, {12e-3, 8e-3}, {20e-3, 16e-3}, 1e-3, 2, 1900.0, 0, T, 2e-3);
+  fill_box<2>(p, {33e-3, 3e-3}, {35e-3, 23e-3}, 1e-3, 2, 7800.0, 2, T, 2e-3);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const double a = static_cast<double>(k);
+    p.position[k][0] += 0.1e-3 * std::sin(1.7 * a) + (p.material[k] == 1 ? shift : 0.0);
+    p.position[k][1] += 0.1e-3 * std::cos(2.3 * a);
+  }
+  return p;
+}
+
+}  // namespace
+
+// The assembly's passes, K's rows and the map back share their nodes, rows and particles between
+// threads, each thread adding only into its own in particle order: the system is the same bit for bit
+// on one and two threads, for a fresh pattern, a refilled one and a rebuilt one.
+TEST(ThermalAssembly, SameNumbersOnOneAndTwoThreads) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {40, 30});
+  const auto other_grid = make_grid<2>({0.0, 0.0}, 1e-3, {41, 30});  // forgets the kept pattern
+  const auto mats = two_materials();
+  const fm::Particles<2> first = large_block(0.0), nudged = large_block(1e-7), moved = large_block(0.4e-3);
+  ASSERT_GE(first.size(), 4000u);
+  const int threads_before = omp_get_max_threads();
+  for (fm::ShapeKind shape : kShapes) {
+    SCOPED_TRACE(fm::to_string(shape));
+    std::vector<fc::NodalThermalSystem> systems[2];
+    std::vector<double> mapped[2];
+    for (int threads = 1; threads <= 2; ++threads) {
+      omp_set_num_threads(threads);
+      fc::assemble_thermal(other_grid, first, shape, mats);
+      auto& s = systems[threads - 1];
+      s.push_back(fc::assemble_thermal(grid, first, shape, mats));   // fresh pattern
+      s.push_back(fc::assemble_thermal(grid, nudged, shape, mats));  // same layout: refilled
+      s.push_back(fc::assemble_thermal(grid, moved, shape, mats));   // new layout: rebuilt
+      Eigen::VectorXd delta(s.back().mass.size());
+      for (Eigen::Index u = 0; u < delta.size(); ++u) delta[u] = 0.03 * static_cast<double>(u % 11) - 0.1;
+      fm::Particles<2> p = moved;
+      fc::add_nodal_change_to_particles(grid, p, shape, mats, s.back(), delta);
+      mapped[threads - 1] = p.temperature;
+    }
+    omp_set_num_threads(threads_before);
+    for (std::size_t i = 0; i < systems[0].size(); ++i) {
+      SCOPED_TRACE(i);
+      expect_identical(systems[0][i], systems[1][i]);
+    }
+    EXPECT_EQ(mapped[0], mapped[1]);
+    EXPECT_NE(mapped[0], moved.temperature);
+    // Not a vacuous comparison: the three systems differ from each other.
+    EXPECT_FALSE(systems[0][0].conductance.isApprox(systems[0][2].conductance));
   }
 }
