@@ -86,6 +86,10 @@ TEST_F(Limits, ResourceBombsRefusedBeforeAllocation) {
   expect_refused("--set grid.hi=[70,70] --set grid.cell_size=0.01", "grid: 49014001 grid nodes", "nodes per particle");
   // --set growing an array to 2e8 elements.
   expect_refused("--set 'bodies[200000000]=1'", "--set bodies[200000000]", "beyond the end of an array of 1");
+  // The same under a key the scene does not have (or has as null): an array made from nothing.
+  expect_refused("--set 'extra[100000000]=1'", "--set extra[100000000]", "beyond the end of an array of 0");
+  expect_refused("--set 'bodies[0].spin[50000000]=1'", "--set bodies[0].spin[50000000]", "beyond the end of an array of 0");
+  expect_refused("--set 'extra[9999999999999999999]9=1'", "--set extra[9999999999999999999]9", "beyond the end");
 }
 
 TEST_F(Limits, EndlessRunsRefusedWithTheirNumbers) {

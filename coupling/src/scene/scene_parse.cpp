@@ -270,10 +270,13 @@ void check_indices(const Json& doc, const Json::json_pointer& ptr, const std::st
   if (ptr.empty()) return;
   const Json::json_pointer parent = ptr.parent_pointer();
   check_indices(doc, parent, path);
-  if (!doc.contains(parent) || !doc.at(parent).is_array()) return;
   const std::string& token = ptr.back();
-  if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos) return;  // JSON refuses it
-  const std::size_t size = doc.at(parent).size();
+  if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos) return;  // a key, not an index
+  // A number under a missing or null parent makes that parent an array of index + 1 elements
+  // (nlohmann::json's pointer creation): an empty array, as far as appending goes.
+  const bool absent = !doc.contains(parent) || doc.at(parent).is_null();
+  if (!absent && !doc.at(parent).is_array()) return;  // an object's key, or JSON refuses it
+  const std::size_t size = absent ? 0 : doc.at(parent).size();
   if (token.size() > 9 || std::stoul(token) > size)
     throw SceneError("--set " + path + ": index " + token + " is beyond the end of an array of " + std::to_string(size) +
                      " elements (expected at most " + std::to_string(size) + ", which appends one)");
