@@ -2,6 +2,7 @@
 // materials have mass): (node, slot, field) entries grouped by node, shared between the threads by
 // ranges of grid nodes. The list is the same for every thread count.
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/thread_partition.hpp>
 
 #include <omp.h>
 
@@ -49,8 +50,8 @@ void Simulation<Dim>::find_contact_nodes() {
   {
     const int t = omp_get_thread_num(), T = omp_get_num_threads();
     ContactNodeListing& w = contact_node_listing_[static_cast<std::size_t>(t)];
-    const long span = static_cast<long>(span_hi) - span_lo;
-    const int node_lo = span_lo + static_cast<int>(span * t / T), node_hi = span_lo + static_cast<int>(span * (t + 1) / T);
+    const EvenShare share(span_lo, span_hi, t, T);
+    const int node_lo = static_cast<int>(share.lo), node_hi = static_cast<int>(share.hi);
     w.slot_begin.resize(nf), w.slot_end.resize(nf), w.field_end.resize(nf);
     w.entries.assign(nf, 0), w.groups.assign(nf, 0), w.entry_base.resize(nf), w.group_base.resize(nf);
     for (std::size_t f = 0; f < nf; ++f) {

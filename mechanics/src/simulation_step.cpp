@@ -66,7 +66,7 @@ void Simulation<Dim>::step_with(double dt) {
   // Below ~2000 particles per thread the fork/join and the scatter-buffer reduction cost more than
   // the particle work they share.
   const int max_threads = omp_get_max_threads();
-  threads_ = std::max(1, std::min(max_threads, static_cast<int>(p_.size() / 2000)));
+  threads_ = threads_for_particles(p_.size(), max_threads);
   if (static_cast<int>(thread_nodes_.size()) != threads_ - 1) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
     for (auto& t : thread_nodes_) t.resize(nodes_.mass.size(), contact_);

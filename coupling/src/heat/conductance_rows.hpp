@@ -2,6 +2,7 @@
 // Internal to thermal_assembly.cpp: the conductance matrix K in CSR from the assembly's per-row sums,
 // with its rows shared between threads, and the thread ranges of the assembly's passes.
 #include <frictherm/mechanics/grid.hpp>
+#include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/thermal/problem.hpp>
 
 #include <omp.h>
@@ -17,9 +18,8 @@ namespace frictherm::coupling::assembly_detail {
 struct NodeRange {
   int lo = 0, hi = 0;
   static NodeRange of_thread(int begin, int end) {
-    const long span = std::max(0L, static_cast<long>(end) - begin);
-    const long t = omp_get_thread_num(), T = omp_get_num_threads();
-    return {begin + static_cast<int>(span * t / T), begin + static_cast<int>(span * (t + 1) / T)};
+    const mechanics::EvenShare s(begin, end, omp_get_thread_num(), omp_get_num_threads());
+    return {static_cast<int>(s.lo), static_cast<int>(s.hi)};
   }
   bool holds(int i) const { return i >= lo && i < hi; }
   /// The nodes [reach[0], reach[1]] overlap the range.
@@ -27,10 +27,9 @@ struct NodeRange {
   bool meets(const Reach& reach) const { return reach[1] >= lo && reach[0] < hi; }
 };
 
-/// Threads for a pass over the particles: as the mechanics step (Simulation::step_with), none for
-/// fewer than ~2000 particles per thread.
+/// Threads for a pass over the particles: as the mechanics step (Simulation::step_with).
 inline int assembly_threads(std::size_t particles) {
-  return std::max(1, std::min(omp_get_max_threads(), static_cast<int>(particles / 2000)));
+  return mechanics::threads_for_particles(particles, omp_get_max_threads());
 }
 
 /// K's sparsity pattern of the last assembly (per dimension and kernel, per calling thread): the

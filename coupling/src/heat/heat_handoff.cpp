@@ -20,9 +20,7 @@ void HeatAccumulator::add(const std::vector<double>& nodal_work) {
     const double joules = nodal_work[i];
     if (joules == 0.0) continue;
     if (!std::isfinite(joules)) throw std::invalid_argument("HeatAccumulator: non-finite work on node " + std::to_string(i));
-    if (!is_touched_[i]) is_touched_[i] = 1, touched_.push_back(i);
-    work_[i] += joules;
-    total_ += joules;
+    accumulate(i, joules);
   }
 }
 
@@ -32,12 +30,7 @@ void HeatAccumulator::add(std::size_t node, double joules) {
   if (!std::isfinite(joules))
     throw std::invalid_argument("HeatAccumulator: non-finite work on node " + std::to_string(node));
   if (is_touched_.size() != work_.size()) is_touched_.assign(work_.size(), 0);
-  if (!is_touched_[node]) {
-    is_touched_[node] = 1;
-    touched_.push_back(node);
-  }
-  work_[node] += joules;
-  total_ += joules;
+  accumulate(node, joules);
 }
 
 void HeatAccumulator::clear() {

@@ -54,7 +54,7 @@ class Run {
     // spinning waits fewer while another process holds a core (thread_policy.hpp).
     const std::size_t particles = sim_->particles().size();
     omp_set_num_threads(threads > 0 ? threads : default_thread_count(particles));
-    const int stepping = std::min(omp_get_max_threads(), static_cast<int>(particles / 2000));  // as Simulation::step
+    const int stepping = mechanics::threads_for_particles(particles, omp_get_max_threads());  // as Simulation::step
     if (threads <= 0 && std::getenv("OMP_NUM_THREADS") == nullptr && waiting_threads_spin() && stepping >= 2)
       governor_.emplace(stepping);
     r_.particles = sim_->particles().size();

@@ -1,5 +1,6 @@
 // Passive waiting and a default thread count that does not oversubscribe a shared machine.
 #include <frictherm/coupling/thread_policy.hpp>
+#include <frictherm/mechanics/thread_partition.hpp>
 
 #include <omp.h>
 #include <time.h>
@@ -41,8 +42,7 @@ int idle_cores() {
 
 int default_thread_count(std::size_t particles) {
   if (std::getenv("OMP_NUM_THREADS") != nullptr) return std::max(1, omp_get_max_threads());
-  const int by_size = static_cast<int>(std::min<std::size_t>(particles / 2000, 1024));
-  return std::max(1, std::min(idle_cores(), by_size));
+  return mechanics::threads_for_particles(particles, idle_cores());
 }
 
 bool waiting_threads_spin() {

@@ -9,6 +9,7 @@
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/coupling/scene_cost.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/thread_partition.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -65,7 +66,7 @@ SceneCost estimate_scene_cost(const Scene& s) {
   for (int d = 0; d < dim; ++d) c.grid_nodes *= static_cast<double>(s.cells[d]) + 1.0;
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   const double wanted = s.threads > 0 ? s.threads : hw;
-  c.threads = static_cast<int>(std::max(1.0, std::min(wanted, std::floor(c.particles / 2000.0))));
+  c.threads = static_cast<int>(std::max(1.0, std::min(wanted, std::floor(c.particles / static_cast<double>(mechanics::kParticlesPerThread)))));
   c.memory_bytes = kBaseBytes + c.particles * bytes_per_particle(dim) + c.grid_nodes * bytes_per_node(dim) +
                    (c.threads - 1) * c.grid_nodes * 8.0 * (1 + 2 * dim) +
                    (s.thermal.enabled ? c.grid_nodes * thermal_bytes_per_node(dim) : 0.0);

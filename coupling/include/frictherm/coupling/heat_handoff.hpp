@@ -44,6 +44,12 @@ class HeatAccumulator {
   }
 
  private:
+  /// work_[node] += joules and the running sum; node marked as touched (is_touched_ sized).
+  void accumulate(std::size_t node, double joules) {
+    if (!is_touched_[node]) is_touched_[node] = 1, touched_.push_back(node);
+    work_[node] += joules;
+    total_ += joules;
+  }
   std::vector<double> work_;
   std::vector<std::size_t> touched_;  // nodes with work, so clear() is cheap
   std::vector<unsigned char> is_touched_;

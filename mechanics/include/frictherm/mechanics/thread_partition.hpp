@@ -8,10 +8,30 @@
 // more threads' ranges (at most threads − 1 of them with contact; the one shared field without
 // contact) goes through per-thread buffers, cleared and summed over its own slots. A PBX with 59
 // materials on two threads then sums one field's slots per scatter instead of every field's.
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
 namespace frictherm::mechanics {
+
+/// Particles per thread below which a loop over particles costs more in fork/join and buffer sums
+/// than the work it shares: the step, the coupler's assembly and the default thread count use it.
+inline constexpr std::size_t kParticlesPerThread = 2000;
+
+/// Threads for a loop over `particles`: at most `available`, at least one.
+inline int threads_for_particles(std::size_t particles, int available) {
+  return std::max(1, std::min(available, static_cast<int>(std::min<std::size_t>(particles / kParticlesPerThread, 1 << 20))));
+}
+
+/// Thread t's share [lo, hi) of [begin, end) split evenly among T threads (a loop over nodes or rows).
+struct EvenShare {
+  long lo = 0, hi = 0;
+  EvenShare(long begin, long end, int t, int T) {
+    const long span = std::max(0L, end - begin);
+    lo = begin + span * t / T;
+    hi = begin + span * (t + 1) / T;
+  }
+};
 
 struct ThreadPartition {
   int threads = 0;
