@@ -136,3 +136,43 @@ TEST(ThermalProblem, RevisionTracksOperatorChangesOnly) {
   const auto q = make_grid_1d(3, 0.0, 1.0, Material{}).problem();
   EXPECT_NE(q.revision(), p.revision());  // unique across objects
 }
+
+// reset() in the old object's storage is the same as a new Problem: every source, boundary, fixed node
+// and reaction of the old one gone, the new M and K in force (heat rate bitwise that of a fresh
+// Problem), a new revision, and the constructor's checks (a non-symmetric K is refused by name).
+TEST(ThermalProblem, ResetEqualsAFreshProblem) {
+  const auto a = make_grid_1d(4, 0.0, 1.0, Material{});
+  const auto b = make_grid_1d(4, 0.0, 3.0, Material{2.0, 0.5});
+  ft::Problem p(a.mass, a.k);
+  p.set_source(Eigen::VectorXd::Ones(4));
+  p.add_flux(1, 2.0);
+  p.add_convection(2, 0.5, 10.0);
+  p.set_dirichlet(3, 7.0);
+  ft::Reaction rx;
+  rx.heat = Eigen::VectorXd::Constant(4, 1e3);
+  rx.prefactor = 1e10;
+  rx.activation_temperature = 1e4;
+  p.set_reaction(rx);
+  const auto r0 = p.revision();
+
+  p.reset(b.mass, b.k);
+  const ft::Problem fresh(b.mass, b.k);
+  EXPECT_NE(p.revision(), r0);
+  EXPECT_FALSE(p.has_source());
+  EXPECT_FALSE(p.has_reaction());
+  EXPECT_TRUE(p.dirichlet_nodes().empty());
+  EXPECT_FALSE(p.is_dirichlet(3));
+  EXPECT_EQ(p.flux().cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(p.convection_coefficients().cwiseAbs().maxCoeff(), 0.0);
+  const Eigen::Vector4d temp(300.0, 310.0, 305.0, 900.0);
+  Eigen::VectorXd w(4), w_fresh(4);
+  p.heat_rate(0.0, temp, w);
+  fresh.heat_rate(0.0, temp, w_fresh);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(w[i], w_fresh[i]) << i;
+  EXPECT_NE(w.cwiseAbs().maxCoeff(), 0.0);  // K of b acts: the temperatures differ
+
+  Eigen::MatrixXd bad = Eigen::MatrixXd(b.k);
+  bad(0, 1) = -5.0;
+  const auto msg = message_of([&] { p.reset(b.mass, dense_to_sparse(bad)); });
+  EXPECT_NE(msg.find("not symmetric"), std::string::npos) << msg;
+}

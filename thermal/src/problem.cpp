@@ -23,6 +23,17 @@ std::uint64_t next_revision() {
 Problem::Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol)
     : mass_(std::move(mass)) {
   k_.swap(conductance);  // (Eigen 3.4's SparseMatrix has no move: a move would copy)
+  check_and_clear(symmetry_tol);
+}
+
+void Problem::reset(const Eigen::VectorXd& mass, const SparseMatrix& conductance, double symmetry_tol) {
+  mass_ = mass;       // Eigen keeps the storage of a vector of the same size
+  k_ = conductance;   // and of a matrix of the same size with no more non-zeros
+  check_and_clear(symmetry_tol);
+}
+
+// The constructor's checks of M and K, then no sources, boundaries or reaction and a new revision.
+void Problem::check_and_clear(double symmetry_tol) {
   const Index n = mass_.size();
   if (n == 0) fail("the mass vector M is empty (need at least one node)");
   for (Index i = 0; i < n; ++i) {
@@ -87,11 +98,18 @@ Problem::Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry
       fail(os.str());
     }
   }
+  has_source_ = false;
+  q0_.resize(0);
+  q1_.resize(0);
+  ramp_t0_ = ramp_t1_ = 0.0;
   fixed_.assign(static_cast<std::size_t>(n), 0);
-  fixed_value_ = Eigen::VectorXd::Zero(n);
-  flux_ = Eigen::VectorXd::Zero(n);
-  ha_ = Eigen::VectorXd::Zero(n);
-  ha_tinf_ = Eigen::VectorXd::Zero(n);
+  dirichlet_nodes_.clear();
+  fixed_value_.setZero(n);
+  flux_.setZero(n);
+  ha_.setZero(n);
+  ha_tinf_.setZero(n);
+  has_reaction_ = false;
+  reaction_ = Reaction{};
   revision_ = next_revision();
 }
 

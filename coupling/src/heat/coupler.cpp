@@ -73,7 +73,8 @@ void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
   system_assembled_ = true;
   system_gathered_ = false;
   system_changed();
-  problem_.emplace(system_.mass, system_.conductance);
+  if (problem_) problem_->reset(system_.mass, system_.conductance);  // the last window's storage
+  else problem_.emplace(system_.mass, system_.conductance);
   for (const FixedTemperatureFace& f : opt_.fixed_faces) {
     const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
     for (std::size_t u = 0; u < system_.size(); ++u)

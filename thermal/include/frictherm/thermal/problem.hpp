@@ -29,6 +29,10 @@ class Problem {
   // non-finite entry or a negative diagonal. K is assumed positive semi-definite; only these
   // necessary conditions are checked.
   Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol = 1e-12);
+  // The same as assigning Problem(mass, conductance, symmetry_tol), in this object's storage: a
+  // coupled run's windows keep their sizes, so nothing is allocated. Same checks and throws; after a
+  // throw only another reset or the destructor may be called.
+  void reset(const Eigen::VectorXd& mass, const SparseMatrix& conductance, double symmetry_tol = 1e-12);
 
   Index size() const { return mass_.size(); }
   const Eigen::VectorXd& mass() const { return mass_; }
@@ -112,6 +116,7 @@ class Problem {
   void check_node(Index node, const char* what) const;
   void check_source_vector(const Eigen::VectorXd& q, const char* what) const;
   void touch();
+  void check_and_clear(double symmetry_tol);
 
   Eigen::VectorXd mass_;
   SparseMatrix k_;
