@@ -98,19 +98,14 @@ void Problem::check_and_clear(double symmetry_tol) {
       fail(os.str());
     }
   }
-  has_source_ = false;
-  q0_.resize(0);
-  q1_.resize(0);
-  ramp_t0_ = ramp_t1_ = 0.0;
+  clear_source();
   fixed_.assign(static_cast<std::size_t>(n), 0);
   dirichlet_nodes_.clear();
   fixed_value_.setZero(n);
   flux_.setZero(n);
   ha_.setZero(n);
   ha_tinf_.setZero(n);
-  has_reaction_ = false;
-  reaction_ = Reaction{};
-  revision_ = next_revision();
+  clear_reaction();  // and a new revision
 }
 
 void Problem::touch() { revision_ = next_revision(); }

@@ -65,8 +65,9 @@ SceneCost estimate_scene_cost(const Scene& s) {
   c.grid_nodes = 1.0;
   for (int d = 0; d < dim; ++d) c.grid_nodes *= static_cast<double>(s.cells[d]) + 1.0;
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const double wanted = s.threads > 0 ? s.threads : hw;
-  c.threads = static_cast<int>(std::max(1.0, std::min(wanted, std::floor(c.particles / static_cast<double>(mechanics::kParticlesPerThread)))));
+  const int wanted = s.threads > 0 ? s.threads : static_cast<int>(hw);
+  // (a bomb's particle count can exceed any integer; 1e15 particles already ask for the most threads)
+  c.threads = mechanics::threads_for_particles(static_cast<std::size_t>(std::min(c.particles, 1e15)), wanted);
   c.memory_bytes = kBaseBytes + c.particles * bytes_per_particle(dim) + c.grid_nodes * bytes_per_node(dim) +
                    (c.threads - 1) * c.grid_nodes * 8.0 * (1 + 2 * dim) +
                    (s.thermal.enabled ? c.grid_nodes * thermal_bytes_per_node(dim) : 0.0);
