@@ -15,6 +15,7 @@
 #include <fstream>
 #include <string>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -112,6 +113,24 @@ TEST_F(Files, InputsAreNeverWrittenOverEvenWithForce) {
   ASSERT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv")).code, 0);
   EXPECT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv")).code, 2);
   EXPECT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv") + " --force").code, 0);
+}
+
+// A result is published by renaming over its name, which would turn a device or a pipe (-o /dev/null
+// as root) into a regular file: such a name is refused even with --force, and left as it was. A named
+// pipe in the scratch folder stands for them (the test must not risk /dev/null).
+TEST_F(Files, SpecialFilesAreNeverReplacedEvenWithForce) {
+  const std::string scene = write("tiny.json", kTinyScene);
+  const std::string pipe = path("pipe.h5");
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  const Result r = frictherm("run " + scene + " -o " + pipe + " --quiet --force");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("it is a named pipe, not a regular file"));
+  EXPECT_TRUE(fs::is_fifo(pipe));
+  ASSERT_EQ(frictherm("run " + scene + " -o " + path("run.h5") + " --quiet").code, 0);
+  const Result csv = frictherm("export-csv " + path("run.h5") + " -o " + pipe + " --force");
+  EXPECT_EQ(csv.code, 2) << csv.output;
+  EXPECT_TRUE(fs::is_fifo(pipe));
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_NE(e.path().extension(), ".part") << e.path();
 }
 
 // Two runs started together on one output file: the first to finish publishes it; the second finds

@@ -35,6 +35,15 @@ int rename_no_replace(const char* from, const char* to) {
   return 0;
 }
 
+/// What a non-regular, non-folder file is, for the refusal above.
+std::string special_file_kind(mode_t mode) {
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a named pipe";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "a special file";
+}
+
 }  // namespace
 
 std::vector<std::string> scene_input_files(const Scene& scene) {
@@ -60,6 +69,11 @@ void check_output_path(const std::string& path, const std::vector<std::string>& 
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return;  // nothing there (or a dangling link: created through it)
   if (S_ISDIR(st.st_mode)) throw OutputError("cannot write '" + path + "': it is a folder");
+  // A result is published by renaming its temporary file over the name, which would replace a device,
+  // pipe or socket (/dev/null, /dev/full) by a regular file: refused, whatever --force says.
+  if (!S_ISREG(st.st_mode))
+    throw OutputError("cannot write '" + path + "': it is " + special_file_kind(st.st_mode) +
+                      ", not a regular file; choose a file name for the result");
   if (!overwrite)
     throw OutputError("'" + path + "' exists; refusing to replace an existing result (give " + how_to_overwrite +
                       " to replace it, or choose another output file)");
