@@ -3,6 +3,18 @@
 
 namespace frictherm::cli {
 
+namespace {
+/// Whether `a` is one of the command's options (its name before any "=VALUE", or -h/--help).
+bool is_option(const std::string& a, const std::vector<OptionSpec>& spec) {
+  const std::string name = a.substr(0, a.compare(0, 2, "--") == 0 ? a.find('=') : std::string::npos);
+  if (name == "-h" || name == "--help") return true;
+  for (const auto& s : spec)
+    for (const auto& n : s.names)
+      if (n == name) return true;
+  return false;
+}
+}  // namespace
+
 ParsedArgs parse_args(const std::string& command, const std::vector<std::string>& args,
                       const std::vector<OptionSpec>& spec) {
   ParsedArgs out;
@@ -33,6 +45,11 @@ ParsedArgs parse_args(const std::string& command, const std::vector<std::string>
       if (name.size() < a.size()) {
         value = a.substr(eq + 1);
       } else if (i + 1 < args.size()) {
+        // `-o --force` is a forgotten value, not a file named --force (that one is ./--force).
+        if (is_option(args[i + 1], spec))
+          throw UsageError(command, "option '" + a + "' needs a value, got the option '" + args[i + 1] + "'" +
+                                        (a.compare(0, 2, "--") == 0 ? " (write " + a + "=VALUE for a value that starts with '-')"
+                                                                    : " (a file of that name is ./" + args[i + 1] + ")"));
         value = args[++i];
       } else {
         throw UsageError(command, "option '" + a + "' needs a value");

@@ -85,6 +85,13 @@ TEST_F(Cli, BadArgumentsExitTwoWithOneMessage) {
     EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
     EXPECT_THAT(r.output, StartsWith("frictherm")) << args;
   }
+  // An option where a value belongs is a forgotten value: refused, nothing written under its name.
+  const std::string tiny = write("tiny.json", kTinyScene);
+  const Result forgotten = frictherm("run " + tiny + " -o --force");
+  EXPECT_EQ(forgotten.code, 2) << forgotten.output;
+  EXPECT_THAT(forgotten.output, HasSubstr("option '-o' needs a value, got the option '--force'"));
+  EXPECT_FALSE(fs::exists(fs::current_path() / "--force"));
+  EXPECT_EQ(frictherm("run " + tiny + " --threads --quiet").code, 2);
   const Result missing = frictherm("validate " + path("nope.json"));
   EXPECT_EQ(missing.code, 2);
   EXPECT_THAT(missing.output, HasSubstr("cannot open scene file"));
