@@ -237,6 +237,7 @@ CASES = [
      "--set run.end_time"),
     ("--set without =", scene(), {}, ["validate", "SCENE", "--set", "solver.cfl"], "--set solver.cfl"),
     ("--set into a number", scene(), {}, ["validate", "SCENE", "--set", "dimension.x=1"], "--set dimension.x"),
+    ("-o followed by an option", scene(), {}, ["run", "SCENE", "-o", "--force"], "option '-o'"),
 ]
 
 
