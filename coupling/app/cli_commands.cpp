@@ -167,7 +167,13 @@ int export_csv_command(const std::vector<std::string>& args) {
         std::cerr << "frictherm: cannot create '" << out_path << "'\n";
         return kUsage;
       }
-      coupling::export_series_csv(path, out);
+      try {
+        coupling::export_series_csv(path, out);
+      } catch (...) {  // an unreadable run: no half-written CSV left under the temporary name
+        out.close();
+        std::remove(live.c_str());
+        throw;
+      }
       out.close();
       if (!out) {
         std::remove(live.c_str());

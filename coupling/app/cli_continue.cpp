@@ -81,11 +81,11 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
   return run_from_checkpoint(q, "continue", [&] {
     if (!std::filesystem::exists(q.checkpoint))
       throw coupling::OutputError("no checkpoint " + q.checkpoint + " (runs with coupling.continuation write one at the end of loading)");
+    q.scene = checkpoint_scene_or_refuse(q.checkpoint, overrides);  // first: refuses an unreadable checkpoint
     const coupling::CheckpointMarks marks = coupling::checkpoint_marks(q.checkpoint);
     if (!marks.end_of_loading)
       throw coupling::OutputError(q.checkpoint + " was taken at t = " + std::to_string(marks.time) +
                                   " s, before the end of loading: finish the run first (frictherm resume " + q.run + ")");
-    q.scene = coupling::checkpoint_scene(q.checkpoint, overrides);
     if (!(q.scene.thermal.enabled && q.scene.thermal.continuation_duration > 0.0))
       throw coupling::SceneError("coupling.continuation: the scene has no thermal continuation (expected a duration > 0)");
   });

@@ -59,6 +59,17 @@ void remove_quietly(const std::string& path) {
 
 }  // namespace
 
+coupling::Scene checkpoint_scene_or_refuse(const std::string& checkpoint,
+                                           const std::vector<coupling::SceneOverride>& more) {
+  try {
+    return coupling::checkpoint_scene(checkpoint, more);
+  } catch (const coupling::SceneError&) {
+    throw;  // a --set of `continue` the scene refuses
+  } catch (const std::exception& e) {
+    throw coupling::OutputError(std::string(e.what()) + " (" + checkpoint + " is not a readable checkpoint)");
+  }
+}
+
 coupling::RunOptions resume_run_options(const ResumeRequest& q) {
   coupling::RunOptions opt;
   opt.threads = q.threads;
@@ -94,6 +105,14 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
   }
   opt.output = continuation;
   const coupling::CheckpointMarks marks = coupling::checkpoint_marks(q.checkpoint);
+  if (append) {
+    try {
+      coupling::check_appendable(q.run, marks);
+    } catch (const std::exception& e) {
+      throw coupling::OutputError(std::string(e.what()) + "; the resumed run could not be appended to it (move it " +
+                                  "away to write the continuation alone, from the checkpoint's state)");
+    }
+  }
   try {
     out.result = coupling::run_scene(q.scene, opt);
   } catch (...) {
@@ -162,7 +181,7 @@ int resume_command(const std::vector<std::string>& args, const std::string& comm
   if (several_processes(launcher_info())) return decomposed_resume_command(q);  // mpirun -n K (K > 1)
   return run_from_checkpoint(q, "resume", [&q] {
     if (!exists(q.checkpoint)) throw coupling::OutputError("no checkpoint " + q.checkpoint + " to resume " + q.run + " from");
-    q.scene = coupling::checkpoint_scene(q.checkpoint);
+    q.scene = checkpoint_scene_or_refuse(q.checkpoint);
   });
 }
 

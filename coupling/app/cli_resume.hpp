@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace frictherm::cli {
 
@@ -31,6 +32,11 @@ struct ResumeOutcome {
 /// The run options every resume starts from: threads, wall-clock checkpoints, quiet, command line,
 /// signals handled, resuming from request.checkpoint.
 coupling::RunOptions resume_run_options(const ResumeRequest& request);
+
+/// coupling::checkpoint_scene, with a checkpoint that does not read (empty, truncated, not HDF5)
+/// refused as a bad input (OutputError: exit code 2) rather than a failed run.
+coupling::Scene checkpoint_scene_or_refuse(const std::string& checkpoint,
+                                           const std::vector<coupling::SceneOverride>& more = {});
 ResumeOutcome resume_from_checkpoint(const ResumeRequest& request);
 
 /// The exit code and message of a resumed run ("resumed" / "continued").

@@ -133,6 +133,47 @@ TEST_F(Files, SpecialFilesAreNeverReplacedEvenWithForce) {
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_NE(e.path().extension(), ".part") << e.path();
 }
 
+// Damaged inputs of resume, continue and export-csv (a truncated checkpoint, a truncated result) are
+// refused before any work as bad input, exit code 2, naming the file; nothing is left behind and the
+// damaged files are not touched.
+TEST_F(Files, DamagedCheckpointOrResultIsRefusedBeforeAnyWork) {
+  const std::string scene = write("tiny.json", kTinyScene), run = path("run.h5");
+  ASSERT_EQ(frictherm("run " + scene + " -o " + run + " --quiet --set run.checkpoint_interval=1e-3").code, 0);
+  const std::string checkpoint = slurp(run + ".checkpoint"), result = slurp(run);
+  ASSERT_GT(checkpoint.size(), 1000u);
+  auto write_bytes = [](const std::string& p, const std::string& bytes) { std::ofstream(p, std::ios::binary) << bytes; };
+  auto no_leftovers = [&] {
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      const std::string name = e.path().filename().string();
+      EXPECT_EQ(name.find(".part"), std::string::npos) << name;
+      EXPECT_EQ(name.find(".continuation"), std::string::npos) << name;
+      EXPECT_FALSE(name.rfind("out", 0) == 0) << name;
+    }
+  };
+  for (const std::string& cut : {checkpoint.substr(0, checkpoint.size() / 2), std::string()}) {
+    write_bytes(run + ".checkpoint", cut);
+    for (const std::string command : {"resume", "continue"}) {
+      const Result r = frictherm(command + " " + run + " -o " + path("out.h5") + " --quiet");
+      EXPECT_EQ(r.code, 2) << command << ": " << r.output;
+      EXPECT_THAT(r.output, HasSubstr("not a readable checkpoint")) << command;
+    }
+    EXPECT_TRUE(slurp(run + ".checkpoint") == cut);
+    no_leftovers();
+  }
+  write_bytes(run + ".checkpoint", checkpoint);
+  write_bytes(run, result.substr(0, result.size() / 3));
+  const Result r = frictherm("resume " + run + " -o " + path("out.h5") + " --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("could not be appended"));
+  const Result csv = frictherm("export-csv " + run + " -o " + path("out.csv"));
+  EXPECT_EQ(csv.code, 2) << csv.output;
+  EXPECT_TRUE(slurp(run) == result.substr(0, result.size() / 3));
+  no_leftovers();
+  // The intact pair still resumes.
+  write_bytes(run, result);
+  EXPECT_EQ(frictherm("resume " + run + " -o " + path("resumed.h5") + " --quiet").code, 0);
+}
+
 // Two runs started together on one output file: the first to finish publishes it; the second finds
 // the name taken and keeps its own result under its temporary name (exit code 2, saying where).
 // Both files are complete, readable results; nothing is truncated.

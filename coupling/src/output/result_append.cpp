@@ -181,6 +181,28 @@ std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_nam
   return xdmf_document(xml);
 }
 
+void check_appendable(const std::string& original, const CheckpointMarks& marks) {
+  const h5detail::Quiet quiet;
+  const Handle f{check_id(H5Fopen(original.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), original, "cannot open it"), H5Fclose};
+  for (const char* group : {"/meta", "/series", "/snapshots"})
+    if (!exists(f.get(), group)) throw std::runtime_error("'" + original + "': no " + group + " (not a frictherm result)");
+  const std::vector<std::string> cols = [&] {
+    const Handle g{check_id(H5Gopen2(f.get(), "series", H5P_DEFAULT), original, "/series"), H5Gclose};
+    return members(g.get());
+  }();
+  if (!cols.empty()) {
+    const std::string where = "/series/" + cols.front();
+    const Handle d{check_id(H5Dopen2(f.get(), where.c_str(), H5P_DEFAULT), original, where), H5Dclose};
+    if (rows_of(d.get(), original, where) < static_cast<hsize_t>(marks.series_rows))
+      throw std::runtime_error("'" + original + "': " + where + " has fewer rows than the checkpoint counts (" +
+                               std::to_string(marks.series_rows) + ")");
+  }
+  const Handle g{check_id(H5Gopen2(f.get(), "snapshots", H5P_DEFAULT), original, "/snapshots"), H5Gclose};
+  if (members(g.get()).size() < static_cast<std::size_t>(marks.snapshots))
+    throw std::runtime_error("'" + original + "': fewer snapshots than the checkpoint counts (" +
+                             std::to_string(marks.snapshots) + ")");
+}
+
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
                    const std::string& output) {
   const std::string tmp = temporary_path(output);

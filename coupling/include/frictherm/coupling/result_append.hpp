@@ -19,6 +19,11 @@ namespace frictherm::coupling {
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
                    const std::string& output);
 
+/// Throws std::runtime_error naming the file and the defect when `original` cannot take the append
+/// (not an HDF5 file, truncated, not a frictherm result, fewer series rows or snapshots than `marks`):
+/// resume checks it before running, so a damaged result costs no run time.
+void check_appendable(const std::string& original, const CheckpointMarks& marks);
+
 /// The XDMF document of every snapshot (and /failure) in `h5_path`, pointing at `h5_name`.
 std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name);
 
