@@ -48,6 +48,15 @@ TEST(ThermalProblem, RejectsSizeMismatchAsymmetryAndNegativeDiagonal) {
 
   a = -Eigen::MatrixXd(g.k);
   EXPECT_NE(message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); }).find("< 0"), std::string::npos);
+
+  // A diagonal below zero by round-off only (a node whose particles all conduct nothing: the row sums
+  // of its neighbours' entries leave ±1e-35 or so) passes; beyond 1e-12 of max |K| it is refused.
+  const double kmax = Eigen::MatrixXd(g.k).cwiseAbs().maxCoeff();
+  a = Eigen::MatrixXd(g.k);
+  a(0, 0) = -1e-14 * kmax, a(0, 1) = a(1, 0) = 0.0;
+  EXPECT_NO_THROW(ft::Problem(g.mass, dense_to_sparse(a)));
+  a(0, 0) = -1e-9 * kmax;
+  EXPECT_NE(message_of([&] { ft::Problem p(g.mass, dense_to_sparse(a)); }).find("< 0"), std::string::npos);
 }
 
 // The symmetry sweep (one pass with a cursor per row) against every kind of one-sided entry: an upper

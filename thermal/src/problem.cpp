@@ -91,10 +91,13 @@ void Problem::check_and_clear(double symmetry_tol) {
   }
   for (Index c = 0; c < n; ++c)  // lower entries after the last mirror found
     for (Index q = cursor[static_cast<std::size_t>(c)]; q < outer[c + 1] && inner[q] < c; ++q) check(c, inner[q], value[q]);
+  // A diagonal below zero by more than the round-off of the row sums it is built from (the same
+  // tolerance as symmetry: a node whose particles all have conductivity 0 sums to ±1e-35 or so).
   for (Index r = 0; r < n; ++r) {
-    if (k_.coeff(r, r) < 0.0) {
+    if (k_.coeff(r, r) < -tol) {
       std::ostringstream os;
-      os << "K(" << r << "," << r << ") = " << k_.coeff(r, r) << " < 0: K must be positive semi-definite";
+      os << "K(" << r << "," << r << ") = " << k_.coeff(r, r) << " < 0 (tolerance " << tol
+         << "): K must be positive semi-definite";
       fail(os.str());
     }
   }

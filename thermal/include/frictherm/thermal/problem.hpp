@@ -26,7 +26,7 @@ class Problem {
  public:
   // Throws std::invalid_argument if M has a non-positive or non-finite entry, if K is not
   // square of the same size, not symmetric (|K_ij − K_ji| > symmetry_tol·max|K|), has a
-  // non-finite entry or a negative diagonal. K is assumed positive semi-definite; only these
+  // non-finite entry or a diagonal below −symmetry_tol·max|K|. K is assumed positive semi-definite; only these
   // necessary conditions are checked.
   Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol = 1e-12);
   // The same as assigning Problem(mass, conductance, symmetry_tol), in this object's storage: a
