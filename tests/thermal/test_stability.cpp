@@ -153,3 +153,30 @@ TEST(ThermalStability, CvodeAdamsHitsItsStepLimitWithAClearError) {
   EXPECT_NO_THROW(bdf->advance(p, t, 0.0, 1000 * dt_limit));
   EXPECT_LT(bdf->stats().steps, 500);
 }
+
+// Forward Euler sub-steps a window to its stability limit, at most max_steps of them: a window that
+// needs more (a conductivity of 1e12 W/mK in a scene: 3e7 sub-steps per mechanics step, a run that
+// never ends) is refused before any sub-step, however many it would need.
+TEST(ThermalStability, ForwardEulerRefusesWindowsBeyondMaxSteps) {
+  const auto g = make_grid_1d(40, 0.0, 39e-6, kMat);
+  const ft::Problem p = g.problem();
+  const double dt_limit = g.dx * g.dx / (2 * kMat.alpha());
+  ft::IntegratorOptions o;
+  o.max_steps = 100;  // fe_safety 0.9: 90 dt_limit fit in 100 sub-steps
+  auto fe = ft::make_integrator("forward_euler", o);
+  Eigen::VectorXd t(g.n);
+  for (int i = 0; i < g.n; ++i) t[i] = 300.0 + 50.0 * std::sin(0.3 * i);
+  EXPECT_NO_THROW(fe->advance(p, t, 0.0, 89.0 * dt_limit));
+  EXPECT_EQ(fe->stats().steps, 99);
+  const Eigen::VectorXd before = t;
+  for (double windows : {91.0, 1e6, 1e30}) {
+    try {
+      fe->advance(p, t, 0.0, windows * dt_limit);
+      FAIL() << "no exception for " << windows << " dt_limit";
+    } catch (const ft::StabilityError& e) {
+      EXPECT_NE(std::string(e.what()).find("more than max_steps = 100"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(t, before);  // state untouched
+  }
+  EXPECT_EQ(fe->stats().steps, 99);  // not one sub-step taken by the refused windows
+}

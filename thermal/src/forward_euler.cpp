@@ -39,15 +39,21 @@ void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eige
     return;
   }
 
-  // Steps requested by the caller: one per window unless fe_max_dt caps the step.
-  long n = 1;
-  if (opt_.fe_max_dt > 0.0) n = static_cast<long>(std::ceil(window / opt_.fe_max_dt - 1e-12));
-  n = std::max(n, 1L);
-  if (opt_.fe_stability_policy == "substep") {
-    if (window / static_cast<double>(n) > h_stable) {
-      n = static_cast<long>(std::ceil(window / h_stable));
-    }
-  } else if (opt_.fe_stability_policy == "refuse") {
+  // Steps requested by the caller: one per window unless fe_max_dt caps the step; counted as doubles
+  // first, so that a window of 1e20 stable steps is refused by max_steps rather than cast.
+  double steps = 1.0;
+  if (opt_.fe_max_dt > 0.0) steps = std::max(1.0, std::ceil(window / opt_.fe_max_dt - 1e-12));
+  if (opt_.fe_stability_policy == "substep" && window / steps > h_stable) steps = std::ceil(window / h_stable);
+  if (!(steps <= static_cast<double>(opt_.max_steps))) {
+    std::ostringstream os;
+    os << "forward_euler: the window [" << t0 << ", " << t1 << "] s needs " << steps
+       << " sub-steps (stability limit " << h_stable << " s with fe_safety " << opt_.fe_safety
+       << (opt_.fe_max_dt > 0.0 ? ", or fe_max_dt" : "") << "), more than max_steps = " << opt_.max_steps
+       << ". Use an implicit integrator such as cvode_bdf (or \"auto\"), shorter windows, or a larger max_steps";
+    throw StabilityError(os.str(), window / steps, dt_limit);
+  }
+  const long n = static_cast<long>(steps);
+  if (opt_.fe_stability_policy == "refuse") {
     const double h = window / static_cast<double>(n);
     if (h > h_stable) {
       std::ostringstream os;
