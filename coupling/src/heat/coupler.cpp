@@ -21,8 +21,7 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
     : grid_(grid),
       shape_(shape),
       opt_(std::move(options)),
-      integrator_(thermal::make_integrator(opt_.integrator == "auto" ? "cvode_bdf" : opt_.integrator,
-                                           opt_.integrator_options)),
+      integrator_(thermal::make_integrator(opt_.assembled_integrator(), opt_.integrator_options)),
       pending_(grid.node_count()),
       plastic_(opt_.plastic),
       tracker_(Dim, opt_.hotspots, opt_.thickness),
@@ -280,7 +279,7 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
   const bool reaction_starts = opt_.reaction.enabled && !continuing_;
   if (!continuing_) {  // a fresh integrator: the continuation depends only on the end-of-loading state
     stats_offset_ += integrator_->stats();
-    integrator_ = thermal::make_integrator(opt_.integrator, opt_.integrator_options);
+    integrator_ = thermal::make_integrator(opt_.assembled_integrator(), opt_.integrator_options);
   }
   continuing_ = true;
   if (!system_assembled_ || reaction_starts) {  // a reaction held back during loading joins the problem now

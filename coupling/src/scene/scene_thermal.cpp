@@ -52,7 +52,7 @@ void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
     c.matrix_free_max_substeps = t.integer("matrix_free_max_substeps", c.matrix_free_max_substeps, 0, 1000000);
   }
   try {
-    thermal::make_integrator(c.integrator == "auto" ? "cvode_bdf" : c.integrator, o);  // the thermal module's own checks, before any step
+    thermal::make_integrator(c.assembled_integrator(), o);  // the thermal module's own checks, before any step
   } catch (const std::invalid_argument& e) {
     t.fail(e.what());
   }

@@ -68,6 +68,8 @@ struct CouplerOptions {
   /// with a reaction and in the continuation.
   std::string integrator = "cvode_bdf";
   thermal::IntegratorOptions integrator_options;
+  /// The thermal::make_integrator name of the assembled windows: `integrator`, with "auto" as cvode_bdf.
+  std::string assembled_integrator() const { return integrator == "auto" ? "cvode_bdf" : integrator; }
   /// forward_euler and auto: a window that needs at most this many stable forward-Euler sub-steps is
   /// integrated matrix-free (no K assembled; 0: never). Longer windows assemble K (forward_euler
   /// sub-steps on it, or cvode_bdf for auto). Only with the "substep" stability policy and the
