@@ -237,6 +237,8 @@ CASES = [
      "--set run.end_time"),
     ("--set without =", scene(), {}, ["validate", "SCENE", "--set", "solver.cfl"], "--set solver.cfl"),
     ("--set into a number", scene(), {}, ["validate", "SCENE", "--set", "dimension.x=1"], "--set dimension.x"),
+    ("contact.boundary_spacing 1e-12 (2e11 boundary points)", scene(contact={"boundary_spacing": 1e-12}), {},
+     ["validate", "SCENE"], "contact.boundary_spacing"),
     ("-o followed by an option", scene(), {}, ["run", "SCENE", "-o", "--force"], "option '-o'"),
 ]
 

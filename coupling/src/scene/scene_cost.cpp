@@ -28,6 +28,11 @@ constexpr double kBaseBytes = 40e6;
 // refused as mostly empty, unless run.max_memory is given (docs/scenes.md, "Cost limits").
 constexpr double kMaxEmptyGridNodes = 1e7;
 constexpr double kMaxNodesPerParticle = 100.0;
+// 2D bodies' outlines are sampled at contact.boundary_spacing (penalty contact's boundary points):
+// at most this many points, each with its position, normal and bookkeeping.
+constexpr double kMaxBoundaryPoints = 1e7;
+constexpr double kBytesPerBoundaryPoint = 64.0;
+constexpr double kMinBoundarySpacingPerCell = 0.01;
 double bytes_per_particle(int dim) { return dim == 2 ? 420.0 : 520.0; }
 double bytes_per_node(int dim) { return dim == 2 ? 115.0 : 165.0; }
 double thermal_bytes_per_node(int dim) { return dim == 2 ? 300.0 : 700.0; }
@@ -64,13 +69,23 @@ SceneCost estimate_scene_cost(const Scene& s) {
   }
   c.grid_nodes = 1.0;
   for (int d = 0; d < dim; ++d) c.grid_nodes *= static_cast<double>(s.cells[d]) + 1.0;
+  // Boundary points (2D: every body's outline, as Simulation::add_body samples it): an outline is
+  // counted as twice its bounding box's perimeter (an annulus has two loops), one point per spacing.
+  if (dim == 2) {
+    const double spacing = s.contact.options.boundary_spacing > 0.0 ? s.contact.options.boundary_spacing
+                                                                      : 0.5 * std::min(s.cell_size[0], s.cell_size[1]);
+    for (const BodySpec& b : s.bodies)
+      c.boundary_points +=
+          4.0 * ((b.shape.box_hi[0] - b.shape.box_lo[0]) + (b.shape.box_hi[1] - b.shape.box_lo[1])) / spacing + 2.0;
+  }
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   const int wanted = s.threads > 0 ? s.threads : static_cast<int>(hw);
   // (a bomb's particle count can exceed any integer; 1e15 particles already ask for the most threads)
   c.threads = mechanics::threads_for_particles(static_cast<std::size_t>(std::min(c.particles, 1e15)), wanted);
   c.memory_bytes = kBaseBytes + c.particles * bytes_per_particle(dim) + c.grid_nodes * bytes_per_node(dim) +
                    (c.threads - 1) * c.grid_nodes * 8.0 * (1 + 2 * dim) +
-                   (s.thermal.enabled ? c.grid_nodes * thermal_bytes_per_node(dim) : 0.0);
+                   (s.thermal.enabled ? c.grid_nodes * thermal_bytes_per_node(dim) : 0.0) +
+                   c.boundary_points * kBytesPerBoundaryPoint;
   if (s.max_memory > 0.0) {
     c.memory_limit = s.max_memory;
     c.memory_limit_source = "run.max_memory";
@@ -145,6 +160,18 @@ void check_scene_cost(const Scene& s, const SceneCost& c) {
                      format_number(c.time_step) + " s (the first time step, set by " + c.time_step_key + ") to reach " +
                      format_number(s.end_time) + " s; expected at most " + format_number(kMaxStepCount) +
                      " steps: shorten run.end_time, or set run.max_steps to stop earlier");
+  const double min_cell = *std::min_element(s.cell_size.begin(), s.cell_size.begin() + s.dimension);
+  const double spacing = s.contact.options.boundary_spacing;
+  if (spacing > 0.0 && spacing < kMinBoundarySpacingPerCell * min_cell * (1.0 - 1e-12))  // (1/100 itself accepted)
+    throw SceneError("contact.boundary_spacing: expected 0 (half the cell size) or a spacing of at least " +
+                     format_number(kMinBoundarySpacingPerCell * min_cell) + " m (1/100 of the cell size " +
+                     format_number(min_cell) + " m: finer outlines add contact points faster than they add " +
+                     "accuracy, and each costs every step), got " + format_number(spacing) + " m");
+  if (!(c.boundary_points <= kMaxBoundaryPoints))
+    throw SceneError("contact.boundary_spacing: the bodies' outlines would be sampled at about " +
+                     format_number(c.boundary_points) + " boundary points (spacing " +
+                     format_number(s.contact.options.boundary_spacing) + " m); expected at most " +
+                     format_number(kMaxBoundaryPoints) + " (a spacing near half the cell size; 0 chooses it)");
   // A mostly empty dense grid (the mechanics grid is dense: every node costs memory and time each
   // step) is refused unless run.max_memory is given explicitly.
   if (s.max_memory <= 0.0 && c.grid_nodes > kMaxEmptyGridNodes && c.grid_nodes > kMaxNodesPerParticle * c.particles)

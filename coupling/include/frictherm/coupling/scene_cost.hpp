@@ -18,6 +18,7 @@ constexpr double kMaxSnapshotCount = 1e5;    // snapshots (each one also ends a 
 struct SceneCost {
   double particles = 0.0;      // upper bound: each body's bounding box filled at particles_per_cell
   double grid_nodes = 0.0;     // the dense background grid, (cells + 1)^dim
+  double boundary_points = 0.0;  // 2D: the bodies' outlines sampled at contact.boundary_spacing (an upper bound)
   int threads = 1;             // threads the estimate assumes (per-thread nodal scatter buffers)
   double memory_bytes = 0.0;   // estimated peak resident memory
   double memory_limit = 0.0;   // bytes
