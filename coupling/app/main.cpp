@@ -1,6 +1,8 @@
 // frictherm: the command-line program (run, validate, export-csv, ensemble).
 #include "cli.hpp"
 
+#include <frictherm/coupling/h5_output.hpp>
+
 #include <exception>
 #include <iostream>
 #include <string>
@@ -65,6 +67,7 @@ int dispatch(const std::vector<std::string>& words, const std::string& command_l
 }  // namespace
 
 int main(int argc, char** argv) {
+  frictherm::coupling::hdf5_program_setup();
   frictherm::cli::prepare_process(argv);
   std::vector<std::string> words(argv + 1, argv + argc);
   std::string command_line;

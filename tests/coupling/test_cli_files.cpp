@@ -10,11 +10,13 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -172,6 +174,36 @@ TEST_F(Files, DamagedCheckpointOrResultIsRefusedBeforeAnyWork) {
   // The intact pair still resumes.
   write_bytes(run, result);
   EXPECT_EQ(frictherm("resume " + run + " -o " + path("resumed.h5") + " --quiet").code, 0);
+}
+
+// A write that fails mid-run (a full disk; here the file-size limit RLIMIT_FSIZE, whose writes fail
+// with EFBIG as a full disk's do with ENOSPC) ends the run with exit code 1 and the system's reason,
+// not a crash: HDF5 1.10's clean-up at exit segfaulted on the file whose close had failed (exit code
+// 139) after dumping its error stack. The partial result stays under its temporary name.
+TEST_F(Files, FailedWriteEndsTheRunWithAMessageNotACrash) {
+  const std::string scene = std::string(FRICTHERM_SOURCE_DIR) + "/examples/sliding_block.json";
+  const std::string out = path("run.h5"), log = path("stderr.txt");
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);  // the write fails instead of the signal killing the process
+    const rlimit limit{200 * 1024, 200 * 1024};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    std::freopen(log.c_str(), "w", stderr);
+    execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", out.c_str(), "--quiet", "--set", "run.threads=1",
+          "--set", "run.end_time=2e-3", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  const std::string message = slurp(log);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0) << "\n" << message;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << message;
+  EXPECT_THAT(message, HasSubstr("File too large"));
+  EXPECT_EQ(message.find("HDF5-DIAG"), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(out));
+  bool partial = false;
+  for (const auto& e : fs::directory_iterator(dir_)) partial = partial || e.path().extension() == ".part";
+  EXPECT_TRUE(partial) << "the partial result is kept under its temporary name";
 }
 
 // Two runs started together on one output file: the first to finish publishes it; the second finds

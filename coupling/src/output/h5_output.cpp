@@ -378,6 +378,11 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.write_xdmf();  // an empty collection; also proves early that the XDMF file can be written
 }
 
+void hdf5_program_setup() {
+  H5dont_atexit();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
 H5Output::~H5Output() {
   if (!impl_ || impl_->closed) return;
   try {

@@ -3,6 +3,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -55,11 +56,27 @@ class Quiet {
   void* data_ = nullptr;
 };
 
+// One error-stack description on one line; the file driver's long report of a failed read or write
+// ("file write failed: time = ..., errno = 28, error message = 'No space left on device', ...")
+// shortened to its first words and the system's reason ("file write failed: No space left on device").
+inline std::string error_description(const char* desc) {
+  std::string d(desc);
+  const std::string tag = "error message = '";
+  if (const auto m = d.find(tag); m != std::string::npos) {
+    const auto end = d.find('\'', m + tag.size());
+    const std::string reason = d.substr(m + tag.size(), end == std::string::npos ? std::string::npos : end - m - tag.size());
+    d = d.substr(0, std::min(d.find(':'), m)) + ": " + reason;
+  }
+  for (char& c : d)
+    if (c == '\n') c = ' ';
+  return d;
+}
+
 // H5Ewalk2 callback: joins the descriptions of the two innermost error-stack entries.
 inline herr_t collect_error(unsigned n, const H5E_error2_t* err, void* out) {
   auto& text = *static_cast<std::string*>(out);
   if (n < 2 && err->desc != nullptr && *err->desc != '\0') {
-    text += (text.empty() ? "" : "; ") + std::string(err->desc);
+    text += (text.empty() ? "" : "; ") + error_description(err->desc);
   }
   return 0;
 }

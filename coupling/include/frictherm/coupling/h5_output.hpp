@@ -42,6 +42,13 @@ struct H5OutputOptions {
   bool replace_existing = true;
 };
 
+/// For a program rather than a library user, first thing in main (before any other HDF5 call): HDF5's
+/// automatic error-stack dumps off (every failure becomes an exception that carries the library's own
+/// description, h5_util.hpp), and no HDF5 clean-up at exit, where HDF5 1.10 crashes on a file whose
+/// close failed (a full disk: exit code 139 after the run had reported the failure). Files are closed
+/// by their owners before exit either way.
+void hdf5_program_setup();
+
 class H5Output {
  public:
   /// Creates or truncates `path` (or creates a temporary sibling, options.via_temporary). dim is 2 or 3. Throws std::runtime_error naming the file when it
