@@ -311,6 +311,27 @@ TEST(DistributedThermal, BadLayoutRefusedOnEveryRank) {
                std::invalid_argument);
 }
 
+// ---- a diagonal below zero by round-off only is accepted, beyond 1e-12 of max |K| refused (every rank) ----
+// (a node only zero-conductivity particles reach sums to ±1e-35 or so: serial Problem's rule)
+TEST(DistributedThermal, RoundOffNegativeDiagonalAcceptedRealOneRefused) {
+  const Grid2D g = make_grid_2d(8, 8, 0.0, 0.0, 1.0 / 7.0, Material{1.0, 1.0});
+  const ft::RowRange rows = ft::partition_rows(g.size(), MPI_COMM_WORLD);
+  const double kmax = Eigen::MatrixXd(g.k).cwiseAbs().maxCoeff();
+  for (const double diagonal : {-1e-14 * kmax, -1e-9 * kmax}) {
+    ft::SparseMatrix k = g.k.middleRows(rows.begin, rows.size());
+    if (comm_rank() == comm_size() - 1) {  // the last rank's last node: its row and its diagonal
+      const ft::Index r = rows.size() - 1, c = rows.begin + r;
+      for (ft::SparseMatrix::InnerIterator it(k, r); it; ++it) it.valueRef() = it.col() == c ? diagonal : 0.0;
+    }
+    auto build = [&] {
+      ft::DistributedProblem p(MPI_COMM_WORLD, g.size(), rows.begin, Eigen::VectorXd(g.mass.segment(rows.begin, rows.size())),
+                               std::move(k));
+    };
+    if (diagonal > -1e-12 * kmax) EXPECT_NO_THROW(build());
+    else EXPECT_THROW(build(), std::invalid_argument);
+  }
+}
+
 // ---- forward Euler's guard: the global stability limit, refused on every rank ----
 TEST(DistributedThermal, ForwardEulerRefusesBeyondItsLimitOnEveryRank) {
   const double h = 1.0 / 15.0;
