@@ -4,6 +4,7 @@
 #include "test_scene_support.hpp"
 
 #include <frictherm/coupling/csv_export.hpp>
+#include <frictherm/coupling/decomposed_support.hpp>
 #include <frictherm/coupling/runner.hpp>
 
 #include <gmock/gmock.h>
@@ -268,4 +269,27 @@ TEST(SceneThermalRun, ConductionBetweenBlocksThroughTheRunner) {
   EXPECT_LT(read_doubles(r.output, "/meta/max_assembly_residual").at(0), 1e-12);
   fs::remove_all(dir);
   }
+}
+
+// The decomposed run gathers every matrix-free window (it has no reuse of the last gather): a scene
+// that leaves coupling.reuse_distance at its serial default runs there with the default integrator
+// ("auto"); one that asks for reuse is told which key to change.
+TEST(SceneThermal, DecomposedRunTakesTheDefaultReuseDistanceRefusesAnExplicitOne) {
+  Json scene = Json::parse(R"({
+    "dimension": 2,
+    "grid": {"lo": [0, 0], "hi": [0.02, 0.01], "cell_size": 0.001},
+    "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+    "bodies": [{"name": "a", "material": "soft", "shape": {"type": "rectangle", "lo": [0.002, 0.002], "hi": [0.018, 0.008]}}],
+    "run": {"end_time": 1e-3},
+    "solver": {"scheme": "usl"},
+    "thermal": {"materials": {"soft": {"heat_capacity": 1, "conductivity": 1}}},
+    "coupling": {}
+  })");
+  const fc::Scene defaults = fc::parse_scene(scene.dump());
+  EXPECT_EQ(defaults.thermal.coupler.integrator, "auto");
+  EXPECT_EQ(fc::decomposed_run_refusal(defaults), "");
+  scene["coupling"]["reuse_distance"] = 0.02;
+  EXPECT_THAT(fc::decomposed_run_refusal(fc::parse_scene(scene.dump())), ::testing::StartsWith("coupling.reuse_distance: 0.02"));
+  scene["coupling"]["reuse_distance"] = 0.0;
+  EXPECT_EQ(fc::decomposed_run_refusal(fc::parse_scene(scene.dump())), "");
 }

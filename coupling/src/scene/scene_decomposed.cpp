@@ -84,10 +84,12 @@ std::string thermal_refusal(const Scene& s) {
     return refuse("thermal.fixed_temperature", std::to_string(c.fixed_faces.size()) + " face(s)", "adiabatic faces");
   if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
   // Every window policy runs (every_step, every_n_steps, adaptive: DecomposedHeat::after_step). Matrix-free
-  // windows gather every window: the serial reuse of the last gather is not decomposed.
-  if (matrix_free && c.reuse_distance != 0.0)
-    return refuse("coupling.reuse_distance", number(c.reuse_distance) + " (the default is 0.01)",
-                  "0: the gather every window, or an integrator other than forward_euler and auto");
+  // windows gather every window: the serial reuse of the last gather is not decomposed. The default
+  // reuse distance is a speed-up of the serial run, so a scene that does not set it runs (gathering
+  // every window, the exact form); one that asks for reuse is told.
+  if (matrix_free && c.reuse_distance != 0.0 && t.reuse_distance_given)
+    return refuse("coupling.reuse_distance", number(c.reuse_distance),
+                  "0 or no key: the gather every window, or an integrator other than forward_euler and auto");
   // Plastic heating and the sub-grid relaxation run (DecomposedHeat, decomposed_sources.cpp).
   if (t.continuation_duration > 0.0)
     return refuse("coupling.continuation", "duration " + number(t.continuation_duration), "no continuation");

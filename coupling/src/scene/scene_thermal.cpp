@@ -242,6 +242,7 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   }
   spec.coupler.subgrid_relaxation_time =
       c->number("subgrid_relaxation_time", spec.coupler.subgrid_relaxation_time, Range::positive());
+  spec.reuse_distance_given = static_cast<bool>(c->find("reuse_distance"));
   spec.coupler.reuse_distance = c->number("reuse_distance", spec.coupler.reuse_distance, Range::closed(0.0, 0.5));
   parse_hotspots(*c, spec.coupler.hotspots, spec.coupler.fates);
   c->finish();

@@ -33,6 +33,7 @@ struct ThermalSceneSpec {
   double continuation_duration = 0.0;  // s of thermal-only integration after the mechanics ends
   long continuation_intervals = 100;   // series rows (windows) over the continuation
   bool stop_when_decided = false;      // end the continuation once every hot spot has a fate
+  bool reuse_distance_given = false;   // coupling.reuse_distance set by the scene (not its default)
   /// thermal.preconditioner: the PETSc preconditioner of a decomposed run's Krylov solve ("jacobi",
   /// "bjacobi", "hypre"; thermal::DistributedOptions). The serial run does not read it.
   std::string preconditioner = "jacobi";
