@@ -2,6 +2,7 @@
 import numpy as np
 
 from ._h5 import plain, text
+from .ranks import JoinedGroup, joined_groups, open_rank_files
 from .snapshot import Snapshot
 from .table import Table
 
@@ -19,7 +20,8 @@ class Run:
     ``dim``, ``format_version``, ``meta`` (dict: str, int or float), ``status``, ``series``,
     ``hotspots``, ``hotspot_fates`` (Table), ``energy_books`` (dict), ``snapshots`` (list of
     Snapshot), ``snapshot_times`` (array), ``failure`` (Snapshot or None), ``snapshot(i)``,
-    ``snapshot_at(time)``.
+    ``snapshot_at(time)``. A decomposed run's snapshots are read from its rank files
+    (OUT.rank<r>.h5, frictherm/ranks.py), joined and ordered by particle id.
     """
 
     def __init__(self, h5file, path):
@@ -35,6 +37,7 @@ class Run:
         self._series = None
         self._tables = {}
         self._snapshots = None
+        self._rank_files = None  # a decomposed run's OUT.rank<r>.h5, opened on first use
         if "dim" in a:
             self.dim = int(a["dim"])
         elif "meta" in h5file and "dimension" in h5file["meta"]:
@@ -45,6 +48,8 @@ class Run:
 
     # ---- life time ----
     def close(self):
+        for f in self._rank_files or []:
+            f.close()
         self.file.close()
 
     def __enter__(self):
@@ -105,12 +110,25 @@ class Run:
 
     # ---- snapshots ----
     @property
+    def ranks(self):
+        """How many ranks wrote the run (1: a serial run, its snapshots in this file)."""
+        return int(self.meta.get("ranks", 1))
+
+    def _decomposed_files(self):
+        if self._rank_files is None:
+            self._rank_files = open_rank_files(self.path, self.ranks)
+        return self._rank_files
+
+    @property
     def snapshots(self):
         """The ended regular snapshots in time order (the failure state is ``failure``)."""
         if self._snapshots is None:
-            g = self.file["snapshots"] if "snapshots" in self.file else {}
-            names = sorted(g.keys()) if g else []
-            self._snapshots = [Snapshot(self, g[n], n, i) for i, n in enumerate(names)]
+            if self.ranks > 1:
+                groups = joined_groups(self._decomposed_files(), "snapshots")
+            else:
+                g = self.file["snapshots"] if "snapshots" in self.file else {}
+                groups = {n: g[n] for n in sorted(g.keys())} if g else {}
+            self._snapshots = [Snapshot(self, grp, n, i) for i, (n, grp) in enumerate(groups.items())]
         return self._snapshots
 
     @property
@@ -119,6 +137,11 @@ class Run:
 
     @property
     def failure(self):
+        if self.ranks > 1:
+            files = self._decomposed_files()
+            if all("failure" in f for f in files):
+                return Snapshot(self, JoinedGroup([f["failure"] for f in files]), "failure", None)
+            return None
         return Snapshot(self, self.file["failure"], "failure", None) if "failure" in self.file else None
 
     def snapshot(self, which="last"):

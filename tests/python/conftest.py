@@ -51,3 +51,18 @@ def ensemble_file(workdir):
     subprocess.run([_exe(), "ensemble", SCENE, "--seed-key", "output.snapshot_count", "--first-seed", "2", "-n", "2",
                     "-o", out, "--quiet", "--threads", "1"] + _sets(SETS[1:]), check=True)
     return out
+
+
+@pytest.fixture(scope="session")
+def decomposed_pair(workdir):
+    """The small decomposed sliding block (tests/coupling/scenes) run serially and on 2 ranks: the
+    decomposed run's snapshots live in OUT.rank<r>.h5 (frictherm/ranks.py joins them)."""
+    mpiexec = shutil.which("mpiexec")
+    if mpiexec is None:
+        pytest.skip("mpiexec is not installed")
+    scene = os.path.join(SOURCE, "tests", "coupling", "scenes", "decomposed_sliding_block.json")
+    serial, decomposed = os.path.join(workdir, "serial.h5"), os.path.join(workdir, "decomposed.h5")
+    subprocess.run([_exe(), "run", scene, "-o", serial, "--quiet", "--threads", "1"], check=True)
+    subprocess.run([mpiexec, "-n", "2", "--oversubscribe", "--allow-run-as-root", _exe(), "run", scene, "-o", decomposed,
+                    "--quiet"], check=True)
+    return serial, decomposed
