@@ -239,6 +239,9 @@ CASES = [
     ("--set into a number", scene(), {}, ["validate", "SCENE", "--set", "dimension.x=1"], "--set dimension.x"),
     ("contact.boundary_spacing 1e-12 (2e11 boundary points)", scene(contact={"boundary_spacing": 1e-12}), {},
      ["validate", "SCENE"], "contact.boundary_spacing"),
+    ("material name with a slash", scene().replace('"soft"', '"so/ft"'), {}, ["validate", "SCENE"], "materials.so/ft"),
+    ("body name with a slash", scene(bodies=[dict(BASE["bodies"][0], name="bl/ock")]), {}, ["validate", "SCENE"],
+     "bodies[0].name"),
     ("-o followed by an option", scene(), {}, ["run", "SCENE", "-o", "--force"], "option '-o'"),
 ]
 

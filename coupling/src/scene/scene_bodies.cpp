@@ -187,6 +187,9 @@ void parse_bodies(const JsonReader& root, Scene& s, ParseContext& ctx) {
     const auto name = b.find("name");
     body.name = name ? name->as_string() : "body" + std::to_string(index);
     if (name && body.name.empty()) name->expected("a non-empty name");
+    // A body names columns of the results (mean_temperature.<name>, ...), and HDF5 splits names at '/'.
+    if (name && body.name.find('/') != std::string::npos)
+      name->expected("a name without '/' (body names name columns of the HDF5 results)");
     const auto same = std::find(ctx.body_names.begin(), ctx.body_names.end(), body.name);
     if (same != ctx.body_names.end())
       (name ? *name : b).fail("the name \"" + body.name + "\" is already used by bodies[" +
