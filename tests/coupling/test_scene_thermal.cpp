@@ -127,7 +127,7 @@ TEST(SceneThermal, ErrorsNameTheKeyPath) {
       {"/coupling/window/steps", 3, "coupling.window.steps: unknown key"},
       {"/coupling/heating_order", "third", "coupling.heating_order: expected one of \"first\", \"second\", got \"third\""},
       {"/coupling/continuation/duration", -1.0, "coupling.continuation.duration: expected a number > 0"},
-      {"/coupling/continuation/intervals", 2.5, "coupling.continuation.intervals: expected an integer in [1, 10000000]"},
+      {"/coupling/continuation/intervals", 2.5, "coupling.continuation.intervals: expected an integer in [1, 100000]"},
       {"/coupling/hotspots/mode", "relative", "coupling.hotspots.mode: expected one of \"rise\", \"absolute\""},
       {"/coupling/hotspots/link_factor", 0.5, "coupling.hotspots.link_factor: expected a number in [1, 10]"},
       {"/coupling/mode", "two_way", "coupling.mode: unknown key"},

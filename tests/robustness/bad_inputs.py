@@ -239,6 +239,11 @@ CASES = [
     ("--set into a number", scene(), {}, ["validate", "SCENE", "--set", "dimension.x=1"], "--set dimension.x"),
     ("contact.boundary_spacing 1e-12 (2e11 boundary points)", scene(contact={"boundary_spacing": 1e-12}), {},
      ["validate", "SCENE"], "contact.boundary_spacing"),
+    ("continuation of 1e7 intervals", scene(
+        materials={"soft": BASE["materials"]["soft"]},
+        thermal={"materials": {"soft": {"heat_capacity": 1000, "conductivity": 1}}},
+        coupling={"continuation": {"duration": 1e-3, "intervals": 10000000}}), {}, ["validate", "SCENE"],
+     "coupling.continuation.intervals"),
     ("material name with a slash", scene().replace('"soft"', '"so/ft"'), {}, ["validate", "SCENE"], "materials.so/ft"),
     ("body name with a slash", scene(bodies=[dict(BASE["bodies"][0], name="bl/ock")]), {}, ["validate", "SCENE"],
      "bodies[0].name"),

@@ -236,7 +236,7 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
                                                                                            : HeatingOrder::second;
   if (const auto cont = c->find("continuation")) {
     spec.continuation_duration = cont->number("duration", Range::positive());
-    spec.continuation_intervals = cont->integer("intervals", spec.continuation_intervals, 1, 10000000);
+    spec.continuation_intervals = cont->integer("intervals", spec.continuation_intervals, 1, 100000);  // (10^5: as snapshots)
     spec.stop_when_decided = cont->find("stop_when_decided") && cont->at("stop_when_decided").as_bool();
     cont->finish();
   }
