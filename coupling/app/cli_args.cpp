@@ -4,15 +4,20 @@
 namespace frictherm::cli {
 
 namespace {
-/// Whether `a` is one of the command's options (its name before any "=VALUE", or -h/--help).
-bool is_option(const std::string& a, const std::vector<OptionSpec>& spec) {
-  const std::string name = a.substr(0, a.compare(0, 2, "--") == 0 ? a.find('=') : std::string::npos);
-  if (name == "-h" || name == "--help") return true;
+/// The option name of the argument `a`: "--name=VALUE" gives "--name", anything else itself.
+std::string option_name(const std::string& a) {
+  return a.substr(0, a.compare(0, 2, "--") == 0 ? a.find('=') : std::string::npos);
+}
+/// The option named by the argument `a`, or nullptr.
+const OptionSpec* find_option(const std::string& a, const std::vector<OptionSpec>& spec) {
+  const std::string name = option_name(a);
+  const OptionSpec* match = nullptr;
   for (const auto& s : spec)
     for (const auto& n : s.names)
-      if (n == name) return true;
-  return false;
+      if (n == name) match = &s;
+  return match;
 }
+bool is_help(const std::string& a) { return a == "-h" || a == "--help"; }
 }  // namespace
 
 ParsedArgs parse_args(const std::string& command, const std::vector<std::string>& args,
@@ -29,24 +34,20 @@ ParsedArgs parse_args(const std::string& command, const std::vector<std::string>
       options_done = true;
       continue;
     }
-    if (a == "-h" || a == "--help") {
+    if (is_help(a)) {
       out.help = true;
       continue;
     }
-    const std::size_t eq = a.find('=');
-    const std::string name = (a.compare(0, 2, "--") == 0 && eq != std::string::npos) ? a.substr(0, eq) : a;
-    const OptionSpec* match = nullptr;
-    for (const auto& s : spec)
-      for (const auto& n : s.names)
-        if (n == name) match = &s;
+    const std::string name = option_name(a);
+    const OptionSpec* match = find_option(a, spec);
     if (!match) throw UsageError(command, "unknown option '" + a + "'");
     std::string value;
     if (match->takes_value) {
       if (name.size() < a.size()) {
-        value = a.substr(eq + 1);
+        value = a.substr(name.size() + 1);
       } else if (i + 1 < args.size()) {
         // `-o --force` is a forgotten value, not a file named --force (that one is ./--force).
-        if (is_option(args[i + 1], spec))
+        if (is_help(args[i + 1]) || find_option(args[i + 1], spec))
           throw UsageError(command, "option '" + a + "' needs a value, got the option '" + args[i + 1] + "'" +
                                         (a.compare(0, 2, "--") == 0 ? " (write " + a + "=VALUE for a value that starts with '-')"
                                                                     : " (a file of that name is ./" + args[i + 1] + ")"));

@@ -224,7 +224,7 @@ void Simulation<Dim>::setup_penalty() {
   penalty_.emplace(grid_, PenaltyOptions{Dim == 2 ? opt_.thickness : 1.0});
   for (const PenaltyPairSettings& ps : settings) penalty_->add_pair(ps);
 
-  const double spacing = contact_opt_.boundary_spacing > 0.0 ? contact_opt_.boundary_spacing : 0.5 * h;
+  const double spacing = contact_opt_.boundary_point_spacing(h);
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     const int m = body_material_[i];
     const std::string& name = bodies_[i].name;

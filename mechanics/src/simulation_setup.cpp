@@ -134,7 +134,7 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
   int body_mat = p_.material[before];
   for (std::size_t k = before; k < p_.size(); ++k)
     if (p_.material[k] != body_mat) body_mat = -1;
-  const double spacing = contact_opt_.boundary_spacing > 0.0 ? contact_opt_.boundary_spacing : 0.5 * grid_.min_cell_size();
+  const double spacing = contact_opt_.boundary_point_spacing(grid_.min_cell_size());
   body_loops_.push_back(Dim == 2 ? region.boundary_loops(spacing) : std::vector<std::vector<Vec<2>>>{});
   body_loop_spacing_.push_back(spacing);
   body_material_.push_back(body_mat);

@@ -60,11 +60,18 @@ class JoinedGroup:
         self.attrs = parts[0].attrs
         names = [k for k in parts[0].keys() if all(k in g for g in parts[1:])]
         self._names = names
-        if "id" in names:
-            ids = np.concatenate([np.asarray(g["id"][()]) for g in parts])
-            self.order = np.argsort(ids, kind="stable")
-        else:
-            self.order = slice(None)
+        self._order = None
+
+    @property
+    def order(self):
+        """The joined rows sorted by particle id, read on first use (listing snapshots reads no data)."""
+        if self._order is None:
+            if "id" in self._names:
+                ids = np.concatenate([np.asarray(g["id"][()]) for g in self.parts])
+                self._order = np.argsort(ids, kind="stable")
+            else:
+                self._order = slice(None)
+        return self._order
 
     def keys(self):
         return list(self._names)

@@ -186,10 +186,7 @@ void parse_bodies(const JsonReader& root, Scene& s, ParseContext& ctx) {
     const std::size_t index = s.bodies.size();
     const auto name = b.find("name");
     body.name = name ? name->as_string() : "body" + std::to_string(index);
-    if (name && body.name.empty()) name->expected("a non-empty name");
-    // A body names columns of the results (mean_temperature.<name>, ...), and HDF5 splits names at '/'.
-    if (name && body.name.find('/') != std::string::npos)
-      name->expected("a name without '/' (body names name columns of the HDF5 results)");
+    if (name) check_result_name(*name, body.name, "body");
     const auto same = std::find(ctx.body_names.begin(), ctx.body_names.end(), body.name);
     if (same != ctx.body_names.end())
       (name ? *name : b).fail("the name \"" + body.name + "\" is already used by bodies[" +
@@ -243,6 +240,13 @@ SceneVec read_vec(const JsonReader& value, int dim, const Range& range) {
   SceneVec out{};
   for (int d = 0; d < dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
   return out;
+}
+
+void check_result_name(const JsonReader& where, const std::string& name, const char* what) {
+  if (name.empty()) where.fail(std::string(what) + " names must not be empty");
+  if (name.find('/') != std::string::npos)
+    where.fail(std::string(what) + " names must not contain '/' (they name columns of the HDF5 results), got \"" +
+               name + "\"");
 }
 
 std::string format_vec(const SceneVec& v, int dim) {

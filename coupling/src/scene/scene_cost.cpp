@@ -72,8 +72,7 @@ SceneCost estimate_scene_cost(const Scene& s) {
   // Boundary points (2D: every body's outline, as Simulation::add_body samples it): an outline is
   // counted as twice its bounding box's perimeter (an annulus has two loops), one point per spacing.
   if (dim == 2) {
-    const double spacing = s.contact.options.boundary_spacing > 0.0 ? s.contact.options.boundary_spacing
-                                                                      : 0.5 * std::min(s.cell_size[0], s.cell_size[1]);
+    const double spacing = s.contact.options.boundary_point_spacing(std::min(s.cell_size[0], s.cell_size[1]));
     for (const BodySpec& b : s.bodies)
       c.boundary_points +=
           4.0 * ((b.shape.box_hi[0] - b.shape.box_lo[0]) + (b.shape.box_hi[1] - b.shape.box_lo[1])) / spacing + 2.0;

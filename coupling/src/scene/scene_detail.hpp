@@ -26,6 +26,9 @@ struct ParseContext {
 SceneVec read_vec(const JsonReader& value, int dim, const Range& range = Range::any());
 /// "(x, y)" or "(x, y, z)".
 std::string format_vec(const SceneVec& v, int dim);
+/// Material and body names label columns of the results (mean_temperature.<name>, ...), and HDF5
+/// splits names at '/': fails at `where` ("material" or "body" names) for an empty name or a '/'.
+void check_result_name(const JsonReader& where, const std::string& name, const char* what);
 /// The first Dim components of a SceneVec (the serial scene build and the decomposed set-up).
 template <int Dim>
 mechanics::Vec<Dim> to_vec(const SceneVec& v) {

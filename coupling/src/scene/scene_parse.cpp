@@ -136,10 +136,7 @@ void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
   if (names.empty()) mats.expected("at least one material");
   for (const std::string& name : names) {
     const JsonReader m = mats.at(name);
-    if (name.empty()) m.fail("material names must not be empty");
-    // A material names columns of the results (mean_temperature.<name>, ...), and HDF5 splits names at '/'.
-    if (name.find('/') != std::string::npos)
-      m.fail("material names must not contain '/' (they name columns of the HDF5 results), got \"" + name + "\"");
+    detail::check_result_name(m, name, "material");
     if (!m.is_object()) m.expected("an object with the material's type and properties");
     s.materials.push_back(parse_material(m, name, s));
     ctx.material_names.push_back(name);

@@ -68,12 +68,12 @@ DistributedProblem::DistributedProblem(MPI_Comm comm, Index global_size, Index f
     if (!(std::isfinite(mass_[i]) && mass_[i] > 0.0)) bad << "mass of node " << first_ + i << " is " << mass_[i] << ", expected > 0";
   }
   k_.makeCompressed();
-  // A diagonal below zero by more than round-off (1e-12 of the largest |K| entry on any rank, as
-  // thermal::Problem): a node only zero-conductivity particles reach sums to ±1e-35 or so.
+  // A diagonal below zero by more than round-off (kConductanceRoundOff of the largest |K| entry on
+  // any rank, as thermal::Problem).
   double kmax = 0.0;
   for (Index e = 0; e < k_.nonZeros(); ++e) kmax = std::max(kmax, std::abs(k_.valuePtr()[e]));
   MPI_Allreduce(MPI_IN_PLACE, &kmax, 1, MPI_DOUBLE, MPI_MAX, comm_);  // (NaN entries are refused below)
-  const double diagonal_tol = 1e-12 * kmax;
+  const double diagonal_tol = kConductanceRoundOff * kmax;
   for (Index i = 0; i < k_.rows() && bad.tellp() == 0; ++i) {
     for (SparseMatrix::InnerIterator it(k_, i); it; ++it) {
       if (!std::isfinite(it.value())) bad << "conductance row " << first_ + i << " has a non-finite entry";

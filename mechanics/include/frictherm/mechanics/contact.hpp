@@ -100,6 +100,10 @@ struct ContactOptions {
   /// Penalty contact: spacing of the boundary points sampled on each body's region (m); 0: half
   /// the smallest cell size. Used when a body is added, so set it before add_body().
   double boundary_spacing = 0.0;
+  /// The spacing the boundary points are sampled at on a grid whose smallest cell is `min_cell` (m).
+  double boundary_point_spacing(double min_cell) const {
+    return boundary_spacing > 0.0 ? boundary_spacing : 0.5 * min_cell;
+  }
 };
 
 }  // namespace frictherm::mechanics

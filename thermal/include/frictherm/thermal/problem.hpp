@@ -22,17 +22,21 @@ namespace frictherm::thermal {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Index = Eigen::Index;
 
+/// Round-off allowed in an assembled K, relative to its largest |entry|: the asymmetry of a mirror
+/// pair, and a diagonal below zero (a node only zero-conductivity particles reach sums to ±1e-35).
+constexpr double kConductanceRoundOff = 1e-12;
+
 class Problem {
  public:
   // Throws std::invalid_argument if M has a non-positive or non-finite entry, if K is not
   // square of the same size, not symmetric (|K_ij − K_ji| > symmetry_tol·max|K|), has a
   // non-finite entry or a diagonal below −symmetry_tol·max|K|. K is assumed positive semi-definite; only these
   // necessary conditions are checked.
-  Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol = 1e-12);
+  Problem(Eigen::VectorXd mass, SparseMatrix conductance, double symmetry_tol = kConductanceRoundOff);
   // The same as assigning Problem(mass, conductance, symmetry_tol), in this object's storage: a
   // coupled run's windows keep their sizes, so nothing is allocated. Same checks and throws; after a
   // throw only another reset or the destructor may be called.
-  void reset(const Eigen::VectorXd& mass, const SparseMatrix& conductance, double symmetry_tol = 1e-12);
+  void reset(const Eigen::VectorXd& mass, const SparseMatrix& conductance, double symmetry_tol = kConductanceRoundOff);
 
   Index size() const { return mass_.size(); }
   const Eigen::VectorXd& mass() const { return mass_; }
