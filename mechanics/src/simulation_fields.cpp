@@ -173,8 +173,9 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
 
 template <int Dim>
 void Simulation<Dim>::update_partition() {
-  if (partition_.matches(threads_, fields_.size(), p_.size())) return;
-  partition_.build(threads_, material_begin_, material_end_, field_of_material_, fields_.size(), p_.size());
+  if (!partition_.matches(threads_, fields_.size(), p_.size()))
+    partition_.build(threads_, material_begin_, material_end_, field_of_material_, fields_.size(), p_.size());
+  if (!pass_split_.matches(threads_, p_.size())) pass_split_.reset(partition_);
 }
 
 // Each thread clears the slots it scatters into: in the nodes, the fields whose first thread it is;

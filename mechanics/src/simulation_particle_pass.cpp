@@ -22,9 +22,9 @@
 namespace frictherm::mechanics {
 
 namespace {
-// The parts of the thread partition this thread runs (see simulation_step.cpp).
+// The parts of the split this thread runs (see simulation_step.cpp).
 template <class Fn>
-void for_each_part(const ThreadPartition& partition, Fn&& fn) {
+void for_each_part(const PassSplit& partition, Fn&& fn) {
   for (int t = omp_get_thread_num(); t < partition.threads; t += omp_get_num_threads()) fn(t);
 }
 
@@ -75,13 +75,23 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     if constexpr (refreshable) return st.data();
     else return nullptr;
   }();
+  // On two or more threads each particle's external work goes to its block of the split, summed in
+  // block order after the pass: the same sum wherever the split's boundaries are (thread_partition.hpp).
+  const bool blocked = pass_split_.threads > 1;
+  if (blocked) work_blocks_.assign(pass_split_.blocks(), 0.0);
+  double* const work_block = work_blocks_.data();
 
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
   {
   thread_local step_detail::StencilBoxes<Dim> boxes;
   if (refresh) boxes.reset(nm);
-  for_each_part(partition_, [&](int t) {
+  for_each_part(pass_split_, [&](int t) {
+    const double started = omp_get_wtime();
     std::size_t m = 0;  // the material of the particles run() is given
+    auto add_work = [&](std::size_t k, double w) {
+      if (blocked) work_block[k / PassSplit::kBlock] += w;
+      else work += w;
+    };
     // Particle k at its new position: its stencil for the next step, and its material's box.
     [[maybe_unused]] auto refresh_stencil = [&](std::size_t k, IVec<Dim>& lo, IVec<Dim>& hi) {
       if constexpr (refreshable) {
@@ -117,7 +127,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         if constexpr (Kinematics) {
           const Vec<Dim> v_old = p_.velocity[k];
           if (flip) {
-            work += p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt;
+            add_work(k, p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt);
             p_.velocity[k] += dt * a;
             if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
           } else if (update == ParticleUpdate::xpic) {
@@ -126,7 +136,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
             p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
             v = vf;
           }
-          if (!flip) work += p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt;
+          if (!flip) add_work(k, p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt);
           p_.position[k] += dt * v;
           const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
           if (!ok) bad = std::min(bad, static_cast<long>(k));
@@ -144,7 +154,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         // Not updated by this pass: with refresh, this part's even share of them moved (rigid) and their
         // stencils evaluated.
         if (!refresh) continue;
-        const std::size_t b = material_begin_[m], n = material_end_[m] - b, T = static_cast<std::size_t>(partition_.threads);
+        const std::size_t b = material_begin_[m], n = material_end_[m] - b, T = static_cast<std::size_t>(pass_split_.threads);
         const std::size_t tt = static_cast<std::size_t>(t);
         for (std::size_t k = b + n * tt / T; k < b + n * (tt + 1) / T; ++k) {
           if (mat.is_rigid()) rigid_motion_[m].move(p_.velocity[k], p_.position[k]);
@@ -153,7 +163,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         continue;
       }
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-      const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+      const std::size_t kb = pass_split_.lo(t, material_begin_[m]), ke = pass_split_.hi(t, material_end_[m]);
       if (kb >= ke) continue;
       if constexpr (!Stress) {
         run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [](std::size_t, const Mat<Dim>&) { return true; });
@@ -206,12 +216,17 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         return ok;
       });
     }
+    pass_split_.seconds[static_cast<std::size_t>(t)] = omp_get_wtime() - started;
   });
   if (refresh) {
 #pragma omp critical(frictherm_stencil_boxes)
     boxes.merge_into(box_lo_, box_hi_);
   }
   }  // omp parallel
+  if (blocked) {
+    for (const double w : work_blocks_) work += w;
+    pass_split_.rebalance(material_begin_, material_end_, field_of_material_);
+  }
   if constexpr (Kinematics) {
     for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
     external_work_ += work;

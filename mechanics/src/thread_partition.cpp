@@ -61,4 +61,73 @@ void ThreadPartition::build(int thread_count, const std::vector<std::size_t>& ma
     if (first_thread[f] < last_thread[f]) shared_fields.push_back(static_cast<int>(f));
 }
 
+namespace {
+// The block boundary nearest to particle index k (n, the end, counts as one).
+std::size_t nearest_block(std::size_t k, std::size_t n) {
+  const std::size_t b = PassSplit::kBlock;
+  const std::size_t down = k / b * b;
+  const std::size_t up = std::min(n, down + b);
+  return k - down <= up - k ? down : up;
+}
+}  // namespace
+
+void PassSplit::reset(const ThreadPartition& p) {
+  threads = p.threads;
+  particles = p.particles;
+  begin = p.begin;
+  for (std::size_t t = 1; t < static_cast<std::size_t>(threads); ++t)
+    begin[t] = std::max(begin[t - 1], nearest_block(begin[t], particles));
+  seconds.assign(static_cast<std::size_t>(threads), 0.0);
+  cost.assign(static_cast<std::size_t>(threads), 0.0);
+}
+
+void PassSplit::rebalance(const std::vector<std::size_t>& material_begin, const std::vector<std::size_t>& material_end,
+                          const std::vector<int>& field_of_material) {
+  if (threads < 2) return;
+  const std::size_t T = static_cast<std::size_t>(threads), nm = material_begin.size();
+  // Particles with a field before index k (materials are stored in order, ThreadPartition::build).
+  auto weight_at = [&](std::size_t k) {
+    std::size_t w = 0;
+    for (std::size_t m = 0; m < nm && material_begin[m] < k; ++m)
+      if (field_of_material[m] >= 0) w += std::min(k, material_end[m]) - material_begin[m];
+    return static_cast<double>(w);
+  };
+  // The first index with `w` particles with a field before it.
+  auto index_at = [&](double w) {
+    double before = 0.0;
+    for (std::size_t m = 0; m < nm; ++m) {
+      if (field_of_material[m] < 0) continue;
+      const double count = static_cast<double>(material_end[m] - material_begin[m]);
+      if (before + count >= w) return material_begin[m] + static_cast<std::size_t>(std::llround(std::max(0.0, w - before)));
+      before += count;
+    }
+    return particles;
+  };
+  weight.resize(T + 1);
+  for (std::size_t t = 0; t <= T; ++t) weight[t] = weight_at(begin[t]);
+  // Seconds per particle with a field in each part, smoothed: a pass that a descheduled thread
+  // stretched moves the boundaries a little, not all the way.
+  constexpr double keep = 0.75;
+  for (std::size_t t = 0; t < T; ++t) {
+    const double w = weight[t + 1] - weight[t];
+    if (!(w > 0.0) || !(seconds[t] > 0.0)) return;  // nothing measured to balance by
+    const double c = seconds[t] / w;
+    cost[t] = cost[t] > 0.0 ? keep * cost[t] + (1.0 - keep) * c : c;
+  }
+  // The cumulative cost over the weight coordinate, linear within each part; boundary t moves halfway
+  // towards where it reaches t / T of the total.
+  double total = 0.0;
+  for (std::size_t t = 0; t < T; ++t) total += cost[t] * (weight[t + 1] - weight[t]);
+  std::size_t part = 0;
+  double reached = 0.0;  // the cost before part `part`
+  for (std::size_t t = 1; t < T; ++t) {
+    const double goal = total * static_cast<double>(t) / static_cast<double>(T);
+    while (part + 1 < T && reached + cost[part] * (weight[part + 1] - weight[part]) < goal)
+      reached += cost[part] * (weight[part + 1] - weight[part]), ++part;
+    const double target = weight[part] + (goal - reached) / cost[part];
+    const std::size_t k = index_at(0.5 * (weight[t] + target));
+    begin[t] = std::max(begin[t - 1], std::min(particles, nearest_block(k, particles)));
+  }
+}
+
 }  // namespace frictherm::mechanics

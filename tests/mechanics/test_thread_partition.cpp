@@ -1,7 +1,8 @@
 // The thread partition of the particle loops (thread_partition.hpp): its ranges, the fields it
 // shares, and that a multimaterial contact run gives the same particles on 1, 2 and 3 threads (to
 // round-off: only a shared field's sums are split among threads) and bit for bit the same whether
-// its parts run on their own threads or on fewer (a nested region).
+// its parts run on their own threads or on fewer (a nested region). The particle passes' timed
+// split (PassSplit) moves to equal measured cost, and the numbers do not depend on where it is.
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
@@ -84,14 +85,55 @@ TEST(ThreadPartition, RangesTileTheParticlesAndBalanceTheFieldedOnes) {
   EXPECT_EQ(p.shared_fields[0], 1);
 }
 
+// The particles of the second half cost twice as much per particle as those of the first (a grain
+// yielding, a binder reading scattered nodes): the split ends where the two threads' seconds are
+// equal, on a block boundary, and a rigid material without a field counts for nothing.
+TEST(PassSplit, MovesToWhereTheMeasuredCostsAreEqual) {
+  const Materials m = layout({1000, 1000, 256}, {0, 1, -1});
+  const std::size_t n = 2256;
+  auto cost_of = [&](std::size_t k) { return k < 1000 ? 1.0 : k < 2000 ? 2.0 : 0.0; };
+  ThreadPartition p;
+  p.build(2, m.begin, m.end, m.field, 2, n);
+  PassSplit split;
+  split.reset(p);
+  EXPECT_EQ(split.begin[1] % PassSplit::kBlock, 0u);
+  EXPECT_NEAR(static_cast<double>(split.begin[1]), 1000.0, PassSplit::kBlock / 2.0);  // even count to start
+  for (int pass = 0; pass < 40; ++pass) {
+    for (int t = 0; t < 2; ++t) {
+      double seconds = 0.0;
+      for (std::size_t k = split.begin[t]; k < split.begin[t + 1]; ++k) seconds += 1e-7 * cost_of(k);
+      split.seconds[static_cast<std::size_t>(t)] = seconds;
+    }
+    split.rebalance(m.begin, m.end, m.field);
+    ASSERT_EQ(split.begin.front(), 0u);
+    ASSERT_EQ(split.begin.back(), n);
+    ASSERT_EQ(split.begin[1] % PassSplit::kBlock, 0u) << "pass " << pass;
+  }
+  // Equal cost: 1000 + 2 (b − 1000) = 2 (2000 − b) → b = 1250, within a block of the rounding.
+  EXPECT_NEAR(static_cast<double>(split.begin[1]), 1250.0, static_cast<double>(PassSplit::kBlock));
+  // One pass in which the second thread was descheduled (ten times its time) moves the boundary by
+  // less than a sixth of the particles, not to the far end.
+  const std::size_t settled = split.begin[1];
+  split.seconds[0] = 1e-7 * 1250.0, split.seconds[1] = 10.0 * 1e-7 * 1500.0;
+  split.rebalance(m.begin, m.end, m.field);
+  EXPECT_GT(split.begin[1], settled);
+  EXPECT_LT(split.begin[1] - settled, n / 6);
+  // Nothing measured (a thread ran no part): the split stays.
+  const std::size_t before = split.begin[1];
+  split.seconds[1] = 0.0;
+  split.rebalance(m.begin, m.end, m.field);
+  EXPECT_EQ(split.begin[1], before);
+}
+
 namespace {
 
 // Five elastic blocks, each its own material, colliding with friction (Coulomb μ = 0.3) on a 2D
 // grid: ~12,500 particles, enough for three threads (the step uses one per 2,000 particles).
-std::unique_ptr<Simulation<2>> colliding_blocks() {
+std::unique_ptr<Simulation<2>> colliding_blocks(double gravity = 0.0) {
   SimulationOptions o;
   o.shape = ShapeKind::ugimp;
   o.scheme = UpdateScheme::usl;
+  o.gravity = Vec<3>(0.0, -gravity, 0.0);
   auto sim = std::make_unique<Simulation<2>>(Grid<2>(Vec<2>::Zero(), Vec<2>::Constant(0.0125), IVec<2>{80, 40}), o);
   ContactOptions c;
   c.default_pair.law = FrictionLaw::coulomb(0.3);
@@ -116,14 +158,15 @@ struct RunResult {
   std::vector<Vec<2>> position, velocity;
   double w1 = 0.0, w2 = 0.0;
   std::size_t particles = 0;
+  double external_work = 0.0;
 };
 
-RunResult run_colliding_blocks(int steps) {
-  auto sim = colliding_blocks();
+RunResult run_colliding_blocks(int steps, double gravity = 0.0) {
+  auto sim = colliding_blocks(gravity);
   for (int s = 0; s < steps; ++s) sim->step();
   const auto& p = sim->particles();
   return {p.position, p.velocity, sim->cumulative_frictional_work(HeatingOrder::first),
-          sim->cumulative_frictional_work(HeatingOrder::second), p.size()};
+          sim->cumulative_frictional_work(HeatingOrder::second), p.size(), sim->external_work()};
 }
 
 double largest_speed(const RunResult& r) {
@@ -163,16 +206,20 @@ TEST(ThreadPartition, CollidingBlocksAgreeOnOneTwoAndThreeThreads) {
 
 // Inside an enclosing parallel region the step's regions get one thread each (nesting off), while
 // the step still asks for three: each thread then runs all three parts, in the same arithmetic as
-// three threads would, so the particles are bit-identical.
+// three threads would, so the particles are bit-identical. Under gravity the particle pass's work
+// is summed in the split's blocks: the same bits although the runs' timings, and so their splits,
+// differ, and although one thread sums three parts where three threads sum one each.
 TEST(ThreadPartition, FewerThreadsThanPartsGiveTheSameParticles) {
   constexpr int steps = 40;
+  constexpr double gravity = 9.81;
   omp_set_num_threads(3);
-  const RunResult three = run_colliding_blocks(steps);
+  const RunResult three = run_colliding_blocks(steps, gravity);
+  ASSERT_NE(three.external_work, 0.0) << "gravity must work on the blocks";
   const int saved_levels = omp_get_max_active_levels();
   omp_set_max_active_levels(1);
   std::vector<RunResult> nested(2);
 #pragma omp parallel num_threads(2)
-  nested[static_cast<std::size_t>(omp_get_thread_num())] = run_colliding_blocks(steps);
+  nested[static_cast<std::size_t>(omp_get_thread_num())] = run_colliding_blocks(steps, gravity);
   omp_set_max_active_levels(saved_levels);
   omp_set_num_threads(1);
   for (const RunResult& r : nested) {
@@ -182,5 +229,6 @@ TEST(ThreadPartition, FewerThreadsThanPartsGiveTheSameParticles) {
       ASSERT_EQ(r.position[k], three.position[k]) << k;
     }
     EXPECT_NEAR(r.w2, three.w2, 1e-12 * three.w2);
+    EXPECT_EQ(r.external_work, three.external_work);
   }
 }

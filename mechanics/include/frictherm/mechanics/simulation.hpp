@@ -427,6 +427,8 @@ class Simulation {
   static constexpr double penalty_sliver_ = 0.25;
   std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1), shared fields only
   ThreadPartition partition_;  // each thread's particles, the fields threads share
+  PassSplit pass_split_;       // each thread's particles in the particle passes (timed, rebalanced)
+  std::vector<double> work_blocks_;  // the particle pass's external work per PassSplit block (threads > 1)
   struct TransferScratch {  // XPIC/FMPM, per slot
     std::vector<Vec<Dim>> start;     // XPIC: lumped v^n at the momentum update
     std::vector<Vec<Dim>> filtered;  // v* (the series' sum)

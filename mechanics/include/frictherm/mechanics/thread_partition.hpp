@@ -71,4 +71,37 @@ struct ThreadPartition {
   }
 };
 
+/// The split of the particle passes (grid-to-particle and stress update: they gather from the nodes
+/// and write only their own particles, so where the threads' shares meet does not change a single
+/// particle's numbers). A particle's cost differs by material and state (a yielding HMX grain's J2
+/// return, a binder particle without one), so an even count leaves one thread waiting for the other:
+/// on the PBX the main thread waited 6.4 % of its samples at the pass's end. Each pass records the
+/// seconds of every thread's share; `rebalance` moves each boundary halfway towards where the
+/// measured costs (seconds per particle with a field, smoothed over passes) would be equal.
+/// Boundaries sit on multiples of kBlock particles, and the pass sums its per-particle work in those
+/// blocks, in block order: the sum does not depend on where the boundaries are, so a run gives the
+/// same numbers whatever the timings (thread_partition.cpp).
+struct PassSplit {
+  static constexpr std::size_t kBlock = 128;
+  int threads = 0;
+  std::size_t particles = 0;
+  std::vector<std::size_t> begin;  // threads + 1 entries, as ThreadPartition::begin
+  std::vector<double> seconds;     // per part: the last pass's time (0: not measured)
+  std::vector<double> cost;        // per part: smoothed seconds per particle with a field (0: none yet)
+  std::vector<double> weight;      // scratch of rebalance: particles with a field before each boundary
+
+  bool matches(int t, std::size_t n) const { return threads == t && particles == n; }
+  /// Starts from the partition's boundaries, moved to the nearest block boundary.
+  void reset(const ThreadPartition& p);
+  /// Moves the boundaries after a pass that recorded `seconds` (weights as ThreadPartition::build).
+  void rebalance(const std::vector<std::size_t>& material_begin, const std::vector<std::size_t>& material_end,
+                 const std::vector<int>& field_of_material);
+  std::size_t lo(int t, std::size_t b) const { return b > begin[static_cast<std::size_t>(t)] ? b : begin[static_cast<std::size_t>(t)]; }
+  std::size_t hi(int t, std::size_t e) const {
+    const std::size_t x = begin[static_cast<std::size_t>(t) + 1];
+    return e < x ? e : x;
+  }
+  std::size_t blocks() const { return (particles + kBlock - 1) / kBlock; }
+};
+
 }  // namespace frictherm::mechanics
