@@ -30,13 +30,16 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   }
 
   // The node groups of contact_entries_ (find_contact_nodes): each group reads and writes only its own
-  // node's slots and work entries, so groups run in parallel. Stats and pair books go to per-thread
-  // accumulators, summed in thread order afterwards (deterministic for a given thread count).
+  // node's slots and work entries, so groups run in parallel, handed out in chunks as threads come
+  // free (a group's cost depends on its materials and whether they slide). Stats are counts; the pair
+  // books' entries are listed per thread and added in group order afterwards, so every number is
+  // the same whichever thread ran a group, and on one thread as on several.
   const long groups = static_cast<long>(contact_groups_.size()) - 1;
   const int threads = groups >= 256 ? threads_ : 1;
   contact_thread_work_.resize(static_cast<std::size_t>(threads));
   for (auto& t : contact_thread_work_) {
     t.stats = ContactStats{};
+    t.entries.clear();
     if (heat && t.marked.size() != nm * nm) {
       t.pair_first.assign(nm * nm, 0.0), t.pair_second.assign(nm * nm, 0.0), t.marked.assign(nm * nm, 0);
       t.touched.clear();
@@ -59,17 +62,17 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
       if (forces) nodes_.force[static_cast<std::size_t>(slot)] += dp / dt;  // eq. 19
     };
-    auto add_work = [&](int node, int ma, int mb, double w1, double w2) {
+    auto add_work = [&](long group, int node, int ma, int mb, double w1, double w2) {
       if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
       work_first_[static_cast<std::size_t>(node)] += w1;
       work_second_[static_cast<std::size_t>(node)] += w2;
       const std::size_t k = static_cast<std::size_t>(std::min(ma, mb)) * nm + static_cast<std::size_t>(std::max(ma, mb));
-      acc.add(k, w1, w2);
+      acc.entries.push_back({group, k, w1, w2});
     };
     ContactStats& stats = acc.stats;
     auto pair_of = [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); };
 
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, 64)
     for (long g = 0; g < groups; ++g) {
       const int node = contact_entries_[contact_groups_[static_cast<std::size_t>(g)]].node;
       const int guarded = gather_contact_sides(static_cast<std::size_t>(g), dt, sides, slots, mats, entries);
@@ -84,21 +87,44 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       contact_detail::resolve_contact_node(
           sides, mats, h, ctx, lagged_normal, lagged_step, pair_of, dps,
           [&](std::size_t j, const Vec<Dim>& dp) { apply(slots[j], dp); },
-          [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); }, stats.sliding_nodes);
+          [&](int ma, int mb, double w1, double w2) { add_work(g, node, ma, mb, w1, w2); }, stats.sliding_nodes);
     }
   }
-  for (auto& t : contact_thread_work_) {
-    if (!heat) continue;
+  if (!heat) return;
+  for (const auto& t : contact_thread_work_) {
     contact_stats_.contact_nodes += t.stats.contact_nodes;
     contact_stats_.multi_nodes += t.stats.multi_nodes;
     contact_stats_.sliding_nodes += t.stats.sliding_nodes;
     contact_stats_.guarded += t.stats.guarded;
-    for (const std::size_t k : t.touched) {  // (the others add zero)
-      pair_work_first_[k] += t.pair_first[k], pair_work_second_[k] += t.pair_second[k];
-      t.pair_first[k] = t.pair_second[k] = 0.0, t.marked[k] = 0;
-    }
-    t.touched.clear();
   }
+  // The pair books: every thread's entries (each list in increasing group order, as the chunks were
+  // handed out) merged in group order, summed into the first thread's books, then into the run's.
+  ContactThreadWork& books = contact_thread_work_.front();
+  const std::size_t T = contact_thread_work_.size();
+  contact_merge_cursor_.assign(T, 0);
+  while (true) {
+    std::size_t from = T;
+    for (std::size_t t = 0; t < T; ++t) {
+      const auto& list = contact_thread_work_[t].entries;
+      if (contact_merge_cursor_[t] < list.size() &&
+          (from == T || list[contact_merge_cursor_[t]].group < contact_thread_work_[from].entries[contact_merge_cursor_[from]].group))
+        from = t;
+    }
+    if (from == T) break;
+    auto& list = contact_thread_work_[from].entries;
+    for (std::size_t& q = contact_merge_cursor_[from]; q < list.size();) {  // the rest of this group
+      const auto& e = list[q];
+      const long group = e.group;
+      books.add(e.k, e.w1, e.w2);
+      ++q;
+      if (q == list.size() || list[q].group != group) break;
+    }
+  }
+  for (const std::size_t k : books.touched) {  // (the others add zero)
+    pair_work_first_[k] += books.pair_first[k], pair_work_second_[k] += books.pair_second[k];
+    books.pair_first[k] = books.pair_second[k] = 0.0, books.marked[k] = 0;
+  }
+  books.touched.clear();
 }
 
 // The materials at contact node `group` above min_mass_fraction of the node's mass (lighter ones take

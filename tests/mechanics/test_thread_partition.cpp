@@ -232,3 +232,49 @@ TEST(ThreadPartition, FewerThreadsThanPartsGiveTheSameParticles) {
     EXPECT_EQ(r.external_work, three.external_work);
   }
 }
+
+namespace {
+
+// A slider pressed onto a base and dragged along it over 320 cells: ~640 contact nodes, enough for
+// the contact pass to use threads (it needs 256 node groups), all of one material pair.
+double sliding_interface_work(int steps) {
+  SimulationOptions o;
+  o.shape = ShapeKind::ugimp;
+  o.scheme = UpdateScheme::usl;
+  Simulation<2> sim(Grid<2>(Vec<2>::Zero(), Vec<2>::Constant(0.0125), IVec<2>{324, 12}), o);
+  ContactOptions c;
+  c.default_pair.law = FrictionLaw::coulomb(0.3);
+  sim.enable_contact(c);
+  Material m;
+  m.name = "block", m.kind = MaterialKind::linear_elastic, m.density = 1200.0, m.youngs_modulus = 2e8, m.poisson_ratio = 0.3;
+  const int base = sim.add_material(m), slider = sim.add_material(m);
+  sim.add_body("base", *make_box<2>(Vec<2>(0.025, 0.025), Vec<2>(4.025, 0.075), base), 2, Vec<2>(0.0, 0.0));
+  sim.add_body("slider", *make_box<2>(Vec<2>(0.025, 0.075), Vec<2>(4.025, 0.125), slider), 2, Vec<2>(2.0, -0.5));
+  for (int s = 0; s < steps; ++s) sim.step();
+  return sim.cumulative_frictional_work(HeatingOrder::second, base, slider);
+}
+
+}  // namespace
+
+// The contact pass hands its node groups to whichever thread is free and adds the pair's work in
+// group order afterwards: three threads and one thread running the three parts give the same bits
+// (summed per thread and then over threads, as before, they differed in the last digits).
+TEST(ThreadPartition, PairWorkIsTheSameBitsWhicheverThreadResolvesAGroup) {
+  constexpr int steps = 20;
+  omp_set_num_threads(3);
+  const double three = sliding_interface_work(steps);
+  ASSERT_GT(three, 0.0) << "the slider must rub";
+  const int saved_levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(1);
+  double nested = 0.0;
+#pragma omp parallel num_threads(2)
+  {
+    const double w = sliding_interface_work(steps);
+    if (omp_get_thread_num() == 0) nested = w;
+  }
+  omp_set_max_active_levels(saved_levels);
+  omp_set_num_threads(1);
+  const double one = sliding_interface_work(steps);
+  std::printf("[pair work] 3 threads %.17g J, one thread per region %.17g J, 1 thread %.17g J\n", three, nested, one);
+  EXPECT_EQ(nested, three);
+}
