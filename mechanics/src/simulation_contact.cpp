@@ -30,10 +30,10 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   }
 
   // The node groups of contact_entries_ (find_contact_nodes): each group reads and writes only its own
-  // node's slots and work entries, so groups run in parallel, handed out in chunks as threads come
-  // free (a group's cost depends on its materials and whether they slide). Stats are counts; the pair
-  // books' entries are listed per thread and added in group order afterwards, so every number is
-  // the same whichever thread ran a group, and on one thread as on several.
+  // node's slots and work entries, so groups run in parallel. Stats are counts; the pair books'
+  // entries are listed per thread and added in group order afterwards, so every number is the same
+  // whichever thread ran a group. (Handing the groups out in chunks as threads came free, schedule
+  // dynamic, made the PBX's contact phase slower: 22.1 % of the wall time against 20.0 %.)
   const long groups = static_cast<long>(contact_groups_.size()) - 1;
   const int threads = groups >= 256 ? threads_ : 1;
   contact_thread_work_.resize(static_cast<std::size_t>(threads));
@@ -72,7 +72,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     ContactStats& stats = acc.stats;
     auto pair_of = [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); };
 
-#pragma omp for schedule(dynamic, 64)
+#pragma omp for schedule(static)
     for (long g = 0; g < groups; ++g) {
       const int node = contact_entries_[contact_groups_[static_cast<std::size_t>(g)]].node;
       const int guarded = gather_contact_sides(static_cast<std::size_t>(g), dt, sides, slots, mats, entries);
@@ -97,8 +97,8 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     contact_stats_.sliding_nodes += t.stats.sliding_nodes;
     contact_stats_.guarded += t.stats.guarded;
   }
-  // The pair books: every thread's entries (each list in increasing group order, as the chunks were
-  // handed out) merged in group order, summed into the first thread's books, then into the run's.
+  // The pair books: every thread's entries (each list in increasing group order) merged in group
+  // order, summed into the first thread's books, then into the run's.
   ContactThreadWork& books = contact_thread_work_.front();
   const std::size_t T = contact_thread_work_.size();
   contact_merge_cursor_.assign(T, 0);

@@ -256,9 +256,9 @@ double sliding_interface_work(int steps) {
 
 }  // namespace
 
-// The contact pass hands its node groups to whichever thread is free and adds the pair's work in
-// group order afterwards: three threads and one thread running the three parts give the same bits
-// (summed per thread and then over threads, as before, they differed in the last digits).
+// The contact pass adds the pair's work in node-group order after its threads have listed it: three
+// threads and one thread running the three parts give the same bits (summed per thread and then
+// over threads, as before, they differed in the last digits).
 TEST(ThreadPartition, PairWorkIsTheSameBitsWhicheverThreadResolvesAGroup) {
   constexpr int steps = 20;
   omp_set_num_threads(3);
