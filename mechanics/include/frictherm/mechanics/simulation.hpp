@@ -386,13 +386,12 @@ class Simulation {
     ContactStats stats;
     // Material pair k = min·nm + max: the pass's work, zero outside `touched` (the pairs it added
     // to, marked in `marked`), so a pass clears and sums only those, not all nm² pairs of a PBX.
-    // Only the first thread's are summed into: the threads list their node groups' entries, in group
-    // order, and the pass adds the lists merged in group order (resolve_contact).
+    // Only the first thread's are summed into: the threads list their node groups' entries, and the
+    // pass adds the lists in thread order, which is group order (resolve_contact).
     std::vector<double> pair_first, pair_second;
     std::vector<std::uint8_t> marked;
     std::vector<std::size_t> touched;
     struct PairEntry {
-      long group;
       std::size_t k;
       double w1, w2;
     };
@@ -404,7 +403,6 @@ class Simulation {
     }
   };
   std::vector<ContactThreadWork> contact_thread_work_;
-  std::vector<std::size_t> contact_merge_cursor_;  // per thread: the next pair-book entry to merge
   // Normal-stress regularisation (ContactOptions::regularized): per grid node the lagged normal
   // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
   // in contact on the previous step starts again from σ).
