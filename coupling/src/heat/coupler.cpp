@@ -62,7 +62,16 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
   assemble(p);
   nodal_temperature_ = system_.temperature;
   tracker_.set_reference(p);
+  interface_.start(grid_, opt_.thickness, p, opt_.materials, opt_.interface_temperature, time);
   tracker_.update(p, opt_.materials, time);
+}
+
+template <int Dim>
+void Coupler<Dim>::update_interface_and_hotspots(mechanics::Particles<Dim>& p, double time) {
+  if (interface_.enabled()) interface_.update(p, shape_, step_stencils(), system_, nodal_temperature_, time);
+  const bool by_interface = opt_.hotspots_by_interface_temperature && interface_.enabled() &&
+                            interface_.particle_temperature().size() == p.size();
+  tracker_.update(p, opt_.materials, time, by_interface ? &interface_.particle_temperature() : nullptr);
 }
 
 template <int Dim>
@@ -217,6 +226,7 @@ bool Coupler<Dim>::after_step(mechanics::Particles<Dim>& p, const std::vector<do
   const double before = pending_.total();
   pending_.add(nodal_work);
   books_.work_received += pending_.total() - before;
+  interface_.add_step(nodal_work, time);  // the frictional heat's flux history (off unless asked)
   if (opt_.plastic.enabled) {
     double dw = 0.0;
     const double heat = plastic_.collect(grid_, p, shape_, pending_, dw);  // β Δw_p S_ip on the nodes
@@ -267,7 +277,7 @@ bool Coupler<Dim>::close_window(mechanics::Particles<Dim>& p, double time) {
   window_start_ = time;
   window_steps_ = 0;
   max_rise_ = 0.0;
-  tracker_.update(p, opt_.materials, time);
+  update_interface_and_hotspots(p, time);
   return true;
 }
 
@@ -292,7 +302,7 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
   ++books_.continuation_intervals;
   window_start_ = time;
   window_steps_ = 0;
-  tracker_.update(p, opt_.materials, time);
+  update_interface_and_hotspots(p, time);
   fates_.update(p, particle_progress_, tracker_, time);
 }
 

@@ -46,11 +46,11 @@ void HotSpotTracker::set_reference(const mechanics::Particles<Dim>& p) {
 
 template <int Dim>
 void HotSpotTracker::update(const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
-                            double time) {
+                            double time, const std::vector<double>* criterion) {
   if (Dim != dim_) throw std::logic_error("HotSpotTracker: particles of another dimension");
   if (reference_.size() != p.size()) set_reference(p);
   double max_temperature = 0.0;
-  std::vector<HotCandidate> hot = candidates(p, materials, max_temperature);
+  std::vector<HotCandidate> hot = candidates(p, materials, max_temperature, nullptr, nullptr, criterion);
   update_from(std::move(hot), max_temperature, p.size(), time);
 }
 
@@ -59,9 +59,11 @@ std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<
                                                      const std::vector<ThermalProperties>& materials,
                                                      double& max_temperature,
                                                      const std::vector<std::int64_t>* ids,
-                                                     const std::vector<double>* reference) const {
+                                                     const std::vector<double>* reference,
+                                                     const std::vector<double>* criterion) const {
   if (Dim != dim_) throw std::logic_error("HotSpotTracker: particles of another dimension");
-  if ((ids && ids->size() != p.size()) || (reference && reference->size() != p.size()))
+  if ((ids && ids->size() != p.size()) || (reference && reference->size() != p.size()) ||
+      (criterion && criterion->size() != p.size()))
     throw std::invalid_argument("HotSpotTracker: one id and one reference temperature per particle");
   const std::vector<double>& T0_p = reference ? *reference : reference_;
   std::vector<HotCandidate> hot;
@@ -69,7 +71,7 @@ std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<
   for (std::size_t k = 0; k < p.size(); ++k) {
     const auto id = static_cast<std::size_t>(p.material[k]);
     if (id >= materials.size() || !materials[id].conducts) continue;
-    const double T = p.temperature[k];
+    const double T = criterion ? (*criterion)[k] : p.temperature[k];
     max_temperature = std::max(max_temperature, T);
     const double T0 = k < T0_p.size() ? T0_p[k] : 0.0;
     const double level = opt_.mode == HotSpotOptions::Mode::absolute ? T : T - T0;
@@ -80,7 +82,7 @@ std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<
     c.spacing = 2.0 * p.half_size[k].maxCoeff();
     c.temperature = T;
     c.volume = p.volume[k];
-    c.excess = p.mass[k] * materials[id].heat_capacity * (T - T0);
+    c.excess = p.mass[k] * materials[id].heat_capacity * (p.temperature[k] - T0);
     c.material = p.material[k];
     hot.push_back(c);
   }
@@ -275,12 +277,16 @@ template void HotSpotTracker::set_reference<3>(const mechanics::Particles<3>&);
 template std::vector<HotCandidate> HotSpotTracker::candidates<2>(const mechanics::Particles<2>&,
                                                                   const std::vector<ThermalProperties>&, double&,
                                                                   const std::vector<std::int64_t>*,
+                                                                  const std::vector<double>*,
                                                                   const std::vector<double>*) const;
 template std::vector<HotCandidate> HotSpotTracker::candidates<3>(const mechanics::Particles<3>&,
                                                                   const std::vector<ThermalProperties>&, double&,
                                                                   const std::vector<std::int64_t>*,
+                                                                  const std::vector<double>*,
                                                                   const std::vector<double>*) const;
-template void HotSpotTracker::update<2>(const mechanics::Particles<2>&, const std::vector<ThermalProperties>&, double);
-template void HotSpotTracker::update<3>(const mechanics::Particles<3>&, const std::vector<ThermalProperties>&, double);
+template void HotSpotTracker::update<2>(const mechanics::Particles<2>&, const std::vector<ThermalProperties>&, double,
+                                        const std::vector<double>*);
+template void HotSpotTracker::update<3>(const mechanics::Particles<3>&, const std::vector<ThermalProperties>&, double,
+                                        const std::vector<double>*);
 
 }  // namespace frictherm::coupling

@@ -53,6 +53,7 @@ void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& na
   const CouplerOptions& o = coupler_.options();
   if (o.plastic.enabled) names.insert(names.end(), {"plastic_work", "plastic_heat"});
   if (o.reaction.enabled) names.insert(names.end(), {"reaction_heat", "max_reaction_progress"});
+  if (o.interface_temperature.enabled) names.emplace_back("max_interface_temperature");
   out.declare_table("hotspots", hotspot_columns(Dim));
   if (spec_.continuation_duration > 0.0)
     out.declare_table("hotspot_fates", std::vector<std::string>(std::begin(kFateColumns), std::end(kFateColumns)));
@@ -77,6 +78,10 @@ void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
   if (o.reaction.enabled) {
     const std::vector<double>& lam = coupler_.reaction_progress();
     row.insert(row.end(), {b.reaction_heat_released, lam.empty() ? 0.0 : *std::max_element(lam.begin(), lam.end())});
+  }
+  if (o.interface_temperature.enabled) {  // NaN until some node has received frictional heat
+    const double t_int = coupler_.interface_temperature().max_temperature();
+    row.push_back(std::isfinite(t_int) ? t_int : std::numeric_limits<double>::quiet_NaN());
   }
   if (windows == hotspot_windows_written_) return;
   hotspot_windows_written_ = windows;
@@ -152,6 +157,9 @@ void ThermalRun<Dim>::write_fields(H5Output& out) const {
   const std::vector<double>& lam = coupler_.reaction_progress();
   if (coupler_.options().reaction.enabled && !lam.empty())
     out.snapshot_field("reaction_progress", lam.data(), lam.size(), 1);
+  const std::vector<double>& t_int = coupler_.interface_temperature().particle_temperature();
+  if (coupler_.options().interface_temperature.enabled && !t_int.empty())
+    out.snapshot_field("interface_temperature", t_int.data(), t_int.size(), 1);
 }
 
 template <int Dim>

@@ -83,6 +83,8 @@ std::string thermal_refusal(const Scene& s) {
   if (!c.fixed_faces.empty())
     return refuse("thermal.fixed_temperature", std::to_string(c.fixed_faces.size()) + " face(s)", "adiabatic faces");
   if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
+  if (c.interface_temperature.enabled)
+    return refuse("coupling.interface_temperature", "on", "off (the sub-cell interface temperature is serial)");
   // Every window policy runs (every_step, every_n_steps, adaptive: DecomposedHeat::after_step). Matrix-free
   // windows gather every window: the serial reuse of the last gather is not decomposed. The default
   // reuse distance is a speed-up of the serial run, so a scene that does not set it runs (gathering

@@ -178,9 +178,31 @@ void parse_window(const JsonReader& c, WindowPolicy& w) {
   if (win->is_object()) win->finish();
 }
 
-void parse_hotspots(const JsonReader& c, HotSpotOptions& h, HotSpotFateOptions& f) {
+// coupling.interface_temperature: true/false, or {"enabled": bool, "bins_per_level": n}.
+void parse_interface_temperature(const JsonReader& c, InterfaceTemperatureOptions& o) {
+  const auto it = c.find("interface_temperature");
+  if (!it) return;
+  if (!it->is_object()) {
+    o.enabled = it->as_bool();
+    return;
+  }
+  o.enabled = !it->find("enabled") || it->at("enabled").as_bool();
+  o.bins_per_level = static_cast<int>(it->integer("bins_per_level", o.bins_per_level, 2, 64));
+  it->finish();
+}
+
+void parse_hotspots(const JsonReader& c, HotSpotOptions& h, HotSpotFateOptions& f, CouplerOptions& coupler) {
   const auto hs = c.find("hotspots");
   if (!hs) return;
+  // "interface": judged by the sub-cell interface temperature, which this turns on.
+  if (hs->choice("temperature", {"grid", "interface"}, "grid") == "interface") {
+    coupler.hotspots_by_interface_temperature = true;
+    if (!coupler.interface_temperature.enabled) {
+      if (const auto it = c.find("interface_temperature"))
+        it->fail("is off, but \"hotspots\": {\"temperature\": \"interface\"} needs it");
+      coupler.interface_temperature.enabled = true;
+    }
+  }
   h.mode = hs->choice("mode", {"rise", "absolute"}, "rise") == "absolute" ? HotSpotOptions::Mode::absolute
                                                                            : HotSpotOptions::Mode::rise;
   h.threshold = hs->number("threshold", h.threshold,
@@ -244,7 +266,8 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
       c->number("subgrid_relaxation_time", spec.coupler.subgrid_relaxation_time, Range::positive());
   spec.reuse_distance_given = static_cast<bool>(c->find("reuse_distance"));
   spec.coupler.reuse_distance = c->number("reuse_distance", spec.coupler.reuse_distance, Range::closed(0.0, 0.5));
-  parse_hotspots(*c, spec.coupler.hotspots, spec.coupler.fates);
+  parse_interface_temperature(*c, spec.coupler.interface_temperature);
+  parse_hotspots(*c, spec.coupler.hotspots, spec.coupler.fates, spec.coupler);
   c->finish();
   return spec;
 }

@@ -26,6 +26,7 @@
 #include <frictherm/coupling/heat_sources.hpp>
 #include <frictherm/coupling/hotspot_fates.hpp>
 #include <frictherm/coupling/hotspots.hpp>
+#include <frictherm/coupling/interface_temperature.hpp>
 #include <frictherm/coupling/state_visit.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/thermal/integrator.hpp>
@@ -94,6 +95,10 @@ struct CouplerOptions {
   PlasticHeatingOptions plastic;  // plastic work as a heat source (off by default)
   ReactionOptions reaction;       // Arrhenius reaction heat (off by default)
   HotSpotFateOptions fates;       // runaway criteria of the continuation
+  /// Sub-cell interface temperature of rubbing contacts (interface_temperature.hpp; off by default).
+  InterfaceTemperatureOptions interface_temperature;
+  /// Hot spots judged by the interface temperature instead of T_p (needs interface_temperature).
+  bool hotspots_by_interface_temperature = false;
 };
 
 /// Where the heat went (J). Without fixed faces nodal_energy_change equals heat_delivered up to the
@@ -162,6 +167,8 @@ class Coupler {
   thermal::IntegratorStats integrator_stats() const;
   const HotSpotTracker& hotspots() const { return tracker_; }
   const HotSpotFates& fates() const { return fates_; }
+  /// The sub-cell interface temperatures (enabled() false unless options().interface_temperature asks).
+  const InterfaceTemperature<Dim>& interface_temperature() const { return interface_; }
   /// Reaction progress λ_p of every particle (0 for non-reacting ones); empty without a reaction.
   const std::vector<double>& reaction_progress() const { return particle_progress_; }
   /// q Σ_p m_p λ_p over reacting particles (J): the reaction heat the particles carry.
@@ -205,6 +212,9 @@ class Coupler {
   PlasticHeatSource<Dim> plastic_;
   HotSpotTracker tracker_;
   HotSpotFates fates_;
+  InterfaceTemperature<Dim> interface_;
+  /// The interface model's update after a window or interval ending at `time`, then the hot spots.
+  void update_interface_and_hotspots(mechanics::Particles<Dim>& particles, double time);
   std::vector<double> particle_progress_;       // λ_p (reaction only)
   std::vector<double> particle_progress_ref_;   // λ_p at the last assembly
   Eigen::VectorXd nodal_progress_;              // λ_i on the unknowns, current
@@ -238,6 +248,7 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
   if (continuing_) throw std::logic_error("Coupler: checkpoints are taken during loading, not in the continuation");
   pending_.visit_state(v);
   v("pending_plastic", pending_plastic_);
+  if (interface_.enabled()) interface_.visit_state(v);
   if (opt_.plastic.enabled) plastic_.visit_state(v);
   tracker_.visit_state(v);
   std::vector<double> progress = particle_progress_;  // empty without a reaction
@@ -296,6 +307,8 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
     system_.mass = std::move(mass);
     min_unknown_mass_ = system_.mass.size() > 0 ? system_.mass.minCoeff() : 0.0;
     nearest_mass_.clear();
+    if (interface_.enabled())
+      interface_.update(particles, shape_, step_stencils(), system_, nodal_temperature_, window_start_);
     if (tracker_.options_changed()) tracker_.redetect(particles, opt_.materials, window_start_);
   } else {
     (void)particles;

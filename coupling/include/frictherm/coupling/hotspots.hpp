@@ -65,7 +65,10 @@ class HotSpotTracker {
   /// (candidates() then update_from()).
   template <int Dim>
   void update(const mechanics::Particles<Dim>& particles, const std::vector<ThermalProperties>& materials,
-              double time);
+              double time, const std::vector<double>* criterion = nullptr);
+  /// `criterion`, when given, is the temperature each particle is judged (and its peak reported) by
+  /// instead of T_p: the sub-cell interface temperature (interface_temperature.hpp); the excess
+  /// energy stays Σ m C_v (T_p − T0_p), the heat the particles hold.
   /// The hot particles of the current state, with `index` = ids[k] when ids are given (else k), and
   /// the highest temperature of the conducting particles (−∞ without any). T0_p from `reference`
   /// when given (a decomposed run carries it with the particles), else set_reference's.
@@ -73,7 +76,8 @@ class HotSpotTracker {
   std::vector<HotCandidate> candidates(const mechanics::Particles<Dim>& particles,
                                        const std::vector<ThermalProperties>& materials, double& max_temperature,
                                        const std::vector<std::int64_t>* ids = nullptr,
-                                       const std::vector<double>* reference = nullptr) const;
+                                       const std::vector<double>* reference = nullptr,
+                                       const std::vector<double>* criterion = nullptr) const;
   /// Clusters and matches candidates gathered from anywhere (every rank of a decomposed run: the same
   /// list in the same order on every rank gives the same hot spots and ids everywhere). Particle
   /// indices are below `particle_count`.

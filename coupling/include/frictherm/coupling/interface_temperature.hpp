@@ -1,0 +1,122 @@
+#pragma once
+// The sub-cell interface temperature of rubbing contacts (design §7, issue 31; the model and its
+// history: thermal/interface_heating.hpp).
+//
+// Every mechanics step, each grid node that receives frictional heat W_i adds W_i / A_i to its flux
+// history (A_i = h^{Dim−1}, times the thickness in 2D: the contact area eq. 11 gives a node along an
+// interface). After each coupling window the node's interface temperature is
+//
+//     T_int,i = T_i + Σ_bins (flux history ⊛ R_x),     R_x = two half-spaces − what the lumped grid resolves,
+//
+// with the two half-spaces the node's two heaviest materials (one material: the same on both sides),
+// T_i the node's grid temperature at the end of the window. A particle's interface temperature is
+// T_p plus the largest correction among the nodes its shape functions reach (the hottest interface it
+// touches). The correction reconstructs the surface value of heat the grid already holds: it adds no
+// energy and takes none (the energy books are those of the grid).
+#include <frictherm/coupling/state_visit.hpp>
+#include <frictherm/coupling/thermal_assembly.hpp>
+#include <frictherm/thermal/interface_heating.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace frictherm::coupling {
+
+struct InterfaceTemperatureOptions {
+  bool enabled = false;
+  /// Bins of each width in the flux history (interface_heating.hpp): the convolution's error falls
+  /// as 1/bins_per_level², its cost grows as bins_per_level.
+  int bins_per_level = 8;
+};
+
+template <int Dim>
+class InterfaceTemperature {
+ public:
+  /// Per-material conductivity and volumetric heat capacity from the particles (ρ = Σ m / Σ V).
+  void start(const mechanics::Grid<Dim>& grid, double thickness, const mechanics::Particles<Dim>& particles,
+             const std::vector<ThermalProperties>& materials, const InterfaceTemperatureOptions& options,
+             double time);
+  bool enabled() const { return enabled_; }
+  /// One mechanics step's frictional heat (J by grid node), ending at `time`.
+  void add_step(const std::vector<double>& nodal_work, double time);
+  /// After a window or continuation interval ending at the last add_step (or later, `time`):
+  /// interface temperatures of the heated nodes and of the particles.
+  void update(const mechanics::Particles<Dim>& particles, mechanics::ShapeKind shape,
+              const mechanics::StencilView<Dim>& stencils, const NodalThermalSystem& system,
+              const Eigen::VectorXd& nodal_temperature, double time);
+
+  /// T_int,p of every particle (T_p where no heated node reaches it); empty before the first update.
+  const std::vector<double>& particle_temperature() const { return particle_temperature_; }
+  /// The heated nodes (grid indices), their corrections and interface temperatures at the last update.
+  const std::vector<int>& nodes() const { return nodes_; }
+  const std::vector<double>& node_correction() const { return node_correction_; }
+  const std::vector<double>& node_temperature() const { return node_temperature_; }
+  /// The hottest interface node's temperature at the last update (−∞ before any heat).
+  double max_temperature() const { return max_temperature_; }
+  /// Σ over nodes of the heat per area times the area handed to the history (J): equals the
+  /// frictional heat received (the books check it).
+  double heat_recorded() const { return heat_recorded_; }
+
+  template <class V> void visit_state(V&& v);
+
+ private:
+  std::optional<mechanics::Grid<Dim>> grid_;
+  std::vector<thermal::HalfSpace> sides_;  // per material: k and ρ c (k = 0 for non-conducting)
+  std::vector<double> heat_capacity_;      // per material: c (J/(kg K)), 0 for non-conducting
+  /// R_x tables by (material a ≤ b, f in per cent), built on first use.
+  std::map<std::array<int, 3>, thermal::SubcellCorrection> corrections_;
+  const thermal::SubcellCorrection& correction(const std::array<int, 3>& key);
+  double h_ = 0.0, area_ = 0.0;
+  bool enabled_ = false;
+  thermal::BinnedHeatHistory history_{8};
+  std::vector<int> slot_of_node_;  // grid node → slot, −1 for never heated
+  std::vector<int> nodes_;         // slot → grid node
+  std::vector<double> node_correction_, node_temperature_, particle_temperature_;
+  std::vector<double> slot_material_mass_;  // slots × materials, scratch of update
+  double max_temperature_ = -std::numeric_limits<double>::infinity();
+  double heat_recorded_ = 0.0;
+};
+
+template <int Dim>
+template <class V>
+void InterfaceTemperature<Dim>::visit_state(V&& v) {
+  constexpr bool reading = std::decay_t<V>::reading;
+  thermal::BinnedHeatHistory::Flat f;
+  if constexpr (!reading) f = history_.flatten();
+  v("interface/boundaries", f.boundaries);
+  v("interface/levels", f.levels);
+  v("interface/energy", f.energy);
+  v("interface/open", f.open);
+  v("interface/nodes", nodes_);
+  v("interface/heat_recorded", heat_recorded_);
+  if constexpr (reading) {
+    if (f.boundaries.empty()) return;  // a checkpoint written without the model: it starts now
+    history_.restore(f);
+    if (nodes_.size() != history_.slot_count())
+      throw std::invalid_argument("checkpoint: interface/nodes has " + std::to_string(nodes_.size()) +
+                                  " entries for " + std::to_string(history_.slot_count()) + " history slots");
+    std::fill(slot_of_node_.begin(), slot_of_node_.end(), -1);
+    for (std::size_t s = 0; s < nodes_.size(); ++s) {
+      const int node = nodes_[s];
+      if (node < 0 || static_cast<std::size_t>(node) >= slot_of_node_.size())
+        throw std::invalid_argument("checkpoint: interface/nodes names grid node " + std::to_string(node) +
+                                    " outside the grid");
+      slot_of_node_[static_cast<std::size_t>(node)] = static_cast<int>(s);
+    }
+  }
+}
+
+extern template class InterfaceTemperature<2>;
+extern template class InterfaceTemperature<3>;
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,178 @@
+// The sub-cell interface temperature of rubbing contacts (interface_temperature.hpp).
+#include <frictherm/coupling/interface_temperature.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <array>
+#include <map>
+
+namespace frictherm::coupling {
+
+template <int Dim>
+void InterfaceTemperature<Dim>::start(const mechanics::Grid<Dim>& grid, double thickness,
+                                      const mechanics::Particles<Dim>& p,
+                                      const std::vector<ThermalProperties>& materials,
+                                      const InterfaceTemperatureOptions& options, double time) {
+  enabled_ = options.enabled;
+  if (!enabled_) return;
+  grid_.emplace(grid);
+  if (options.bins_per_level < 2)
+    throw std::invalid_argument("interface temperature: bins_per_level must be at least 2");
+  history_ = thermal::BinnedHeatHistory(static_cast<std::size_t>(options.bins_per_level));
+  history_.reset(time);
+  h_ = grid.min_cell_size();
+  area_ = grid.cell_volume() / h_ * (Dim == 2 ? thickness : 1.0);  // h^{Dim−1} (× t in 2D)
+  // Density per material from its particles now (ρ = Σ m / Σ V).
+  std::vector<double> mass(materials.size(), 0.0), volume(materials.size(), 0.0);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const auto m = static_cast<std::size_t>(p.material[k]);
+    if (m < materials.size()) mass[m] += p.mass[k], volume[m] += p.volume[k];
+  }
+  sides_.assign(materials.size(), thermal::HalfSpace{});
+  heat_capacity_.assign(materials.size(), 0.0);
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    if (!materials[m].conducts || !(volume[m] > 0.0)) continue;
+    sides_[m].conductivity = materials[m].conductivity;
+    sides_[m].volumetric_heat_capacity = mass[m] / volume[m] * materials[m].heat_capacity;
+    heat_capacity_[m] = materials[m].heat_capacity;
+  }
+  corrections_.clear();
+  slot_of_node_.assign(grid.node_count(), -1);
+  nodes_.clear();
+  node_correction_.clear(), node_temperature_.clear();
+  particle_temperature_.assign(p.temperature.begin(), p.temperature.end());  // no heat yet: T_p
+  max_temperature_ = -std::numeric_limits<double>::infinity();
+  heat_recorded_ = 0.0;
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::add_step(const std::vector<double>& nodal_work, double time) {
+  if (!enabled_) return;
+  for (std::size_t i = 0; i < nodal_work.size(); ++i) {
+    const double w = nodal_work[i];
+    if (!(w > 0.0)) continue;  // heat only (the books guard against non-finite work upstream)
+    int& slot = slot_of_node_[i];
+    if (slot < 0) {
+      slot = static_cast<int>(history_.add_slot());
+      nodes_.push_back(static_cast<int>(i));
+    }
+    history_.add(static_cast<std::size_t>(slot), w / area_);
+    heat_recorded_ += w;
+  }
+  if (time > history_.boundaries().back()) history_.close(time);
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mechanics::ShapeKind shape,
+                                       const mechanics::StencilView<Dim>& stencils, const NodalThermalSystem& system,
+                                       const Eigen::VectorXd& nodal_temperature, double time) {
+  if (!enabled_) return;
+  const std::size_t slots = nodes_.size(), nm = sides_.size();
+  particle_temperature_.assign(p.temperature.begin(), p.temperature.end());
+  node_correction_.assign(slots, 0.0);
+  node_temperature_.assign(slots, 0.0);
+  max_temperature_ = -std::numeric_limits<double>::infinity();
+  if (slots == 0) return;
+
+  const mechanics::Grid<Dim>& grid = *grid_;
+  auto for_each_particle_node = [&](auto&& f) {
+    mechanics::dispatch_shape(shape, [&](auto kernel) {
+      using Kernel = decltype(kernel);
+      const mechanics::Stencil<Dim, Kernel>* step = stencils.template as<Kernel>(p.size());
+      mechanics::Stencil<Dim, Kernel> own;
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        const auto m = static_cast<std::size_t>(p.material[k]);
+        if (m >= nm || !(sides_[m].volumetric_heat_capacity > 0.0) || !(sides_[m].conductivity > 0.0)) continue;
+        if (!step) own.evaluate(grid, p.position[k], p.half_size[k]);
+        const mechanics::Stencil<Dim, Kernel>& st = step ? step[k] : own;
+        st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>&) {
+          const int s = slot_of_node_[static_cast<std::size_t>(i)];
+          if (s >= 0 && w > 0.0) f(k, m, static_cast<std::size_t>(s), w);
+        });
+      }
+    });
+  };
+
+  // Pass 1: each heated node's two heaviest conducting materials (Σ_p S_ip m_p per material) and its
+  // projection factor f = (Σ S² m c / Σ S m c)^{1/Dim} (per axis; exact for a regular lattice).
+  slot_material_mass_.assign(slots * (nm + 2), 0.0);
+  const std::size_t stride = nm + 2;
+  for_each_particle_node([&](std::size_t k, std::size_t m, std::size_t s, double w) {
+    double* row = &slot_material_mass_[s * stride];
+    const double mc = p.mass[k] * heat_capacity_[m];
+    row[m] += w * p.mass[k];
+    row[nm] += w * mc;
+    row[nm + 1] += w * w * mc;
+  });
+  std::vector<int> group_of_slot(slots, -1);
+  std::vector<const thermal::SubcellCorrection*> groups;
+  std::map<std::array<int, 3>, int> group_index;
+  for (std::size_t s = 0; s < slots; ++s) {
+    const double* row = &slot_material_mass_[s * stride];
+    int first = -1, second = -1;
+    for (std::size_t m = 0; m < nm; ++m) {
+      const double x = row[m];
+      if (!(x > 0.0)) continue;
+      if (first < 0 || x > row[first]) {
+        second = first, first = static_cast<int>(m);
+      } else if (second < 0 || x > row[second]) {
+        second = static_cast<int>(m);
+      }
+    }
+    if (first < 0) continue;  // no conducting material reaches the node now: no interface there
+    if (second < 0) second = first;
+    const double f = std::pow(row[nm + 1] / row[nm], 1.0 / Dim);
+    const int f_percent = std::clamp(static_cast<int>(std::lround(100.0 * f)), 5, 100);
+    const std::array<int, 3> key{std::min(first, second), std::max(first, second), f_percent};
+    auto [it, fresh] = group_index.emplace(key, static_cast<int>(groups.size()));
+    if (fresh) groups.push_back(&correction(key));
+    group_of_slot[s] = it->second;
+  }
+
+  // The correction R_x ⊛ flux per slot: R_x at every bin boundary, once per material pair.
+  const auto& boundaries = history_.boundaries();
+  std::vector<std::vector<double>> responses(groups.size() + 1);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    responses[g].resize(boundaries.size());
+    for (std::size_t j = 0; j < boundaries.size(); ++j) responses[g][j] = groups[g]->step_response(time - boundaries[j]);
+  }
+  responses.back().assign(boundaries.size(), 0.0);  // slots without a pair now: no correction
+  for (auto& g : group_of_slot)
+    if (g < 0) g = static_cast<int>(groups.size());
+  history_.convolve(responses, group_of_slot, node_correction_);
+
+  for (std::size_t s = 0; s < slots; ++s) {
+    const auto node = static_cast<std::size_t>(nodes_[s]);
+    const int u = node < system.unknown.size() ? system.unknown[node] : -1;
+    if (u < 0 || group_of_slot[s] == static_cast<int>(groups.size())) {
+      node_temperature_[s] = std::numeric_limits<double>::quiet_NaN();  // not a thermal node now
+      continue;
+    }
+    node_temperature_[s] = nodal_temperature[u] + node_correction_[s];
+    max_temperature_ = std::max(max_temperature_, node_temperature_[s]);
+  }
+
+  // Pass 2: each particle's hottest touched interface, T_p + max correction.
+  std::vector<double> best(p.size(), 0.0);
+  for_each_particle_node([&](std::size_t k, std::size_t, std::size_t s, double) {
+    best[k] = std::max(best[k], node_correction_[s]);
+  });
+  for (std::size_t k = 0; k < p.size(); ++k) particle_temperature_[k] += best[k];
+}
+
+template <int Dim>
+const thermal::SubcellCorrection& InterfaceTemperature<Dim>::correction(const std::array<int, 3>& key) {
+  auto it = corrections_.find(key);
+  if (it == corrections_.end()) {
+    const thermal::HalfSpace& a = sides_[static_cast<std::size_t>(key[0])];
+    const thermal::HalfSpace& b = sides_[static_cast<std::size_t>(key[1])];
+    it = corrections_.emplace(key, thermal::SubcellCorrection(a, b, h_, 0.01 * key[2])).first;
+  }
+  return it->second;
+}
+
+template class InterfaceTemperature<2>;
+template class InterfaceTemperature<3>;
+
+}  // namespace frictherm::coupling
