@@ -348,7 +348,7 @@ TEST_F(CliMpirun, ThreeDimensionalHeatedBlockWithCvodeEqualsTheSerialRun) {
 }
 
 // The PBX specimen of Nairn et al. 2018 (examples/pbx_compaction.json) with the overrides that make it
-// decomposable (no reaction, no continuation; its FLIP/PIC blend, its sub-grid relaxation, its cvode_bdf
+// decomposable (no reaction, no continuation, no sub-cell interface temperature; its FLIP/PIC blend, its sub-grid relaxation, its cvode_bdf
 // with PCG at rtol 1e-8 and its adaptive windows run as they are), for 0.2 us of compaction (about 360 steps
 // at the Mie-Grüneisen CFL step: the piston has moved 0.6 nm, the grains touch the walls and each other,
 // no chaos yet): the time steps (each particle's current wave speed counts, as in the serial run),
@@ -358,7 +358,7 @@ TEST_F(CliMpirun, ThreeDimensionalHeatedBlockWithCvodeEqualsTheSerialRun) {
 // thermal steps); the books closed.
 TEST_F(CliMpirun, PbxCompactionEqualsTheSerialRun) {
   const std::string sets =
-      " --set thermal.reaction=null --set coupling.continuation=null"
+      " --set thermal.reaction=null --set coupling.continuation=null --set coupling.interface_temperature=null"
       " --set run.end_time=2e-7 --set output.series_interval=null"
       " --set output.snapshot_count=1";
   const std::string pbx = std::string("'") + FRICTHERM_SOURCE_DIR + "/examples/pbx_compaction.json'" + sets;
