@@ -30,7 +30,7 @@ import sys
 
 from . import open as open_run
 from .study_analysis import study_levels
-from .study_runs import Output, cell_sets, find_program, last_line, read_scene, run_program, scene_cfl
+from .study_runs import Output, cell_sets, find_program, last_line, read_scene, run_program, scene_cfl, validate
 
 __all__ = ["run_study", "Study", "Output", "find_program", "main"]
 
@@ -108,10 +108,12 @@ class Study:
         b = along_cfl[h_min]["best"]
         if b is not None and b.extrapolated:
             return b.limit, "extrapolated in C at h = %g m" % h_min
-        f = self.value(label, h_min, c_min)
-        if math.isfinite(f):
-            return f, "the finest run (h = %g m, C = %g): no extrapolation possible" % (h_min, c_min)
-        return None, "none (the finest run has no value)"
+        have = [r for r in self.rows if math.isfinite(r["values"].get(label, math.nan))]
+        if have:
+            r = min(have, key=lambda r: (r["cell"], r["cfl"]))
+            return (r["values"][label], "the finest run (h = %g m, C = %g): no extrapolation possible"
+                    % (r["cell"], r["cfl"]))
+        return None, "none (no run has a value)"
 
     def write(self, directory, charts=True):
         """study.csv, study.md and the charts into `directory`; returns the list of files written."""
@@ -129,19 +131,35 @@ def _plan(scene_path, cells, cfls, sets, scale_with_cell):
     return plan
 
 
+def _command(program, scene_path, out, threads, run_sets):
+    cmd = [program, "run", os.path.abspath(scene_path), "-o", out, "--force", "--quiet", "--threads", str(threads)]
+    for s in run_sets:
+        cmd += ["--set", s]
+    return cmd
+
+
+def _record(out, record_path, cmd):
+    """The record of an earlier run of the same command whose output is still there, else None."""
+    if os.path.exists(out) and os.path.exists(record_path):
+        with open(record_path) as f:
+            old = json.load(f)
+        if old.get("command") == cmd:
+            return old
+    return None
+
+
+def _skipped_row(cell, cfl, outputs, runs_dir, note):
+    return dict(cell=cell, cfl=cfl, status="skipped", values={o.label: math.nan for o in outputs}, wall_s=math.nan,
+                cpu_s=math.nan, run_wall_s=math.nan, steps=0, particles=0,
+                file=os.path.join(runs_dir, _run_name(cell, cfl) + ".h5"), note=note, returncode=None)
+
+
 def _one_run(program, scene_path, cell, cfl, run_sets, threads, runs_dir, outputs, reuse):
     name = _run_name(cell, cfl)
     out = os.path.join(runs_dir, name + ".h5")
     record_path = os.path.join(runs_dir, name + ".json")
-    cmd = [program, "run", os.path.abspath(scene_path), "-o", out, "--force", "--quiet", "--threads", str(threads)]
-    for s in run_sets:
-        cmd += ["--set", s]
-    record = None
-    if reuse and os.path.exists(out) and os.path.exists(record_path):
-        with open(record_path) as f:
-            old = json.load(f)
-        if old.get("command") == cmd:
-            record = old
+    cmd = _command(program, scene_path, out, threads, run_sets)
+    record = _record(out, record_path, cmd) if reuse else None
     if record is None:
         rc, wall, cpu = run_program(cmd, os.path.join(runs_dir, name + ".log"))
         record = dict(command=cmd, returncode=rc, wall_s=wall, cpu_s=cpu,
@@ -171,7 +189,8 @@ def _one_run(program, scene_path, cell, cfl, run_sets, threads, runs_dir, output
 
 def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), reduce="final", sets=(),
               scale_with_cell=(), threads=1, jobs=1, program=None, workdir=None, reuse=True, reference=None,
-              assumed_order=None, tolerance=0.01, units=None, write=True, charts=True, log=print):
+              assumed_order=None, tolerance=0.01, units=None, max_cpu=None, plan_only=False, write=True, charts=True,
+              log=print):
     """Runs `scene` at every cell size of `cells` (m; default the scene's own) and CFL factor of
     `cfls` (default the scene's own) and returns a Study.
 
@@ -189,6 +208,10 @@ def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), r
     assumed_order  with only 2 levels in a direction, extrapolate with this order (marked as assumed)
     tolerance relative error to the reference for the recommended (cheapest sufficient) run
     units     {output label: unit} for the charts (else guessed: J for work, K for temperature)
+    max_cpu   skip a run whose CPU time, predicted from the finished ones (CPU s per particle-step
+              times its particles x steps from `frictherm validate`), exceeds this many seconds
+    plan_only check every combination with `frictherm validate` and return
+              {(cell, C): (particles, estimated steps)} without running anything
     log       a function for progress lines (None: quiet)
     """
     program = find_program(program)
@@ -214,15 +237,23 @@ def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), r
     plan = _plan(scene, cells, cfls, sets, scale_with_cell)
     workdir = workdir or os.path.join(os.getcwd(), os.path.splitext(os.path.basename(scene))[0] + "_study")
     runs_dir = os.path.join(workdir, "runs")
-    os.makedirs(runs_dir, exist_ok=True)
     if log:
         log("study of %s: %d runs (cells %s m, C %s), %d thread(s) each, %d at once, in %s"
             % (scene, len(plan), ", ".join("%g" % h for h in sorted(cells, reverse=True)),
                ", ".join("%g" % c for c in sorted(cfls, reverse=True)), threads, jobs, runs_dir))
     plan.sort(key=lambda p: (-p[0], -p[1]))  # cheapest first: a broken set-up shows at once
+    estimates = {(cell, cfl): validate(program, scene, run_sets) for cell, cfl, run_sets in plan}  # scene errors now
+    if log:
+        for cell, cfl, _ in plan:
+            n, steps = estimates[(cell, cfl)]
+            log("  plan: h = %-9g C = %-7g %9s particles x %9s steps" % (cell, cfl, n, steps))
+    if plan_only:
+        return estimates
+    os.makedirs(runs_dir, exist_ok=True)
     rows = []
 
     def done(row):
+        row["estimate"] = estimates[(row["cell"], row["cfl"])]
         rows.append(row)
         if log:
             vals = "  ".join("%s = %.6g" % (k, v) for k, v in row["values"].items())
@@ -230,15 +261,31 @@ def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), r
                 % (row["cell"], row["cfl"], row["status"], row["cpu_s"], row["wall_s"], row["steps"], vals,
                    ("  (" + row["note"] + ")") if row["note"] else ""))
 
-    if jobs <= 1:
+    def predicted_cpu(cell, cfl):
+        """CPU s of a run from the finished ones: CPU s per particle-step times its particles x steps."""
+        rates = sorted(r["cpu_s"] / (r["particles"] * r["steps"]) for r in rows
+                       if r["status"] == "completed" and r["particles"] and r["steps"])
+        n, steps = estimates[(cell, cfl)]
+        if not rates or not n or not steps:
+            return None
+        return rates[len(rates) // 2] * n * steps
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        pending = set()
         for cell, cfl, run_sets in plan:
-            done(_one_run(program, scene, cell, cfl, run_sets, threads, runs_dir, outs, reuse))
-    else:
-        with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = [pool.submit(_one_run, program, scene, cell, cfl, run_sets, threads, runs_dir, outs, reuse)
-                       for cell, cfl, run_sets in plan]
-            for fut in concurrent.futures.as_completed(futures):
-                done(fut.result())
+            while len(pending) >= max(1, jobs):
+                finished, pending = concurrent.futures.wait(pending, return_when=concurrent.futures.FIRST_COMPLETED)
+                for fut in finished:
+                    done(fut.result())
+            guess = predicted_cpu(cell, cfl) if max_cpu else None
+            out = os.path.join(runs_dir, _run_name(cell, cfl) + ".h5")
+            cmd = _command(program, scene, out, threads, run_sets)
+            if guess is not None and guess > max_cpu and not (reuse and _record(out, out[:-3] + ".json", cmd)):
+                done(_skipped_row(cell, cfl, outs, runs_dir, "predicted %.0f s CPU > max_cpu %g s" % (guess, max_cpu)))
+                continue
+            pending.add(pool.submit(_one_run, program, scene, cell, cfl, run_sets, threads, runs_dir, outs, reuse))
+        for fut in concurrent.futures.as_completed(pending):
+            done(fut.result())
     rows.sort(key=lambda r: (-r["cell"], -r["cfl"]))
     study = Study(scene, rows, outs, cells, cfls, sets=sets, reference=reference, assumed_order=assumed_order,
                   tolerance=tolerance, program=program)
@@ -281,6 +328,9 @@ def main(argv=None):
     ap.add_argument("-j", "--jobs", type=int, default=1, help="runs at once (default 1)")
     ap.add_argument("--frictherm", help="the frictherm program (default: $FRICTHERM, PATH, the build tree)")
     ap.add_argument("-o", "--out", help="directory for runs, table and charts (default SCENE_study)")
+    ap.add_argument("--max-cpu", type=float, metavar="S",
+                    help="skip runs predicted (from the finished ones) to take more than S CPU seconds")
+    ap.add_argument("--plan", action="store_true", help="validate every combination, print the plan, run nothing")
     ap.add_argument("--rerun", action="store_true", help="rerun even runs that are already there")
     ap.add_argument("--no-charts", action="store_true")
     ap.add_argument("-q", "--quiet", action="store_true")
@@ -307,15 +357,17 @@ def main(argv=None):
         study = run_study(a.scene, cells=a.cells, cfls=a.cfl, outputs=outputs, reduce=a.reduce, sets=a.set,
                           scale_with_cell=a.scale_with_cell, threads=a.threads, jobs=a.jobs, program=a.frictherm,
                           workdir=a.out, reuse=not a.rerun, reference=reference, assumed_order=a.assumed_order,
-                          tolerance=a.tolerance, units=units, charts=not a.no_charts,
-                          log=None if a.quiet else print)
+                          tolerance=a.tolerance, units=units, max_cpu=a.max_cpu, plan_only=a.plan,
+                          charts=not a.no_charts, log=None if a.quiet and not a.plan else print)
     except (ValueError, KeyError, FileNotFoundError, RuntimeError) as e:
         print("frictherm.study: %s" % (e.args[0] if e.args else e), file=sys.stderr)
         return 2
+    if a.plan:
+        return 0
     if not a.quiet:
         from .study_report import summary_lines
         print("\n".join(summary_lines(study)))
-    return 0 if all(r["status"] == "completed" for r in study.rows) else 1
+    return 0 if all(r["status"] in ("completed", "skipped") for r in study.rows) else 1
 
 
 if __name__ == "__main__":

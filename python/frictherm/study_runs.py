@@ -154,6 +154,28 @@ def scene_cfl(scene):
 # Running
 
 
+def validate(program, scene_path, sets):
+    """`frictherm validate SCENE --set ...`: checks one combination before anything runs and returns
+    its particle count and estimated step count (docs/scenes.md, "Cost limits"). A scene error is a
+    ValueError with the program's message, which names the key."""
+    cmd = [program, "validate", scene_path]
+    for s in sets:
+        cmd += ["--set", s]
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if p.returncode != 0:
+        msg = [ln for ln in p.stdout.splitlines() if ln.strip()]
+        raise ValueError("%s with %s: %s" % (os.path.basename(scene_path), " ".join("--set " + s for s in sets),
+                                             msg[-1] if msg else "frictherm validate failed (exit code %d)" % p.returncode))
+    particles = steps = None
+    for line in p.stdout.splitlines():
+        words = line.split()
+        if len(words) >= 2 and words[0] == "particles" and words[1].isdigit():
+            particles = int(words[1])
+        elif len(words) >= 3 and words[0] == "steps" and words[1] == "about" and words[2].isdigit():
+            steps = int(words[2])
+    return particles, steps
+
+
 def run_program(cmd, log_path, env=None):
     """Runs `cmd` with its output to `log_path`. Returns (exit code, wall s, CPU s): the CPU time of
     the child alone (user + system, from wait4), so runs made side by side are measured apart."""
