@@ -298,7 +298,7 @@ def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), r
     return study
 
 
-def _floats(text):
+def parse_floats(text):
     return [float(x) for x in text.replace(" ", "").split(",") if x]
 
 
@@ -309,8 +309,8 @@ def main(argv=None):
                     "observed order and the extrapolated value (study.md) and charts of an output against the "
                     "resolution and the cost. docs/study.md.")
     ap.add_argument("scene")
-    ap.add_argument("--cells", type=_floats, help="cell sizes in m, comma-separated (default: the scene's)")
-    ap.add_argument("--cfl", type=_floats, help="CFL factors C, comma-separated (default: the scene's)")
+    ap.add_argument("--cells", type=parse_floats, help="cell sizes in m, comma-separated (default: the scene's)")
+    ap.add_argument("--cfl", type=parse_floats, help="CFL factors C, comma-separated (default: the scene's)")
     ap.add_argument("--output", action="append", default=None,
                     help="a /series column, COLUMN:REDUCE (final, max, min, mean, at=T, since=T) or meta:KEY; "
                          "repeatable (default friction_work_second)")

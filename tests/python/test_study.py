@@ -29,7 +29,8 @@ def _exe():
 
 @pytest.fixture(scope="module")
 def study(workdir):
-    return run_study(SCENE, cells=CELLS, cfls=[0.5], outputs=OUTPUTS, program=_exe(),
+    # jobs=2: the two runs side by side, each one's CPU time measured apart (wait4)
+    return run_study(SCENE, cells=CELLS, cfls=[0.5], outputs=OUTPUTS, program=_exe(), jobs=2,
                      workdir=os.path.join(workdir, "study"), log=None)
 
 
