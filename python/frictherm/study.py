@@ -79,13 +79,15 @@ class Study:
                       for c in self.cfls}
         along_cfl = {h: study_levels(self.cfls, [self.value(label, h, c) for c in self.cfls], self.assumed_order)
                      for h in self.cells}
-        c_limits = [(h, a["best"].limit) for h, a in along_cfl.items() if a["best"] is not None and a["best"].extrapolated]
+        c_limits = [(h, a["best"].limit) for h, a in along_cfl.items()
+                    if a["best"] is not None and a["best"].extrapolated]
         limit_both = study_levels([h for h, _ in c_limits], [f for _, f in c_limits]) if len(c_limits) >= 3 else None
         ref, source = self._reference(label, along_cell, along_cfl, limit_both)
         errors = {}
         for r in self.rows:
             f = r["values"].get(label, math.nan)
-            errors[(r["cell"], r["cfl"])] = (f - ref) / abs(ref) if ref not in (None, 0) and math.isfinite(f) else math.nan
+            ok = ref not in (None, 0) and math.isfinite(f)
+            errors[(r["cell"], r["cfl"])] = (f - ref) / abs(ref) if ok else math.nan
         ok = [r for r in self.rows if r["status"] == "completed" and math.isfinite(errors[(r["cell"], r["cfl"])])
               and abs(errors[(r["cell"], r["cfl"])]) <= self.tolerance]
         rec = min(ok, key=lambda r: r["cpu_s"]) if ok else None

@@ -141,7 +141,8 @@ def study_levels(levels, values, assumed_order=None):
     Extrapolation per consecutive triple, which shows whether p settles: the asymptotic range),
     ``best`` (the finest triple's Extrapolation, or with 2 levels and `assumed_order` an
     extrapolation with that order, or None)."""
-    pairs = sorted(((h, f) for h, f in zip(levels, values) if f is not None and math.isfinite(f)), key=lambda hv: -hv[0])
+    pairs = sorted(((h, f) for h, f in zip(levels, values) if f is not None and math.isfinite(f)),
+                   key=lambda hv: -hv[0])
     hs = [h for h, _ in pairs]
     fs = [f for _, f in pairs]
     triples = [three_levels(hs[i:i + 3], fs[i:i + 3]) for i in range(len(hs) - 2)]

@@ -98,7 +98,8 @@ def summary_lines(study):
                     cells.append(row["status"])
                 else:
                     err = a["errors"][(h, c)]
-                    cells.append("%.6g (%s %%, %.3g s)" % (row["values"][o.label], _g(100 * err, "%+.2f"), row["cpu_s"]))
+                    cells.append("%.6g (%s %%, %.3g s)"
+                                 % (row["values"][o.label], _g(100 * err, "%+.2f"), row["cpu_s"]))
             out.append("| %g | " % (h * k) + " | ".join(cells) + " |")
         ref, source = a["reference"]
         out += ["", "Each entry: value (relative error to the reference, CPU seconds of the run). Reference: "
@@ -190,7 +191,7 @@ def write_charts(study, directory):
                     la = a["along_cfl"][h]
                     col = colors[i % len(colors)]
                     ax.plot(la["levels"], la["values"], MARKERS[j % len(MARKERS)] + "-", color=col,
-                            label=("%s, h = %g %s" % (o.label, h * k, lu)) if len(group) > 1 else "h = %g %s" % (h * k, lu))
+                            label=("%s, " % o.label if len(group) > 1 else "") + "h = %g %s" % (h * k, lu))
                     b = la["best"]
                     if b is not None and b.extrapolated:
                         ax.axhline(b.limit, color=col, ls="--", lw=0.8)
@@ -209,8 +210,8 @@ def write_charts(study, directory):
         for j, o in enumerate(group):
             a = study.analysis(o.label)
             for i, c in enumerate(study.cfls):
-                pts = [(r["cpu_s"], abs(a["errors"][(r["cell"], c)]), r["cell"]) for r in study.rows
-                       if r["cfl"] == c and math.isfinite(a["errors"][(r["cell"], c)]) and a["errors"][(r["cell"], c)] != 0]
+                errs = [(r, a["errors"][(r["cell"], c)]) for r in study.rows if r["cfl"] == c]
+                pts = [(r["cpu_s"], abs(e), r["cell"]) for r, e in errs if math.isfinite(e) and e != 0]
                 if not pts:
                     continue
                 pts.sort()

@@ -164,8 +164,8 @@ def validate(program, scene_path, sets):
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     if p.returncode != 0:
         msg = [ln for ln in p.stdout.splitlines() if ln.strip()]
-        raise ValueError("%s with %s: %s" % (os.path.basename(scene_path), " ".join("--set " + s for s in sets),
-                                             msg[-1] if msg else "frictherm validate failed (exit code %d)" % p.returncode))
+        why = msg[-1] if msg else "frictherm validate failed (exit code %d)" % p.returncode
+        raise ValueError("%s with %s: %s" % (os.path.basename(scene_path), " ".join("--set " + s for s in sets), why))
     particles = steps = None
     for line in p.stdout.splitlines():
         words = line.split()
@@ -229,7 +229,8 @@ class Output:
             column, _, red = spec.partition(":")
             self.kind, self.column, self.reduce = "series", column, red or reduce
             name = self.reduce.split("=")[0]
-            if name not in ("final", "max", "min", "mean", "at", "since") or (name in ("at", "since")) != ("=" in self.reduce):
+            timed = name in ("at", "since")
+            if name not in ("final", "max", "min", "mean", "at", "since") or timed != ("=" in self.reduce):
                 raise ValueError("%s: unknown reduction '%s' (one of %s)" % (spec, self.reduce, ", ".join(REDUCTIONS)))
             if "=" in self.reduce:
                 self.time = float(self.reduce.split("=", 1)[1])
@@ -258,7 +259,9 @@ class Output:
             return float(np.min(y))
         if name == "mean":  # time average (trapezoid rule over the series rows)
             t = np.asarray(s["time"], dtype=float)
-            return float(np.trapz(y, t) / (t[-1] - t[0])) if t[-1] > t[0] else float(y[-1])
+            if t[-1] <= t[0]:
+                return float(y[-1])
+            return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(t)) / (t[-1] - t[0]))
         t = np.asarray(s["time"], dtype=float)
         if not t[0] <= self.time <= t[-1]:
             raise ValueError("%s: time %g s is outside the series (%g to %g s)" % (self.spec, self.time, t[0], t[-1]))

@@ -1,7 +1,6 @@
 """frictherm.study on a real (small) study, and its scene handling and output reductions."""
 import csv
 import json
-import math
 import os
 import subprocess
 
