@@ -98,18 +98,20 @@ class Study:
 
     def _reference(self, label, along_cell, along_cfl, limit_both):
         """The value errors are measured against, best first: the one given; the limit in both h and C;
-        the limit in h at the smallest C; the limit in C at the smallest h; the finest, smallest-C run."""
+        the limit in h at the smallest C that has one; the limit in C at the smallest h that has one;
+        the finest, smallest-C run."""
         if label in self.reference:
             return float(self.reference[label]), "given"
         if limit_both and limit_both["best"] is not None and limit_both["best"].extrapolated:
             return limit_both["best"].limit, "extrapolated in C at each cell, then in the cell size"
-        c_min, h_min = self.cfls[-1], self.cells[-1]
-        b = along_cell[c_min]["best"]
-        if b is not None and b.extrapolated:
-            return b.limit, "extrapolated in the cell size at C = %g" % c_min
-        b = along_cfl[h_min]["best"]
-        if b is not None and b.extrapolated:
-            return b.limit, "extrapolated in C at h = %g m" % h_min
+        for c in sorted(along_cell):
+            b = along_cell[c]["best"]
+            if b is not None and b.extrapolated:
+                return b.limit, "extrapolated in the cell size at C = %g" % c
+        for h in sorted(along_cfl):
+            b = along_cfl[h]["best"]
+            if b is not None and b.extrapolated:
+                return b.limit, "extrapolated in C at h = %g m" % h
         have = [r for r in self.rows if math.isfinite(r["values"].get(label, math.nan))]
         if have:
             r = min(have, key=lambda r: (r["cell"], r["cfl"]))

@@ -48,14 +48,16 @@ class Extrapolation:
             return ("monotone over %s: order p = %.3g, extrapolated %s, GCI %.3g %%"
                     % (lv, self.order, fmt % self.limit, 100.0 * self.gci))
         if self.status == CONVERGED:
-            return "identical over %s (to round-off): %s" % (lv, fmt % self.limit)
+            return "converged over %s (the finest values agree to round-off): %s" % (lv, fmt % self.limit)
+        f1, f2, f3 = self.values
+        spread = max(self.values) - min(self.values)
+        rel = " (%.2g %% of the finest)" % (100.0 * spread / abs(f3)) if f3 else ""
         if self.status == OSCILLATORY:
-            return ("oscillatory over %s (differences %s then %s): no order, no extrapolation; values span %s"
-                    % (lv, fmt % (self.values[1] - self.values[0]), fmt % (self.values[2] - self.values[1]),
-                       fmt % (max(self.values) - min(self.values))))
+            return ("oscillatory over %s (differences %s then %s): no order, no extrapolation; values span %s%s"
+                    % (lv, fmt % (f2 - f1), fmt % (f3 - f2), fmt % spread, rel))
         if self.status == DIVERGING:
-            return ("not converging over %s (differences %s then %s): no extrapolation"
-                    % (lv, fmt % (self.values[1] - self.values[0]), fmt % (self.values[2] - self.values[1])))
+            return ("not converging over %s (differences %s then %s): no extrapolation; values span %s%s"
+                    % (lv, fmt % (f2 - f1), fmt % (f3 - f2), fmt % spread, rel))
         return "%s (%s)" % (self.status, lv)
 
     def as_dict(self):

@@ -99,7 +99,7 @@ def summary_lines(study):
                 else:
                     err = a["errors"][(h, c)]
                     cells.append("%.6g (%s %%, %.3g s)"
-                                 % (row["values"][o.label], _g(100 * err, "%+.2f"), row["cpu_s"]))
+                                 % (row["values"][o.label], _g(100 * err, "%+.2g"), row["cpu_s"]))
             out.append("| %g | " % (h * k) + " | ".join(cells) + " |")
         ref, source = a["reference"]
         out += ["", "Each entry: value (relative error to the reference, CPU seconds of the run). Reference: "
@@ -144,6 +144,15 @@ def _groups(outputs):
 MARKERS = "osD^v<>pP*X"
 
 
+def _level_ticks(ax, levels):
+    """A log axis with a tick at each level of the study, labelled plainly (5, 2.5, 1.25)."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+    ax.set_xscale("log")
+    ax.xaxis.set_major_locator(FixedLocator(sorted(levels)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: "%g" % x))
+    ax.xaxis.set_minor_locator(NullLocator())
+
+
 def write_charts(study, directory):
     """Per group of outputs with one unit: value against the cell size (one line per C, dashed: the
     extrapolated limit), value against C (one line per cell size), and the work-precision chart:
@@ -173,7 +182,7 @@ def write_charts(study, directory):
                     b = la["best"]
                     if b is not None and b.extrapolated and b.status in (MONOTONE, CONVERGED, "assumed order"):
                         ax.axhline(b.limit, color=col, ls="--", lw=0.8)
-            ax.set_xscale("log")
+            _level_ticks(ax, [h * k for h in study.cells])
             ax.set_xlabel("cell size h (%s)" % lu)
             ax.set_ylabel(_axis_label(group))
             ax.set_title("against the cell size (dashed: extrapolated h → 0)", fontsize=9)
@@ -195,7 +204,7 @@ def write_charts(study, directory):
                     b = la["best"]
                     if b is not None and b.extrapolated:
                         ax.axhline(b.limit, color=col, ls="--", lw=0.8)
-            ax.set_xscale("log")
+            _level_ticks(ax, study.cfls)
             ax.set_xlabel("CFL factor C (time step = C h / wave speed)")
             ax.set_ylabel(_axis_label(group))
             ax.set_title("against C (dashed: extrapolated C → 0)", fontsize=9)
@@ -218,7 +227,7 @@ def write_charts(study, directory):
                 ax.plot([p[0] for p in pts], [100 * p[1] for p in pts], MARKERS[j % len(MARKERS)] + "-",
                         color=colors[i % len(colors)],
                         label="%s, C = %g" % (o.label, c) if len(group) > 1 else "C = %g" % c)
-                for x, y, h in pts:
+                for x, y, h in pts if j == 0 else []:  # the first output's points carry the labels
                     ax.annotate("%g" % (h * k), (x, 100 * y), fontsize=6, xytext=(3, 3), textcoords="offset points")
                 drawn = True
         if drawn:
