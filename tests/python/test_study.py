@@ -146,3 +146,13 @@ def test_output_reductions():
         Output("ww").value(run)
     with pytest.raises(ValueError, match="outside the series"):
         Output("w:at=5").value(run)
+
+
+def test_command_line_plan_and_refusal(workdir, capsys):
+    from frictherm.study import main
+    d = os.path.join(workdir, "cli_study")
+    assert main([SCENE, "--cells", "1e-3,5e-4", "--cfl", "0.5,0.25", "--frictherm", _exe(), "-o", d, "--plan"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("plan: h = ") == 4 and not os.path.exists(os.path.join(d, "runs"))  # nothing ran
+    assert main([SCENE, "--cells", "7e-4", "--frictherm", _exe(), "-o", d, "-q"]) == 2
+    assert "grid.cell_size" in capsys.readouterr().err
