@@ -128,9 +128,10 @@ def write_markdown(study, path):
 
 
 def _axis_label(outputs):
-    units = {o.unit for o in outputs}
-    names = ", ".join(o.label for o in outputs)
-    return names + ((" (%s)" % units.pop()) if len(units) == 1 and "" not in units else "")
+    """The output's name and unit; several outputs (named in the legend): the unit only."""
+    unit = outputs[0].unit
+    name = outputs[0].label if len(outputs) == 1 and len(outputs[0].label) <= 40 else "value"
+    return name + (" (%s)" % unit if unit else "")
 
 
 def _groups(outputs):
@@ -176,7 +177,7 @@ def write_charts(study, directory):
                 a = study.analysis(o.label)
                 for i, c in enumerate(study.cfls):
                     la = a["along_cell"][c]
-                    col = colors[i % len(colors)]
+                    col = colors[(j * len(study.cfls) + i) % len(colors)]
                     ax.plot([h * k for h in la["levels"]], la["values"], MARKERS[j % len(MARKERS)] + "-", color=col,
                             label="%s, C = %g" % (o.label, c) if len(group) > 1 else "C = %g" % c)
                     b = la["best"]
@@ -198,7 +199,7 @@ def write_charts(study, directory):
                 a = study.analysis(o.label)
                 for i, h in enumerate(study.cells):
                     la = a["along_cfl"][h]
-                    col = colors[i % len(colors)]
+                    col = colors[(j * len(study.cells) + i) % len(colors)]
                     ax.plot(la["levels"], la["values"], MARKERS[j % len(MARKERS)] + "-", color=col,
                             label=("%s, " % o.label if len(group) > 1 else "") + "h = %g %s" % (h * k, lu))
                     b = la["best"]
@@ -225,7 +226,7 @@ def write_charts(study, directory):
                     continue
                 pts.sort()
                 ax.plot([p[0] for p in pts], [100 * p[1] for p in pts], MARKERS[j % len(MARKERS)] + "-",
-                        color=colors[i % len(colors)],
+                        color=colors[(j * len(study.cfls) + i) % len(colors)],
                         label="%s, C = %g" % (o.label, c) if len(group) > 1 else "C = %g" % c)
                 for x, y, h in pts if j == 0 else []:  # the first output's points carry the labels
                     ax.annotate("%g" % (h * k), (x, 100 * y), fontsize=6, xytext=(3, 3), textcoords="offset points")
