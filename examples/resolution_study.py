@@ -7,8 +7,8 @@ scene, its outputs and its default cell sizes and CFL factors; the options chang
 
 presets
   sliding_block   examples/sliding_block.json (Nairn et al. 2018 fig. 2), the frictional work of both
-                  orders at the end, cells 5, 2.5, 1.25 mm x C 0.5, 0.25, 0.125 (about 10 CPU minutes;
-                  docs/study.md shows it with --max-cpu 100); the rigid-block value of the work (appendix
+                  orders at the end, cells 5, 2.5, 1.25 mm x C 0.5, 0.25, 0.125 (about 11 CPU minutes;
+                  docs/study.md shows it with --max-cpu 200); the rigid-block value of the work (appendix
                   eqs. 52-54) is 0.099856 J: pass it as --reference to measure errors against it
   fig7            examples/oscillating_block.json (fig. 7): the work of both orders after the pushers
                   start (W(end) - W(t1)) against C = 1 ... 0.0125 at the scene's 2.5 mm cells
