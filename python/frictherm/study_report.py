@@ -108,6 +108,12 @@ def summary_lines(study):
             out += ["- " + s for s in _direction_lines(la, "along h at C = %g" % c)]
         for h, la in a["along_cfl"].items():
             out += ["- " + s for s in _direction_lines(la, "along C at h = %g %s" % (h * k, lu))]
+        for what, direction in (("h", a["along_cell"]), ("C", a["along_cfl"])):
+            limits = [d["best"].limit for d in direction.values() if d["best"] is not None and d["best"].extrapolated]
+            if len(limits) >= 2:
+                lo, hi = min(limits), max(limits)
+                out.append("- the %d limits in %s span %.6g to %.6g (%.2g %%): an uncertainty of the limit that one "
+                           "triple's GCI does not show" % (len(limits), what, lo, hi, 100 * (hi - lo) / abs(hi)))
         if a["limit_both"] is not None:
             out += ["- " + s for s in _direction_lines(a["limit_both"], "the limits in C, along h")]
         rec = a["recommendation"]
