@@ -70,3 +70,39 @@ def test_study_levels_triples_and_failed_levels():
 def test_two_levels_with_an_assumed_order():
     e = two_levels([0.2, 0.1], [1.0 + 0.2**2, 1.0 + 0.1**2], 2.0)
     assert e.limit == pytest.approx(1.0, abs=1e-14) and e.status == "assumed order"
+
+
+def _synthetic_study(tolerance=0.1, reference=None):
+    """A Study over rows made up as f = 1 + 3 h^2 + 0.5 C (no runs): along h the limit at each C is
+    1 + 0.5 C (order 2), along C the limit at each h is 1 + 3 h^2 (order 1), both together 1."""
+    from frictherm.study import Study
+    from frictherm.study_runs import Output
+    cells, cfls = [0.04, 0.02, 0.01], [0.4, 0.2, 0.1]
+    rows = [dict(cell=h, cfl=c, status="completed", values={"f": 1.0 + 3.0 * h**2 + 0.5 * c}, wall_s=0.0,
+                 cpu_s=1e-6 / (h**3 * c), run_wall_s=0.0, steps=1, particles=1, file="x.h5", note="")
+            for h in cells for c in cfls]
+    return Study("synthetic.json", rows, [Output("f")], cells, cfls, reference=reference, tolerance=tolerance)
+
+
+def test_study_reference_errors_and_recommendation_on_synthetic_rows():
+    st = _synthetic_study()
+    a = st.analysis("f")
+    for c, la in a["along_cell"].items():
+        assert la["best"].order == pytest.approx(2.0, rel=1e-8) and la["best"].limit == pytest.approx(1 + 0.5 * c)
+    for h, la in a["along_cfl"].items():
+        assert la["best"].order == pytest.approx(1.0, rel=1e-8) and la["best"].limit == pytest.approx(1 + 3 * h**2)
+    ref, source = a["reference"]
+    assert ref == pytest.approx(1.0, abs=1e-10) and source.startswith("extrapolated in C at each cell")
+    errors = {(r["cell"], r["cfl"]): r["values"]["f"] - 1.0 for r in st.rows}
+    for key, e in errors.items():
+        assert a["errors"][key] == pytest.approx(e, abs=1e-10)
+    # the cheapest run within 10 %: by brute force over the made-up costs
+    best = min((r for r in st.rows if errors[(r["cell"], r["cfl"])] <= 0.1), key=lambda r: r["cpu_s"])
+    assert a["recommendation"] is best
+    from frictherm.study_report import summary_lines
+    text = "\n".join(summary_lines(st))
+    assert "the 3 limits in h span" in text and "Cheapest run within 10 %" in text
+    # a given reference wins over every extrapolation
+    given = _synthetic_study(reference={"f": 2.0}).analysis("f")
+    f = 1.0 + 3.0 * 0.01**2 + 0.5 * 0.1
+    assert given["reference"] == (2.0, "given") and given["errors"][(0.01, 0.1)] == pytest.approx((f - 2.0) / 2.0)
