@@ -127,6 +127,19 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   const double area = std::sqrt(2.0 * (a.domain + b.domain) * std::min(a.domain, b.domain)) / h_perp;
   if (!(area > 0.0)) return out;
 
+  // A sliver (ContactSide::sliver) gets normal contact only, whether the pair is found in contact or
+  // separated: no friction, no adhesive hold (eq. 25), no heat. Letting a separated sliver hold by
+  // adhesion made the constraint switch between "stick" and "normal only" from step to step with the
+  // sign of the approach velocity; at a node a rigid body barely reaches (the oscillating block's
+  // pushers, moved by a fraction of a cell) that pinned the heavy block field there on some steps and
+  // not on others, and the block's particles gained kinetic energy without bound at small time steps.
+  if (a.sliver || b.sliver) {
+    if (in_contact) {
+      out.changed = true;
+      out.dp = d_n * n;
+    }
+    return out;
+  }
   if (!in_contact) {  // separated: only an adhesive interface with tensile strength may hold (eq. 25)
     const double N = -d_n / (area * c.dt), S_stick = d_t / (area * c.dt);
     if (s.law.holds_when_separated(S_stick, N)) {
@@ -137,15 +150,9 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     // Extent detection: domains that touch but move apart this step still rub through the law's area
     // term (adhesion S_a A_c, eq. 24 with N = 0); no normal change. Without it an area law loses its
     // traction at every touching node whose normal velocity noise points outward that step.
-    if (c.separation == SeparationMethod::extent && touching && s.law.needs_area() && !(a.sliver || b.sliver) &&
-        d_t > 0.0)
+    if (c.separation == SeparationMethod::extent && touching && s.law.needs_area() && d_t > 0.0)
       apply_friction(a, b, s.law.in_contact(ContactImpulse{0.0, d_t, out.reduced_mass, area, c.dt}), t_vec, 0.0,
                      n, t_vec, d_t, c, out);
-    return out;
-  }
-  if (a.sliver || b.sliver) {  // normal change only: no friction, no heat (ContactSide::sliver)
-    out.changed = true;
-    out.dp = d_n * n;
     return out;
   }
   const double d_n_law = regularized_normal(d_n, d_t, out.reduced_mass, area, c);

@@ -88,6 +88,8 @@ struct OscillatingBlock {
     }
     sim->fix_face(FixedFace{1, false, {{true, true, true}}});
     ContactOptions co;
+    if (v.separation == SeparationMethod::extent)
+      co.use_extent_detection();  // with its companions, as a scene gets it (the pushers' law has an area term)
     co.separation = v.separation;
     co.default_pair.law = FrictionLaw::adhesion(0.0, 1e15, 1e15);  // pushers bonded to the block
     co.default_pair.normal = NormalMethod::max_volume_gradient;
