@@ -40,6 +40,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   for (auto& t : contact_thread_work_) {
     t.stats = ContactStats{};
     t.entries.clear();
+    t.rigid_work.clear();
     if (heat && t.marked.size() != nm * nm) {
       t.pair_first.assign(nm * nm, 0.0), t.pair_second.assign(nm * nm, 0.0), t.marked.assign(nm * nm, 0);
       t.touched.clear();
@@ -84,10 +85,23 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       }
       double* lagged_normal = regularized ? &lagged_normal_traction_[static_cast<std::size_t>(node)] : nullptr;
       double* lagged_step = regularized ? &lagged_normal_step_[static_cast<std::size_t>(node)] : nullptr;
+      // The energy books' rigid work: in the momentum-update pass (the changes the particles receive)
+      // every change a deformable material gets at a node with a rigid partner comes from the rigid
+      // body, whose velocity is prescribed: it does the work Δp·v_rigid (the heaviest rigid side's
+      // velocity, the one lump_partners gives the virtual material).
+      const ContactSide<Dim>* rigid = nullptr;
+      if (forces)
+        for (const auto& sd : sides)
+          if (sd.rigid && (!rigid || sd.mass > rigid->mass)) rigid = &sd;
+      double rigid_work = 0.0;
       contact_detail::resolve_contact_node(
           sides, mats, h, ctx, lagged_normal, lagged_step, pair_of, dps,
-          [&](std::size_t j, const Vec<Dim>& dp) { apply(slots[j], dp); },
+          [&](std::size_t j, const Vec<Dim>& dp) {
+            apply(slots[j], dp);
+            if (rigid) rigid_work += dp.dot(rigid->rigid_velocity);
+          },
           [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); }, stats.sliding_nodes);
+      if (rigid) acc.rigid_work.push_back(rigid_work);
     }
   }
   if (!heat) return;
@@ -101,8 +115,10 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   // then into the run's. The static schedule gives thread t the t-th contiguous run of groups, so
   // this is group order, as on one thread (a dynamic schedule would need the lists merged by group).
   ContactThreadWork& books = contact_thread_work_.front();
-  for (const auto& t : contact_thread_work_)
+  for (const auto& t : contact_thread_work_) {
     for (const auto& e : t.entries) books.add(e.k, e.w1, e.w2);
+    for (const double w : t.rigid_work) rigid_work_ += w;  // group order too: the same sum on any thread count
+  }
   for (const std::size_t k : books.touched) {  // (the others add zero)
     pair_work_first_[k] += books.pair_first[k], pair_work_second_[k] += books.pair_second[k];
     books.pair_first[k] = books.pair_second[k] = 0.0, books.marked[k] = 0;

@@ -234,19 +234,27 @@ void Simulation<Dim>::sum_shared_fields(Accumulated which) {
 // Fixed components are zeroed; components driven by a rigid boundary material take its velocity; rigid
 // fields (contact) take m v_rigid and no force.
 template <int Dim>
-void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const {
+double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const {
+  // With `force` (the momentum update) the work of the rigid bodies on the deformable material is
+  // returned: the impulse a rigid velocity condition adds, m v_rigid − (p + f dt), and the reaction of
+  // a force on a rigid field (penalty contact: the slave's force on a rigid master), each dotted
+  // with the rigid velocity.
+  double work = 0.0;
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (!F.rigid) continue;
     const Vec<Dim> v = field_velocity_[f];
     for (std::size_t s = F.first; s < F.first + F.count; ++s) {
       momentum[s] = nodes_.mass[s] * v;
-      if (force) (*force)[s].setZero();
+      if (force) {
+        work -= (*force)[s].dot(v) * dt;
+        (*force)[s].setZero();
+      }
     }
   }
   // One parallel region over the deformable fields (one per grain in a PBX: a region each would
   // cost more than their few hundred slots).
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_) reduction(+ : work)
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -261,10 +269,12 @@ void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::ve
         for (int d = 0; d < Dim; ++d)
           if (driven & (1u << d)) {
             const double target = nodes_.mass[s] * rigid_velocity_[i][d];
-            if (force)
+            if (force) {
+              work += (target - momentum[s][d] - (*force)[s][d] * dt) * rigid_velocity_[i][d];
               (*force)[s][d] = (target - momentum[s][d]) / dt;
-            else
+            } else {
               momentum[s][d] = target;
+            }
           }
       }
       if (const std::uint8_t mask = fixed_mask_[i]) {
@@ -276,6 +286,7 @@ void Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::ve
       }
     }
   }
+  return work;
 }
 
 // v_i = p_i / m_i after the velocity boundary conditions on p_i; empty nodes get no velocity.
@@ -300,14 +311,35 @@ void Simulation<Dim>::update_grid(double dt) {
     for (std::size_t i = 0; i < n; ++i)
       transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
   }
+  rigid_work_ += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
   if (opt_.damping_rate > 0.0 && time_ < opt_.damping_until) {
     // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
-    // (explicit: stable for c dt < 2; the scene checks c dt_max < 1).
-    const double c = opt_.damping_rate;
-#pragma omp parallel for num_threads(threads_) schedule(static)
-    for (std::size_t i = 0; i < n; ++i) nodes_.force[i] -= c * nodes_.momentum[i];
+    // (explicit: stable for c dt < 2; the scene checks c dt_max < 1). After the velocity conditions,
+    // on the components they leave free (the same forces as damping first: the conditions replace the
+    // force of the components they set, and fixed ones have p = 0), so that its work, c p²/m dt per
+    // component, is the energy it removes.
+    const double c = opt_.damping_rate, mmin_damped = mmin;
+    double removed = 0.0;
+#pragma omp parallel num_threads(threads_) reduction(+ : removed)
+    for (std::size_t f = 0; f < fields_.size(); ++f) {
+      const VelocityField<Dim>& F = fields_[f];
+      if (F.rigid) continue;
+      const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
+#pragma omp for schedule(static) nowait
+      for (long ss = b; ss < e; ++ss) {
+        const std::size_t s = static_cast<std::size_t>(ss);
+        const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(slot_node_[s])];
+        const double m = nodes_.mass[s];
+        for (int d = 0; d < Dim; ++d) {
+          if (driven & (1u << d)) continue;
+          const double p = nodes_.momentum[s][d];
+          nodes_.force[s][d] -= c * p;
+          if (m > mmin_damped) removed += c * p * p / m * dt;
+        }
+      }
+    }
+    damping_work_ += removed;
   }
-  apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
   if (contact_) resolve_contact(ContactPass::updated, dt);
@@ -408,7 +440,7 @@ template struct NodalFields<3>;
   template void Simulation<D>::update_partition();                                                            \
   template void Simulation<D>::clear_scatter_targets(int, Accumulated);                                      \
   template void Simulation<D>::sum_shared_fields(Accumulated);                                               \
-  template void Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
+  template double Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::update_grid(double);                                                           \
   template void Simulation<D>::move_rigid_particles(double, double);                                          \

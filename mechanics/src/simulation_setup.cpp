@@ -293,21 +293,6 @@ double Simulation<Dim>::kinetic_energy() const {
 }
 
 template <int Dim>
-double Simulation<Dim>::strain_energy() const {
-  double e = 0.0;
-  for (std::size_t k = 0; k < p_.size(); ++k) {
-    const Material& m = materials_[static_cast<std::size_t>(p_.material[k])];
-    if (m.kind == MaterialKind::neo_hookean)
-      e += p_.initial_volume[k] *
-           neo_hookean_energy_density<Dim>(p_.deformation_gradient[k], m.lame_lambda(), m.shear_modulus());
-    else if (m.kind == MaterialKind::linear_elastic)
-      e += p_.volume[k] * linear_elastic_energy_density<Dim>(p_.stress[k], p_.stress_zz[k], m.youngs_modulus,
-                                                              m.poisson_ratio, opt_.analysis);
-  }
-  return e;
-}
-
-template <int Dim>
 Vec<Dim> Simulation<Dim>::linear_momentum() const {
   Vec<Dim> P = Vec<Dim>::Zero();
   for (std::size_t k = 0; k < p_.size(); ++k)

@@ -43,6 +43,9 @@ auto& Simulation<Dim>::stencils() {
 template <int Dim>
 double Simulation<Dim>::step(double dt_limit) {
   finalize();
+  // The energy books' start (EnergyBalance::initial): once, before the first step moves anything.
+  if (std::isnan(initial_energy_))
+    initial_energy_ = kinetic_energy() + strain_energy() + (penalty_ ? penalty_->stored_energy() : 0.0);
   lap_ = PhaseLap{};
   nested_phase_ = 0.0;
   const double dt = std::min(stable_time_step(), dt_limit);

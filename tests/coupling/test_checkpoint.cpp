@@ -44,6 +44,12 @@ void expect_identical(const mechanics::Simulation<2>& a, const mechanics::Simula
   for (HeatingOrder o : {HeatingOrder::first, HeatingOrder::second})
     EXPECT_EQ(a.cumulative_frictional_work(o), b.cumulative_frictional_work(o));
   EXPECT_EQ(a.external_work(), b.external_work());
+  // The energy books' cumulative sums and start (the series' energy balance) survive the resume.
+  const mechanics::EnergyBalance ea = a.energy_balance(HeatingOrder::second), eb = b.energy_balance(HeatingOrder::second);
+  EXPECT_EQ(ea.initial, eb.initial);
+  EXPECT_EQ(ea.rigid_work, eb.rigid_work);
+  EXPECT_EQ(ea.damping_work, eb.damping_work);
+  EXPECT_EQ(ea.numerical_dissipation(), eb.numerical_dissipation());
 }
 
 // The block slides from t ≈ 0.25 tf on; the checkpoint is taken while it slides, the comparison

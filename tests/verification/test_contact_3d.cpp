@@ -1,12 +1,15 @@
 // Multimaterial contact in 3D: two elastic blocks collide obliquely with Coulomb friction (MVG
 // normals, position separation). Checks what holds without an analytic solution: total momentum is
 // conserved (contact exchanges are equal and opposite, eq. 18), the blocks really exchange momentum,
-// frictional work is finite, non-negative and bounded by the kinetic energy lost, and the contact
-// area term (no thickness in 3D, eq. 11) gives sliding nodes.
+// the contact area term (no thickness in 3D, eq. 11) gives sliding nodes, and the mechanics pays for
+// the heat: the frictional work at either order is at most the mechanical energy the blocks lost.
 //
-// Not asserted: an energy bound. The friction work (grid velocities at contact nodes) exceeds the
-// mechanical energy the particles lose in this impact (measured 0.023 J second order, 0.035 J first
-// order, against 0.016 J); see docs/contact.md, known limitations.
+// The energy lost is measured after the blocks have separated, as the initial kinetic energy less the
+// mean of kinetic + strain energy over 80 µs of free flight (about one period 2L/c = 76 µs of the
+// blocks' first mode): the sum at a single step swings by up to 1.6e-3 J from step to step in free
+// flight (the velocities and stresses of a step are staggered in time), a tenth of what is lost.
+// Before the heat's mass floor (contact_pair.hpp, kHeatMassFloor) the work was 0.023 J (second
+// order) and 0.035 J (first order) against 0.0177 J lost (docs/contact.md, "Frictional work in impacts").
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <gtest/gtest.h>
@@ -42,7 +45,7 @@ TEST(Contact3D, ObliqueCollisionConservesMomentumWithFiniteHeat) {
   };
   sim.finalize();
   const auto [P0, scale] = momentum();
-  const double ke0 = sim.kinetic_energy();
+  const double ke0 = sim.kinetic_energy(), se0 = sim.strain_energy();
   auto body_momentum = [&](int mat) {
     Vec<3> P = Vec<3>::Zero();
     for (std::size_t k = 0; k < p.size(); ++k)
@@ -52,23 +55,52 @@ TEST(Contact3D, ObliqueCollisionConservesMomentumWithFiniteHeat) {
   const Vec<3> Pa0 = body_momentum(a);
   long sliding = 0;
   double drift = 0.0;
-  for (int s = 0; s < 150; ++s) {  // the impact lasts about 2 L/c = 80 µs = 40 steps
+  // Mean of kinetic + strain energy and of the books' remainder over the free flight after the impact.
+  const double t_free = 260e-6, t_end = 340e-6;
+  double e_free = 0.0, remainder_free = 0.0;
+  long free_steps = 0, contact_in_free = 0;
+  while (sim.time() < t_end) {  // the impact lasts about 250 µs (contact nodes until then)
     sim.step();
     drift = std::max(drift, (momentum().first - P0).norm() / scale);
     sliding += sim.contact_stats().sliding_nodes;
     for (HeatingOrder order : {HeatingOrder::first, HeatingOrder::second})
       for (double w : sim.frictional_work(order)) ASSERT_TRUE(std::isfinite(w) && w >= 0.0);
+    if (sim.time() > t_free) {
+      const EnergyBalance e = sim.energy_balance(HeatingOrder::second);
+      e_free += e.kinetic + e.stored;
+      remainder_free += e.numerical_dissipation();
+      contact_in_free += sim.contact_stats().contact_nodes;
+      ++free_steps;
+    }
   }
+  ASSERT_GT(free_steps, 20);
+  e_free /= static_cast<double>(free_steps);
+  remainder_free /= static_cast<double>(free_steps);
   const double exchanged = (body_momentum(a) - Pa0).norm() / Pa0.norm();
+  const double w1 = sim.cumulative_frictional_work(HeatingOrder::first);
   const double w2 = sim.cumulative_frictional_work(HeatingOrder::second);
-  const double e_end = sim.kinetic_energy() + sim.strain_energy();
+  const double lost = ke0 + se0 - e_free;
+  const EnergyBalance books = sim.energy_balance(HeatingOrder::second);
   std::printf("[contact 3D] momentum drift %.2e of sum m|v|, exchanged %.2f of block a's momentum, %ld sliding "
-              "node-steps, friction work %.4g J (first order %.4g J), KE0 %.4g J, KE+SE at end %.4g J\n",
-              drift, exchanged, sliding, w2, sim.cumulative_frictional_work(HeatingOrder::first), ke0, e_end);
+              "node-steps, friction work %.4g J (first order %.4g J), KE0 %.4g J, energy lost (mean over the "
+              "free flight) %.4g J: W2/lost %.3f, W1/lost %.3f, mean remainder %.4g J\n",
+              drift, exchanged, sliding, w2, w1, ke0, lost, w2 / lost, w1 / lost, remainder_free);
   // Contact changes are equal and opposite at every node; the only loss is the force on nodes lighter
   // than 1e-12 of a particle (docs/contact.md, known limitations: measured up to 2.5e-10 in 2D).
   EXPECT_LT(drift, 1e-9);
   EXPECT_GT(exchanged, 0.3);  // the collision happened
   EXPECT_GT(sliding, 0);
   EXPECT_GT(w2, 0.0);
+  EXPECT_EQ(contact_in_free, 0);  // the blocks had separated: the mean is over free flight
+  // The books: no loads and no rigid bodies, so what was lost is the start's energy less the end's.
+  EXPECT_EQ(books.initial, ke0 + se0);
+  EXPECT_EQ(books.external_work + books.rigid_work + books.damping_work + books.plastic_work, 0.0);
+  EXPECT_EQ(books.friction_work, w2);
+  // The heat is paid for: at either order at most the energy lost (1 %: the mean's own spread, the
+  // step-to-step swing of 1.6e-3 J averaged over ≥ 40 steps of a periodic motion). Measured 0.78 and 0.81.
+  EXPECT_LE(w2, 1.01 * lost);
+  EXPECT_LE(w1, 1.01 * lost);
+  // What the friction does not account for is the scheme's own loss (the normal contact stops the
+  // approach at the nodes inelastically): not negative. Measured +0.004 J.
+  EXPECT_GE(remainder_free, -0.01 * lost);
 }

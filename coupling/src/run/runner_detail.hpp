@@ -13,7 +13,8 @@
 namespace frictherm::coupling::detail {
 
 /// Series columns: time, step, dt, kinetic_energy, strain_energy, total_energy, external_work,
-/// momentum_x, momentum_y (, momentum_z).
+/// momentum_x, momentum_y (, momentum_z), then the energy balance: rigid_work, damping_work,
+/// plastic_dissipation, energy_lost, numerical_dissipation.
 std::vector<std::string> series_names(int dim);
 /// With contact: cumulative frictional work (total and per listed pair, both orders), contact and
 /// sliding node counts, each body's mean velocity and the contact heat rate (total and per pair).

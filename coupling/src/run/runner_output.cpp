@@ -15,6 +15,9 @@ std::vector<std::string> series_names(int dim) {
                              "strain_energy", "total_energy",  "external_work"};
   const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
   for (int d = 0; d < dim; ++d) n.emplace_back(axes[d]);
+  // The energy balance (mechanics::EnergyBalance, docs/output.md "Energy balance").
+  for (const char* c : {"rigid_work", "damping_work", "plastic_dissipation", "energy_lost", "numerical_dissipation"})
+    n.emplace_back(c);
   return n;
 }
 
@@ -106,6 +109,8 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
                           ke + se,    sim.external_work()};
   const auto P = sim.linear_momentum();
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+  const mechanics::EnergyBalance e = sim.energy_balance(order);
+  row.insert(row.end(), {e.rigid_work, e.damping_work, e.plastic_work, e.lost(), e.numerical_dissipation()});
   append_body_means(row, sim);
   if (!sim.contact_enabled()) return row;
   for (auto each : {mechanics::HeatingOrder::first, mechanics::HeatingOrder::second}) {

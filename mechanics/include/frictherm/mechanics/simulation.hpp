@@ -123,6 +123,23 @@ struct BodyInfo {
 template <int Dim>
 struct ContactSide;  // contact internals (mechanics/src/contact_side.hpp)
 
+/// The mechanical energy books of a run (J; docs/output.md, "Energy balance"). The energy the bodies
+/// lost, lost() = initial + external_work + rigid_work − kinetic − stored, pays for the damping, the
+/// plastic and the frictional work; what is left, numerical_dissipation(), is the scheme's own loss
+/// (or, if negative, its gain): the normal part of the contact impulses, FLIP/grid transfers, fixed faces.
+struct EnergyBalance {
+  double kinetic = 0.0;        // of the deformable particles
+  double stored = 0.0;         // strain_energy() (elastic and equation-of-state) + penalty springs
+  double initial = 0.0;        // kinetic + stored at the start of the first step
+  double external_work = 0.0;  // loads and gravity (external_work())
+  double rigid_work = 0.0;     // rigid materials on the deformable bodies (rigid_work())
+  double damping_work = 0.0;   // removed by the mass-proportional damping (damping_work())
+  double plastic_work = 0.0;   // Σ_p σ:Δε_p V of the particles (plastic_work())
+  double friction_work = 0.0;  // cumulative frictional work of the order asked for
+  double lost() const { return initial + external_work + rigid_work - kinetic - stored; }
+  double numerical_dissipation() const { return lost() - damping_work - plastic_work - friction_work; }
+};
+
 template <int Dim>
 class Simulation {
  public:
@@ -211,10 +228,23 @@ class Simulation {
   void forget_stencils() { stencils_current_ = false; }
 
   double kinetic_energy() const;  // of deformable particles (J)
-  double strain_energy() const;   // J
+  /// Energy stored in the deformable materials (J): elastic strain energy (linear elastic, neo-Hookean)
+  /// and, for Mie-Grüneisen, the equation-of-state energy m e − W_p plus the shear energy V s:s/(4G)
+  /// (simulation_energy.cpp).
+  double strain_energy() const;
   Vec<Dim> linear_momentum() const;  // of deformable particles (kg m/s)
   /// Work done by external loads and body force so far (J), accumulated each step.
   double external_work() const { return external_work_; }
+  /// Work done by rigid materials (walls, pistons) on the deformable bodies so far (J): per step the
+  /// momentum the rigid fields and rigid velocity conditions give the deformable material in the
+  /// momentum update (what the particles receive) times the rigid velocity.
+  double rigid_work() const { return rigid_work_; }
+  /// Energy removed by the mass-proportional damping so far (J, ≥ 0): c |p_i|²/m_i dt per node and step.
+  double damping_work() const { return damping_work_; }
+  /// Plastic work of the particles so far, Σ_p σ:Δε_p V (J).
+  double plastic_work() const;
+  /// The energy books now (frictional work of `order`). Before the first step initial = kinetic + stored.
+  EnergyBalance energy_balance(HeatingOrder order) const;
 
   // ---- checkpoint -------------------------------------------------------------------------
   /// Calls v(name, member) for every member that changes while stepping and that the next step
@@ -246,6 +276,9 @@ class Simulation {
     v("step", step_);
     v("last_dt", last_dt_);
     v("external_work", external_work_);
+    v("rigid_work", rigid_work_);
+    v("damping_work", damping_work_);
+    v("initial_energy", initial_energy_);
     v("work_first", work_first_);
     v("work_second", work_second_);
     v("pair_work_first", pair_work_first_);
@@ -314,8 +347,8 @@ class Simulation {
   /// has a field (rigid ones only with include_rigid), then the shared fields are summed.
   template <class Scatter> void scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter);
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
-  /// come) the forces are made consistent instead.
-  void apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
+  /// come) the forces are made consistent instead, and the rigid bodies' work is returned (0 without).
+  double apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
   void update_grid(double dt);
   /// XPIC/FMPM (transfer.hpp): transfer_.filtered = Σ_{j<order} (I − S⁺S)^j w0 per deformable field,
   /// w0 = transfer_.start (XPIC) or nodes_.velocity (FMPM); simulation_transfer.cpp.
@@ -396,6 +429,7 @@ class Simulation {
       double w1, w2;
     };
     std::vector<PairEntry> entries;
+    std::vector<double> rigid_work;  // Δp·v_rigid of each change a rigid partner made, in group order
     void add(std::size_t k, double w1, double w2) {
       if (!marked[k]) marked[k] = 1, touched.push_back(k);
       pair_first[k] += w1;
@@ -470,6 +504,8 @@ class Simulation {
   long step_ = 0;
   double last_dt_ = 0.0;
   double external_work_ = 0.0;
+  double rigid_work_ = 0.0, damping_work_ = 0.0;  // energy books (rigid_work(), damping_work())
+  double initial_energy_ = std::numeric_limits<double>::quiet_NaN();  // kinetic + stored before the first step
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
   // Per particle: the dilatational wave speed of its state (J, e change only in the stress update,
   // which refreshes it); −∞ for rigid particles. stable_time_step adds |v_p| to it.
