@@ -81,13 +81,15 @@ TEST(SpuriousHeat, PressedBlockWorkVanishes) {
     EXPECT_LT(creep, 0.01 * rubbing) << "C = " << cfl;
     EXPECT_GE(creep, 0.0);
   }
-  // The benchmark tells the updates apart: MUSL with the same preload creeps at the two nodes just
-  // outside the block's corners (measured 9.7 mJ, 286 % of the rubbing work, with pure FLIP; 0.76 mJ
-  // with the FLIP/PIC blend τ = 15 µs the example scenes used before).
+  // MUSL with the same preload used to creep at the two nodes just outside the block's corners
+  // (9.7 mJ, 286 % of the rubbing work, with pure FLIP): the end-of-step slip of the sliver of block
+  // mass there, a small-mass node's velocity. Since the heat's mass floor (issue 31, contact_pair.hpp
+  // kHeatMassFloor) it does not: measured 0.0000 mJ. Bound: as the trusted combination, 1 %.
   OscillatingBlockVariant musl = pressed;
   musl.scheme = mechanics::UpdateScheme::musl;
   const double musl_creep = second_order_work(0.5, musl), rubbing = second_order_work(0.5, trusted());
   std::printf("[pressed block, MUSL, C = 0.5] spurious %.4f mJ = %.1f %% of the rubbing work\n", 1e3 * musl_creep,
               100 * musl_creep / rubbing);
-  EXPECT_GT(musl_creep, 0.05 * rubbing);
+  EXPECT_LT(musl_creep, 0.01 * rubbing);
+  EXPECT_GE(musl_creep, 0.0);
 }
