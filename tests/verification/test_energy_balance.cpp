@@ -85,7 +85,9 @@ TEST(EnergyBalance, RigidPistonWorkIsTheBarsEnergy) {
       if (!contact && refine == 1) remainder_coarse = r.remainder / r.rigid_work;
       // The velocity condition's loss is the driven nodes' (the particles beside them take the jump
       // to V through FLIP): first order in h, so halving the cell halves it (measured 0.47).
-      if (!contact && refine == 2) EXPECT_LT(r.remainder / r.rigid_work, 0.6 * remainder_coarse);
+      if (!contact && refine == 2) {
+        EXPECT_LT(r.remainder / r.rigid_work, 0.6 * remainder_coarse);
+      }
     }
 }
 
