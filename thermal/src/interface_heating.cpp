@@ -30,24 +30,37 @@ constexpr double kGaussW[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066
 // The unit-step response of node 0 of a uniform infinite chain (node mass m = h C, conductance k/h,
 // λ = α/h²) fed at node 0, with source and conduction both passed through the projection stencil
 // P̂(φ) = f + (1 − f) cos φ, in units of 1/m: (1/π) ∫₀^π P̂ (1 − e^{−s t})/s dφ, s = 2λ P̂ (1 − cos φ).
-// Composite Gauss–Legendre on panels that shrink geometrically towards φ = 0, where the integrand
+// Composite Gauss–Legendre (ChainQuadrature) on panels that shrink geometrically towards φ = 0, where the integrand
 // concentrates at late times (φ ≲ 1/√(λt)).
-double filtered_chain_step(double t, double lambda, double f) {
-  double sum = 0.0;
-  double hi = kPi;
-  for (int panel = 0; panel < 80 && hi > 1e-12; ++panel) {
-    const double lo = panel == 79 ? 0.0 : 0.7 * hi;
-    const double mid = 0.5 * (hi + lo), half = 0.5 * (hi - lo);
-    for (int i = 0; i < 8; ++i) {
-      const double phi = mid + half * kGaussX[i];
-      const double filter = f + (1.0 - f) * std::cos(phi);
-      const double one_minus_cos = 2.0 * std::sin(0.5 * phi) * std::sin(0.5 * phi);  // no cancellation
-      const double s = 2.0 * lambda * filter * one_minus_cos;
-      const double st = s * t;
-      const double value = st < 1e-8 ? t * (1.0 - 0.5 * st) : -std::expm1(-st) / s;
-      sum += half * kGaussW[i] * filter * value;
+// The quadrature's nodes and weights in φ, with cos φ and 1 − cos φ (= 2 sin²(φ/2), no cancellation),
+// computed once: they do not depend on t, λ or f.
+struct ChainQuadrature {
+  std::vector<double> weight, cos_phi, one_minus_cos;
+  ChainQuadrature() {
+    double hi = kPi;
+    for (int panel = 0; panel < 80 && hi > 1e-12; ++panel) {
+      const double lo = panel == 79 ? 0.0 : 0.7 * hi;
+      const double mid = 0.5 * (hi + lo), half = 0.5 * (hi - lo);
+      for (int i = 0; i < 8; ++i) {
+        const double phi = mid + half * kGaussX[i];
+        weight.push_back(half * kGaussW[i]);
+        cos_phi.push_back(std::cos(phi));
+        one_minus_cos.push_back(2.0 * std::sin(0.5 * phi) * std::sin(0.5 * phi));
+      }
+      hi = lo;
     }
-    hi = lo;
+  }
+};
+
+double filtered_chain_step(double t, double lambda, double f) {
+  static const ChainQuadrature q;
+  double sum = 0.0;
+  for (std::size_t j = 0; j < q.weight.size(); ++j) {
+    const double filter = f + (1.0 - f) * q.cos_phi[j];
+    const double s = 2.0 * lambda * filter * q.one_minus_cos[j];
+    const double st = s * t;
+    const double value = st < 1e-8 ? t * (1.0 - 0.5 * st) : -std::expm1(-st) / s;
+    sum += q.weight[j] * filter * value;
   }
   return sum / kPi;
 }
