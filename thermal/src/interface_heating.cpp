@@ -27,11 +27,6 @@ constexpr double kGaussX[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255
 constexpr double kGaussW[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
                                0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
 
-// The unit-step response of node 0 of a uniform infinite chain (node mass m = h C, conductance k/h,
-// λ = α/h²) fed at node 0, with source and conduction both passed through the projection stencil
-// P̂(φ) = f + (1 − f) cos φ, in units of 1/m: (1/π) ∫₀^π P̂ (1 − e^{−s t})/s dφ, s = 2λ P̂ (1 − cos φ).
-// Composite Gauss–Legendre (ChainQuadrature) on panels that shrink geometrically towards φ = 0, where the integrand
-// concentrates at late times (φ ≲ 1/√(λt)).
 // The quadrature's nodes and weights in φ, with cos φ and 1 − cos φ (= 2 sin²(φ/2), no cancellation),
 // computed once: they do not depend on t, λ or f.
 struct ChainQuadrature {
@@ -52,6 +47,11 @@ struct ChainQuadrature {
   }
 };
 
+// The unit-step response of node 0 of a uniform infinite chain (node mass m = h C, conductance k/h,
+// λ = α/h²) fed at node 0, with source and conduction both passed through the projection stencil
+// P̂(φ) = f + (1 − f) cos φ, in units of 1/m: (1/π) ∫₀^π P̂ (1 − e^{−s t})/s dφ, s = 2λ P̂ (1 − cos φ).
+// Composite Gauss–Legendre (ChainQuadrature) on panels that shrink geometrically towards φ = 0, where the integrand
+// concentrates at late times (φ ≲ 1/√(λt)).
 double filtered_chain_step(double t, double lambda, double f) {
   static const ChainQuadrature q;
   double sum = 0.0;
