@@ -3,7 +3,9 @@
     import frictherm
     with frictherm.open("results/sliding_block_heating.h5") as run:
         t, T = run.series["time"], run.series["max_temperature"]
-        df = run.series.to_dataframe()              # pandas, optional
+        df = run.series.to_dataframe()              # pandas, indexed by time; df.attrs["units"]
+        run.unit_of("max_temperature")              # 'K' (every dataset has units and long_name)
+        ds = run.to_xarray()                        # the whole run as an xarray.Dataset
         last = run.snapshots[-1]                    # .step, .time, .fields, last["temperature"]
         spots = run.hotspots                        # a Table, like the series
         books = run.energy_books                    # heat_delivered, particle_energy_change, ...
@@ -19,11 +21,11 @@ from ._h5 import is_count_column
 from .ensemble import Ensemble
 from .run import ENERGY_BOOK_KEYS, SUPPORTED_FORMAT_VERSION, Run
 from .snapshot import Snapshot, physical_shape
-from .table import Table
+from .table import FATE_NAMES, Table
 
 __version__ = "0.1.0"
 __all__ = ["open", "Run", "Ensemble", "Snapshot", "Table", "physical_shape", "is_count_column",
-           "ENERGY_BOOK_KEYS", "SUPPORTED_FORMAT_VERSION"]
+           "ENERGY_BOOK_KEYS", "SUPPORTED_FORMAT_VERSION", "FATE_NAMES"]
 
 
 def open(path):  # noqa: A001  (frictherm.open, like h5py.File / io.open)

@@ -86,9 +86,10 @@ def test_hotspot_table_agrees_with_the_series(run):
 
 
 def test_series_as_dataframe(run):
-    df = run.series.to_dataframe()
+    df = run.series.to_dataframe(index=None)  # row numbers, time a column
     assert list(df.columns) == run.series.columns
     assert df.shape == (len(run.series), len(run.series.columns))
+    assert run.series.to_dataframe().shape == (len(run.series), len(run.series.columns) - 1)  # time: the index
     assert np.array_equal(df["kinetic_energy"].to_numpy(), run.series["kinetic_energy"])
     assert str(df["step"].dtype) == "int64"
 

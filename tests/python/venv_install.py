@@ -23,6 +23,13 @@ CHECK = textwrap.dedent("""
         t = run.series["time"]
         assert (t[1:] > t[:-1]).all(), "series time not increasing"
         assert run.snapshots and "temperature" in run.snapshot("last").fields
+        # Self-describing (issue 33 item 2): time index, units, plain JSON scene, xarray.
+        df = run.series.to_dataframe()
+        assert df.index.name == "time" and df.attrs["units"]["kinetic_energy"] == "J"
+        assert run.unit_of("max_temperature") == "K"
+        assert len(run.snapshot("last").to_dataframe()) == run.snapshot("last").particle_count
+        assert isinstance(json.loads(run.meta["scene_json"]), dict)
+        assert run.to_xarray()["temperature"].attrs["units"] == "K"
     print("installed frictherm", frictherm.__version__, "read", sys.argv[2])
 """)
 

@@ -133,12 +133,14 @@ struct H5Output::Impl {
     const Handle space = io.space(1, &zero, &unlimited);
     Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), io.file, "cannot create a property list"), H5Pclose};
     check(H5Pset_chunk(dcpl.get(), 1, &chunk), io.file, "cannot set chunking");
-    for (const auto& n : columns)
+    for (const auto& n : columns) {
       sets.emplace_back(check_id(H5Dcreate2(group_out.get(), n.c_str(),
                                             H5Output::is_count_column(n) ? H5T_STD_I64LE : H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                             dcpl.get(), H5P_DEFAULT),
                                  io.file, "cannot create /" + name + "/" + n),
                         H5Dclose);
+      io.describe(sets.back().get(), n, dim, false, "/" + name + "/" + n);  // units, long_name
+    }
     flush_file();
   }
 
@@ -261,6 +263,7 @@ struct H5Output::Impl {
                             io.file, "cannot create " + where),
                    H5Dclose};
     if (n > 0) check(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), io.file, "cannot write " + where);
+    io.describe(d.get(), name, dim, false, where);
     points = n;
     fields.push_back({name, components, integer});
   }
@@ -280,6 +283,7 @@ struct H5Output::Impl {
                      H5Dclose};
       check(H5Dwrite(d.get(), H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, ids.data()), io.file,
             "cannot write " + path);
+      io.describe(d.get(), name, dim, false, path);
     }
     return "/xdmf/" + name;
   }
@@ -333,7 +337,20 @@ struct H5Output::Impl {
     if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
       check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
     }
-    io.scalar_dataset(meta.get(), key, type, value, bytes, "/meta/" + key);
+    const Handle d = io.scalar_dataset(meta.get(), key, type, value, bytes, "/meta/" + key);
+    io.describe(d.get(), key, dim, H5Tget_class(type) == H5T_STRING, "/meta/" + key);
+    flush_file();
+  }
+
+  // /meta/<key> as a small 1-D dataset (numbers or fixed-length strings).
+  void metadata_array(const std::string& key, hid_t type, const void* values, std::size_t n, bool text) {
+    check_name(key, "metadata");
+    const Scoped held(*this);
+    if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
+      check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
+    }
+    const Handle d = io.array_dataset(meta.get(), key, type, values, n, "/meta/" + key);
+    io.describe(d.get(), key, dim, text, "/meta/" + key);
     flush_file();
   }
 };
@@ -411,6 +428,29 @@ void H5Output::write_metadata(const std::string& key, double value) {
   Impl& m = live();
   const Quiet quiet;
   m.metadata(key, H5T_IEEE_F64LE, &value, sizeof value);
+}
+
+void H5Output::write_metadata(const std::string& key, const std::vector<double>& values) {
+  Impl& m = live();
+  const Quiet quiet;
+  m.metadata_array(key, H5T_IEEE_F64LE, values.data(), values.size(), false);
+}
+
+void H5Output::write_metadata(const std::string& key, const std::vector<std::int64_t>& values) {
+  Impl& m = live();
+  const Quiet quiet;
+  m.metadata_array(key, H5T_STD_I64LE, values.data(), values.size(), false);
+}
+
+void H5Output::write_metadata(const std::string& key, const std::vector<std::string>& values) {
+  Impl& m = live();
+  const Quiet quiet;
+  std::size_t longest = 1;
+  for (const auto& v : values) longest = std::max(longest, v.size());
+  std::string packed(values.size() * longest, '\0');  // fixed-length, NUL-padded
+  for (std::size_t i = 0; i < values.size(); ++i) packed.replace(i * longest, values[i].size(), values[i]);
+  const Handle t = m.io.string_type(longest);
+  m.metadata_array(key, t.get(), packed.data(), values.size(), true);
 }
 
 void H5Output::write_integer_metadata(const std::string& key, std::int64_t value) {
