@@ -21,11 +21,13 @@ from ._h5 import is_count_column
 from .ensemble import Ensemble
 from .run import ENERGY_BOOK_KEYS, SUPPORTED_FORMAT_VERSION, Run
 from .snapshot import Snapshot, physical_shape
+from .native import Scene, SceneError, load_scene, run, validate
 from .table import FATE_NAMES, Table
 
 __version__ = "0.1.0"
 __all__ = ["open", "Run", "Ensemble", "Snapshot", "Table", "physical_shape", "is_count_column",
-           "ENERGY_BOOK_KEYS", "SUPPORTED_FORMAT_VERSION", "FATE_NAMES"]
+           "ENERGY_BOOK_KEYS", "SUPPORTED_FORMAT_VERSION", "FATE_NAMES",
+           "Scene", "SceneError", "load_scene", "run", "validate"]
 
 
 def open(path):  # noqa: A001  (frictherm.open, like h5py.File / io.open)
