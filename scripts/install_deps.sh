@@ -4,6 +4,7 @@ set -euo pipefail
 packages=(build-essential cmake pkg-config libeigen3-dev libsundials-dev libhdf5-dev libgtest-dev
           nlohmann-json3-dev libboost-dev libmuparser-dev libpng-dev libtiff-dev libopenmpi-dev openmpi-bin petsc-dev python3 python3-numpy python3-matplotlib python3-h5py
           python3-paraview python3-pandas python3-pytest python3-xarray python3-venv
+          python3-dev pybind11-dev
           clang libclang-rt-dev libomp-dev)  # clang, its sanitizer/libFuzzer runtimes and OpenMP: scripts/run_checks.sh
 missing=()
 for p in "${packages[@]}"; do

@@ -132,3 +132,10 @@ def test_decomposed_run_files_have_units(decomposed_pair):
         assert datasets_without_units(path) == [], path
     with frictherm.open(decomposed) as r:
         assert r.unit_of("temperature") == "K" and r.snapshot("last").unit_of("velocity") == "m/s"
+
+
+def test_ensemble_file_has_units(ensemble_file):
+    assert datasets_without_units(ensemble_file) == []
+    with frictherm.open(ensemble_file) as ens:
+        assert ens.members.units["simulated_time"] == "s" and ens.hotspots.units["size"] == "m^2"
+        assert list(ens.hotspots.names_of("fate")) == [frictherm.FATE_NAMES[int(c)] for c in ens.hotspots["fate"]]

@@ -85,6 +85,13 @@ const std::map<std::string, Entry>& catalogue() {
       {"decision_time", {"s", "time the fate was decided"}},
       {"runaway_time", {"s", "runaway time"}},
       {"time_to_runaway", {"s", "time to runaway"}},
+      // an ensemble's /members (ensemble.cpp); its /hotspots use the names above
+      {"seed", {"1", "seed"}},
+      {"status", {"1", "member status (0 completed, 1 stopped at max_steps, 2 failed)"}},
+      {"simulated_time", {"s", "simulated time"}},
+      {"hotspots", {"1", "hot spots"}},
+      {"runaway", {"1", "runaway hot spots"}},
+      {"dying", {"1", "dying hot spots"}},
       // snapshot fields (docs/output.md)
       {"position", {"m", "position"}},
       {"velocity", {"m/s", "velocity"}},
