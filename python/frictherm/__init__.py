@@ -12,8 +12,12 @@
         meta = run.meta                             # decoded: str, int, float
 
 `open` also reads ensemble files (`frictherm ensemble`): an Ensemble with .members, .hotspots,
-.summary and .member(seed). Needs numpy and h5py (Debian python3-numpy, python3-h5py); pandas
-(python3-pandas) only for to_dataframe, matplotlib only for frictherm.plot.
+.summary and .member(seed). Needs numpy, h5py and pandas (Debian python3-numpy, python3-h5py,
+python3-pandas); xarray only for to_xarray, matplotlib only for frictherm.plot.
+
+Built with pybind11 (CMake build or install, not `pip install`), the package also runs scenes:
+frictherm.load_scene(path or dict), scene.set(key, value), frictherm.validate(scene),
+frictherm.run(scene, output=..., threads=..., observer=...) (frictherm/native.py).
 """
 import h5py
 
