@@ -75,6 +75,11 @@ struct H5Output::Impl {
   std::size_t count = 0;
   std::vector<std::string> grid_xml;
   std::string failure_xml;
+  // RUN_reference.xdmf: the same snapshots drawn at the reference positions X (`initial_position`),
+  // for ParaView's Warp By Vector on `displacement`; written once a snapshot has that field.
+  std::string reference_path;
+  std::vector<std::string> reference_xml;
+  std::string reference_failure_xml;
   double last_time = -std::numeric_limits<double>::infinity();
   std::set<std::size_t> connectivity;
 
@@ -208,13 +213,13 @@ struct H5Output::Impl {
 
   void write_xdmf() {
     if (!options.write_xdmf) return;
-    if (failure_xml.empty()) {
-      write_text_atomically(xdmf_path, xdmf_document(grid_xml));
-    } else {
-      std::vector<std::string> all = grid_xml;
-      all.push_back(failure_xml);
-      write_text_atomically(xdmf_path, xdmf_document(all));
-    }
+    const auto document = [](std::vector<std::string> grids, const std::string& failure, const std::string& name) {
+      if (!failure.empty()) grids.push_back(failure);
+      return xdmf_document(grids, name);
+    };
+    write_text_atomically(xdmf_path, document(grid_xml, failure_xml, "particles"));
+    if (!reference_xml.empty() || !reference_failure_xml.empty())
+      write_text_atomically(reference_path, document(reference_xml, reference_failure_xml, "particles_reference"));
   }
 
   void discard_snapshot() noexcept {
@@ -314,11 +319,19 @@ struct H5Output::Impl {
       flush_file();
       discard_snapshot();  // closes the (now linked) group and lifts the eviction hold
       if (drawable && options.write_xdmf) {
+        XdmfGrid reference = grid;
+        reference.geometry = "initial_position";
+        const bool has_reference = std::any_of(grid.fields.begin(), grid.fields.end(), [&](const XdmfField& f) {
+          return f.name == reference.geometry && f.components == dim && !f.integer;
+        });
         if (!failure) {
           grid_xml.push_back(xdmf_grid_xml(grid, io_name(), dim));
+          if (has_reference) reference_xml.push_back(xdmf_grid_xml(reference, io_name(), dim));
           last_time = time;
         } else {
           failure_xml = time > last_time ? xdmf_grid_xml(grid, io_name(), dim) : std::string();
+          reference_failure_xml =
+              time > last_time && has_reference ? xdmf_grid_xml(reference, io_name(), dim) : std::string();
         }
       }
       if (!failure) ++count;
@@ -362,6 +375,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.final_path = path;
   m.io.file = options.via_temporary ? temporary_path(path) : path;
   m.xdmf_path = xdmf_path_for(path);
+  m.reference_path = xdmf_reference_path_for(path);
   m.dim = dim;
   m.options = options;
   const Quiet quiet;

@@ -185,6 +185,12 @@ void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const st
       vectors(f, [&](std::size_t k) { return p.velocity[k]; });
     } else if (f == "displacement") {
       vectors(f, [&](std::size_t k) { return mechanics::Vec<Dim>(p.position[k] - p.initial_position[k]); });
+      // With it the reference positions X (dim columns), the geometry of RUN_reference.xdmf: Warp By
+      // Vector on `displacement` there draws x = X + u (docs/output.md "In ParaView").
+      buf.resize(n * Dim);
+      for (std::size_t k = 0; k < n; ++k)
+        for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = p.initial_position[k][d];
+      out.snapshot_field("initial_position", buf.data(), n, Dim);
     } else if (f == "stress") {
       buf.assign(n * 9, 0.0);
       for (std::size_t k = 0; k < n; ++k) {
