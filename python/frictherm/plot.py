@@ -51,6 +51,8 @@ def plot_particles(run, snap, field, out_png):
     pos = snap["position"].astype(float)
     values, clabel = field_values(snap, field)
     side = particle_side(run, snap)
+    factor, lunit = scale_for(np.abs(pos[:, :2]).max(), "m")  # mm or µm axes for small specimens
+    pos, side = pos * factor, side * factor
     order = np.argsort(pos[:, 2]) if run.dim == 3 else np.arange(len(pos))
     pos, values, side = pos[order], values[order], side[order]
     # Fixed axes boxes (no tight_layout or colorbar stealing space later), so that the data-unit to
@@ -68,8 +70,8 @@ def plot_particles(run, snap, field, out_png):
                     vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1.0)
     unit = unit_of(field)
     fig.colorbar(sc, cax=cax).set_label(clabel + (f" ({unit})" if unit else ""))
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
+    ax.set_xlabel(f"x ({lunit})")
+    ax.set_ylabel(f"y ({lunit})")
     what = "failure state" if snap.is_failure else f"snapshot {snap.label}"
     ax.set_title(f"{clabel} at t = {snap.time:.4g} s (step {snap.step}, {what})")
     fig.savefig(out_png)
@@ -199,11 +201,14 @@ def draw_hotspots(run, snap, png):
     img = plt.imread(png)
     fig = plt.figure(figsize=(7.5, 6), dpi=120)
     fig.figimage(img, 0, 0)
-    ax, pad = _frame(fig, snap["position"].astype(float), particle_side(run, snap))
+    pos = snap["position"].astype(float)
+    factor, _ = scale_for(np.abs(pos[:, :2]).max(), "m")  # the axes plot_particles drew
+    ax, pad = _frame(fig, pos * factor, particle_side(run, snap) * factor)
     ax.set_zorder(1)  # above the figure image (figure images are drawn after axes of equal zorder)
     ax.patch.set_alpha(0.0)
     ax.set_axis_off()
-    for x, y, d, i in zip(sel["centroid_x"], sel["centroid_y"], sel["equivalent_diameter"], sel["id"]):
+    for x, y, d, i in zip(sel["centroid_x"] * factor, sel["centroid_y"] * factor, sel["equivalent_diameter"] * factor,
+                          sel["id"]):
         ax.add_patch(plt.Circle((x, y), max(d, 2 * pad) / 2, fill=False, color="cyan", lw=1.2))
         ax.annotate("%d" % i, (x, y), color="cyan", fontsize=7, xytext=(4, 4), textcoords="offset points")
     fig.savefig(png)
