@@ -64,6 +64,7 @@ const std::map<std::string, Entry>& catalogue() {
       {"reaction_heat", {"J", "reaction heat released"}},
       {"max_reaction_progress", {"1", "maximum reaction progress"}},
       {"max_interface_temperature", {"K", "maximum interface temperature"}},
+      {"max_interface_reaction_progress", {"1", "maximum reaction progress at the interface temperature"}},
       // /hotspots and /hotspot_fates
       {"id", {"1", "id"}},
       {"particle_count", {"1", "particles"}},
@@ -106,6 +107,7 @@ const std::map<std::string, Entry>& catalogue() {
       {"body", {"1", "body id"}},
       {"reaction_progress", {"1", "reaction progress"}},
       {"interface_temperature", {"K", "interface temperature"}},
+      {"interface_reaction_progress", {"1", "reaction progress at the interface temperature"}},
       {"polyvertex", {"1", "XDMF polyvertex connectivity"}},
       {"connectivity", {"1", "XDMF polyvertex connectivity"}},
       // /meta numbers
