@@ -7,6 +7,8 @@
 #include "frictherm/mechanics/distributed.hpp"
 #include "distributed/petsc_check.hpp"
 
+#include <frictherm/mechanics/constitutive/stress_update.hpp>
+
 #include <petscdmda.h>
 #include <petscdmswarm.h>
 #include <petscsf.h>
@@ -96,9 +98,8 @@ struct DecomposedMpm<Dim>::Impl {
   int rank = 0, size = 1;
   Grid<Dim> grid;
   std::vector<Material> materials;
-  // Per material, hoisted out of the stress update's particle loop: Lamé λ, shear modulus μ, the
-  // Mie-Grüneisen limit J (mie_gruneisen_min_J) and the linear-elastic wave speed.
-  std::vector<double> lambda, mu, min_J, c0;
+  // Per material, hoisted out of the stress update's particle loop (constitutive/stress_update.hpp).
+  std::vector<StressLaw> laws;
   bool has_mie_gruneisen = false;
   // Rigid materials (velocity boundary conditions on the nodes they touch, as the serial
   // map_rigid_particles / apply_velocity_bc / update_grid): per axis d and local node, the largest
