@@ -208,7 +208,7 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
-// below the empty-node mass get neither (as the serial update_grid).
+// below the empty-node mass get neither (as the serial nodal_velocities).
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
@@ -223,7 +223,7 @@ void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
       node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
     }
     if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0; driven && m > empty_node_mass)
-      for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial update_grid)
+      for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial nodal_velocities)
         if (driven & (1u << d)) node[velocity + d] = drive_velocity[static_cast<std::size_t>(q)][d];
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
