@@ -65,7 +65,7 @@ TEST(StepPhases, ListsPerScheme) {
                    "velocity_from_momentum", "stress_update"}));
   // Damping: one phase between the velocity conditions and the momentum update.
   const Names damped = names(UpdateScheme::usl, false, 100.0);
-  ASSERT_EQ(damped.size(), 9u);
+  ASSERT_EQ(damped.size(), 10u);
   EXPECT_EQ(damped[4], "damping");
 }
 
