@@ -16,7 +16,6 @@ namespace frictherm::mechanics {
 using contact_detail::PairContext;
 template <int Dim>
 void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
-  const NestedPhase timed(phase_times_.contact, nested_phase_);  // called inside other phases
   const bool heat = pass == ContactPass::updated;
   const bool forces = pass == ContactPass::updated;
   const std::size_t nm = materials_.size();
