@@ -251,6 +251,86 @@ CASES = [
 ]
 
 
+# --- runtime failures (issue 34) ---------------------------------------------------------------
+# Scenes that pass validation and fail during the run. Each must end as a blow-up does: exit code 1,
+# the first message line naming the key (and, for a friction law, the state N, v, A where it failed),
+# the result published (OUT.h5 readable, /meta/status "failed", the state under /failure), its XDMF
+# naming only files that exist, no temporary left behind.
+def contact_scene(law, where="pair", thermal=False):
+    """A block sliding at 0.1 m/s onto a fixed base: the pair's law is evaluated from step 0 at v = 0.1 m/s."""
+    soft = BASE["materials"]["soft"]
+    s = {"dimension": 2, "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.005},
+         "materials": {"base": soft, "block": soft},
+         "bodies": [{"name": "base", "material": "base", "shape": {"type": "rectangle", "lo": [0, 0], "hi": [0.1, 0.02]}},
+                    {"name": "block", "material": "block", "velocity": [0.1, -0.02],
+                     "shape": {"type": "rectangle", "lo": [0.02, 0.02], "hi": [0.05, 0.035]}}],
+         "boundary": {"fixed": [{"face": "y_min"}]},
+         "run": {"end_time": 5e-3, "threads": 1}, "output": {"snapshot_count": 4}}
+    if where == "pair":
+        s["contact"] = {"pairs": [{"materials": ["base", "block"], "normal": [0, 1], "law": law}]}
+    else:
+        s["contact"] = {"law": law}
+    if thermal:
+        s["thermal"] = {"materials": {m: {"heat_capacity": 1000, "conductivity": 1} for m in ("base", "block")}}
+        s["coupling"] = {"continuation": {"duration": 1e-3, "intervals": 2}}
+    return json.dumps(s)
+
+
+def expression(text):
+    return {"type": "expression", "sliding_traction": text}
+
+
+# The validator samples v in {0, 1e-3, 1, 1e3} m/s: a law bad only for 2e-3 < v < 0.5 passes it.
+RUNTIME_CASES = [
+    ("expression law negative while sliding", contact_scene(expression("(v>2e-3 && v<0.5) ? -N : 0.3*N")),
+     ["contact.pairs[0].law", "materials 'base' and 'block'", "returned S = -", "N = ", "sliding speed = 0.1"]),
+    ("expression law NaN while sliding", contact_scene(expression("(v>2e-3 && v<0.5) ? sqrt(-1) : 0.3*N")),
+     ["contact.pairs[0].law", "nan for N = ", "A_c = "]),
+    ("expression law infinite while sliding", contact_scene(expression("(v>2e-3 && v<0.5) ? 1e308*N*N : 0.3*N")),
+     ["contact.pairs[0].law", "returned S = inf"]),
+    ("contact.law expression negative", contact_scene(expression("(v>2e-3 && v<0.5) ? -N : 0.3*N"), where="default"),
+     ["contact.law", "returned S = -"]),
+    ("expression law negative, thermal scene",
+     contact_scene(expression("(v>2e-3 && v<0.5) ? -0.2*N : 0.2*N"), thermal=True),
+     ["contact.pairs[0].law", "returned S = -"]),
+]
+
+
+def check_published(workdir, out):
+    """Problems with the published result `out` of a failed run (empty list: none)."""
+    import h5py  # only the runtime cases need it
+    problems = []
+    path = os.path.join(workdir, out)
+    left = [f for f in os.listdir(workdir) if f.endswith(".part") or f.endswith(".tmp")]
+    if left:
+        problems.append("temporaries left behind: %s" % left)
+    if not os.path.exists(path):
+        return problems + ["%s was not published" % out]
+    try:
+        with h5py.File(path, "r") as f:
+            status = f["meta/status"][()]
+            status = status.decode() if isinstance(status, bytes) else str(status)
+            if status != "failed":
+                problems.append("/meta/status = %s (expected failed)" % status)
+            if "failure" not in f or "position" not in f["failure"]:
+                problems.append("no failing state under /failure")
+            if "meta/failure" not in f:
+                problems.append("no /meta/failure message")
+    except Exception as e:  # noqa: BLE001 - any unreadable file is the finding
+        problems.append("%s does not read: %s" % (out, e))
+    xdmf = os.path.splitext(path)[0] + ".xdmf"
+    if not os.path.exists(xdmf):
+        problems.append("no XDMF file")
+    else:
+        import re
+        with open(xdmf) as fx:
+            named = set(re.findall(r">\s*([^<>:\s]+):/", fx.read()))
+        for n in named:
+            if not os.path.exists(os.path.join(workdir, n)):
+                problems.append("the XDMF names %s, which does not exist" % n)
+    return problems
+
+
 def run_case(exe, workdir, case):
     name, text, files, argv, key = case
     for rel, data in files.items():
@@ -323,7 +403,34 @@ def main():
             shutil.copytree(workdir, os.path.join(a.keep, case[0].replace(" ", "_").replace("/", "_")), dirs_exist_ok=True)
         shutil.rmtree(workdir, ignore_errors=True)
     print("%d of %d bad inputs refused as expected" % (count - failures, count))
-    return 1 if failures else 0
+    runtime_failures = 0
+    runtime_count = 0
+    for name, text, keys in RUNTIME_CASES:
+        if a.k not in name:
+            continue
+        runtime_count += 1
+        workdir = tempfile.mkdtemp(prefix="frictherm_fail_")
+        code, out, err, wall, usage, _ = run_case(os.path.abspath(a.exe), workdir,
+                                                  (name, text, {}, ["run", "SCENE", "-o", "out.h5"], ""))
+        first = (err.strip().splitlines() or [""])[0]
+        problems = []
+        if code != 1:
+            problems.append("exit code %s (expected 1)" % code)
+        for k in keys:
+            if k not in first:
+                problems.append("message does not name '%s'" % k)
+        os.remove(os.path.join(workdir, "scene.json"))
+        problems += check_published(workdir, "out.h5")
+        shown = first if len(first) < 220 else first[:217] + "..."
+        print("%-4s rc=%s wall=%.2fs  %-44s %s" % ("FAIL" if problems else "ok", code, wall, name, shown))
+        for p in problems:
+            print("     -> " + p)
+        runtime_failures += 1 if problems else 0
+        if a.keep:
+            shutil.copytree(workdir, os.path.join(a.keep, name.replace(" ", "_").replace("/", "_")), dirs_exist_ok=True)
+        shutil.rmtree(workdir, ignore_errors=True)
+    print("%d of %d runtime failures ended cleanly" % (runtime_count - runtime_failures, runtime_count))
+    return 1 if failures or runtime_failures else 0
 
 
 if __name__ == "__main__":
