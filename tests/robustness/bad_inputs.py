@@ -250,6 +250,27 @@ CASES = [
     ("-o followed by an option", scene(), {}, ["run", "SCENE", "-o", "--force"], "option '-o'"),
 ]
 
+# --- inputs of continue, resume and export-csv are never replaced, --force or not (issue 34) -----
+# A sixth element: commands run first (each must succeed); the files they leave must be byte-equal
+# after the refused command.
+RESULT_SETUP = [["run", "SCENE", "-o", "R.h5", "-q"]]  # R.h5, R.xdmf and the end-of-loading R.h5.checkpoint
+THERMAL = json.dumps(dict(json.loads(scene()),
+                          thermal={"materials": {"soft": {"heat_capacity": 1000, "conductivity": 1}}},
+                          coupling={"continuation": {"duration": 1e-3, "intervals": 2}},
+                          run={"end_time": 5e-4, "threads": 1}))
+CASES += [
+    ("continue -o its input", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5"], "refusing to write 'R.h5'",
+     RESULT_SETUP),
+    ("continue -o its input --force", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5", "--force"],
+     "refusing to write 'R.h5'", RESULT_SETUP),
+    ("continue -o its checkpoint --force", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5.checkpoint", "--force"],
+     "refusing to write 'R.h5.checkpoint'", RESULT_SETUP),
+    ("resume -o its checkpoint --force", THERMAL, {}, ["resume", "R.h5", "-o", "R.h5.checkpoint", "--force"],
+     "refusing to write 'R.h5.checkpoint'", RESULT_SETUP),
+    ("export-csv -o its input --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "R.h5", "--force"],
+     "refusing to write 'R.h5'", RESULT_SETUP),
+]
+
 
 # --- runtime failures (issue 34) ---------------------------------------------------------------
 # Scenes that pass validation and fail during the run. Each must end as a blow-up does: exit code 1,
@@ -331,8 +352,20 @@ def check_published(workdir, out):
     return problems
 
 
+def file_hashes(workdir):
+    import hashlib
+    out = {}
+    for f in sorted(os.listdir(workdir)):
+        path = os.path.join(workdir, f)
+        if os.path.isfile(path) and not f.startswith("."):
+            with open(path, "rb") as fh:
+                out[f] = hashlib.sha1(fh.read()).hexdigest()
+    return out
+
+
 def run_case(exe, workdir, case):
-    name, text, files, argv, key = case
+    name, text, files, argv, key = case[:5]
+    setup = case[5] if len(case) > 5 else []
     for rel, data in files.items():
         path = os.path.join(workdir, rel)
         os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -342,6 +375,11 @@ def run_case(exe, workdir, case):
     if text is not None:
         with open(scene_path, "w") as f:
             f.write(text)
+    for command in setup:
+        done = subprocess.run([exe] + [scene_path if a == "SCENE" else a for a in command], cwd=workdir,
+                              stdin=subprocess.DEVNULL, capture_output=True)
+        if done.returncode != 0:
+            raise RuntimeError("setup %s failed: %s" % (command, done.stderr.decode(errors="replace")))
     args = [a.replace("SCENE", scene_path) if a == "SCENE" else a for a in argv]
     key = key.replace("SCENE", scene_path)
     t0 = time.monotonic()
@@ -376,6 +414,16 @@ def main():
             continue
         count += 1
         workdir = tempfile.mkdtemp(prefix="frictherm_bad_")
+        before = None
+        if len(case) > 5:  # the files of the setup commands, to compare after the refusal
+            try:
+                run_case(os.path.abspath(a.exe), workdir, case[:2] + ({}, ["--version"], "", case[5]))
+            except RuntimeError as e:
+                print("FAIL %s: %s" % (case[0], e))
+                failures += 1
+                continue
+            before = file_hashes(workdir)
+            case = case[:5]
         code, out, err, wall, usage, key = run_case(os.path.abspath(a.exe), workdir, case)
         cpu = usage.ru_utime + usage.ru_stime
         rss_mb = usage.ru_maxrss / 1024.0
@@ -392,6 +440,13 @@ def main():
             problems.append("%.2f s CPU (limit %.1f)" % (cpu, CPU_LIMIT))
         if rss_mb > RSS_LIMIT_MB:
             problems.append("%.0f MB resident (limit %.0f)" % (rss_mb, RSS_LIMIT_MB))
+        if before is not None:
+            after = file_hashes(workdir)
+            for f, h in before.items():
+                if after.get(f) != h:
+                    problems.append("%s was %s" % (f, "changed" if f in after else "removed"))
+            if sorted(after) != sorted(before):
+                problems.append("files left: %s" % sorted(set(after) - set(before)))
         status = "FAIL" if problems else "ok"
         shown = first if len(first) < 220 else first[:217] + "..."
         print("%-4s rc=%s cpu=%.2fs wall=%.2fs rss=%.0fMB  %-44s %s" % (status, code, cpu, wall, rss_mb, case[0], shown))
