@@ -272,6 +272,44 @@ CASES += [
 ]
 
 
+# --- damaged checkpoints: every array's size and finiteness checked before any step (issue 34) ----
+def damage(name, change):
+    """A setup step: rewrites dataset `name` of R.h5.checkpoint with change(old values)."""
+    def apply(workdir):
+        import h5py
+        import numpy
+        with h5py.File(os.path.join(workdir, "R.h5.checkpoint"), "r+") as f:
+            data = change(numpy.array(f[name][...]))
+            del f[name]
+            f.create_dataset(name, data=data)
+    return apply
+
+
+def with_nan(values):
+    values = values.astype(float)
+    values.flat[min(7, values.size - 1)] = float("nan")
+    return values
+
+
+CASES += [
+    ("checkpoint: 10 nodal temperatures", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /nodal_temperature holds 10 items, expected",
+     RESULT_SETUP + [damage("nodal_temperature", lambda v: v[:10])]),
+    ("checkpoint: 1e7 work_first", THERMAL, {}, ["continue", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/work_first holds 10000000 items, expected",
+     RESULT_SETUP + [damage("mechanics/work_first", lambda v: __import__("numpy").zeros(10 ** 7))]),
+    ("checkpoint: NaN velocity", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/particles/velocity holds a non-finite value",
+     RESULT_SETUP + [damage("mechanics/particles/velocity", with_nan)]),
+    ("checkpoint: 10 particle masses", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/particles/mass holds 10 items, expected",
+     RESULT_SETUP + [damage("mechanics/particles/mass", lambda v: v[:10])]),
+    ("checkpoint: infinite time", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/time holds a non-finite value",
+     RESULT_SETUP + [damage("mechanics/time", lambda v: v * float("inf"))]),
+]
+
+
 # --- runtime failures (issue 34) ---------------------------------------------------------------
 # Scenes that pass validation and fail during the run. Each must end as a blow-up does: exit code 1,
 # the first message line naming the key (and, for a friction law, the state N, v, A where it failed),
@@ -376,6 +414,9 @@ def run_case(exe, workdir, case):
         with open(scene_path, "w") as f:
             f.write(text)
     for command in setup:
+        if callable(command):
+            command(workdir)
+            continue
         done = subprocess.run([exe] + [scene_path if a == "SCENE" else a for a in command], cwd=workdir,
                               stdin=subprocess.DEVNULL, capture_output=True)
         if done.returncode != 0:

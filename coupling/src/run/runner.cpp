@@ -307,7 +307,13 @@ class Run {
   }
 
   void restore() {
-    read_checkpoint(o_.resume_checkpoint, *sim_, [&](const ckpt::Reader& r) { visit_run_state(r); });
+    try {  // a checkpoint that does not fit the scene is a bad input (exit code 2), refused before any step
+      read_checkpoint(o_.resume_checkpoint, *sim_, [&](const ckpt::Reader& r) { visit_run_state(r); });
+    } catch (const SceneError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
     if (o_.resume_appends) base_marks_ = checkpoint_marks(o_.resume_checkpoint);
   }
 
