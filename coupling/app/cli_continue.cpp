@@ -4,6 +4,7 @@
 #include "cli_resume.hpp"
 
 #include <frictherm/coupling/checkpoint.hpp>
+#include <frictherm/coupling/output_files.hpp>
 
 #include <filesystem>
 #include <iostream>
@@ -22,7 +23,7 @@ const char* const kContinueHelp =
     "end-of-loading hot spots again (ids from 0). OUT.h5.checkpoint is its end-of-loading checkpoint.\n"
     "\n"
     "  -o, --output FILE     result (default RUN.continued.h5)\n"
-    "  -f, --force           replace FILE if it exists (else refused)\n"
+    "  -f, --force           replace FILE if it exists (else refused; never RUN.h5 itself)\n"
     "  -s, --set KEY=VALUE   a thermal setting (repeatable): thermal.* (integrator, rtol, atol,\n"
     "                        linear_solver, reaction.*, stability, ...; not thermal.materials),\n"
     "                        coupling.continuation.* (duration, intervals, stop_when_decided),\n"
@@ -79,6 +80,12 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
       overrides.push_back(o);
     }
   return run_from_checkpoint(q, "continue", [&] {
+    // The continued run is a new result: it never replaces RUN.h5 or its checkpoint, --force or not
+    // (resume appends in place; continue would lose the continuation it started from).
+    if (q.output == q.run || coupling::same_file(q.output, q.run))
+      throw coupling::OutputError("refusing to write '" + q.output + "': it is the input of continue ('" + q.run +
+                                  "', with its checkpoint " + q.checkpoint + "), which is never replaced; choose "
+                                  "another output file (default RUN.continued.h5)");
     if (!std::filesystem::exists(q.checkpoint))
       throw coupling::OutputError("no checkpoint " + q.checkpoint + " (runs with coupling.continuation write one at the end of loading)");
     q.scene = checkpoint_scene_or_refuse(q.checkpoint, overrides);  // first: refuses an unreadable checkpoint

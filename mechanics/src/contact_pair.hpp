@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -217,6 +219,23 @@ std::size_t lump_partners(const std::vector<ContactSide<Dim>>& sides, const std:
 /// Three or more: each material against the others lumped into one virtual material; its change is
 /// applied to it alone, frictional work summed with eq. 40 (1/m_red = Σ_j 1/m_j, eq. 39). Calls
 /// apply(j, Δp) for the momentum change of sides[j] and, in the heating pass (ctx.heat), add_work(a, b,
+/// A friction law that failed at a contact node (FrictionLaw::in_contact threw: an expression law
+/// returning a negative, NaN or infinite traction), with the material pair whose law it is.
+struct ContactPairError : std::runtime_error {
+  ContactPairError(const std::string& what, int a, int b) : std::runtime_error(what), material_a(a), material_b(b) {}
+  int material_a, material_b;
+};
+
+template <int Dim>
+PairChange<Dim> pair_contact_of(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const Vec<Dim>& h, PairContext& ctx,
+                                int ma, int mb) {
+  try {
+    return pair_contact(a, b, h, ctx);
+  } catch (const std::exception& e) {
+    throw ContactPairError(e.what(), ma, mb);
+  }
+}
+
 /// W1, W2) for the frictional work of the material pair (a, b), counting sliding pairs in
 /// sliding_nodes. lagged_normal / lagged_step: the node's regularisation state (null when off), used
 /// by two-material nodes only. dps: scratch.
@@ -234,7 +253,7 @@ void resolve_contact_node(const std::vector<ContactSide<Dim>>& sides, const std:
       ctx.settings = &pair_of(mats[ia], mats[ib]);
       ctx.lagged_normal = lagged_normal;
       ctx.lagged_step = lagged_step;
-      const PairChange<Dim> r = pair_contact(sides[ia], sides[ib], h, ctx);
+      const PairChange<Dim> r = pair_contact_of(sides[ia], sides[ib], h, ctx, mats[ia], mats[ib]);
       ctx.lagged_normal = ctx.lagged_step = nullptr;
       if (r.changed) {
         apply(ia, r.dp);
@@ -260,7 +279,7 @@ void resolve_contact_node(const std::vector<ContactSide<Dim>>& sides, const std:
       const std::size_t dominant = lump_partners(sides, mats, a, rest, pair_of);
       if (dominant == count) continue;  // all its partners here use penalty contact
       ctx.settings = &pair_of(mats[a], mats[dominant]);
-      const PairChange<Dim> r = pair_contact(sides[a], rest, h, ctx);
+      const PairChange<Dim> r = pair_contact_of(sides[a], rest, h, ctx, mats[a], mats[dominant]);
       if (r.changed) dps[a] = r.dp;
       if (r.sliding && heat) {
         ++sliding_nodes;

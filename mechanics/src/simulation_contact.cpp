@@ -1,6 +1,7 @@
 // Multimaterial contact at nodes that carry two or more materials (Nairn, Bardenhagen & Smith 2018
 // §2.2–2.12): normal, detection, contact area, stick change and friction law, consistent forces and
 // frictional work. Sign convention in contact.hpp: n̂ points from material a to material b.
+#include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include "contact_pair.hpp"
@@ -10,10 +11,27 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <string>
 
 namespace frictherm::mechanics {
 
 using contact_detail::PairContext;
+
+namespace {
+
+// The first contact node group (in group order, so the same on any thread count) whose friction law threw.
+struct ContactFailure {
+  long group = -1;
+  int node = -1, material_a = -1, material_b = -1;
+  std::string what;
+  void keep(long g, int n, int a, int b, const char* message) {
+#pragma omp critical(frictherm_contact_failure)
+    if (group < 0 || g < group) group = g, node = n, material_a = a, material_b = b, what = message;
+  }
+};
+
+}  // namespace
 template <int Dim>
 void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const bool heat = pass == ContactPass::updated;
@@ -46,6 +64,10 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     }
   }
 
+  // A friction law that throws (an expression law's negative or non-finite traction) must not leave
+  // the parallel region (that would end the program): the failure at the first such group is kept
+  // and thrown after it as a SimulationError, the run's ordinary breakdown.
+  ContactFailure failure;
 #pragma omp parallel num_threads(threads)
   {
     ContactThreadWork& acc = contact_thread_work_[static_cast<std::size_t>(omp_get_thread_num())];
@@ -75,6 +97,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
 #pragma omp for schedule(static)
     for (long g = 0; g < groups; ++g) {
       const int node = contact_entries_[contact_groups_[static_cast<std::size_t>(g)]].node;
+      try {
       const int guarded = gather_contact_sides(static_cast<std::size_t>(g), dt, sides, slots, mats, entries);
       if (heat) stats.guarded += guarded;
       const std::size_t count = sides.size();
@@ -101,7 +124,30 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
           },
           [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); }, stats.sliding_nodes);
       if (rigid) acc.rigid_work.push_back(rigid_work);
+      } catch (const contact_detail::ContactPairError& e) {
+        failure.keep(g, node, e.material_a, e.material_b, e.what());
+      } catch (const std::exception& e) {
+        failure.keep(g, node, -1, -1, e.what());
+      }
     }
+  }
+  if (failure.group >= 0) {  // "step S, t = T s: contact.pairs[0].law (materials 'a' and 'b') at node ..."
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << "step " << step_ << ", t = " << time_ << " s: ";
+    if (failure.material_a >= 0) {
+      const std::string& origin = contact_pair(failure.material_a, failure.material_b).origin;
+      msg << (origin.empty() ? std::string("contact") : origin) << " (materials '"
+          << materials_[static_cast<std::size_t>(failure.material_a)].name << "' and '"
+          << materials_[static_cast<std::size_t>(failure.material_b)].name << "')";
+    } else {
+      msg << "contact";
+    }
+    const Vec<Dim> x = grid_.node_position(failure.node);
+    msg << " at node " << failure.node << " (";
+    for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << x[d];
+    msg << ") m: " << failure.what;
+    throw SimulationError(msg.str(), step_, time_, -1);
   }
   if (!heat) return;
   for (const auto& t : contact_thread_work_) {

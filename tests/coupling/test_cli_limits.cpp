@@ -1,15 +1,16 @@
 // Resource bombs and endless runs refused by `frictherm validate` (issue 15 items 1-2, scene_cost.hpp):
-// each bad scene exits with code 2 within a second, with one message naming the key path and the
-// numbers, before anything large is allocated.
+// each bad scene exits with code 2, with one message naming the key path and the numbers, before
+// anything large is allocated (its peak resident size is checked, not its wall time: a loaded
+// machine must not fail the test; tests/robustness/bad_inputs.py bounds CPU time and 200 MB).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -22,20 +23,21 @@ namespace {
 struct Result {
   int code = -1;
   std::string output;
-  double seconds = 0.0;
+  double peak_mb = 0.0;  // largest resident size of any child this process has waited for
 };
 
 Result validate(const std::string& scene, const std::string& sets) {
   const std::string cmd = std::string("'") + FRICTHERM_EXE + "' validate '" + scene + "' " + sets + " 2>&1";
   Result r;
-  const auto t0 = std::chrono::steady_clock::now();
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
   char buf[4096];
   std::size_t n;
   while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
   const int status = pclose(p);
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rusage children{};
+  getrusage(RUSAGE_CHILDREN, &children);
+  r.peak_mb = static_cast<double>(children.ru_maxrss) / 1024.0;  // kB on Linux
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
@@ -57,13 +59,14 @@ class Limits : public ::testing::Test {
     std::ofstream(scene_) << kBase;
   }
   void TearDown() override { fs::remove(scene_); }
-  // A refusal: exit code 2, one message starting with "frictherm: SCENE: KEY", within a second.
+  // A refusal: exit code 2, one message starting with "frictherm: SCENE: KEY", nothing large allocated:
+  // every bomb here asks for terabytes, the sanitizer build's program holds about 300 MB.
   void expect_refused(const std::string& sets, const std::string& key, const std::string& detail) {
     const Result r = validate(scene_, sets);
     EXPECT_EQ(r.code, 2) << sets << "\n" << r.output;
     EXPECT_THAT(r.output, StartsWith("frictherm: " + scene_ + ": " + key)) << sets;
     EXPECT_THAT(r.output, HasSubstr(detail)) << sets;
-    EXPECT_LT(r.seconds, 1.0) << sets;
+    EXPECT_LT(r.peak_mb, 1500.0) << sets;
   }
   std::string scene_;
 };

@@ -58,7 +58,9 @@ std::string mpi_exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string mpirun() {
   const Result which = shell("command -v mpirun");
   if (which.code != 0 || which.output.empty()) return "";
-  std::string cmd = "mpirun --oversubscribe";  // 2 processes even on a 1-core machine
+  // 2 processes even on a 1-core machine; waiting ranks yield their core (Open MPI polls busily unless
+  // it counts more ranks than slots, and other processes may hold the cores: issue 34).
+  std::string cmd = "env OMPI_MCA_mpi_yield_when_idle=1 mpirun --oversubscribe";
   if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
   return cmd;
 }

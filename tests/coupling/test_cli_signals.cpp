@@ -1,5 +1,6 @@
-// SIGINT / SIGTERM end a run cleanly: the program finishes the current step, writes the series and a
-// last snapshot, sets /meta/status to "interrupted", says so, and exits with 128 + the signal.
+// SIGINT / SIGTERM end a run cleanly: the program finishes the current step, writes a checkpoint
+// (also without run.checkpoint_interval), the series and a last snapshot, sets /meta/status to
+// "interrupted", says so, and exits with 128 + the signal. A second signal is absorbed (issue 34).
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
@@ -65,23 +66,33 @@ struct Interrupted {
   std::string stderr_text;
 };
 
-// Starts `frictherm run`, waits until it has written series rows for a while, sends `signal`.
-Interrupted run_and_signal(const fs::path& dir, int signal) {
-  const std::string scene = (dir / "long.json").string(), out = (dir / "long.h5").string();
+// A file of `dir` whose name ends in ".part" (a run's output before it is published).
+bool part_file_exists(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.size() > 5 && n.compare(n.size() - 5, 5, ".part") == 0) return true;
+  }
+  return false;
+}
+
+// Starts `frictherm ARGS...`, waits until it has written series rows for a while, sends `signal`
+// `times` times in a row.
+Interrupted command_and_signal(const fs::path& dir, const std::vector<std::string>& args, int signal, int times = 1) {
   const std::string err = (dir / "stderr.txt").string();
-  std::ofstream(scene) << kLongScene;
   const pid_t pid = fork();
   if (pid == 0) {
     std::freopen(err.c_str(), "w", stderr);
-    execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
+    std::vector<char*> argv{const_cast<char*>(FRICTHERM_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(FRICTHERM_EXE, argv.data());
     _exit(127);
   }
   // The handlers are installed before the output file is created; wait for the file (written as
   // "<out>.<pid>.part" until the run ends, output_files.hpp), then a while.
-  const std::string live = out + "." + std::to_string(pid) + ".part";
-  for (int i = 0; i < 200 && !fs::exists(live); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  for (int i = 0; i < 400 && !part_file_exists(dir); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  kill(pid, signal);
+  for (int k = 0; k < times; ++k) kill(pid, signal);  // as `timeout` does: to the process, then its group
   int status = 0;
   waitpid(pid, &status, 0);
   Interrupted r;
@@ -89,6 +100,13 @@ Interrupted run_and_signal(const fs::path& dir, int signal) {
   std::ifstream in(err);
   r.stderr_text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   return r;
+}
+
+// Starts `frictherm run` of the long scene into dir/long.h5 and signals it.
+Interrupted run_and_signal(const fs::path& dir, int signal, int times = 1) {
+  const std::string scene = (dir / "long.json").string(), out = (dir / "long.h5").string();
+  std::ofstream(scene) << kLongScene;
+  return command_and_signal(dir, {"run", scene, "-o", out, "--quiet"}, signal, times);
 }
 
 class Signals : public ::testing::TestWithParam<int> {};
@@ -128,6 +146,40 @@ TEST_P(Signals, RunStopsCleanlyWithStatusInterruptedAndReadableFile) {
   EXPECT_EQ(static_cast<double>(step), steps);
   H5Gclose(last);
   H5Gclose(g);
+  H5Fclose(f);
+  // The scene sets no run.checkpoint_interval: the interruption still leaves a checkpoint to resume
+  // from, and says how (71b95b2 wrote none, so the `resume` the docs promise was refused).
+  EXPECT_TRUE(fs::exists(dir / "long.h5.checkpoint"));
+  EXPECT_NE(r.stderr_text.find("Go on with: frictherm resume"), std::string::npos) << r.stderr_text;
+  fs::remove_all(dir);
+}
+
+// Two SIGTERMs in a row (`timeout` signals the process, then its group): the second is absorbed, the
+// run ends as after one (71b95b2: killed at once, status "running", no checkpoint). Then `resume`
+// goes on from the checkpoint: interrupted again, the appended result has more steps.
+TEST(SignalsTwice, SecondSignalAbsorbedAndResumeGoesOn) {
+  const fs::path dir = fs::temp_directory_path() / ("frictherm_signals_twice_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Interrupted r = run_and_signal(dir, SIGTERM, 2);
+  EXPECT_EQ(r.exit_code, 128 + SIGTERM) << r.stderr_text;
+  const std::string out = (dir / "long.h5").string();
+  double steps = -1.0;
+  {
+    const hid_t f = H5Fopen(out.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(f, 0) << "the interrupted run's file must open";
+    EXPECT_EQ(read_string(f, "/meta/status"), "interrupted");
+    steps = read_double(f, "/meta/steps");
+    H5Fclose(f);
+  }
+  ASSERT_TRUE(fs::exists(out + ".checkpoint"));
+
+  const Interrupted again = command_and_signal(dir, {"resume", out, "--quiet"}, SIGTERM, 2);
+  EXPECT_EQ(again.exit_code, 128 + SIGTERM) << again.stderr_text;
+  const hid_t f = H5Fopen(out.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << "the resumed result must open";
+  EXPECT_EQ(read_string(f, "/meta/status"), "interrupted");
+  EXPECT_GT(read_double(f, "/meta/steps"), steps) << "resume did not go on from the checkpoint";
   H5Fclose(f);
   fs::remove_all(dir);
 }

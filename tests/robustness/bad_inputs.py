@@ -250,9 +250,160 @@ CASES = [
     ("-o followed by an option", scene(), {}, ["run", "SCENE", "-o", "--force"], "option '-o'"),
 ]
 
+# --- inputs of continue, resume and export-csv are never replaced, --force or not (issue 34) -----
+# A sixth element: commands run first (each must succeed); the files they leave must be byte-equal
+# after the refused command.
+RESULT_SETUP = [["run", "SCENE", "-o", "R.h5", "-q"]]  # R.h5, R.xdmf and the end-of-loading R.h5.checkpoint
+THERMAL = json.dumps(dict(json.loads(scene()),
+                          thermal={"materials": {"soft": {"heat_capacity": 1000, "conductivity": 1}}},
+                          coupling={"continuation": {"duration": 1e-3, "intervals": 2}},
+                          run={"end_time": 5e-4, "threads": 1}))
+CASES += [
+    ("continue -o its input", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5"], "refusing to write 'R.h5'",
+     RESULT_SETUP),
+    ("continue -o its input --force", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5", "--force"],
+     "refusing to write 'R.h5'", RESULT_SETUP),
+    ("continue -o its checkpoint --force", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5.checkpoint", "--force"],
+     "refusing to write 'R.h5.checkpoint'", RESULT_SETUP),
+    ("resume -o its checkpoint --force", THERMAL, {}, ["resume", "R.h5", "-o", "R.h5.checkpoint", "--force"],
+     "refusing to write 'R.h5.checkpoint'", RESULT_SETUP),
+    ("export-csv -o its input --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "R.h5", "--force"],
+     "refusing to write 'R.h5'", RESULT_SETUP),
+]
+
+
+# --- damaged checkpoints: every array's size and finiteness checked before any step (issue 34) ----
+def damage(name, change):
+    """A setup step: rewrites dataset `name` of R.h5.checkpoint with change(old values)."""
+    def apply(workdir):
+        import h5py
+        import numpy
+        with h5py.File(os.path.join(workdir, "R.h5.checkpoint"), "r+") as f:
+            data = change(numpy.array(f[name][...]))
+            del f[name]
+            f.create_dataset(name, data=data)
+    return apply
+
+
+def with_nan(values):
+    values = values.astype(float)
+    values.flat[min(7, values.size - 1)] = float("nan")
+    return values
+
+
+CASES += [
+    ("checkpoint: 10 nodal temperatures", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /nodal_temperature holds 10 items, expected",
+     RESULT_SETUP + [damage("nodal_temperature", lambda v: v[:10])]),
+    ("checkpoint: 1e7 work_first", THERMAL, {}, ["continue", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/work_first holds 10000000 items, expected",
+     RESULT_SETUP + [damage("mechanics/work_first", lambda v: __import__("numpy").zeros(10 ** 7))]),
+    ("checkpoint: NaN velocity", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/particles/velocity holds a non-finite value",
+     RESULT_SETUP + [damage("mechanics/particles/velocity", with_nan)]),
+    ("checkpoint: 10 particle masses", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/particles/mass holds 10 items, expected",
+     RESULT_SETUP + [damage("mechanics/particles/mass", lambda v: v[:10])]),
+    ("checkpoint: infinite time", THERMAL, {}, ["resume", "R.h5"],
+     "checkpoint 'R.h5.checkpoint': /mechanics/time holds a non-finite value",
+     RESULT_SETUP + [damage("mechanics/time", lambda v: v * float("inf"))]),
+]
+
+
+# --- runtime failures (issue 34) ---------------------------------------------------------------
+# Scenes that pass validation and fail during the run. Each must end as a blow-up does: exit code 1,
+# the first message line naming the key (and, for a friction law, the state N, v, A where it failed),
+# the result published (OUT.h5 readable, /meta/status "failed", the state under /failure), its XDMF
+# naming only files that exist, no temporary left behind.
+def contact_scene(law, where="pair", thermal=False):
+    """A block sliding at 0.1 m/s onto a fixed base: the pair's law is evaluated from step 0 at v = 0.1 m/s."""
+    soft = BASE["materials"]["soft"]
+    s = {"dimension": 2, "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.005},
+         "materials": {"base": soft, "block": soft},
+         "bodies": [{"name": "base", "material": "base", "shape": {"type": "rectangle", "lo": [0, 0], "hi": [0.1, 0.02]}},
+                    {"name": "block", "material": "block", "velocity": [0.1, -0.02],
+                     "shape": {"type": "rectangle", "lo": [0.02, 0.02], "hi": [0.05, 0.035]}}],
+         "boundary": {"fixed": [{"face": "y_min"}]},
+         "run": {"end_time": 5e-3, "threads": 1}, "output": {"snapshot_count": 4}}
+    if where == "pair":
+        s["contact"] = {"pairs": [{"materials": ["base", "block"], "normal": [0, 1], "law": law}]}
+    else:
+        s["contact"] = {"law": law}
+    if thermal:
+        s["thermal"] = {"materials": {m: {"heat_capacity": 1000, "conductivity": 1} for m in ("base", "block")}}
+        s["coupling"] = {"continuation": {"duration": 1e-3, "intervals": 2}}
+    return json.dumps(s)
+
+
+def expression(text):
+    return {"type": "expression", "sliding_traction": text}
+
+
+# The validator samples v in {0, 1e-3, 1, 1e3} m/s: a law bad only for 2e-3 < v < 0.5 passes it.
+RUNTIME_CASES = [
+    ("expression law negative while sliding", contact_scene(expression("(v>2e-3 && v<0.5) ? -N : 0.3*N")),
+     ["contact.pairs[0].law", "materials 'base' and 'block'", "returned S = -", "N = ", "sliding speed = 0.1"]),
+    ("expression law NaN while sliding", contact_scene(expression("(v>2e-3 && v<0.5) ? sqrt(-1) : 0.3*N")),
+     ["contact.pairs[0].law", "nan for N = ", "A_c = "]),
+    ("expression law infinite while sliding", contact_scene(expression("(v>2e-3 && v<0.5) ? 1e308*N*N : 0.3*N")),
+     ["contact.pairs[0].law", "returned S = inf"]),
+    ("contact.law expression negative", contact_scene(expression("(v>2e-3 && v<0.5) ? -N : 0.3*N"), where="default"),
+     ["contact.law", "returned S = -"]),
+    ("expression law negative, thermal scene",
+     contact_scene(expression("(v>2e-3 && v<0.5) ? -0.2*N : 0.2*N"), thermal=True),
+     ["contact.pairs[0].law", "returned S = -"]),
+]
+
+
+def check_published(workdir, out):
+    """Problems with the published result `out` of a failed run (empty list: none)."""
+    import h5py  # only the runtime cases need it
+    problems = []
+    path = os.path.join(workdir, out)
+    left = [f for f in os.listdir(workdir) if f.endswith(".part") or f.endswith(".tmp")]
+    if left:
+        problems.append("temporaries left behind: %s" % left)
+    if not os.path.exists(path):
+        return problems + ["%s was not published" % out]
+    try:
+        with h5py.File(path, "r") as f:
+            status = f["meta/status"][()]
+            status = status.decode() if isinstance(status, bytes) else str(status)
+            if status != "failed":
+                problems.append("/meta/status = %s (expected failed)" % status)
+            if "failure" not in f or "position" not in f["failure"]:
+                problems.append("no failing state under /failure")
+            if "meta/failure" not in f:
+                problems.append("no /meta/failure message")
+    except Exception as e:  # noqa: BLE001 - any unreadable file is the finding
+        problems.append("%s does not read: %s" % (out, e))
+    xdmf = os.path.splitext(path)[0] + ".xdmf"
+    if not os.path.exists(xdmf):
+        problems.append("no XDMF file")
+    else:
+        import re
+        with open(xdmf) as fx:
+            named = set(re.findall(r">\s*([^<>:\s]+):/", fx.read()))
+        for n in named:
+            if not os.path.exists(os.path.join(workdir, n)):
+                problems.append("the XDMF names %s, which does not exist" % n)
+    return problems
+
+
+def file_hashes(workdir):
+    import hashlib
+    out = {}
+    for f in sorted(os.listdir(workdir)):
+        path = os.path.join(workdir, f)
+        if os.path.isfile(path) and not f.startswith("."):
+            with open(path, "rb") as fh:
+                out[f] = hashlib.sha1(fh.read()).hexdigest()
+    return out
+
 
 def run_case(exe, workdir, case):
-    name, text, files, argv, key = case
+    name, text, files, argv, key = case[:5]
+    setup = case[5] if len(case) > 5 else []
     for rel, data in files.items():
         path = os.path.join(workdir, rel)
         os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -262,6 +413,14 @@ def run_case(exe, workdir, case):
     if text is not None:
         with open(scene_path, "w") as f:
             f.write(text)
+    for command in setup:
+        if callable(command):
+            command(workdir)
+            continue
+        done = subprocess.run([exe] + [scene_path if a == "SCENE" else a for a in command], cwd=workdir,
+                              stdin=subprocess.DEVNULL, capture_output=True)
+        if done.returncode != 0:
+            raise RuntimeError("setup %s failed: %s" % (command, done.stderr.decode(errors="replace")))
     args = [a.replace("SCENE", scene_path) if a == "SCENE" else a for a in argv]
     key = key.replace("SCENE", scene_path)
     t0 = time.monotonic()
@@ -296,6 +455,16 @@ def main():
             continue
         count += 1
         workdir = tempfile.mkdtemp(prefix="frictherm_bad_")
+        before = None
+        if len(case) > 5:  # the files of the setup commands, to compare after the refusal
+            try:
+                run_case(os.path.abspath(a.exe), workdir, case[:2] + ({}, ["--version"], "", case[5]))
+            except RuntimeError as e:
+                print("FAIL %s: %s" % (case[0], e))
+                failures += 1
+                continue
+            before = file_hashes(workdir)
+            case = case[:5]
         code, out, err, wall, usage, key = run_case(os.path.abspath(a.exe), workdir, case)
         cpu = usage.ru_utime + usage.ru_stime
         rss_mb = usage.ru_maxrss / 1024.0
@@ -312,6 +481,13 @@ def main():
             problems.append("%.2f s CPU (limit %.1f)" % (cpu, CPU_LIMIT))
         if rss_mb > RSS_LIMIT_MB:
             problems.append("%.0f MB resident (limit %.0f)" % (rss_mb, RSS_LIMIT_MB))
+        if before is not None:
+            after = file_hashes(workdir)
+            for f, h in before.items():
+                if after.get(f) != h:
+                    problems.append("%s was %s" % (f, "changed" if f in after else "removed"))
+            if sorted(after) != sorted(before):
+                problems.append("files left: %s" % sorted(set(after) - set(before)))
         status = "FAIL" if problems else "ok"
         shown = first if len(first) < 220 else first[:217] + "..."
         print("%-4s rc=%s cpu=%.2fs wall=%.2fs rss=%.0fMB  %-44s %s" % (status, code, cpu, wall, rss_mb, case[0], shown))
@@ -323,7 +499,34 @@ def main():
             shutil.copytree(workdir, os.path.join(a.keep, case[0].replace(" ", "_").replace("/", "_")), dirs_exist_ok=True)
         shutil.rmtree(workdir, ignore_errors=True)
     print("%d of %d bad inputs refused as expected" % (count - failures, count))
-    return 1 if failures else 0
+    runtime_failures = 0
+    runtime_count = 0
+    for name, text, keys in RUNTIME_CASES:
+        if a.k not in name:
+            continue
+        runtime_count += 1
+        workdir = tempfile.mkdtemp(prefix="frictherm_fail_")
+        code, out, err, wall, usage, _ = run_case(os.path.abspath(a.exe), workdir,
+                                                  (name, text, {}, ["run", "SCENE", "-o", "out.h5"], ""))
+        first = (err.strip().splitlines() or [""])[0]
+        problems = []
+        if code != 1:
+            problems.append("exit code %s (expected 1)" % code)
+        for k in keys:
+            if k not in first:
+                problems.append("message does not name '%s'" % k)
+        os.remove(os.path.join(workdir, "scene.json"))
+        problems += check_published(workdir, "out.h5")
+        shown = first if len(first) < 220 else first[:217] + "..."
+        print("%-4s rc=%s wall=%.2fs  %-44s %s" % ("FAIL" if problems else "ok", code, wall, name, shown))
+        for p in problems:
+            print("     -> " + p)
+        runtime_failures += 1 if problems else 0
+        if a.keep:
+            shutil.copytree(workdir, os.path.join(a.keep, name.replace(" ", "_").replace("/", "_")), dirs_exist_ok=True)
+        shutil.rmtree(workdir, ignore_errors=True)
+    print("%d of %d runtime failures ended cleanly" % (runtime_count - runtime_failures, runtime_count))
+    return 1 if failures or runtime_failures else 0
 
 
 if __name__ == "__main__":

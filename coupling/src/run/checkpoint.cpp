@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
@@ -184,11 +185,89 @@ void write_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, 
   write_file(path, sim, scene.text, scene.source, joined_overrides(scene.overrides), marks, extra);
 }
 
+namespace {
+
+// Items (first dimension) of dataset `name`, or -1 when the checkpoint has none of that name.
+long items(hid_t f, const std::string& path, const std::string& name) {
+  if (H5Lexists(f, name.substr(0, name.find('/')).c_str(), H5P_DEFAULT) <= 0) return -1;
+  if (name.find('/') != std::string::npos && H5Lexists(f, name.c_str(), H5P_DEFAULT) <= 0) return -1;
+  const Handle d{check_id(H5Dopen2(f, name.c_str(), H5P_DEFAULT), path, "cannot open '" + name + "'"), H5Dclose};
+  const Handle space{check_id(H5Dget_space(d.get()), path, "dataspace of '" + name + "'"), H5Sclose};
+  hsize_t dims[2] = {0, 0};
+  if (H5Sget_simple_extent_ndims(space.get()) < 1) return 0;
+  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  return static_cast<long>(dims[0]);
+}
+
+// Every value of the double dataset `name` (when present) is finite; else the first item that is not.
+void require_finite(hid_t f, const std::string& path, const std::string& name) {
+  if (items(f, path, name) <= 0) return;
+  const Handle d{check_id(H5Dopen2(f, name.c_str(), H5P_DEFAULT), path, "cannot open '" + name + "'"), H5Dclose};
+  const Handle type{check_id(H5Dget_type(d.get()), path, "type of '" + name + "'"), H5Tclose};
+  if (H5Tget_class(type.get()) != H5T_FLOAT) return;
+  const Handle space{check_id(H5Dget_space(d.get()), path, "dataspace of '" + name + "'"), H5Sclose};
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  std::vector<double> v(static_cast<std::size_t>(n));
+  check(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path, "cannot read '" + name + "'");
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw std::runtime_error("checkpoint '" + path + "': /" + name + " holds a non-finite value (" +
+                               std::to_string(v[i]) + " at value " + std::to_string(i) + "); the checkpoint is damaged");
+}
+
+// The arrays' sizes against the simulation built from the scene (P particles, G grid nodes, M
+// materials) and the values the next step reads for finiteness, before any state is restored
+// (issue 34: truncated, padded or NaN arrays had been accepted). Arrays a run has not filled yet
+// may be empty.
+void check_arrays(hid_t f, const std::string& path, std::size_t particles, std::size_t nodes, std::size_t materials) {
+  const long P = static_cast<long>(particles), G = static_cast<long>(nodes), M = static_cast<long>(materials);
+  auto require = [&](const std::string& name, long expected, bool may_be_empty, const char* what) {
+    const long n = items(f, path, name);
+    if (n < 0 || n == expected || (may_be_empty && n == 0)) return;
+    throw std::runtime_error("checkpoint '" + path + "': /" + name + " holds " + std::to_string(n) +
+                             " items, expected " + std::to_string(expected) + " (" + what +
+                             "); the checkpoint is damaged or belongs to another scene");
+  };
+  static const char* const kParticleArrays[] = {
+      "position", "initial_position", "velocity", "half_size", "mass", "initial_volume", "volume",
+      "deformation_gradient", "stress", "stress_zz", "temperature", "plastic_strain", "internal_energy",
+      "plastic_work", "material", "body"};
+  for (const char* a : kParticleArrays) {
+    const std::string name = std::string("mechanics/particles/") + a;
+    require(name, P, false, "the scene's particles");
+    require_finite(f, path, name);
+  }
+  require("mechanics/wave_speed", P, true, "the scene's particles");
+  for (const char* a : {"mechanics/work_first", "mechanics/work_second", "mechanics/contact/lagged_normal_traction",
+                        "mechanics/contact/lagged_normal_step", "pending/work", "system/unknown"})
+    require(a, G, true, "the scene's grid nodes");
+  for (const char* a : {"mechanics/pair_work_first", "mechanics/pair_work_second"})
+    require(a, M * M, true, "material pairs of the scene");
+  for (const char* a : {"hotspots/owner", "hotspots/reference", "reaction/particle_progress"})
+    require(a, P, true, "the scene's particles");
+  // The thermal unknowns: as many temperatures and masses as grid nodes listed, at most G.
+  const long unknowns = items(f, path, "system/grid_node");
+  if (unknowns > G)
+    throw std::runtime_error("checkpoint '" + path + "': /system/grid_node holds " + std::to_string(unknowns) +
+                             " items, expected at most " + std::to_string(G) + " (the scene's grid nodes)");
+  if (unknowns >= 0) {
+    require("nodal_temperature", unknowns, false, "the thermal unknowns listed in /system/grid_node");
+    require("system/mass", unknowns, false, "the thermal unknowns listed in /system/grid_node");
+  }
+  for (const char* a : {"mechanics/time", "mechanics/last_dt", "mechanics/work_first", "mechanics/work_second",
+                        "mechanics/pair_work_first", "mechanics/pair_work_second", "nodal_temperature", "system/mass",
+                        "pending/work", "window_start"})
+    require_finite(f, path, a);
+}
+
+}  // namespace
+
 template <int Dim>
 void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
                      const std::function<void(const ckpt::Reader&)>& extra) {
   const h5detail::Quiet quiet;
   const Handle f = open_checkpoint(path, Dim);
+  check_arrays(f.get(), path, sim.particles().size(), sim.grid().node_count(), sim.materials().size());
   {
     const Handle g{check_id(H5Gopen2(f.get(), "mechanics", H5P_DEFAULT), path, "checkpoint has no /mechanics"),
                    H5Gclose};

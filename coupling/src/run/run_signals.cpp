@@ -8,16 +8,21 @@ namespace frictherm::coupling::detail {
 namespace {
 
 volatile std::sig_atomic_t g_signal = 0;
+volatile std::sig_atomic_t g_count = 0;
 struct sigaction g_previous_int, g_previous_term;
 
 extern "C" void on_interrupt(int signal) {
-  g_signal = signal;
-  // A second SIGINT or SIGTERM takes the default action (async-signal-safe: sigaction).
+  if (g_signal == 0) g_signal = signal;
+  // The second is absorbed: `timeout` sends SIGTERM to the process and again to its group, and the run
+  // is then writing its last rows and checkpoint. A third takes the default action at once
+  // (async-signal-safe: sigaction, raise).
+  if (++g_count < 3) return;
   struct sigaction dfl {};
   dfl.sa_handler = SIG_DFL;
   sigemptyset(&dfl.sa_mask);
   sigaction(SIGINT, &dfl, nullptr);
   sigaction(SIGTERM, &dfl, nullptr);
+  raise(signal);
 }
 
 }  // namespace
@@ -25,8 +30,10 @@ extern "C" void on_interrupt(int signal) {
 InterruptGuard::InterruptGuard(bool enabled) : enabled_(enabled) {
   if (!enabled_) return;
   g_signal = 0;
+  g_count = 0;
   struct sigaction sa {};
   sa.sa_handler = on_interrupt;
+  sa.sa_flags = SA_RESTART;  // a write under way when the signal comes goes on (no EINTR in HDF5)
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, &g_previous_int);
   sigaction(SIGTERM, &sa, &g_previous_term);

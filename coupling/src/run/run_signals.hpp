@@ -1,7 +1,7 @@
 #pragma once
 // SIGINT / SIGTERM during a run: the first one asks the run loop to stop after the current step
-// (flush, status `interrupted`, exit code 128 + signal); the handlers are then reset to the
-// default, so a second signal ends the process at once (the file keeps what its last flush held).
+// (final checkpoint, flush, status `interrupted`, exit code 128 + signal); a second one is absorbed
+// (`timeout` sends two), a third ends the process at once (the file keeps what its last flush held).
 namespace frictherm::coupling::detail {
 
 /// Installs the handlers for its lifetime when `enabled` (the library never does so unasked:

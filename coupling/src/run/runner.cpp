@@ -62,22 +62,26 @@ class Run {
     if (!o_.resume_checkpoint.empty()) restore();
     H5Output out = open_output();
     out_ = &out;
-    // Generated bodies (ellipse_packing): the image beside the output (an appended output: the result has it).
-    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) write_microstructure_images(out);
-    detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
-    std::vector<std::string> series_columns = detail::series_names(Dim);
-    detail::append_body_series_names<Dim>(series_columns, *sim_);
-    detail::append_contact_series_names<Dim>(series_columns, *sim_);
-    if (thermal_) thermal_->declare_output(out, series_columns);  // thermal hook: columns + /hotspots
-    out.declare_series(series_columns);
-    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) {  // appended output: the result has these
-      series();
-      snapshot();
-    }
     std::ostream& log = o_.log ? *o_.log : std::cerr;
     detail::ProgressLine progress(std::cerr, show_progress(o_), s_.end_time);
-    last_flush_ = Clock::now();
+    // From here on the output exists: whatever goes wrong (a step, a coupling window, the thermal
+    // continuation, writing) ends the run as a blow-up does, with the state under /failure and the
+    // result published with status "failed" (issue 34).
+    // Generated bodies (ellipse_packing): the image beside the output (an appended output: the result
+    // has it). A refused image path is a bad output (exit code 2), not a failed run.
+    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) write_microstructure_images(out);
     try {
+      detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
+      std::vector<std::string> series_columns = detail::series_names(Dim);
+      detail::append_body_series_names<Dim>(series_columns, *sim_);
+      detail::append_contact_series_names<Dim>(series_columns, *sim_);
+      if (thermal_) thermal_->declare_output(out, series_columns);  // thermal hook: columns + /hotspots
+      out.declare_series(series_columns);
+      if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) {  // appended output: the result has these
+        series();
+        snapshot();
+      }
+      last_flush_ = Clock::now();
       loop(progress);
       if (thermal_ && r_.status == RunResult::Status::completed) {
         if (thermal_->has_continuation()) checkpoint(true);  // end of loading: always (frictherm continue)
@@ -88,22 +92,27 @@ class Run {
         if (detail::interrupt_signal() != 0) interrupted();
       }
     } catch (const mechanics::SimulationError& e) {
-      progress.finish();
-      out.begin_failure(e.step(), e.time(), e.what());
-      detail::write_fields<Dim>(out, *sim_, snapshot_field_names(Dim));
-      out.end_snapshot();
-      r_.status = RunResult::Status::failed;
-      r_.message = e.what();
-      out.write_metadata("failure", r_.message);
+      fail(progress, e.step(), e.time(), e.what());
+    } catch (const std::exception& e) {  // not a breakdown of the mechanics: where the run was
+      fail(progress, sim_->step_count(), sim_->time(),
+           std::string(continuation_started_ ? "thermal continuation after step " : "step ") +
+               std::to_string(sim_->step_count()) + ", t = " + format_number(sim_->time()) + " s: " + e.what());
     }
     progress.finish();
     if (r_.status != RunResult::Status::failed) {
       // At the end and on SIGINT/SIGTERM, before the rows the schedule does not have (the state and
       // marks of an uninterrupted run at this step). After the continuation began, the end-of-loading
       // checkpoint stays: a resume reruns the continuation from it.
-      if (checkpoints_ && !continuation_started_) checkpoint(false);
-      if (last_series_step_ != sim_->step_count()) series();
-      if (last_snapshot_step_ != sim_->step_count()) snapshot();
+      // Interrupted: always, so that `frictherm resume` can go on (issue 34; it costs milliseconds).
+      try {
+        if ((checkpoints_ || r_.status == RunResult::Status::interrupted) && !continuation_started_) checkpoint(false);
+        if (last_series_step_ != sim_->step_count()) series();
+        if (last_snapshot_step_ != sim_->step_count()) snapshot();
+      } catch (const std::exception& e) {
+        fail(progress, sim_->step_count(), sim_->time(),
+             "writing the end of the run at step " + std::to_string(sim_->step_count()) + ", t = " +
+                 format_number(sim_->time()) + " s: " + e.what());
+      }
     }
     if (r_.status == RunResult::Status::interrupted) {
       r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " +
@@ -142,6 +151,22 @@ class Run {
   }
 
  private:
+  // The run's failure: the state at it under /failure (fields as a snapshot) and the message. A
+  // failure to write that state is added to the message; the result is still published.
+  void fail(detail::ProgressLine& progress, long step, double time, const std::string& message) {
+    progress.finish();
+    r_.status = RunResult::Status::failed;
+    r_.message = message;
+    try {
+      out_->begin_failure(step, time, message);
+      detail::write_fields<Dim>(*out_, *sim_, snapshot_field_names(Dim));
+      out_->end_snapshot();
+    } catch (const std::exception& e) {
+      r_.message += std::string(" (the failing state was not written: ") + e.what() + ")";
+    }
+    out_->write_metadata("failure", r_.message);
+  }
+
   // RunResult::phase_seconds, also written to /meta as time_<phase>.
   void record_phase_seconds(H5Output& out) {
     const mechanics::StepPhaseTimes& m = sim_->phase_times();
@@ -184,8 +209,7 @@ class Run {
     if (!o_.resume_checkpoint.empty()) inputs.push_back(o_.resume_checkpoint);
     check_output_path(r_.output, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
     check_output_path(xdmf_path_for(r_.output), inputs, true, "");
-    if (s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0 ||
-        (s_.thermal.enabled && s_.thermal.continuation_duration > 0.0)) {
+    {  // every run may write one: an interrupted run always does
       std::vector<std::string> others;  // a resumed run may go on replacing its own checkpoint
       for (const std::string& f : inputs)
         if (!(f == o_.resume_checkpoint && checkpoint_file() == o_.resume_checkpoint)) others.push_back(f);
@@ -283,7 +307,13 @@ class Run {
   }
 
   void restore() {
-    read_checkpoint(o_.resume_checkpoint, *sim_, [&](const ckpt::Reader& r) { visit_run_state(r); });
+    try {  // a checkpoint that does not fit the scene is a bad input (exit code 2), refused before any step
+      read_checkpoint(o_.resume_checkpoint, *sim_, [&](const ckpt::Reader& r) { visit_run_state(r); });
+    } catch (const SceneError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw OutputError(e.what());
+    }
     if (o_.resume_appends) base_marks_ = checkpoint_marks(o_.resume_checkpoint);
   }
 

@@ -191,6 +191,7 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
   if (const auto n = c->find("normal")) parse_normal(*n, dim, false, o.default_pair);
   if (const auto law = c->find("law")) {
     o.default_pair.law = parse_friction_law(*law);
+    o.default_pair.origin = law->path();  // named when the law fails during the run
     check_penalty_law(o.default_pair, *law);
   } else if (o.default_pair.method == mechanics::ContactMethod::penalty) {
     o.default_pair.law = mechanics::FrictionLaw::frictionless();  // the default "stick" has no penalty form
@@ -227,6 +228,7 @@ ContactSpec parse_contact_section(const JsonReader& root, int dim, const std::ve
       }
       const JsonReader law = p.at("law", "a friction law");
       ps.settings.law = parse_friction_law(law);
+      ps.settings.origin = law.path();
       check_penalty_law(ps.settings, law);
       if (const auto n = p.find("normal")) parse_normal(*n, dim, true, ps.settings);
       if (const auto pen = p.find("penalty")) parse_penalty(*pen, ps.settings.penalty);

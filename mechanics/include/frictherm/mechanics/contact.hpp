@@ -63,6 +63,9 @@ struct ContactPairSettings {
   Vec<3> normal_vector = Vec<3>::UnitY();  // specified normal, from the pair's first material to its second
   ContactMethod method = ContactMethod::multimaterial;
   PenaltySettings penalty;                 // method == penalty
+  /// Where these settings were given (e.g. the scene key "contact.pairs[0].law"), for messages only:
+  /// a friction law that fails during a step is reported with it (Simulation::resolve_contact).
+  std::string origin;
 };
 
 struct ContactOptions {
