@@ -148,9 +148,9 @@ void check_continuation_rerun(const std::string& integrator) {
 TEST(ThermalCheckpoint, ContinuationRerunFromEndOfLoadingEqualsUninterruptedRun) { check_continuation_rerun(""); }
 
 // The scene default "auto": the loading's last windows are matrix-free gathers (no assembled K), so
-// the checkpointed system is not the one the restored particles assemble (on 71b95b2 the continuation
-// then failed: "temperature vector has 129 entries for 138 nodes"); the rerun reassembles as the
-// uninterrupted run does and repeats it bit for bit.
+// the checkpointed system is not the one the restored particles assemble (on 71b95b2 a continuation
+// from such a checkpoint could fail: "temperature vector has 129 entries for 138 nodes" on a small
+// sliding block); the rerun reassembles as the uninterrupted run does and repeats it bit for bit.
 TEST(ThermalCheckpoint, ContinuationRerunAfterMatrixFreeWindowsEqualsUninterruptedRun) {
   check_continuation_rerun("auto");
 }

@@ -311,6 +311,11 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
     const double residual = books_.max_assembly_residual;
     assemble(particles);  // problem and reaction state from the restored particles
     books_.max_assembly_residual = residual;
+    // The written system was assembled from these particles unless the last window was a matrix-free
+    // gather (or an older one reused): then it differs, and like the uninterrupted run the
+    // continuation must assemble afresh and start from its projected temperatures.
+    system_assembled_ = grid_node == system_.grid_node && unknown == system_.unknown &&
+                        mass.size() == system_.mass.size() && mass == system_.mass;
     system_.grid_node = std::move(grid_node);  // the adaptive estimate's M: the last window's
     system_.unknown = std::move(unknown);
     system_.mass = std::move(mass);
