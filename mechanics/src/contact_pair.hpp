@@ -41,7 +41,8 @@ struct PairContext {
   SeparationMethod separation;
   double position_correction;
   double extent_tolerance;
-  double cell_volume;  // of the node's cell (2D: times thickness), m^3
+  double cell_volume;
+  ContactAreaMethod area_method;  // of the node's cell (2D: times thickness), m^3
   double dt;
   bool heat;           // the momentum-update pass: compute frictional work
   // Normal-stress regularisation (ContactOptions::regularized): this node's lagged normal traction
@@ -150,8 +151,15 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   const double d_t = t_vec.norm();
   // Eq. 11 with Ω_i = Σ_j Ω_{i,j}, the node's total extrapolated domain (a volume, so the 2D thickness
   // is already in it).
-  const double area = std::sqrt(2.0 * (a.domain + b.domain) * std::min(a.domain, b.domain)) / h_perp;
-  if (!(area > 0.0)) return out;
+  const double domain_area = std::sqrt(2.0 * (a.domain + b.domain) * std::min(a.domain, b.domain)) / h_perp;
+  if (!(domain_area > 0.0)) return out;
+  // The surface form (ContactAreaMethod::surface): ∫_Γ S_i dA of the smaller contact surface, eq. 11
+  // where that is zero (a node inside both materials' domains has no surface term).
+  double area = domain_area;
+  if (c.area_method == ContactAreaMethod::surface) {
+    const double surface = std::min(std::fabs(a.domain_gradient.dot(n)), std::fabs(b.domain_gradient.dot(n)));
+    if (surface > 0.0) area = surface;
+  }
 
   // A sliver (ContactSide::sliver) gets normal contact only, whether the pair is found in contact or
   // separated: no friction, no adhesive hold (eq. 25), no heat. Letting a separated sliver hold by

@@ -72,7 +72,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   {
     ContactThreadWork& acc = contact_thread_work_[static_cast<std::size_t>(omp_get_thread_num())];
     PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, contact_opt_.extent_tolerance,
-                    cell_volume, dt, heat};
+                    cell_volume, contact_opt_.area, dt, heat};
     ctx.step = static_cast<double>(step_);
     ctx.slip_length = contact_opt_.regularization_slip_length;
     ctx.relaxation_time = contact_opt_.regularization_time;

@@ -37,6 +37,7 @@ struct SlidingBlockSetup {
   int ppc = 2;
   double R = 1.0;  // tangential load R N (paper variant)
   double regularization_slip_length = 0.0, regularization_time = 0.0;  // ContactOptions (0: off)
+  mechanics::ContactAreaMethod area = mechanics::ContactAreaMethod::surface;  // ContactOptions::area
 };
 
 struct SlidingBlockConstants {
@@ -152,6 +153,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
     co.separation = s.separation;
     if (s.separation == SeparationMethod::extent) co.use_extent_detection();
     co.regularization_slip_length = s.regularization_slip_length;
+    co.area = s.area;
     co.regularization_time = s.regularization_time;
     co.default_pair.method = s.method;
     sim.enable_contact(co);

@@ -69,9 +69,11 @@ TEST(ExtentSeparation, PreloadedInterfaceRowsCarryTheAppliedPressure) {
 }
 
 // Adhesion (μ = 0.2, S_a = 0.3 N, R = 1) with extent detection against the rigid block, errors relative to
-// its own v_max. Measured: 3.9 % / 2.0 % of v_max and −3.4 % / −1.7 % of the work at 5 / 2.5 mm (touching
-// nodes that move apart keep S_a A_c). At 1.25 mm the sliding block still floats by about the tolerance
-// (13 %, docs/contact.md, "Known limitations"), so the finest level is not asserted here.
+// its own v_max. With eq. 11's contact area it was 3.9 % / 2.0 % of v_max and −3.4 % / −1.7 % of the work
+// at 5 / 2.5 mm, first order in h (the area of the block's two end nodes); with the surface area (the
+// default, docs/contact.md "Contact area") measured 0.24 % / 0.10 % and 0.08 % / 0.09 %: both levels are
+// at the noise of the rigid-block comparison, so they are bounded, not ordered. Bounds: 1 % of v_max
+// and of the work (four times the 5 mm velocity error; a quarter of eq. 11's).
 TEST(ExtentSeparation, AdhesionBlockAtTwoResolutions) {
   using C = SlidingBlockConstants;
   const double S_a = 0.3 * C::normal_stress();
@@ -91,10 +93,9 @@ TEST(ExtentSeparation, AdhesionBlockAtTwoResolutions) {
     std::printf("[adhesion, extent, %.2f mm cells] max |v - v_rigid|/v_max %.4f (v_max %.2f m/s), work %.5g J vs %.5g J\n",
                 cell * 1e3, e, v_max, h.work_second.back(), Q);
   }
-  EXPECT_LT(velocity_error[0], 0.05);
-  EXPECT_LT(velocity_error[1], 0.025);
-  EXPECT_LT(velocity_error[1], velocity_error[0]);
-  EXPECT_LT(work_error[1], 0.03);
-  EXPECT_LT(work_error[1], work_error[0]);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_LT(velocity_error[i], 0.01) << i;
+    EXPECT_LT(work_error[i], 0.01) << i;
+  }
 }
 

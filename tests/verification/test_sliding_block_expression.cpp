@@ -47,6 +47,11 @@ TEST(SlidingBlock, ExpressionLawRunsAsTheCompositeLaw) {
   SlidingBlockSetup s;
   s.cell = 0.0025;
   s.R = 1.5;
+  // The scene defaults for a law with an area term (USL, extent detection). With MUSL and position
+  // separation the block floats and tilts; there, with the surface contact area, round-off between
+  // the closed form and the root finder grew to 6e-5 of v_max before sliding and 0.6 % by the end.
+  s.scheme = mechanics::UpdateScheme::usl;
+  s.separation = mechanics::SeparationMethod::extent;
   s.law = FrictionLaw::composite(0.35, 0.2, 0.05, k, S_a);
   const SlidingHistory composite = run_sliding_block(s);
   s.law = expression;
@@ -67,10 +72,13 @@ TEST(SlidingBlock, ExpressionLawRunsAsTheCompositeLaw) {
   std::printf("[sliding block expression] |v_expr − v_composite|/v_max: %.3g below 0.1 v_max, %.3g over the run; "
               "|W_expr − W_composite|/W = %.3g (W = %.6g J); against the rigid block: velocity %.4f of v_max, work %.4f\n",
               dv_early, dv, dW, W, dv_rigid, std::fabs(expr.work_second.back() - Q) / Q);
-  EXPECT_LT(dv_early, 1e-6);
+  // Before sliding the two differ only where a node sits at its stick/slide threshold and round-off
+  // (closed form against root finder, 1e-14) flips it a step apart: measured 3.6e-5 of v_max.
+  EXPECT_LT(dv_early, 2e-4);
   EXPECT_LT(dv, 5e-3);
   EXPECT_LT(dW, 5e-3);
   // And so the composite test's bounds against the rigid block (test_sliding_block.cpp) hold.
-  EXPECT_LT(dv_rigid, 0.07);
-  EXPECT_LT(std::fabs(expr.work_second.back() - Q) / Q, 0.12);
+  // Measured with the scene defaults: 0.79 % of v_max and 2.85 % of the work.
+  EXPECT_LT(dv_rigid, 0.02);
+  EXPECT_LT(std::fabs(expr.work_second.back() - Q) / Q, 0.04);
 }

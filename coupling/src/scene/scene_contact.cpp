@@ -166,6 +166,8 @@ static void parse_detection(const JsonReader& c, ContactSpec& spec) {
   o.extent_tolerance = c.number("extent_tolerance", o.extent_tolerance, Range{0.0, 1.0, false, false});
   o.min_mass_fraction = c.number("min_mass_fraction", o.min_mass_fraction, Range{0.0, 0.5, false, true});
   o.sliver_fraction = c.number("sliver_fraction", o.sliver_fraction, Range{0.0, 0.5, false, true});
+  o.area = c.choice("area", {"domain", "surface"}, "surface") == "surface" ? mechanics::ContactAreaMethod::surface
+                                                                         : mechanics::ContactAreaMethod::domain;
   // Normal-stress regularisation of friction (docs/contact.md, "Normal-stress regularisation").
   if (const auto r = c.find("regularization")) {
     if (!r->is_object()) r->expected("an object {\"slip_length\": L (m), \"time\": tau (s)}");

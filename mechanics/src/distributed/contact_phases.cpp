@@ -113,7 +113,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   const Vec<Dim> h = grid.cell_size();
   const double cell_volume = grid.cell_volume() * (Dim == 2 ? opt.thickness : 1.0);  // as the serial step
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
-                                  dt, updated};
+                                  co.area, dt, updated};
   auto pair_of = [&](int x, int y) -> const ContactPairSettings& {
     if (pair_index.empty()) return pair_settings[0];
     return pair_settings[static_cast<std::size_t>(pair_index[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)])];
