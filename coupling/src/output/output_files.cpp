@@ -3,6 +3,7 @@
 #include <frictherm/coupling/output_files.hpp>
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #ifdef __linux__
@@ -96,6 +97,26 @@ void publish_file(const std::string& temporary, const std::string& path, bool ov
                              "alone: this run's result is in '" + temporary + "'");
   throw std::runtime_error("cannot rename '" + temporary + "' to '" + path + "': " + std::strerror(err) +
                            "; this run's result is in '" + temporary + "'");
+}
+
+OutputClaim::OutputClaim(const std::string& output) : lock_path_(output + ".lock") {
+  fd_ = ::open(lock_path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) return;  // a folder we cannot write into: the output's own checks say so
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (err == EWOULDBLOCK)
+      throw OutputError("'" + output + "' is being written by another run (it holds " + lock_path_ +
+                        "); refusing to start a second run on the same output");
+    return;  // no locks on this file system: unclaimed, as before
+  }
+}
+
+OutputClaim::~OutputClaim() {
+  if (fd_ < 0) return;
+  ::unlink(lock_path_.c_str());  // while still held: a run waiting on it takes a fresh file
+  ::close(fd_);
 }
 
 }  // namespace frictherm::coupling

@@ -47,6 +47,7 @@ class Run {
     const detail::InterruptGuard interrupt_guard(o_.handle_signals);  // before the file exists
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
     check_output_files();  // before anything is built: refusals cost nothing
+    const OutputClaim claim(r_.output);  // a second run on this output is refused before it writes
     sim_ = build_simulation<Dim>(s_);
     if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;

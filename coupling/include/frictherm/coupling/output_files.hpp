@@ -33,4 +33,20 @@ std::string temporary_path(const std::string& path);
 /// std::runtime_error says that the result stays under `temporary`.
 void publish_file(const std::string& temporary, const std::string& path, bool overwrite);
 
+/// The output claimed for one run (issue 34): an advisory lock (flock) on "<output>.lock", held until
+/// destruction, so a second run on the same output is refused (OutputError naming the output) before
+/// it writes anything, not at publication after it had replaced the XDMF and checkpoint. The kernel
+/// drops the lock when the process ends, killed or not; a leftover lock file claims nothing.
+class OutputClaim {
+ public:
+  explicit OutputClaim(const std::string& output);
+  ~OutputClaim();
+  OutputClaim(const OutputClaim&) = delete;
+  OutputClaim& operator=(const OutputClaim&) = delete;
+
+ private:
+  std::string lock_path_;
+  int fd_ = -1;
+};
+
 }  // namespace frictherm::coupling
