@@ -184,47 +184,6 @@ TEST(SignalsTwice, SecondSignalAbsorbedAndResumeGoesOn) {
   fs::remove_all(dir);
 }
 
-// A second run on the output of a run still writing is refused before it writes anything (issue 34:
-// on 71b95b2 it was refused only at publication, after replacing the first run's XDMF). The first
-// run, interrupted after, publishes its result as usual.
-TEST(OutputClaim, SecondRunOnTheSameOutputRefusedBeforeWriting) {
-  const fs::path dir = fs::temp_directory_path() / ("frictherm_claim_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string scene = (dir / "long.json").string(), out = (dir / "long.h5").string();
-  std::ofstream(scene) << kLongScene;
-  const pid_t first = fork();
-  if (first == 0) {
-    std::freopen((dir / "first.txt").string().c_str(), "w", stderr);
-    execl(FRICTHERM_EXE, FRICTHERM_EXE, "run", scene.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  for (int i = 0; i < 400 && !part_file_exists(dir); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
-  const fs::path xdmf = dir / "long.xdmf";
-  ASSERT_TRUE(fs::exists(xdmf));
-  const auto xdmf_time = fs::last_write_time(xdmf);
-  const std::string second = std::string(FRICTHERM_EXE) + " run '" + scene + "' -o '" + out + "' --force --quiet 2>&1";
-  FILE* p = popen(second.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::string text;
-  char buf[4096];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) text.append(buf, n);
-  const int status = pclose(p);
-  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << text;
-  EXPECT_NE(text.find("is being written by another run"), std::string::npos) << text;
-  EXPECT_TRUE(fs::last_write_time(xdmf) == xdmf_time) << "the refused run wrote the first run's XDMF";
-  kill(first, SIGTERM);
-  int first_status = 0;
-  waitpid(first, &first_status, 0);
-  EXPECT_EQ(WIFEXITED(first_status) ? WEXITSTATUS(first_status) : -1, 128 + SIGTERM);
-  const hid_t f = H5Fopen(out.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  ASSERT_GE(f, 0);
-  EXPECT_EQ(read_string(f, "/meta/status"), "interrupted");
-  H5Fclose(f);
-  EXPECT_FALSE(fs::exists(out + ".lock")) << "the claim is released with the run";
-  fs::remove_all(dir);
-}
-
 INSTANTIATE_TEST_SUITE_P(IntAndTerm, Signals, ::testing::Values(SIGINT, SIGTERM));
 
 }  // namespace
