@@ -5,7 +5,9 @@
   plot_run.py RUN.h5 --list
 
 Writes PREFIX_particles.png (particles as squares sized to their spacing, coloured by a field)
-and PREFIX_series.png (series against /series/time). PREFIX defaults to RUN without .h5.
+and PREFIX_series.png (series against /series/time, grouped by unit into a few panels: energies,
+temperatures, heat rates, lengths, ...; lines named by their long_name, axes in units with SI
+prefixes where they read better: ms, ns, µm, mJ). PREFIX defaults to RUN without .h5.
 
 Fields: any stored snapshot field (temperature, mass, material, ...), one component of a stored
 field (velocity_x, position_z, stress_xy, or velocity_0 ...), or a derived one:
@@ -14,7 +16,8 @@ field (velocity_x, position_z, stress_xy, or velocity_0 ...), or a derived one:
   von_mises               sqrt(3/2 s:s) of the Cauchy stress
   pressure                -trace(stress)/3
 In 2D the out-of-plane stress comes from the field stress_zz when stored (plane strain), else 0
-(plane stress). 3D runs are drawn projected on the x-y plane, highest z on top.
+(plane stress). 3D runs are drawn projected on the x-y plane, highest z on top, and as three slices
+normal to z in PREFIX_slices.png.
 
 Reads the run through the frictherm Python package (python/frictherm; draws with frictherm.plot).
 Uses the Debian packages python3-h5py, python3-matplotlib and python3-numpy; runs headless.
@@ -25,7 +28,7 @@ import sys
 
 import frictherm
 from frictherm.fields import field_values
-from frictherm.plot import plot_particles, plot_series
+from frictherm.plot import plot_particles, plot_series, plot_slices
 
 
 def list_run(run):
@@ -84,6 +87,9 @@ def main(argv=None):
                 raise SystemExit(f"plot_run.py: {e.args[0]}")
             plot_particles(run, snap, field, prefix + "_particles.png")
             wrote.append(prefix + "_particles.png")
+            if run.dim == 3:  # the projection hides the inside: three slices normal to z as well
+                plot_slices(run, snap, field, prefix + "_slices.png")
+                wrote.append(prefix + "_slices.png")
         else:
             print("plot_run.py: no snapshots in this run; no particle picture", file=sys.stderr)
         columns = run.series.columns

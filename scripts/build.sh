@@ -1,12 +1,31 @@
 #!/usr/bin/env bash
 # Configures and builds frictherm (Release) into ./build (through ccache when it is installed).
+#   scripts/build.sh            everything: library, program, tests, benchmarks, MPI parts when found
+#                               (README command 2; turns tests, benchmarks and MPI on in an existing build)
+#   scripts/build.sh --program  the `frictherm` program and what it links, nothing else (README command 1):
+#                               a new build folder is configured without tests, benchmarks and the MPI
+#                               parts; an existing one keeps its configuration and builds the program only.
+# BUILD_DIR (default build) names the folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+build=${BUILD_DIR:-build}
+mode=${1:-all}
+case "$mode" in all|--program) ;; *) echo "build.sh: the argument is --program or nothing, not '$mode'" >&2; exit 2;; esac
 jobs=$(nproc 2>/dev/null || echo 2)
 launcher=()
 if command -v ccache >/dev/null 2>&1; then
   export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(dirname "$(pwd)")}
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 fi
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}"
-cmake --build build -j "$jobs"
+if [ "$mode" = --program ]; then
+  options=()
+  if [ ! -f "$build/CMakeCache.txt" ]; then
+    options=(-DFRICTHERM_BUILD_TESTS=OFF -DFRICTHERM_BUILD_BENCH=OFF -DFRICTHERM_WITH_MPI=OFF)
+  fi
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${options[@]}"
+  cmake --build "$build" -j "$jobs" --target frictherm
+else
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" \
+        -DFRICTHERM_BUILD_TESTS=ON -DFRICTHERM_BUILD_BENCH=ON -DFRICTHERM_WITH_MPI=ON
+  cmake --build "$build" -j "$jobs"
+fi

@@ -26,7 +26,7 @@ if [ "$label" != unit ] && [ "$fuzz_seconds" -eq 0 ]; then fuzz_build=OFF; fi
 case "$opt" in -O0|-O1|-O2|-O3|-Og) ;; *) echo "run_checks.sh: CHECKS_OPT must be one of -O0 -O1 -O2 -O3 -Og, not '$opt'" >&2; exit 2;; esac
 jobs=$(nproc 2>/dev/null || echo 2)
 
-scripts/install_deps.sh
+scripts/install_deps.sh all
 launcher=()
 if command -v ccache >/dev/null 2>&1; then
   export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(dirname "$root")}

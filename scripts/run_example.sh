@@ -1,15 +1,19 @@
 #!/usr/bin/env bash
-# README command 1: install the Debian packages, build, run the main example scene and draw it.
+# README command 1: install the Debian packages the program needs, build the program, run the main
+# example scene and draw it.
 #   scripts/run_example.sh [SCENE.json] [FIELD]  (default: examples/sliding_block_heating.json, temperature)
 # Leaves results/<scene>.h5 (+ .xdmf for ParaView) and results/<scene>_particles.png, _series.png.
+# Installs and builds only what this needs (scripts/install_deps.sh program, scripts/build.sh --program):
+# no tests, benchmarks, ParaView, clang or sanitizer runtimes; command 2 (scripts/run_tests.sh) adds them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:-examples/sliding_block_heating.json}
 field=${2:-temperature}
 name=$(basename "$scene" .json)
-scripts/install_deps.sh
-scripts/build.sh
+build=${BUILD_DIR:-build}
+scripts/install_deps.sh program
+scripts/build.sh --program
 mkdir -p results
-./build/coupling/frictherm run "$scene" -o "results/$name.h5" --force  # rerunning replaces the old result
+"$build/coupling/frictherm" run "$scene" -o "results/$name.h5" --force  # rerunning replaces the old result
 /usr/bin/python3 examples/plot_run.py "results/$name.h5" --field "$field" -o "results/$name"
 echo "wrote results/$name.h5, results/$name.xdmf, results/${name}_particles.png, results/${name}_series.png"

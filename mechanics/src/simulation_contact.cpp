@@ -34,7 +34,6 @@ struct ContactFailure {
 }  // namespace
 template <int Dim>
 void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
-  const NestedPhase timed(phase_times_.contact, nested_phase_);  // called inside other phases
   const bool heat = pass == ContactPass::updated;
   const bool forces = pass == ContactPass::updated;
   const std::size_t nm = materials_.size();

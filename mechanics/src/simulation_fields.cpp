@@ -299,50 +299,69 @@ void Simulation<Dim>::velocity_from_momentum() {
     nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
 }
 
-// p_i^{n+1} = p_i^n + f_i dt after boundary conditions on both; with contact, contact is resolved on
-// p^{n+1} with consistent forces (Nairn 2018 eq. 19); then v_i^{n+1} = p_i^{n+1}/m_i, a_i = f_i/m_i.
+// The grid update p_i^{n+1} = p_i^n + f_i dt after the velocity conditions on both, in phases (the
+// step's lists, simulation_step.cpp); with contact, contact is resolved on p^{n+1} with consistent
+// forces (Nairn 2018 eq. 19) between advance_grid_momentum and nodal_velocities, which then gives
+// v_i^{n+1} = p_i^{n+1}/m_i, a_i = f_i/m_i.
+
+// XPIC filters v^n, the velocity p^n/m the momentum update starts from.
 template <int Dim>
-void Simulation<Dim>::update_grid(double dt) {
+void Simulation<Dim>::save_start_velocity() {
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
-  if (opt_.particle_update == ParticleUpdate::xpic) {  // XPIC filters v^n, the velocity p^n/m updated here
-    transfer_.start.resize(n);
+  transfer_.start.resize(n);
 #pragma omp parallel for num_threads(threads_) schedule(static)
-    for (std::size_t i = 0; i < n; ++i)
-      transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+}
+
+template <int Dim>
+void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
   rigid_work_ += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
-  if (opt_.damping_rate > 0.0 && time_ < opt_.damping_until) {
-    // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
-    // (explicit: stable for c dt < 2; the scene checks c dt_max < 1). After the velocity conditions,
-    // on the components they leave free (the same forces as damping first: the conditions replace the
-    // force of the components they set, and fixed ones have p = 0), so that its work, c p²/m dt per
-    // component, is the energy it removes.
-    const double c = opt_.damping_rate, mmin_damped = mmin;
-    double removed = 0.0;
+}
+
+// Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
+// (explicit: stable for c dt < 2; the scene checks c dt_max < 1). After the velocity conditions,
+// on the components they leave free (the same forces as damping first: the conditions replace the
+// force of the components they set, and fixed ones have p = 0), so that its work, c p²/m dt per
+// component, is the energy it removes.
+template <int Dim>
+void Simulation<Dim>::apply_damping(double dt) {
+  if (!(opt_.damping_rate > 0.0 && time_ < opt_.damping_until)) return;
+  const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
+  double removed = 0.0;
 #pragma omp parallel num_threads(threads_) reduction(+ : removed)
-    for (std::size_t f = 0; f < fields_.size(); ++f) {
-      const VelocityField<Dim>& F = fields_[f];
-      if (F.rigid) continue;
-      const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
+  for (std::size_t f = 0; f < fields_.size(); ++f) {
+    const VelocityField<Dim>& F = fields_[f];
+    if (F.rigid) continue;
+    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
 #pragma omp for schedule(static) nowait
-      for (long ss = b; ss < e; ++ss) {
-        const std::size_t s = static_cast<std::size_t>(ss);
-        const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(slot_node_[s])];
-        const double m = nodes_.mass[s];
-        for (int d = 0; d < Dim; ++d) {
-          if (driven & (1u << d)) continue;
-          const double p = nodes_.momentum[s][d];
-          nodes_.force[s][d] -= c * p;
-          if (m > mmin_damped) removed += c * p * p / m * dt;
-        }
+    for (long ss = b; ss < e; ++ss) {
+      const std::size_t s = static_cast<std::size_t>(ss);
+      const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(slot_node_[s])];
+      const double m = nodes_.mass[s];
+      for (int d = 0; d < Dim; ++d) {
+        if (driven & (1u << d)) continue;
+        const double p = nodes_.momentum[s][d];
+        nodes_.force[s][d] -= c * p;
+        if (m > mmin_damped) removed += c * p * p / m * dt;
       }
     }
-    damping_work_ += removed;
   }
+  damping_work_ += removed;
+}
+
+template <int Dim>
+void Simulation<Dim>::advance_grid_momentum(double dt) {
+  const std::size_t n = nodes_.mass.size();
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
-  if (contact_) resolve_contact(ContactPass::updated, dt);
+}
+
+template <int Dim>
+void Simulation<Dim>::nodal_velocities() {
+  const double mmin = empty_node_mass_;
+  const std::size_t n = nodes_.mass.size();
   // Nodes driven by a rigid boundary material keep its prescribed velocity components (the force was
   // zeroed consistently, so only the velocity needs resetting when the prescribed velocity changes).
 #pragma omp parallel for num_threads(threads_) schedule(static)
@@ -442,7 +461,11 @@ template struct NodalFields<3>;
   template void Simulation<D>::sum_shared_fields(Accumulated);                                               \
   template double Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
-  template void Simulation<D>::update_grid(double);                                                           \
+  template void Simulation<D>::save_start_velocity();                                                         \
+  template void Simulation<D>::apply_grid_velocity_conditions(double);                                        \
+  template void Simulation<D>::apply_damping(double);                                                         \
+  template void Simulation<D>::advance_grid_momentum(double);                                                 \
+  template void Simulation<D>::nodal_velocities();                                                            \
   template void Simulation<D>::move_rigid_particles(double, double);                                          \
   template Simulation<D>::RigidMotion Simulation<D>::rigid_motion(std::size_t, double, double) const;         \
   template void Simulation<D>::check_particle(long, double) const;                                            \

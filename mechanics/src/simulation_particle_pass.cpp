@@ -6,9 +6,9 @@
 // With `refresh` (USL with contact) the pass also evaluates each moved particle's stencil for the next
 // step while its position is at hand, and moves the rigid materials' particles and evaluates theirs:
 // the start of the next step and the heat hand-off after it need not pass over the particles again.
-#include <frictherm/mechanics/mie_gruneisen.hpp>
-#include <frictherm/mechanics/plane_strain_update.hpp>
+#include <frictherm/mechanics/constitutive/stress_update.hpp>
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/transfer/pic_blend.hpp>
 
 #include "stencil_access.hpp"
 
@@ -49,7 +49,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   long beyond = -1;                              // max-reduction identity
   double work = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
-  const double pic = std::isfinite(opt_.pic_relaxation_time) ? -std::expm1(-dt / opt_.pic_relaxation_time) : 0.0;
+  const double pic = pic_blend_fraction(dt, opt_.pic_relaxation_time);
   const ParticleUpdate update = opt_.particle_update;
   const bool flip = update == ParticleUpdate::flip;
   const Analysis an = opt_.analysis;
@@ -129,7 +129,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           if (flip) {
             add_work(k, p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt);
             p_.velocity[k] += dt * a;
-            if (pic > 0.0) p_.velocity[k] = (1.0 - pic) * p_.velocity[k] + pic * v;  // FLIP/PIC blend
+            pic_blend(p_.velocity[k], v, pic);
           } else if (update == ParticleUpdate::xpic) {
             p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
           } else {
@@ -169,52 +169,25 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [](std::size_t, const Mat<Dim>&) { return true; });
         continue;
       }
-      const double lam = mat.lame_lambda(), mu = mat.shear_modulus();
-      const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
-      const double c0 = mg || nh ? 0.0 : mat.p_wave_speed(an);
-      const double min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;  // per material, not per particle
+      const StressLaw law = stress_law(mat, an);  // per material, not per particle
+      const auto state = [&](std::size_t k) {
+        return StressState<Dim>{p_.deformation_gradient[k], p_.volume[k], p_.initial_volume[k],
+                                p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
+                                p_.internal_energy[k], p_.plastic_work[k], wave_speed_[k]};
+      };
       if constexpr (Dim == 2) {
-        if (mg) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
+        if (law.mie_gruneisen()) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
           // A local copy: no particle store can touch it, so the compiler hoists what depends on the
           // material only (ρ0 C0², −2G/3, …) out of the loop.
           const MieGruneisenParams params = mat.mie_gruneisen;
           run(ix, kb, ke, VelocityGradient2{}, [&](std::size_t k, const VelocityGradient2& L) {
-            Mat<2>& F = p_.deformation_gradient[k];
-            const double det_A = deformation_update_2d(L, dt, F);
-            p_.volume[k] = determinant_2d(F) * p_.initial_volume[k];
-            double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-            const MieGruneisenStatus status = mie_gruneisen_update_plane_strain(
-                L, dt, p_.volume[k] / p_.initial_volume[k], det_A, params, min_J, p_.stress[k], p_.stress_zz[k],
-                p_.plastic_strain[k], p_.internal_energy[k], wp, wave_speed_[k]);
-            p_.plastic_work[k] += wp * p_.volume[k];
-            return status == MieGruneisenStatus::ok;
+            return update_stress_plane_strain(params, law.min_J, L, dt, state(k));
           });
           continue;
         }
       }
-      run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [&](std::size_t k, const Mat<Dim>& L) {
-        Mat<Dim>& F = p_.deformation_gradient[k];
-        const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-        Mat<Dim> F_new;
-        F_new.noalias() = A * F;  // (no aliasing temporary, no out-of-line product)
-        F = F_new;
-        p_.volume[k] = F.determinant() * p_.initial_volume[k];
-        bool ok = true;
-        if (mg) {
-          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-          ok = mie_gruneisen_update<Dim>(L, dt, p_.volume[k] / p_.initial_volume[k], mat.mie_gruneisen, min_J,
-                                         p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k], p_.internal_energy[k],
-                                         wp, &wave_speed_[k]) == MieGruneisenStatus::ok;
-          p_.plastic_work[k] += wp * p_.volume[k];
-        } else if (nh) {
-          neo_hookean_stress<Dim>(F, lam, mu, p_.stress[k], p_.stress_zz[k]);
-          wave_speed_[k] = mat.wave_speed(an, p_.volume[k] / p_.initial_volume[k]);
-        } else {
-          linear_elastic_update<Dim>(L, dt, lam, mu, an, p_.stress[k], p_.stress_zz[k]);
-          wave_speed_[k] = c0;
-        }
-        return ok;
-      });
+      run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()),
+          [&](std::size_t k, const Mat<Dim>& L) { return update_stress<Dim>(mat, law, an, L, dt, state(k)); });
     }
     pass_split_.seconds[static_cast<std::size_t>(t)] = omp_get_wtime() - started;
   });

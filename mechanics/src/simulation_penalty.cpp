@@ -266,7 +266,7 @@ void Simulation<Dim>::apply_penalty_forces() {
   pc.compute(boundary_, [&](int k, int i) {
     return touches_field(boundary_, i, w, pc.pair(static_cast<std::size_t>(k)).master, master_has_mass);
   });
-  pc.scatter_forces(boundary_, w, nodes_.force);  // K·36; rigid fields drop theirs in update_grid
+  pc.scatter_forces(boundary_, w, nodes_.force);  // K·36; rigid fields drop theirs in nodal_velocities
   pc.scatter_heat(boundary_, w, work_first_);     // penalty heat has no first/second-order split
   pc.scatter_heat(boundary_, w, work_second_);
   pc.update_frequency_bound(boundary_, w, nodes_.mass, empty_node_mass_);  // for the next time step

@@ -1,6 +1,6 @@
 // Simulation set-up: materials, bodies filled with particles, boundary conditions and loads.
-#include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/time_step/cfl_time_step.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -259,29 +259,23 @@ double Simulation<Dim>::stable_time_step() const {
       const Material& mat = materials_[m];
       const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
       if (mat.is_rigid()) continue;
-      const bool nh = mat.kind == MaterialKind::neo_hookean, mg = mat.kind == MaterialKind::mie_gruneisen;
-      const double c0 = mg ? 0.0 : mat.p_wave_speed(opt_.analysis);
 #pragma omp for schedule(static) nowait
       for (std::size_t k = b; k < e; ++k) {
         if (!finalized_ && p_.material[k] != static_cast<int>(m)) continue;
-        const double J = p_.volume[k] / p_.initial_volume[k];
-        const double c = mg   ? mie_gruneisen_wave_speed(mat.mie_gruneisen, J, p_.internal_energy[k])
-                         : nh ? mat.wave_speed(opt_.analysis, J)
-                              : c0;
+        const double c = particle_wave_speed(mat, opt_.analysis, p_.volume[k] / p_.initial_volume[k], p_.internal_energy[k]);
         cmax = std::max(cmax, c + p_.velocity[k].norm());
       }
     }
   }
-  for (const Material& mat : materials_)  // rigid bodies move material through the grid too
-    if (mat.is_rigid()) cmax = std::max(cmax, mat.rigid_velocity_at(time_).norm());
+  cmax = with_rigid_speeds(cmax, materials_, time_);
   const double dt_penalty = penalty_time_step_limit(cmax);  // light nodes under contacts (simulation_penalty.cpp)
   cmax *= penalty_wave_factor();
-  // Explicit damping −c p_i: c dt ≤ 0.5 while it acts (stable up to 2, accurate well below 1).
   const double dt_damping = opt_.damping_rate > 0.0 && time_ < opt_.damping_until
-                                ? 0.5 / opt_.damping_rate
+                                ? damping_time_step_limit(opt_.damping_rate)
                                 : std::numeric_limits<double>::infinity();
-  if (cmax <= 0.0) return std::min(opt_.max_time_step, dt_damping);
-  return std::min({opt_.cfl * grid_.min_cell_size() / cmax, opt_.max_time_step, dt_penalty, dt_damping});
+  const double dt = cfl_time_step(opt_.cfl, grid_.min_cell_size(), cmax, opt_.max_time_step);
+  if (cmax <= 0.0) return std::min(dt, dt_damping);
+  return std::min({dt, dt_penalty, dt_damping});
 }
 
 template <int Dim>

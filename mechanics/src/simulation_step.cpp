@@ -1,10 +1,11 @@
-// One explicit MPM step: particle-to-grid, contact, grid momentum update, grid-to-particle, stress
-// update. Particle loops are templated on the shape-function kernel (static dispatch) and threaded
-// with OpenMP; scatters go to per-thread nodal buffers that are summed afterwards. Every particle
-// scatters into the slots of its material's velocity field (field_of_material_), so the same loops
-// serve the shared single field and the per-material fields of multimaterial contact. With the
-// extended B-spline the weights are precomputed per step (simulation_ebs.cpp) and the same loops
-// read them.
+// One explicit MPM step as a list of named phases (step/phase_list.hpp), built once per scene by
+// build_phases from the update scheme and the options and run by PhaseList::run, which times each
+// phase; the phases read no clock. The particle loops are templated on the shape-function kernel
+// (static dispatch) and threaded with OpenMP; scatters go to per-thread nodal buffers that are summed
+// afterwards. Every particle scatters into the slots of its material's velocity field
+// (field_of_material_), so the same loops serve the shared single field and the per-material fields
+// of multimaterial contact. With the extended B-spline the weights are precomputed per step
+// (simulation_ebs.cpp) and the same loops read them.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
@@ -46,37 +47,141 @@ double Simulation<Dim>::step(double dt_limit) {
   // The energy books' start (EnergyBalance::initial): once, before the first step moves anything.
   if (std::isnan(initial_energy_))
     initial_energy_ = kinetic_energy() + strain_energy() + (penalty_ ? penalty_->stored_energy() : 0.0);
-  lap_ = PhaseLap{};
-  nested_phase_ = 0.0;
-  const double dt = std::min(stable_time_step(), dt_limit);
-  lap_.to(phase_times_.time_step);
-  if (!(dt > 0.0) || !std::isfinite(dt)) {
-    std::ostringstream msg;
-    msg << "step " << step_ << ", t = " << time_ << " s: time step " << dt << " s is not positive and finite";
-    throw SimulationError(msg.str(), step_, time_, -1);
-  }
-  if (opt_.shape == ShapeKind::extended_bspline)
-    step_with<ExtendedBSplineKernel>(dt);
-  else
-    dispatch_shape(opt_.shape, [&](auto kernel) { step_with<decltype(kernel)>(dt); });
-  last_dt_ = dt;
-  return dt;
+  if (phases_.empty() || phases_key_ != phase_key()) build_phases();
+  StepContext ctx;
+  ctx.dt_limit = dt_limit;
+  ctx.t = time_;
+  phases_.run(ctx, phase_times_);
+  last_dt_ = ctx.dt;
+  return ctx.dt;
+}
+
+// What the phase lists depend on; a change rebuilds them.
+template <int Dim>
+long Simulation<Dim>::phase_key() const {
+  long key = static_cast<long>(opt_.shape);
+  key = key * 4 + static_cast<long>(opt_.scheme);
+  key = key * 8 + static_cast<long>(opt_.particle_update);
+  key = key * 2 + (opt_.damping_rate > 0.0);
+  key = key * 2 + contact_;
+  key = key * 2 + (contact_ && contact_opt_.separation == SeparationMethod::extent);
+  key = key * 2 + penalty_.has_value();
+  key = key * 2 + !resolved_loads_.empty();
+  return key;
 }
 
 template <int Dim>
+void Simulation<Dim>::build_phases() {
+  phases_.clear();
+  if (opt_.shape == ShapeKind::extended_bspline)
+    build_phases<ExtendedBSplineKernel>();
+  else
+    dispatch_shape(opt_.shape, [&](auto kernel) { build_phases<decltype(kernel)>(); });
+  phases_key_ = phase_key();
+}
+
+template <int Dim>
+std::vector<const char*> Simulation<Dim>::step_phase_names() {
+  finalize();
+  if (phases_.empty() || phases_key_ != phase_key()) build_phases();
+  std::vector<const char*> names;
+  for (const StepPhase& p : phases_.phases()) names.push_back(p.name);
+  return names;
+}
+
+// The step's phase lists. USF: stress from the extrapolated grid velocities, then the forces; USL:
+// forces from the start-of-step stress, the stress update after the grid update (with the
+// grid-to-particle update in one pass); MUSL: as USL, then the momenta remapped from the updated
+// particles and the stress from their velocities. Contact (multimaterial) passes follow each
+// momentum projection; penalty contact adds its forces before the grid update and moves its boundary
+// points with the velocity the stress update uses (simulation_penalty.cpp).
+template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::step_with(double dt) {
+void Simulation<Dim>::build_phases() {
+  using T = StepPhaseTimes;
+  PhaseList& P = phases_;
+  const UpdateScheme scheme = opt_.scheme;
+  const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
+  const bool penalty = penalty_.has_value();
+  const bool flip = opt_.particle_update == ParticleUpdate::flip;
+  // USL with contact: the particle pass also evaluates the next step's stencils and boxes and moves
+  // the rigid particles (nothing after it in the step needs this step's stencils).
+  const bool refresh = usl && contact_ && !is_extended<Kernel>;
+
+  P.add("time_step", &T::time_step, [this](StepContext& c) {
+    c.dt = std::min(stable_time_step(), c.dt_limit);
+    if (!(c.dt > 0.0) || !std::isfinite(c.dt)) {
+      std::ostringstream msg;
+      msg << "step " << step_ << ", t = " << time_ << " s: time step " << c.dt << " s is not positive and finite";
+      throw SimulationError(msg.str(), step_, time_, -1);
+    }
+  });
+  P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
+  P.add("particle_to_grid", &T::particle_to_grid, [this, usf](StepContext& c) { map_to_grid<Kernel>(c.dt, !usf); });
+  if (contact_)
+    P.add("contact_extrapolated", &T::contact, [this](StepContext& c) { contact_at_extrapolated<Kernel>(c.dt); });
+  if (usf) {
+    P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
+    P.add("stress_update", &T::stress_update, [this](StepContext& c) { stress_pass<Kernel>(c.dt); });
+    P.add("internal_forces", &T::particle_to_grid, [this](StepContext&) { add_internal_forces<Kernel>(); });
+    if (penalty)  // the points move with the velocity the stress update used
+      P.add("move_boundary_points", &T::contact, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
+  }
+  if (!resolved_loads_.empty())
+    P.add("external_loads", &T::particle_to_grid, [this](StepContext& c) { map_external_loads<Kernel>(c.t); });
+  if (penalty)  // point forces into the nodal forces (Kakouris 2024 eq. 36), before the velocity conditions
+    P.add("penalty_forces", &T::contact, [this](StepContext&) { apply_penalty_forces(); });
+  if (opt_.particle_update == ParticleUpdate::xpic)
+    P.add("start_velocity", &T::grid_update, [this](StepContext&) { save_start_velocity(); });
+  P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
+  if (opt_.damping_rate > 0.0) P.add("damping", &T::grid_update, [this](StepContext& c) { apply_damping(c.dt); });
+  P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
+  if (contact_)
+    P.add("contact_updated", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::updated, c.dt); });
+  P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
+  if (!flip)  // XPIC/FMPM
+    P.add("velocity_filter", usl ? &T::stress_update : &T::grid_to_particle,
+          [this](StepContext&) { filter_grid_velocity(stencils<Kernel>()); });
+  if (usl) {  // grid-to-particle and stress update in one pass over the stencils
+    P.add("particle_update", &T::stress_update, [this, refresh](StepContext& c) {
+      const ParticlePassResult r = particle_pass<true, true>(c.dt, stencils<Kernel>(), refresh);
+      c.bad = r.bad, c.beyond = r.beyond;
+    });
+    if (penalty) P.add("move_boundary_points", &T::grid_to_particle, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
+  } else {
+    P.add("grid_to_particle", &T::grid_to_particle, [this](StepContext& c) {
+      c.bad = particle_pass<true, false>(c.dt, stencils<Kernel>()).bad;
+    });
+  }
+  if (!refresh)
+    P.add("move_rigid_particles", &T::grid_to_particle, [this](StepContext& c) { move_rigid_particles(c.dt, c.t); });
+  P.add("end_particle_update", &T::grid_to_particle, [this, refresh](StepContext& c) { end_particle_update(c, refresh); });
+  if (musl) {
+    P.add("remap_momentum", &T::particle_to_grid, [this](StepContext&) { remap_momentum<Kernel>(); });
+    if (contact_)
+      P.add("contact_remapped", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::remapped, c.dt); });
+    P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
+    if (penalty)  // with the remapped velocity, as the stress update
+      P.add("move_boundary_points", &T::grid_update, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
+    P.add("stress_update", &T::stress_update, [this](StepContext& c) { stress_pass<Kernel>(c.dt); });
+  }
+}
+
+// The start of a step: threads for this step's particle count, the thread partition, the rigid
+// fields' velocities, the stencils (EBS: rebuilt per field; contact: with the per-material boxes of
+// nodes and the field layout) and the nodes driven by rigid boundary materials.
+template <int Dim>
+template <class Kernel>
+void Simulation<Dim>::prepare_step(double t) {
   // Below ~2000 particles per thread the fork/join and the scatter-buffer reduction cost more than
   // the particle work they share.
   const int max_threads = omp_get_max_threads();
   threads_ = threads_for_particles(p_.size(), max_threads);
   if (static_cast<int>(thread_nodes_.size()) != threads_ - 1) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
-    for (auto& t : thread_nodes_) t.resize(nodes_.mass.size(), contact_);
+    for (auto& tn : thread_nodes_) tn.resize(nodes_.mass.size(), contact_);
   }
   update_partition();
-  StepPhaseTimes& pt = phase_times_;
-  const double t = time_;
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
       field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
@@ -101,63 +206,36 @@ void Simulation<Dim>::step_with(double dt) {
     std::fill(work_first_.begin(), work_first_.end(), 0.0);
     std::fill(work_second_.begin(), work_second_.end(), 0.0);
   }
-  lap_.to(pt.shape_functions);
-  const bool usf = opt_.scheme == UpdateScheme::usf;
-  map_to_grid<Kernel>(dt, /*with_forces=*/!usf);
-  lap_.to(pt.particle_to_grid);
-  if (contact_) {
-    find_contact_nodes();
-    if (contact_opt_.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
-    resolve_contact(ContactPass::extrapolated, dt);
-    lap_.to(pt.contact, nested_phase_);
-  }
-  if (usf) {
-    velocity_from_momentum();
-    lap_.to(pt.grid_update);
-    throw_beyond_hugoniot(particle_pass<false, true>(dt, stencils<Kernel>()).beyond);
-    lap_.to(pt.stress_update);
-    add_internal_forces<Kernel>();
-    lap_.to(pt.particle_to_grid);
-    move_boundary_points(dt, t);  // penalty: the points move with the velocity the stress update used
-    lap_.to(pt.contact, nested_phase_);
-  }
-  map_external_loads<Kernel>(t);
-  lap_.to(pt.particle_to_grid);
-  apply_penalty_forces();  // penalty pairs: point forces into the nodal forces (Kakouris 2024 eq. 36)
-  lap_.to(pt.contact, nested_phase_);
-  update_grid(dt);         // velocity conditions act on the penalty forces too
-  lap_.to(pt.grid_update, nested_phase_);  // less its contact pass (resolve_contact times itself)
-  if (opt_.particle_update != ParticleUpdate::flip) filter_grid_velocity(stencils<Kernel>());  // XPIC/FMPM
-  // USL: the stress update from the same nodal velocities in the same pass over the stencils (timed
-  // as stress_update); USF and MUSL: the grid-to-particle update alone. USL with contact also evaluates
-  // the next step's stencils and boxes in that pass (and moves the rigid particles): nothing after it
-  // in the step needs this step's stencils.
-  const bool usl = opt_.scheme == UpdateScheme::usl;
-  const bool refresh = usl && contact_ && !is_extended<Kernel>;
-  const ParticlePassResult pass = usl ? particle_pass<true, true>(dt, stencils<Kernel>(), refresh)
-                                      : particle_pass<true, false>(dt, stencils<Kernel>());
-  lap_.to(usl ? pt.stress_update : pt.grid_to_particle);
-  if (usl) move_boundary_points(dt, t);  // (see simulation_penalty.cpp)
-  if (!refresh) move_rigid_particles(dt, t);
+}
+
+// Multimaterial contact after the momentum extrapolation: the contact nodes, the extents (extent
+// separation) and the first contact pass.
+template <int Dim>
+template <class Kernel>
+void Simulation<Dim>::contact_at_extrapolated(double dt) {
+  find_contact_nodes();
+  if (contact_opt_.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
+  resolve_contact(ContactPass::extrapolated, dt);
+}
+
+// USF and MUSL: the stress update from nodes_.velocity alone.
+template <int Dim>
+template <class Kernel>
+void Simulation<Dim>::stress_pass(double dt) {
+  throw_beyond_hugoniot(particle_pass<false, true>(dt, stencils<Kernel>()).beyond);
+}
+
+// After grid-to-particle: the step's time and count advance, a particle with a non-finite state or
+// outside the grid stops the run (check_particle), then (USL) one compressed past its Hugoniot's limit.
+// The stencils are current again only if the particle pass evaluated them (refreshed).
+template <int Dim>
+void Simulation<Dim>::end_particle_update(StepContext& ctx, bool refreshed) {
   stencils_current_ = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
-  lap_.to(pt.grid_to_particle);
-  time_ += dt;
+  time_ += ctx.dt;
   ++step_;
-  check_particle(pass.bad, dt);
-  stencils_current_ = refresh;  // every particle inside the grid: the pass evaluated every stencil
-  if (usl) {
-    throw_beyond_hugoniot(pass.beyond);
-  } else if (opt_.scheme == UpdateScheme::musl) {
-    remap_momentum<Kernel>();
-    lap_.to(pt.particle_to_grid);
-    if (contact_) resolve_contact(ContactPass::remapped, dt);
-    lap_.to(pt.contact, nested_phase_);
-    velocity_from_momentum();
-    move_boundary_points(dt, t);  // MUSL: with the remapped velocity, as the stress update
-    lap_.to(pt.grid_update);
-    throw_beyond_hugoniot(particle_pass<false, true>(dt, stencils<Kernel>()).beyond);
-    lap_.to(pt.stress_update);
-  }
+  check_particle(ctx.bad, ctx.dt);
+  stencils_current_ = refreshed;  // every particle inside the grid: the pass evaluated every stencil
+  throw_beyond_hugoniot(ctx.beyond);
 }
 
 // Every particle's stencil (rigid ones too), and with contact per material the box of nodes it reaches
@@ -207,7 +285,7 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
     using Kernel = decltype(kernel);
     auto& st = stencils<Kernel>();
     if (!stencils_current_ || st.size() != p_.size()) {
-      PhaseLap lap;
+      PhaseLap lap;  // outside the step: timed with the step's shape_functions phase
       evaluate_stencils<Kernel>();
       stencils_current_ = true;
       lap.to(phase_times_.shape_functions);
@@ -363,8 +441,8 @@ void Simulation<Dim>::map_external_loads(double t) {
   }
 }
 
-// MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p (step_with
-// then resolves contact again on the remapped momenta).
+// MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p (the MUSL
+// list then resolves contact again on the remapped momenta).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::remap_momentum() {
@@ -380,6 +458,10 @@ void Simulation<Dim>::remap_momentum() {
 
 #define FRICTHERM_INSTANTIATE_STEP(D) \
   template double Simulation<D>::step(double); \
+  template std::vector<const char*> Simulation<D>::step_phase_names(); \
+  template void Simulation<D>::build_phases(); \
+  template long Simulation<D>::phase_key() const; \
+  template void Simulation<D>::end_particle_update(StepContext&, bool); \
   template StencilView<D> Simulation<D>::current_stencils();
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)

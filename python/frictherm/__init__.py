@@ -3,15 +3,21 @@
     import frictherm
     with frictherm.open("results/sliding_block_heating.h5") as run:
         t, T = run.series["time"], run.series["max_temperature"]
-        df = run.series.to_dataframe()              # pandas, optional
+        df = run.series.to_dataframe()              # pandas, indexed by time; df.attrs["units"]
+        run.unit_of("max_temperature")              # 'K' (every dataset has units and long_name)
+        ds = run.to_xarray()                        # the whole run as an xarray.Dataset
         last = run.snapshots[-1]                    # .step, .time, .fields, last["temperature"]
         spots = run.hotspots                        # a Table, like the series
         books = run.energy_books                    # heat_delivered, particle_energy_change, ...
         meta = run.meta                             # decoded: str, int, float
 
 `open` also reads ensemble files (`frictherm ensemble`): an Ensemble with .members, .hotspots,
-.summary and .member(seed). Needs numpy and h5py (Debian python3-numpy, python3-h5py); pandas
-(python3-pandas) only for to_dataframe, matplotlib only for frictherm.plot.
+.summary and .member(seed). Needs numpy, h5py and pandas (Debian python3-numpy, python3-h5py,
+python3-pandas); xarray only for to_xarray, matplotlib only for frictherm.plot.
+
+Built with pybind11 (CMake build or install, not `pip install`), the package also runs scenes:
+frictherm.load_scene(path or dict), scene.set(key, value), frictherm.validate(scene),
+frictherm.run(scene, output=..., threads=..., observer=...) (frictherm/native.py).
 """
 import h5py
 
@@ -19,11 +25,13 @@ from ._h5 import is_count_column
 from .ensemble import Ensemble
 from .run import ENERGY_BOOK_KEYS, SUPPORTED_FORMAT_VERSION, Run
 from .snapshot import Snapshot, physical_shape
-from .table import Table
+from .native import Scene, SceneError, load_scene, run, validate
+from .table import FATE_NAMES, Table
 
 __version__ = "0.1.0"
 __all__ = ["open", "Run", "Ensemble", "Snapshot", "Table", "physical_shape", "is_count_column",
-           "ENERGY_BOOK_KEYS", "SUPPORTED_FORMAT_VERSION"]
+           "ENERGY_BOOK_KEYS", "SUPPORTED_FORMAT_VERSION", "FATE_NAMES",
+           "Scene", "SceneError", "load_scene", "run", "validate"]
 
 
 def open(path):  # noqa: A001  (frictherm.open, like h5py.File / io.open)

@@ -40,6 +40,10 @@ class JoinedArray:
         self._group, self._name = group, name
 
     @property
+    def attrs(self):  # units, long_name: the same in every rank file
+        return self._group.parts[0][self._name].attrs
+
+    @property
     def shape(self):
         parts = [g[self._name].shape for g in self._group.parts]
         return (sum(p[0] for p in parts),) + tuple(parts[0][1:])

@@ -83,6 +83,53 @@ class Run:
         mechanics-only run. heat_delivered equals particle_energy_change when the books close."""
         return {k: self.meta[k] for k in ENERGY_BOOK_KEYS if k in self.meta}
 
+    @property
+    def scene_json(self):
+        """The scene as run (overrides applied) as plain JSON text: ``json.loads`` reads it. Files
+        written before /meta/scene_json give the scene file's text (which may hold comments)."""
+        return self.meta.get("scene_json", self.meta.get("scene", ""))
+
+    @property
+    def scene(self):
+        """The scene as run, as a dict (from /meta/scene_json)."""
+        import json
+        return json.loads(self.scene_json)
+
+    @property
+    def grid(self):
+        """{"lo", "hi", "cells", "cell_size"} as arrays (m; cells: counts), from /meta/grid_* or, in
+        older files, the text /meta/grid."""
+        m = self.meta
+        if "grid_lo" in m:
+            return {k: np.asarray(m["grid_" + k]) for k in ("lo", "hi", "cells", "cell_size")}
+        parts = dict(p.strip().split(" ", 1) for p in m.get("grid", "").split(";") if p.strip())
+        return {k: np.array(parts[k].split(), dtype=np.int64 if k == "cells" else float) for k in parts}
+
+    @property
+    def materials(self):
+        """Material names by id (/meta/material_names, or the older text /meta/materials)."""
+        if "material_names" in self.meta:
+            return list(self.meta["material_names"])
+        return [p.split()[1] for p in self.meta.get("materials", "").split(";") if len(p.split()) >= 2]
+
+    def unit_of(self, name):
+        """The units of a series column, snapshot field or /meta entry ("" when unknown): the
+        file's `units` attribute, or for files written before them the known SI units."""
+        if name in self.series.units:
+            return self.series.units[name]
+        if self.snapshots and name in self.snapshots[0]:
+            return self.snapshots[0].unit_of(name)
+        if "meta" in self.file and name in self.file["meta"] and "units" in self.file["meta"][name].attrs:
+            return text(self.file["meta"][name].attrs["units"])
+        from .fields import unit_of
+        return unit_of(name)
+
+    def to_xarray(self, snapshots=True):
+        """The run as an xarray.Dataset: series on ``time``, snapshot fields on (``snapshot``,
+        ``particle``, ...) with units (frictherm/xr.py)."""
+        from .xr import run_to_xarray
+        return run_to_xarray(self, snapshots)
+
     # ---- tables ----
     @property
     def series(self):
@@ -105,7 +152,8 @@ class Run:
 
     @property
     def hotspot_fates(self):
-        """/hotspot_fates of the thermal-only continuation (fate 0 undecided, 1 dying, 2 runaway)."""
+        """/hotspot_fates of the thermal-only continuation (fate 0 undecided, 1 dying, 2 runaway;
+        ``hotspot_fates.names_of("fate")`` gives the names, the DataFrame has them in ``fate_name``)."""
         return self.table("hotspot_fates")
 
     # ---- snapshots ----

@@ -3,6 +3,8 @@ import numpy as np
 
 from ._h5 import text
 
+AXES = "xyz"
+
 
 def physical_shape(data, dim):
     """A stored per-particle array in its physical shape: (n,) scalars, (n, dim) vectors,
@@ -69,6 +71,50 @@ class Snapshot:
 
     def __getitem__(self, name):
         return physical_shape(self.raw(name), self._run.dim)
+
+    def unit_of(self, name):
+        """The units of a stored field (its `units` attribute; for older files the known SI units)."""
+        if name in self._group and "units" in self._group[name].attrs:
+            return text(self._group[name].attrs["units"])
+        from .fields import unit_of
+        return unit_of(name)
+
+    def long_name(self, name):
+        if name in self._group and "long_name" in self._group[name].attrs:
+            return text(self._group[name].attrs["long_name"])
+        return name.replace("_", " ")
+
+    def columns(self):
+        """{column name: (n,) array}: scalars by their name, vector components as name_x, name_y
+        (name_z in 3D), tensor components as name_xx, name_xy, ... in the run's dimension."""
+        out = {}
+        for name in self.fields:
+            data = self[name]
+            if data.ndim == 1:
+                out[name] = data
+            elif data.ndim == 2:
+                for i in range(data.shape[1]):
+                    out[f"{name}_{AXES[i] if data.shape[1] <= 3 else i}"] = data[:, i]
+            else:
+                for i in range(data.shape[1]):
+                    for j in range(data.shape[2]):
+                        out[f"{name}_{AXES[i]}{AXES[j]}"] = data[:, i, j]
+        return out
+
+    def to_dataframe(self):
+        """The particles as a pandas DataFrame, one row per particle (columns as ``columns()``);
+        ``df.attrs["units"]`` gives each column's units, ``df.attrs["time"]`` and ``["step"]`` the
+        snapshot's."""
+        import pandas as pd
+        cols = self.columns()
+        df = pd.DataFrame(cols)
+        df.index.name = "particle"
+        units = {}
+        for c in cols:
+            base = c if c in self else c.rpartition("_")[0]
+            units[c] = self.unit_of(base)
+        df.attrs.update(units=units, time=self.time, step=self.step)
+        return df
 
     def stress_tensor(self):
         """The Cauchy stress as (n, 3, 3); in 2D the out-of-plane stress_zz when stored (plane

@@ -12,6 +12,7 @@
 #include "thermal_test_support.hpp"
 
 #include <frictherm/coupling/coupler.hpp>
+#include <frictherm/coupling/interface_reaction.hpp>
 
 #include <gtest/gtest.h>
 
@@ -47,9 +48,12 @@ struct Trace {
 
 // Strip [0, W] × [−H, H], interface y = 0, material 0 below and 1 above. flux(x, t) in W/m² over the
 // step ending at t (evaluated at the step's midpoint), sampled at the node above x_probe.
+// `configure` may change the coupler's options; `finish` sees the coupler and particles at the end.
 Trace run_strip(const Side& a, const Side& b, double h, fm::ShapeKind shape, double dt, long steps,
                 long steps_per_window, const std::function<double(double, double)>& flux, double x_probe,
-                bool model = true, const std::function<double(double)>& exact = {}) {
+                bool model = true, const std::function<double(double)>& exact = {},
+                const std::function<void(fc::CouplerOptions&)>& configure = {},
+                const std::function<void(fc::Coupler<2>&, fm::Particles<2>&, double)>& finish = {}) {
   const int nx = 8, ny = 24;  // cells across, and per side
   const double thickness = 1e-3, T0 = 300.0;
   const auto grid = make_grid<2>({0.0, -ny * h}, h, {nx, 2 * ny});
@@ -65,6 +69,7 @@ Trace run_strip(const Side& a, const Side& b, double h, fm::ShapeKind shape, dou
   opt.window.steps = steps_per_window;
   opt.thickness = thickness;
   opt.interface_temperature.enabled = model;
+  if (configure) configure(opt);
   fc::Coupler<2> cp(grid, shape, opt);
   cp.start(p, 0.0);
   // The interface nodes and their share of the interface (half a cell at the strip's sides).
@@ -110,6 +115,7 @@ Trace run_strip(const Side& a, const Side& b, double h, fm::ShapeKind shape, dou
   const fc::EnergyBooks& books = cp.books();
   tr.books_gap = std::abs(books.nodal_energy_change - books.heat_delivered) / books.heat_delivered;
   tr.final_particle_temperature = p.temperature;
+  if (finish) finish(cp, p, dt * static_cast<double>(steps));
   return tr;
 }
 
@@ -197,4 +203,87 @@ TEST(InterfaceTemperature, ModelAddsAndTakesNoHeat) {
   for (std::size_t k = 0; k < on.final_particle_temperature.size(); ++k)
     ASSERT_EQ(on.final_particle_temperature[k], off.final_particle_temperature[k]);
   EXPECT_EQ(on.books_gap, off.books_gap);
+}
+
+// The Arrhenius verdict at the interface temperature (interface_reaction.hpp). A constant flux
+// heats the HMX|binder interface by θ(t) = 100 K √(t/t_end) over t_end = 2 µs (the constant-flux case
+// above); HMX reacts with first-order kinetics, Θ = 4000 K and Z chosen so that the exact interface
+// history gives the exposure E = ∫ Z exp(−Θ/(T0 + θ(t))) dt = 1.5 (λ = 1 − e^{−E} = 0.78). At 4 µm
+// the grid shows a sixth of the rise, so the nodal progress at the grid temperature stays at 0.14,
+// and only the interface reading calls the hot spot a runaway (λ ≥ 0.5). The heat of reaction is
+// 1 J/kg (a millikelvin at full reaction): the check is of the verdict, not of the ignition.
+// Measured: λ_int 0.794 against 0.777 exact; tolerance 10 % of λ (a 1 % error in the rise moves k by
+// 4 % at Θ/T² = 0.025/K).
+TEST(InterfaceTemperature, ArrheniusVerdictAtTheInterface) {
+  const double t_end = 2e-6, h = 4e-6, T0 = 300.0, theta = 4000.0;
+  const double c = half_spaces(kHmx, kBinder);
+  const double q = 100.0 / (c * std::sqrt(t_end));
+  const auto rise = [&](double t) { return q * c * std::sqrt(t); };
+  double unit_exposure = 0.0;  // ∫ exp(−Θ/T(t)) dt by the midpoint rule on 10⁵ intervals
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    const double t = (i + 0.5) * t_end / n;
+    unit_exposure += std::exp(-theta / (T0 + rise(t))) * t_end / n;
+  }
+  const double Z = 1.5 / unit_exposure, exact = 1.0 - std::exp(-1.5);
+  for (bool by_interface : {true, false}) {
+    double lambda_interface = 0.0, lambda_grid = 0.0;
+    frictherm::coupling::HotSpotFate fate = frictherm::coupling::HotSpotFate::undecided;
+    run_strip(
+        kHmx, kBinder, h, fm::ShapeKind::ugimp, t_end / 400, 400, 4, [&](double, double) { return q; }, 4 * h, true,
+        {},
+        [&](fc::CouplerOptions& o) {
+          o.reaction.enabled = true;
+          o.reaction.kinetics = {Z, theta, 1.0};  // 1 J/kg: 1 mK at full reaction, but the nodes react
+          o.reaction.reacting = {1, 0};  // HMX (material 0) reacts
+          o.hotspots.threshold = 5.0;    // K of rise: the interface layer of particles is hot
+          o.hotspots_by_interface_temperature = by_interface;
+        },
+        [&](fc::Coupler<2>& cp, fm::Particles<2>& p, double t) {
+          cp.continue_thermal(p, t + 1e-9);  // one short interval: the fates' first look
+          for (double l : cp.interface_reaction().progress()) lambda_interface = std::max(lambda_interface, l);
+          for (double l : cp.reaction_progress()) lambda_grid = std::max(lambda_grid, l);
+          ASSERT_FALSE(cp.fates().records().empty());
+          fate = cp.fates().records().front().fate;
+          for (const auto& r : cp.fates().records())
+            if (r.fate == frictherm::coupling::HotSpotFate::runaway) fate = r.fate;
+        });
+    std::cout << (by_interface ? "by interface" : "by grid") << ": interface progress " << lambda_interface
+              << " (exact history " << exact << "), grid progress " << lambda_grid << "\n";
+    EXPECT_NEAR(lambda_interface, exact, 0.1 * exact);
+    EXPECT_LT(lambda_grid, 0.25 * lambda_interface);
+    EXPECT_EQ(fate == frictherm::coupling::HotSpotFate::runaway, by_interface);
+  }
+}
+
+// The progress integrator alone: exact for a constant temperature, second order in the update
+// interval for a rising one (T = 300 K + 200 K t/t₁, Θ = 4000 K: E from 10⁵ midpoint intervals).
+TEST(InterfaceTemperature, ReactionProgressIsSecondOrderInTheUpdateInterval) {
+  fc::ReactionOptions r;
+  r.enabled = true;
+  r.kinetics = {1e6, 4000.0, 0.0};
+  r.reacting = {1};
+  const std::vector<std::int32_t> material{0};
+  fc::InterfaceReaction constant;
+  constant.start(1, 0.0);
+  for (int i = 1; i <= 7; ++i) constant.advance(material, r, {500.0}, 1e-7 * i);
+  const double k500 = 1e6 * std::exp(-4000.0 / 500.0);
+  EXPECT_NEAR(constant.progress()[0], 1.0 - std::exp(-k500 * 7e-7), 1e-14);
+  const double t1 = 1e-5;
+  auto T = [&](double t) { return 300.0 + 200.0 * t / t1; };
+  double E = 0.0;
+  for (int i = 0; i < 100000; ++i) E += 1e6 * std::exp(-4000.0 / T((i + 0.5) * t1 / 100000)) * t1 / 100000;
+  const double exact = 1.0 - std::exp(-E);
+  double previous = 0.0;
+  for (int updates : {10, 20, 40}) {
+    fc::InterfaceReaction ramp;
+    ramp.start(1, 0.0);
+    ramp.advance(material, r, {T(0.0)}, 0.0);
+    for (int i = 1; i <= updates; ++i) ramp.advance(material, r, {T(t1 * i / updates)}, t1 * i / updates);
+    const double error = std::abs(ramp.progress()[0] - exact);
+    if (previous > 0.0) {
+      EXPECT_NEAR(previous / error, 4.0, 0.4) << updates << " updates";
+    }
+    previous = error;
+  }
 }

@@ -86,9 +86,10 @@ def test_hotspot_table_agrees_with_the_series(run):
 
 
 def test_series_as_dataframe(run):
-    df = run.series.to_dataframe()
+    df = run.series.to_dataframe(index=None)  # row numbers, time a column
     assert list(df.columns) == run.series.columns
     assert df.shape == (len(run.series), len(run.series.columns))
+    assert run.series.to_dataframe().shape == (len(run.series), len(run.series.columns) - 1)  # time: the index
     assert np.array_equal(df["kinetic_energy"].to_numpy(), run.series["kinetic_energy"])
     assert str(df["step"].dtype) == "int64"
 
@@ -208,3 +209,22 @@ def test_decomposed_run_snapshots_join_the_rank_files(decomposed_pair):
                 decomposed.snapshots
     finally:
         os.rename(decomposed_file.replace(".h5", ".rank1.moved"), decomposed_file.replace(".h5", ".rank1.h5"))
+
+
+def test_series_figure_groups_columns_by_unit_with_prefixed_axes(run, tmp_path):
+    """frictherm.plot (issue 33 item 4): the series figure has one panel per unit (not one per column),
+    every column but time/step in exactly one panel of its own unit, and axes read with SI prefixes
+    (3e-6 m as 3 µm, 2e-8 s as 20 ns); with no file name the figure is returned (notebooks)."""
+    from frictherm.plot import plot_series, scale_for, series_groups
+    groups = series_groups(run)
+    placed = [c for _, _, names in groups for c in names]
+    assert sorted(placed) == sorted(c for c in run.series.columns if c not in ("time", "step"))
+    assert all(run.series.unit_of(c) == unit for _, unit, names in groups for c in names)
+    assert len(groups) == len({unit for _, unit, _ in groups}) < len(placed)
+    assert scale_for([0.0, 3e-6], "m") == (1e6, "µm")
+    factor, unit = scale_for([0.0, 2e-8], "s")
+    assert unit == "ns" and abs(factor * 2e-8 - 20.0) < 1e-12
+    assert scale_for([1.0, 300.0], "K") == (1.0, "K")  # no prefixes on temperatures
+    fig = plot_series(run)
+    assert len([ax for ax in fig.axes if ax.get_visible()]) == len(groups)
+    assert plot_series(run, None, str(tmp_path / "s.png")) is None and (tmp_path / "s.png").stat().st_size > 10000

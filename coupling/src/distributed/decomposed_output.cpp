@@ -3,6 +3,7 @@
 #include <frictherm/coupling/distributed.hpp>
 #include <frictherm/coupling/xdmf.hpp>
 
+#include "output/h5_io.hpp"
 #include "output/h5_util.hpp"
 
 #include <hdf5.h>
@@ -54,6 +55,7 @@ void write_dataset(hid_t group, const std::string& file, const std::string& name
                                   file, "cannot create dataset " + name),
                      H5Dclose};
   if (rows > 0) h5::check(H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, "cannot write " + name);
+  h5::Io{file}.describe(d.get(), name, 3, false, name);  // units, long_name (no field here depends on dim)
 }
 
 // A scalar attribute of the snapshot group (the serial file's `step` and `time`, docs/output.md).

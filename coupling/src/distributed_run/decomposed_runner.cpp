@@ -204,6 +204,7 @@ class DecomposedRun {
 
   void write_start_metadata() {
     out_->write_metadata("scene", s_.text);
+    out_->write_metadata("scene_json", s_.json);
     out_->write_metadata("scene_file", s_.source);
     out_->write_metadata("version", FRICTHERM_VERSION);
     out_->write_metadata("command_line", o_.command_line);

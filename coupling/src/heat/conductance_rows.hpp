@@ -27,7 +27,7 @@ struct NodeRange {
   bool meets(const Reach& reach) const { return reach[1] >= lo && reach[0] < hi; }
 };
 
-/// Threads for a pass over the particles: as the mechanics step (Simulation::step_with).
+/// Threads for a pass over the particles: as the mechanics step (its particle phases, docs/step.md).
 inline int assembly_threads(std::size_t particles) {
   return mechanics::threads_for_particles(particles, omp_get_max_threads());
 }

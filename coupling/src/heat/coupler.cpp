@@ -63,15 +63,24 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
   nodal_temperature_ = system_.temperature;
   tracker_.set_reference(p);
   interface_.start(grid_, opt_.thickness, p, opt_.materials, opt_.interface_temperature, time);
+  interface_reaction_ = InterfaceReaction{};
+  if (interface_.enabled() && reaction_active()) interface_reaction_.start(p.size(), time);
   tracker_.update(p, opt_.materials, time);
 }
 
 template <int Dim>
 void Coupler<Dim>::update_interface_and_hotspots(mechanics::Particles<Dim>& p, double time) {
   if (interface_.enabled()) interface_.update(p, shape_, step_stencils(), system_, nodal_temperature_, time);
+  if (interface_reaction_.started() && reaction_active())
+    interface_reaction_.advance(p.material, opt_.reaction, interface_.particle_temperature(), time);
+  tracker_.update(p, opt_.materials, time, hotspot_temperature(p));
+}
+
+template <int Dim>
+const std::vector<double>* Coupler<Dim>::hotspot_temperature(const mechanics::Particles<Dim>& p) const {
   const bool by_interface = opt_.hotspots_by_interface_temperature && interface_.enabled() &&
                             interface_.particle_temperature().size() == p.size();
-  tracker_.update(p, opt_.materials, time, by_interface ? &interface_.particle_temperature() : nullptr);
+  return by_interface ? &interface_.particle_temperature() : nullptr;
 }
 
 template <int Dim>
@@ -298,12 +307,19 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
   }
   problem_->clear_source();
   if (!fates_.started()) fates_.begin(tracker_, window_start_);  // the hot spots at the end of loading
+  if (interface_.enabled() && opt_.reaction.enabled && !interface_reaction_.started())
+    interface_reaction_.start(p.size(), window_start_);  // a reaction held back until the continuation
   advance_and_map(p, window_start_, time);
   ++books_.continuation_intervals;
   window_start_ = time;
   window_steps_ = 0;
   update_interface_and_hotspots(p, time);
-  fates_.update(p, particle_progress_, tracker_, time);
+  // The verdict reads the hot-spot temperature: the interface's, with its Arrhenius progress, when the
+  // scene judges hot spots by it (interface_reaction.hpp).
+  const std::vector<double>* criterion = hotspot_temperature(p);
+  const bool interface_progress = criterion && interface_reaction_.started();
+  fates_.update(p, particle_progress_, tracker_, time, criterion,
+                interface_progress ? &interface_reaction_.progress() : nullptr);
 }
 
 template <int Dim>

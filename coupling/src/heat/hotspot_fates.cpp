@@ -39,16 +39,20 @@ void HotSpotFates::begin(const HotSpotTracker& tracker, double time) {
 
 template <int Dim>
 void HotSpotFates::update(const mechanics::Particles<Dim>& p, const std::vector<double>& progress,
-                          const HotSpotTracker& tracker, double time) {
+                          const HotSpotTracker& tracker, double time, const std::vector<double>* criterion,
+                          const std::vector<double>* criterion_progress) {
+  if (criterion && criterion->size() != p.size()) criterion = nullptr;
+  if (criterion_progress && criterion_progress->size() != p.size()) criterion_progress = nullptr;
   last_time_ = time;
   for (HotSpotFateRecord& r : records_) {
     double peak = 0.0, lam = 0.0;
     bool hot = false;
     for (std::size_t k : r.particles) {
       if (k >= p.size()) continue;
-      const double T = p.temperature[k];
+      const double T = criterion ? (*criterion)[k] : p.temperature[k];
       peak = std::max(peak, T);
       if (k < progress.size()) lam = std::max(lam, progress[k]);
+      if (criterion_progress) lam = std::max(lam, (*criterion_progress)[k]);
       hot = hot || tracker.is_hot(k, T);
     }
     r.previous_peak_temperature = r.peak_temperature;
@@ -81,8 +85,8 @@ bool HotSpotFates::all_decided() const {
 }
 
 template void HotSpotFates::update<2>(const mechanics::Particles<2>&, const std::vector<double>&, const HotSpotTracker&,
-                                      double);
+                                      double, const std::vector<double>*, const std::vector<double>*);
 template void HotSpotFates::update<3>(const mechanics::Particles<3>&, const std::vector<double>&, const HotSpotTracker&,
-                                      double);
+                                      double, const std::vector<double>*, const std::vector<double>*);
 
 }  // namespace frictherm::coupling

@@ -75,6 +75,11 @@ struct H5Output::Impl {
   std::size_t count = 0;
   std::vector<std::string> grid_xml;
   std::string failure_xml;
+  // RUN_reference.xdmf: the same snapshots drawn at the reference positions X (`initial_position`),
+  // for ParaView's Warp By Vector on `displacement`; written once a snapshot has that field.
+  std::string reference_path;
+  std::vector<std::string> reference_xml;
+  std::string reference_failure_xml;
   double last_time = -std::numeric_limits<double>::infinity();
   std::set<std::size_t> connectivity;
 
@@ -133,12 +138,14 @@ struct H5Output::Impl {
     const Handle space = io.space(1, &zero, &unlimited);
     Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), io.file, "cannot create a property list"), H5Pclose};
     check(H5Pset_chunk(dcpl.get(), 1, &chunk), io.file, "cannot set chunking");
-    for (const auto& n : columns)
+    for (const auto& n : columns) {
       sets.emplace_back(check_id(H5Dcreate2(group_out.get(), n.c_str(),
                                             H5Output::is_count_column(n) ? H5T_STD_I64LE : H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                             dcpl.get(), H5P_DEFAULT),
                                  io.file, "cannot create /" + name + "/" + n),
                         H5Dclose);
+      io.describe(sets.back().get(), n, dim, false, "/" + name + "/" + n);  // units, long_name
+    }
     flush_file();
   }
 
@@ -206,13 +213,13 @@ struct H5Output::Impl {
 
   void write_xdmf() {
     if (!options.write_xdmf) return;
-    if (failure_xml.empty()) {
-      write_text_atomically(xdmf_path, xdmf_document(grid_xml));
-    } else {
-      std::vector<std::string> all = grid_xml;
-      all.push_back(failure_xml);
-      write_text_atomically(xdmf_path, xdmf_document(all));
-    }
+    const auto document = [](std::vector<std::string> grids, const std::string& failure, const std::string& name) {
+      if (!failure.empty()) grids.push_back(failure);
+      return xdmf_document(grids, name);
+    };
+    write_text_atomically(xdmf_path, document(grid_xml, failure_xml, "particles"));
+    if (!reference_xml.empty() || !reference_failure_xml.empty())
+      write_text_atomically(reference_path, document(reference_xml, reference_failure_xml, "particles_reference"));
   }
 
   void discard_snapshot() noexcept {
@@ -261,6 +268,7 @@ struct H5Output::Impl {
                             io.file, "cannot create " + where),
                    H5Dclose};
     if (n > 0) check(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), io.file, "cannot write " + where);
+    io.describe(d.get(), name, dim, false, where);
     points = n;
     fields.push_back({name, components, integer});
   }
@@ -280,6 +288,7 @@ struct H5Output::Impl {
                      H5Dclose};
       check(H5Dwrite(d.get(), H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, ids.data()), io.file,
             "cannot write " + path);
+      io.describe(d.get(), name, dim, false, path);
     }
     return "/xdmf/" + name;
   }
@@ -310,11 +319,19 @@ struct H5Output::Impl {
       flush_file();
       discard_snapshot();  // closes the (now linked) group and lifts the eviction hold
       if (drawable && options.write_xdmf) {
+        XdmfGrid reference = grid;
+        reference.geometry = "initial_position";
+        const bool has_reference = std::any_of(grid.fields.begin(), grid.fields.end(), [&](const XdmfField& f) {
+          return f.name == reference.geometry && f.components == dim && !f.integer;
+        });
         if (!failure) {
           grid_xml.push_back(xdmf_grid_xml(grid, io_name(), dim));
+          if (has_reference) reference_xml.push_back(xdmf_grid_xml(reference, io_name(), dim));
           last_time = time;
         } else {
           failure_xml = time > last_time ? xdmf_grid_xml(grid, io_name(), dim) : std::string();
+          reference_failure_xml =
+              time > last_time && has_reference ? xdmf_grid_xml(reference, io_name(), dim) : std::string();
         }
       }
       if (!failure) ++count;
@@ -333,7 +350,20 @@ struct H5Output::Impl {
     if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
       check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
     }
-    io.scalar_dataset(meta.get(), key, type, value, bytes, "/meta/" + key);
+    const Handle d = io.scalar_dataset(meta.get(), key, type, value, bytes, "/meta/" + key);
+    io.describe(d.get(), key, dim, H5Tget_class(type) == H5T_STRING, "/meta/" + key);
+    flush_file();
+  }
+
+  // /meta/<key> as a small 1-D dataset (numbers or fixed-length strings).
+  void metadata_array(const std::string& key, hid_t type, const void* values, std::size_t n, bool text) {
+    check_name(key, "metadata");
+    const Scoped held(*this);
+    if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
+      check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
+    }
+    const Handle d = io.array_dataset(meta.get(), key, type, values, n, "/meta/" + key);
+    io.describe(d.get(), key, dim, text, "/meta/" + key);
     flush_file();
   }
 };
@@ -345,6 +375,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.final_path = path;
   m.io.file = options.via_temporary ? temporary_path(path) : path;
   m.xdmf_path = xdmf_path_for(path);
+  m.reference_path = xdmf_reference_path_for(path);
   m.dim = dim;
   m.options = options;
   const Quiet quiet;
@@ -411,6 +442,29 @@ void H5Output::write_metadata(const std::string& key, double value) {
   Impl& m = live();
   const Quiet quiet;
   m.metadata(key, H5T_IEEE_F64LE, &value, sizeof value);
+}
+
+void H5Output::write_metadata(const std::string& key, const std::vector<double>& values) {
+  Impl& m = live();
+  const Quiet quiet;
+  m.metadata_array(key, H5T_IEEE_F64LE, values.data(), values.size(), false);
+}
+
+void H5Output::write_metadata(const std::string& key, const std::vector<std::int64_t>& values) {
+  Impl& m = live();
+  const Quiet quiet;
+  m.metadata_array(key, H5T_STD_I64LE, values.data(), values.size(), false);
+}
+
+void H5Output::write_metadata(const std::string& key, const std::vector<std::string>& values) {
+  Impl& m = live();
+  const Quiet quiet;
+  std::size_t longest = 1;
+  for (const auto& v : values) longest = std::max(longest, v.size());
+  std::string packed(values.size() * longest, '\0');  // fixed-length, NUL-padded
+  for (std::size_t i = 0; i < values.size(); ++i) packed.replace(i * longest, values[i].size(), values[i]);
+  const Handle t = m.io.string_type(longest);
+  m.metadata_array(key, t.get(), packed.data(), values.size(), true);
 }
 
 void H5Output::write_integer_metadata(const std::string& key, std::int64_t value) {

@@ -66,10 +66,10 @@ std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name,
   if (grid.points == 0) throw std::invalid_argument("XDMF: grid " + grid.name + " has no points");
   const XdmfField* position = nullptr;
   for (const auto& f : grid.fields) {
-    if (f.name == "position") position = &f;
+    if (f.name == grid.geometry) position = &f;
   }
   if (position == nullptr || position->components != dim || position->integer) {
-    throw std::invalid_argument("XDMF: grid " + grid.name + " needs a position field with " +
+    throw std::invalid_argument("XDMF: grid " + grid.name + " needs a " + grid.geometry + " field with " +
                                 std::to_string(dim) + " float components");
   }
   const std::string n = std::to_string(grid.points);
@@ -85,10 +85,10 @@ std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name,
   out += in3 + "</Topology>\n";
   out += in3 + "<Geometry GeometryType=\"" + (dim == 2 ? "XY" : "XYZ") + "\">\n";
   data_item(out, in4, dims_text(grid.points, dim), 0, h5_file_name,
-            grid.h5_group + "/position");
+            grid.h5_group + "/" + grid.geometry);
   out += in3 + "</Geometry>\n";
   for (const auto& f : grid.fields) {
-    if (&f == position) continue;
+    if (f.name == "position" || f.name == "initial_position") continue;  // the geometries of the two files
     out += in3 + "<Attribute Name=\"" + xml_escape(f.name) + "\" AttributeType=\"" +
            xdmf_attribute_type(f.components) + "\" Center=\"Node\">\n";
     if (f.integer && f.bytes != 0 && f.bytes != 4 && f.bytes != 8)
@@ -102,13 +102,13 @@ std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name,
   return out;
 }
 
-std::string xdmf_document(const std::vector<std::string>& grid_xml) {
+std::string xdmf_document(const std::vector<std::string>& grid_xml, const std::string& collection) {
   std::string out =
       "<?xml version=\"1.0\" ?>\n"
       "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
       "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
       "  <Domain>\n"
-      "   <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+      "   <Grid Name=\"" + xml_escape(collection) + "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (const auto& g : grid_xml) out += g;
   out +=
       "   </Grid>\n"
@@ -134,6 +134,11 @@ void write_text_atomically(const std::string& path, const std::string& text) {
     std::remove(tmp.c_str());
     throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + reason);
   }
+}
+
+std::string xdmf_reference_path_for(const std::string& h5_path) {
+  const std::string x = xdmf_path_for(h5_path);
+  return x.substr(0, x.size() - 5) + "_reference.xdmf";
 }
 
 std::string xdmf_path_for(const std::string& h5_path) {

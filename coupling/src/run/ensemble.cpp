@@ -4,6 +4,7 @@
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/h5_output.hpp>
 
+#include "output/h5_io.hpp"
 #include "output/h5_util.hpp"
 
 #include <algorithm>
@@ -88,7 +89,7 @@ const std::vector<double>& need(const SeriesTable& t, const std::string& name, c
 
 // One column group with a `columns` attribute (fixed-length strings) and 1-D double datasets.
 void write_columns(hid_t file, const std::string& path, const std::string& group,
-                   const std::vector<std::string>& names, const std::vector<std::vector<double>>& cols) {
+                   const std::vector<std::string>& names, const std::vector<std::vector<double>>& cols, int dim) {
   const Handle g{check_id(H5Gcreate2(file, group.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path,
                           "cannot create /" + group),
                  H5Gclose};
@@ -119,6 +120,7 @@ void write_columns(hid_t file, const std::string& path, const std::string& group
     if (n > 0)
       check(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), path,
             "cannot write " + where);
+    h5detail::Io{path}.describe(d.get(), names[j], dim, false, where);  // units, long_name (output_quantities.hpp)
   }
 }
 
@@ -153,6 +155,7 @@ void write_strings(hid_t file, const std::string& path, const std::string& name,
                           path, "cannot create /" + name),
                  H5Dclose};
   if (n > 0) check(H5Dwrite(d.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, packed.data()), path, "cannot write /" + name);
+  h5detail::Io{path}.describe(d.get(), name, 2, true, "/" + name);  // text: units "", long_name
 }
 
 void write_attribute(hid_t file, const std::string& path, const std::string& name, const std::string& value) {
@@ -256,14 +259,22 @@ EnsembleSummary aggregate_members(const std::string& scene_path, const EnsembleO
   const Handle file{check_id(H5Fcreate(live.c_str(), H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT), live,
                              "cannot create the file"),
                     H5Fclose};
+  int dim = 2;  // the members' dimension (hot-spot sizes: m^2 in 2D, m^3 in 3D)
+  for (const MemberRecord& r : records) {
+    try {
+      dim = static_cast<int>(read_metadata_number(r.file, "dimension"));
+      break;
+    } catch (const std::exception&) {  // a member without a readable file: try the next
+    }
+  }
   write_columns(file.get(), o.output, "members",
                 {"seed", "status", "steps", "simulated_time", "wall_time", "hotspots", "max_peak_temperature", "runaway",
                  "dying"},
-                m);
+                m, dim);
   write_columns(file.get(), o.output, "hotspots",
                 {"seed", "id", "peak_temperature", "equivalent_diameter", "size", "birth_time", "duration", "fate",
                  "time_to_runaway"},
-                h);
+                h, dim);
   const hid_t f = file.get();
   std::vector<std::string> files;
   for (const MemberRecord& r : records) files.push_back(r.file);

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -148,12 +149,15 @@ class Run {
     } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
+    if (observer_error_) std::rethrow_exception(observer_error_);  // published first, as a failed run
     return r_;
   }
 
  private:
   // The run's failure: the state at it under /failure (fields as a snapshot) and the message. A
   // failure to write that state is added to the message; the result is still published.
+  std::exception_ptr observer_error_;  // what the observer threw (rethrown once the result is out)
+
   void fail(detail::ProgressLine& progress, long step, double time, const std::string& message) {
     progress.finish();
     r_.status = RunResult::Status::failed;
@@ -282,7 +286,14 @@ class Run {
         if (s_.checkpoint_interval > 0.0)
           next_checkpoint_ = (std::floor(t / s_.checkpoint_interval + 1e-9) + 1.0) * s_.checkpoint_interval;
       }
-      if (o_.observer) o_.observer(StepView(*sim_));  // the user's per-step diagnostics
+      if (o_.observer) {  // the user's per-step diagnostics
+        try {
+          o_.observer(StepView(*sim_));
+        } catch (...) {  // ends the run as a failure, then goes on to the caller (runner.hpp)
+          observer_error_ = std::current_exception();
+          throw;
+        }
+      }
       progress.update(sim_->step_count(), t);
       if (detail::interrupt_signal() != 0) return interrupted();
     }

@@ -185,6 +185,12 @@ void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const st
       vectors(f, [&](std::size_t k) { return p.velocity[k]; });
     } else if (f == "displacement") {
       vectors(f, [&](std::size_t k) { return mechanics::Vec<Dim>(p.position[k] - p.initial_position[k]); });
+      // With it the reference positions X (dim columns), the geometry of RUN_reference.xdmf: Warp By
+      // Vector on `displacement` there draws x = X + u (docs/output.md "In ParaView").
+      buf.resize(n * Dim);
+      for (std::size_t k = 0; k < n; ++k)
+        for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = p.initial_position[k][d];
+      out.snapshot_field("initial_position", buf.data(), n, Dim);
     } else if (f == "stress") {
       buf.assign(n * 9, 0.0);
       for (std::size_t k = 0; k < n; ++k) {
@@ -214,6 +220,7 @@ template <int Dim>
 void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simulation<Dim>& sim,
                           const RunOptions& options) {
   out.write_metadata("scene", s.text);
+  out.write_metadata("scene_json", s.json);
   out.write_metadata("scene_file", s.source);
   std::string overrides;
   for (const auto& o : s.overrides) overrides += (overrides.empty() ? "" : "\n") + o.path + "=" + o.value;
@@ -245,6 +252,28 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
   grid << "; cell_size";
   for (int d = 0; d < Dim; ++d) grid << ' ' << g.cell_size()[d];
   out.write_metadata("grid", grid.str());
+  // The same as numbers (units in their attributes): grid_lo, grid_hi, grid_cells, grid_cell_size.
+  std::vector<double> lo, hi, h;
+  std::vector<std::int64_t> cells;
+  for (int d = 0; d < Dim; ++d) {
+    lo.push_back(g.lo()[d]);
+    hi.push_back(g.hi()[d]);
+    h.push_back(g.cell_size()[d]);
+    cells.push_back(g.cells()[static_cast<std::size_t>(d)]);
+  }
+  out.write_metadata("grid_lo", lo);
+  out.write_metadata("grid_hi", hi);
+  out.write_metadata("grid_cells", cells);
+  out.write_metadata("grid_cell_size", h);
+  std::vector<std::string> material_names, material_kinds, body_names;  // by id
+  for (const auto& mat : sim.materials()) {
+    material_names.push_back(mat.name);
+    material_kinds.push_back(mechanics::to_string(mat.kind));
+  }
+  for (const auto& body : sim.bodies()) body_names.push_back(body.name);
+  out.write_metadata("material_names", material_names);
+  out.write_metadata("material_kinds", material_kinds);
+  out.write_metadata("body_names", body_names);
   out.write_metadata("cell_size", g.min_cell_size());
   for (std::size_t m = 0; m < sim.materials().size(); ++m)
     materials << (m ? "; " : "") << m << ' ' << sim.materials()[m].name << ' '

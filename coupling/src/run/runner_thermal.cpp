@@ -54,6 +54,7 @@ void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& na
   if (o.plastic.enabled) names.insert(names.end(), {"plastic_work", "plastic_heat"});
   if (o.reaction.enabled) names.insert(names.end(), {"reaction_heat", "max_reaction_progress"});
   if (o.interface_temperature.enabled) names.emplace_back("max_interface_temperature");
+  if (o.interface_temperature.enabled && o.reaction.enabled) names.emplace_back("max_interface_reaction_progress");
   out.declare_table("hotspots", hotspot_columns(Dim));
   if (spec_.continuation_duration > 0.0)
     out.declare_table("hotspot_fates", std::vector<std::string>(std::begin(kFateColumns), std::end(kFateColumns)));
@@ -83,6 +84,7 @@ void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
     const double t_int = coupler_.interface_temperature().max_temperature();
     row.push_back(std::isfinite(t_int) ? t_int : std::numeric_limits<double>::quiet_NaN());
   }
+  if (o.interface_temperature.enabled && o.reaction.enabled) row.push_back(coupler_.interface_reaction().max_progress());
   if (windows == hotspot_windows_written_) return;
   hotspot_windows_written_ = windows;
   for (const HotSpot& h : hs.hot_spots()) {
@@ -160,6 +162,9 @@ void ThermalRun<Dim>::write_fields(H5Output& out) const {
   const std::vector<double>& t_int = coupler_.interface_temperature().particle_temperature();
   if (coupler_.options().interface_temperature.enabled && !t_int.empty())
     out.snapshot_field("interface_temperature", t_int.data(), t_int.size(), 1);
+  const std::vector<double>& lam_int = coupler_.interface_reaction().progress();
+  if (coupler_.interface_reaction().started() && !lam_int.empty())
+    out.snapshot_field("interface_reaction_progress", lam_int.data(), lam_int.size(), 1);
 }
 
 template <int Dim>

@@ -8,7 +8,7 @@
 // thermal section adds its nodal system (an allowance, not fitted).
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/coupling/scene_cost.hpp>
-#include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/time_step/cfl_time_step.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 
 #include <algorithm>
@@ -112,10 +112,8 @@ SceneCost estimate_scene_cost(const Scene& s) {
       double v2 = 0.0;
       for (const auto& f : m.rigid_velocity) v2 += f(0.0) * f(0.0);
       w = std::sqrt(v2);
-    } else if (m.kind == mechanics::MaterialKind::mie_gruneisen) {
-      w = mechanics::mie_gruneisen_wave_speed(m.mie_gruneisen, 1.0, 0.0);
     } else {
-      w = m.p_wave_speed(s.options.analysis);
+      w = mechanics::particle_wave_speed(m, s.options.analysis, /*J=*/1.0, /*e=*/0.0);
     }
     if (!(w <= fastest_wave)) {
       fastest_wave = w;
@@ -127,13 +125,13 @@ SceneCost estimate_scene_cost(const Scene& s) {
   for (int d = 0; d < dim; ++d) h = std::min(h, s.cell_size[d]);
   c.time_step_key = fastest_speed > fastest_wave ? speed_key : wave_key;
   if (std::isnan(c.wave_speed)) return c.time_step = c.wave_speed, c;  // refused by check_scene_cost
-  c.time_step = c.wave_speed > 0.0 ? s.options.cfl * h / c.wave_speed : std::numeric_limits<double>::infinity();
+  c.time_step = mechanics::cfl_time_step(s.options.cfl, h, c.wave_speed, std::numeric_limits<double>::infinity());
   if (!(s.options.max_time_step >= c.time_step)) {
     c.time_step = s.options.max_time_step;
     c.time_step_key = "solver.max_time_step";
   }
-  if (s.options.damping_rate > 0.0 && 0.5 / s.options.damping_rate < c.time_step) {
-    c.time_step = 0.5 / s.options.damping_rate;
+  if (s.options.damping_rate > 0.0 && mechanics::damping_time_step_limit(s.options.damping_rate) < c.time_step) {
+    c.time_step = mechanics::damping_time_step_limit(s.options.damping_rate);
     c.time_step_key = "solver.damping.rate";
   }
 

@@ -346,6 +346,7 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   Scene s;
   s.text = text;
   s.overrides = overrides;
+  s.json = doc.dump(2, ' ', false, Json::error_handler_t::replace);  // /meta/scene_json: json.loads reads it
   s.source = source;
   s.name = name;
   s.description = root.string("description", "");

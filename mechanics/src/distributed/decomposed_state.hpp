@@ -7,6 +7,8 @@
 #include "frictherm/mechanics/distributed.hpp"
 #include "distributed/petsc_check.hpp"
 
+#include <frictherm/mechanics/constitutive/stress_update.hpp>
+
 #include <petscdmda.h>
 #include <petscdmswarm.h>
 #include <petscsf.h>
@@ -96,12 +98,11 @@ struct DecomposedMpm<Dim>::Impl {
   int rank = 0, size = 1;
   Grid<Dim> grid;
   std::vector<Material> materials;
-  // Per material, hoisted out of the stress update's particle loop: Lamé λ, shear modulus μ, the
-  // Mie-Grüneisen limit J (mie_gruneisen_min_J) and the linear-elastic wave speed.
-  std::vector<double> lambda, mu, min_J, c0;
+  // Per material, hoisted out of the stress update's particle loop (constitutive/stress_update.hpp).
+  std::vector<StressLaw> laws;
   bool has_mie_gruneisen = false;
   // Rigid materials (velocity boundary conditions on the nodes they touch, as the serial
-  // map_rigid_particles / apply_velocity_bc / update_grid): per axis d and local node, the largest
+  // map_rigid_particles / apply_velocity_bc / nodal_velocities): per axis d and local node, the largest
   // rigid material prescribing component d whose particles' stencils reach the node with S > 0 (−1:
   // none; the serial loop lets the last material win), completed at the owners in sum_to_owners;
   // per owned node the driven components (bit d) and their prescribed velocity at the step's start.

@@ -4,6 +4,7 @@
 #include "distributed/decomposed_state.hpp"
 
 #include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/time_step/cfl_time_step.hpp>
 
 // PETSc 3.18 has no public setter of the swarm's migration type (DMSwarmSetMigrateType came in
 // 3.19); the private header gives the field. Needed because the PIC default (DMSWARM_MIGRATE_
@@ -141,12 +142,9 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   s.grid = grid;
   s.materials = mats;
   for (const Material& m : mats) {
-    const bool mg = m.kind == MaterialKind::mie_gruneisen, elastic = !mg && !m.is_rigid();
+    const bool mg = m.kind == MaterialKind::mie_gruneisen;
     s.has_rigid = s.has_rigid || m.is_rigid();
-    s.lambda.push_back(elastic ? m.lame_lambda() : 0.0);
-    s.mu.push_back(elastic ? m.shear_modulus() : 0.0);
-    s.min_J.push_back(mg ? mie_gruneisen_min_J(m.mie_gruneisen) : 0.0);
-    s.c0.push_back(m.kind == MaterialKind::linear_elastic ? m.p_wave_speed(options.analysis) : 0.0);
+    s.laws.push_back(stress_law(m, options.analysis));
     s.has_mie_gruneisen = s.has_mie_gruneisen || mg;
   }
   s.opt = options;
@@ -515,10 +513,8 @@ std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() 
 template <int Dim>
 double DecomposedMpm<Dim>::Impl::initial_wave_speed(int material, double J, double energy) const {
   const Material& m = materials[static_cast<std::size_t>(material)];
-  if (m.is_rigid()) return -std::numeric_limits<double>::infinity();  // rigid_speed() counts them
-  if (m.kind == MaterialKind::mie_gruneisen) return mie_gruneisen_wave_speed(m.mie_gruneisen, J, energy);
-  if (m.kind == MaterialKind::neo_hookean) return m.wave_speed(opt.analysis, J);
-  return c0[static_cast<std::size_t>(material)];
+  if (m.is_rigid()) return -std::numeric_limits<double>::infinity();  // stable_time_step counts them
+  return particle_wave_speed(m, opt.analysis, J, energy);
 }
 
 // Simulation::stable_time_step over the ranks: the largest c_p + |v_p| of every rank (MPI_MAX), so
@@ -533,10 +529,8 @@ double DecomposedMpm<Dim>::stable_time_step(double cfl, double max_time_step) co
       cmax = std::max(cmax, f.wave_speed[k] + Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k).norm());
   }
   MPI_Allreduce(MPI_IN_PLACE, &cmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
-  for (const Material& m : s.materials)  // rigid bodies move material through the grid too
-    if (m.is_rigid()) cmax = std::max(cmax, m.rigid_velocity_at(s.time).norm());
-  if (cmax <= 0.0) return max_time_step;
-  return std::min(cfl * s.grid.min_cell_size() / cmax, max_time_step);
+  cmax = with_rigid_speeds(cmax, s.materials, s.time);
+  return cfl_time_step(cfl, s.grid.min_cell_size(), cmax, max_time_step);
 }
 
 template <int Dim>

@@ -8,8 +8,8 @@
 // in 2D and 3D alike.
 #include "distributed/decomposed_state.hpp"
 
-#include <frictherm/mechanics/mie_gruneisen.hpp>
-#include <frictherm/mechanics/plane_strain_update.hpp>
+#include <frictherm/mechanics/constitutive/stress_update.hpp>
+#include <frictherm/mechanics/transfer/pic_blend.hpp>
 
 #include <mpi.h>
 
@@ -208,7 +208,7 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
-// below the empty-node mass get neither (as the serial update_grid).
+// below the empty-node mass get neither (as the serial nodal_velocities).
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
@@ -223,7 +223,7 @@ void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
       node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
     }
     if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0; driven && m > empty_node_mass)
-      for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial update_grid)
+      for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial nodal_velocities)
         if (driven & (1u << d)) node[velocity + d] = drive_velocity[static_cast<std::size_t>(q)][d];
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
@@ -246,8 +246,7 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const auto& st = stencils<Kernel>();
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
-  // The serial update_particles' FLIP/PIC blend: α = 1 − e^(−dt/τ).
-  const double pic = std::isfinite(opt.pic_relaxation_time) ? -std::expm1(-dt / opt.pic_relaxation_time) : 0.0;
+  const double pic = pic_blend_fraction(dt, opt.pic_relaxation_time);  // the serial FLIP/PIC blend
   for (PetscInt k = 0; k < f.n; ++k) {
     if (rigid(f.material[k])) {  // the serial move_rigid_particles: v(t), x += ½ (v(t) + v(t + dt)) dt
       const Material& m = materials[static_cast<std::size_t>(f.material[k])];
@@ -266,18 +265,16 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
     });
     Eigen::Map<Vec<Dim>> vp(f.velocity + Dim * k);
     vp += dt * acc;
-    if (pic > 0.0) vp = (1.0 - pic) * vp + pic * v;  // FLIP/PIC blend
+    pic_blend(vp, v, pic);
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
-// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0, then the material's
-// stress as the serial update_stress, by the same inline functions in the same order: hypoelastic
-// linear elastic (Jaumann), Neo-Hookean (Kakouris 2024 eq. 47) or Mie-Grüneisen pressure with J2
-// plasticity (mie_gruneisen.hpp; in 2D the plane-strain scalar form of plane_strain_update.hpp), which
-// also update ε̄p, e, the plastic work V σ:Δε_p and the wave speed of the CFL step. A particle
-// compressed past its Hugoniot's limit stops the run on every rank (one reduction, here).
+// Phase 13, local: L_p = Σ_i v_i ⊗ G_ip, then the serial particle pass's stress update
+// (constitutive/stress_update.hpp: F, V, the material's stress, ε̄p, e, the plastic work and the wave
+// speed of the CFL step). A particle compressed past its Hugoniot's limit stops the run on every rank
+// (one reduction, here).
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
@@ -295,55 +292,31 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
       if (mat.is_rigid()) continue;
       const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
       const Stencil<Dim, Kernel>& sk = st[static_cast<std::size_t>(k)];
-      const bool mg = mat.kind == MaterialKind::mie_gruneisen;
+      // The particle's F and σ in locals, updated by the serial kernel, then stored.
+      Mat<Dim> F = Eigen::Map<const Mat<Dim>>(f.F + Dim * Dim * k);
+      Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
+      const StressState<Dim> state{F, f.volume[k], f.volume0[k], sigma, f.stress_zz[k], f.plastic_strain[k],
+                                   f.internal_energy[k], f.plastic_work[k], f.wave_speed[k]};
+      bool ok = true;
       if constexpr (Dim == 2) {
-        if (mg) {  // the serial 2D Mie-Grüneisen loop, on scalars
+        if (laws[m].mie_gruneisen()) {  // the serial 2D Mie-Grüneisen path, on scalars
           VelocityGradient2 L;
           sk.for_each(ix, [&](int slot, double, const Vec<2>& G) {
             L.add(Vec<2>(Eigen::Map<const Vec<2>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)), G);
           });
-          Mat<2> F = Eigen::Map<const Mat<2>>(f.F + 4 * k);
-          const double det_A = deformation_update_2d(L, dt, F);
-          Eigen::Map<Mat<2>>(f.F + 4 * k) = F;
-          f.volume[k] = determinant_2d(F) * f.volume0[k];
-          Mat<2> sigma = Eigen::Map<const Mat<2>>(f.stress + 4 * k);
-          double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-          if (mie_gruneisen_update_plane_strain(L, dt, f.volume[k] / f.volume0[k], det_A, mat.mie_gruneisen, min_J[m],
-                                                sigma, f.stress_zz[k], f.plastic_strain[k], f.internal_energy[k], wp,
-                                                f.wave_speed[k]) != MieGruneisenStatus::ok)
-            beyond = std::max(beyond, static_cast<long>(f.id[k]));
-          Eigen::Map<Mat<2>>(f.stress + 4 * k) = sigma;
-          f.plastic_work[k] += wp * f.volume[k];
-          continue;
+          ok = update_stress_plane_strain(mat.mie_gruneisen, laws[m].min_J, L, dt, state);
         }
       }
-      Mat<Dim> L = Mat<Dim>::Zero();
-      sk.for_each(ix, [&](int slot, double, const Vec<Dim>& G) {
-        L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)) *
-                       G.transpose();
-      });
-      Eigen::Map<Mat<Dim>> F(f.F + Dim * Dim * k);
-      const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-      Mat<Dim> F_new;
-      F_new.noalias() = A * F;  // as the serial update_stress
-      F = F_new;
-      f.volume[k] = F.determinant() * f.volume0[k];
-      Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
-      if (mg) {
-        double wp = 0.0;
-        if (mie_gruneisen_update<Dim>(L, dt, f.volume[k] / f.volume0[k], mat.mie_gruneisen, min_J[m], sigma,
-                                      f.stress_zz[k], f.plastic_strain[k], f.internal_energy[k], wp,
-                                      &f.wave_speed[k]) != MieGruneisenStatus::ok)
-          beyond = std::max(beyond, static_cast<long>(f.id[k]));
-        f.plastic_work[k] += wp * f.volume[k];
-      } else if (mat.kind == MaterialKind::neo_hookean) {
-        const Mat<Dim> Fk = F;
-        neo_hookean_stress<Dim>(Fk, lambda[m], mu[m], sigma, f.stress_zz[k]);
-        f.wave_speed[k] = mat.wave_speed(an, f.volume[k] / f.volume0[k]);
-      } else {
-        linear_elastic_update<Dim>(L, dt, lambda[m], mu[m], an, sigma, f.stress_zz[k]);
-        f.wave_speed[k] = c0[m];
+      if (Dim != 2 || !laws[m].mie_gruneisen()) {
+        Mat<Dim> L = Mat<Dim>::Zero();
+        sk.for_each(ix, [&](int slot, double, const Vec<Dim>& G) {
+          L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)) *
+                         G.transpose();
+        });
+        ok = update_stress<Dim>(mat, laws[m], an, L, dt, state);
       }
+      if (!ok) beyond = std::max(beyond, static_cast<long>(f.id[k]));
+      Eigen::Map<Mat<Dim>>(f.F + Dim * Dim * k) = F;
       Eigen::Map<Mat<Dim>>(f.stress + Dim * Dim * k) = sigma;
     }
     petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");

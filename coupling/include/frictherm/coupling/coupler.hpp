@@ -27,6 +27,7 @@
 #include <frictherm/coupling/hotspot_fates.hpp>
 #include <frictherm/coupling/hotspots.hpp>
 #include <frictherm/coupling/interface_temperature.hpp>
+#include <frictherm/coupling/interface_reaction.hpp>
 #include <frictherm/coupling/state_visit.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/thermal/integrator.hpp>
@@ -169,6 +170,9 @@ class Coupler {
   const HotSpotFates& fates() const { return fates_; }
   /// The sub-cell interface temperatures (enabled() false unless options().interface_temperature asks).
   const InterfaceTemperature<Dim>& interface_temperature() const { return interface_; }
+  /// Reaction progress at the interface temperature (interface_reaction.hpp); started() only with the
+  /// interface model and a reaction, from the time the reaction joins the problem.
+  const InterfaceReaction& interface_reaction() const { return interface_reaction_; }
   /// Reaction progress λ_p of every particle (0 for non-reacting ones); empty without a reaction.
   const std::vector<double>& reaction_progress() const { return particle_progress_; }
   /// q Σ_p m_p λ_p over reacting particles (J): the reaction heat the particles carry.
@@ -213,8 +217,12 @@ class Coupler {
   HotSpotTracker tracker_;
   HotSpotFates fates_;
   InterfaceTemperature<Dim> interface_;
+  InterfaceReaction interface_reaction_;
   /// The interface model's update after a window or interval ending at `time`, then the hot spots.
   void update_interface_and_hotspots(mechanics::Particles<Dim>& particles, double time);
+  /// The particle temperatures hot spots are judged by: the interface's when the scene asks for them
+  /// and the model has a reading for every particle, nullptr for T_p.
+  const std::vector<double>* hotspot_temperature(const mechanics::Particles<Dim>& particles) const;
   std::vector<double> particle_progress_;       // λ_p (reaction only)
   std::vector<double> particle_progress_ref_;   // λ_p at the last assembly
   Eigen::VectorXd nodal_progress_;              // λ_i on the unknowns, current
@@ -249,6 +257,7 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
   pending_.visit_state(v);
   v("pending_plastic", pending_plastic_);
   if (interface_.enabled()) interface_.visit_state(v);
+  if (interface_.enabled()) interface_reaction_.visit_state(v);  // empty until a reaction starts
   if (opt_.plastic.enabled) plastic_.visit_state(v);
   tracker_.visit_state(v);
   std::vector<double> progress = particle_progress_;  // empty without a reaction
@@ -302,6 +311,11 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
     const double residual = books_.max_assembly_residual;
     assemble(particles);  // problem and reaction state from the restored particles
     books_.max_assembly_residual = residual;
+    // The written system was assembled from these particles unless the last window was a matrix-free
+    // gather (or an older one reused): then it differs, and like the uninterrupted run the
+    // continuation must assemble afresh and start from its projected temperatures.
+    system_assembled_ = grid_node == system_.grid_node && unknown == system_.unknown &&
+                        mass.size() == system_.mass.size() && mass == system_.mass;
     system_.grid_node = std::move(grid_node);  // the adaptive estimate's M: the last window's
     system_.unknown = std::move(unknown);
     system_.mass = std::move(mass);

@@ -15,6 +15,8 @@
 // and in tables; version 1 stored them as doubles. Readers: frictherm/coupling/results.hpp (C++),
 // the Python package `frictherm` (python/frictherm).
 //   /xdmf/polyvertex_<n>   int32 0..n-1, the Polyvertex connectivity the XDMF file points at
+// Every dataset carries the attributes units (SI, temperatures K; "1" counts, "" text) and long_name
+// (output_quantities.hpp); categorical columns (hot-spot fate) also flag_values and flag_meanings.
 // Beside RUN.h5 an XDMF file RUN.xdmf (ParaView: Xdmf3ReaderS) lists every ended snapshot.
 //
 // Not thread-safe (the serial HDF5 library is not): use one thread for all output calls.
@@ -66,6 +68,11 @@ class H5Output {
   /// The file is flushed after each call.
   void write_metadata(const std::string& key, const std::string& value);
   void write_metadata(const std::string& key, double value);
+  /// Small 1-D arrays under /meta/<key> (grid corners, cell counts, material names): doubles, int64
+  /// or fixed-length UTF-8 strings.
+  void write_metadata(const std::string& key, const std::vector<double>& values);
+  void write_metadata(const std::string& key, const std::vector<std::int64_t>& values);
+  void write_metadata(const std::string& key, const std::vector<std::string>& values);
   /// Integers (steps, counts) are stored as int64.
   void write_integer_metadata(const std::string& key, std::int64_t value);
   template <class I, std::enable_if_t<std::is_integral_v<I> && !std::is_same_v<I, bool>, int> = 0>

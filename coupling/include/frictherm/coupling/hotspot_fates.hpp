@@ -53,10 +53,13 @@ class HotSpotFates {
   void begin(const HotSpotTracker& tracker, double time);
   bool started() const { return started_; }
   /// After a continuation interval ending at `time`. `progress` is the particles' reaction progress
-  /// (empty without a reaction).
+  /// (empty without a reaction). `criterion`, when given, replaces T_p as each particle's temperature
+  /// (the interface temperature); `criterion_progress`, when given, is a second progress (the one at
+  /// that temperature, interface_reaction.hpp) and the larger of the two decides.
   template <int Dim>
   void update(const mechanics::Particles<Dim>& particles, const std::vector<double>& progress,
-              const HotSpotTracker& tracker, double time);
+              const HotSpotTracker& tracker, double time, const std::vector<double>* criterion = nullptr,
+              const std::vector<double>* criterion_progress = nullptr);
   /// End of the continuation: the falling-and-below-start rule for undecided spots.
   void finish();
   /// Every followed spot has a fate (true with no spot).

@@ -92,7 +92,8 @@ struct RunOptions {
   std::string checkpoint_file;
   /// Called after every mechanics step (not during the thermal-only continuation), after the step's
   /// heat handoff and series row, so diagnostics need no copy of the run loop. An exception thrown
-  /// by the observer ends the run and propagates out of run_scene (the file written so far stays).
+  /// by the observer ends the run and propagates out of run_scene once the result is published (status
+  /// "failed", the state under /failure).
   std::function<void(const StepView&)> observer;
 };
 

@@ -97,6 +97,7 @@ struct SceneOverride {
 struct Scene {
   std::string text;    // the scene file as read (stored in the output's metadata)
   std::vector<SceneOverride> overrides;  // applied on top of `text`
+  std::string json;    // the scene as run: `text` with the overrides, as plain JSON (no comments)
   std::string source;  // file path, or "<string>"
   std::string name;    // file name without folder and extension ("scene" for strings)
   std::string description;

@@ -24,7 +24,11 @@ struct XdmfGrid {
   long step = 0;
   double time = 0.0;
   std::size_t points = 0;
-  std::vector<XdmfField> fields;  // must include "position" with `dim` components
+  std::vector<XdmfField> fields;  // must include the geometry field with `dim` components
+  // The field drawn as the points: "position" (current configuration x), or "initial_position" for
+  // the reference-configuration file RUN_reference.xdmf (X; ParaView's Warp By Vector on
+  // `displacement` then moves the points to x = X + u). Neither geometry field is an Attribute.
+  std::string geometry = "position";
 };
 
 /// "Scalar" (1), "Vector" (3), "Tensor" (9), "Tensor6" (6), otherwise "Matrix". Only these widths are
@@ -37,7 +41,7 @@ std::string xdmf_attribute_type(int components);
 std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name, int dim);
 
 /// A whole XDMF document around already rendered grids (see xdmf_grid_xml).
-std::string xdmf_document(const std::vector<std::string>& grid_xml);
+std::string xdmf_document(const std::vector<std::string>& grid_xml, const std::string& collection = "particles");
 
 /// Writes `text` to `path` atomically: `path`.tmp is written, then renamed over `path`, so a
 /// reader never sees a half-written file. Throws std::runtime_error naming the file.
@@ -45,6 +49,10 @@ void write_text_atomically(const std::string& path, const std::string& text);
 
 /// RUN.h5 -> RUN.xdmf (also for .hdf5/.he5; any other name gets .xdmf appended).
 std::string xdmf_path_for(const std::string& h5_path);
+
+/// RUN.h5 -> RUN_reference.xdmf: the snapshots drawn at the reference positions X (the
+/// `initial_position` field), for a displacement warp in ParaView (docs/output.md "In ParaView").
+std::string xdmf_reference_path_for(const std::string& h5_path);
 
 /// Escapes &, <, >, " and ' for XML text and attribute values.
 std::string xml_escape(const std::string& text);

@@ -28,6 +28,7 @@
 #include <frictherm/mechanics/particles.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/mechanics/transfer.hpp>
@@ -84,7 +85,7 @@ struct NodalFields {
   std::vector<Vec<Dim>> domain_gradient;
   void resize(std::size_t n, bool with_contact = false);
   /// To n slots without clearing the ones kept (a layout change of the step: the step's scatter
-  /// clears every slot of a field before adding to it and update_grid sets every velocity and
+  /// clears every slot of a field before adding to it and nodal_velocities sets every velocity and
   /// acceleration, so no slot is read before it is written).
   void resize_slots(std::size_t n, bool with_contact);
 };
@@ -215,6 +216,8 @@ class Simulation {
   double last_time_step() const { return last_dt_; }
   /// Wall time spent in each phase of step() since the start.
   const StepPhaseTimes& phase_times() const { return phase_times_; }
+  /// The names of the step's phases in order, for this scene's scheme and options (finalizes).
+  std::vector<const char*> step_phase_names();
   /// The shape functions of every particle at the current positions, read-only, for code outside the
   /// step (the thermal coupling's M, K and map back: Nairn et al. 2018 eqs. 37-38 use the same
   /// S_ip and G_ip). They are the stencils the next step starts from: evaluated here if the last
@@ -305,7 +308,15 @@ class Simulation {
   }
 
  private:
-  template <class Kernel> void step_with(double dt);
+  // The step as phase lists (step/phase_list.hpp; simulation_step.cpp): built by the first step and
+  // again when a setting they depend on changes (phase_key()).
+  template <class Kernel> void build_phases();
+  void build_phases();
+  long phase_key() const;
+  template <class Kernel> void prepare_step(double t);  // stencils, field layout, rigid-driven nodes
+  template <class Kernel> void contact_at_extrapolated(double dt);  // contact nodes, extents, first pass
+  template <class Kernel> void stress_pass(double dt);  // USF, MUSL: the stress update alone
+  void end_particle_update(StepContext& ctx, bool refreshed);  // time and step advance, particle checks
   template <class Kernel> void map_to_grid(double dt, bool with_forces);
   template <class Kernel> void add_internal_forces();
   /// `evaluated`: this step's stencils of every particle (contact), or null to evaluate them here.
@@ -349,7 +360,12 @@ class Simulation {
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead, and the rigid bodies' work is returned (0 without).
   double apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
-  void update_grid(double dt);
+  // The grid update p_i^{n+1} = p_i^n + f_i dt in phases (simulation_fields.cpp).
+  void save_start_velocity();                  // XPIC: v^n = p^n/m, before the momentum update
+  void apply_grid_velocity_conditions(double dt);  // velocity conditions on p and f, rigid work
+  void apply_damping(double dt);               // −c p_i on the free components, damping work
+  void advance_grid_momentum(double dt);       // p_i += f_i dt
+  void nodal_velocities();                     // v_i = p_i/m_i, a_i = f_i/m_i, driven components
   /// XPIC/FMPM (transfer.hpp): transfer_.filtered = Σ_{j<order} (I − S⁺S)^j w0 per deformable field,
   /// w0 = transfer_.start (XPIC) or nodes_.velocity (FMPM); simulation_transfer.cpp.
   template <class Stencils> void filter_grid_velocity(const Stencils& st);
@@ -512,8 +528,8 @@ class Simulation {
   std::vector<double> wave_speed_;
   bool wave_speed_ready_ = false;  // set by the first stress update
   StepPhaseTimes phase_times_;
-  PhaseLap lap_;  // step(): phase boundaries
-  double nested_phase_ = 0.0;  // contact time inside the phase the lap is in
+  PhaseList phases_;     // the step (build_phases)
+  long phases_key_ = -1;  // phase_key() the list was built for
   // The stencils of st_linear_/st_ugimp_/st_quadratic_ were evaluated at the current positions (and,
   // with contact, box_lo_/box_hi_ from them) by current_stencils(): the next step starts from them.
   bool stencils_current_ = false;

@@ -22,26 +22,6 @@ struct StepPhaseTimes {
   }
 };
 
-/// Adds its lifetime to `phase` and to `nested` (a phase timed inside another: the outer lap
-/// subtracts `nested` so that no time is counted twice).
-class NestedPhase {
- public:
-  NestedPhase(double& phase, double& nested) : phase_(phase), nested_(nested), start_(Clock::now()) {}
-  ~NestedPhase() {
-    const double d = std::chrono::duration<double>(Clock::now() - start_).count();
-    phase_ += d;
-    nested_ += d;
-  }
-  NestedPhase(const NestedPhase&) = delete;
-  NestedPhase& operator=(const NestedPhase&) = delete;
-
- private:
-  using Clock = std::chrono::steady_clock;
-  double& phase_;
-  double& nested_;
-  Clock::time_point start_;
-};
-
 /// A lap clock: to(acc) adds the time since the last lap (or construction) to acc.
 class PhaseLap {
  public:
@@ -50,12 +30,6 @@ class PhaseLap {
     const Clock::time_point now = Clock::now();
     accumulator += std::chrono::duration<double>(now - last_).count();
     last_ = now;
-  }
-  /// As to(), less the time `nested` phases took meanwhile (then reset).
-  void to(double& accumulator, double& nested) {
-    to(accumulator);
-    accumulator -= nested;
-    nested = 0.0;
   }
 
  private:

@@ -1,0 +1,92 @@
+#pragma once
+// The stress update of one particle (the constitutive switch), written once for the serial particle
+// pass (simulation_particle_pass.cpp) and the decomposed stress_update (distributed/usl_phases.cpp):
+// F ← (I + L dt) F, V = det(F) V0, then the material's stress: hypoelastic linear elastic (Jaumann),
+// Neo-Hookean (Kakouris 2024 eq. 47) or Mie-Grüneisen pressure with J2 plasticity (mie_gruneisen.hpp;
+// in 2D the plane-strain scalar form of plane_strain_update.hpp), which also update ε̄p, e, the
+// plastic work V σ:Δε_p and the wave speed of the CFL step (time_step/cfl_time_step.hpp).
+#include <frictherm/mechanics/material.hpp>
+#include <frictherm/mechanics/mie_gruneisen.hpp>
+#include <frictherm/mechanics/plane_strain_update.hpp>
+
+namespace frictherm::mechanics {
+
+/// What the stress update needs of a material beyond its parameters, computed once per material
+/// (not per particle).
+struct StressLaw {
+  MaterialKind kind = MaterialKind::linear_elastic;
+  double lambda = 0.0, mu = 0.0;  // Lamé constants (linear elastic, Neo-Hookean)
+  double c0 = 0.0;                // linear elastic: the P-wave speed (its wave speed at any state)
+  double min_J = 0.0;             // Mie-Grüneisen: the limit of its Hugoniot (mie_gruneisen_min_J)
+  bool mie_gruneisen() const { return kind == MaterialKind::mie_gruneisen; }
+};
+
+inline StressLaw stress_law(const Material& mat, Analysis an) {
+  StressLaw law;
+  law.kind = mat.kind;
+  const bool mg = mat.kind == MaterialKind::mie_gruneisen;
+  law.lambda = mat.lame_lambda(), law.mu = mat.shear_modulus();
+  law.c0 = mat.kind == MaterialKind::linear_elastic ? mat.p_wave_speed(an) : 0.0;
+  law.min_J = mg ? mie_gruneisen_min_J(mat.mie_gruneisen) : 0.0;
+  return law;
+}
+
+/// One particle's state the stress update changes (references into the particle storage or locals).
+template <int Dim>
+struct StressState {
+  Mat<Dim>& F;             // deformation gradient
+  double& volume;          // V
+  double initial_volume;   // V0
+  Mat<Dim>& stress;        // σ
+  double& stress_zz;       // σ_zz (plane strain)
+  double& plastic_strain;  // ε̄p
+  double& internal_energy; // e (J/m^3 of reference volume, mie_gruneisen.hpp)
+  double& plastic_work;    // Σ V σ:Δε_p (J)
+  double& wave_speed;      // c_p of the new state (m/s), for the CFL step
+};
+
+/// The update of a deformable particle from its velocity gradient L over dt; false: compressed past
+/// its Hugoniot's limit (the state is then left as mie_gruneisen_update leaves it).
+template <int Dim>
+FRICTHERM_ALWAYS_INLINE bool update_stress(const Material& mat, const StressLaw& law, Analysis an, const Mat<Dim>& L,
+                                           double dt, const StressState<Dim>& s) {
+  const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+  Mat<Dim> F_new;
+  F_new.noalias() = A * s.F;  // (no aliasing temporary, no out-of-line product)
+  s.F = F_new;
+  s.volume = s.F.determinant() * s.initial_volume;
+  if (law.kind == MaterialKind::mie_gruneisen) {
+    double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+    const bool ok = mie_gruneisen_update<Dim>(L, dt, s.volume / s.initial_volume, mat.mie_gruneisen, law.min_J, s.stress,
+                                              s.stress_zz, s.plastic_strain, s.internal_energy, wp,
+                                              &s.wave_speed) == MieGruneisenStatus::ok;
+    s.plastic_work += wp * s.volume;
+    return ok;
+  }
+  if (law.kind == MaterialKind::neo_hookean) {
+    neo_hookean_stress<Dim>(s.F, law.lambda, law.mu, s.stress, s.stress_zz);
+    s.wave_speed = mat.wave_speed(an, s.volume / s.initial_volume);
+  } else {
+    linear_elastic_update<Dim>(L, dt, law.lambda, law.mu, an, s.stress, s.stress_zz);
+    s.wave_speed = law.c0;
+  }
+  return true;
+}
+
+/// The 2D Mie-Grüneisen update on scalars (the PBX path: plane_strain_update.hpp, the same arithmetic
+/// as update_stress<2>). `params` best a local copy, so that the compiler hoists what depends on the
+/// material only out of the particle loop.
+FRICTHERM_ALWAYS_INLINE bool update_stress_plane_strain(const MieGruneisenParams& params, double min_J,
+                                                        const VelocityGradient2& L, double dt,
+                                                        const StressState<2>& s) {
+  const double det_A = deformation_update_2d(L, dt, s.F);
+  s.volume = determinant_2d(s.F) * s.initial_volume;
+  double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+  const MieGruneisenStatus status =
+      mie_gruneisen_update_plane_strain(L, dt, s.volume / s.initial_volume, det_A, params, min_J, s.stress, s.stress_zz,
+                                        s.plastic_strain, s.internal_energy, wp, s.wave_speed);
+  s.plastic_work += wp * s.volume;
+  return status == MieGruneisenStatus::ok;
+}
+
+}  // namespace frictherm::mechanics

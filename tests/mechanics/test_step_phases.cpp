@@ -1,0 +1,90 @@
+// The step's phase lists (step/phase_list.hpp, simulation_step.cpp): which phases each update scheme
+// and option runs, in which order, and that their timers account for the steps' wall time.
+#include <frictherm/mechanics/simulation.hpp>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+using namespace frictherm::mechanics;
+
+namespace {
+Material elastic(const std::string& name) {
+  Material m;
+  m.name = name;
+  m.density = 1000;
+  m.youngs_modulus = 1e7;
+  m.poisson_ratio = 0.3;
+  return m;
+}
+
+// Two blocks approaching each other; with `contact` in multimaterial contact.
+std::vector<std::string> names(UpdateScheme scheme, bool contact, double damping = 0.0) {
+  SimulationOptions o;
+  o.scheme = scheme;
+  o.damping_rate = damping;
+  o.damping_until = 1.0;
+  Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
+  const int a = sim.add_material(elastic("a")), b = sim.add_material(elastic("b"));
+  sim.add_body("a", *make_box<2>(Vec<2>(0.2, 0.2), Vec<2>(0.45, 0.6), a), 2, Vec<2>(1.0, 0.0));
+  sim.add_body("b", *make_box<2>(Vec<2>(0.55, 0.2), Vec<2>(0.8, 0.6), b), 2, Vec<2>(-1.0, 0.0));
+  if (contact) sim.enable_contact(ContactOptions{});
+  std::vector<std::string> out;
+  for (const char* n : sim.step_phase_names()) out.emplace_back(n);
+  return out;
+}
+using Names = std::vector<std::string>;
+}  // namespace
+
+TEST(StepPhases, ListsPerScheme) {
+  const Names grid = {"velocity_conditions", "momentum_update", "nodal_velocities"};
+  auto join = [](Names a, const Names& b) { return a.insert(a.end(), b.begin(), b.end()), a; };
+  EXPECT_EQ(names(UpdateScheme::usl, false),
+            join(join({"time_step", "shape_functions", "particle_to_grid"}, grid),
+                 {"particle_update", "move_rigid_particles", "end_particle_update"}));
+  EXPECT_EQ(names(UpdateScheme::usf, false),
+            join(join({"time_step", "shape_functions", "particle_to_grid", "velocity_from_momentum", "stress_update",
+                       "internal_forces"},
+                      grid),
+                 {"grid_to_particle", "move_rigid_particles", "end_particle_update"}));
+  EXPECT_EQ(names(UpdateScheme::musl, false),
+            join(join({"time_step", "shape_functions", "particle_to_grid"}, grid),
+                 {"grid_to_particle", "move_rigid_particles", "end_particle_update", "remap_momentum",
+                  "velocity_from_momentum", "stress_update"}));
+  // Contact: a pass after each momentum projection; USL's particle pass moves the rigid particles.
+  EXPECT_EQ(names(UpdateScheme::usl, true),
+            Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_conditions",
+                   "momentum_update", "contact_updated", "nodal_velocities", "particle_update",
+                   "end_particle_update"}));
+  EXPECT_EQ(names(UpdateScheme::musl, true),
+            Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_conditions",
+                   "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle",
+                   "move_rigid_particles", "end_particle_update", "remap_momentum", "contact_remapped",
+                   "velocity_from_momentum", "stress_update"}));
+  // Damping: one phase between the velocity conditions and the momentum update.
+  const Names damped = names(UpdateScheme::usl, false, 100.0);
+  ASSERT_EQ(damped.size(), 10u);
+  EXPECT_EQ(damped[4], "damping");
+}
+
+TEST(StepPhases, TimersAccountForTheSteps) {
+  SimulationOptions o;
+  Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
+  const int a = sim.add_material(elastic("a")), b = sim.add_material(elastic("b"));
+  sim.add_body("a", *make_box<2>(Vec<2>(0.2, 0.2), Vec<2>(0.45, 0.6), a), 2, Vec<2>(1.0, 0.0));
+  sim.add_body("b", *make_box<2>(Vec<2>(0.55, 0.2), Vec<2>(0.8, 0.6), b), 2, Vec<2>(-1.0, 0.0));
+  sim.enable_contact(ContactOptions{});
+  sim.finalize();
+  const auto start = std::chrono::steady_clock::now();
+  for (int s = 0; s < 50; ++s) sim.step();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const StepPhaseTimes& t = sim.phase_times();
+  // Every phase is timed once and nothing twice: the timers sum to the steps' wall time less what
+  // runs outside the phases (the loop, the energy books' start: well below half here).
+  EXPECT_GT(t.total(), 0.5 * wall);
+  EXPECT_LE(t.total(), wall);
+  for (double x : {t.time_step, t.shape_functions, t.particle_to_grid, t.contact, t.grid_update, t.stress_update})
+    EXPECT_GT(x, 0.0);
+}
