@@ -581,7 +581,8 @@ TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
 // waited in the next collective; now every rank finishes the step, agrees, and names the pair's key.
 TEST_F(CliMpirun, ExpressionLawFailureEndsTheRunAsFailed) {
   const std::string law =
-      " --set 'contact.pairs[0].law={\"type\":\"expression\",\"sliding_traction\":\"(v>2 && v<100) ? -0.3*N : 0.3*N\"}'";
+      " --set 'contact.pairs[0].law={\"type\":\"expression\",\"sliding_traction\":\"(v>2 && v<100) ? -0.3*N : 0.3*N\"}'"
+      " --set 'contact.separation=\"position\"'";  // an expression law's default, "extent", is serial only
   const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + law + " -q -o '" + path("serial.h5") + "'");
   const Result d = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + law + " -q -o '" +
                          path("split.h5") + "'");
