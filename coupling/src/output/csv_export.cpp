@@ -64,9 +64,9 @@ void export_series_csv(const std::string& h5_path, std::ostream& out) {
       checkpoint = f.get() >= 0 && H5Lexists(f.get(), "mechanics", H5P_DEFAULT) > 0 && H5Lexists(f.get(), "marks", H5P_DEFAULT) > 0;
       result = f.get() >= 0 && H5Aexists(f.get(), "format") > 0 && H5Lexists(f.get(), "meta", H5P_DEFAULT) > 0;
     }
+    if (result && !checkpoint) return;  // a result without series rows: nothing to write
     throw std::runtime_error("'" + h5_path + "' has no time series (/series): " +
                              (checkpoint ? "it is a checkpoint (read by frictherm resume and continue); export the result it belongs to"
-                              : result   ? "the run ended before its first series row"
                                          : "not a result of frictherm run"));
   }
   write_series_csv(table, out);
