@@ -24,7 +24,7 @@ namespace {
 
 /// Loads a scene with the --set overrides; a problem becomes "frictherm: SCENE: message" and exit
 /// code 2 (returned as false).
-bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene) {
+bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene, std::ostream& err = std::cerr) {
   try {
     std::vector<coupling::SceneOverride> overrides;
     if (a.lists.count("set"))
@@ -32,7 +32,7 @@ bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene) 
     scene = coupling::load_scene(path, overrides);
     return true;
   } catch (const coupling::SceneError& e) {
-    std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    err << "frictherm: " << path << ": " << e.what() << '\n';
     return false;
   }
 }
@@ -128,21 +128,30 @@ int serial_run_command(const ParsedArgs& a, const std::string& path, const coupl
 
 int validate_command(const std::vector<std::string>& args) {
   const ParsedArgs a = parse_args("validate", args, {kSetOption});
+  // Under mpirun every rank validates (and exits alike); only rank 0 says so (issue 34: once per rank).
+  std::ostream null_stream(nullptr);
+  const bool speaks = launcher_info().rank <= 0;
+  std::ostream& out = speaks ? std::cout : null_stream;
+  std::ostream& err = speaks ? std::cerr : null_stream;
   if (a.help) {
-    std::cout << kValidateHelp;
+    out << kValidateHelp;
     return kOk;
   }
   const std::string& path = single_positional("validate", a, "SCENE");
   coupling::Scene scene;
-  if (!load(path, a, scene)) return kUsage;
+  if (!load(path, a, scene, err)) return kUsage;
   try {
-    coupling::describe_scene(scene, std::cout);
+    coupling::check_output_folder(scene.output.file, "output.file");  // as `run` checks it (no -o here)
+    coupling::describe_scene(scene, out);
   } catch (const coupling::SceneError& e) {
-    std::cout.flush();
-    std::cerr << "frictherm: " << path << ": " << e.what() << '\n';
+    out.flush();
+    err << "frictherm: " << path << ": " << e.what() << '\n';
+    return kUsage;
+  } catch (const coupling::OutputError& e) {
+    err << "frictherm: " << path << ": " << e.what() << '\n';
     return kUsage;
   }
-  std::cout << "ok\n";
+  out << "ok\n";
   return kOk;
 }
 

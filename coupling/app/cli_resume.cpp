@@ -11,9 +11,11 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -97,6 +99,10 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
     continuation = q.output + "." + std::to_string(static_cast<long>(getpid())) + ".continuation.h5";
     opt.resume_appends = true;
     opt.overwrite = true;
+    // The resumed run's checkpoints count rows of the appended result, which exists only once it is
+    // published: they stay beside the continuation until then (issue 34: a killed resume had moved
+    // RUN.h5.checkpoint past RUN.h5, and the next resume was refused).
+    opt.checkpoint_file = continuation + ".checkpoint";
   } else {
     opt.overwrite = q.force;
     if (!q.quiet)
@@ -119,6 +125,8 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
     if (append) {
       remove_quietly(continuation);
       remove_quietly(coupling::xdmf_path_for(continuation));
+      remove_quietly(coupling::xdmf_reference_path_for(continuation));
+      remove_quietly(opt.checkpoint_file);
     }
     throw;
   }
@@ -130,6 +138,11 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
     }
     remove_quietly(continuation);
     remove_quietly(coupling::xdmf_path_for(continuation));
+    remove_quietly(coupling::xdmf_reference_path_for(continuation));
+    // Now that the rows it counts are in the published result: the resumed run's last checkpoint.
+    if (exists(opt.checkpoint_file) && std::rename(opt.checkpoint_file.c_str(), coupling::checkpoint_path(q.output).c_str()) != 0)
+      throw std::runtime_error("cannot rename '" + opt.checkpoint_file + "' to '" + coupling::checkpoint_path(q.output) +
+                               "': " + std::strerror(errno) + " (" + q.output + " is complete; its checkpoint is the earlier one)");
     out.result.output = q.output;
   }
   return out;

@@ -10,12 +10,17 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -238,9 +243,10 @@ TEST_F(Files, TwoWritersOfOneFileBothKeepReadableResults) {
     } else {
       const std::string err = slurp(path("stderr" + std::to_string(k) + ".txt"));
       EXPECT_EQ(codes[k], 2) << err;
-      if (err.find("refusing to replace an existing result") != std::string::npos) {
-        // It started after the other had published (a loaded machine): refused before any step,
-        // nothing of its own written, the other's file untouched.
+      if (err.find("refusing to replace an existing result") != std::string::npos ||
+          err.find("is being written by another run") != std::string::npos) {
+        // It started while the other held the output's claim, or after it had published: refused
+        // before any step, nothing of its own written, the other's file untouched.
         EXPECT_FALSE(fs::exists(live)) << err;
       } else {
         // Both ran at once: the later one keeps its result under its own name.
@@ -250,6 +256,43 @@ TEST_F(Files, TwoWritersOfOneFileBothKeepReadableResults) {
     }
   }
   EXPECT_GE(published, 1);
+}
+
+// The output is claimed (flock on OUT.h5.lock) before anything is built or written (issue 34 item 3:
+// a second run a second after the first had replaced the first's XDMF and checkpoint before it was
+// refused at publication). The test holds the claim itself, as a running first run would, so nothing
+// depends on timing: the second run must be refused with exit code 2 (with --force: by the claim), leaving every
+// file of the folder byte-equal and adding none. Once the claim is let go (the lock file stays
+// behind, as after a killed run) the same command runs, and removes the lock file at its end.
+// (The first version of this test waited up to 10 s for a first run's .part file; on a loaded machine
+// that wait ran out, the ASSERT returned without killing the first run, and ctest then waited for that
+// orphan, which held the test's output pipe, until its time limit: 357 s.)
+TEST_F(Files, SecondRunOnAClaimedOutputIsRefusedBeforeWriting) {
+  const std::string scene = write("tiny.json", kTinyScene), out = path("same.h5");
+  ASSERT_EQ(frictherm("run " + scene + " -o " + out + " --quiet --set run.checkpoint_interval=1e-3").code, 0);
+  auto files = [&] {
+    std::vector<std::pair<std::string, std::string>> all;
+    for (const auto& e : fs::directory_iterator(dir_)) all.emplace_back(e.path().filename().string(), slurp(e.path().string()));
+    std::sort(all.begin(), all.end());
+    return all;
+  };
+  const int fd = ::open((out + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  const auto before = files();
+  ASSERT_EQ(before.size(), 6u);  // tiny.json, same.h5, same.xdmf, same_reference.xdmf, same.h5.checkpoint, same.h5.lock
+  // Without --force the existing result is refused first; with it, the claim refuses the run.
+  for (const std::string force : {"", " --force"}) {
+    const Result r = frictherm("run " + scene + " -o " + out + " --quiet" + force);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(force.empty() ? "exists; refusing to replace" : "is being written by another run"));
+    EXPECT_TRUE(files() == before) << "the refused run changed or added a file";
+  }
+  ::close(fd);  // let go; the lock file stays, claiming nothing
+  const Result after = frictherm("run " + scene + " -o " + out + " --quiet --force");
+  EXPECT_EQ(after.code, 0) << after.output;
+  EXPECT_EQ(status_of(out), "completed");
+  EXPECT_FALSE(fs::exists(out + ".lock")) << "the claim is released with the run";
 }
 
 // The library level of the same: a file that appears under the final name while an H5Output writes

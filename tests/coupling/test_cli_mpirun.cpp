@@ -52,6 +52,7 @@
 #include <string>
 #include <vector>
 
+#include <hdf5.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -65,6 +66,22 @@ namespace {
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
+// /meta/status of a result ("" when it does not read).
+std::string status_of(const std::string& file) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return "";
+  std::string s;
+  if (const hid_t d = H5Dopen2(f, "/meta/status", H5P_DEFAULT); d >= 0) {
+    const hid_t t = H5Dget_type(d);
+    s.assign(H5Tget_size(t), '\0');
+    H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data());
+    s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
+    H5Tclose(t);
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return s;
+}
 
 
 class CliMpirun : public frictherm::test::MpirunScratchTest {
@@ -552,6 +569,47 @@ TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
   EXPECT_EQ(failure_point(d.output), point) << d.output;
   EXPECT_THAT(d.output, HasSubstr("left the grid"));
   EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty()) << "the series before the failure stay readable";
+  EXPECT_EQ(status_of(path("split.h5")), "failed");  // issue 34: ended as the serial run, with /failure
+  EXPECT_EQ(read_doubles(path("split.h5"), "/failure/position").size(), read_doubles(path("serial.h5"), "/failure/position").size());
+}
+
+
+// Issue 34: a decomposed run that fails ends as the serial run does, status failed and the failing
+// state under /failure (it had kept status "running"). A friction law that throws on one rank (an
+// expression law that passes the validator's sample points, v in {0, 1e-3, 1, 1e3} m/s, and turns
+// negative while the block slides at 10 m/s) had left that rank's exception behind while the other
+// waited in the next collective; now every rank finishes the step, agrees, and names the pair's key.
+TEST_F(CliMpirun, ExpressionLawFailureEndsTheRunAsFailed) {
+  const std::string law =
+      " --set 'contact.pairs[0].law={\"type\":\"expression\",\"sliding_traction\":\"(v>2 && v<100) ? -0.3*N : 0.3*N\"}'"
+      " --set 'contact.separation=\"position\"'";  // an expression law's default, "extent", is serial only
+  const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + law + " -q -o '" + path("serial.h5") + "'");
+  const Result d = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + law + " -q -o '" +
+                         path("split.h5") + "'");
+  EXPECT_EQ(s.code, 1) << s.output;
+  EXPECT_EQ(d.code, 1) << d.output;
+  EXPECT_THAT(d.output, HasSubstr("contact.pairs[0].law (materials 'base' and 'block')"));
+  EXPECT_THAT(d.output, HasSubstr("returned S = -"));
+  EXPECT_EQ(status_of(path("split.h5")), "failed");
+  EXPECT_FALSE(read_doubles(path("split.h5"), "/failure/position").empty()) << "the failing state under /failure";
+  EXPECT_EQ(read_doubles(path("split.h5"), "/failure/position").size(),
+            read_doubles(path("serial.h5"), "/failure/position").size()) << "every particle, once";
+  EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty());
+}
+
+// `validate` under mpirun: every rank validates, rank 0 alone prints (issue 34: once per rank).
+TEST_F(CliMpirun, ValidateUnderMpirunSpeaksOnce) {
+  const Result ok = shell(mpirun(2) + " " + exe() + " validate " + scene("decomposed_sliding_block.json"));
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  std::size_t count = 0;
+  for (std::size_t at = ok.output.find("\nok\n"); at != std::string::npos; at = ok.output.find("\nok\n", at + 1)) ++count;
+  EXPECT_EQ(count, 1u) << ok.output;
+  const Result bad = shell(mpirun(2) + " " + exe() + " validate " + scene("decomposed_sliding_block.json") +
+                           " --set run.end_time=-1");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  std::size_t said = 0;
+  for (std::size_t at = bad.output.find("run.end_time"); at != std::string::npos; at = bad.output.find("run.end_time", at + 1)) ++said;
+  EXPECT_EQ(said, 1u) << bad.output;
 }
 
 TEST_F(CliMpirun, OneRankRunsTheSerialProgram) {

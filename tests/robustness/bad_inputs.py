@@ -250,6 +250,83 @@ CASES = [
     ("-o followed by an option", scene(), {}, ["run", "SCENE", "-o", "--force"], "option '-o'"),
 ]
 
+# --- every command refuses bad input by its key, fast (issue 34 item 6) ------------------------
+THERMAL_FOR_SETUP = json.dumps(dict(json.loads(scene()),
+                                    thermal={"materials": {"soft": {"heat_capacity": 1000, "conductivity": 1}}},
+                                    coupling={"continuation": {"duration": 1e-3, "intervals": 2}},
+                                    run={"end_time": 5e-4, "threads": 1}))
+
+
+def many_materials(n):
+    """n materials, the last one's Poisson ratio out of range: refused in time linear in n."""
+    mats = {"m%d" % k: BASE["materials"]["soft"] for k in range(n)}
+    mats["m%d" % (n - 1)] = dict(BASE["materials"]["soft"], poisson_ratio=0.7)
+    return scene(materials=mats)
+
+
+def many_constants(n):
+    """An expression law with n named constants whose expression names an unknown variable."""
+    soft = BASE["materials"]["soft"]
+    s = json.loads(scene(materials={"base": soft, "block": soft}))
+    s["bodies"][0]["material"] = "block"
+    s["contact"] = {"pairs": [{"materials": ["base", "block"],
+                               "law": {"type": "expression", "sliding_traction": "k0*N + undefined_name",
+                                       "constants": {"k%d" % k: 0.1 for k in range(n)}}}]}
+    return json.dumps(s)
+
+
+def foreign_h5(workdir):
+    import h5py
+    with h5py.File(os.path.join(workdir, "foreign.h5"), "w") as f:
+        f["x"] = [1.0, 2.0]
+
+
+def collision_scene():
+    soft = BASE["materials"]["soft"]
+    s = json.loads(scene(materials={"a": soft, "b.c": soft, "a.b": soft, "c": soft}))
+    s["bodies"][0]["material"] = "a"
+    s["contact"] = {"pairs": [{"materials": ["a", "b.c"], "law": {"type": "coulomb", "mu": 0.3}},
+                              {"materials": ["a.b", "c"], "law": {"type": "coulomb", "mu": 0.3}}]}
+    return json.dumps(s)
+
+
+def thermal_scene(**thermal):
+    return json.dumps(dict(json.loads(scene()),
+                           thermal=dict({"materials": {"soft": {"heat_capacity": 1000, "conductivity": 1}}}, **thermal),
+                           coupling={"continuation": {"duration": 1e-3, "intervals": 2}},
+                           run={"end_time": 5e-4, "threads": 1}))
+
+
+CASES += [
+    ("output folder missing (validate)", scene(output={"snapshot_count": 4, "file": "nope/out.h5"}), {},
+     ["validate", "SCENE"], "output.file: the folder 'nope'"),
+    ("output folder missing (run)", scene(output={"snapshot_count": 4, "file": "nope/out.h5"}), {},
+     ["run", "SCENE"], "output.file: the folder 'nope'"),
+    ("output file is a folder (validate)", scene(output={"snapshot_count": 4, "file": "outdir"}),
+     {"outdir/keep": b""}, ["validate", "SCENE"], "output.file: 'outdir' is a folder"),
+    ("export-csv of a foreign HDF5 file", scene(), {}, ["export-csv", "foreign.h5", "-o", "s.csv"],
+     "'foreign.h5' has no time series", [foreign_h5]),
+    ("export-csv of a checkpoint", THERMAL_FOR_SETUP, {}, ["export-csv", "R.h5.checkpoint"],
+     "'R.h5.checkpoint' has no time series (/series): it is a checkpoint", [["run", "SCENE", "-o", "R.h5", "-q"]]),
+    ("resume: the checkpoint of another run", scene(run={"end_time": 2e-3, "threads": 1, "checkpoint_interval": 1e-3}),
+     {}, ["resume", "R.h5"], "'R.h5' is the result of run ",
+     [["run", "SCENE", "-o", "R.h5", "-q"], ["run", "SCENE", "-o", "S.h5", "-q"],
+      lambda d: shutil.copyfile(os.path.join(d, "S.h5.checkpoint"), os.path.join(d, "R.h5.checkpoint"))]),
+    ("end_time 5e-324", scene(run={"end_time": 5e-324}), {}, ["validate", "SCENE"], "run.end_time"),
+    ("material names colliding once joined with '.'", collision_scene(), {}, ["validate", "SCENE"],
+     "contact.pairs[1].materials: the names 'a.b' and 'c' joined"),
+    ("key holding \\u0000", json.dumps(dict(json.loads(scene()), **{"ru\x00n": 1})), {}, ["validate", "SCENE"],
+     "ru\\u0000n: unknown key"),
+    ("50,000 materials", many_materials(50000), {}, ["validate", "SCENE"], "materials.m49999.poisson_ratio"),
+    ("expression law with 200,000 constants", many_constants(200000), {}, ["validate", "SCENE"],
+     "contact.pairs[0].law.constants: expected at most 1000 named constants, got 200000"),
+    ("expression law with 1,000 constants", many_constants(1000), {}, ["validate", "SCENE"],
+     "contact.pairs[0].law.sliding_traction: unknown variable undefined_name"),
+    ("continuation duration 1e300", thermal_scene().replace('"duration": 0.001', '"duration": 1e300'), {},
+     ["validate", "SCENE"], "coupling.continuation.duration"),
+    ("thermal rtol 1e-300", thermal_scene(rtol=1e-300), {}, ["validate", "SCENE"], "thermal.rtol"),
+]
+
 # --- inputs of continue, resume and export-csv are never replaced, --force or not (issue 34) -----
 # A sixth element: commands run first (each must succeed); the files they leave must be byte-equal
 # after the refused command.

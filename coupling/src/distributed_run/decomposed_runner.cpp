@@ -84,7 +84,7 @@ class DecomposedRun {
     } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
       r_.status = RunResult::Status::failed;
       r_.message = e.what();
-      if (out_) out_->write_metadata("failure", r_.message);
+      write_failure(e.step(), e.time());
     }
     progress.finish();
     if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
@@ -126,11 +126,14 @@ class DecomposedRun {
 
   // Rank 0 checks every file of every rank as the serial run checks its output (docs/robustness.md):
   // never an input, an existing file only with --force / output.overwrite; all ranks agree.
-  void check_output_files() const {
+  // Rank 0 also claims the output for the run (OutputClaim, as the serial run; issue 34).
+  void check_output_files() {
     std::string error;
     if (rank_ == 0) {
       try {
+        check_output_folder(r_.output, o_.output.empty() ? "output.file" : "output file");
         const std::vector<std::string> inputs = scene_input_files(s_);
+        claim_ = std::make_unique<OutputClaim>(r_.output);
         for (const std::string& f : decomposed_output_files(r_.output, size_))
           check_output_path(f, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
       } catch (const std::exception& e) {
@@ -245,7 +248,9 @@ class DecomposedRun {
     constexpr double none = -std::numeric_limits<double>::infinity();
     // max of −id: lowest id; the last: whether --checkpoint-every's wall interval has passed on some rank
     const bool wall = o_.checkpoint_wall_interval > 0.0 && seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval;
-    double v[4] = {static_cast<double>(detail::interrupt_signal()), none, none, wall ? 1.0 : 0.0};
+    // v[4]: the highest rank whose friction law threw in the step (-1: none).
+    double v[5] = {static_cast<double>(detail::interrupt_signal()), none, none, wall ? 1.0 : 0.0,
+                   mpm_->contact_failure().empty() ? -1.0 : static_cast<double>(rank_)};
     for (std::size_t k = 0; k < p.mass.size(); ++k) {
       const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k), xk(p.position.data() + Dim * k);
       if (!(vk.allFinite() && xk.allFinite()))
@@ -253,9 +258,20 @@ class DecomposedRun {
       else if (!grid_->contains(xk))
         v[2] = std::max(v[2], -static_cast<double>(p.id[k]));
     }
-    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, v, 5, MPI_DOUBLE, MPI_MAX, comm_);
     signal = static_cast<int>(v[0]);
     checkpoint_due = v[3] > 0.0;
+    if (v[4] >= 0.0) {  // every rank: the failing rank's message, then the run's ordinary breakdown
+      const int from = static_cast<int>(v[4]);
+      std::string what = mpm_->contact_failure();
+      long length = static_cast<long>(what.size());
+      MPI_Bcast(&length, 1, MPI_LONG, from, comm_);
+      what.resize(static_cast<std::size_t>(length));
+      MPI_Bcast(what.data(), static_cast<int>(length), MPI_CHAR, from, comm_);
+      throw mechanics::SimulationError("step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: " +
+                                           what + " (on rank " + std::to_string(from) + ")",
+                                       step_, time_, -1);
+    }
     const std::string at = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: particle ";
     if (v[1] > none)
       throw mechanics::SimulationError(at + format_number(-v[1]) + " has a non-finite velocity or position (the step "
@@ -378,6 +394,34 @@ class DecomposedRun {
     output_seconds_ += seconds_since(c0);
   }
 
+  // Collective: the failing state under /failure of OUT.h5 as the serial run writes it (every
+  // particle, gathered by id: position, velocity, material; a failed run's cost is not a concern),
+  // and the message in /meta/failure. A failure to write that state is added to the message.
+  void write_failure(long step, double time) {
+    const std::vector<typename Mpm::Particle> all = mpm_->gather();
+    if (rank_ != 0 || !out_) return;
+    try {
+      const std::size_t n = all.size();
+      std::vector<double> position(n * Dim), velocity(n * 3, 0.0);
+      std::vector<std::int32_t> material(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        for (int d = 0; d < Dim; ++d) {
+          position[k * Dim + static_cast<std::size_t>(d)] = all[k].position[d];
+          velocity[k * 3 + static_cast<std::size_t>(d)] = all[k].velocity[d];
+        }
+        material[k] = all[k].material;
+      }
+      out_->begin_failure(step, time, r_.message);
+      out_->snapshot_field("position", position.data(), n, Dim);
+      out_->snapshot_field("velocity", velocity.data(), n, 3);
+      out_->snapshot_field("material", material.data(), n);
+      out_->end_snapshot();
+    } catch (const std::exception& e) {
+      r_.message += std::string(" (the failing state was not written: ") + e.what() + ")";
+    }
+    out_->write_metadata("failure", r_.message);
+  }
+
   // Collective: every rank writes its particles; rank 0 rewrites OUT.xdmf.
   void snapshot() {
     const Clock::time_point c0 = Clock::now();
@@ -442,6 +486,7 @@ class DecomposedRun {
   std::unique_ptr<Mpm> mpm_;
   std::unique_ptr<DecomposedHeat> heat_;  // scenes with a `thermal` section
   std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
+  std::unique_ptr<OutputClaim> claim_;    // rank 0: the output claimed for the run
   std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
   std::unique_ptr<DecomposedOutput> snapshots_out_;
   int temperature_ = 0;

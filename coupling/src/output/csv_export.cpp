@@ -1,5 +1,7 @@
 #include <frictherm/coupling/csv_export.hpp>
 
+#include "output/h5_util.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <ostream>
@@ -47,7 +49,27 @@ void write_series_csv(const SeriesTable& table, std::ostream& out) {
 }
 
 void export_series_csv(const std::string& h5_path, std::ostream& out) {
-  write_series_csv(read_series(h5_path), out);
+  const bool hdf5 = [&] {
+    const h5detail::Quiet quiet;
+    return H5Fis_hdf5(h5_path.c_str()) > 0;
+  }();
+  if (!hdf5)
+    throw std::runtime_error("'" + h5_path + "' is not an HDF5 file; export-csv reads a result of frictherm run (RUN.h5)");
+  const SeriesTable table = read_series(h5_path);
+  if (table.names.empty()) {  // issue 34: a foreign file or a checkpoint gave exit code 0 and nothing written
+    bool checkpoint = false, result = false;
+    {
+      const h5detail::Quiet quiet;
+      const h5detail::Handle f{H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+      checkpoint = f.get() >= 0 && H5Lexists(f.get(), "mechanics", H5P_DEFAULT) > 0 && H5Lexists(f.get(), "marks", H5P_DEFAULT) > 0;
+      result = f.get() >= 0 && H5Aexists(f.get(), "format") > 0 && H5Lexists(f.get(), "meta", H5P_DEFAULT) > 0;
+    }
+    if (result && !checkpoint) return;  // a result without series rows: nothing to write
+    throw std::runtime_error("'" + h5_path + "' has no time series (/series): " +
+                             (checkpoint ? "it is a checkpoint (read by frictherm resume and continue); export the result it belongs to"
+                                         : "not a result of frictherm run"));
+  }
+  write_series_csv(table, out);
   out.flush();
   if (!out) throw std::runtime_error("export of the series of '" + h5_path + "': writing the CSV failed");
 }

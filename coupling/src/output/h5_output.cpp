@@ -27,9 +27,13 @@
 #include "output/h5_io.hpp"
 #include "output/h5_util.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -211,15 +215,27 @@ struct H5Output::Impl {
 
   void flush_file() { check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), io.file, "cannot flush"); }
 
+  static std::string document(std::vector<std::string> grids, const std::string& failure, const std::string& name) {
+    if (!failure.empty()) grids.push_back(failure);
+    return xdmf_document(grids, name);
+  }
+  bool has_reference() const { return !reference_xml.empty() || !reference_failure_xml.empty(); }
+
+  // Written under the final names after every snapshot; through a temporary the XDMF files are
+  // written only with the result (publish): until then they would describe a file that is not
+  // under the name they give (issue 34: a second run had relabelled the first run's snapshots).
   void write_xdmf() {
-    if (!options.write_xdmf) return;
-    const auto document = [](std::vector<std::string> grids, const std::string& failure, const std::string& name) {
-      if (!failure.empty()) grids.push_back(failure);
-      return xdmf_document(grids, name);
-    };
+    if (!options.write_xdmf || options.via_temporary) return;
     write_text_atomically(xdmf_path, document(grid_xml, failure_xml, "particles"));
-    if (!reference_xml.empty() || !reference_failure_xml.empty())
+    if (has_reference())
       write_text_atomically(reference_path, document(reference_xml, reference_failure_xml, "particles_reference"));
+  }
+
+  // The result renamed onto its name with its XDMF files (publish_with_xdmf, output_files.hpp).
+  void publish() {
+    if (!options.write_xdmf) return publish_file(io.file, final_path, options.replace_existing);
+    publish_with_xdmf(io.file, final_path, options.replace_existing, document(grid_xml, failure_xml, "particles"),
+                      has_reference() ? document(reference_xml, reference_failure_xml, "particles_reference") : "");
   }
 
   void discard_snapshot() noexcept {
@@ -406,7 +422,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.meta = io.group(m.file.get(), "meta", "/meta");
   m.snapshots = io.group(m.file.get(), "snapshots", "/snapshots");
   m.flush_file();
-  m.write_xdmf();  // an empty collection; also proves early that the XDMF file can be written
+  m.write_xdmf();  // an empty collection; also proves early that the XDMF file can be written (not via_temporary)
 }
 
 void hdf5_program_setup() {
@@ -587,6 +603,30 @@ void H5Output::flush() {
   m.flush_file();
 }
 
+void H5Output::sync() {
+  flush();
+  Impl& m = live();
+  void* handle = nullptr;
+  check(H5Fget_vfd_handle(m.file.get(), H5P_DEFAULT, &handle), m.io.file, "cannot get the file's descriptor");
+  if (handle != nullptr && ::fsync(*static_cast<int*>(handle)) != 0)
+    throw std::runtime_error("HDF5 file '" + m.io.file + "': cannot make the written rows durable (fsync: " +
+                             std::strerror(errno) + ")");
+}
+
+void H5Output::abandon() noexcept {
+  if (!impl_ || impl_->closed) return;
+  Impl& m = *impl_;
+  const Quiet quiet;
+  m.discard_snapshot();
+  m.series_sets.clear();
+  m.tables.clear();
+  m.series.reset();
+  m.snapshots.reset();
+  m.meta.reset();
+  m.file.reset();
+  m.closed = true;
+}
+
 void H5Output::close() {
   Impl& m = live();
   m.discard_snapshot();
@@ -600,7 +640,7 @@ void H5Output::close() {
   m.meta.reset();
   m.file.reset();
   m.closed = true;
-  if (m.io.file != m.final_path) publish_file(m.io.file, m.final_path, m.options.replace_existing);
+  if (m.io.file != m.final_path) m.publish();
 }
 
 std::size_t H5Output::snapshot_count() const { return impl_ ? impl_->count : 0; }

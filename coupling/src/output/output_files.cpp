@@ -1,8 +1,10 @@
 // Safe output files: inputs never overwritten, existing results only when asked, temporary names
 // renamed on success (output_files.hpp).
 #include <frictherm/coupling/output_files.hpp>
+#include <frictherm/coupling/xdmf.hpp>
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #ifdef __linux__
@@ -79,6 +81,19 @@ void check_output_path(const std::string& path, const std::vector<std::string>& 
                       " to replace it, or choose another output file)");
 }
 
+void check_output_folder(const std::string& path, const std::string& what) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw OutputError(what + ": '" + path + "' is a folder; expected a file name for the result, e.g. '" +
+                      (path.empty() || path.back() == '/' ? path : path + "/") + "run.h5'");
+  const std::size_t slash = path.find_last_of('/');
+  const std::string folder = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  if (::stat(folder.c_str(), &st) != 0)
+    throw OutputError(what + ": the folder '" + folder + "' of '" + path + "' does not exist (" +
+                      std::strerror(errno) + "); create it first");
+  if (!S_ISDIR(st.st_mode)) throw OutputError(what + ": '" + folder + "' in '" + path + "' is not a folder");
+}
+
 std::string temporary_path(const std::string& path) {
   const std::string stem = path + "." + std::to_string(static_cast<long>(::getpid()));
   std::string candidate = stem + ".part";
@@ -96,6 +111,63 @@ void publish_file(const std::string& temporary, const std::string& path, bool ov
                              "alone: this run's result is in '" + temporary + "'");
   throw std::runtime_error("cannot rename '" + temporary + "' to '" + path + "': " + std::strerror(err) +
                            "; this run's result is in '" + temporary + "'");
+}
+
+void publish_with_xdmf(const std::string& temporary, const std::string& path, bool overwrite, const std::string& xdmf,
+                       const std::string& reference_xdmf) {
+  const std::string x = xdmf_path_for(path), r = xdmf_reference_path_for(path);
+  const std::string pid = "." + std::to_string(static_cast<long>(::getpid())) + ".tmp";
+  const std::string x_tmp = x + pid, r_tmp = r + pid;
+  try {
+    write_text_atomically(x_tmp, xdmf);
+    if (!reference_xdmf.empty()) write_text_atomically(r_tmp, reference_xdmf);
+    if (overwrite) {
+      ::unlink(x.c_str());
+      ::unlink(r.c_str());
+    }
+    publish_file(temporary, path, overwrite);
+  } catch (...) {
+    ::unlink(x_tmp.c_str());
+    ::unlink(r_tmp.c_str());
+    throw;
+  }
+  if (std::rename(x_tmp.c_str(), x.c_str()) != 0 ||
+      (!reference_xdmf.empty() && std::rename(r_tmp.c_str(), r.c_str()) != 0)) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(x_tmp.c_str());
+    ::unlink(r_tmp.c_str());
+    throw std::runtime_error("'" + path + "' is published but its XDMF file could not be: " + reason);
+  }
+}
+
+OutputClaim::OutputClaim(const std::string& output) : lock_path_(output + ".lock") {
+  // The holder unlinks the lock file before it lets go, so a run that opened the old file and then
+  // got its lock holds a file no longer under the name: it tries again on the name's current file.
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    fd_ = ::open(lock_path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) return;  // a folder we cannot write into: the output's own checks say so
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      ::close(fd_);
+      fd_ = -1;
+      if (err == EWOULDBLOCK)
+        throw OutputError("'" + output + "' is being written by another run (it holds " + lock_path_ +
+                          "); refusing to start a second run on the same output");
+      return;  // no locks on this file system: unclaimed, as before
+    }
+    struct stat held {}, named {};
+    if (::fstat(fd_, &held) == 0 && ::stat(lock_path_.c_str(), &named) == 0 && held.st_dev == named.st_dev &&
+        held.st_ino == named.st_ino)
+      return;
+    ::close(fd_);
+    fd_ = -1;
+  }
+}
+
+OutputClaim::~OutputClaim() {
+  if (fd_ < 0) return;
+  ::unlink(lock_path_.c_str());  // while still held: a run waiting on it takes a fresh file
+  ::close(fd_);
 }
 
 }  // namespace frictherm::coupling

@@ -6,8 +6,15 @@
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/xdmf.hpp>
 
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
@@ -156,15 +163,16 @@ XdmfGrid grid_of(hid_t g, const std::string& name, const std::string& path, cons
 
 }  // namespace
 
-std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name) {
+std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name, const std::string& geometry) {
   const h5detail::Quiet quiet;
   const Handle f{check_id(H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), h5_path, "cannot open"), H5Fclose};
   const int dim = read_attribute<int>(f.get(), "dim", H5T_NATIVE_INT, h5_path);
   std::vector<std::string> xml;
   const auto add = [&](hid_t g, const std::string& name, const std::string& path) {
-    const XdmfGrid grid = grid_of(g, name, path, h5_path);
+    XdmfGrid grid = grid_of(g, name, path, h5_path);
+    grid.geometry = geometry;
     bool drawable = false;
-    for (const XdmfField& fd : grid.fields) drawable = drawable || (fd.name == "position" && fd.components == dim);
+    for (const XdmfField& fd : grid.fields) drawable = drawable || (fd.name == geometry && fd.components == dim);
     if (drawable && grid.points > 0 && exists(f.get(), grid.connectivity)) xml.push_back(xdmf_grid_xml(grid, h5_name, dim));
   };
   if (exists(f.get(), "/snapshots")) {
@@ -178,7 +186,8 @@ std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_nam
     const Handle g{check_id(H5Gopen2(f.get(), "failure", H5P_DEFAULT), h5_path, "/failure"), H5Gclose};
     add(g.get(), "failure", "/failure");
   }
-  return xdmf_document(xml);
+  if (geometry != "position" && xml.empty()) return "";  // no reference positions: no such file
+  return xdmf_document(xml, geometry == "position" ? "particles" : "particles_reference");
 }
 
 void check_appendable(const std::string& original, const CheckpointMarks& marks) {
@@ -186,6 +195,19 @@ void check_appendable(const std::string& original, const CheckpointMarks& marks)
   const Handle f{check_id(H5Fopen(original.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), original, "cannot open it"), H5Fclose};
   for (const char* group : {"/meta", "/series", "/snapshots"})
     if (!exists(f.get(), group)) throw std::runtime_error("'" + original + "': no " + group + " (not a frictherm result)");
+  // The result the checkpoint belongs to (issue 34): a later run on the same output that did not
+  // finish leaves its checkpoint beside the earlier run's result. Older files have no identity.
+  if (!marks.run_id.empty() && exists(f.get(), "/meta/run_id")) {
+    const Handle d{check_id(H5Dopen2(f.get(), "/meta/run_id", H5P_DEFAULT), original, "/meta/run_id"), H5Dclose};
+    const Handle t{check_id(H5Dget_type(d.get()), original, "type of /meta/run_id"), H5Tclose};
+    std::string id(H5Tget_size(t.get()), '\0');
+    check(H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, id.data()), original, "cannot read /meta/run_id");
+    id.resize(id.find('\0') == std::string::npos ? id.size() : id.find('\0'));
+    if (id != marks.run_id)
+      throw std::runtime_error("'" + original + "' is the result of run " + id + ", the checkpoint belongs to run " +
+                               marks.run_id + " (a later run on the same output that did not finish, or files of " +
+                               "two runs put together)");
+  }
   const std::vector<std::string> cols = [&] {
     const Handle g{check_id(H5Gopen2(f.get(), "series", H5P_DEFAULT), original, "/series"), H5Gclose};
     return members(g.get());
@@ -203,28 +225,114 @@ void check_appendable(const std::string& original, const CheckpointMarks& marks)
                              std::to_string(marks.snapshots) + ")");
 }
 
+namespace {
+
+// copy_file with read(2)/write(2), for the system's reason when a write fails (std::filesystem said
+// "Input/output error" where the write had failed with "File too large").
+void copy_bytes(const std::string& from, const std::string& to) {
+  const int in = ::open(from.c_str(), O_RDONLY | O_CLOEXEC);
+  if (in < 0) throw std::runtime_error("cannot read '" + from + "': " + std::strerror(errno));
+  const int out = ::open(to.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (out < 0) {
+    const std::string reason = std::strerror(errno);
+    ::close(in);
+    throw std::runtime_error("cannot create '" + to + "': " + reason);
+  }
+  std::vector<char> buf(1 << 20);
+  std::string error;
+  for (;;) {
+    const ssize_t n = ::read(in, buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) error = "cannot read '" + from + "': " + std::strerror(errno);
+    if (n <= 0) break;
+    for (ssize_t done = 0; done < n && error.empty();) {
+      const ssize_t w = ::write(out, buf.data() + done, static_cast<std::size_t>(n - done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) error = "cannot write '" + to + "': " + std::strerror(w < 0 ? errno : ENOSPC);
+      done += w > 0 ? w : 0;
+    }
+    if (!error.empty()) break;
+  }
+  ::close(in);
+  if (::close(out) != 0 && error.empty()) error = "cannot write '" + to + "': " + std::strerror(errno);
+  if (!error.empty()) throw std::runtime_error(error);
+}
+
+// The joined result in `tmp`: the original's rows up to the marks, then the continuation's.
+void append_into(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
+                 const std::string& tmp) {
+  copy_bytes(original, tmp);
+  const h5detail::Quiet quiet;
+  const Handle out{check_id(H5Fopen(tmp.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), tmp, "cannot open the copy"), H5Fclose};
+  const Handle cont{check_id(H5Fopen(continuation.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), continuation, "cannot open"),
+                    H5Fclose};
+  append_columns(out.get(), cont.get(), "series", marks.series_rows, original, continuation);
+  for (const auto& [table, rows] : marks.table_rows) append_columns(out.get(), cont.get(), table, rows, original, continuation);
+  append_snapshots(out.get(), cont.get(), marks.snapshots, original, continuation);
+  replace_meta(out.get(), cont.get(), original, continuation);
+  check(H5Fflush(out.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush");
+}
+
+// append_into in a child process: HDF5 1.10 crashes (SIGSEGV in H5Ocopy's clean-up) when a write
+// fails under it, a full disk or the file-size limit (issue 34, found by the fault injection). The
+// child's message comes back through a pipe; a crash is reported as a failed write.
+void append_in_child(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
+                     const std::string& tmp) {
+  int fds[2];
+  if (::pipe(fds) != 0) return append_into(original, continuation, marks, tmp);
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return append_into(original, continuation, marks, tmp);
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    int code = 0;
+    try {
+      append_into(original, continuation, marks, tmp);
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      for (std::size_t done = 0; done < what.size();) {
+        const ssize_t w = ::write(fds[1], what.data() + done, what.size() - done);
+        if (w <= 0) break;
+        done += static_cast<std::size_t>(w);
+      }
+      code = 1;
+    }
+    ::_exit(code);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    message.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+  if (WIFSIGNALED(status))
+    throw std::runtime_error("writing '" + tmp + "' failed: the HDF5 library ended the process with signal " +
+                             std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) +
+                             "), as it does after a failed write (a full disk or the file-size limit)");
+  throw std::runtime_error(message.empty() ? "writing '" + tmp + "' failed" : message);
+}
+
+}  // namespace
+
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
                    const std::string& output) {
   const std::string tmp = temporary_path(output);
   try {
-    std::filesystem::copy_file(original, tmp);
-    {
-      const h5detail::Quiet quiet;
-      const Handle out{check_id(H5Fopen(tmp.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), tmp, "cannot open the copy"), H5Fclose};
-      const Handle cont{check_id(H5Fopen(continuation.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), continuation, "cannot open"),
-                        H5Fclose};
-      append_columns(out.get(), cont.get(), "series", marks.series_rows, original, continuation);
-      for (const auto& [table, rows] : marks.table_rows)
-        append_columns(out.get(), cont.get(), table, rows, original, continuation);
-      append_snapshots(out.get(), cont.get(), marks.snapshots, original, continuation);
-      replace_meta(out.get(), cont.get(), original, continuation);
-      check(H5Fflush(out.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush");
-    }
+    append_in_child(original, continuation, marks, tmp);
     const std::size_t slash = output.find_last_of('/');
     const std::string name = slash == std::string::npos ? output : output.substr(slash + 1);
-    const std::string xdmf = xdmf_of_result(tmp, name);
-    publish_file(tmp, output, true);
-    write_text_atomically(xdmf_path_for(output), xdmf);
+    publish_with_xdmf(tmp, output, true, xdmf_of_result(tmp, name), xdmf_of_result(tmp, name, "initial_position"));
   } catch (...) {
     std::remove(tmp.c_str());
     throw;

@@ -1,5 +1,6 @@
 #include <frictherm/coupling/xdmf.hpp>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -120,14 +121,26 @@ std::string xdmf_document(const std::vector<std::string>& grid_xml, const std::s
 void write_text_atomically(const std::string& path, const std::string& text) {
   const std::string tmp = path + "." + std::to_string(static_cast<long>(::getpid())) + ".tmp";  // one per process:
                                                                                                   // two writers never share it
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      throw std::runtime_error("cannot write '" + tmp + "': " + std::strerror(errno));
+  {  // write(2) itself, for the system's reason when it fails (a full disk: "No space left on device")
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error("cannot write '" + tmp + "': " + std::strerror(errno));
+    std::size_t done = 0;
+    while (done < text.size()) {
+      const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const std::string reason = n < 0 ? std::strerror(errno) : "nothing written";
+        ::close(fd);
+        std::remove(tmp.c_str());
+        throw std::runtime_error("cannot write '" + tmp + "': " + reason);
+      }
+      done += static_cast<std::size_t>(n);
     }
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write '" + tmp + "': write failed");
+    if (::close(fd) != 0) {
+      const std::string reason = std::strerror(errno);
+      std::remove(tmp.c_str());
+      throw std::runtime_error("cannot write '" + tmp + "': " + reason);
+    }
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string reason = std::strerror(errno);

@@ -9,8 +9,10 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
@@ -151,14 +153,19 @@ void write_file(const std::string& path, mechanics::Simulation<Dim>& sim, const 
     ckpt::write_marks(root, f.get(), tmp, marks);
     if (extra) extra(root);
     check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush the checkpoint");
+    void* handle = nullptr;  // durable before it takes the name (issue 34)
+    check(H5Fget_vfd_handle(f.get(), H5P_DEFAULT, &handle), tmp, "cannot get the checkpoint's descriptor");
+    if (handle != nullptr && ::fsync(*static_cast<int*>(handle)) != 0)
+      throw std::runtime_error("checkpoint '" + tmp + "': cannot make it durable (fsync: " + std::strerror(errno) + ")");
   } catch (...) {
     std::remove(tmp.c_str());
     throw;
   }
   // POSIX rename replaces `path` atomically: a reader sees the old or the new checkpoint, never half.
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
     std::remove(tmp.c_str());
-    throw std::runtime_error("checkpoint '" + path + "': cannot rename '" + tmp + "' over it");
+    throw std::runtime_error("checkpoint '" + path + "': cannot rename '" + tmp + "' over it: " + reason);
   }
 }
 
@@ -287,6 +294,7 @@ CheckpointMarks checkpoint_marks(const std::string& path) {
   r("marks/series_rows", m.series_rows);
   r("marks/snapshots", m.snapshots);
   r("marks/end_of_loading", m.end_of_loading);
+  if (H5Lexists(f.get(), "marks/run_id", H5P_DEFAULT) > 0) m.run_id = read_text(f.get(), path, "marks/run_id");
   const std::string names = read_text(f.get(), path, "marks/table_names");
   std::vector<long> rows;
   r("marks/table_rows", rows);
@@ -362,6 +370,7 @@ void ckpt::write_marks(const Writer& w, hid_t f, const std::string& file, Checkp
     rows.push_back(n);
   }
   write_text(f, file, "marks/table_names", names);
+  write_text(f, file, "marks/run_id", m.run_id);
   w("marks/table_rows", rows);
 }
 

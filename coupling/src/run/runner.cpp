@@ -23,6 +23,7 @@
 #include <iostream>
 #include <limits>
 #include <optional>
+#include <random>
 
 namespace frictherm::coupling {
 
@@ -38,6 +39,14 @@ bool show_progress(const RunOptions& o) {
   return isatty(STDERR_FILENO) != 0;
 }
 
+// 128 random bits in hex: a result's identity (RunOptions::run_id).
+std::string fresh_run_id() {
+  std::random_device device;
+  char text[33];
+  for (int k = 0; k < 4; ++k) std::snprintf(text + 8 * k, 9, "%08x", static_cast<unsigned>(device()));
+  return text;
+}
+
 template <int Dim>
 class Run {
  public:
@@ -48,6 +57,8 @@ class Run {
     const detail::InterruptGuard interrupt_guard(o_.handle_signals);  // before the file exists
     r_.output = o_.output.empty() ? s_.output.file : o_.output;
     check_output_files();  // before anything is built: refusals cost nothing
+    const OutputClaim claim(r_.output);  // a second run on this output is refused before it writes
+    check_output_files();  // again under the claim: another run may have published meanwhile
     sim_ = build_simulation<Dim>(s_);
     if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);  // thermal hook
     const int threads = o_.threads > 0 ? o_.threads : s_.threads;
@@ -61,6 +72,7 @@ class Run {
     r_.particles = sim_->particles().size();
     check_checkpoints();
     if (!o_.resume_checkpoint.empty()) restore();
+    run_id_ = !o_.run_id.empty() ? o_.run_id : !base_marks_.run_id.empty() ? base_marks_.run_id : fresh_run_id();
     H5Output out = open_output();
     out_ = &out;
     std::ostream& log = o_.log ? *o_.log : std::cerr;
@@ -73,6 +85,7 @@ class Run {
     if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) write_microstructure_images(out);
     try {
       detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
+      out.write_metadata("run_id", run_id_);
       std::vector<std::string> series_columns = detail::series_names(Dim);
       detail::append_body_series_names<Dim>(series_columns, *sim_);
       detail::append_contact_series_names<Dim>(series_columns, *sim_);
@@ -115,33 +128,47 @@ class Run {
                  format_number(sim_->time()) + " s: " + e.what());
       }
     }
-    if (r_.status == RunResult::Status::interrupted) {
+    if (r_.status == RunResult::Status::interrupted)
       r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " +
                    std::to_string(sim_->step_count()) + ", t = " + format_number(sim_->time()) + " s";
-      out.write_metadata("interruption", r_.message);
-    }
     if (r_.status == RunResult::Status::stopped_at_max_steps && !o_.quiet)
       log << "frictherm: note: stopped at run.max_steps = " << s_.max_steps << " (t = " << sim_->time()
           << " s of end_time " << s_.end_time << " s)\n";
     r_.steps = sim_->step_count();
     r_.time = sim_->time();
     r_.wall_time = seconds_since(t0);
-    record_phase_seconds(out);
-    if (checkpoints_written_ > 0) {
-      out.write_metadata("checkpoints_written", checkpoints_written_);
-      out.write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, all checkpoints of this run
-    }
     r_.snapshots = out.snapshot_count();
     r_.series_rows = out.series_rows();
     const char* status = r_.status == RunResult::Status::failed                 ? "failed"
                          : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
                          : r_.status == RunResult::Status::interrupted          ? "interrupted"
                                                                                 : "completed";
-    if (thermal_) thermal_->write_metadata(out, *sim_);  // thermal hook: integrator statistics, energy books
-    out.write_metadata("status", status);
-    out.write_metadata("steps", r_.steps);
-    out.write_metadata("final_time", r_.time);
-    out.write_metadata("wall_time", r_.wall_time);
+    // The last writes. A write that fails here or failed while the run was ended (a full disk) leaves
+    // the result unpublished under its temporary name, its status `running`: never under its name
+    // with status `running` (issue 34), and the first reason is the one reported.
+    try {
+      if (!write_error_.empty()) throw std::runtime_error(write_error_);
+      if (r_.status == RunResult::Status::interrupted) out.write_metadata("interruption", r_.message);
+      record_phase_seconds(out);
+      if (checkpoints_written_ > 0) {
+        out.write_metadata("checkpoints_written", checkpoints_written_);
+        out.write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, all checkpoints of this run
+      }
+      if (thermal_) thermal_->write_metadata(out, *sim_);  // thermal hook: integrator statistics, energy books
+      out.write_metadata("status", status);
+      out.write_metadata("steps", r_.steps);
+      out.write_metadata("final_time", r_.time);
+      out.write_metadata("wall_time", r_.wall_time);
+      out.sync();  // before the name: the published result is on disk
+    } catch (const std::exception& e) {
+      const std::string live = out.live_path();
+      out_ = nullptr;
+      out.abandon();
+      throw std::runtime_error((r_.status == RunResult::Status::failed ? r_.message + "; then " : std::string()) +
+                               "writing the result failed at step " + std::to_string(r_.steps) + ", t = " +
+                               format_number(r_.time) + " s: " + e.what() + "; what was written stays in " + live +
+                               " (status running), not published as " + r_.output);
+    }
     out_ = nullptr;
     try {
       out.close();  // renames "<output>.<pid>.part" onto the output
@@ -168,8 +195,14 @@ class Run {
     } catch (const std::exception& e) {
       r_.message += std::string(" (the failing state was not written: ") + e.what() + ")";
     }
-    out_->write_metadata("failure", r_.message);
+    try {
+      out_->write_metadata("failure", r_.message);
+    } catch (const std::exception& e) {  // the end of execute() says that the result is incomplete
+      if (write_error_.empty()) write_error_ = e.what();
+    }
   }
+
+  std::string write_error_;  // the first write that failed while the run was being ended
 
   // RunResult::phase_seconds, also written to /meta as time_<phase>.
   void record_phase_seconds(H5Output& out) {
@@ -209,6 +242,7 @@ class Run {
   // The output, its XDMF file and generated images never land on a file this run reads; an existing
   // output is replaced only when asked (RunOptions::overwrite, output.overwrite).
   void check_output_files() const {
+    check_output_folder(r_.output, o_.output.empty() ? "output.file" : "output file");
     std::vector<std::string> inputs = scene_input_files(s_);
     if (!o_.resume_checkpoint.empty()) inputs.push_back(o_.resume_checkpoint);
     check_output_path(r_.output, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
@@ -325,7 +359,12 @@ class Run {
     } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
-    if (o_.resume_appends) base_marks_ = checkpoint_marks(o_.resume_checkpoint);
+    base_marks_ = checkpoint_marks(o_.resume_checkpoint);
+    if (!o_.resume_appends) {  // the output starts at the checkpoint: rows count from 0
+      const std::string id = base_marks_.run_id;
+      base_marks_ = CheckpointMarks{};
+      base_marks_.run_id = id;
+    }
   }
 
   // Rows and snapshots of the result at this state, counted from the result this output is appended to.
@@ -342,12 +381,13 @@ class Run {
       m.table_rows.emplace_back(t, base + static_cast<long>(out_->table_rows(t)));
     }
     m.end_of_loading = end_of_loading;
+    m.run_id = run_id_;
     return m;
   }
 
   void checkpoint(bool end_of_loading = false) {
     const Clock::time_point c0 = Clock::now();
-    out_->flush();  // the rows the marks count are in the file
+    out_->sync();  // the rows the marks count are in the file and durable before the checkpoint is (issue 34)
     write_checkpoint(checkpoint_file(), *sim_, s_, marks(end_of_loading),
                      [&](const ckpt::Writer& w) { visit_run_state(w); });
     last_checkpoint_ = Clock::now();
@@ -413,6 +453,7 @@ class Run {
   bool checkpoints_ = false;
   bool continuation_started_ = false;
   CheckpointMarks base_marks_;  // resume_appends: the result's rows and snapshots at the checkpoint
+  std::string run_id_;          // /meta/run_id and every checkpoint's marks
   double checkpoint_seconds_ = 0.0;
   long checkpoints_written_ = 0;
   double next_checkpoint_ = 0.0;                      // simulated time of the next checkpoint

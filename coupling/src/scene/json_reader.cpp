@@ -180,12 +180,25 @@ void JsonReader::set_key_table_observer(KeyTableObserver observer) { key_table_o
 
 std::vector<std::string> JsonReader::keys() const {
   require_object();
-  map_ = true;
   std::vector<std::string> out;
-  for (auto it = value_->begin(); it != value_->end(); ++it) {
-    out.push_back(it.key());
-    mark(it.key());
+  for (auto it = value_->begin(); it != value_->end(); ++it) out.push_back(it.key());
+  // Every key counts as known. Keys of an object are unique (json_text refuses duplicates): once
+  // per key, not a search of the known keys per key (issue 34: 50,000 materials took 12 s).
+  if (known_.empty() && !map_) {
+    known_ = out;
+  } else {
+    for (const std::string& k : out) mark(k);
   }
+  map_ = true;
+  return out;
+}
+
+std::vector<std::pair<std::string, JsonReader>> JsonReader::members() const {
+  const std::vector<std::string> names = keys();
+  std::vector<std::pair<std::string, JsonReader>> out;
+  out.reserve(names.size());
+  std::size_t k = 0;
+  for (auto it = value_->begin(); it != value_->end(); ++it, ++k) out.emplace_back(names[k], JsonReader(it.value(), member_path(names[k])));
   return out;
 }
 
@@ -194,6 +207,7 @@ void JsonReader::require_object() const {
 }
 
 void JsonReader::mark(const std::string& key) const {
+  if (map_) return;  // keys() made every key known; finish() checks none
   if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
 }
 
@@ -262,6 +276,7 @@ std::vector<double> JsonReader::vector(const std::string& key, std::size_t n, co
 void JsonReader::finish() const {
   require_object();
   if (key_table_observer()) key_table_observer()(path_, known_, map_);
+  if (map_) return;  // keys() made every key known
   for (auto it = value_->begin(); it != value_->end(); ++it) {
     if (std::find(known_.begin(), known_.end(), it.key()) != known_.end()) continue;
     std::string allowed;

@@ -63,29 +63,37 @@ std::string line_column(const std::string& text, std::size_t end) {
   return "line " + std::to_string(line) + ", column " + std::to_string(column);
 }
 
-class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
-  using Base = nlohmann::detail::json_sax_dom_parser<Json>;
-
+// Builds the document itself rather than through nlohmann's json_sax_dom_parser, whose key() looks
+// the key up in the ordered object (a linear search: 50,000 materials took 12 s, issue 34); the
+// duplicate check below is a set lookup, so a key is appended without a search.
+class SceneSax {
  public:
-  SceneSax(Json& document, const std::string& text, const char** furthest, std::string root_path)
-      : Base(document, true), text_(text), furthest_(furthest), root_path_(std::move(root_path)) {}
+  using number_integer_t = Json::number_integer_t;
+  using number_unsigned_t = Json::number_unsigned_t;
+  using number_float_t = Json::number_float_t;
+  using string_t = Json::string_t;
+  using binary_t = Json::binary_t;
 
-  bool null() { return value(), Base::null(); }
-  bool boolean(bool v) { return value(), Base::boolean(v); }
-  bool number_integer(number_integer_t v) { return value(), Base::number_integer(v); }
-  bool number_unsigned(number_unsigned_t v) { return value(), Base::number_unsigned(v); }
-  bool number_float(number_float_t v, const string_t& s) { return value(), Base::number_float(v, s); }
+  SceneSax(Json& document, const std::string& text, const char** furthest, std::string root_path)
+      : root_(document), text_(text), furthest_(furthest), root_path_(std::move(root_path)) {}
+
+  bool null() { return value(), put(Json(nullptr)); }
+  bool boolean(bool v) { return value(), put(Json(v)); }
+  bool number_integer(number_integer_t v) { return value(), put(Json(v)); }
+  bool number_unsigned(number_unsigned_t v) { return value(), put(Json(v)); }
+  bool number_float(number_float_t v, const string_t&) { return value(), put(Json(v)); }
   bool string(string_t& v) {
     value();
     if (v.size() > kMaxStringLength)
       fail(named_path() + ": a string of " + std::to_string(v.size()) + " characters at " + here() + "; expected at most " +
            std::to_string(kMaxStringLength));
-    return Base::string(v);
+    return put(Json(std::move(v)));
   }
-  bool binary(binary_t& v) { return value(), Base::binary(v); }
-  bool start_object(std::size_t n) {
+  bool binary(binary_t&) { return false; }  // not in JSON text
+  bool start_object(std::size_t) {
     open(true);
-    return Base::start_object(n);
+    stack_.push_back(place(Json(Json::value_t::object)));
+    return true;
   }
   bool key(string_t& k) {
     Frame& f = frames_.back();
@@ -96,19 +104,25 @@ class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
     f.key = k;
     if (!f.keys.insert(k).second)
       fail(path() + ": duplicate key '" + k + "' at " + here() + " (a key may appear once in an object)");
-    return Base::key(k);
+    auto& members = static_cast<Json::object_t::Container&>(stack_.back()->get_ref<Json::object_t&>());
+    members.emplace_back(k, Json());
+    member_ = &members.back().second;
+    return true;
   }
   bool end_object() {
     frames_.pop_back();
-    return Base::end_object();
+    stack_.pop_back();
+    return true;
   }
-  bool start_array(std::size_t n) {
+  bool start_array(std::size_t) {
     open(false);
-    return Base::start_array(n);
+    stack_.push_back(place(Json(Json::value_t::array)));
+    return true;
   }
   bool end_array() {
     frames_.pop_back();
-    return Base::end_array();
+    stack_.pop_back();
+    return true;
   }
   template <class Exception>
   bool parse_error(std::size_t position, const std::string& token, const Exception& ex) {
@@ -173,6 +187,29 @@ class SceneSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   }
   [[noreturn]] void fail(const std::string& message) const { throw SceneError(message); }
 
+  // The new value: the document, the next element of the open array or the member of the last key.
+  Json* place(Json&& v) {
+    if (stack_.empty()) {
+      root_ = std::move(v);
+      return &root_;
+    }
+    Json& top = *stack_.back();
+    if (top.is_array()) {
+      auto& elements = top.get_ref<Json::array_t&>();
+      elements.push_back(std::move(v));
+      return &elements.back();
+    }
+    *member_ = std::move(v);
+    return member_;
+  }
+  bool put(Json&& v) {
+    place(std::move(v));
+    return true;
+  }
+
+  Json& root_;
+  std::vector<Json*> stack_;  // the open objects and arrays
+  Json* member_ = nullptr;    // the value of the last key
   const std::string& text_;
   const char** furthest_;
   std::string root_path_;

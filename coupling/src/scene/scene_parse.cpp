@@ -132,10 +132,9 @@ mechanics::Material parse_material(const JsonReader& m, const std::string& name,
 
 void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
   const JsonReader mats = root.at("materials", "an object mapping material names to their properties");
-  const auto names = mats.keys();
-  if (names.empty()) mats.expected("at least one material");
-  for (const std::string& name : names) {
-    const JsonReader m = mats.at(name);
+  const auto members = mats.members();
+  if (members.empty()) mats.expected("at least one material");
+  for (const auto& [name, m] : members) {
     detail::check_result_name(m, name, "material");
     if (!m.is_object()) m.expected("an object with the material's type and properties");
     s.materials.push_back(parse_material(m, name, s));
@@ -191,9 +190,14 @@ void parse_solver(const JsonReader& root, Scene& s) {  // after the contact sect
   solver->finish();
 }
 
+constexpr double kMinEndTime = 1e-290;  // s: end_time / 10^6 stays a normal double
+
 void parse_run(const JsonReader& root, Scene& s) {
   const JsonReader run = root.at("run", "an object with at least end_time (s)");
   s.end_time = run.number("end_time", Range::positive());
+  // The default intervals are end_time / 20 and / 5000, snapshot_count divides it by up to 10^6:
+  // 5e-324 s made them 0 and the refusal blamed snapshot_interval (issue 34).
+  if (s.end_time < kMinEndTime) run.at("end_time").expected("a time of at least " + format_number(kMinEndTime) + " s");
   s.max_steps = run.integer("max_steps", 0, 1, std::numeric_limits<long>::max());
   s.threads = static_cast<int>(run.integer("threads", 0, 1, 1024));
   if (run.has("checkpoint_interval")) s.checkpoint_interval = run.number("checkpoint_interval", Range::positive());

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace frictherm::coupling {
 
@@ -19,7 +20,9 @@ void parse_integrator(const JsonReader& t, ThermalSceneSpec& spec) {
   names.insert(names.begin(), "auto");  // coupler.hpp: matrix-free forward Euler or cvode_bdf by window
   c.integrator = t.choice("integrator", names, "auto");
   const bool explicit_allowed = c.integrator == "forward_euler" || c.integrator == "auto";
-  o.rtol = t.number("rtol", o.rtol, Range::open(0.0, 1.0));
+  // CVODE refuses a tolerance near the unit round-off ("too much accuracy requested" once
+  // 2.2e-16 / rtol > 1): at least 1e-14 (issue 34: rtol 1e-300 failed the run).
+  o.rtol = t.number("rtol", o.rtol, Range{1e-14, 1.0, false, true});
   o.atol = t.number("atol", o.atol, Range::positive());
   o.max_steps = t.integer("max_steps", o.max_steps, 1, std::numeric_limits<int>::max());
   if (const auto ls = t.find("linear_solver")) {
@@ -63,26 +66,29 @@ constexpr double kDefaultTaylorQuinney = 0.9;  // the classical fraction for met
 void parse_materials(const JsonReader& t, ThermalSceneSpec& spec, const std::vector<mechanics::Material>& mats,
                      std::optional<JsonReader>& taylor_quinney_key) {
   std::vector<std::string> names;
-  for (const auto& m : mats) names.push_back(m.name);
+  std::unordered_map<std::string, std::size_t> index;  // a name's material id (a lookup, not a search)
+  for (const auto& m : mats) {
+    index.emplace(m.name, names.size());
+    names.push_back(m.name);
+  }
   spec.coupler.materials.assign(mats.size(), ThermalProperties{});
   spec.coupler.plastic.taylor_quinney.assign(mats.size(), 0.0);
   const JsonReader table =
       t.at("materials", "an object mapping material names to {\"heat_capacity\": J/(kg K), \"conductivity\": W/(m K)}");
-  for (const std::string& name : table.keys()) {
-    const JsonReader m = table.at(name);
-    const auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) {
+  for (const auto& [name, m] : table.members()) {
+    const auto found = index.find(name);
+    if (found == index.end()) {
       std::string known;
       for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
       m.fail("no material of this name in \"materials\" (defined: " + known + ")");
     }
     if (!m.is_object()) m.expected("an object with heat_capacity and conductivity");
-    ThermalProperties& p = spec.coupler.materials[static_cast<std::size_t>(it - names.begin())];
+    ThermalProperties& p = spec.coupler.materials[found->second];
     p.conducts = true;
     p.heat_capacity = m.number("heat_capacity", Range::positive());
     p.conductivity = m.number("conductivity", Range::non_negative());
     if (const auto tq = m.find("taylor_quinney"); tq && !taylor_quinney_key) taylor_quinney_key = tq;
-    spec.coupler.plastic.taylor_quinney[static_cast<std::size_t>(it - names.begin())] =
+    spec.coupler.plastic.taylor_quinney[found->second] =
         m.number("taylor_quinney", kDefaultTaylorQuinney, Range::closed(0.0, 1.0));
     m.finish();
   }
@@ -257,7 +263,9 @@ ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
   spec.heating_order = c->choice("heating_order", {"first", "second"}, "second") == "first" ? HeatingOrder::first
                                                                                            : HeatingOrder::second;
   if (const auto cont = c->find("continuation")) {
-    spec.continuation_duration = cont->number("duration", Range::positive());
+    // At most 1e12 s (~32,000 years): 1e20 s exhausted CVODE's steps in a window and 1e300 s failed its
+    // corrector (the run failed; issue 34), 1e12 s completes.
+    spec.continuation_duration = cont->number("duration", Range::left_open(0.0, 1e12));
     spec.continuation_intervals = cont->integer("intervals", spec.continuation_intervals, 1, 100000);  // (10^5: as snapshots)
     spec.stop_when_decided = cont->find("stop_when_decided") && cont->at("stop_when_decided").as_bool();
     cont->finish();

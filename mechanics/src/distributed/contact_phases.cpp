@@ -107,6 +107,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
   constexpr int mass_position = Dof::mass_position, domain = Dof::domain, domain_gradient = Dof::domain_gradient;
   if (updated) stats = DecomposedContactStats{};
+  if (!updated) contact_failure.clear();  // phase 6 opens the step's contact
   if (contact_nodes.empty()) return;
   const ContactOptions& co = opt.contact_options;
   const std::size_t n = materials.size();
@@ -157,6 +158,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
       if (sides.size() > 2) ++stats.multi_nodes;
     }
     const std::size_t uq = q;
+    try {
     contact_detail::resolve_contact_node(
         sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
         [&](std::size_t j, const Vec<Dim>& dp) {
@@ -174,6 +176,18 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
           cumulative_second += w2;
         },
         stats.sliding_nodes);
+    } catch (const std::exception& e) {  // kept, not thrown: the other ranks would wait in the next collective
+      if (!contact_failure.empty()) continue;
+      const auto* pe = dynamic_cast<const contact_detail::ContactPairError*>(&e);
+      if (pe && pe->material_a >= 0 && pe->material_b >= 0) {
+        const std::string& origin = pair_of(pe->material_a, pe->material_b).origin;
+        contact_failure = (origin.empty() ? std::string("contact") : origin) + " (materials '" +
+                          materials[static_cast<std::size_t>(pe->material_a)].name + "' and '" +
+                          materials[static_cast<std::size_t>(pe->material_b)].name + "'): " + e.what();
+      } else {
+        contact_failure = std::string("contact: ") + e.what();
+      }
+    }
   }
 }
 
@@ -187,6 +201,11 @@ double DecomposedMpm<Dim>::cumulative_frictional_work(HeatingOrder order) const 
   double w = order == HeatingOrder::first ? impl_->cumulative_first : impl_->cumulative_second;
   MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
   return w;
+}
+
+template <int Dim>
+const std::string& DecomposedMpm<Dim>::contact_failure() const {
+  return impl_->contact_failure;
 }
 
 template <int Dim>
@@ -205,7 +224,8 @@ DecomposedContactStats DecomposedMpm<Dim>::contact_stats() const {
   template void DecomposedMpm<D>::Impl::resolve_contact(bool, double);                  \
   template const std::vector<double>& DecomposedMpm<D>::frictional_work(HeatingOrder) const; \
   template double DecomposedMpm<D>::cumulative_frictional_work(HeatingOrder) const;     \
-  template DecomposedContactStats DecomposedMpm<D>::contact_stats() const;
+  template DecomposedContactStats DecomposedMpm<D>::contact_stats() const;               \
+  template const std::string& DecomposedMpm<D>::contact_failure() const;
 FRICTHERM_INSTANTIATE_CONTACT(2)
 FRICTHERM_INSTANTIATE_CONTACT(3)
 #undef FRICTHERM_INSTANTIATE_CONTACT

@@ -218,6 +218,10 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<double> work_first, work_second;
   double cumulative_first = 0.0, cumulative_second = 0.0;
   DecomposedContactStats stats;
+  // The first friction law that threw in this step's contact phases on this rank ("" if none): the
+  // step goes on at every rank (that node's contact as far as it got) and the run loop agrees on the
+  // failure after it (issue 34: one rank's exception had left the others waiting in a collective).
+  std::string contact_failure;
   int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
   Stencils current;                      // current_stencils(), valid until the next step or add
   bool current_valid = false;

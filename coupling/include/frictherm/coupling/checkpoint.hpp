@@ -32,6 +32,9 @@ struct CheckpointMarks {
   long snapshots = 0;
   std::vector<std::pair<std::string, long>> table_rows;  // /hotspots, /hotspot_fates, ...
   bool end_of_loading = false;  // taken after the last mechanics step, before the thermal continuation
+  /// The result this checkpoint belongs to: /meta/run_id of the result (issue 34). A run draws a
+  /// fresh one; resume and continue keep their checkpoint's. Empty in checkpoints of older versions.
+  std::string run_id;
 };
 
 /// Writes the state of `sim` (finalized first if it is not), the scene's text, source path and --set

@@ -14,7 +14,8 @@ namespace frictherm::coupling {
 void write_series_csv(const SeriesTable& table, std::ostream& out);
 
 /// read_series + write_series_csv. A run without series writes nothing. Throws
-/// std::runtime_error naming the file on an HDF5 failure or when `out` fails.
+/// std::runtime_error naming the file on an HDF5 failure, when `out` fails, and for a file that is
+/// not HDF5, a checkpoint or another program's HDF5 file (issue 34: they had given nothing, exit 0).
 void export_series_csv(const std::string& h5_path, std::ostream& out);
 
 }  // namespace frictherm::coupling

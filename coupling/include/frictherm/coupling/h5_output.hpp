@@ -32,7 +32,8 @@ namespace frictherm::coupling {
 struct H5OutputOptions {
   /// Series rows kept in memory before they are written (and the file flushed).
   std::size_t series_batch_rows = 64;
-  /// Write RUN.xdmf beside RUN.h5 (rewritten after every ended snapshot).
+  /// Write RUN.xdmf beside RUN.h5 (rewritten after every ended snapshot; with via_temporary written
+  /// once, with the result in close(), so that it never describes another file than the one named).
   bool write_xdmf = true;
   /// Write the file under a temporary name in the same folder ("<path>.<pid>.part", created
   /// exclusively, never truncating another file) and rename it onto `path` in close() (issue 15:
@@ -120,6 +121,12 @@ class H5Output {
 
   /// Writes buffered series rows and flushes the file to the operating system.
   void flush();
+  /// flush() and then fsync(2): the rows and snapshots written so far are durable (a checkpoint that
+  /// counts them is written after this). Throws std::runtime_error with the system's reason.
+  void sync();
+  /// Closes the file without writing anything more and without publishing it: after a write failed
+  /// (a full disk), what was written stays under live_path(). Further calls throw std::logic_error.
+  void abandon() noexcept;
   /// Flushes, rewrites the XDMF file and closes the file. Further calls throw std::logic_error.
   void close();
 

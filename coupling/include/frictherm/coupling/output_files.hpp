@@ -33,4 +33,33 @@ std::string temporary_path(const std::string& path);
 /// std::runtime_error says that the result stays under `temporary`.
 void publish_file(const std::string& temporary, const std::string& path, bool overwrite);
 
+/// The result `path` can be created: its folder exists and is a folder, and `path` is not a folder.
+/// Else OutputError "<what>: ..." (`what`: the scene key output.file, or the option -o) naming the
+/// path (issue 34: `validate` accepted both, `run` then named its temporary file).
+void check_output_folder(const std::string& path, const std::string& what);
+
+/// publish_file for a result with its XDMF files (`xdmf` for xdmf_path_for(path), `reference_xdmf`
+/// for xdmf_reference_path_for(path); an empty text: none). Both are written completely first;
+/// replacing, the earlier result's XDMF files are removed before the result takes the name; then
+/// they take theirs. Whenever the process is killed, an XDMF file beside a result describes that
+/// result, or there is none (issue 34).
+void publish_with_xdmf(const std::string& temporary, const std::string& path, bool overwrite, const std::string& xdmf,
+                       const std::string& reference_xdmf);
+
+/// The output claimed for one run (issue 34): an advisory lock (flock) on "<output>.lock", held until
+/// destruction, so a second run on the same output is refused (OutputError naming the output) before
+/// it writes anything, not at publication after it had replaced the XDMF and checkpoint. The kernel
+/// drops the lock when the process ends, killed or not; a leftover lock file claims nothing.
+class OutputClaim {
+ public:
+  explicit OutputClaim(const std::string& output);
+  ~OutputClaim();
+  OutputClaim(const OutputClaim&) = delete;
+  OutputClaim& operator=(const OutputClaim&) = delete;
+
+ private:
+  std::string lock_path_;
+  int fd_ = -1;
+};
+
 }  // namespace frictherm::coupling

@@ -24,7 +24,9 @@ void append_result(const std::string& original, const std::string& continuation,
 /// resume checks it before running, so a damaged result costs no run time.
 void check_appendable(const std::string& original, const CheckpointMarks& marks);
 
-/// The XDMF document of every snapshot (and /failure) in `h5_path`, pointing at `h5_name`.
-std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name);
+/// The XDMF document of every snapshot (and /failure) in `h5_path`, pointing at `h5_name`, drawn at
+/// `geometry`: "position", or "initial_position" for RUN_reference.xdmf ("" when no snapshot has it).
+std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name,
+                           const std::string& geometry = "position");
 
 }  // namespace frictherm::coupling

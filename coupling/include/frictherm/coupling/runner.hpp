@@ -90,6 +90,10 @@ struct RunOptions {
   /// Where checkpoints go; empty: "<output>.checkpoint". May be resume_checkpoint itself (a resumed
   /// run goes on replacing the checkpoint it started from, atomically).
   std::string checkpoint_file;
+  /// The result's identity, /meta/run_id, also stored in every checkpoint it writes (issue 34: a
+  /// resume refuses a checkpoint of another result). Empty: the resumed checkpoint's, else a fresh
+  /// random one.
+  std::string run_id;
   /// Called after every mechanics step (not during the thermal-only continuation), after the step's
   /// heat handoff and series row, so diagnostics need no copy of the run loop. An exception thrown
   /// by the observer ends the run and propagates out of run_scene once the result is published (status

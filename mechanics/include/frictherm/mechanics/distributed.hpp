@@ -240,6 +240,10 @@ class DecomposedMpm {
   double cumulative_frictional_work(HeatingOrder order) const;
   /// Collective: the last step's contact counters summed over ranks.
   DecomposedContactStats contact_stats() const;
+  /// Not collective: the first friction law that threw during the last step's contact on this rank
+  /// (its message naming the pair's scene key and the state), "" if none. The step went on at every
+  /// rank (that node's contact as far as it got); the caller agrees on it and ends the run.
+  const std::string& contact_failure() const;
   /// Collective: every particle of every rank, sorted by id, on every rank.
   std::vector<Particle> gather() const;
   /// Collective: the largest stable step over all ranks, C min(h) / max_p (c_p + |v_p|) (Nairn 2018
