@@ -8,7 +8,8 @@
                            observer=lambda s: print(s.step, s.time, s.kinetic_energy))
 
 Built with the C++ library when CMake finds pybind11 (Debian pybind11-dev): the module lives in the
-build tree (build/python/frictherm) and in the CMake install, not in a `pip install ./python`.
+build tree (build/python/frictherm) and in the CMake install; `pip install ./python` copies it into the
+environment when it finds it (FRICTHERM_BUILD_DIR, python/setup.py, docs/python.md "Installing").
 """
 import json
 import os
@@ -23,8 +24,8 @@ except ImportError as e:  # the reader works without the bindings
 def _need_native():
     if _native is None:
         raise ImportError("frictherm was installed without its compiled part (frictherm/_native): build frictherm with "
-                          f"CMake and pybind11 (Debian pybind11-dev) and use build/python or the CMake install "
-                          f"({_IMPORT_ERROR})")
+                          f"CMake and pybind11 (Debian pybind11-dev) and use build/python, the CMake install, or "
+                          f"FRICTHERM_BUILD_DIR=<build> pip install ./python ({_IMPORT_ERROR})")
     return _native
 
 
@@ -100,7 +101,8 @@ def validate(scene):
 def run(scene, output, threads=1, observer=None, overwrite=True, every=1):
     """Runs the scene to its end time, writing `output` (HDF5, as `frictherm run -o`). `observer`,
     if given, is called every `every` mechanics steps with a Step: ``step``, ``time``, ``dt``,
-    ``kinetic_energy``, ``strain_energy`` and ``particles()`` (NumPy views, valid during the call).
+    ``kinetic_energy``, ``strain_energy``, ``series`` (the latest /series row as {column: value};
+    ``series_new``: this step wrote it) and ``particles()`` (NumPy views, valid during the call).
     Ctrl-C (SIGINT, or SIGTERM) ends the run after the current step, writes its series and a last
     snapshot (status ``interrupted``) and raises KeyboardInterrupt; a second Ctrl-C ends the process
     at once, as for the program. The handlers are Python's again after the run. Returns {"status", "output", "steps", "time", "wall_time", "snapshots",

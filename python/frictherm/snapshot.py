@@ -116,6 +116,36 @@ class Snapshot:
         df.attrs.update(units=units, time=self.time, step=self.step)
         return df
 
+    @property
+    def has_nodes(self):
+        """True when the file holds the thermal grid's nodes at this snapshot (/nodes, runs with heat)."""
+        f = self._group.file
+        return self.index is not None and "nodes" in f and self.label in f["nodes"]
+
+    def nodes(self):
+        """The thermal grid's nodes at this snapshot as a pandas DataFrame, one row per node that is
+        a thermal unknown: position_x, position_y (position_z), temperature (K, the nodal T_i at the
+        snapshot time), heat_capacity (J/K, M_i) and lattice_x, ... (grid node coordinates);
+        ``df.attrs`` as for to_dataframe. KeyError when the file has none (runs without heat,
+        decomposed runs, the failure state)."""
+        import pandas as pd
+        if not self.has_nodes:
+            raise KeyError(f"snapshot {self.label} has no thermal grid nodes (/nodes/{self.label})")
+        g = self._group.file["nodes"][self.label]
+        cols, units = {}, {}
+        for name in g:
+            data = np.asarray(g[name][()])
+            unit = text(g[name].attrs["units"]) if "units" in g[name].attrs else ""
+            if data.ndim == 1:
+                cols[name], units[name] = data, unit
+            else:
+                for i in range(data.shape[1]):
+                    cols[f"{name}_{AXES[i]}"], units[f"{name}_{AXES[i]}"] = data[:, i], unit
+        df = pd.DataFrame(cols)
+        df.index.name = "node"
+        df.attrs.update(units=units, time=self.time, step=self.step)
+        return df
+
     def stress_tensor(self):
         """The Cauchy stress as (n, 3, 3); in 2D the out-of-plane stress_zz when stored (plane
         strain), else 0 (plane stress)."""

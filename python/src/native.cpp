@@ -8,6 +8,7 @@
 //     status `interrupted`, and native.py then raises KeyboardInterrupt; the handlers are restored after.
 //   * Particle arrays handed to the observer are NumPy views of the simulation's own arrays,
 //     read-only and valid only during that call (copy them to keep them).
+#include <frictherm/coupling/h5_output.hpp>
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
@@ -16,6 +17,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -67,8 +69,25 @@ py::dict particle_views(const mechanics::Simulation<Dim>& sim, py::handle owner)
 struct Step {
   long step;
   double time, dt, kinetic_energy, strain_energy;
+  py::dict series;  // the latest /series row, column -> value (int for count columns, as in the file)
+  bool series_new;  // this step wrote it
   const coupling::StepView* view;
 };
+
+// StepView::series_row as a dict in column order; count columns (stored as int64) as Python ints.
+py::dict series_dict(const coupling::StepView& v) {
+  py::dict d;
+  const auto& names = v.series_columns();
+  const auto& row = v.series_row();
+  if (row.size() != names.size()) return d;  // no row yet (a resumed run before its first one)
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    if (coupling::H5Output::is_count_column(names[j]))
+      d[py::str(names[j])] = py::int_(static_cast<long long>(std::llround(row[j])));
+    else
+      d[py::str(names[j])] = py::float_(row[j]);
+  }
+  return d;
+}
 
 }  // namespace
 
@@ -82,6 +101,11 @@ PYBIND11_MODULE(_native, m) {
       .def_readonly("dt", &Step::dt)
       .def_readonly("kinetic_energy", &Step::kinetic_energy)
       .def_readonly("strain_energy", &Step::strain_energy)
+      .def_readonly("series", &Step::series,
+                    "the latest series row as {column: value}, the row written to the file's /series "
+                    "(units: frictherm.open(...).unit_of(column)); empty before a resumed run's first row")
+      .def_readonly("series_new", &Step::series_new, "True when this step wrote `series` (rows come every "
+                    "output.series_interval)")
       .def(
           "particles",
           [](py::object self) {
@@ -122,7 +146,8 @@ PYBIND11_MODULE(_native, m) {
       if (every > 1 && v.step() % every != 0) return;
       if (!has_observer) return;
       py::gil_scoped_acquire gil;
-      py::object step = py::cast(Step{v.step(), v.time(), v.dt(), v.kinetic_energy(), v.strain_energy(), &v});
+      py::object step = py::cast(Step{v.step(), v.time(), v.dt(), v.kinetic_energy(), v.strain_energy(),
+                                      series_dict(v), v.series_row_is_new(), &v});
       observer(step);
       step.cast<Step&>().view = nullptr;  // a kept Step object no longer reaches the simulation
     };

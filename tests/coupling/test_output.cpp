@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -374,6 +375,52 @@ TEST(Output, FailureDiscardsUnfinishedSnapshotAndMisuseIsReported) {
   const File f(path);
   EXPECT_TRUE(links(f.id, "/snapshots").empty());
   EXPECT_EQ(shape(f.id, "/failure/position"), (std::vector<hsize_t>{3, 2}));
+}
+
+// The thermal grid's nodes (node_field): /nodes/<the snapshot's number> with step and time, only with an
+// ended snapshot (an unfinished one leaves neither), refused for the failure state and for mismatched
+// rows, and drawn by RUN_nodes.xdmf (its own file: RUN.xdmf keeps only the particles).
+TEST(Output, NodeFieldsFollowTheirSnapshot) {
+  const TempDir tmp;
+  const std::string path = tmp.file("nodes.h5");
+  const std::size_t n = 4, m = 5;  // particles, nodes
+  const std::vector<double> x(3 * m, 0.25), t{300.0, 301.0, 302.0, 303.0, 304.0};
+  const std::vector<std::int32_t> lattice(2 * m, 1);
+  {
+    H5Output out(path, 2);
+    for (int k = 0; k < 2; ++k) {
+      out.begin_snapshot(10L * k, 0.5 * k);
+      Particles(n, 2, k).write(out, n, 2);
+      if (k == 1) {  // the first snapshot has no nodes
+        out.node_field("position", x.data(), m, 2);
+        out.node_field("temperature", t.data(), m, 1);
+        out.node_field("lattice", lattice.data(), m, 2);
+        EXPECT_THROW(out.node_field("heat_capacity", t.data(), m - 1, 1), std::invalid_argument);
+        EXPECT_THROW(out.node_field("position", x.data(), m, 3), std::invalid_argument);
+      }
+      out.end_snapshot();
+    }
+    out.begin_snapshot(30, 1.5);  // never ended: its nodes must not appear
+    out.node_field("temperature", t.data(), m, 1);
+    out.begin_failure(31, 1.6, "stopped");
+    EXPECT_THROW(out.node_field("temperature", t.data(), m, 1), std::logic_error);
+    out.end_snapshot();
+  }
+  const File f(path);
+  EXPECT_EQ(links(f.id, "/nodes"), (std::vector<std::string>{"000001"}));
+  EXPECT_EQ(shape(f.id, "/nodes/000001/position"), (std::vector<hsize_t>{m, 2}));
+  EXPECT_EQ(shape(f.id, "/nodes/000001/lattice"), (std::vector<hsize_t>{m, 2}));
+  EXPECT_EQ(read_attr<std::int64_t>(f.id, "/nodes/000001", "step", H5T_NATIVE_INT64), 10);
+  EXPECT_EQ(read_attr<double>(f.id, "/nodes/000001", "time", H5T_NATIVE_DOUBLE), 0.5);
+  EXPECT_EQ(read_string(f.id, "/nodes/000001/temperature", "units"), "K");
+  std::ifstream nodes(frictherm::coupling::xdmf_nodes_path_for(path));
+  const std::string text((std::istreambuf_iterator<char>(nodes)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("nodes.h5:/nodes/000001/temperature"), std::string::npos) << text;
+  EXPECT_NE(text.find("Dimensions=\"5\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">nodes.h5:/xdmf/polyvertex_5"),
+            std::string::npos) << text;
+  std::ifstream particles(frictherm::coupling::xdmf_path_for(path));
+  const std::string ptext((std::istreambuf_iterator<char>(particles)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(ptext.find("/nodes/"), std::string::npos);
 }
 
 TEST(Output, UnwritablePathGivesClearError) {

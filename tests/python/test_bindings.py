@@ -43,10 +43,14 @@ def test_python_run_equals_the_program_run(workdir, cfl):
     """The CFL sweep of the issue: one scene, two CFL factors, each equal to `frictherm run --set`."""
     scene = frictherm.load_scene(SCENE).set("run.end_time", END).set("solver.cfl", cfl)
     seen = []
+    rows = []  # the series rows the observer was handed as new
 
     def observer(step):
         p = step.particles()
         seen.append((step.step, step.time, step.kinetic_energy, float(np.sum(p["mass"] * np.sum(p["velocity"] ** 2, 1)))))
+        if step.series_new:
+            rows.append(step.series)
+        assert step.series["time"] <= step.time  # the latest row, never one of a later step
 
     py_out = os.path.join(workdir, f"py_{cfl}.h5")
     result = frictherm.run(scene, output=py_out, threads=1, observer=observer)
@@ -61,6 +65,14 @@ def test_python_run_equals_the_program_run(workdir, cfl):
     assert [s[0] for s in seen] == list(range(1, len(seen) + 1))
     for _, _, ke, mv2 in seen:
         assert ke == pytest.approx(0.5 * mv2, rel=1e-12)
+    # The observer sees the series rows the file holds (step.series, issue 33 item 1): the file's rows
+    # after the first (t = 0, written before any step), every column, bit for bit and in order.
+    assert len(rows) > 10 and list(rows[-1]) == list(a)
+    with frictherm.open(py_out) as r:
+        for c in a:
+            stored = np.asarray(r.file["series"][c][()])
+            assert [row[c] for row in rows] == stored[1:].tolist(), c
+        assert rows[-1]["time"] == r.series["time"][-1] and rows[-1]["step"] == result["steps"]
 
 
 def test_scene_errors_name_the_key():

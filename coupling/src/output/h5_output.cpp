@@ -18,371 +18,55 @@
 //   until someone runs h5clear. The 1.8 format still has checksummed object headers.
 // * Not covered: a crash inside H5Fflush itself (HDF5 writes are not atomic) and power loss (no
 //   fsync; a killed process loses nothing the kernel already received).
-#include <frictherm/coupling/h5_output.hpp>
+//
+// The series and tables: h5_output_columns.cpp; snapshots and XDMF: h5_output_snapshots.cpp.
+#include "output/h5_output_impl.hpp"
+
 #include <frictherm/coupling/output_files.hpp>
-#include <frictherm/coupling/xdmf.hpp>
-
-#include <hdf5.h>
-
-#include "output/h5_io.hpp"
-#include "output/h5_util.hpp"
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <cmath>
-#include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <iostream>
-#include <limits>
-#include <map>
-#include <set>
 #include <stdexcept>
 #include <utility>
 
 namespace frictherm::coupling {
 namespace {
 
-constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
-
 using h5detail::check;
 using h5detail::check_id;
-using h5detail::fail;
-using h5detail::Handle;
-using h5detail::Quiet;
-using h5detail::Io;
 using h5detail::check_name;
-using h5detail::base_name;
+using h5detail::Handle;
+using h5detail::Io;
+using h5detail::Quiet;
 
 }  // namespace
 
-struct H5Output::Impl {
-  Io io;                   // io.file: the file being written
-  std::string final_path;  // where close() puts it (io.file unless options.via_temporary)
-  std::string xdmf_path;
-  int dim = 2;
-  H5OutputOptions options;
-  Handle file, meta, snapshots, series;
-  H5AC_cache_config_t cache{};
-  int holds = 0;
-  bool closed = false;
-
-  enum class Kind { none, snapshot, failure } kind = Kind::none;
-  Handle group;  // the snapshot being written (anonymous until end_snapshot)
-  long step = 0;
-  double time = 0.0;
-  std::string message;
-  std::size_t points = kNone;
-  std::vector<XdmfField> fields;
-
-  std::size_t count = 0;
-  std::vector<std::string> grid_xml;
-  std::string failure_xml;
-  // RUN_reference.xdmf: the same snapshots drawn at the reference positions X (`initial_position`),
-  // for ParaView's Warp By Vector on `displacement`; written once a snapshot has that field.
-  std::string reference_path;
-  std::vector<std::string> reference_xml;
-  std::string reference_failure_xml;
-  double last_time = -std::numeric_limits<double>::infinity();
-  std::set<std::size_t> connectivity;
-
-  std::vector<std::string> series_names;
-  std::vector<Handle> series_sets;
-  std::vector<double> pending;  // row-major rows not yet written
-  hsize_t series_written = 0;
-
-  // Evictions off while anything is modified between two flushes (see the top of the file).
-  void set_evictions(bool on) {
-    cache.evictions_enabled = on;
-    check(H5Fset_mdc_config(file.get(), &cache), io.file, "cannot configure the metadata cache");
+void H5Output::Impl::metadata(const std::string& key, hid_t type, const void* value, std::size_t bytes) {
+  check_name(key, "metadata");
+  const Scoped held(*this);
+  if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
+    check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
   }
-  void hold() {
-    if (holds++ == 0) set_evictions(false);
+  const Handle d = io.scalar_dataset(meta.get(), key, type, value, bytes, "/meta/" + key);
+  io.describe(d.get(), key, dim, H5Tget_class(type) == H5T_STRING, "/meta/" + key);
+  flush_file();
+}
+
+void H5Output::Impl::metadata_array(const std::string& key, hid_t type, const void* values, std::size_t n, bool text) {
+  check_name(key, "metadata");
+  const Scoped held(*this);
+  if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
+    check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
   }
-  void release() noexcept {
-    if (holds > 0 && --holds == 0) {
-      cache.evictions_enabled = true;
-      H5Fset_mdc_config(file.get(), &cache);
-    }
-  }
-  struct Scoped {
-    Impl& m;
-    explicit Scoped(Impl& impl) : m(impl) { m.hold(); }
-    ~Scoped() { m.release(); }
-    Scoped(const Scoped&) = delete;
-    Scoped& operator=(const Scoped&) = delete;
-  };
-
-  // /<name> with a `columns` attribute and one extendible 1-D double dataset per column (series, tables).
-  void create_columns(const std::string& name, const std::vector<std::string>& columns, const char* what,
-                      Handle& group_out, std::vector<Handle>& sets) {
-    std::set<std::string> seen;
-    std::size_t longest = 1;
-    for (const auto& n : columns) {
-      check_name(n, what);
-      if (!seen.insert(n).second) throw std::invalid_argument(std::string(what) + " '" + n + "' declared twice");
-      longest = std::max(longest, n.size());
-    }
-    const Quiet quiet;
-    const Scoped hold_cache(*this);
-    group_out = io.group(file.get(), name, "/" + name);
-    std::string packed(columns.size() * longest, '\0');  // fixed-length, NUL-padded names
-    for (std::size_t i = 0; i < columns.size(); ++i) packed.replace(i * longest, columns[i].size(), columns[i]);
-    {
-      const Handle type = io.string_type(longest);
-      const hsize_t n_columns = columns.size();
-      const Handle s = io.space(1, &n_columns);
-      const Handle a{check_id(H5Acreate2(group_out.get(), "columns", type.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT),
-                              io.file, "cannot create /" + name + " attribute columns"),
-                     H5Aclose};
-      check(H5Awrite(a.get(), type.get(), packed.data()), io.file, "cannot write /" + name + " attribute columns");
-    }
-    const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = 1024;
-    const Handle space = io.space(1, &zero, &unlimited);
-    Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), io.file, "cannot create a property list"), H5Pclose};
-    check(H5Pset_chunk(dcpl.get(), 1, &chunk), io.file, "cannot set chunking");
-    for (const auto& n : columns) {
-      sets.emplace_back(check_id(H5Dcreate2(group_out.get(), n.c_str(),
-                                            H5Output::is_count_column(n) ? H5T_STD_I64LE : H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
-                                            dcpl.get(), H5P_DEFAULT),
-                                 io.file, "cannot create /" + name + "/" + n),
-                        H5Dclose);
-      io.describe(sets.back().get(), n, dim, false, "/" + name + "/" + n);  // units, long_name
-    }
-    flush_file();
-  }
-
-  // ---- extra append-only tables /<name>/<column> (hot spots, coupling), written with the series ----
-  struct Table {
-    Handle group;
-    std::vector<std::string> names;
-    std::vector<Handle> sets;
-    std::vector<double> pending;  // row-major rows not yet written
-    hsize_t written = 0;
-  };
-  std::map<std::string, Table> tables;
-
-  void write_table(const std::string& name, Table& t) {
-    const std::size_t cols = t.names.size();
-    if (cols == 0 || t.pending.empty()) return;
-    hsize_t rows = t.pending.size() / cols;
-    std::vector<double> column(rows);
-    const hsize_t total = t.written + rows;
-    for (std::size_t j = 0; j < cols; ++j) {
-      for (hsize_t r = 0; r < rows; ++r) column[r] = t.pending[r * cols + j];
-      if (H5Output::is_count_column(t.names[j]))  // int64 on disk: round, do not truncate
-        for (double& v : column) v = std::nearbyint(v);
-      const std::string where = "/" + name + "/" + t.names[j];
-      const hid_t ds = t.sets[j].get();
-      check(H5Dset_extent(ds, &total), io.file, "cannot extend " + where);
-      const Handle fs{check_id(H5Dget_space(ds), io.file, "cannot get the dataspace of " + where), H5Sclose};
-      check(H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, &t.written, nullptr, &rows, nullptr), io.file,
-            "cannot select rows of " + where);
-      const Handle ms = io.space(1, &rows);
-      check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, ms.get(), fs.get(), H5P_DEFAULT, column.data()), io.file,
-            "cannot write " + where);
-    }
-    t.written = total;
-    t.pending.clear();
-  }
-  // ---- end of extra tables ----
-
-  void write_pending() {
-    for (auto& [name, table] : tables) write_table(name, table);  // extra tables
-    const std::size_t cols = series_names.size();
-    if (cols == 0 || pending.empty()) return;
-    hsize_t rows = pending.size() / cols;
-    std::vector<double> column(rows);
-    const hsize_t total = series_written + rows;
-    for (std::size_t j = 0; j < cols; ++j) {
-      for (hsize_t r = 0; r < rows; ++r) column[r] = pending[r * cols + j];
-      if (H5Output::is_count_column(series_names[j]))  // int64 on disk: round, do not truncate
-        for (double& v : column) v = std::nearbyint(v);
-      const std::string where = "/series/" + series_names[j];
-      const hid_t ds = series_sets[j].get();
-      check(H5Dset_extent(ds, &total), io.file, "cannot extend " + where);
-      const Handle fs{check_id(H5Dget_space(ds), io.file, "cannot get the dataspace of " + where), H5Sclose};
-      check(H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, &series_written, nullptr, &rows, nullptr), io.file,
-            "cannot select rows of " + where);
-      const Handle ms = io.space(1, &rows);
-      check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, ms.get(), fs.get(), H5P_DEFAULT, column.data()), io.file,
-            "cannot write " + where);
-    }
-    series_written = total;
-    pending.clear();
-  }
-
-  void flush_file() { check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), io.file, "cannot flush"); }
-
-  static std::string document(std::vector<std::string> grids, const std::string& failure, const std::string& name) {
-    if (!failure.empty()) grids.push_back(failure);
-    return xdmf_document(grids, name);
-  }
-  bool has_reference() const { return !reference_xml.empty() || !reference_failure_xml.empty(); }
-
-  // Written under the final names after every snapshot; through a temporary the XDMF files are
-  // written only with the result (publish): until then they would describe a file that is not
-  // under the name they give (issue 34: a second run had relabelled the first run's snapshots).
-  void write_xdmf() {
-    if (!options.write_xdmf || options.via_temporary) return;
-    write_text_atomically(xdmf_path, document(grid_xml, failure_xml, "particles"));
-    if (has_reference())
-      write_text_atomically(reference_path, document(reference_xml, reference_failure_xml, "particles_reference"));
-  }
-
-  // The result renamed onto its name with its XDMF files (publish_with_xdmf, output_files.hpp).
-  void publish() {
-    if (!options.write_xdmf) return publish_file(io.file, final_path, options.replace_existing);
-    publish_with_xdmf(io.file, final_path, options.replace_existing, document(grid_xml, failure_xml, "particles"),
-                      has_reference() ? document(reference_xml, reference_failure_xml, "particles_reference") : "");
-  }
-
-  void discard_snapshot() noexcept {
-    if (kind == Kind::none) return;
-    group.reset();  // an anonymous group that was never linked is deleted when closed
-    kind = Kind::none;
-    fields.clear();
-    release();
-  }
-
-  void begin(Kind k, long s, double t) {
-    if (kind != Kind::none) throw std::logic_error("H5Output: begin_snapshot while a snapshot is open");
-    hold();
-    Handle g{H5Gcreate_anon(file.get(), H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-    if (g.get() < 0) {
-      release();
-      fail(io.file, "cannot create a snapshot group");
-    }
-    group = std::move(g);
-    kind = k;
-    step = s;
-    time = t;
-    points = kNone;
-    fields.clear();
-  }
-
-  void field(const std::string& name, bool integer, const void* data, std::size_t n, int components) {
-    if (kind == Kind::none) throw std::logic_error("H5Output: snapshot_field outside begin/end_snapshot");
-    check_name(name, "snapshot field");
-    if (components < 1) throw std::invalid_argument("snapshot field " + name + ": components must be >= 1");
-    if (points != kNone && n != points) {
-      throw std::invalid_argument("snapshot field " + name + " has " + std::to_string(n) + " rows, earlier fields " +
-                                  std::to_string(points));
-    }
-    if (name == "position" && components != dim) {
-      throw std::invalid_argument("snapshot field position needs " + std::to_string(dim) + " components");
-    }
-    if (n > 0 && data == nullptr) throw std::invalid_argument("snapshot field " + name + ": null data");
-    const std::string where = "snapshot field " + name + " (step " + std::to_string(step) + ")";
-    const hsize_t dims[2] = {n, static_cast<hsize_t>(components)};
-    const Handle s = io.space(components == 1 ? 1 : 2, dims);
-    const hid_t file_type = integer ? H5T_STD_I32LE : H5T_IEEE_F64LE;
-    const hid_t mem_type = integer ? H5T_NATIVE_INT32 : H5T_NATIVE_DOUBLE;
-    const Handle d{check_id(H5Dcreate2(group.get(), name.c_str(), file_type, s.get(), H5P_DEFAULT, H5P_DEFAULT,
-                                       H5P_DEFAULT),
-                            io.file, "cannot create " + where),
-                   H5Dclose};
-    if (n > 0) check(H5Dwrite(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), io.file, "cannot write " + where);
-    io.describe(d.get(), name, dim, false, where);
-    points = n;
-    fields.push_back({name, components, integer});
-  }
-
-  std::string ensure_connectivity(std::size_t n) {
-    const std::string name = "polyvertex_" + std::to_string(n);
-    if (connectivity.insert(n).second) {
-      if (connectivity.size() == 1) io.group(file.get(), "xdmf", "/xdmf");
-      std::vector<std::int32_t> ids(n);
-      for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<std::int32_t>(i);
-      const hsize_t dims[1] = {n};
-      const Handle s = io.space(1, dims);
-      const std::string path = "/xdmf/" + name;
-      const Handle d{check_id(H5Dcreate2(file.get(), path.c_str(), H5T_STD_I32LE, s.get(), H5P_DEFAULT,
-                                         H5P_DEFAULT, H5P_DEFAULT),
-                              io.file, "cannot create " + path),
-                     H5Dclose};
-      check(H5Dwrite(d.get(), H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, ids.data()), io.file,
-            "cannot write " + path);
-      io.describe(d.get(), name, dim, false, path);
-    }
-    return "/xdmf/" + name;
-  }
-
-  void end() {
-    if (kind == Kind::none) throw std::logic_error("H5Output: end_snapshot without begin_snapshot");
-    const bool failure = kind == Kind::failure;
-    char name[32];
-    std::snprintf(name, sizeof name, "%06zu", count);
-    const std::string path = failure ? std::string("/failure") : "/snapshots/" + std::string(name);
-    try {
-      const std::int64_t s = step;
-      io.attribute(group.get(), "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &s, path);
-      io.attribute(group.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path);
-      if (failure) io.string_attribute(group.get(), "message", message, path);
-      XdmfGrid grid{failure ? "failure" : name, path, "", step, time, points == kNone ? 0 : points, fields};
-      const bool drawable = grid.points > 0 && std::any_of(fields.begin(), fields.end(), [](const XdmfField& f) {
-                              return f.name == "position";
-                            });
-      if (drawable && options.write_xdmf) grid.connectivity = ensure_connectivity(grid.points);
-      if (failure && H5Lexists(file.get(), "failure", H5P_DEFAULT) > 0) {
-        check(H5Ldelete(file.get(), "failure", H5P_DEFAULT), io.file, "cannot replace /failure");
-      }
-      check(H5Olink(group.get(), failure ? file.get() : snapshots.get(), failure ? "failure" : name, H5P_DEFAULT,
-                    H5P_DEFAULT),
-            io.file, "cannot link " + path);
-      write_pending();
-      flush_file();
-      discard_snapshot();  // closes the (now linked) group and lifts the eviction hold
-      if (drawable && options.write_xdmf) {
-        XdmfGrid reference = grid;
-        reference.geometry = "initial_position";
-        const bool has_reference = std::any_of(grid.fields.begin(), grid.fields.end(), [&](const XdmfField& f) {
-          return f.name == reference.geometry && f.components == dim && !f.integer;
-        });
-        if (!failure) {
-          grid_xml.push_back(xdmf_grid_xml(grid, io_name(), dim));
-          if (has_reference) reference_xml.push_back(xdmf_grid_xml(reference, io_name(), dim));
-          last_time = time;
-        } else {
-          failure_xml = time > last_time ? xdmf_grid_xml(grid, io_name(), dim) : std::string();
-          reference_failure_xml =
-              time > last_time && has_reference ? xdmf_grid_xml(reference, io_name(), dim) : std::string();
-        }
-      }
-      if (!failure) ++count;
-    } catch (...) {
-      discard_snapshot();
-      throw;
-    }
-    write_xdmf();
-  }
-
-  std::string io_name() const { return base_name(final_path); }
-
-  void metadata(const std::string& key, hid_t type, const void* value, std::size_t bytes) {
-    check_name(key, "metadata");
-    const Scoped held(*this);
-    if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
-      check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
-    }
-    const Handle d = io.scalar_dataset(meta.get(), key, type, value, bytes, "/meta/" + key);
-    io.describe(d.get(), key, dim, H5Tget_class(type) == H5T_STRING, "/meta/" + key);
-    flush_file();
-  }
-
-  // /meta/<key> as a small 1-D dataset (numbers or fixed-length strings).
-  void metadata_array(const std::string& key, hid_t type, const void* values, std::size_t n, bool text) {
-    check_name(key, "metadata");
-    const Scoped held(*this);
-    if (H5Lexists(meta.get(), key.c_str(), H5P_DEFAULT) > 0) {
-      check(H5Ldelete(meta.get(), key.c_str(), H5P_DEFAULT), io.file, "cannot replace /meta/" + key);
-    }
-    const Handle d = io.array_dataset(meta.get(), key, type, values, n, "/meta/" + key);
-    io.describe(d.get(), key, dim, text, "/meta/" + key);
-    flush_file();
-  }
-};
+  const Handle d = io.array_dataset(meta.get(), key, type, values, n, "/meta/" + key);
+  io.describe(d.get(), key, dim, text, "/meta/" + key);
+  flush_file();
+}
 
 H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : impl_(std::make_unique<Impl>()) {
   if (dim != 2 && dim != 3) throw std::invalid_argument("H5Output: dim must be 2 or 3");
@@ -392,6 +76,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.io.file = options.via_temporary ? temporary_path(path) : path;
   m.xdmf_path = xdmf_path_for(path);
   m.reference_path = xdmf_reference_path_for(path);
+  m.nodes_path = xdmf_nodes_path_for(path);
   m.dim = dim;
   m.options = options;
   const Quiet quiet;
@@ -422,7 +107,7 @@ H5Output::H5Output(const std::string& path, int dim, H5OutputOptions options) : 
   m.meta = io.group(m.file.get(), "meta", "/meta");
   m.snapshots = io.group(m.file.get(), "snapshots", "/snapshots");
   m.flush_file();
-  m.write_xdmf();  // an empty collection; also proves early that the XDMF file can be written (not via_temporary)
+  m.write_xdmf();  // an empty collection; also proves early that the XDMF file can be written
 }
 
 void hdf5_program_setup() {
@@ -489,120 +174,6 @@ void H5Output::write_integer_metadata(const std::string& key, std::int64_t value
   m.metadata(key, H5T_NATIVE_INT64, &value, sizeof value);
 }
 
-bool H5Output::is_count_column(const std::string& name) {
-  static const std::set<std::string> exact{"step", "id", "fate", "seed", "status", "steps", "runaway", "dying",
-                                           "material_mask", "hotspots"};
-  auto ends_with = [&name](const std::string& tail) {
-    return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
-  };
-  if (name.rfind("penalty_contacts.", 0) == 0) return true;
-  if (name.find('.') != std::string::npos) return false;  // per-body or per-pair columns carry user names
-  return exact.count(name) > 0 || ends_with("_count") || ends_with("_nodes") || ends_with("_windows");
-}
-
-void H5Output::begin_snapshot(long step, double time) {
-  Impl& m = live();
-  const Quiet quiet;
-  m.begin(Impl::Kind::snapshot, step, time);
-}
-
-void H5Output::begin_failure(long step, double time, const std::string& message) {
-  Impl& m = live();
-  const Quiet quiet;
-  m.discard_snapshot();
-  m.begin(Impl::Kind::failure, step, time);
-  m.message = message.size() > 16384 ? message.substr(0, 16384) : message;
-}
-
-void H5Output::snapshot_field(const std::string& name, const double* data, std::size_t n, int components) {
-  Impl& m = live();
-  const Quiet quiet;
-  m.field(name, false, data, n, components);
-}
-
-void H5Output::snapshot_field(const std::string& name, const std::int32_t* data, std::size_t n) {
-  Impl& m = live();
-  const Quiet quiet;
-  m.field(name, true, data, n, 1);
-}
-
-void H5Output::end_snapshot() {
-  Impl& m = live();
-  const Quiet quiet;
-  m.end();
-}
-
-bool H5Output::in_snapshot() const { return impl_ && impl_->kind != Impl::Kind::none; }
-
-void H5Output::declare_series(const std::vector<std::string>& names) {
-  Impl& m = live();
-  if (!m.series_names.empty()) throw std::logic_error("H5Output: series already declared");
-  if (names.empty() || names.front() != "time") {
-    throw std::invalid_argument("series columns must start with \"time\"");
-  }
-  m.create_columns("series", names, "series column", m.series, m.series_sets);
-  m.series_names = names;
-}
-
-void H5Output::append_series(const std::vector<double>& row) {
-  Impl& m = live();
-  if (m.series_names.empty()) throw std::logic_error("H5Output: append_series before declare_series");
-  if (row.size() != m.series_names.size()) {
-    throw std::invalid_argument("series row has " + std::to_string(row.size()) + " values, " +
-                                std::to_string(m.series_names.size()) + " columns declared");
-  }
-  m.pending.insert(m.pending.end(), row.begin(), row.end());
-  if (m.pending.size() >= m.options.series_batch_rows * row.size()) flush();
-}
-
-// ---- extra tables (declare_table / append_table_row) ----
-void H5Output::declare_table(const std::string& name, const std::vector<std::string>& columns) {
-  Impl& m = live();
-  check_name(name, "table");
-  if (name == "meta" || name == "snapshots" || name == "series" || name == "failure" || name == "xdmf" ||
-      m.tables.count(name) != 0)
-    throw std::logic_error("H5Output: table /" + name + " already exists or is reserved");
-  if (columns.empty()) throw std::invalid_argument("table /" + name + " needs at least one column");
-  Impl::Table t;
-  m.create_columns(name, columns, "table column", t.group, t.sets);
-  t.names = columns;
-  m.tables.emplace(name, std::move(t));
-}
-
-void H5Output::append_table_row(const std::string& name, const std::vector<double>& row) {
-  Impl& m = live();
-  const auto it = m.tables.find(name);
-  if (it == m.tables.end()) throw std::logic_error("H5Output: append_table_row before declare_table(" + name + ")");
-  Impl::Table& t = it->second;
-  if (row.size() != t.names.size())
-    throw std::invalid_argument("table /" + name + " row has " + std::to_string(row.size()) + " values, " +
-                                std::to_string(t.names.size()) + " columns declared");
-  t.pending.insert(t.pending.end(), row.begin(), row.end());
-  if (t.pending.size() >= m.options.series_batch_rows * row.size()) flush();
-}
-
-std::size_t H5Output::table_rows(const std::string& name) const {
-  if (!impl_) return 0;
-  const auto it = impl_->tables.find(name);
-  if (it == impl_->tables.end() || it->second.names.empty()) return 0;
-  return it->second.written + it->second.pending.size() / it->second.names.size();
-}
-// ---- end of extra tables ----
-
-std::size_t H5Output::series_rows() const {
-  if (!impl_) return 0;
-  const Impl& m = *impl_;
-  return m.series_names.empty() ? 0 : m.series_written + m.pending.size() / m.series_names.size();
-}
-
-void H5Output::flush() {
-  Impl& m = live();
-  const Quiet quiet;
-  const Impl::Scoped hold(m);
-  m.write_pending();
-  m.flush_file();
-}
-
 void H5Output::sync() {
   flush();
   Impl& m = live();
@@ -621,6 +192,7 @@ void H5Output::abandon() noexcept {
   m.series_sets.clear();
   m.tables.clear();
   m.series.reset();
+  m.nodes.reset();
   m.snapshots.reset();
   m.meta.reset();
   m.file.reset();
@@ -636,6 +208,7 @@ void H5Output::close() {
   m.series_sets.clear();
   m.tables.clear();
   m.series.reset();
+  m.nodes.reset();
   m.snapshots.reset();
   m.meta.reset();
   m.file.reset();

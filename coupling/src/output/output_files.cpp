@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 namespace frictherm::coupling {
 
@@ -114,30 +115,32 @@ void publish_file(const std::string& temporary, const std::string& path, bool ov
 }
 
 void publish_with_xdmf(const std::string& temporary, const std::string& path, bool overwrite, const std::string& xdmf,
-                       const std::string& reference_xdmf) {
-  const std::string x = xdmf_path_for(path), r = xdmf_reference_path_for(path);
+                       const std::string& reference_xdmf, const std::string& nodes_xdmf) {
+  // RUN.xdmf, RUN_reference.xdmf and RUN_nodes.xdmf: each written beside its name first, the old ones
+  // removed, the result renamed into place, then the XDMF files (a kill leaves an XDMF that matches
+  // its result, or none).
   const std::string pid = "." + std::to_string(static_cast<long>(::getpid())) + ".tmp";
-  const std::string x_tmp = x + pid, r_tmp = r + pid;
+  const std::pair<std::string, const std::string*> files[] = {
+      {xdmf_path_for(path), &xdmf}, {xdmf_reference_path_for(path), &reference_xdmf}, {xdmf_nodes_path_for(path), &nodes_xdmf}};
+  auto remove_temporaries = [&] {
+    for (const auto& f : files) ::unlink((f.first + pid).c_str());
+  };
   try {
-    write_text_atomically(x_tmp, xdmf);
-    if (!reference_xdmf.empty()) write_text_atomically(r_tmp, reference_xdmf);
-    if (overwrite) {
-      ::unlink(x.c_str());
-      ::unlink(r.c_str());
-    }
+    for (const auto& f : files)
+      if (!f.second->empty()) write_text_atomically(f.first + pid, *f.second);
+    if (overwrite)
+      for (const auto& f : files) ::unlink(f.first.c_str());
     publish_file(temporary, path, overwrite);
   } catch (...) {
-    ::unlink(x_tmp.c_str());
-    ::unlink(r_tmp.c_str());
+    remove_temporaries();
     throw;
   }
-  if (std::rename(x_tmp.c_str(), x.c_str()) != 0 ||
-      (!reference_xdmf.empty() && std::rename(r_tmp.c_str(), r.c_str()) != 0)) {
-    const std::string reason = std::strerror(errno);
-    ::unlink(x_tmp.c_str());
-    ::unlink(r_tmp.c_str());
-    throw std::runtime_error("'" + path + "' is published but its XDMF file could not be: " + reason);
-  }
+  for (const auto& f : files)
+    if (!f.second->empty() && std::rename((f.first + pid).c_str(), f.first.c_str()) != 0) {
+      const std::string reason = std::strerror(errno);
+      remove_temporaries();
+      throw std::runtime_error("'" + path + "' is published but its XDMF file could not be: " + reason);
+    }
 }
 
 OutputClaim::OutputClaim(const std::string& output) : lock_path_(output + ".lock") {

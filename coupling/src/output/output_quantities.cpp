@@ -108,6 +108,9 @@ const std::map<std::string, Entry>& catalogue() {
       {"reaction_progress", {"1", "reaction progress"}},
       {"interface_temperature", {"K", "interface temperature"}},
       {"interface_reaction_progress", {"1", "reaction progress at the interface temperature"}},
+      // /nodes: the thermal grid's nodes (runner_thermal.cpp; position and temperature as above)
+      {"heat_capacity", {"J/K", "nodal heat capacity"}},
+      {"lattice", {"1", "grid node coordinates (position = grid lo + lattice * cell size)"}},
       {"polyvertex", {"1", "XDMF polyvertex connectivity"}},
       {"connectivity", {"1", "XDMF polyvertex connectivity"}},
       // /meta numbers

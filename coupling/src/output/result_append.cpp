@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <utility>
 #include <stdexcept>
 #include <vector>
 
@@ -114,6 +115,19 @@ void append_snapshots(hid_t out, hid_t cont, long keep, const std::string& file,
     for (const std::string& n : members(sc.get())) copy_object(sc.get(), n, so.get(), snapshot_name(k++), file);
   }
   if (exists(cont, "/failure")) copy_object(cont, "/failure", out, "/failure", file);
+  // The thermal grid's nodes: numbered as the snapshots they belong to.
+  if (exists(out, "/nodes")) {
+    const Handle no{check_id(H5Gopen2(out, "nodes", H5P_DEFAULT), file, "/nodes"), H5Gclose};
+    for (const std::string& n : members(no.get()))
+      if (std::stol(n) >= keep) check(H5Ldelete(no.get(), n.c_str(), H5P_DEFAULT), file, "cannot remove /nodes/" + n);
+  }
+  if (exists(cont, "/nodes")) {
+    if (!exists(out, "/nodes")) check_id(H5Gclose(H5Gcreate2(out, "nodes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)), file, "/nodes");
+    const Handle nc{check_id(H5Gopen2(cont, "nodes", H5P_DEFAULT), cont_file, "/nodes"), H5Gclose};
+    const Handle no{check_id(H5Gopen2(out, "nodes", H5P_DEFAULT), file, "/nodes"), H5Gclose};
+    for (const std::string& n : members(nc.get()))
+      copy_object(nc.get(), n, no.get(), snapshot_name(static_cast<std::size_t>(keep + std::stol(n))), file);
+  }
   if (exists(cont, "/xdmf")) {  // Polyvertex connectivities of new particle counts
     if (!exists(out, "/xdmf")) check_id(H5Gclose(H5Gcreate2(out, "xdmf", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)), file, "/xdmf");
     const Handle xc{check_id(H5Gopen2(cont, "xdmf", H5P_DEFAULT), cont_file, "/xdmf"), H5Gclose};
@@ -163,31 +177,53 @@ XdmfGrid grid_of(hid_t g, const std::string& name, const std::string& path, cons
 
 }  // namespace
 
-std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name, const std::string& geometry) {
+XdmfDocuments xdmf_documents_of_result(const std::string& h5_path, const std::string& h5_name) {
   const h5detail::Quiet quiet;
   const Handle f{check_id(H5Fopen(h5_path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), h5_path, "cannot open"), H5Fclose};
   const int dim = read_attribute<int>(f.get(), "dim", H5T_NATIVE_INT, h5_path);
-  std::vector<std::string> xml;
-  const auto add = [&](hid_t g, const std::string& name, const std::string& path) {
-    XdmfGrid grid = grid_of(g, name, path, h5_path);
-    grid.geometry = geometry;
+  std::vector<std::string> xml, reference, nodes;
+  // A grid drawn at `geometry` when the group has that field (dim float components) and its connectivity.
+  const auto render = [&](const XdmfGrid& grid, const std::string& geometry, std::vector<std::string>& into) {
     bool drawable = false;
-    for (const XdmfField& fd : grid.fields) drawable = drawable || (fd.name == geometry && fd.components == dim);
-    if (drawable && grid.points > 0 && exists(f.get(), grid.connectivity)) xml.push_back(xdmf_grid_xml(grid, h5_name, dim));
-  };
-  if (exists(f.get(), "/snapshots")) {
-    const Handle s{check_id(H5Gopen2(f.get(), "snapshots", H5P_DEFAULT), h5_path, "/snapshots"), H5Gclose};
-    for (const std::string& n : members(s.get())) {
-      const Handle g{check_id(H5Gopen2(s.get(), n.c_str(), H5P_DEFAULT), h5_path, "/snapshots/" + n), H5Gclose};
-      add(g.get(), n, "/snapshots/" + n);
+    for (const XdmfField& fd : grid.fields)
+      drawable = drawable || (fd.name == geometry && fd.components == dim && !fd.integer);
+    if (drawable && grid.points > 0 && exists(f.get(), grid.connectivity)) {
+      XdmfGrid g = grid;
+      g.geometry = geometry;
+      into.push_back(xdmf_grid_xml(g, h5_name, dim));
     }
-  }
+  };
+  const auto add = [&](hid_t g, const std::string& name, const std::string& path) {
+    const XdmfGrid grid = grid_of(g, name, path, h5_path);
+    render(grid, "position", xml);
+    render(grid, "initial_position", reference);  // RUN_reference.xdmf (displacement warp)
+  };
+  const auto each = [&](const char* group, const auto& visit) {
+    if (!exists(f.get(), std::string("/") + group)) return;
+    const Handle s{check_id(H5Gopen2(f.get(), group, H5P_DEFAULT), h5_path, std::string("/") + group), H5Gclose};
+    for (const std::string& n : members(s.get())) {
+      const std::string path = std::string("/") + group + "/" + n;
+      const Handle g{check_id(H5Gopen2(s.get(), n.c_str(), H5P_DEFAULT), h5_path, path), H5Gclose};
+      visit(g.get(), n, path);
+    }
+  };
+  each("snapshots", add);
   if (exists(f.get(), "/failure")) {
     const Handle g{check_id(H5Gopen2(f.get(), "failure", H5P_DEFAULT), h5_path, "/failure"), H5Gclose};
     add(g.get(), "failure", "/failure");
   }
-  if (geometry != "position" && xml.empty()) return "";  // no reference positions: no such file
-  return xdmf_document(xml, geometry == "position" ? "particles" : "particles_reference");
+  each("nodes", [&](hid_t g, const std::string& n, const std::string& path) {
+    render(grid_of(g, n, path, h5_path), "position", nodes);
+  });
+  XdmfDocuments d;
+  d.current = xdmf_document(xml);
+  if (!reference.empty()) d.reference = xdmf_document(reference, "particles_reference");
+  if (!nodes.empty()) d.nodes = xdmf_document(nodes, "thermal_nodes");
+  return d;
+}
+
+std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name) {
+  return xdmf_documents_of_result(h5_path, h5_name).current;
 }
 
 void check_appendable(const std::string& original, const CheckpointMarks& marks) {
@@ -332,7 +368,10 @@ void append_result(const std::string& original, const std::string& continuation,
     append_in_child(original, continuation, marks, tmp);
     const std::size_t slash = output.find_last_of('/');
     const std::string name = slash == std::string::npos ? output : output.substr(slash + 1);
-    publish_with_xdmf(tmp, output, true, xdmf_of_result(tmp, name), xdmf_of_result(tmp, name, "initial_position"));
+    const XdmfDocuments xdmf = xdmf_documents_of_result(tmp, name);
+    // RUN_reference.xdmf and RUN_nodes.xdmf are written when the result has their grids; the old
+    // ones are removed either way (publish_with_xdmf), so no stale file stays.
+    publish_with_xdmf(tmp, output, true, xdmf.current, xdmf.reference, xdmf.nodes);
   } catch (...) {
     std::remove(tmp.c_str());
     throw;

@@ -154,6 +154,11 @@ std::string xdmf_reference_path_for(const std::string& h5_path) {
   return x.substr(0, x.size() - 5) + "_reference.xdmf";
 }
 
+std::string xdmf_nodes_path_for(const std::string& h5_path) {
+  const std::string x = xdmf_path_for(h5_path);
+  return x.substr(0, x.size() - 5) + "_nodes.xdmf";
+}
+
 std::string xdmf_path_for(const std::string& h5_path) {
   for (const char* ext : {".h5", ".hdf5", ".he5"}) {
     const std::size_t len = std::strlen(ext);

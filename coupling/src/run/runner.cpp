@@ -86,11 +86,11 @@ class Run {
     try {
       detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
       out.write_metadata("run_id", run_id_);
-      std::vector<std::string> series_columns = detail::series_names(Dim);
-      detail::append_body_series_names<Dim>(series_columns, *sim_);
-      detail::append_contact_series_names<Dim>(series_columns, *sim_);
-      if (thermal_) thermal_->declare_output(out, series_columns);  // thermal hook: columns + /hotspots
-      out.declare_series(series_columns);
+      series_columns_ = detail::series_names(Dim);
+      detail::append_body_series_names<Dim>(series_columns_, *sim_);
+      detail::append_contact_series_names<Dim>(series_columns_, *sim_);
+      if (thermal_) thermal_->declare_output(out, series_columns_);  // thermal hook: columns + /hotspots
+      out.declare_series(series_columns_);
       if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) {  // appended output: the result has these
         series();
         snapshot();
@@ -321,7 +321,7 @@ class Run {
       }
       if (o_.observer) {  // the user's per-step diagnostics
         try {
-          o_.observer(StepView(*sim_));
+          o_.observer(StepView(*sim_, series_columns_, last_series_row_, last_series_step_ == sim_->step_count()));
         } catch (...) {  // ends the run as a failure, then goes on to the caller (runner.hpp)
           observer_error_ = std::current_exception();
           throw;
@@ -413,6 +413,7 @@ class Run {
     std::vector<double> row = detail::series_row<Dim>(*sim_, series_memory_, heating_order());
     if (thermal_) thermal_->extend_series_row(row, *out_, *sim_, sim_->time());  // thermal hook
     out_->append_series(row);
+    last_series_row_.swap(row);  // what the observer sees (StepView::series_row), not computed again
     last_series_step_ = sim_->step_count();
     if (seconds_since(last_flush_) >= o_.flush_interval) {  // a killed run loses at most flush_interval
       out_->flush();
@@ -438,6 +439,8 @@ class Run {
   H5Output* out_ = nullptr;
   RunResult r_;
   long last_series_step_ = -1;
+  std::vector<std::string> series_columns_;  // the /series columns
+  std::vector<double> last_series_row_;      // the last row appended (StepView::series_row)
   long last_snapshot_step_ = -1;
   double coupling_seconds_ = 0.0;       // in thermal_->after_step (heating and solve)
   std::optional<ThreadGovernor> governor_;  // default thread count with spinning waits

@@ -165,6 +165,29 @@ void ThermalRun<Dim>::write_fields(H5Output& out) const {
   const std::vector<double>& lam_int = coupler_.interface_reaction().progress();
   if (coupler_.interface_reaction().started() && !lam_int.empty())
     out.snapshot_field("interface_reaction_progress", lam_int.data(), lam_int.size(), 1);
+  write_nodes(out);
+}
+
+// The thermal grid's state at the snapshot (/nodes, RUN.xdmf "thermal_nodes"): the nodes that are
+// unknowns of the last system, where they are, their temperature T_i and heat capacity M_i (eq. 38).
+template <int Dim>
+void ThermalRun<Dim>::write_nodes(H5Output& out) const {
+  const NodalThermalSystem* system = coupler_.system();
+  const Eigen::VectorXd& t = coupler_.nodal_temperature();
+  if (system == nullptr || system->size() == 0 || static_cast<std::size_t>(t.size()) != system->size()) return;
+  const std::size_t n = system->size();
+  const mechanics::Grid<Dim>& grid = coupler_.grid();
+  std::vector<double> x(n * Dim);
+  std::vector<std::int32_t> lattice(n * Dim);
+  for (std::size_t k = 0; k < n; ++k) {
+    const mechanics::Vec<Dim> p = grid.node_position(system->grid_node[k]);
+    const mechanics::IVec<Dim> i = grid.node_lattice(system->grid_node[k]);
+    for (int d = 0; d < Dim; ++d) x[k * Dim + d] = p[d], lattice[k * Dim + d] = static_cast<std::int32_t>(i[d]);
+  }
+  out.node_field("position", x.data(), n, Dim);
+  out.node_field("temperature", t.data(), n, 1);
+  out.node_field("heat_capacity", system->mass.data(), n, 1);
+  out.node_field("lattice", lattice.data(), n, Dim);
 }
 
 template <int Dim>

@@ -32,7 +32,8 @@ class ThermalRun {
   void continuation(H5Output& out, mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields,
                     SeriesMemory& memory);
   /// Particle fields of the thermal side into the open snapshot (reaction_progress with a reaction).
-  void write_fields(H5Output& out) const;
+  void write_fields(H5Output& out) const;  // and write_nodes
+  void write_nodes(H5Output& out) const;   // /nodes of the open snapshot
   /// Integrator statistics and energy books into /meta (thermal_*).
   void write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const;
 

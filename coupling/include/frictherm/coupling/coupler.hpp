@@ -179,6 +179,10 @@ class Coupler {
   double particle_reaction_heat(const mechanics::Particles<Dim>& particles) const;
   /// The system of the last window (nullptr before the first assembly).
   const NodalThermalSystem* system() const { return has_system_ ? &system_ : nullptr; }
+  /// The nodal temperatures T_i (K) at the end of the last window or continuation interval, one per
+  /// unknown of system() (grid node system()->grid_node[k]): the thermal grid's own state.
+  const Eigen::VectorXd& nodal_temperature() const { return nodal_temperature_; }
+  const mechanics::Grid<Dim>& grid() const { return grid_; }
   const CouplerOptions& options() const { return opt_; }
 
   /// Checkpoints (issue 17; state_visit.hpp visitors): everything the next step, window or the

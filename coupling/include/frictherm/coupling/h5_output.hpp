@@ -14,10 +14,17 @@
 // Format version 2 (frictherm 0.1, issue 14): integers (steps, ids, counts) are int64, in /meta
 // and in tables; version 1 stored them as doubles. Readers: frictherm/coupling/results.hpp (C++),
 // the Python package `frictherm` (python/frictherm).
+//   /nodes/000000 ...      the thermal grid's nodes at snapshot 000000 ... (runs with heat; node_field):
+//                          attrs step and time; position (n, dim) of the nodes that are thermal unknowns,
+//                          temperature T_i (n) at the snapshot time, heat_capacity M_i (n), lattice
+//                          (n, dim) int32 node coordinates i (position = grid lo + i * cell size);
+//                          same numbering as /snapshots
 //   /xdmf/polyvertex_<n>   int32 0..n-1, the Polyvertex connectivity the XDMF file points at
 // Every dataset carries the attributes units (SI, temperatures K; "1" counts, "" text) and long_name
 // (output_quantities.hpp); categorical columns (hot-spot fate) also flag_values and flag_meanings.
-// Beside RUN.h5 an XDMF file RUN.xdmf (ParaView: Xdmf3ReaderS) lists every ended snapshot.
+// Beside RUN.h5 an XDMF file RUN.xdmf (ParaView: Xdmf3ReaderS) lists every ended snapshot;
+// RUN_reference.xdmf draws them at their reference positions and, when snapshots have /nodes,
+// RUN_nodes.xdmf draws the thermal grid's nodes.
 //
 // Not thread-safe (the serial HDF5 library is not): use one thread for all output calls.
 #include <cstddef>
@@ -90,6 +97,12 @@ class H5Output {
   void snapshot_field(const std::string& name, const double* data, std::size_t n, int components);
   /// Integer per-particle field (material id, body id).
   void snapshot_field(const std::string& name, const std::int32_t* data, std::size_t n);
+  /// The thermal grid's nodes at this snapshot (/nodes/<the snapshot's number>): n rows x components,
+  /// like snapshot_field; every node field of one snapshot has the same n (independent of the particles'),
+  /// and `position` (n x dim) is the geometry of RUN_nodes.xdmf's grid. Regular snapshots only
+  /// (std::logic_error for the failure state); linked and flushed with the snapshot in end_snapshot.
+  void node_field(const std::string& name, const double* data, std::size_t n, int components);
+  void node_field(const std::string& name, const std::int32_t* data, std::size_t n, int components = 1);
   /// Links the snapshot into the file, writes pending series rows, flushes the file (H5Fflush)
   /// and rewrites the XDMF file (temporary file, then rename). Only ended snapshots are visible
   /// in the file: one interrupted mid-way is never half-present.

@@ -44,7 +44,7 @@ void check_output_folder(const std::string& path, const std::string& what);
 /// they take theirs. Whenever the process is killed, an XDMF file beside a result describes that
 /// result, or there is none (issue 34).
 void publish_with_xdmf(const std::string& temporary, const std::string& path, bool overwrite, const std::string& xdmf,
-                       const std::string& reference_xdmf);
+                       const std::string& reference_xdmf, const std::string& nodes_xdmf = "");
 
 /// The output claimed for one run (issue 34): an advisory lock (flock) on "<output>.lock", held until
 /// destruction, so a second run on the same output is refused (OutputError naming the output) before

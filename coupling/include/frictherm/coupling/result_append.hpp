@@ -13,8 +13,8 @@ namespace frictherm::coupling {
 /// series and table rows and snapshots (renumbered after the kept ones, /failure if it has one);
 /// /meta keys the continuation wrote replace the original's. The file is built as
 /// "<output>.<pid>.part" (a copy of `original`) and renamed onto `output` only when complete, so
-/// `original` (which may be `output` itself) stays whole if anything fails; `output`'s XDMF file is
-/// rebuilt. Throws std::runtime_error naming the file and what does not fit (columns differ, fewer
+/// `original` (which may be `output` itself) stays whole if anything fails; `output`'s XDMF files
+/// (RUN.xdmf, RUN_reference.xdmf and RUN_nodes.xdmf, xdmf_documents_of_result) are rebuilt. Throws std::runtime_error naming the file and what does not fit (columns differ, fewer
 /// rows than the marks).
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
                    const std::string& output);
@@ -24,9 +24,17 @@ void append_result(const std::string& original, const std::string& continuation,
 /// resume checks it before running, so a damaged result costs no run time.
 void check_appendable(const std::string& original, const CheckpointMarks& marks);
 
-/// The XDMF document of every snapshot (and /failure) in `h5_path`, pointing at `h5_name`, drawn at
-/// `geometry`: "position", or "initial_position" for RUN_reference.xdmf ("" when no snapshot has it).
-std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name,
-                           const std::string& geometry = "position");
+/// The XDMF document of every snapshot (and /failure) in `h5_path`, pointing at `h5_name`.
+std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_name);
+
+/// The XDMF files of a result as H5Output writes them: `current` (RUN.xdmf: the particles at their
+/// positions), `reference` (RUN_reference.xdmf: the particles at initial_position; empty when no
+/// snapshot has it) and `nodes` (RUN_nodes.xdmf: the thermal grid's nodes; empty without /nodes).
+struct XdmfDocuments {
+  std::string current;
+  std::string reference;
+  std::string nodes;
+};
+XdmfDocuments xdmf_documents_of_result(const std::string& h5_path, const std::string& h5_name);
 
 }  // namespace frictherm::coupling

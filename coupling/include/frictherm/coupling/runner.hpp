@@ -35,7 +35,19 @@ class StepView {
  public:
   template <int Dim>
   explicit StepView(const mechanics::Simulation<Dim>& sim) : dim_(Dim), sim_(&sim) {}
+  /// With the run's series: its columns, its latest row (the one written to /series, not computed
+  /// again) and whether this step wrote it (rows come every output.series_interval, not every step).
+  template <int Dim>
+  StepView(const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& series_columns,
+           const std::vector<double>& series_row, bool series_row_is_new)
+      : dim_(Dim), sim_(&sim), columns_(&series_columns), row_(&series_row), row_is_new_(series_row_is_new) {}
   int dim() const { return dim_; }
+  /// The /series column names (empty without a series); series_row() has one value per column,
+  /// in this order, as written to the file (count columns hold whole numbers).
+  const std::vector<std::string>& series_columns() const { return columns_ ? *columns_ : empty_names(); }
+  const std::vector<double>& series_row() const { return row_ ? *row_ : empty_row(); }
+  /// True when this step wrote series_row(); otherwise it is the row of an earlier step.
+  bool series_row_is_new() const { return row_is_new_; }
   long step() const { return dim_ == 2 ? simulation<2>().step_count() : simulation<3>().step_count(); }
   double time() const { return dim_ == 2 ? simulation<2>().time() : simulation<3>().time(); }
   double dt() const { return dim_ == 2 ? simulation<2>().last_time_step() : simulation<3>().last_time_step(); }
@@ -50,8 +62,19 @@ class StepView {
   }
 
  private:
+  static const std::vector<std::string>& empty_names() {
+    static const std::vector<std::string> none;
+    return none;
+  }
+  static const std::vector<double>& empty_row() {
+    static const std::vector<double> none;
+    return none;
+  }
   int dim_;
   const void* sim_;
+  const std::vector<std::string>* columns_ = nullptr;
+  const std::vector<double>* row_ = nullptr;
+  bool row_is_new_ = false;
 };
 
 struct RunOptions {
@@ -95,7 +118,8 @@ struct RunOptions {
   /// random one.
   std::string run_id;
   /// Called after every mechanics step (not during the thermal-only continuation), after the step's
-  /// heat handoff and series row, so diagnostics need no copy of the run loop. An exception thrown
+  /// heat handoff and series row, so diagnostics need no copy of the run loop. The StepView carries
+  /// the latest series row as written (series_row(), series_row_is_new()). An exception thrown
   /// by the observer ends the run and propagates out of run_scene once the result is published (status
   /// "failed", the state under /failure).
   std::function<void(const StepView&)> observer;

@@ -3,7 +3,10 @@
 // One temporal collection; one Uniform grid per snapshot with Polyvertex topology (one vertex
 // cell per particle, connectivity 0..n-1 read from the HDF5 file), geometry from the snapshot's
 // `position` dataset (XY in 2D, XYZ in 3D) and every other field as a node-centred Attribute.
-// Heavy data is referenced by the HDF5 file's name relative to the XDMF file.
+// Heavy data is referenced by the HDF5 file's name relative to the XDMF file. A run with heat also
+// gets RUN_nodes.xdmf: the thermal grid's nodes (/nodes/NNNNNN) as Polyvertex points with their
+// temperature, a file of its own because ParaView's Xdmf3ReaderS reads the top-level grids of one
+// file as pieces of a single data set (the nodes would be merged with the particles).
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -43,12 +46,16 @@ std::string xdmf_grid_xml(const XdmfGrid& grid, const std::string& h5_file_name,
 /// A whole XDMF document around already rendered grids (see xdmf_grid_xml).
 std::string xdmf_document(const std::vector<std::string>& grid_xml, const std::string& collection = "particles");
 
+
 /// Writes `text` to `path` atomically: `path`.tmp is written, then renamed over `path`, so a
 /// reader never sees a half-written file. Throws std::runtime_error naming the file.
 void write_text_atomically(const std::string& path, const std::string& text);
 
 /// RUN.h5 -> RUN.xdmf (also for .hdf5/.he5; any other name gets .xdmf appended).
 std::string xdmf_path_for(const std::string& h5_path);
+
+/// RUN.h5 -> RUN_nodes.xdmf: the thermal grid's nodes of every snapshot (/nodes, runs with heat).
+std::string xdmf_nodes_path_for(const std::string& h5_path);
 
 /// RUN.h5 -> RUN_reference.xdmf: the snapshots drawn at the reference positions X (the
 /// `initial_position` field), for a displacement warp in ParaView (docs/output.md "In ParaView").
