@@ -141,13 +141,15 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
   mass_peak_ = sys.mass;
   rayleigh_scale_ = 1.0;
+  // With them, the first sub-step's f_i at sys.temperature (what the coupler advances from), summed
+  // in particle order as substeps_with sums it, while the particle's G' is at hand.
+  force_.setZero(n);
   Expanded e;
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k]) continue;
     keep<Kernel>(k, thermal_properties_of(materials, p.material[k]), p.volume[k], sys, e);
-    // Whether it carries flux at the temperatures the window starts from (sys.temperature, what the
-    // coupler advances from), as the first sub-step would find: that sub-step then looks again only
-    // at the particles with a node whose temperature differs (a fixed node), not at every one.
+    // Whether it carries flux at the temperatures the window starts from, as the first sub-step
+    // would find.
     const Kept& c = kept_[k];
     if (c.conductance == 0.0) {
       quiet_[k] = 1;
@@ -159,8 +161,15 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       hi = std::max(hi, sys.temperature[e.unknown[a]]);
     }
     quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+    if (quiet_[k]) continue;
+    // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
+    mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+    for (int a = 0; a < e.count; ++a) grad += e.g(a) * sys.temperature[e.unknown[a]];
+    grad *= c.conductance;
+    for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
   }
-  flux_temperature_ = sys.temperature;  // quiet_ holds for these temperatures
+  flux_temperature_ = sys.temperature;  // quiet_ and force_ hold for these temperatures
+  first_force_ready_ = true;
 }
 
 template <int Dim>
@@ -286,6 +295,7 @@ template <class Kernel>
 typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
     const AssemblyOptions& opt, NodalThermalSystem& sys, double max_shift, const mechanics::StencilView<Dim>& view) {
+  first_force_ready_ = false;
   if (gathered_at_.size() != p.size() || kept_.size() != p.size() ||
       stencils_.template of<Kernel>().size() != p.size())
     return Refresh::regather;
@@ -372,6 +382,7 @@ void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, Noda
   if (kept_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
   const auto n = static_cast<Eigen::Index>(sys.size());
   if (next_mct_.size() != n) throw std::logic_error("ExplicitConduction::reproject: the sums are of other unknowns");
+  first_force_ready_ = false;
   // The eq. 38 sums, kept with the particles' temperatures by the gather, refresh and map_back.
   for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
 }
@@ -428,9 +439,20 @@ template <class Kernel>
 void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen::VectorXd& T, const Eigen::VectorXd& q,
                                             const std::vector<FixedNode>& fixed, double h, long substeps) {
   const auto n = static_cast<Eigen::Index>(sys.size());
+  // The gather's f_i serve the first sub-step if it starts from the temperatures they were made at
+  // (no fixed node changed one): the same sums, the particle pass saved.
+  bool force_ready = first_force_ready_ && force_.size() == n && flux_temperature_.size() == n &&
+                     T == flux_temperature_;
+  first_force_ready_ = false;
   force_.resize(n);
   Expanded e;
   for (long s = 0; s < substeps; ++s) {
+    if (force_ready) {
+      force_ready = false;
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
     force_.setZero();
     // Nodes whose temperature changed since the last sub-step, as a prefix count over the unknowns:
     // a particle whose nodes all kept theirs and that was quiet then is quiet now, and is passed over

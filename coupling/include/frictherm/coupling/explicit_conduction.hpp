@@ -188,6 +188,7 @@ class ExplicitConduction {
   double rayleigh_scale_ = 1.0;            // max_a M_peak_a / M_a
   std::vector<std::size_t> moved_;         // refresh scratch: particles to gather again
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
+  bool first_force_ready_ = false;        // force_ holds f_i at flux_temperature_ (made by the gather)
   // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
   // streaming every particle's kept lists): per particle the runs of its unknown numbers (row by row) and whether its
   // nodal temperatures agreed to round-off when last looked at; per unknown the temperature of the
