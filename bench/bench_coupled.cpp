@@ -7,9 +7,16 @@
 // 1 and 2 threads, and 2 threads while a busy child process spins on one core. Prints wall time, CPU
 // time of this process (getrusage: all its threads), particle-steps per wall second and per CPU-second,
 // and the ratios coupled/mechanics and (2 threads)/(1 thread). Asserts nothing.
+// The 3D case (issue 35): examples/pbx_3d.json (85,184 particles, 17 HMX grains in binder, second-order
+// frictional heating, forward-Euler conduction, USL, uGIMP) stopped after --steps3 steps (run.max_steps),
+// on 1 thread: mechanics only (thermal and coupling removed), a window every step (the scene's own
+// reuse_distance 0: M and G' gathered every window), a window every step with the default reuse
+// (0.01 cells) and the default adaptive window; the same figures and ratios.
 //   bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--repeat N] [--scratch DIR]
-// --quick: 5 mm only, 2 ms. The default end times are 10 ms at 5 mm and 1 ms at 1 mm. --repeat N
-// (default 3): the idle cases N times, interleaved; the median-CPU run of each stands for it.
+//                 [--dims 2,3] [--steps3 N] [--scene3 PATH]
+// --quick: 5 mm only, 2 ms, 3D 50 steps. The default end times are 10 ms at 5 mm and 1 ms at 1 mm;
+// 3D: 100 steps. --repeat N (default 3): the idle cases N times, interleaved; the median-CPU run of
+// each stands for it. --dims 2 or 3: one of the two cases only.
 #include "cpu_time.hpp"
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
@@ -85,10 +92,24 @@ struct Figures {
   double heating_share = 0, heating_per_step = 0;
 };
 
+std::string scratch_file(const std::string& scratch) {
+  return scratch + "/bench_coupled_" + std::to_string(getpid()) + ".h5";
+}
+
+Figures run_scene_case(const Scene& scene, const std::string& label, const char* mode, int threads,
+                       const std::string& scratch);
+
 Figures run_case(double h, double end_time, Mode mode, int threads, const std::string& scratch) {
-  const std::string out = scratch + "/bench_coupled_" + std::to_string(getpid()) + ".h5";
-  const Scene scene = parse_scene(twin_scene(h, end_time, mode, out), "bench_coupled twin");
+  const Scene scene = parse_scene(twin_scene(h, end_time, mode, scratch_file(scratch)), "bench_coupled twin");
+  char label[32];
+  std::snprintf(label, sizeof label, "%4.1f mm", h * 1e3);
+  return run_scene_case(scene, label, name(mode), threads, scratch);
+}
+
+Figures run_scene_case(const Scene& scene, const std::string& label, const char* mode, int threads,
+                       const std::string& scratch) {
   RunOptions opt;
+  opt.output = scratch_file(scratch);
   opt.threads = threads;
   opt.quiet = true;
   opt.overwrite = true;  // one scratch file per process, rewritten by every case
@@ -105,9 +126,9 @@ Figures run_case(double h, double end_time, Mode mode, int threads, const std::s
     if (phase == "heating" || phase == "thermal_solve") heating += sec;
   f.heating_share = heating / f.wall;
   f.heating_per_step = r.steps > 0 ? heating / static_cast<double>(r.steps) : 0.0;
-  std::printf("  %4.1f mm  %-18s %d thr%s  %6zu particles %6ld steps  wall %7.3f s  cpu %7.3f s  "
+  std::printf("  %s  %-18s %d thr%s  %6zu particles %6ld steps  wall %7.3f s  cpu %7.3f s  "
               "%6.2f M p-steps/s  %6.2f M p-steps/cpu-s  heating+solve %4.1f %% (%5.1f us/step)\n",
-              h * 1e3, name(mode), threads, threads > 1 ? "s" : " ", r.particles, r.steps, f.wall, f.cpu,
+              label.c_str(), mode, threads, threads > 1 ? "s" : " ", r.particles, r.steps, f.wall, f.cpu,
               f.rate_wall / 1e6, f.rate_cpu / 1e6, 100 * f.heating_share, 1e6 * f.heating_per_step);
   std::fflush(stdout);
   if (r.status == RunResult::Status::failed) std::printf("  FAILED: %s\n", r.message.c_str());
@@ -140,6 +161,41 @@ void stop_busy(pid_t pid) {
   waitpid(pid, nullptr, 0);
 }
 
+// The 3D PBX-like case on 1 thread: the modes interleaved `repeat` times, medians by CPU time.
+void run_3d(const std::string& path, long steps, int repeat, const std::string& scratch) {
+  const std::string max_steps = std::to_string(steps);
+  struct Case3 {
+    const char* mode;
+    std::vector<SceneOverride> set;
+  };
+  const std::vector<Case3> cases = {
+      {"mechanics only", {{"thermal", "null"}, {"coupling", "null"}}},
+      {"every step (scene)", {}},  // reuse_distance 0: gathered every window
+      {"every step, reuse", {{"coupling.reuse_distance", "null"}}},  // the default 0.01 cells
+      {"adaptive window", {{"coupling.reuse_distance", "null"}, {"coupling.window", "\"adaptive\""}}},
+  };
+  std::printf("3D: %s, %ld steps, 1 thread\n", path.c_str(), steps);
+  std::vector<Scene> scenes;
+  for (const Case3& c : cases) {
+    std::vector<SceneOverride> set = c.set;
+    set.push_back({"run.max_steps", max_steps});
+    scenes.push_back(load_scene(path, set));
+  }
+  std::vector<std::vector<Figures>> runs(cases.size());
+  for (int r = 0; r < repeat; ++r)
+    for (std::size_t m = 0; m < cases.size(); ++m)
+      runs[m].push_back(run_scene_case(scenes[m], "3D PBX", cases[m].mode, 1, scratch));
+  std::vector<Figures> f;
+  for (auto& v : runs) f.push_back(median_by_cpu(v));
+  std::printf("  medians of %d runs, 1 thread:\n", repeat);
+  for (std::size_t m = 0; m < cases.size(); ++m)
+    std::printf("  3D %-20s wall %7.3f s  cpu %7.3f s  %6.3f M p-steps/s  %6.3f M p-steps/cpu-s  "
+                "coupled/mechanics wall %.2fx cpu %.2fx\n",
+                cases[m].mode, f[m].wall, f[m].cpu, f[m].rate_wall / 1e6, f[m].rate_cpu / 1e6,
+                f[m].wall / f[0].wall, f[m].cpu / f[0].cpu);
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -148,11 +204,23 @@ int main(int argc, char** argv) {
   double end5 = 0.010, end1 = 0.001;
   std::string scratch = "/tmp";
   int repeat = 3;
+  bool dim2 = true, dim3 = true;
+  long steps3 = 100;
+  std::string scene3 = std::string(FRICTHERM_SOURCE_DIR) + "/examples/pbx_3d.json";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
       cells = {0.005};
       end5 = 0.002;
+      steps3 = 50;
+    } else if (a == "--dims" && i + 1 < argc) {
+      const std::string d = argv[++i];
+      dim2 = d.find('2') != std::string::npos;
+      dim3 = d.find('3') != std::string::npos;
+    } else if (a == "--steps3" && i + 1 < argc) {
+      steps3 = std::max(1L, std::atol(argv[++i]));
+    } else if (a == "--scene3" && i + 1 < argc) {
+      scene3 = argv[++i];
     } else if (a == "--cells" && i + 1 < argc) {
       cells.clear();
       std::string l = argv[++i];
@@ -170,13 +238,15 @@ int main(int argc, char** argv) {
     } else if (a == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else {
-      std::fprintf(stderr, "usage: bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--repeat N] [--scratch DIR]\n");
+      std::fprintf(stderr, "usage: bench_coupled [--quick] [--cells 5,1] [--end5 S] [--end1 S] [--repeat N] [--scratch DIR]\n"
+                           "                     [--dims 2,3] [--steps3 N] [--scene3 PATH]\n");
       return 2;
     }
   }
   const char* wp = std::getenv("OMP_WAIT_POLICY");
   std::printf("bench_coupled: sliding-block twin; OMP_WAIT_POLICY=%s; %ld online CPUs\n", wp ? wp : "(unset)",
               sysconf(_SC_NPROCESSORS_ONLN));
+  if (!dim2) cells.clear();
   for (const double h : cells) {
     const double end_time = h > 0.003 ? end5 : end1;
     std::printf("cell %.1f mm, end time %g s\n", h * 1e3, end_time);
@@ -215,5 +285,6 @@ int main(int argc, char** argv) {
                 "%.2fx)\n",
                 f2[1].wall / f1[1].wall, fb2.wall / fb1.wall, fb2.wall / f1[1].wall);
   }
+  if (dim3) run_3d(scene3, steps3, repeat, scratch);
   return 0;
 }

@@ -6,30 +6,79 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <stdexcept>
 #include <string>
 
 namespace frictherm::coupling {
 namespace {
 
+// The stencil's nodes in for_each's order with the same products (node index, S_ip and the
+// components of G_ip as scalars: passing a Vec through memory stalled the passes on store
+// forwarding). f(i, S, gx, gy, gz); gz = 0 in 2D.
+template <int Dim, class Kernel, class F>
+inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix, F&& f) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = ix.stride;
+  const mechanics::IVec<Dim> b = st.first_node();
+  if constexpr (Dim == 2) {
+    for (int j = 0; j < K; ++j) {
+      const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+      const int row = ix.shift + (b[1] + j) * sd[1] + b[0] * sd[0];
+      for (int i = 0; i < K; ++i) {
+        const double wx = st.axis[0].w[i];
+        f(row + i * sd[0], wx * wy, st.axis[0].dw[i] * wy, wx * dwy, 0.0);
+      }
+    }
+  } else {
+    for (int k = 0; k < K; ++k) {
+      const double wz = st.axis[2].w[k], dwz = st.axis[2].dw[k];
+      for (int j = 0; j < K; ++j) {
+        const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+        const int row = ix.shift + (b[2] + k) * sd[2] + (b[1] + j) * sd[1] + b[0] * sd[0];
+        for (int i = 0; i < K; ++i) {
+          const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
+          f(row + i * sd[0], wx * wy * wz, dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
+        }
+      }
+    }
+  }
+}
+
 // Relative spread of a particle's nodal temperatures below which they are taken as equal in the
 // sub-steps: 256 ε, the order of the re-projection's own round-off (T_i = Σ m C T S / Σ m C S over
 // ~10–30 terms). At 300 K it is 1.7e-11 K.
 constexpr double kQuietSpread = 256.0 * 2.220446049250313e-16;
 
-// A stencil's grid nodes, S_ip and G_ip, in stencil order.
-template <class NodeList, class Stencil, class Grid>
-void copy_nodes(const Grid& grid, const Stencil& st, NodeList& nl) {
-  nl.count = 0;
-  st.for_each(grid, [&](int i, double w, const auto& g) {
-    nl.node[nl.count] = i;
-    nl.S[nl.count] = w;
-    nl.G[nl.count] = g;
-    ++nl.count;
-  });
-}
-
 }  // namespace
+
+template <int Dim>
+template <class Kernel, bool WithG>
+void ExplicitConduction<Dim>::expand(std::size_t k, const std::vector<int>& unknown, Expanded& e) const {
+  const Kept& c = kept_[k];
+  int n = 0;
+  for_each_node(stencils_.template of<Kernel>()[k], indexer_, [&](int i, double w, double gx, double gy, double gz) {
+    const int u = unknown[static_cast<std::size_t>(i)];
+    if (u < 0) return;
+    e.unknown[n] = u;
+    e.S[n] = w;
+    if constexpr (WithG) {
+      e.G[0][n] = gx;
+      e.G[1][n] = gy;
+      if constexpr (Dim == 3) e.G[2][n] = gz;
+    }
+    ++n;
+  });
+  e.count = n;
+  if constexpr (WithG)
+    if (c.lumped)  // lump dropped nodes, as keep()
+      for (int a = 0; a < n; ++a) {
+        const double share = e.S[a] / c.s_kept;
+        for (int d = 0; d < Dim; ++d) e.G[d][a] += share * c.g_dropped[d];
+      }
+}
 
 template <int Dim>
 template <class Kernel>
@@ -45,48 +94,36 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   sys.dropped_mass = 0.0;
   sys.conductance.resize(0, 0);  // no K on this path
   mct_.assign(n_nodes, 0.0);
-  if (!view.template as<Kernel>(p.size())) nodes_.resize(p.size());  // scratch only without the step's stencils
-  kept_mass_.resize(p.size());
-  kept_flux_.resize(p.size());
+  indexer_ = mechanics::NodeIndexer<Dim>{grid.strides(), 0};
+  StencilVector<Kernel>& kept_stencils = stencils_.template of<Kernel>();
+  kept_stencils.resize(p.size());
+  kept_.resize(p.size());
   gathered_at_.assign(p.position.begin(), p.position.end());
   unknown_runs_.assign(p.size() * kMaxRuns, UnknownRun{1, 0});  // empty until keep()
-  quiet_.assign(p.size(), 0);
-  flux_temperature_.resize(0);  // new unknowns: every particle is looked at in the next sub-step
+  quiet_.assign(p.size(), 1);  // particles that hold no heat carry no flux
+  flux_temperature_.resize(0);  // set with quiet_ at the end
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
 
-  // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them. With the step's
-  // stencils nothing is stored (pass 2 reads them again); otherwise each stencil is evaluated once and
-  // its node list kept for pass 2.
+  // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them; each
+  // heat-holding particle's stencil kept (copied from the step's, or evaluated here).
   holds_heat_.assign(p.size(), 0);
   for (std::size_t k = 0; k < p.size(); ++k) {
-    kept_mass_[k].count = 0;
-    kept_flux_[k].count = 0;
-    kept_flux_[k].conductance = 0.0;
-    kept_flux_[k].rayleigh = 0.0;
+    kept_[k] = Kept{};
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    kept_mass_[k].heat_capacity = mc;
+    kept_[k].heat_capacity = mc;
     const double mct = mc * p.temperature[k];
-    if (step_stencils) {
-      step_stencils[k].for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>&) {
-        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
-        mct_[static_cast<std::size_t>(i)] += mct * w;
-      });
-      continue;
-    }
-    Nodes& nl = nodes_[k];
-    mechanics::Stencil<Dim, Kernel> st;
-    st.evaluate(grid, p.position[k], p.half_size[k]);
-    copy_nodes(grid, st, nl);
-    for (int a = 0; a < nl.count; ++a) {
-      const auto i = static_cast<std::size_t>(nl.node[a]);
-      sys.grid_mass[i] += mc * nl.S[a];
-      mct_[i] += mct * nl.S[a];
-    }
+    mechanics::Stencil<Dim, Kernel>& st = kept_stencils[k];
+    if (step_stencils) st = step_stencils[k];
+    else st.evaluate(grid, p.position[k], p.half_size[k]);
+    st.for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+      sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+      mct_[static_cast<std::size_t>(i)] += mct * w;
+    });
   }
   if (!(sys.particle_heat_capacity > 0.0))
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
@@ -99,43 +136,75 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   next_mct_.resize(n);
   for (Eigen::Index u = 0; u < n; ++u) next_mct_[u] = mct_[static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)])];
 
-  // Pass 2: per heat-holding particle its kept nodes (S, lumped G') and the bounds of M⁻¹K.
+  // Pass 2: per heat-holding particle its lumping, runs and the bounds of M⁻¹K.
   row_bound_.assign(static_cast<std::size_t>(n), 0.0);
   rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
   mass_peak_ = sys.mass;
   rayleigh_scale_ = 1.0;
-  Nodes from_step;
+  // With them, the first sub-step's f_i at sys.temperature (what the coupler advances from), summed
+  // in particle order as substeps_with sums it, while the particle's G' is at hand.
+  force_.setZero(n);
+  Expanded e;
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k]) continue;
-    if (step_stencils) copy_nodes(grid, step_stencils[k], from_step);
-    keep(k, step_stencils ? from_step : nodes_[k], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
+    keep<Kernel>(k, thermal_properties_of(materials, p.material[k]), p.volume[k], sys, e);
+    // Whether it carries flux at the temperatures the window starts from, as the first sub-step
+    // would find.
+    const Kept& c = kept_[k];
+    if (c.conductance == 0.0) {
+      quiet_[k] = 1;
+      continue;
+    }
+    double lo = sys.temperature[e.unknown[0]], hi = lo;
+    for (int a = 1; a < e.count; ++a) {
+      lo = std::min(lo, sys.temperature[e.unknown[a]]);
+      hi = std::max(hi, sys.temperature[e.unknown[a]]);
+    }
+    quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+    if (quiet_[k]) continue;
+    // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
+    mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+    for (int a = 0; a < e.count; ++a) grad += e.g(a) * sys.temperature[e.unknown[a]];
+    grad *= c.conductance;
+    for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
   }
+  flux_temperature_ = sys.temperature;  // quiet_ and force_ hold for these temperatures
+  first_force_ready_ = true;
 }
 
 template <int Dim>
-void ExplicitConduction<Dim>::keep(std::size_t k, const Nodes& nl, const ThermalProperties& m, double volume,
-                                   const NodalThermalSystem& sys) {
-  KeptMass& c = kept_mass_[k];
-  KeptFlux& f = kept_flux_[k];
+template <class Kernel>
+void ExplicitConduction<Dim>::keep(std::size_t k, const ThermalProperties& m, double volume,
+                                   const NodalThermalSystem& sys, Expanded& e) {
+  Kept& c = kept_[k];
   c.count = 0;
-  f.count = 0;
-  f.conductance = 0.0;
-  f.rayleigh = 0.0;
-  mechanics::Vec<Dim> G[capacity];  // G' of the kept nodes
+  c.conductance = 0.0;
+  c.rayleigh = 0.0;
+  c.lumped = 0;
   double s_kept = 0.0;
   mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
-  for (int a = 0; a < nl.count; ++a) {
-    const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
+  int total = 0, n = 0;
+  for_each_node(stencils_.template of<Kernel>()[k], indexer_, [&](int i, double w, double gx, double gy, double gz) {
+    ++total;
+    const int u = sys.unknown[static_cast<std::size_t>(i)];
     if (u >= 0) {
-      s_kept += nl.S[a];
-      c.unknown[c.count] = u;
-      G[c.count] = nl.G[a];
-      c.S[c.count] = nl.S[a];
-      ++c.count;
+      s_kept += w;
+      e.unknown[n] = u;
+      e.S[n] = w;
+      e.G[0][n] = gx;
+      e.G[1][n] = gy;
+      if constexpr (Dim == 3) e.G[2][n] = gz;
+      ++n;
     } else {
-      g_dropped += nl.G[a];
+      g_dropped[0] += gx;
+      g_dropped[1] += gy;
+      if constexpr (Dim == 3) g_dropped[2] += gz;
     }
-  }
+  });
+  e.count = n;
+  c.count = n;
+  c.s_kept = s_kept;
+  c.g_dropped = g_dropped;
   // The per-window passes skip it while none of its unknowns changed (any_changed).
   // Its unknowns as runs of numbers: the stencil lists them x fastest, so a new row starts where the
   // number jumps by more than a row of the stencil could (the unknowns of a grid row are numbered
@@ -143,8 +212,8 @@ void ExplicitConduction<Dim>::keep(std::size_t k, const Nodes& nl, const Thermal
   UnknownRun* runs = &unknown_runs_[k * kMaxRuns];
   std::fill(runs, runs + kMaxRuns, UnknownRun{1, 0});
   int r = 0;
-  for (int a = 0; a < c.count; ++a) {
-    const int u = c.unknown[a];
+  for (int a = 0; a < n; ++a) {
+    const int u = e.unknown[a];
     if (a > 0 && r + 1 < kMaxRuns && (u < runs[r].lo || u > runs[r].hi + capacity)) ++r;
     if (runs[r].lo > runs[r].hi) runs[r] = {u, u};
     runs[r].lo = std::min(runs[r].lo, u);
@@ -152,40 +221,61 @@ void ExplicitConduction<Dim>::keep(std::size_t k, const Nodes& nl, const Thermal
   }
   quiet_[k] = 0;
   // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
-  if (!(m.conductivity > 0.0) || c.count == 0 || !(s_kept > 0.0)) return;
-  if (c.count < nl.count)
-    for (int a = 0; a < c.count; ++a) G[a] += (c.S[a] / s_kept) * g_dropped;  // lump dropped nodes
-  f.conductance = volume * m.conductivity;
-  f.count = c.count;
-  for (int a = 0; a < c.count; ++a) f.unknown[a] = c.unknown[a], f.G[a] = G[a];
+  if (!(m.conductivity > 0.0) || n == 0 || !(s_kept > 0.0)) return;
+  if (n < total) {
+    c.lumped = 1;
+    for (int a = 0; a < n; ++a) {  // lump dropped nodes
+      const double share = e.S[a] / s_kept;
+      for (int d = 0; d < Dim; ++d) e.G[d][a] += share * g_dropped[d];
+    }
+  }
+  c.conductance = volume * m.conductivity;
   // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
   // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
   // Σ_p c_p (Σ_a |G'_a|²/M_a)(Σ_a M_a x_a²), so λ ≤ max_i Σ_{p∋i} c_p Σ_a |G'_a|²/M_a.
   double gsum = 0.0, g2m = 0.0;
   double gnorm[capacity];
-  for (int a = 0; a < c.count; ++a) {
-    gnorm[a] = G[a].norm();
-    gsum += gnorm[a];
-    g2m += gnorm[a] * gnorm[a] / sys.mass[c.unknown[a]];
+  double g2[capacity];
+  int a0 = 0;
+#if defined(__SSE2__)
+  // Two nodes at a time (sqrtpd, divpd: the pass was bound by the divider). The same correctly
+  // rounded operations in the same order as Vec::norm() (x² + y²) + z² and |G'|²/M: the same bits.
+  for (; a0 + 1 < n; a0 += 2) {
+    __m128d s2 = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(&e.G[0][a0]), _mm_loadu_pd(&e.G[0][a0])),
+                            _mm_mul_pd(_mm_loadu_pd(&e.G[1][a0]), _mm_loadu_pd(&e.G[1][a0])));
+    if constexpr (Dim == 3)
+      s2 = _mm_add_pd(s2, _mm_mul_pd(_mm_loadu_pd(&e.G[2][a0]), _mm_loadu_pd(&e.G[2][a0])));
+    const __m128d gn = _mm_sqrt_pd(s2);
+    _mm_storeu_pd(&gnorm[a0], gn);
+    const __m128d mass = _mm_set_pd(sys.mass[e.unknown[a0 + 1]], sys.mass[e.unknown[a0]]);
+    _mm_storeu_pd(&g2[a0], _mm_div_pd(_mm_mul_pd(gn, gn), mass));
   }
-  f.rayleigh = f.conductance * g2m;
-  for (int a = 0; a < c.count; ++a) {
-    row_bound_[static_cast<std::size_t>(c.unknown[a])] += f.conductance * gnorm[a] * gsum;
-    rayleigh_bound_[static_cast<std::size_t>(c.unknown[a])] += f.rayleigh;
+#endif
+  for (int a = a0; a < n; ++a) {
+    gnorm[a] = e.g(a).norm();
+    g2[a] = gnorm[a] * gnorm[a] / sys.mass[e.unknown[a]];
+  }
+  for (int a = 0; a < n; ++a) {  // the sums in node order
+    gsum += gnorm[a];
+    g2m += g2[a];
+  }
+  c.rayleigh = c.conductance * g2m;
+  for (int a = 0; a < n; ++a) {
+    row_bound_[static_cast<std::size_t>(e.unknown[a])] += c.conductance * gnorm[a] * gsum;
+    rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] += c.rayleigh;
   }
 }
 
 template <int Dim>
-void ExplicitConduction<Dim>::remove_bounds(const KeptFlux& f) {
+void ExplicitConduction<Dim>::remove_bounds(const Kept& c, const Expanded& e) {
+  if (c.conductance == 0.0) return;  // keep() added none
   double gsum = 0.0;
   double gnorm[capacity];
-  for (int a = 0; a < f.count; ++a) {
-    gnorm[a] = f.G[a].norm();
-    gsum += gnorm[a];
-  }
-  for (int a = 0; a < f.count; ++a) {
-    row_bound_[static_cast<std::size_t>(f.unknown[a])] -= f.conductance * gnorm[a] * gsum;
-    rayleigh_bound_[static_cast<std::size_t>(f.unknown[a])] -= f.rayleigh;
+  for (int a = 0; a < e.count; ++a) gnorm[a] = e.g(a).norm();
+  for (int a = 0; a < e.count; ++a) gsum += gnorm[a];
+  for (int a = 0; a < e.count; ++a) {
+    row_bound_[static_cast<std::size_t>(e.unknown[a])] -= c.conductance * gnorm[a] * gsum;
+    rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] -= c.rayleigh;
   }
 }
 
@@ -194,6 +284,7 @@ void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mec
                                      mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                      const AssemblyOptions& options, NodalThermalSystem& sys,
                                      const mechanics::StencilView<Dim>& stencils) {
+  kind_ = shape;
   mechanics::dispatch_shape(shape, [&](auto kernel) {
     gather_with<decltype(kernel)>(grid, particles, materials, options, sys, stencils);
   });
@@ -204,7 +295,10 @@ template <class Kernel>
 typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
     const AssemblyOptions& opt, NodalThermalSystem& sys, double max_shift, const mechanics::StencilView<Dim>& view) {
-  if (gathered_at_.size() != p.size() || kept_mass_.size() != p.size()) return Refresh::regather;
+  first_force_ready_ = false;
+  if (gathered_at_.size() != p.size() || kept_.size() != p.size() ||
+      stencils_.template of<Kernel>().size() != p.size())
+    return Refresh::regather;
   moved_.clear();
   std::size_t holding = 0;
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -218,23 +312,20 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
   // M_i on every node (eq. 38): each moved particle's weights at its last gather out, at its
   // position now in (the step's stencils when given: the same numbers as evaluating them here).
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
-  moved_nodes_.resize(moved_.size());
+  const StencilVector<Kernel>& kept_stencils = stencils_.template of<Kernel>();
+  StencilVector<Kernel>& now = moved_stencils_.template of<Kernel>();
+  now.resize(moved_.size());
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
-    const double mc = kept_mass_[k].heat_capacity;
-    mechanics::Stencil<Dim, Kernel> st;
-    st.evaluate(grid, gathered_at_[k], p.half_size[k]);
-    st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>&) {
+    const double mc = kept_[k].heat_capacity;
+    kept_stencils[k].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
       sys.grid_mass[static_cast<std::size_t>(i)] -= mc * w;
     });
-    if (step_stencils) {
-      copy_nodes(grid, step_stencils[k], moved_nodes_[j]);
-    } else {
-      st.evaluate(grid, p.position[k], p.half_size[k]);
-      copy_nodes(grid, st, moved_nodes_[j]);
-    }
-    const Nodes& now = moved_nodes_[j];
-    for (int a = 0; a < now.count; ++a) sys.grid_mass[static_cast<std::size_t>(now.node[a])] += mc * now.S[a];
+    if (step_stencils) now[j] = step_stencils[k];
+    else now[j].evaluate(grid, p.position[k], p.half_size[k]);
+    now[j].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+      sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+    });
   }
 
   // The unknowns must stay those of the gather (select_unknowns' rule): the kept lists, the lumping
@@ -260,20 +351,17 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
   }
   rayleigh_scale_ = scale;
 
-  // The moved particles' kept lists, bounds and eq. 38 sums for the next reproject(), anew.
+  // The moved particles' kept state, bounds and eq. 38 sums for the next reproject(), anew.
+  Expanded e;
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
-    const double mct = kept_mass_[k].heat_capacity * p.temperature[k];
-    {
-      const KeptMass& c = kept_mass_[k];  // the eq. 38 sums: its old terms out
-      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] -= mct * c.S[a];
-    }
-    remove_bounds(kept_flux_[k]);
-    keep(k, moved_nodes_[j], thermal_properties_of(materials, p.material[k]), p.volume[k], sys);
-    {
-      const KeptMass& c = kept_mass_[k];  // and its new ones in
-      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += mct * c.S[a];
-    }
+    const double mct = kept_[k].heat_capacity * p.temperature[k];
+    expand<Kernel, true>(k, sys.unknown, e);  // as its last keep(): the unknowns have not changed
+    for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
+    remove_bounds(kept_[k], e);
+    stencils_.template of<Kernel>()[k] = now[j];
+    keep<Kernel>(k, thermal_properties_of(materials, p.material[k]), p.volume[k], sys, e);
+    for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];  // and its new ones in
     gathered_at_[k] = p.position[k];
   }
   return Refresh::refreshed;
@@ -291,9 +379,10 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh(
 
 template <int Dim>
 void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
-  if (kept_mass_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
+  if (kept_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
   const auto n = static_cast<Eigen::Index>(sys.size());
   if (next_mct_.size() != n) throw std::logic_error("ExplicitConduction::reproject: the sums are of other unknowns");
+  first_force_ready_ = false;
   // The eq. 38 sums, kept with the particles' temperatures by the gather, refresh and map_back.
   for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
 }
@@ -341,12 +430,33 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
   for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;  // Dirichlet values first
   const double h = window / static_cast<double>(substeps);
   const Eigen::VectorXd q = joules / window;  // constant over the window: ∫ q dt = W (design §4)
+  mechanics::dispatch_shape(kind_, [&](auto kernel) { substeps_with<decltype(kernel)>(sys, T, q, fixed, h, substeps); });
+  return T;
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen::VectorXd& T, const Eigen::VectorXd& q,
+                                            const std::vector<FixedNode>& fixed, double h, long substeps) {
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  // The gather's f_i serve the first sub-step if it starts from the temperatures they were made at
+  // (no fixed node changed one): the same sums, the particle pass saved.
+  bool force_ready = first_force_ready_ && force_.size() == n && flux_temperature_.size() == n &&
+                     T == flux_temperature_;
+  first_force_ready_ = false;
   force_.resize(n);
+  Expanded e;
   for (long s = 0; s < substeps; ++s) {
+    if (force_ready) {
+      force_ready = false;
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
     force_.setZero();
     // Nodes whose temperature changed since the last sub-step, as a prefix count over the unknowns:
     // a particle whose nodes all kept theirs and that was quiet then is quiet now, and is passed over
-    // reading a few bytes instead of its kept list.
+    // reading a few bytes instead of its kept state.
     const bool first = flux_temperature_.size() != n;
     changed_before_.resize(static_cast<std::size_t>(n) + 1);
     changed_before_[0] = 0;
@@ -354,9 +464,9 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
       changed_before_[static_cast<std::size_t>(u) + 1] =
           changed_before_[static_cast<std::size_t>(u)] + (first || T[u] != flux_temperature_[u] ? 1 : 0);
     flux_temperature_ = T;
-    for (std::size_t k = 0; k < kept_flux_.size(); ++k) {
+    for (std::size_t k = 0; k < kept_.size(); ++k) {
       if (quiet_[k] && !any_changed(k)) continue;
-      const KeptFlux& c = kept_flux_[k];
+      const Kept& c = kept_[k];
       if (c.conductance == 0.0) {
         quiet_[k] = 1;  // carries no flux whatever its nodes do
         continue;
@@ -364,33 +474,41 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
       // Nodal temperatures that agree to round-off (the re-projection's own, kQuietSpread) carry no
       // flux through the particle: its terms are left out, which keeps Σ_i f_i = 0 exactly and the
       // nodes it alone touches unchanged (their ΔT_i = 0 lets the map back pass over their particles).
-      double lo = T[c.unknown[0]], hi = lo;
-      for (int a = 1; a < c.count; ++a) {
-        lo = std::min(lo, T[c.unknown[a]]);
-        hi = std::max(hi, T[c.unknown[a]]);
+      expand<Kernel, false>(k, sys.unknown, e);
+      double lo = T[e.unknown[0]], hi = lo;
+      for (int a = 1; a < e.count; ++a) {
+        lo = std::min(lo, T[e.unknown[a]]);
+        hi = std::max(hi, T[e.unknown[a]]);
       }
       quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
       if (quiet_[k]) continue;
+      expand<Kernel, true>(k, sys.unknown, e);
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
       mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
-      for (int a = 0; a < c.count; ++a) grad += c.G[a] * T[c.unknown[a]];
+      for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
       grad *= c.conductance;
-      for (int a = 0; a < c.count; ++a) force_[c.unknown[a]] -= c.G[a].dot(grad);  // f_i = −V k G'·∇T
+      for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);  // f_i = −V k G'·∇T
     }
     for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
     for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
   }
-  return T;
 }
 
 template <int Dim>
 void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
                                        const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
-  if (kept_mass_.size() != p.size())
+  if (kept_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
-  const bool relax = end && beta > 0.0;
   if (next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
     throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
+  mechanics::dispatch_shape(kind_, [&](auto kernel) { map_back_with<decltype(kernel)>(p, sys, delta, beta, end); });
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
+                                            const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+  const bool relax = end && beta > 0.0;
   // Unknowns whose temperature changed in the window, as a prefix count: a particle with none in the
   // runs of its unknowns keeps its temperature (ΔT_p = 0 exactly) and is passed over.
   const auto n = static_cast<std::size_t>(sys.size());
@@ -398,10 +516,12 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
   changed_before_[0] = 0;
   for (std::size_t u = 0; u < n; ++u)
     changed_before_[u + 1] = changed_before_[u] + (relax || delta[static_cast<Eigen::Index>(u)] != 0.0 ? 1 : 0);
+  Expanded c;
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!any_changed(k)) continue;  // also every particle that holds no heat or reaches no unknown (no run)
-    const KeptMass& c = kept_mass_[k];
-    if (c.count == 0) continue;
+    const Kept& kept = kept_[k];
+    if (kept.count == 0) continue;
+    expand<Kernel, false>(k, sys.unknown, c);
     // design §4: the increment, not the nodal value
     double dT = 0.0;
     for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
@@ -418,7 +538,7 @@ void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const Nodal
     if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
     // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
-    const double change = c.heat_capacity * (T - before);
+    const double change = kept.heat_capacity * (T - before);
     for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
   }
 }

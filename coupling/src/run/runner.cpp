@@ -67,8 +67,20 @@ class Run {
     const std::size_t particles = sim_->particles().size();
     omp_set_num_threads(threads > 0 ? threads : default_thread_count(particles));
     const int stepping = mechanics::threads_for_particles(particles, omp_get_max_threads());  // as Simulation::step
-    if (threads <= 0 && std::getenv("OMP_NUM_THREADS") == nullptr && waiting_threads_spin() && stepping >= 2)
+    // Spinning waits (an MPI build: the launcher owns the process; or OMP_WAIT_POLICY=active): the
+    // governor watches the threads, for a count given (--threads, run.threads) as for the default one
+    // (issue 35: an explicit --threads 2 took 16.8x the 1-thread time with another process busy).
+    // OMP_NUM_THREADS in the environment keeps the count fixed (ctest's bit-reproducible runs set it).
+    const bool given = threads > 0;
+    if (std::getenv("OMP_NUM_THREADS") == nullptr && waiting_threads_spin() && stepping >= 2) {
       governor_.emplace(stepping);
+      if (given && !o_.quiet)
+        (o_.log ? *o_.log : std::cerr)
+            << "frictherm: " << threads << " threads with spinning waits (OMP_WAIT_POLICY "
+            << (std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "unset")
+            << "): the thread governor goes on with 1 thread while another process holds a core "
+               "(OMP_NUM_THREADS, OMP_WAIT_POLICY=passive or GOMP_SPINCOUNT keep the count fixed)\n";
+    }
     r_.particles = sim_->particles().size();
     check_checkpoints();
     if (!o_.resume_checkpoint.empty()) restore();

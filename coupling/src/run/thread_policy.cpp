@@ -95,7 +95,7 @@ std::string ThreadGovernor::step_finished() {
     reduced_at_ = Clock::now();
     ++changes_;
     msg << "frictherm: " << full_ << " threads got " << cores << " cores (another process is busy): going on with 1 thread, trying "
-        << full_ << " again in " << backoff_ << " s (a count given by --threads is kept)";
+        << full_ << " again in " << backoff_ << " s (OMP_WAIT_POLICY=passive keeps the count)";
     return msg.str();
   }
   if (probing_) {  // the full count got its cores

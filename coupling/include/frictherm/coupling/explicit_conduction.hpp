@@ -28,6 +28,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -101,35 +102,60 @@ class ExplicitConduction {
 
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
-  /// The stencil of one particle (scratch of the gather): grid node, S_ip and G_ip.
-  struct Nodes {
-    int count = 0;
-    int node[capacity];
-    double S[capacity];
-    mechanics::Vec<Dim> G[capacity];
-  };
-  /// One heat-holding particle's nodes that are unknowns, in stencil order, split by the pass that
-  /// reads them (each window streams its part only): the map back and the re-projection read the
-  /// unknown numbers, S_ip and m_p C_v,p; the conduction sub-steps the unknown numbers, the lumped G'_ip
-  /// and V_p k_p (0 without conduction).
-  struct KeptMass {
-    int count = 0;
+  /// One heat-holding particle's state of its last gather besides its stencil (kept whole: the 1D
+  /// weights and derivatives, ~170 bytes in 3D): its nodes that are unknowns are those of its stencil
+  /// with sys.unknown >= 0, in stencil order, S_ip and G_ip are evaluated again from the kept
+  /// weights (the same products, so the same numbers) and G' lumped with s_kept and g_dropped. Each
+  /// pass thus streams ~300 bytes per particle in 3D instead of expanded lists of ~1100 (issue 35).
+  struct Kept {
     double heat_capacity = 0.0;  // m_p C_v,p (J/K)
+    double conductance = 0.0;    // V_p k_p (W m/K): times G'·G' gives W/K; 0: carries no flux
+    double rayleigh = 0.0;       // V_p k_p Σ_a |G'_ap|²/M_a as added to rayleigh_bound_ (M of that time)
+    double s_kept = 0.0;         // Σ S_ip over its unknowns
+    mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();  // Σ G_ip over its other nodes
+    int count = 0;               // its nodes that are unknowns (0: holds no heat or reaches none)
+    int lumped = 0;              // some node dropped: G'_ip = G_ip + (S_ip / s_kept) g_dropped
+  };
+  /// A particle's unknowns, S_ip and (when asked) G'_ip, in stencil order: the lists of its gather.
+  struct Expanded {
+    int count = 0;
     int unknown[capacity];
     double S[capacity];
+    double G[Dim][capacity];  // by component (scalar stores: Vec temporaries through memory stalled)
+    mechanics::Vec<Dim> g(int a) const {
+      if constexpr (Dim == 2) return mechanics::Vec<Dim>(G[0][a], G[1][a]);
+      else return mechanics::Vec<Dim>(G[0][a], G[1][a], G[2][a]);
+    }
   };
-  struct KeptFlux {
-    int count = 0;
-    double conductance = 0.0;  // V_p k_p (W m/K): times G'·G' gives W/K
-    double rayleigh = 0.0;     // V_p k_p Σ_a |G'_ap|²/M_a as added to rayleigh_bound_ (M of that time)
-    int unknown[capacity];
-    mechanics::Vec<Dim> G[capacity];
+  template <class Kernel>
+  using StencilVector = std::vector<mechanics::Stencil<Dim, Kernel>>;
+  /// Per-particle stencils of one of the kernels (the one of the gather).
+  struct Stencils {
+    StencilVector<mechanics::LinearKernel> linear;
+    StencilVector<mechanics::UGIMPKernel> ugimp;
+    StencilVector<mechanics::QuadraticBSplineKernel> bspline;
+    template <class Kernel>
+    StencilVector<Kernel>& of() {
+      if constexpr (std::is_same_v<Kernel, mechanics::LinearKernel>) return linear;
+      else if constexpr (std::is_same_v<Kernel, mechanics::UGIMPKernel>) return ugimp;
+      else return bspline;
+    }
+    template <class Kernel>
+    const StencilVector<Kernel>& of() const {
+      return const_cast<Stencils*>(this)->template of<Kernel>();
+    }
   };
-  /// The particle's kept lists from its stencil nodes and the unknowns of `sys`, its bounds added.
-  void keep(std::size_t k, const Nodes& nodes, const ThermalProperties& material, double volume,
-            const NodalThermalSystem& sys);
-  /// Its bound contributions taken out again (a refresh), as keep() added them.
-  void remove_bounds(const KeptFlux& f);
+  /// Particle k's kept stencil expanded onto the unknowns of `unknown` (sys.unknown of the gather);
+  /// G' (lumped) only if WithG.
+  template <class Kernel, bool WithG>
+  void expand(std::size_t k, const std::vector<int>& unknown, Expanded& e) const;
+  /// Particle k's Kept, runs and bounds from its kept stencil and the unknowns of `sys`; its
+  /// expansion (S and G') into e.
+  template <class Kernel>
+  void keep(std::size_t k, const ThermalProperties& material, double volume, const NodalThermalSystem& sys,
+            Expanded& e);
+  /// Its bound contributions taken out again (a refresh), as keep() added them (e: its old expansion).
+  void remove_bounds(const Kept& c, const Expanded& e);
   template <class Kernel>
   Refresh refresh_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                        const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
@@ -138,11 +164,19 @@ class ExplicitConduction {
   void gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
                    NodalThermalSystem& sys, const mechanics::StencilView<Dim>& stencils);
+  template <class Kernel>
+  void substeps_with(const NodalThermalSystem& sys, Eigen::VectorXd& T, const Eigen::VectorXd& q,
+                     const std::vector<FixedNode>& fixed, double h, long substeps);
+  template <class Kernel>
+  void map_back_with(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
+                     double beta, const Eigen::VectorXd* end);
 
-  std::vector<Nodes> nodes_;              // gather scratch, by particle (when the coupler evaluates the stencils)
+  mechanics::ShapeKind kind_ = mechanics::ShapeKind::linear;  // the kernel of the kept stencils
+  mechanics::NodeIndexer<Dim> indexer_{};                    // the grid's node numbering
+  Stencils stencils_;                     // by particle, at its gathered position (heat-holding ones)
+  Stencils moved_stencils_;               // refresh scratch: the moved particles' stencils now
   std::vector<unsigned char> holds_heat_;  // gather: particle of a material with thermal properties
-  std::vector<KeptMass> kept_mass_;       // by particle; count 0 for particles that hold no heat
-  std::vector<KeptFlux> kept_flux_;       // by particle; conductance 0 for particles that do not conduct
+  std::vector<Kept> kept_;                // by particle; count 0 for particles that hold no heat
   std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
   std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
   Eigen::VectorXd next_mct_;              // the same by unknown, kept with the T_p by refresh and map_back
@@ -153,8 +187,8 @@ class ExplicitConduction {
   Eigen::VectorXd mass_peak_;              // largest M_a since the gather, by unknown
   double rayleigh_scale_ = 1.0;            // max_a M_peak_a / M_a
   std::vector<std::size_t> moved_;         // refresh scratch: particles to gather again
-  std::vector<Nodes> moved_nodes_;         // refresh scratch: their stencils now, in moved_ order
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
+  bool first_force_ready_ = false;        // force_ holds f_i at flux_temperature_ (made by the gather)
   // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
   // streaming every particle's kept lists): per particle the runs of its unknown numbers (row by row) and whether its
   // nodal temperatures agreed to round-off when last looked at; per unknown the temperature of the

@@ -13,10 +13,11 @@
 // * The default thread count (no --threads, no run.threads, no OMP_NUM_THREADS) is at most the
 //   number of cores not busy with other processes at the start, and one thread per 2000 particles
 //   (the mechanics step's own threshold: below it the fork/join costs more than the shared work).
-// * A run on the default thread count whose waiting threads spin (an MPI build, where the launcher
-//   owns the process and the policy is not set, or OMP_WAIT_POLICY=active) watches whether its
-//   threads get their cores (ThreadGovernor): while another process holds one, two spinning threads
-//   run 10-20 times slower than one, so it goes on with one thread and tries again later.
+// * A run whose waiting threads spin (an MPI build, where the launcher owns the process and the
+//   policy is not set, or OMP_WAIT_POLICY=active), on the default count or on one given by --threads
+//   or run.threads (issue 35; said on stderr), watches whether its threads get their cores
+//   (ThreadGovernor): while another process holds one, two spinning threads run 10-20 times slower
+//   than one, so it goes on with one thread and tries again later.
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -48,7 +49,9 @@ bool waiting_threads_spin();
 /// 0.75 × threads it sets OpenMP's count to 1; after `retry` seconds it tries the full count
 /// again for one window, keeps it if the threads get their cores, else waits twice as long (up to
 /// 16 × retry). The count changes round-off (the scatter buffers' sums), so a run that must be
-/// bit-reproducible gives its count (--threads, run.threads, OMP_NUM_THREADS): then there is no governor.
+/// bit-reproducible sets OMP_NUM_THREADS, or a passive wait policy (OMP_WAIT_POLICY=passive or
+/// GOMP_SPINCOUNT): then there is no governor. A count given by --threads or run.threads with
+/// spinning waits is governed too (issue 35: --threads 2 took 16.8x the 1-thread time on a busy core).
 class ThreadGovernor {
  public:
   ThreadGovernor(int threads, double window = 0.2, double retry = 10.0);
