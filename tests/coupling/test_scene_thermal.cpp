@@ -110,7 +110,7 @@ TEST(SceneThermal, ErrorsNameTheKeyPath) {
     const char* message;  // expected start of the error
   };
   const std::vector<Bad> cases{
-      {"/thermal/rtol", 2.0, "thermal.rtol: expected a number in (0, 1), got 2"},
+      {"/thermal/rtol", 2.0, "thermal.rtol: expected a number in [1e-14, 1), got 2"},
       {"/thermal/atol", 0.0, "thermal.atol: expected a number > 0, got 0"},
       {"/thermal/integrator", "rk4", "thermal.integrator: expected one of \"auto\", \"forward_euler\", \"cvode_bdf\""},
       {"/thermal/materials/steel/heat_capacity", -1.0, "thermal.materials.steel.heat_capacity: expected a number > 0"},
@@ -126,7 +126,7 @@ TEST(SceneThermal, ErrorsNameTheKeyPath) {
       {"/coupling/window/max_temperature_rise", 0.0, "coupling.window.max_temperature_rise: expected a number > 0"},
       {"/coupling/window/steps", 3, "coupling.window.steps: unknown key"},
       {"/coupling/heating_order", "third", "coupling.heating_order: expected one of \"first\", \"second\", got \"third\""},
-      {"/coupling/continuation/duration", -1.0, "coupling.continuation.duration: expected a number > 0"},
+      {"/coupling/continuation/duration", -1.0, "coupling.continuation.duration: expected a number in (0, 1e+12], got -1"},
       {"/coupling/continuation/intervals", 2.5, "coupling.continuation.intervals: expected an integer in [1, 100000]"},
       {"/coupling/hotspots/mode", "relative", "coupling.hotspots.mode: expected one of \"rise\", \"absolute\""},
       {"/coupling/hotspots/link_factor", 0.5, "coupling.hotspots.link_factor: expected a number in [1, 10]"},
