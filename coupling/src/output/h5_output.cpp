@@ -186,17 +186,9 @@ void H5Output::sync() {
 
 void H5Output::abandon() noexcept {
   if (!impl_ || impl_->closed) return;
-  Impl& m = *impl_;
   const Quiet quiet;
-  m.discard_snapshot();
-  m.series_sets.clear();
-  m.tables.clear();
-  m.series.reset();
-  m.nodes.reset();
-  m.snapshots.reset();
-  m.meta.reset();
-  m.file.reset();
-  m.closed = true;
+  impl_->discard_snapshot();
+  impl_->close_handles();
 }
 
 void H5Output::close() {
@@ -205,14 +197,7 @@ void H5Output::close() {
   flush();
   m.write_xdmf();
   const Quiet quiet;
-  m.series_sets.clear();
-  m.tables.clear();
-  m.series.reset();
-  m.nodes.reset();
-  m.snapshots.reset();
-  m.meta.reset();
-  m.file.reset();
-  m.closed = true;
+  m.close_handles();
   if (m.io.file != m.final_path) m.publish();
 }
 

@@ -112,6 +112,17 @@ struct H5Output::Impl {
   // Written under the final names after every snapshot; through a temporary the XDMF files are
   // written only with the result (publish): until then they would describe a file that is not
   // under the name they give (issue 34: a second run had relabelled the first run's snapshots).
+  // Every open handle closed, the file last (close and abandon).
+  void close_handles() noexcept {
+    series_sets.clear();
+    tables.clear();
+    series.reset();
+    nodes.reset();
+    snapshots.reset();
+    meta.reset();
+    file.reset();
+    closed = true;
+  }
   void write_xdmf();
   // The result renamed onto its name with its XDMF files (publish_with_xdmf, output_files.hpp).
   void publish();
