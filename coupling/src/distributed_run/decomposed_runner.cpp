@@ -7,6 +7,7 @@
 // --checkpoint-every wall seconds, at the end and on SIGINT/SIGTERM; a resumed run restores them and
 // rewrites OUT.h5 with the checkpoint's series rows, keeping the rank files' snapshots up to it.
 #include "distributed_run/decomposed_checkpoint.hpp"
+#include "distributed_run/decomposed_failure.hpp"
 #include "distributed_run/decomposed_hotspots.hpp"
 #include "distributed_run/decomposed_redistribute.hpp"
 #include "distributed_run/decomposed_setup.hpp"
@@ -25,12 +26,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 
 namespace frictherm::coupling {
 
@@ -45,6 +48,10 @@ std::string format_number(double v) {
   return buf;
 }
 
+// How long a rank that caught an exception waits for the others to catch it too (an error thrown on
+// every rank alike arrives within the same collective call's return) before it ends them all.
+constexpr double kFailureAgreementSeconds = 30.0;
+
 // OUT.xdmf without its extension: the base of DecomposedOutput's files (OUT.rank<r>.h5, OUT.xdmf).
 std::string output_base(const std::string& out) {
   const std::string x = xdmf_path_for(out);
@@ -58,7 +65,14 @@ class DecomposedRun {
   DecomposedRun(MPI_Comm comm, const Scene& scene, const RunOptions& options) : comm_(comm), s_(scene), o_(options) {
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
+    MPI_Comm_dup(comm_, &failure_comm_);
   }
+  ~DecomposedRun() {
+    if (out_) out_->abandon();  // an exception on its way out: never published with status running
+    if (failure_comm_ != MPI_COMM_NULL) MPI_Comm_free(&failure_comm_);
+  }
+  DecomposedRun(const DecomposedRun&) = delete;
+  DecomposedRun& operator=(const DecomposedRun&) = delete;
 
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
@@ -72,33 +86,41 @@ class DecomposedRun {
     if (checkpoints_ && !resuming_) generation_ = detail::committed_generation(comm_, checkpoint_file_);
     build();
     if (resuming_) restore();
+    if (rank_ == 0)  // the result's identity (/meta/run_id, every checkpoint's marks): a resume keeps its checkpoint's
+      run_id_ = !o_.run_id.empty() ? o_.run_id : resuming_ ? checkpoint_marks(o_.resume_checkpoint).run_id : "";
+    if (rank_ == 0 && run_id_.empty()) run_id_ = detail::fresh_run_id();
     open_output();
-    if (!resuming_) {  // a resumed run's output has the checkpoint's rows and snapshots already
-      series();
-      snapshot();
-    }
     detail::ProgressLine progress(std::cerr, rank_ == 0 && show_progress(), s_.end_time);
     last_flush_ = last_checkpoint_ = Clock::now();
+    // From here on the output exists: whatever throws ends the run as a breakdown does, the state
+    // under /failure and the result published with status "failed" (issue 34), as the serial run.
     try {
+      if (!resuming_) {  // a resumed run's output has the checkpoint's rows and snapshots already
+        series();
+        snapshot();
+      }
       loop(progress);
     } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
-      r_.status = RunResult::Status::failed;
-      r_.message = e.what();
-      write_failure(e.step(), e.time());
+      fail(e.step(), e.time(), e.what());
+    } catch (const std::exception& e) {  // agreed (an output's, a checkpoint's, the heat's) or this rank's alone
+      fail(step_, time_, "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: " + agreed(e.what()));
     }
     progress.finish();
     if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
       // At the end, a stop at run.max_steps or an interruption: before the off-schedule row and
       // snapshot below, which an uninterrupted run does not have (a resume drops them).
-      if (checkpoints_) checkpoint();
-      if (last_series_step_ != step_) series();
-      if (last_snapshot_step_ != step_) snapshot();
+      try {
+        if (checkpoints_) checkpoint();
+        if (last_series_step_ != step_) series();
+        if (last_snapshot_step_ != step_) snapshot();
+      } catch (const std::exception& e) {
+        fail(step_, time_, "writing the end of the run at step " + std::to_string(step_) + ", t = " +
+                               format_number(time_) + " s: " + agreed(e.what()));
+      }
     }
-    if (r_.status == RunResult::Status::interrupted) {
+    if (r_.status == RunResult::Status::interrupted)
       r_.message = std::string("interrupted by ") + detail::signal_name(r_.signal) + " at step " + std::to_string(step_) +
                    ", t = " + format_number(time_) + " s";
-      if (out_) out_->write_metadata("interruption", r_.message);
-    }
     if (r_.status == RunResult::Status::stopped_at_max_steps && !o_.quiet && rank_ == 0)
       (o_.log ? *o_.log : std::cerr) << "frictherm: note: stopped at run.max_steps = " << s_.max_steps << " (t = " << time_
                                      << " s of end_time " << s_.end_time << " s)\n";
@@ -106,11 +128,15 @@ class DecomposedRun {
     r_.time = time_;
     r_.wall_time = seconds_since(t0);
     record_phase_seconds();
-    detail::record_decomposed_traffic(comm_, mpm_->traffic(), mpm_->local_particles(), out_.get(),
-                                      o_.quiet ? nullptr : (o_.log ? o_.log : &std::cerr));
+    try {  // rank 0 writes its metadata after the reductions: a failure there is rank 0's alone
+      detail::record_decomposed_traffic(comm_, mpm_->traffic(), mpm_->local_particles(), out_.get(),
+                                        o_.quiet ? nullptr : (o_.log ? o_.log : &std::cerr));
+    } catch (const std::exception& e) {
+      note_write_error(e.what());
+    }
     r_.snapshots = static_cast<std::size_t>(snapshots_);
     if (heat_) pending_heat_ = heat_->pending_heat();  // collective
-    if (out_) finish_output();
+    finish_output();  // agreed by every rank
     snapshots_out_->close();
     if (heat_ && rank_ == 0 && !o_.quiet) detail::print_decomposed_books(o_.log ? *o_.log : std::cerr, heat_->books(), size_);
     return r_;
@@ -182,7 +208,7 @@ class DecomposedRun {
     if (rank_ == 0) {
       try {
         H5OutputOptions options;
-        options.write_xdmf = false;  // OUT.xdmf joins the rank files (DecomposedOutput)
+        options.write_xdmf = false;  // OUT.xdmf joins the rank files (DecomposedOutput), published with OUT.h5
         options.via_temporary = true;
         options.replace_existing = overwrite() || resuming_;  // a resume rewrites OUT.h5 (checkpoint's rows first)
         out_ = std::make_unique<H5Output>(r_.output, Dim, options);
@@ -195,11 +221,12 @@ class DecomposedRun {
       }
     }
     if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
-    try {
+    try {  // OUT.xdmf is not written during the run: publish() writes it with OUT.h5 (issue 34)
       snapshots_out_ = resuming_ ? std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, snapshots_,
                                                                       detail::split_grids(xdmf_grids_),
-                                                                      redistributed_from_ > 0)
-                                 : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite());
+                                                                      redistributed_from_ > 0, false)
+                                 : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite(),
+                                                                      false);
     } catch (const std::exception& e) {
       throw OutputError(e.what());
     }
@@ -212,6 +239,7 @@ class DecomposedRun {
     out_->write_metadata("version", FRICTHERM_VERSION);
     out_->write_metadata("command_line", o_.command_line);
     out_->write_metadata("status", "running");
+    out_->write_metadata("run_id", run_id_);
     out_->write_metadata("dimension", Dim);
     out_->write_metadata("engine", "decomposed");
     out_->write_metadata("ranks", size_);
@@ -380,16 +408,23 @@ class DecomposedRun {
       row.insert(row.end(), {static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
       if (s_.thermal.coupler.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
     }
+    std::string error;  // rank 0's write failure, agreed below so that no rank goes on alone
     if (out_) {
-      out_->append_series(row);
       series_rows_.insert(series_rows_.end(), row.begin(), row.end());  // for checkpoints
       series_columns_ = static_cast<long>(row.size());
-      if (hot_) hot_->append_table_rows(*out_, time_);
-      if (seconds_since(last_flush_) >= o_.flush_interval) {
-        out_->flush();
-        last_flush_ = Clock::now();
+      try {
+        out_->append_series(row);
+        if (hot_) hot_->append_table_rows(*out_, time_);
+        if (seconds_since(last_flush_) >= o_.flush_interval) {
+          out_->flush();
+          last_flush_ = Clock::now();
+        }
+      } catch (const std::exception& e) {
+        note_write_error(e.what());
+        error = std::string("writing '") + out_->live_path() + "': " + e.what();
       }
     }
+    if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw std::runtime_error(why);
     last_series_step_ = step_;
     output_seconds_ += seconds_since(c0);
   }
@@ -419,7 +454,56 @@ class DecomposedRun {
     } catch (const std::exception& e) {
       r_.message += std::string(" (the failing state was not written: ") + e.what() + ")";
     }
-    out_->write_metadata("failure", r_.message);
+    try {
+      out_->write_metadata("failure", r_.message);
+    } catch (const std::exception& e) {  // finish_output says that the result is incomplete
+      note_write_error(e.what());
+    }
+  }
+
+  // Collective: the run's failure, agreed by every rank: the state at it and the message.
+  void fail(long step, double time, const std::string& message) {
+    r_.status = RunResult::Status::failed;
+    r_.message = message;
+    write_failure(step, time);
+  }
+
+  // Rank 0: the first write into OUT.h5 that failed; the result then stays unpublished (finish_output).
+  void note_write_error(const std::string& what) {
+    if (rank_ == 0 && write_error_.empty()) write_error_ = what;
+  }
+
+  // `what` this rank caught, once every rank has caught it (an error thrown on every rank alike): the
+  // lowest rank's message. Caught on this rank alone (the others wait in a collective call of the
+  // step), it cannot be agreed: rank 0 publishes what it holds as failed, and every rank ends
+  // (MPI_Abort) rather than waiting for ever (issue 34).
+  std::string agreed(const std::string& what) {
+    if (std::optional<std::string> m = detail::agree_on_failure(failure_comm_, what, kFailureAgreementSeconds)) return *m;
+    const std::string why = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: on rank " +
+                            std::to_string(rank_) + " alone: " + what +
+                            " (the other ranks were waiting in a collective call: every rank ends; the failing "
+                            "state is not gathered)";
+    std::cerr << "frictherm: simulation failed: " << why << '\n';
+    if (rank_ == 0 && out_) {
+      r_.status = RunResult::Status::failed;
+      r_.message = why;
+      try {
+        out_->write_metadata("failure", why);
+      } catch (const std::exception& e) {
+        note_write_error(e.what());
+      }
+      r_.wall_time = 0.0;
+      std::string left;
+      try {
+        left = publish();
+      } catch (const std::exception& e) {
+        left = e.what();
+      }
+      std::cerr << "frictherm: " << (left.empty() ? "kept " + r_.output + " (status failed)" : left) << '\n';
+    }
+    std::cerr.flush();
+    MPI_Abort(comm_, 1);
+    std::abort();  // not reached
   }
 
   // Collective: every rank writes its particles; rank 0 rewrites OUT.xdmf.
@@ -450,9 +534,53 @@ class DecomposedRun {
     ph.emplace_back("other", r_.wall_time - accounted);
   }
 
-  // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5.
+  // Collective: rank 0 publishes the result (publish), every rank learns how that went. A write
+  // that failed leaves the result unpublished under its temporary name (status running; exit code 1,
+  // as the serial run); another file under the result's name meanwhile is a refusal (OutputError).
   void finish_output() {
+    std::string error;
+    int refused = 0;
+    if (out_) {
+      try {
+        error = publish();
+      } catch (const std::exception& e) {
+        error = e.what();
+        refused = 1;
+      }
+    }
+    const std::string why = detail::agreed_error(comm_, error);
+    MPI_Bcast(&refused, 1, MPI_INT, 0, comm_);
+    if (why.empty()) return;
+    if (refused) throw OutputError(why);
+    throw DecomposedRunError(why);
+  }
+
+  // Rank 0: metadata and books, then OUT.h5.<pid>.part renamed onto OUT.h5. Returns "" when published,
+  // else why not (a write failed: the result stays under its temporary name); throws when the
+  // publication itself is refused.
+  std::string publish() {
     r_.series_rows = out_->series_rows();
+    try {
+      if (!write_error_.empty()) throw std::runtime_error(write_error_);
+      write_end_metadata();
+      out_->publish_xdmf_with_result(snapshots_out_->xdmf_text());  // OUT.xdmf with OUT.h5, as the serial run's
+      out_->sync();  // before the name: the published result is on disk
+    } catch (const std::exception& e) {
+      const std::string live = out_->live_path();
+      out_->abandon();
+      out_.reset();
+      return (r_.status == RunResult::Status::failed ? r_.message + "; then " : std::string()) +
+             "writing the result failed at step " + std::to_string(step_) + ", t = " + format_number(time_) +
+             " s: " + e.what() + "; what was written stays in " + live + " (status running), not published as " +
+             r_.output;
+    }
+    std::unique_ptr<H5Output> out = std::move(out_);
+    out->close();  // renames OUT.h5.<pid>.part onto OUT.h5
+    return "";
+  }
+
+  void write_end_metadata() {
+    if (r_.status == RunResult::Status::interrupted) out_->write_metadata("interruption", r_.message);
     for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
     if (heat_)
       detail::write_decomposed_heat_metadata(*out_, s_, *heat_, pending_heat_, hot_->tracker().ids_issued());
@@ -470,14 +598,10 @@ class DecomposedRun {
     out_->write_metadata("steps", r_.steps);
     out_->write_metadata("final_time", r_.time);
     out_->write_metadata("wall_time", r_.wall_time);
-    try {
-      out_->close();
-    } catch (const std::exception& e) {
-      throw OutputError(e.what());
-    }
   }
 
   MPI_Comm comm_;
+  MPI_Comm failure_comm_ = MPI_COMM_NULL;  // the failure agreement's alone (decomposed_failure.hpp)
   const Scene& s_;
   const RunOptions& o_;
   int rank_ = 0, size_ = 1;
@@ -488,6 +612,8 @@ class DecomposedRun {
   std::unique_ptr<detail::DecomposedHotSpots<Dim>> hot_;  // with heat_
   std::unique_ptr<OutputClaim> claim_;    // rank 0: the output claimed for the run
   std::unique_ptr<H5Output> out_;         // rank 0: series and metadata
+  std::string write_error_;               // rank 0: the first write into out_ that failed
+  std::string run_id_;                    // rank 0: /meta/run_id and every checkpoint's marks
   std::unique_ptr<DecomposedOutput> snapshots_out_;
   int temperature_ = 0;
   double time_ = 0.0, last_dt_ = 0.0;
@@ -517,6 +643,7 @@ class DecomposedRun {
     m.time = time_;
     m.series_rows = series_columns_ > 0 ? static_cast<long>(series_rows_.size()) / series_columns_ : 0;
     m.snapshots = snapshots_;
+    m.run_id = run_id_;  // rank 0 writes the marks
     if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
     xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
     try {
