@@ -13,6 +13,7 @@
 //   * rank 1's snapshot file (OUT.rank1.h5) over the limit after its first snapshots;
 //   * rank 1's checkpoint file over the limit (run.checkpoint_interval) while its snapshots fit;
 //   * rank 0 over the limit while writing OUT.h5.
+//   * an exception on one rank alone (the fault hook FRICTHERM_FAULT_DECOMPOSED): every rank ends.
 // On 79aaa40 the first ended every rank with MPI_Abort (exit code 1) and OUT.h5 was published by the
 // unwinding with status `running`, no /failure; the checkpoint's failure exited with 2 (a usage error),
 // OUT.h5 again with status `running`, and left the uncommitted generation's rank 0 file behind; the
@@ -136,4 +137,39 @@ TEST_F(CliMpirunFaults, ResultWriteFailingOnRankZeroEndsEveryRankUnpublished) {
     if (e.path().filename().string().rfind("out.h5.", 0) == 0 && e.path().extension() == ".part") part = e.path().string();
   ASSERT_FALSE(part.empty()) << "what was written stays in OUT.h5.<pid>.part";
   EXPECT_THAT(r.output, HasSubstr(part));
+}
+
+// An exception on one rank alone while the other waits in the step's collective calls (std::bad_alloc
+// thrown by the fault hook FRICTHERM_FAULT_DECOMPOSED=RANK:STEP:SECONDS before that rank's step 20,
+// the failure agreement giving up after 2 s instead of the run's 30 s): the other rank cannot be
+// reached through MPI any more, so every rank ends (MPI_Abort, exit code 1 from mpirun) instead of
+// waiting for ever, with a message naming the rank and the exception. When that rank is rank 0, it
+// first publishes OUT.h5 with status `failed` and the message (no failing state: the particles of the
+// other rank cannot be gathered), its XDMF with it; else what rank 0 wrote stays unpublished under
+// its temporary name, and no XDMF file is left naming a result that does not exist.
+TEST_F(CliMpirunFaults, ExceptionOnRankOneAloneEndsEveryRank) {
+  const std::string out = path("out.h5");
+  const Result r = shell("FRICTHERM_FAULT_DECOMPOSED=1:20:2 timeout -s TERM 240 " + frictherm::test::mpirun_command(2) +
+                         " " + exe() + " run " + scene() + " -q -o '" + out + "'");
+  EXPECT_NE(r.code, 124) << "hung: " << r.output;
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("step 20, t = "));
+  EXPECT_THAT(r.output, HasSubstr("on rank 1 alone: std::bad_alloc"));
+  EXPECT_THAT(r.output, HasSubstr("the result is not published"));
+  EXPECT_FALSE(fs::exists(out)) << read_text(out, "/meta/status");
+  EXPECT_FALSE(fs::exists(path("out.xdmf"))) << "an XDMF file naming a result that does not exist";
+}
+
+TEST_F(CliMpirunFaults, ExceptionOnRankZeroAloneEndsEveryRankPublishedAsFailed) {
+  const std::string out = path("out.h5");
+  const Result r = shell("FRICTHERM_FAULT_DECOMPOSED=0:20:2 timeout -s TERM 240 " + frictherm::test::mpirun_command(2) +
+                         " " + exe() + " run " + scene() + " -q -o '" + out + "'");
+  EXPECT_NE(r.code, 124) << "hung: " << r.output;
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("on rank 0 alone: std::bad_alloc"));
+  EXPECT_EQ(read_text(out, "/meta/status"), "failed") << r.output;
+  EXPECT_THAT(read_text(out, "/meta/failure"), HasSubstr("step 20, t = "));
+  EXPECT_FALSE(read_doubles(out, "/series/time").empty());
+  EXPECT_THAT(text("out.xdmf"), HasSubstr("out.rank1.h5:/snapshots/000000/position"));
+  EXPECT_TRUE(leftovers().empty()) << leftovers().front();
 }

@@ -33,6 +33,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <new>
 #include <optional>
 
 namespace frictherm::coupling {
@@ -66,6 +67,11 @@ class DecomposedRun {
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
     MPI_Comm_dup(comm_, &failure_comm_);
+    // Fault injection for tests (tests/coupling/test_cli_mpirun_faults.cpp): FRICTHERM_FAULT_DECOMPOSED=
+    // RANK:STEP[:SECONDS] throws std::bad_alloc on rank RANK before its step STEP (the others go on
+    // into the step's collective calls) and agrees on failures within SECONDS.
+    if (const char* f = std::getenv("FRICTHERM_FAULT_DECOMPOSED"))
+      std::sscanf(f, "%d:%ld:%lf", &fault_rank_, &fault_step_, &agreement_seconds_);
   }
   ~DecomposedRun() {
     if (out_) out_->abandon();  // an exception on its way out: never published with status running
@@ -346,6 +352,7 @@ class DecomposedRun {
         throw mechanics::SimulationError("step " + std::to_string(step_) + ", t = " + format_number(time_) +
                                              " s: the time step " + format_number(dt) + " s does not advance the time",
                                          step_, time_, -1);
+      if (rank_ == fault_rank_ && step_ == fault_step_) throw std::bad_alloc();  // FRICTHERM_FAULT_DECOMPOSED
       mpm_->step(dt);  // times its own phases (DecomposedTraffic::phase_seconds)
       time_ += dt;
       last_dt_ = dt;
@@ -478,12 +485,16 @@ class DecomposedRun {
   // step), it cannot be agreed: rank 0 publishes what it holds as failed, and every rank ends
   // (MPI_Abort) rather than waiting for ever (issue 34).
   std::string agreed(const std::string& what) {
-    if (std::optional<std::string> m = detail::agree_on_failure(failure_comm_, what, kFailureAgreementSeconds)) return *m;
+    if (std::optional<std::string> m = detail::agree_on_failure(failure_comm_, what, agreement_seconds_)) return *m;
     const std::string why = "step " + std::to_string(step_) + ", t = " + format_number(time_) + " s: on rank " +
                             std::to_string(rank_) + " alone: " + what +
                             " (the other ranks were waiting in a collective call: every rank ends; the failing "
                             "state is not gathered)";
-    std::cerr << "frictherm: simulation failed: " << why << '\n';
+    std::cerr << "frictherm: simulation failed: " << why
+              << (rank_ == 0 ? std::string()
+                             : "; the result is not published: what rank 0 wrote stays in " + r_.output +
+                                   ".<pid>.part (status running)")
+              << '\n';
     if (rank_ == 0 && out_) {
       r_.status = RunResult::Status::failed;
       r_.message = why;
@@ -501,6 +512,7 @@ class DecomposedRun {
       }
       std::cerr << "frictherm: " << (left.empty() ? "kept " + r_.output + " (status failed)" : left) << '\n';
     }
+    claim_.reset();  // the output's lock file (MPI_Abort runs no destructor)
     std::cerr.flush();
     MPI_Abort(comm_, 1);
     std::abort();  // not reached
@@ -602,6 +614,9 @@ class DecomposedRun {
 
   MPI_Comm comm_;
   MPI_Comm failure_comm_ = MPI_COMM_NULL;  // the failure agreement's alone (decomposed_failure.hpp)
+  double agreement_seconds_ = kFailureAgreementSeconds;
+  int fault_rank_ = -1;  // FRICTHERM_FAULT_DECOMPOSED
+  long fault_step_ = -1;
   const Scene& s_;
   const RunOptions& o_;
   int rank_ = 0, size_ = 1;
