@@ -22,7 +22,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "cli_test_support.hpp"
+#include "cli_mpirun_test_support.hpp"
 #include "h5_test_support.hpp"
 
 #include <filesystem>
@@ -33,17 +33,11 @@
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-using frictherm::test::read_doubles;
-using frictherm::test::read_text;
-using frictherm::test::Result;
-using frictherm::test::shell;
+using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, read_text, ...
 
 namespace {
 
-std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
-std::string scene() {
-  return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/decomposed_sliding_block.json'";
-}
+std::string scene() { return frictherm::test::scene("decomposed_sliding_block.json"); }
 
 class CliMpirunFaults : public frictherm::test::MpirunScratchTest {
  protected:
@@ -58,6 +52,20 @@ class CliMpirunFaults : public frictherm::test::MpirunScratchTest {
     // System V shared memory between the ranks: Open MPI's default maps a file, which the limit refuses.
     return shell("timeout -s TERM 240 env OMPI_MCA_shmem=sysv " + frictherm::test::mpirun_command(2) + " " + wrapper +
                  exe() + " " + args);
+  }
+
+  // The scene into out.h5 under `mpirun -n 2` with std::bad_alloc thrown on rank `rank` alone before its
+  // step 20 (the fault hook; the agreement gives up after 2 s), under timeout: every rank ends, exit
+  // code 1, the message names the step, the rank and the exception.
+  Result run_with_fault_on_rank(int rank) const {
+    const Result r = shell("FRICTHERM_FAULT_DECOMPOSED=" + std::to_string(rank) + ":20:2 timeout -s TERM 240 " +
+                           frictherm::test::mpirun_command(2) + " " + exe() + " run " + scene() + " -q -o '" +
+                           path("out.h5") + "'");
+    EXPECT_NE(r.code, 124) << "hung: " << r.output;
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("step 20, t = "));
+    EXPECT_THAT(r.output, HasSubstr("on rank " + std::to_string(rank) + " alone: std::bad_alloc"));
+    return r;
   }
 
   // Temporaries left in the folder, and checkpoint files of a generation never committed.
@@ -149,12 +157,7 @@ TEST_F(CliMpirunFaults, ResultWriteFailingOnRankZeroEndsEveryRankUnpublished) {
 // its temporary name, and no XDMF file is left naming a result that does not exist.
 TEST_F(CliMpirunFaults, ExceptionOnRankOneAloneEndsEveryRank) {
   const std::string out = path("out.h5");
-  const Result r = shell("FRICTHERM_FAULT_DECOMPOSED=1:20:2 timeout -s TERM 240 " + frictherm::test::mpirun_command(2) +
-                         " " + exe() + " run " + scene() + " -q -o '" + out + "'");
-  EXPECT_NE(r.code, 124) << "hung: " << r.output;
-  EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("step 20, t = "));
-  EXPECT_THAT(r.output, HasSubstr("on rank 1 alone: std::bad_alloc"));
+  const Result r = run_with_fault_on_rank(1);
   EXPECT_THAT(r.output, HasSubstr("the result is not published"));
   EXPECT_FALSE(fs::exists(out)) << read_text(out, "/meta/status");
   EXPECT_FALSE(fs::exists(path("out.xdmf"))) << "an XDMF file naming a result that does not exist";
@@ -162,11 +165,7 @@ TEST_F(CliMpirunFaults, ExceptionOnRankOneAloneEndsEveryRank) {
 
 TEST_F(CliMpirunFaults, ExceptionOnRankZeroAloneEndsEveryRankPublishedAsFailed) {
   const std::string out = path("out.h5");
-  const Result r = shell("FRICTHERM_FAULT_DECOMPOSED=0:20:2 timeout -s TERM 240 " + frictherm::test::mpirun_command(2) +
-                         " " + exe() + " run " + scene() + " -q -o '" + out + "'");
-  EXPECT_NE(r.code, 124) << "hung: " << r.output;
-  EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("on rank 0 alone: std::bad_alloc"));
+  const Result r = run_with_fault_on_rank(0);
   EXPECT_EQ(read_text(out, "/meta/status"), "failed") << r.output;
   EXPECT_THAT(read_text(out, "/meta/failure"), HasSubstr("step 20, t = "));
   EXPECT_FALSE(read_doubles(out, "/series/time").empty());

@@ -11,7 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "cli_test_support.hpp"
+#include "cli_mpirun_test_support.hpp"
 #include "h5_test_support.hpp"
 
 #include <filesystem>
@@ -22,13 +22,10 @@
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-using frictherm::test::read_text;
-using frictherm::test::Result;
-using frictherm::test::shell;
+using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, read_text, ...
 
 namespace {
 
-std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 
 class CliMpirunRunId : public frictherm::test::MpirunScratchTest {
  protected:
@@ -36,8 +33,8 @@ class CliMpirunRunId : public frictherm::test::MpirunScratchTest {
 
   // The sliding block for 0.2 ms (~70 steps) with a checkpoint every 0.1 ms, into `name`.
   Result run(const std::string& name) const {
-    return shell(frictherm::test::mpirun_command(2) + " " + exe() + " run '" + FRICTHERM_SOURCE_DIR +
-                 "/tests/coupling/scenes/decomposed_sliding_block.json' -q --set run.end_time=2e-4" +
+    return shell(frictherm::test::mpirun_command(2) + " " + exe() + " run " +
+                 frictherm::test::scene("decomposed_sliding_block.json") + " -q --set run.end_time=2e-4" +
                  " --set run.checkpoint_interval=1e-4 -o '" + path(name) + "'");
   }
 
