@@ -29,11 +29,17 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 namespace {
 
 using namespace frictherm;
 
-std::string temp_file(const std::string& name) { return ::testing::TempDir() + "frictherm_ckpt_thermal_" + name + ".h5"; }
+// Named by process: the same test of another build tree, run at the same time on one machine, would
+// write the same files in the shared temporary folder.
+std::string temp_file(const std::string& name) {
+  return ::testing::TempDir() + "frictherm_ckpt_thermal_" + std::to_string(getpid()) + "_" + name + ".h5";
+}
 
 using frictherm::test::expect_same_xdmf;
 using frictherm::test::slurp;
