@@ -6,6 +6,7 @@
 
 #include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/output_files.hpp>
+#include <frictherm/coupling/result_append.hpp>
 
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
@@ -90,6 +91,9 @@ int run_and_report(const coupling::Scene& scene, const std::string& path, const 
   } catch (const coupling::OutputError& e) {  // agreed by every rank
     if (rank == 0) std::cerr << "frictherm: " << e.what() << '\n';
     return kUsage;
+  } catch (const coupling::DecomposedRunError& e) {  // agreed by every rank: the result is not published
+    if (rank == 0) std::cerr << "frictherm: simulation failed: " << e.what() << '\n';
+    return kSimulationFailed;
   } catch (const std::exception& e) {  // perhaps on this rank alone: end every rank rather than hang
     std::cerr << "frictherm: rank " << rank << ": run of " << path << " failed: " << e.what() << '\n';
     MPI_Abort(MPI_COMM_WORLD, kSimulationFailed);
@@ -141,6 +145,12 @@ int decomposed_resume_command(const ResumeRequest& q) {
               << ranks << ": the particles are redistributed (results agree to round-off, not bit-for-bit)\n";
   if (q.output != q.run && !coupling::same_file(q.output, q.run))
     return refuse("-o " + q.output + ": a decomposed run resumes in place (its rank files go on); leave out -o");
+  try {  // the checkpoint belongs to the result it rewrites (issue 34): never another run's rows over it
+    if (std::filesystem::exists(q.run)) coupling::check_same_run(q.run, coupling::checkpoint_marks(q.checkpoint));
+  } catch (const std::exception& e) {
+    return refuse(std::string(e.what()) + "; nothing was changed (the checkpoint " + q.checkpoint +
+                  " would replace the result's rows with another run's)");
+  }
   if (const std::string why = coupling::decomposed_run_refusal(scene); !why.empty()) return refuse(why);
   coupling::RunOptions opt = resume_run_options(q);
   opt.output = q.run;

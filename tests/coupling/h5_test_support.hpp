@@ -1,5 +1,6 @@
 #pragma once
-// Reading one double dataset of a run's HDF5 file in tests (empty when the file or path is absent).
+// Reading one dataset of a run's HDF5 file in tests, doubles or a string (empty when the file or path
+// is absent).
 #include <hdf5.h>
 
 #include <string>
@@ -21,6 +22,31 @@ inline std::vector<double> read_doubles(const std::string& file, const std::stri
   }
   H5Fclose(f);
   return out;
+}
+
+/// A string dataset (/meta/status, /meta/failure, /meta/run_id) or a checkpoint's text (an array of
+/// chars: /marks/run_id), "" when absent.
+inline std::string read_text(const std::string& file, const std::string& path) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return "";
+  std::string s;
+  if (const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT); d >= 0) {
+    const hid_t t = H5Dget_type(d);
+    if (H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) <= 0) {
+      s.assign(H5Tget_size(t), '\0');
+      H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data());
+      s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
+    } else if (H5Tget_class(t) == H5T_INTEGER && H5Tget_size(t) == 1) {
+      const hid_t sp = H5Dget_space(d);
+      s.assign(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)), '\0');
+      if (!s.empty()) H5Dread(d, H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data());
+      H5Sclose(sp);
+    }
+    H5Tclose(t);
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return s;
 }
 
 }  // namespace frictherm::test

@@ -28,65 +28,31 @@
 //     impact) on 2 and 4 ranks: the series within 1e-9, the plastic heat books within 1e-9 of the heat;
 //   * the 3D PBX-like scene (examples/pbx_3d.json) for 40 steps: the series within 1e-9, the books,
 //     every particle once in the rank files;
-//   * a scene the decomposed engine does not support (penalty contact, a rigid contact partner that is
-//     not a boundary wall, the continuation, the KLU solver) is refused with exit code 2 naming the scene key, before any
-//     file is written, and `validate` says so;
-//   * an existing output file (the series file or one rank's file) is refused without --force, left
-//     untouched, and replaced with it;
-//   * a block thrown out of the grid fails (exit code 1) at the serial run's step, naming its particle;
 //   * mpirun -n 1 is the serial program (its file layout and the same numbers);
-//   * Ctrl-C to mpirun stops every rank after the same step with complete, readable files.
 // Skipped when mpirun is not installed. Labels verification;mpi.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "cli_test_support.hpp"
+#include "cli_mpirun_test_support.hpp"
 #include "h5_test_support.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
-
-#include <hdf5.h>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-using frictherm::test::read_doubles;
-using frictherm::test::Result;
-using frictherm::test::shell;
-constexpr auto mpirun = frictherm::test::mpirun_command;
+using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, read_text, ...
+constexpr auto mpirun = mpirun_command;
 
 namespace {
 
-std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
-std::string scene(const char* name) { return std::string("'") + FRICTHERM_SOURCE_DIR + "/tests/coupling/scenes/" + name + "'"; }
-// /meta/status of a result ("" when it does not read).
-std::string status_of(const std::string& file) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return "";
-  std::string s;
-  if (const hid_t d = H5Dopen2(f, "/meta/status", H5P_DEFAULT); d >= 0) {
-    const hid_t t = H5Dget_type(d);
-    s.assign(H5Tget_size(t), '\0');
-    H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data());
-    s.resize(s.find('\0') == std::string::npos ? s.size() : s.find('\0'));
-    H5Tclose(t);
-    H5Dclose(d);
-  }
-  H5Fclose(f);
-  return s;
-}
-
-
-class CliMpirun : public frictherm::test::MpirunScratchTest {
+class CliMpirun : public frictherm::test::CliMpirunTest {
  protected:
-  CliMpirun() : MpirunScratchTest("frictherm_mpirun_") {}
 
   // Runs the scene (with `sets`: --set options) serially into serial.h5 (once: kept if it exists) and under
   // mpirun -n `ranks` into split.h5 (replaced).
@@ -487,131 +453,6 @@ TEST_F(CliMpirun, PlasticImpactEqualsTheSerialRun) {
   }
 }
 
-TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
-  const std::pair<const char*, const char*> cases[] = {
-      {"--set contact.method=penalty", "contact.method: \"penalty\" is not supported in a decomposed run"},
-      {"--set 'materials.base={\"type\":\"rigid\",\"density\":1000,\"velocity\":[0,0]}'",
-       "materials.base.boundary: false (a rigid contact partner) is not supported in a decomposed run"},
-      {"--set 'coupling.continuation={\"duration\":1e-4}'",
-       "coupling.continuation: duration 0.0001 is not supported in a decomposed run"},
-      {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
-       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"}};
-  for (const auto& [set, message] : cases) {
-    const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
-                           " -o '" + path("refused.h5") + "'");
-    EXPECT_EQ(r.code, 2) << set << ": " << r.output;
-    EXPECT_THAT(r.output, HasSubstr(message)) << set;
-    EXPECT_THAT(r.output, HasSubstr("the serial run (without mpirun, or with -n 1) supports it")) << set;
-    EXPECT_TRUE(fs::is_empty(dir_)) << set << ": nothing may be written";
-  }
-  // It is a valid scene: `validate` accepts it and says that it runs serially only, and why.
-  const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") + " --set contact.method=penalty");
-  EXPECT_EQ(v.code, 0) << v.output;
-  EXPECT_THAT(v.output, HasSubstr("serial only (contact.method: \"penalty\" is not supported in a decomposed run"));
-  const Result ok = shell(exe() + " validate " + scene("decomposed_sliding_block.json"));
-  EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it"));
-}
-
-TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
-  const std::string run = mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
-                          " -q --set run.end_time=2e-5 -o '" + path("out.h5") + "'";
-  const char* const files[] = {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"};
-  for (const char* existing : {"out.h5", "out.rank1.h5", "out.xdmf"}) {
-    for (const char* f : files) fs::remove(path(f));
-    std::ofstream(path(existing)) << "an earlier result";
-    const Result r = shell(run);
-    EXPECT_EQ(r.code, 2) << existing << ": " << r.output;
-    EXPECT_THAT(r.output, HasSubstr(std::string(existing) + "' exists; refusing to replace an existing result"));
-    std::ifstream in(path(existing));
-    std::stringstream kept;
-    kept << in.rdbuf();
-    EXPECT_EQ(kept.str(), "an earlier result") << existing;
-    for (const char* f : files)
-      if (std::string(f) != existing) {
-        EXPECT_FALSE(fs::exists(path(f))) << existing << " refused, yet " << f << " written";
-      }
-  }
-  // With --force every file is replaced (here out.xdmf existed).
-  const Result forced = shell(run + " --force");
-  EXPECT_EQ(forced.code, 0) << forced.output;
-  EXPECT_FALSE(read_doubles(path("out.rank1.h5"), "/snapshots/000000/id").empty() &&
-               read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
-  EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty());
-  std::ifstream xdmf(path("out.xdmf"));
-  std::stringstream text;
-  text << xdmf.rdbuf();
-  EXPECT_THAT(text.str(), HasSubstr("out.rank1.h5:/snapshots/000000/position"));
-}
-
-namespace {
-// "step N" and "particle K" of "... failed: step N, t = ... s: particle K ..." ("" when absent).
-std::string failure_point(const std::string& output) {
-  const auto at = output.find("simulation failed: step ");
-  if (at == std::string::npos) return "";
-  const auto step_end = output.find(',', at);
-  const auto particle = output.find(": particle ", step_end);
-  if (step_end == std::string::npos || particle == std::string::npos) return "";
-  const auto particle_end = output.find(' ', particle + 11);
-  return output.substr(at + 19, step_end - at - 19) + " / " + output.substr(particle + 2, particle_end - particle - 2);
-}
-}  // namespace
-
-TEST_F(CliMpirun, ParticleLeavingTheGridFailsAtTheSerialStep) {
-  const std::string throw_block = " --set 'bodies[1].velocity=[400,0]'";  // leaves the 26 mm grid within 40 steps
-  const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + throw_block + " -q -o '" +
-                         path("serial.h5") + "'");
-  const Result d = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + throw_block +
-                         " -q -o '" + path("split.h5") + "'");
-  EXPECT_EQ(s.code, 1) << s.output;
-  EXPECT_EQ(d.code, 1) << d.output;
-  const std::string point = failure_point(s.output);
-  EXPECT_THAT(point, HasSubstr("particle ")) << s.output;
-  EXPECT_EQ(failure_point(d.output), point) << d.output;
-  EXPECT_THAT(d.output, HasSubstr("left the grid"));
-  EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty()) << "the series before the failure stay readable";
-  EXPECT_EQ(status_of(path("split.h5")), "failed");  // issue 34: ended as the serial run, with /failure
-  EXPECT_EQ(read_doubles(path("split.h5"), "/failure/position").size(), read_doubles(path("serial.h5"), "/failure/position").size());
-}
-
-
-// Issue 34: a decomposed run that fails ends as the serial run does, status failed and the failing
-// state under /failure (it had kept status "running"). A friction law that throws on one rank (an
-// expression law that passes the validator's sample points, v in {0, 1e-3, 1, 1e3} m/s, and turns
-// negative while the block slides at 10 m/s) had left that rank's exception behind while the other
-// waited in the next collective; now every rank finishes the step, agrees, and names the pair's key.
-TEST_F(CliMpirun, ExpressionLawFailureEndsTheRunAsFailed) {
-  const std::string law =
-      " --set 'contact.pairs[0].law={\"type\":\"expression\",\"sliding_traction\":\"(v>2 && v<100) ? -0.3*N : 0.3*N\"}'"
-      " --set 'contact.separation=\"position\"'";  // an expression law's default, "extent", is serial only
-  const Result s = shell(exe() + " run " + scene("decomposed_sliding_block.json") + law + " -q -o '" + path("serial.h5") + "'");
-  const Result d = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + law + " -q -o '" +
-                         path("split.h5") + "'");
-  EXPECT_EQ(s.code, 1) << s.output;
-  EXPECT_EQ(d.code, 1) << d.output;
-  EXPECT_THAT(d.output, HasSubstr("contact.pairs[0].law (materials 'base' and 'block')"));
-  EXPECT_THAT(d.output, HasSubstr("returned S = -"));
-  EXPECT_EQ(status_of(path("split.h5")), "failed");
-  EXPECT_FALSE(read_doubles(path("split.h5"), "/failure/position").empty()) << "the failing state under /failure";
-  EXPECT_EQ(read_doubles(path("split.h5"), "/failure/position").size(),
-            read_doubles(path("serial.h5"), "/failure/position").size()) << "every particle, once";
-  EXPECT_FALSE(read_doubles(path("split.h5"), "/series/time").empty());
-}
-
-// `validate` under mpirun: every rank validates, rank 0 alone prints (issue 34: once per rank).
-TEST_F(CliMpirun, ValidateUnderMpirunSpeaksOnce) {
-  const Result ok = shell(mpirun(2) + " " + exe() + " validate " + scene("decomposed_sliding_block.json"));
-  EXPECT_EQ(ok.code, 0) << ok.output;
-  std::size_t count = 0;
-  for (std::size_t at = ok.output.find("\nok\n"); at != std::string::npos; at = ok.output.find("\nok\n", at + 1)) ++count;
-  EXPECT_EQ(count, 1u) << ok.output;
-  const Result bad = shell(mpirun(2) + " " + exe() + " validate " + scene("decomposed_sliding_block.json") +
-                           " --set run.end_time=-1");
-  EXPECT_EQ(bad.code, 2) << bad.output;
-  std::size_t said = 0;
-  for (std::size_t at = bad.output.find("run.end_time"); at != std::string::npos; at = bad.output.find("run.end_time", at + 1)) ++said;
-  EXPECT_EQ(said, 1u) << bad.output;
-}
-
 TEST_F(CliMpirun, OneRankRunsTheSerialProgram) {
   // mpirun -n 1: today's serial program (one file with its snapshots, no rank files), the same numbers.
   const std::string sc = scene("decomposed_sliding_block_3d.json") + " -q --set run.end_time=5e-5";
@@ -626,33 +467,4 @@ TEST_F(CliMpirun, OneRankRunsTheSerialProgram) {
     EXPECT_FALSE(a.empty()) << c;
     EXPECT_EQ(a, read_doubles(path("one.h5"), std::string("/series/") + c)) << c;
   }
-}
-
-TEST_F(CliMpirun, InterruptedRunStopsEveryRankAndKeepsItsFiles) {
-  // Ctrl-C to mpirun once the run writes (Open MPI's mpirun passes it on to the ranks as SIGTERM):
-  // every rank stops after the same step, the files are complete and readable, rank 0 says so.
-  const std::string out = path("x.h5");
-  const std::string cmd = mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
-                          " -q --set run.end_time=1 -o '" + out + "' > '" + path("log") + "' 2>&1 & pid=$!; " +
-                          "for i in $(seq 1 600); do ls '" + out + "'.*.part >/dev/null 2>&1 && break; sleep 0.1; done; " +
-                          "sleep 0.5; kill -INT $pid; wait $pid";
-  const Result r = shell(cmd);
-  std::ifstream in(path("log"));
-  std::stringstream log;
-  log << in.rdbuf();
-  EXPECT_NE(r.code, 0) << log.str();
-  EXPECT_THAT(log.str(), HasSubstr("interrupted by SIG"));
-  EXPECT_THAT(log.str(), HasSubstr("/meta/status = interrupted"));
-  const std::vector<double> t = read_doubles(out, "/series/time");
-  ASSERT_FALSE(t.empty()) << "the series file is renamed into place and readable";
-  EXPECT_LT(t.back(), 1.0) << "stopped before end_time";
-  // The last snapshot is at the interruption, on the ranks that hold particles, listed in the XDMF file.
-  std::ifstream xdmf(path("x.xdmf"));
-  std::stringstream text;
-  text << xdmf.rdbuf();
-  EXPECT_THAT(text.str(), HasSubstr("x.rank0.h5:/snapshots/000001/position"));
-  EXPECT_FALSE(read_doubles(path("x.rank0.h5"), "/snapshots/000001/id").empty() &&
-               read_doubles(path("x.rank1.h5"), "/snapshots/000001/id").empty());
-  const Result csv = shell(exe() + " export-csv '" + out + "'");
-  EXPECT_EQ(csv.code, 0) << csv.output;
 }

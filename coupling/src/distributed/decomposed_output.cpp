@@ -92,8 +92,8 @@ void DecomposedOutput::agree_or_close(const std::string& error) {
   }
 }
 
-DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite)
-    : comm_(comm), dim_(dim), base_(std::move(base)), xdmf_path_(base_ + ".xdmf") {
+DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite, bool write_xdmf)
+    : comm_(comm), dim_(dim), base_(std::move(base)), xdmf_path_(base_ + ".xdmf"), write_xdmf_(write_xdmf) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
   std::string error;
@@ -119,9 +119,9 @@ DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, boo
 }
 
 DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, long kept, std::vector<std::string> grids,
-                                   bool create_missing)
+                                   bool create_missing, bool write_xdmf)
     : comm_(comm), dim_(dim), base_(std::move(base)), xdmf_path_(base_ + ".xdmf"), grids_(std::move(grids)),
-      snapshots_(kept) {
+      write_xdmf_(write_xdmf), snapshots_(kept) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
   std::string error;
@@ -152,7 +152,7 @@ DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, lon
       h5::check(H5Ldelete(g.get(), b, H5P_DEFAULT), file, std::string("cannot remove snapshot ") + b);
     }
     h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
-    if (rank_ == 0) write_text_atomically(xdmf_path_, xdmf_document(grids_));
+    if (rank_ == 0 && write_xdmf_) write_text_atomically(xdmf_path_, xdmf_document(grids_));
   } catch (const std::exception& e) {
     error = e.what();
   }
@@ -160,6 +160,8 @@ DecomposedOutput::DecomposedOutput(MPI_Comm comm, std::string base, int dim, lon
 }
 
 DecomposedOutput::~DecomposedOutput() { close(); }
+
+std::string DecomposedOutput::xdmf_text() const { return xdmf_document(grids_); }
 
 void DecomposedOutput::close() {
   if (file_ >= 0) H5Fclose(file_);
@@ -251,7 +253,7 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
       }
       xml += "    </Grid>\n";
       grids_.push_back(xml);
-      write_text_atomically(xdmf_path_, xdmf_document(grids_));
+      if (write_xdmf_) write_text_atomically(xdmf_path_, xdmf_document(grids_));
     } catch (const std::exception& e) {
       error = e.what();
     }

@@ -103,7 +103,12 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
   } catch (const std::exception& e) {
     error = e.what();
   }
-  agree(comm, error);
+  try {
+    agree(comm, error);
+  } catch (...) {  // a generation that is never committed leaves no file behind
+    std::remove(mine.c_str());
+    throw;
+  }
   // 2. The commit: rank 0's global file, renamed over the previous one once complete.
   if (rank == 0) {
     const std::string tmp = path + "." + std::to_string(static_cast<long>(getpid())) + ".tmp";
@@ -129,7 +134,12 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
       error = e.what();
     }
   }
-  agree(comm, error);
+  try {
+    agree(comm, error);
+  } catch (...) {
+    std::remove(mine.c_str());
+    throw;
+  }
   // 3. The previous generation is no longer named: every rank removes its file.
   if (generation > 1) std::remove(decomposed_rank_checkpoint(path, generation - 1, rank).c_str());
 }

@@ -201,6 +201,8 @@ void H5Output::close() {
   if (m.io.file != m.final_path) m.publish();
 }
 
+void H5Output::publish_xdmf_with_result(std::string text) { live().given_xdmf = std::move(text); }
+
 std::size_t H5Output::snapshot_count() const { return impl_ ? impl_->count : 0; }
 const std::string& H5Output::path() const { return impl_->final_path; }
 const std::string& H5Output::live_path() const { return impl_->io.file; }

@@ -226,24 +226,35 @@ std::string xdmf_of_result(const std::string& h5_path, const std::string& h5_nam
   return xdmf_documents_of_result(h5_path, h5_name).current;
 }
 
+std::string result_run_id(const std::string& result) {
+  const h5detail::Quiet quiet;
+  const Handle f{check_id(H5Fopen(result.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), result, "cannot open it"), H5Fclose};
+  if (!exists(f.get(), "/meta/run_id")) return "";
+  const Handle d{check_id(H5Dopen2(f.get(), "/meta/run_id", H5P_DEFAULT), result, "/meta/run_id"), H5Dclose};
+  const Handle t{check_id(H5Dget_type(d.get()), result, "type of /meta/run_id"), H5Tclose};
+  std::string id(H5Tget_size(t.get()), '\0');
+  check(H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, id.data()), result, "cannot read /meta/run_id");
+  id.resize(id.find('\0') == std::string::npos ? id.size() : id.find('\0'));
+  return id;
+}
+
+void check_same_run(const std::string& result, const CheckpointMarks& marks) {
+  // The result the checkpoint belongs to (issue 34): a later run on the same output that did not
+  // finish leaves its checkpoint beside the earlier run's result. Older files have no identity.
+  if (marks.run_id.empty()) return;
+  const std::string id = result_run_id(result);
+  if (!id.empty() && id != marks.run_id)
+    throw std::runtime_error("'" + result + "' is the result of run " + id + ", the checkpoint belongs to run " +
+                             marks.run_id + " (a later run on the same output that did not finish, or files of " +
+                             "two runs put together)");
+}
+
 void check_appendable(const std::string& original, const CheckpointMarks& marks) {
   const h5detail::Quiet quiet;
   const Handle f{check_id(H5Fopen(original.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), original, "cannot open it"), H5Fclose};
   for (const char* group : {"/meta", "/series", "/snapshots"})
     if (!exists(f.get(), group)) throw std::runtime_error("'" + original + "': no " + group + " (not a frictherm result)");
-  // The result the checkpoint belongs to (issue 34): a later run on the same output that did not
-  // finish leaves its checkpoint beside the earlier run's result. Older files have no identity.
-  if (!marks.run_id.empty() && exists(f.get(), "/meta/run_id")) {
-    const Handle d{check_id(H5Dopen2(f.get(), "/meta/run_id", H5P_DEFAULT), original, "/meta/run_id"), H5Dclose};
-    const Handle t{check_id(H5Dget_type(d.get()), original, "type of /meta/run_id"), H5Tclose};
-    std::string id(H5Tget_size(t.get()), '\0');
-    check(H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, id.data()), original, "cannot read /meta/run_id");
-    id.resize(id.find('\0') == std::string::npos ? id.size() : id.find('\0'));
-    if (id != marks.run_id)
-      throw std::runtime_error("'" + original + "' is the result of run " + id + ", the checkpoint belongs to run " +
-                               marks.run_id + " (a later run on the same output that did not finish, or files of " +
-                               "two runs put together)");
-  }
+  check_same_run(original, marks);
   const std::vector<std::string> cols = [&] {
     const Handle g{check_id(H5Gopen2(f.get(), "series", H5P_DEFAULT), original, "/series"), H5Gclose};
     return members(g.get());

@@ -27,6 +27,17 @@
 
 namespace frictherm::coupling {
 
+namespace detail {
+
+std::string fresh_run_id() {
+  std::random_device device;
+  char text[33];
+  for (int k = 0; k < 4; ++k) std::snprintf(text + 8 * k, 9, "%08x", static_cast<unsigned>(device()));
+  return text;
+}
+
+}  // namespace detail
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -37,14 +48,6 @@ bool show_progress(const RunOptions& o) {
   if (o.quiet || o.progress == RunOptions::Progress::never) return false;
   if (o.progress == RunOptions::Progress::always) return true;
   return isatty(STDERR_FILENO) != 0;
-}
-
-// 128 random bits in hex: a result's identity (RunOptions::run_id).
-std::string fresh_run_id() {
-  std::random_device device;
-  char text[33];
-  for (int k = 0; k < 4; ++k) std::snprintf(text + 8 * k, 9, "%08x", static_cast<unsigned>(device()));
-  return text;
 }
 
 template <int Dim>
@@ -84,7 +87,7 @@ class Run {
     r_.particles = sim_->particles().size();
     check_checkpoints();
     if (!o_.resume_checkpoint.empty()) restore();
-    run_id_ = !o_.run_id.empty() ? o_.run_id : !base_marks_.run_id.empty() ? base_marks_.run_id : fresh_run_id();
+    run_id_ = !o_.run_id.empty() ? o_.run_id : !base_marks_.run_id.empty() ? base_marks_.run_id : detail::fresh_run_id();
     H5Output out = open_output();
     out_ = &out;
     std::ostream& log = o_.log ? *o_.log : std::cerr;

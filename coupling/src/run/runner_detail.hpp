@@ -114,6 +114,9 @@ class OutputSchedule {
   double next_snap_, next_series_;
 };
 
+/// 128 random bits in hex: a result's identity (RunOptions::run_id, /meta/run_id, every checkpoint's marks).
+std::string fresh_run_id();
+
 /// "mm:ss", or "h:mm:ss" past an hour.
 std::string format_duration(double seconds);
 

@@ -20,9 +20,17 @@
 
 #include <mpi.h>
 
+#include <stdexcept>
 #include <string>
 
 namespace frictherm::coupling {
+
+/// Thrown by run_scene_decomposed on every rank alike when the run ended without a published result
+/// (a write into OUT.h5 failed: what was written stays under its temporary name; the message says
+/// where). Exit code 1, as the serial run's failed writes.
+struct DecomposedRunError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// Runs a validated, supported scene over the ranks of `comm` (collective; PETSc initialised).
 /// Output: OUT.h5 (rank 0: the time series and metadata, as the serial file without snapshots),
@@ -34,7 +42,11 @@ namespace frictherm::coupling {
 /// signal; options.checkpoint_file, else OUT.h5.checkpoint) and options.resume_checkpoint (by the
 /// same number of ranks bit-for-bit, by another redistributed; the output goes on in place):
 /// docs/checkpoints.md, "Decomposed runs".
-/// The per-step observer is not supported (std::invalid_argument).
+/// Whatever throws once the output exists ends the run as a breakdown (status `failed`, the state
+/// under /failure, the result published) when it was thrown on every rank alike (a rank file's or a
+/// checkpoint's write failure, the heat's errors); thrown on one rank alone while the others wait in
+/// a collective call, it ends every rank with MPI_Abort after rank 0 has published what it holds
+/// (docs/robustness.md). The per-step observer is not supported (std::invalid_argument).
 RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options);
 
 /// The files a decomposed run writes for output `out` with `ranks` processes: out, the XDMF file

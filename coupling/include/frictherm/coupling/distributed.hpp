@@ -51,19 +51,23 @@ struct DecomposedSnapshot {
 /// vtk_decomposed.py opens it with ParaView's reader). Vectors are written with 3 components in 2D
 /// too (ParaView's vector filters need 3). The
 /// XDMF is rewritten atomically after each snapshot and each rank file flushed, so a run stopped at
-/// any point leaves readable files of what it wrote. Every call is collective; a failure on one rank
+/// any point leaves readable files of what it wrote; with `write_xdmf` false it is not written at all
+/// and xdmf_text() is published by the caller with its result (a decomposed run's OUT.xdmf goes with
+/// OUT.h5, issue 34: never an XDMF beside a result it does not belong to). Every call is collective; a failure on one rank
 /// (e.g. a file that exists without `overwrite`) makes every rank throw.
 class DecomposedOutput {
  public:
-  DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite);
+  DecomposedOutput(MPI_Comm comm, std::string base, int dim, bool overwrite, bool write_xdmf = true);
   /// Resuming a checkpointed run: opens the existing rank files (each rank its own), removes their
   /// snapshots from number `kept` on (written after the checkpoint) and goes on after the kept ones;
   /// `grids` (rank 0) is xdmf_grids() at the checkpoint, and OUT.xdmf is rewritten from it.
   /// `create_missing` (a checkpoint of fewer ranks): a rank without a file starts one.
   DecomposedOutput(MPI_Comm comm, std::string base, int dim, long kept, std::vector<std::string> grids,
-                   bool create_missing = false);
+                   bool create_missing = false, bool write_xdmf = true);
   /// Rank 0: the XDMF text of every snapshot so far (checkpoints store it); snapshots written.
   const std::vector<std::string>& xdmf_grids() const { return grids_; }
+  /// Rank 0: the XDMF document joining every snapshot so far (what BASE.xdmf holds).
+  std::string xdmf_text() const;
   long snapshots() const { return snapshots_; }
   ~DecomposedOutput();
   DecomposedOutput(const DecomposedOutput&) = delete;
@@ -85,6 +89,7 @@ class DecomposedOutput {
   std::string base_, xdmf_path_;
   long long file_ = -1;              // hid_t of this rank's file
   std::vector<std::string> grids_;  // rank 0: the XDMF text of every snapshot so far
+  bool write_xdmf_ = true;          // rank 0 rewrites BASE.xdmf after every snapshot
   long snapshots_ = 0;
 };
 

@@ -140,6 +140,10 @@ class H5Output {
   /// Closes the file without writing anything more and without publishing it: after a write failed
   /// (a full disk), what was written stays under live_path(). Further calls throw std::logic_error.
   void abandon() noexcept;
+  /// With via_temporary and write_xdmf false: `text` is the XDMF document published with the result
+  /// in close() under xdmf_path_for(path()) (publish_with_xdmf), e.g. a decomposed run's OUT.xdmf that
+  /// joins its rank files (issue 34: written with the result, never before it).
+  void publish_xdmf_with_result(std::string text);
   /// Flushes, rewrites the XDMF file and closes the file. Further calls throw std::logic_error.
   void close();
 

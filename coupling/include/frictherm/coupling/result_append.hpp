@@ -19,6 +19,15 @@ namespace frictherm::coupling {
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
                    const std::string& output);
 
+/// /meta/run_id of the result `result` ("" for results of older versions, which have none); throws
+/// std::runtime_error naming the file when it does not open.
+std::string result_run_id(const std::string& result);
+
+/// Throws std::runtime_error naming both runs when the checkpoint (`marks`) belongs to another run than
+/// the result `result` (issue 34: a later run on the same output that did not finish, or files of two
+/// runs put together). Files without an identity (older versions) are not refused.
+void check_same_run(const std::string& result, const CheckpointMarks& marks);
+
 /// Throws std::runtime_error naming the file and the defect when `original` cannot take the append
 /// (not an HDF5 file, truncated, not a frictherm result, fewer series rows or snapshots than `marks`):
 /// resume checks it before running, so a damaged result costs no run time.

@@ -1,0 +1,119 @@
+// Checkpoints of a decomposed run (decomposed_run_impl.hpp, decomposed_checkpoint.hpp): the state
+// each rank writes and reads, the marks and run id as the serial run's, a checkpoint of another rank
+// count redistributed (decomposed_redistribute.hpp); a resumed run rewrites OUT.h5 with the
+// checkpoint's series rows, keeping the rank files' snapshots up to it.
+#include "distributed_run/decomposed_run_impl.hpp"
+
+namespace frictherm::coupling::decomposed {
+
+template <int Dim>
+void DecomposedRun<Dim>::checkpoint() {
+  const Clock::time_point c0 = Clock::now();
+  CheckpointMarks m;
+  m.step = step_;
+  m.time = time_;
+  m.series_rows = series_columns_ > 0 ? static_cast<long>(series_rows_.size()) / series_columns_ : 0;
+  m.snapshots = snapshots_;
+  m.run_id = run_id_;  // rank 0 writes the marks
+  if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
+  xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
+  try {
+    detail::write_decomposed_checkpoint(
+        comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
+        [&](const ckpt::Writer& w) { visit_global_state(w); });
+  } catch (const std::runtime_error& e) {  // on every rank; the previous checkpoint is whole
+    throw OutputError(e.what());
+  }
+  if (rank_ == 0 && redistributed_from_ > size_ && checkpoints_written_ == 0)  // the resumed generation's
+    for (int j = size_; j < redistributed_from_; ++j)                          // files of ranks gone
+      std::remove(detail::decomposed_rank_checkpoint(checkpoint_file_, generation_ - 1, j).c_str());
+  last_checkpoint_ = Clock::now();
+  ++checkpoints_written_;
+  checkpoint_seconds_ += seconds_since(c0);
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::restore() {
+  if (const int old = checkpoint_ranks(o_.resume_checkpoint); old > 0 && old != size_) {
+    redistribute(old);
+    return;
+  }
+  try {  // read errors are agreed by every rank
+    generation_ = detail::read_decomposed_checkpoint(
+        comm_, o_.resume_checkpoint, Dim, [&](const ckpt::Reader& r) { visit_rank_state(r); },
+        [&](const ckpt::Reader& r) { visit_global_state(r); });
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+  std::string error;
+  try {
+    mpm_->restore_checkpoint_state(restored_);
+  } catch (const std::exception& e) {
+    error = o_.resume_checkpoint + ": " + e.what();
+  }
+  if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
+  restored_ = {};
+}
+
+template <int Dim>
+template <class V>
+void DecomposedRun<Dim>::visit_rank_state(const V& v) {
+  typename Mpm::CheckpointState st = mpm_->checkpoint_state();  // reading: the names and a template
+  for (auto& [name, values] : st.reals) v(("mechanics/" + name).c_str(), values);
+  for (auto& [name, values] : st.integers) v(("mechanics/" + name).c_str(), values);
+  v("mechanics/time", st.time);
+  v("mechanics/cumulative_work_first", st.cumulative_first);
+  v("mechanics/cumulative_work_second", st.cumulative_second);
+  v("mechanics/empty_node_mass", st.empty_node_mass);
+  v("mechanics/work_first", st.work_first);
+  v("mechanics/work_second", st.work_second);
+  v("mechanics/contact_stats", st.stats);
+  std::vector<long> owned;  // this rank's owned nodes (DMDA indices, [begin, end) per axis): redistribution
+  if constexpr (!V::reading) for (int b : mpm_->owned_nodes()) owned.push_back(b);
+  v("mechanics/owned_nodes", owned);
+  if constexpr (V::reading) restored_ = std::move(st);
+  if (heat_) heat_->visit_state(v);
+}
+
+template <int Dim>
+template <class V>
+void DecomposedRun<Dim>::visit_global_state(const V& v) {
+  v("run/time", time_);
+  v("run/step", step_);
+  v("run/last_dt", last_dt_);
+  v("run/snapshots", snapshots_);
+  v("run/last_series_step", last_series_step_);
+  v("run/last_snapshot_step", last_snapshot_step_);
+  v("output/series_rows", series_rows_);
+  v("output/series_columns", series_columns_);
+  v("output/xdmf_grids", xdmf_grids_);
+  if (hot_) hot_->visit_state(v);
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::redistribute(int old) {
+  detail::Redistribution<Dim> re(*mpm_, heat_ != nullptr);
+  try {
+    generation_ = detail::read_redistributed_checkpoint(
+        comm_, o_.resume_checkpoint, Dim,
+        [&](const ckpt::Reader& r, int j) {
+          re.take(r, j, j % size_ == rank_);
+          if (heat_ && j == 0) heat_->visit_state(r);  // books and window: the same in every file
+        },
+        [&](const ckpt::Reader& r) { visit_global_state(r); });
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+  re.finish(heat_.get());
+  redistributed_from_ = old;
+}
+
+#define FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(D) \
+  template void DecomposedRun<D>::checkpoint(); \
+  template void DecomposedRun<D>::restore(); \
+  template void DecomposedRun<D>::redistribute(int old);
+FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(2)
+FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(3)
+#undef FRICTHERM_INSTANTIATE_DECOMPOSED_RUN
+
+}  // namespace frictherm::coupling::decomposed

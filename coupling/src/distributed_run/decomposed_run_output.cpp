@@ -1,0 +1,227 @@
+// The decomposed run's output (decomposed_run_impl.hpp): series and metadata on rank 0 (OUT.h5, the
+// serial writer), particle snapshots per rank (OUT.rank<r>.h5), and at the end OUT.h5 published with
+// OUT.xdmf joining the rank files (issue 34: the XDMF goes with its result, never before it).
+#include "distributed_run/decomposed_run_impl.hpp"
+
+namespace frictherm::coupling::decomposed {
+
+template <int Dim>
+void DecomposedRun<Dim>::open_output() {
+  std::string error;
+  if (rank_ == 0) {
+    try {
+      H5OutputOptions options;
+      options.write_xdmf = false;  // OUT.xdmf joins the rank files (DecomposedOutput), published with OUT.h5
+      options.via_temporary = true;
+      options.replace_existing = overwrite() || resuming_;  // a resume rewrites OUT.h5 (checkpoint's rows first)
+      out_ = std::make_unique<H5Output>(r_.output, Dim, options);
+      write_start_metadata();
+      out_->declare_series(series_names());
+      if (hot_) hot_->declare_table(*out_);
+      if (resuming_) rewrite_rows();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw OutputError(why);
+  try {  // OUT.xdmf is not written during the run: publish() writes it with OUT.h5 (issue 34)
+    snapshots_out_ = resuming_ ? std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, snapshots_,
+                                                                    detail::split_grids(xdmf_grids_),
+                                                                    redistributed_from_ > 0, false)
+                               : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite(),
+                                                                    false);
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::write_start_metadata() {
+  out_->write_metadata("scene", s_.text);
+  out_->write_metadata("scene_json", s_.json);
+  out_->write_metadata("scene_file", s_.source);
+  out_->write_metadata("version", FRICTHERM_VERSION);
+  out_->write_metadata("command_line", o_.command_line);
+  out_->write_metadata("status", "running");
+  out_->write_metadata("run_id", run_id_);
+  out_->write_metadata("dimension", Dim);
+  out_->write_metadata("engine", "decomposed");
+  out_->write_metadata("ranks", size_);
+  std::string grid;
+  for (int p : mpm_->processes()) grid += (grid.empty() ? "" : " x ") + std::to_string(p);
+  out_->write_metadata("process_grid", grid);
+  out_->write_metadata("particle_count", r_.particles);
+  out_->write_metadata("snapshots", xdmf_path_for(r_.output));
+}
+
+template <int Dim>
+std::vector<std::string> DecomposedRun<Dim>::series_names() const {
+  std::vector<std::string> n{"time", "step", "dt", "kinetic_energy"};
+  const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
+  for (int d = 0; d < Dim; ++d) n.emplace_back(axes[d]);
+  if (s_.contact.enabled)
+    n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
+  if (heat_) {
+    n.insert(n.end(), {"heat_delivered", "thermal_energy_change", "max_temperature"});
+    for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
+    n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
+    if (s_.thermal.coupler.plastic.enabled) n.insert(n.end(), {"plastic_work", "plastic_heat"});
+  }
+  return n;
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::series() {
+  const Clock::time_point c0 = Clock::now();
+  const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
+  // Kinetic energy and momentum of the deformable particles, as Simulation::kinetic_energy and
+  // linear_momentum (a rigid wall's prescribed motion is not part of the body's).
+  double sums[1 + Dim] = {};
+  for (std::size_t k = 0; k < p.mass.size(); ++k) {
+    if (s_.materials[static_cast<std::size_t>(p.material[k])].is_rigid()) continue;
+    const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k);
+    sums[0] += 0.5 * p.mass[k] * vk.squaredNorm();
+    for (int d = 0; d < Dim; ++d) sums[1 + d] += p.mass[k] * vk[d];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 1 + Dim, MPI_DOUBLE, MPI_SUM, comm_);
+  std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0]};
+  for (int d = 0; d < Dim; ++d) row.push_back(sums[1 + d]);
+  if (s_.contact.enabled) {
+    const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
+    const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);
+    const mechanics::DecomposedContactStats cs = mpm_->contact_stats();
+    row.insert(row.end(), {w1, w2, static_cast<double>(cs.contact_nodes), static_cast<double>(cs.sliding_nodes)});
+  }
+  if (heat_) {
+    const DecomposedHeatBooks& b = heat_->books();
+    // The highest temperature of the conducting particles over all ranks, from the last update.
+    row.insert(row.end(), {b.heat_delivered, b.particle_energy_change, hot_->tracker().max_temperature()});
+    hot_->extend_series_row(row);
+    row.insert(row.end(), {static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
+    if (s_.thermal.coupler.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
+  }
+  std::string error;  // rank 0's write failure, agreed below so that no rank goes on alone
+  if (out_) {
+    series_rows_.insert(series_rows_.end(), row.begin(), row.end());  // for checkpoints
+    series_columns_ = static_cast<long>(row.size());
+    try {
+      out_->append_series(row);
+      if (hot_) hot_->append_table_rows(*out_, time_);
+      if (seconds_since(last_flush_) >= o_.flush_interval) {
+        out_->flush();
+        last_flush_ = Clock::now();
+      }
+    } catch (const std::exception& e) {
+      note_write_error(e.what());
+      error = std::string("writing '") + out_->live_path() + "': " + e.what();
+    }
+  }
+  if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw std::runtime_error(why);
+  last_series_step_ = step_;
+  output_seconds_ += seconds_since(c0);
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::snapshot() {
+  const Clock::time_point c0 = Clock::now();
+  const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
+  DecomposedSnapshot snap;
+  snap.id = p.id;
+  snap.position = p.position;
+  snap.velocity = p.velocity;
+  snap.material = p.material;
+  snap.temperature = mpm_->particle_scalar(temperature_);
+  snapshots_out_->write(step_, time_, snap);
+  ++snapshots_;
+  last_snapshot_step_ = step_;
+  output_seconds_ += seconds_since(c0);
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::finish_output() {
+  std::string error;
+  int refused = 0;
+  if (out_) {
+    try {
+      error = publish();
+    } catch (const std::exception& e) {
+      error = e.what();
+      refused = 1;
+    }
+  }
+  const std::string why = detail::agreed_error(comm_, error);
+  MPI_Bcast(&refused, 1, MPI_INT, 0, comm_);
+  if (why.empty()) return;
+  if (refused) throw OutputError(why);
+  throw DecomposedRunError(why);
+}
+
+template <int Dim>
+std::string DecomposedRun<Dim>::publish() {
+  r_.series_rows = out_->series_rows();
+  try {
+    if (!write_error_.empty()) throw std::runtime_error(write_error_);
+    write_end_metadata();
+    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text());  // OUT.xdmf with OUT.h5, as the serial run's
+    out_->sync();  // before the name: the published result is on disk
+  } catch (const std::exception& e) {
+    const std::string live = out_->live_path();
+    out_->abandon();
+    out_.reset();
+    return (r_.status == RunResult::Status::failed ? r_.message + "; then " : std::string()) +
+           "writing the result failed at step " + std::to_string(step_) + ", t = " + format_number(time_) +
+           " s: " + e.what() + "; what was written stays in " + live + " (status running), not published as " +
+           r_.output;
+  }
+  std::unique_ptr<H5Output> out = std::move(out_);
+  out->close();  // renames OUT.h5.<pid>.part onto OUT.h5
+  return "";
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::write_end_metadata() {
+  if (r_.status == RunResult::Status::interrupted) out_->write_metadata("interruption", r_.message);
+  for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
+  if (heat_)
+    detail::write_decomposed_heat_metadata(*out_, s_, *heat_, pending_heat_, hot_->tracker().ids_issued());
+  const char* status = r_.status == RunResult::Status::failed                 ? "failed"
+                       : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
+                       : r_.status == RunResult::Status::interrupted          ? "interrupted"
+                                                                              : "completed";
+  out_->write_metadata("status", status);
+  if (checkpoints_written_ > 0) {
+    out_->write_metadata("checkpoints_written", checkpoints_written_);
+    out_->write_metadata("checkpoint_write_time", checkpoint_seconds_);  // s, this process's checkpoints
+  }
+  if (resuming_) out_->write_metadata("resumed_from", o_.resume_checkpoint);
+  if (redistributed_from_ > 0) out_->write_metadata("resumed_from_ranks", redistributed_from_);
+  out_->write_metadata("steps", r_.steps);
+  out_->write_metadata("final_time", r_.time);
+  out_->write_metadata("wall_time", r_.wall_time);
+}
+
+template <int Dim>
+void DecomposedRun<Dim>::rewrite_rows() {
+  const auto c = static_cast<std::size_t>(series_columns_);
+  for (std::size_t a = 0; c > 0 && a + c <= series_rows_.size(); a += c)
+    out_->append_series(std::vector<double>(series_rows_.begin() + static_cast<long>(a),
+                                            series_rows_.begin() + static_cast<long>(a + c)));
+  if (hot_) hot_->rewrite_table_rows(*out_);
+  out_->write_metadata("resumed_at_step", step_);
+}
+
+#define FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(D) \
+  template void DecomposedRun<D>::open_output(); \
+  template void DecomposedRun<D>::write_start_metadata(); \
+  template std::vector<std::string> DecomposedRun<D>::series_names() const; \
+  template void DecomposedRun<D>::series(); \
+  template void DecomposedRun<D>::snapshot(); \
+  template void DecomposedRun<D>::finish_output(); \
+  template std::string DecomposedRun<D>::publish(); \
+  template void DecomposedRun<D>::write_end_metadata(); \
+  template void DecomposedRun<D>::rewrite_rows();
+FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(2)
+FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(3)
+#undef FRICTHERM_INSTANTIATE_DECOMPOSED_RUN
+
+}  // namespace frictherm::coupling::decomposed

@@ -1,0 +1,97 @@
+// Refusals of `mpirun -n 2 frictherm run` and `validate` (issue 16, issue 34; coupling/app/cli_run_mpi.cpp,
+// coupling/src/scene/scene_decomposed.cpp, coupling/src/distributed_run/decomposed_runner.cpp):
+//   * a scene the decomposed engine does not support (penalty contact, a rigid contact partner that is
+//     not a boundary wall, the continuation, the KLU solver) is refused with exit code 2 naming the scene key, before any
+//     file is written, and `validate` says so;
+//   * an existing output file (the series file or one rank's file) is refused without --force, left
+//     untouched, and replaced with it;
+//   * `validate` under mpirun: every rank validates, rank 0 alone prints.
+// Skipped when mpirun is not installed. Labels verification;mpi.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "cli_mpirun_test_support.hpp"
+#include "h5_test_support.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, read_text, ...
+constexpr auto mpirun = mpirun_command;
+using CliMpirun = CliMpirunTest;
+
+TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"--set contact.method=penalty", "contact.method: \"penalty\" is not supported in a decomposed run"},
+      {"--set 'materials.base={\"type\":\"rigid\",\"density\":1000,\"velocity\":[0,0]}'",
+       "materials.base.boundary: false (a rigid contact partner) is not supported in a decomposed run"},
+      {"--set 'coupling.continuation={\"duration\":1e-4}'",
+       "coupling.continuation: duration 0.0001 is not supported in a decomposed run"},
+      {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
+       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"}};
+  for (const auto& [set, message] : cases) {
+    const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
+                           " -o '" + path("refused.h5") + "'");
+    EXPECT_EQ(r.code, 2) << set << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(message)) << set;
+    EXPECT_THAT(r.output, HasSubstr("the serial run (without mpirun, or with -n 1) supports it")) << set;
+    EXPECT_TRUE(fs::is_empty(dir_)) << set << ": nothing may be written";
+  }
+  // It is a valid scene: `validate` accepts it and says that it runs serially only, and why.
+  const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") + " --set contact.method=penalty");
+  EXPECT_EQ(v.code, 0) << v.output;
+  EXPECT_THAT(v.output, HasSubstr("serial only (contact.method: \"penalty\" is not supported in a decomposed run"));
+  const Result ok = shell(exe() + " validate " + scene("decomposed_sliding_block.json"));
+  EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it"));
+}
+
+TEST_F(CliMpirun, ExistingOutputIsRefusedWithoutForce) {
+  const std::string run = mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") +
+                          " -q --set run.end_time=2e-5 -o '" + path("out.h5") + "'";
+  const char* const files[] = {"out.h5", "out.rank0.h5", "out.rank1.h5", "out.xdmf"};
+  for (const char* existing : {"out.h5", "out.rank1.h5", "out.xdmf"}) {
+    for (const char* f : files) fs::remove(path(f));
+    std::ofstream(path(existing)) << "an earlier result";
+    const Result r = shell(run);
+    EXPECT_EQ(r.code, 2) << existing << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr(std::string(existing) + "' exists; refusing to replace an existing result"));
+    std::ifstream in(path(existing));
+    std::stringstream kept;
+    kept << in.rdbuf();
+    EXPECT_EQ(kept.str(), "an earlier result") << existing;
+    for (const char* f : files)
+      if (std::string(f) != existing) {
+        EXPECT_FALSE(fs::exists(path(f))) << existing << " refused, yet " << f << " written";
+      }
+  }
+  // With --force every file is replaced (here out.xdmf existed).
+  const Result forced = shell(run + " --force");
+  EXPECT_EQ(forced.code, 0) << forced.output;
+  EXPECT_FALSE(read_doubles(path("out.rank1.h5"), "/snapshots/000000/id").empty() &&
+               read_doubles(path("out.rank0.h5"), "/snapshots/000000/id").empty());
+  EXPECT_FALSE(read_doubles(path("out.h5"), "/series/time").empty());
+  std::ifstream xdmf(path("out.xdmf"));
+  std::stringstream text;
+  text << xdmf.rdbuf();
+  EXPECT_THAT(text.str(), HasSubstr("out.rank1.h5:/snapshots/000000/position"));
+}
+
+// `validate` under mpirun: every rank validates, rank 0 alone prints (issue 34: once per rank).
+TEST_F(CliMpirun, ValidateUnderMpirunSpeaksOnce) {
+  const Result ok = shell(mpirun(2) + " " + exe() + " validate " + scene("decomposed_sliding_block.json"));
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  std::size_t count = 0;
+  for (std::size_t at = ok.output.find("\nok\n"); at != std::string::npos; at = ok.output.find("\nok\n", at + 1)) ++count;
+  EXPECT_EQ(count, 1u) << ok.output;
+  const Result bad = shell(mpirun(2) + " " + exe() + " validate " + scene("decomposed_sliding_block.json") +
+                           " --set run.end_time=-1");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  std::size_t said = 0;
+  for (std::size_t at = bad.output.find("run.end_time"); at != std::string::npos; at = bad.output.find("run.end_time", at + 1)) ++said;
+  EXPECT_EQ(said, 1u) << bad.output;
+}
