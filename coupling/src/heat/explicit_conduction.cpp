@@ -4,7 +4,10 @@
 // change goes back to the particles with the stencils of the gather.
 #include <frictherm/coupling/explicit_conduction.hpp>
 
+#include "conductance_rows.hpp"  // NodeRange, assembly_threads
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -47,10 +50,10 @@ inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mecha
   }
 }
 
-// V_p k_p A_p², A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
+// V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
 // (quick_bound).
 template <int Dim, class Kernel>
-inline double quick_term(const mechanics::Stencil<Dim, Kernel>& st, double conductance) {
+inline double quick_weight(const mechanics::Stencil<Dim, Kernel>& st, double conductance) {
   double sw[Dim], sdw[Dim];
   for (int d = 0; d < Dim; ++d) {
     sw[d] = 0.0;
@@ -67,7 +70,39 @@ inline double quick_term(const mechanics::Stencil<Dim, Kernel>& st, double condu
       if (e != d) t *= sw[e];
     a_p += t;
   }
-  return conductance * a_p * a_p;
+  return conductance * a_p;
+}
+
+// The lowest and highest grid node of a stencil (for_each_node's numbering).
+template <int Dim, class Kernel>
+inline std::array<int, 2> node_span(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix) {
+  const mechanics::IVec<Dim> b = st.first_node();
+  int first = ix.shift, reach = 0;
+  for (int d = 0; d < Dim; ++d) {
+    first += b[d] * ix.stride[d];
+    reach += (Kernel::K - 1) * ix.stride[d];
+  }
+  return {first, first + reach};
+}
+
+using assembly_detail::NodeRange;
+
+// body(k, range) for every particle k of `list` in order, on `threads` threads, each with its own
+// range of grid nodes (all of them on one thread): a scatter adds only into the nodes (or the
+// unknowns at the nodes) of its range, so each sum gets the same terms in the same order on any
+// number of threads (as thermal_assembly.cpp's passes).
+template <class Body>
+void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_t>& list, Body&& body) {
+  if (threads <= 1) {
+    const NodeRange all{0, nodes};
+    for (std::size_t k : list) body(k, all);
+    return;
+  }
+#pragma omp parallel num_threads(threads)
+  {
+    const NodeRange mine = NodeRange::of_thread(0, nodes);
+    for (std::size_t k : list) body(k, mine);
+  }
 }
 
 // Relative spread of a particle's nodal temperatures below which they are taken as equal in the
@@ -157,31 +192,41 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them, and the sums of
   // quick_bound(); each heat-holding particle's stencil kept (copied from the step's, or evaluated
   // here) when a refresh may follow.
+  const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
+  listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);  // throws here
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
+    listed_.push_back(k);
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
     heat_capacity_[k] = mc;
-    const double conductance = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;
-    conductance_[k] = conductance;
-    const double mct = mc * p.temperature[k];
-    const mechanics::Stencil<Dim, Kernel>* st = step_stencils ? &step_stencils[k] : nullptr;
-    if (stencils_kept_) {
-      mechanics::Stencil<Dim, Kernel>& kept = kept_stencils[k];
-      if (step_stencils) kept = step_stencils[k];
-      else kept.evaluate(grid, p.position[k], p.half_size[k]);
-      st = &kept;
+    conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;
+  }
+  if (stencils_kept_) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k]) continue;
+      if (step_stencils) kept_stencils[k] = step_stencils[k];
+      else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
     }
-    const double quick = quick_term(*st, conductance);
-    st->for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+  }
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  scatter_by_node_ranges(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    const double mc = heat_capacity_[k];
+    const double mct = mc * p.temperature[k];
+    const double quick = quick_weight(st, conductance_[k]);
+    for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+      if (!r.holds(i)) return;
       sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
       mct_[static_cast<std::size_t>(i)] += mct * w;
-      quick_sum_[static_cast<std::size_t>(i)] += quick;
+      quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
     });
-  }
+  });
   if (!(sys.particle_heat_capacity > 0.0))
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
 
@@ -200,10 +245,13 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // sub-step's f_i, summed in particle order as substeps_with sums it, while the particle's G' is at
   // hand. The bounds of M⁻¹K wait until asked for (lambda_bound).
   force_.setZero(n);
-  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
-  Expanded e{};
+  // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
+  // fluxes of those that carry flux, scattered by node ranges in particle order.
+  particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
+#pragma omp parallel for num_threads(threads) schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+    Expanded e;
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
     double lo = sys.temperature[e.unknown[0]], hi = lo;
@@ -212,14 +260,26 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       hi = std::max(hi, sys.temperature[e.unknown[a]]);
     }
     quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
-    if (quiet_[k]) continue;
-    expand<Kernel, true>(stencils[k], sys.unknown, e);
+    particle_scratch_[k] = (e.count < e.total ? 1.0 : 0.0) + (quiet_[k] ? 0.0 : 2.0);
+  }
+  listed_.clear();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (particle_scratch_[k] != 0.0) listed_.push_back(k);
+  scatter_by_node_ranges(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    const int what = static_cast<int>(particle_scratch_[k]);
+    Expanded e;
+    expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
+    if (what & 1) add_quick_lumping(st, conductance_[k], sys, e, 1.0, &r);
+    if (!(what & 2)) return;
     // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
     mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
     for (int a = 0; a < e.count; ++a) grad += e.g(a) * sys.temperature[e.unknown[a]];
     grad *= conductance_[k];
-    for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
-  }
+    for (int a = 0; a < e.count; ++a)
+      if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+  });
   flux_temperature_ = sys.temperature;  // quiet_ and force_ hold for these temperatures
   first_force_ready_ = true;
 }
@@ -279,6 +339,35 @@ void ExplicitConduction<Dim>::remove_bounds(std::size_t k, const Expanded& e) {
     row_bound_[static_cast<std::size_t>(e.unknown[a])] -= conductance * gnorm[a] * gsum;
     rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] -= rayleigh_[k];
   }
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::add_quick_lumping(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                                                const NodalThermalSystem& sys, const Expanded& e, double sign,
+                                                const void* range) {
+  // |G'_ip| ≤ |G_ip|₁ + (S_ip / Σ S) |Σ_dropped G|, and |Σ_dropped G| ≤ A_p.
+  const double weight = quick_weight(st, conductance);
+  const double a_p = conductance > 0.0 ? weight / conductance : 0.0;
+  const NodeRange* r = static_cast<const NodeRange*>(range);
+  for (int a = 0; a < e.count; ++a) {
+    const int i = sys.grid_node[static_cast<std::size_t>(e.unknown[a])];
+    if (r && !r->holds(i)) continue;
+    quick_sum_[static_cast<std::size_t>(i)] += sign * weight * a_p * (e.S[a] / e.s_kept);
+  }
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::add_quick(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                                        const NodalThermalSystem& sys, const Expanded& e, double sign) {
+  // The gather's terms (pass 1 and 2) of one particle, in (sign 1) or out (sign −1): e its expansion.
+  if (conductance == 0.0) return;
+  const double quick = sign * quick_weight(st, conductance);
+  for_each_node(st, indexer_, [&](int i, double, double gx, double gy, double gz) {
+    quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+  });
+  if (e.reaches() && e.count < e.total) add_quick_lumping(st, conductance, sys, e, sign);
 }
 
 template <int Dim>
@@ -397,23 +486,17 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     else expand<Kernel, false>(kept[k], sys.unknown, e);
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
     if (bounds_ready_) remove_bounds(k, e);
-    const double quick_old = quick_term(kept[k], conductance_[k]);
-    kept[k].for_each(indexer_, [&](int i, double, const mechanics::Vec<Dim>&) {
-      quick_sum_[static_cast<std::size_t>(i)] -= quick_old;
-    });
+    add_quick(kept[k], conductance_[k], sys, e, -1.0);
     kept[k] = now[j];
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
-    const double quick_new = quick_term(kept[k], conductance_[k]);
-    kept[k].for_each(indexer_, [&](int i, double, const mechanics::Vec<Dim>&) {
-      quick_sum_[static_cast<std::size_t>(i)] += quick_new;
-    });
     if (bounds_ready_) {
       expand<Kernel, true>(kept[k], sys.unknown, e);
       add_bounds(k, sys, e);
     } else {
       expand<Kernel, false>(kept[k], sys.unknown, e);
     }
+    add_quick(kept[k], conductance_[k], sys, e, 1.0);
     quiet_[k] = 0;  // looked at in the next sub-step
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];  // and its new ones in
     gathered_at_[k] = p.position[k];
@@ -528,7 +611,9 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
                      T == flux_temperature_;
   first_force_ready_ = false;
   force_.resize(n);
-  Expanded e{};
+  const int threads = assembly_detail::assembly_threads(holds_heat_.size());
+  const int nodes = static_cast<int>(sys.unknown.size());
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   for (long s = 0; s < substeps; ++s) {
     if (force_ready) {
       force_ready = false;
@@ -543,7 +628,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
     const bool first = flux_temperature_.size() != n;
     count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
     flux_temperature_ = T;
-    const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+    // Each particle's look (threads by particles), then the fluxes of those that carry flux,
+    // scattered by node ranges in particle order.
+    particle_scratch_.assign(holds_heat_.size(), 0.0);  // 1: carries flux
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
       if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
       if (conductance_[k] == 0.0) {
@@ -553,6 +641,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       // Nodal temperatures that agree to round-off (the re-projection's own, kQuietSpread) carry no
       // flux through the particle: its terms are left out, which keeps Σ_i f_i = 0 exactly and the
       // nodes it alone touches unchanged (their ΔT_i = 0 lets the map back pass over their particles).
+      Expanded e;
       expand<Kernel, false>(stencils[k], sys.unknown, e);
       if (!e.reaches()) {
         quiet_[k] = 1;  // no heat capacity of its own reaches an unknown: no conduction
@@ -564,14 +653,23 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         hi = std::max(hi, T[e.unknown[a]]);
       }
       quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
-      if (quiet_[k]) continue;
-      expand<Kernel, true>(stencils[k], sys.unknown, e);
+      if (!quiet_[k]) particle_scratch_[k] = 1.0;
+    }
+    listed_.clear();
+    for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+      if (particle_scratch_[k] != 0.0) listed_.push_back(k);
+    scatter_by_node_ranges(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      if (!r.meets(node_span(st, indexer_))) return;
+      Expanded e;
+      expand<Kernel, true>(st, sys.unknown, e);
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
       mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
       for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
       grad *= conductance_[k];
-      for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);  // f_i = −V k G'·∇T
-    }
+      for (int a = 0; a < e.count; ++a)  // f_i = −V k G'·∇T
+        if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+    });
     for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
     for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
   }
@@ -596,9 +694,16 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   // none among its nodes keeps its temperature (ΔT_p = 0 exactly) and is passed over.
   count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
-  Expanded c{};
+  const int threads = assembly_detail::assembly_threads(p.size());
+  // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
+  // scattered by node ranges in particle order.
+  particle_scratch_.assign(p.size(), 0.0);  // m_p C_v,p ΔT_p of the particles that changed
+  std::vector<unsigned char>& changed = quiet_changed_;
+  changed.assign(p.size(), 0);
+#pragma omp parallel for num_threads(threads) schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+    Expanded c;
     expand<Kernel, false>(stencils[k], sys.unknown, c);
     if (c.count == 0) continue;  // reaches no unknown
     // design §4: the increment, not the nodal value
@@ -616,10 +721,22 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
     if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
-    // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
-    const double change = heat_capacity_[k] * (T - before);
-    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+    particle_scratch_[k] = heat_capacity_[k] * (T - before);
+    changed[k] = 1;
   }
+  listed_.clear();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (changed[k]) listed_.push_back(k);
+  // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
+  scatter_by_node_ranges(threads, static_cast<int>(sys.unknown.size()), listed_, [&](std::size_t k, const NodeRange& r) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    Expanded c;
+    expand<Kernel, false>(st, sys.unknown, c);
+    const double change = particle_scratch_[k];
+    for (int a = 0; a < c.count; ++a)
+      if (r.holds(sys.grid_node[static_cast<std::size_t>(c.unknown[a])])) next_mct_[c.unknown[a]] += change * c.S[a];
+  });
 }
 
 template class ExplicitConduction<2>;

@@ -92,10 +92,11 @@ class ExplicitConduction {
   /// A cruder upper bound of the same eigenvalue, from sums the gather makes anyway (issue 35: the
   /// exact bounds cost a square root and a division per node and particle, and a window far below
   /// the stable step needs only to know that one sub-step is stable):
-  ///   λ ≤ max_i Σ_{p∋i} V_p k_p A_p² / M_i,  A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j w_e,j)
-  /// (A_p = Σ over the stencil of |G_ip|₁ ≥ Σ_a |G'_ap| and ≥ |G'_ip|: lumping moves the dropped
-  /// nodes' G onto kept ones with shares S/Σ S ≤ 1), so it is ≥ the Gershgorin bound of
-  /// lambda_bound() and hence ≥ lambda_bound(); times (1 + 1e-6) against round-off. refresh() keeps
+  ///   λ ≤ max_i Σ_{p∋i} V_p k_p A_p (|G_ip|₁ + [lumped] (S_ip / Σ_a S_ap) A_p) / M_i,
+  ///   A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j w_e,j) = Σ over the stencil of |G_ip|₁
+  /// (A_p ≥ Σ_a |G'_ap|, and |G'_ip| ≤ |G_ip|₁ + (S_ip / Σ S)|Σ_dropped G|: lumping moves the dropped
+  /// nodes' G onto the kept ones with shares S_ip / Σ S), so it is ≥ the Gershgorin bound of
+  /// lambda_bound() (at most ~3–5× above it) and hence ≥ lambda_bound(); times (1 + 1e-6) against round-off. refresh() keeps
   /// its sums up to date (the moved particles' terms out and in), so it bounds the refreshed system.
   double quick_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const;
   /// Whether lambda_bound()'s bounds are made (then refresh() keeps them up to date, as before issue
@@ -169,6 +170,14 @@ class ExplicitConduction {
   void add_bounds(std::size_t k, const NodalThermalSystem& sys, const Expanded& e);
   /// Its bound contributions taken out again (a refresh), as add_bounds() added them.
   void remove_bounds(std::size_t k, const Expanded& e);
+  /// quick_bound()'s sums of one particle with stencil st and expansion e (S, no G), in (sign 1) or
+  /// out (−1); the lumping part only (pass 2 of the gather).
+  template <class Kernel>
+  void add_quick(const mechanics::Stencil<Dim, Kernel>& st, double conductance, const NodalThermalSystem& sys,
+                 const Expanded& e, double sign);
+  template <class Kernel>
+  void add_quick_lumping(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                         const NodalThermalSystem& sys, const Expanded& e, double sign, const void* range = nullptr);
   /// Every heat-holding particle's bound terms, in particle order (as the gather made them before
   /// issue 35: the same sums), with the window's stencils and M of the gather.
   template <class Kernel>
@@ -222,6 +231,12 @@ class ExplicitConduction {
   std::vector<unsigned char> quiet_;          // by particle
   Eigen::VectorXd flux_temperature_;          // T_i of the last sub-step (empty: look at every particle)
   std::vector<int> changed_before_;           // scratch: changed unknowns at grid nodes < i
+  // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
+  // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
+  // in order, so every sum has the same terms in the same order on any number of threads.
+  std::vector<std::size_t> listed_;           // scratch: the particles a scatter visits, in order
+  std::vector<double> particle_scratch_;      // scratch: a per-particle value of a pass
+  std::vector<unsigned char> quiet_changed_;  // scratch: particles whose temperature the map back changed
   /// changed_before_ from whether unknown u changed.
   template <class Changed>
   void count_changed(const std::vector<int>& unknown, Changed&& changed);
