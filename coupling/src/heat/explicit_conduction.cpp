@@ -87,21 +87,23 @@ inline std::array<int, 2> node_span(const mechanics::Stencil<Dim, Kernel>& st, c
 
 using assembly_detail::NodeRange;
 
-// body(k, range) for every particle k of `list` in order, on `threads` threads, each with its own
-// range of grid nodes (all of them on one thread): a scatter adds only into the nodes (or the
-// unknowns at the nodes) of its range, so each sum gets the same terms in the same order on any
-// number of threads (as thermal_assembly.cpp's passes).
-template <class Body>
+// body(k, range, scratch) for every particle k of `list` in order, on `threads` threads, each with
+// its own range of grid nodes (all of them on one thread) and its own Scratch: a scatter adds only
+// into the nodes (or the unknowns at the nodes) of its range, so each sum gets the same terms in the
+// same order on any number of threads (as thermal_assembly.cpp's passes).
+template <class Scratch, class Body>
 void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_t>& list, Body&& body) {
   if (threads <= 1) {
     const NodeRange all{0, nodes};
-    for (std::size_t k : list) body(k, all);
+    Scratch scratch{};
+    for (std::size_t k : list) body(k, all, scratch);
     return;
   }
 #pragma omp parallel num_threads(threads)
   {
     const NodeRange mine = NodeRange::of_thread(0, nodes);
-    for (std::size_t k : list) body(k, mine);
+    Scratch scratch{};
+    for (std::size_t k : list) body(k, mine, scratch);
   }
 }
 
@@ -214,7 +216,20 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     }
   }
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
-  scatter_by_node_ranges(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r) {
+  if (threads <= 1) {  // the same sums without the range checks
+    for (std::size_t k : listed_) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      const double mc = heat_capacity_[k];
+      const double mct = mc * p.temperature[k];
+      const double quick = quick_weight(st, conductance_[k]);
+      for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+        mct_[static_cast<std::size_t>(i)] += mct * w;
+        quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+      });
+    }
+  } else
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
     const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
     if (!r.meets(node_span(st, indexer_))) return;
     const double mc = heat_capacity_[k];
@@ -248,10 +263,12 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel num_threads(threads)
+  {
+  Expanded e{};
+#pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
-    Expanded e;
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
     double lo = sys.temperature[e.unknown[0]], hi = lo;
@@ -262,15 +279,16 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
     particle_scratch_[k] = (e.count < e.total ? 1.0 : 0.0) + (quiet_[k] ? 0.0 : 2.0);
   }
+  }
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (particle_scratch_[k] != 0.0) listed_.push_back(k);
-  scatter_by_node_ranges(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r) {
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
     const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
     if (!r.meets(node_span(st, indexer_))) return;
     const int what = static_cast<int>(particle_scratch_[k]);
-    Expanded e;
-    expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
+    if (what & 2) expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
+    else expand<Kernel, false>(st, sys.unknown, e);
     if (what & 1) add_quick_lumping(st, conductance_[k], sys, e, 1.0, &r);
     if (!(what & 2)) return;
     // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
@@ -631,7 +649,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
     // Each particle's look (threads by particles), then the fluxes of those that carry flux,
     // scattered by node ranges in particle order.
     particle_scratch_.assign(holds_heat_.size(), 0.0);  // 1: carries flux
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel num_threads(threads)
+    {
+    Expanded e{};
+#pragma omp for schedule(static)
     for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
       if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
       if (conductance_[k] == 0.0) {
@@ -641,7 +662,6 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       // Nodal temperatures that agree to round-off (the re-projection's own, kQuietSpread) carry no
       // flux through the particle: its terms are left out, which keeps Σ_i f_i = 0 exactly and the
       // nodes it alone touches unchanged (their ΔT_i = 0 lets the map back pass over their particles).
-      Expanded e;
       expand<Kernel, false>(stencils[k], sys.unknown, e);
       if (!e.reaches()) {
         quiet_[k] = 1;  // no heat capacity of its own reaches an unknown: no conduction
@@ -655,13 +675,13 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
       if (!quiet_[k]) particle_scratch_[k] = 1.0;
     }
+    }
     listed_.clear();
     for (std::size_t k = 0; k < holds_heat_.size(); ++k)
       if (particle_scratch_[k] != 0.0) listed_.push_back(k);
-    scatter_by_node_ranges(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r) {
+    scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
       if (!r.meets(node_span(st, indexer_))) return;
-      Expanded e;
       expand<Kernel, true>(st, sys.unknown, e);
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
       mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
@@ -700,10 +720,12 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   particle_scratch_.assign(p.size(), 0.0);  // m_p C_v,p ΔT_p of the particles that changed
   std::vector<unsigned char>& changed = quiet_changed_;
   changed.assign(p.size(), 0);
-#pragma omp parallel for num_threads(threads) schedule(static)
+#pragma omp parallel num_threads(threads)
+  {
+  Expanded c{};
+#pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
-    Expanded c;
     expand<Kernel, false>(stencils[k], sys.unknown, c);
     if (c.count == 0) continue;  // reaches no unknown
     // design §4: the increment, not the nodal value
@@ -724,14 +746,14 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     particle_scratch_[k] = heat_capacity_[k] * (T - before);
     changed[k] = 1;
   }
+  }
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (changed[k]) listed_.push_back(k);
   // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
-  scatter_by_node_ranges(threads, static_cast<int>(sys.unknown.size()), listed_, [&](std::size_t k, const NodeRange& r) {
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(sys.unknown.size()), listed_, [&](std::size_t k, const NodeRange& r, Expanded& c) {
     const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
     if (!r.meets(node_span(st, indexer_))) return;
-    Expanded c;
     expand<Kernel, false>(st, sys.unknown, c);
     const double change = particle_scratch_[k];
     for (int a = 0; a < c.count; ++a)
