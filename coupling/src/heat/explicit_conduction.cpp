@@ -646,6 +646,36 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
     const bool first = flux_temperature_.size() != n;
     count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
     flux_temperature_ = T;
+    if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
+      Expanded e{};
+      for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
+        if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
+        if (conductance_[k] == 0.0) {
+          quiet_[k] = 1;
+          continue;
+        }
+        expand<Kernel, false>(stencils[k], sys.unknown, e);
+        if (!e.reaches()) {
+          quiet_[k] = 1;
+          continue;
+        }
+        double lo = T[e.unknown[0]], hi = lo;
+        for (int a = 1; a < e.count; ++a) {
+          lo = std::min(lo, T[e.unknown[a]]);
+          hi = std::max(hi, T[e.unknown[a]]);
+        }
+        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        if (quiet_[k]) continue;
+        expand<Kernel, true>(stencils[k], sys.unknown, e);
+        mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+        for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+        grad *= conductance_[k];
+        for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
+      }
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
     // Each particle's look (threads by particles), then the fluxes of those that carry flux,
     // scattered by node ranges in particle order.
     particle_scratch_.assign(holds_heat_.size(), 0.0);  // 1: carries flux
@@ -717,6 +747,31 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   const int threads = assembly_detail::assembly_threads(p.size());
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
+  if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
+    Expanded c{};
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+      expand<Kernel, false>(stencils[k], sys.unknown, c);
+      if (c.count == 0) continue;  // reaches no unknown
+      double dT = 0.0;  // design §4: the increment, not the nodal value
+      for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
+      double pic = 0.0, s = 0.0;
+      if (relax) {
+        for (int a = 0; a < c.count; ++a) {
+          pic += c.S[a] * (*end)[c.unknown[a]];
+          s += c.S[a];
+        }
+      }
+      const double before = p.temperature[k];
+      const double flip = before + dT;
+      const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+      if (T == before) continue;
+      p.temperature[k] = T;
+      const double change = heat_capacity_[k] * (T - before);
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+    }
+    return;
+  }
   particle_scratch_.assign(p.size(), 0.0);  // m_p C_v,p ΔT_p of the particles that changed
   std::vector<unsigned char>& changed = quiet_changed_;
   changed.assign(p.size(), 0);
