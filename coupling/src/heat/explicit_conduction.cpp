@@ -4,7 +4,10 @@
 // change goes back to the particles with the stencils of the gather.
 #include <frictherm/coupling/explicit_conduction.hpp>
 
+#include "conductance_rows.hpp"  // NodeRange, assembly_threads
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -47,6 +50,63 @@ inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mecha
   }
 }
 
+// V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
+// (quick_bound).
+template <int Dim, class Kernel>
+inline double quick_weight(const mechanics::Stencil<Dim, Kernel>& st, double conductance) {
+  double sw[Dim], sdw[Dim];
+  for (int d = 0; d < Dim; ++d) {
+    sw[d] = 0.0;
+    sdw[d] = 0.0;
+    for (int j = 0; j < Kernel::K; ++j) {
+      sw[d] += std::fabs(st.axis[d].w[j]);
+      sdw[d] += std::fabs(st.axis[d].dw[j]);
+    }
+  }
+  double a_p = 0.0;
+  for (int d = 0; d < Dim; ++d) {
+    double t = sdw[d];
+    for (int e = 0; e < Dim; ++e)
+      if (e != d) t *= sw[e];
+    a_p += t;
+  }
+  return conductance * a_p;
+}
+
+// The lowest and highest grid node of a stencil (for_each_node's numbering).
+template <int Dim, class Kernel>
+inline std::array<int, 2> node_span(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix) {
+  const mechanics::IVec<Dim> b = st.first_node();
+  int first = ix.shift, reach = 0;
+  for (int d = 0; d < Dim; ++d) {
+    first += b[d] * ix.stride[d];
+    reach += (Kernel::K - 1) * ix.stride[d];
+  }
+  return {first, first + reach};
+}
+
+using assembly_detail::NodeRange;
+
+// body(k, range, scratch) for every particle k of `list` in order, on `threads` threads, each with
+// its own range of grid nodes (all of them on one thread) and its own Scratch: a scatter adds only
+// into the nodes (or the unknowns at the nodes) of its range, so each sum gets the same terms in the
+// same order on any number of threads (as thermal_assembly.cpp's passes).
+template <class Scratch, class Body>
+void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_t>& list, Body&& body) {
+  if (threads <= 1) {
+    const NodeRange all{0, nodes};
+    Scratch scratch{};
+    for (std::size_t k : list) body(k, all, scratch);
+    return;
+  }
+#pragma omp parallel num_threads(threads)
+  {
+    const NodeRange mine = NodeRange::of_thread(0, nodes);
+    Scratch scratch{};
+    for (std::size_t k : list) body(k, mine, scratch);
+  }
+}
+
 // Relative spread of a particle's nodal temperatures below which they are taken as equal in the
 // sub-steps: 256 ε, the order of the re-projection's own round-off (T_i = Σ m C T S / Σ m C S over
 // ~10–30 terms). At 300 K it is 1.7e-11 K.
@@ -56,12 +116,25 @@ constexpr double kQuietSpread = 256.0 * 2.220446049250313e-16;
 
 template <int Dim>
 template <class Kernel, bool WithG>
-void ExplicitConduction<Dim>::expand(std::size_t k, const std::vector<int>& unknown, Expanded& e) const {
-  const Kept& c = kept_[k];
-  int n = 0;
-  for_each_node(stencils_.template of<Kernel>()[k], indexer_, [&](int i, double w, double gx, double gy, double gz) {
+void ExplicitConduction<Dim>::expand(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown,
+                                     Expanded& e) const {
+  // The sums of the gather before issue 35 (keep()), in the same order: S over the unknowns, G over
+  // the other nodes.
+  double s_kept = 0.0;
+  double g_dropped[Dim] = {};
+  int n = 0, total = 0;
+  for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+    ++total;
     const int u = unknown[static_cast<std::size_t>(i)];
-    if (u < 0) return;
+    if (u < 0) {
+      if constexpr (WithG) {
+        g_dropped[0] += gx;
+        g_dropped[1] += gy;
+        if constexpr (Dim == 3) g_dropped[2] += gz;
+      }
+      return;
+    }
+    s_kept += w;
     e.unknown[n] = u;
     e.S[n] = w;
     if constexpr (WithG) {
@@ -72,11 +145,13 @@ void ExplicitConduction<Dim>::expand(std::size_t k, const std::vector<int>& unkn
     ++n;
   });
   e.count = n;
+  e.total = total;
+  e.s_kept = s_kept;
   if constexpr (WithG)
-    if (c.lumped)  // lump dropped nodes, as keep()
+    if (n < total && e.reaches())  // lump dropped nodes (as thermal_assembly builds K)
       for (int a = 0; a < n; ++a) {
-        const double share = e.S[a] / c.s_kept;
-        for (int d = 0; d < Dim; ++d) e.G[d][a] += share * c.g_dropped[d];
+        const double share = e.S[a] / s_kept;
+        for (int d = 0; d < Dim; ++d) e.G[d][a] += share * g_dropped[d];
       }
 }
 
@@ -85,7 +160,7 @@ template <class Kernel>
 void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                                           const std::vector<ThermalProperties>& materials,
                                           const AssemblyOptions& opt, NodalThermalSystem& sys,
-                                          const mechanics::StencilView<Dim>& view) {
+                                          const mechanics::StencilView<Dim>& view, bool keep_stencils) {
   static_assert(mechanics::Stencil<Dim, Kernel>::node_count <= capacity, "stencil wider than the node list");
   const std::size_t n_nodes = grid.node_count();
   sys.grid_mass.assign(n_nodes, 0.0);
@@ -94,37 +169,79 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   sys.dropped_mass = 0.0;
   sys.conductance.resize(0, 0);  // no K on this path
   mct_.assign(n_nodes, 0.0);
+  quick_sum_.assign(n_nodes, 0.0);
   indexer_ = mechanics::NodeIndexer<Dim>{grid.strides(), 0};
-  StencilVector<Kernel>& kept_stencils = stencils_.template of<Kernel>();
-  kept_stencils.resize(p.size());
-  kept_.resize(p.size());
-  gathered_at_.assign(p.position.begin(), p.position.end());
-  unknown_runs_.assign(p.size() * kMaxRuns, UnknownRun{1, 0});  // empty until keep()
+  heat_capacity_.assign(p.size(), 0.0);
+  conductance_.assign(p.size(), 0.0);
+  rayleigh_.assign(p.size(), 0.0);
+  bounds_ready_ = false;
   quiet_.assign(p.size(), 1);  // particles that hold no heat carry no flux
   flux_temperature_.resize(0);  // set with quiet_ at the end
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
+  StencilVector<Kernel>& kept_stencils = stencils_.template of<Kernel>();
+  stencils_kept_ = keep_stencils || !step_stencils;
+  if (stencils_kept_) {
+    kept_stencils.resize(p.size());
+    gathered_at_.assign(p.position.begin(), p.position.end());
+    window_stencils_ = kept_stencils.data();
+  } else {  // read in place for this window only; refresh() then asks for a gather
+    kept_stencils.clear();
+    gathered_at_.clear();
+    window_stencils_ = step_stencils;
+  }
 
-  // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them; each
-  // heat-holding particle's stencil kept (copied from the step's, or evaluated here).
+  // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them, and the sums of
+  // quick_bound(); each heat-holding particle's stencil kept (copied from the step's, or evaluated
+  // here) when a refresh may follow.
+  const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
+  listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k) {
-    kept_[k] = Kept{};
-    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);  // throws here
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
+    listed_.push_back(k);
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
-    kept_[k].heat_capacity = mc;
+    heat_capacity_[k] = mc;
+    conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;
+  }
+  if (stencils_kept_) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k]) continue;
+      if (step_stencils) kept_stencils[k] = step_stencils[k];
+      else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
+    }
+  }
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  if (threads <= 1) {  // the same sums without the range checks
+    for (std::size_t k : listed_) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      const double mc = heat_capacity_[k];
+      const double mct = mc * p.temperature[k];
+      const double quick = quick_weight(st, conductance_[k]);
+      for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+        mct_[static_cast<std::size_t>(i)] += mct * w;
+        quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+      });
+    }
+  } else
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    const double mc = heat_capacity_[k];
     const double mct = mc * p.temperature[k];
-    mechanics::Stencil<Dim, Kernel>& st = kept_stencils[k];
-    if (step_stencils) st = step_stencils[k];
-    else st.evaluate(grid, p.position[k], p.half_size[k]);
-    st.for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+    const double quick = quick_weight(st, conductance_[k]);
+    for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+      if (!r.holds(i)) return;
       sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
       mct_[static_cast<std::size_t>(i)] += mct * w;
+      quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
     });
-  }
+  });
   if (!(sys.particle_heat_capacity > 0.0))
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
 
@@ -135,101 +252,62 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // by map_back and refresh from here on.
   next_mct_.resize(n);
   for (Eigen::Index u = 0; u < n; ++u) next_mct_[u] = mct_[static_cast<std::size_t>(sys.grid_node[static_cast<std::size_t>(u)])];
-
-  // Pass 2: per heat-holding particle its lumping, runs and the bounds of M⁻¹K.
-  row_bound_.assign(static_cast<std::size_t>(n), 0.0);
-  rayleigh_bound_.assign(static_cast<std::size_t>(n), 0.0);
   mass_peak_ = sys.mass;
   rayleigh_scale_ = 1.0;
-  // With them, the first sub-step's f_i at sys.temperature (what the coupler advances from), summed
-  // in particle order as substeps_with sums it, while the particle's G' is at hand.
+
+  // Pass 2: which particles carry flux at the temperatures the window starts from (sys.temperature,
+  // what the coupler advances from), as the first sub-step would find, and for those the first
+  // sub-step's f_i, summed in particle order as substeps_with sums it, while the particle's G' is at
+  // hand. The bounds of M⁻¹K wait until asked for (lambda_bound).
   force_.setZero(n);
-  Expanded e;
+  // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
+  // fluxes of those that carry flux, scattered by node ranges in particle order.
+  particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
+#pragma omp parallel num_threads(threads)
+  {
+  Expanded e{};
+#pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!holds_heat_[k]) continue;
-    keep<Kernel>(k, thermal_properties_of(materials, p.material[k]), p.volume[k], sys, e);
-    // Whether it carries flux at the temperatures the window starts from, as the first sub-step
-    // would find.
-    const Kept& c = kept_[k];
-    if (c.conductance == 0.0) {
-      quiet_[k] = 1;
-      continue;
-    }
+    if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+    expand<Kernel, false>(stencils[k], sys.unknown, e);
+    if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
     double lo = sys.temperature[e.unknown[0]], hi = lo;
     for (int a = 1; a < e.count; ++a) {
       lo = std::min(lo, sys.temperature[e.unknown[a]]);
       hi = std::max(hi, sys.temperature[e.unknown[a]]);
     }
     quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
-    if (quiet_[k]) continue;
+    particle_scratch_[k] = (e.count < e.total ? 1.0 : 0.0) + (quiet_[k] ? 0.0 : 2.0);
+  }
+  }
+  listed_.clear();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (particle_scratch_[k] != 0.0) listed_.push_back(k);
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    const int what = static_cast<int>(particle_scratch_[k]);
+    if (what & 2) expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
+    else expand<Kernel, false>(st, sys.unknown, e);
+    if (what & 1) add_quick_lumping(st, conductance_[k], sys, e, 1.0, &r);
+    if (!(what & 2)) return;
     // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
     mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
     for (int a = 0; a < e.count; ++a) grad += e.g(a) * sys.temperature[e.unknown[a]];
-    grad *= c.conductance;
-    for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
-  }
+    grad *= conductance_[k];
+    for (int a = 0; a < e.count; ++a)
+      if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+  });
   flux_temperature_ = sys.temperature;  // quiet_ and force_ hold for these temperatures
   first_force_ready_ = true;
 }
 
 template <int Dim>
-template <class Kernel>
-void ExplicitConduction<Dim>::keep(std::size_t k, const ThermalProperties& m, double volume,
-                                   const NodalThermalSystem& sys, Expanded& e) {
-  Kept& c = kept_[k];
-  c.count = 0;
-  c.conductance = 0.0;
-  c.rayleigh = 0.0;
-  c.lumped = 0;
-  double s_kept = 0.0;
-  mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();
-  int total = 0, n = 0;
-  for_each_node(stencils_.template of<Kernel>()[k], indexer_, [&](int i, double w, double gx, double gy, double gz) {
-    ++total;
-    const int u = sys.unknown[static_cast<std::size_t>(i)];
-    if (u >= 0) {
-      s_kept += w;
-      e.unknown[n] = u;
-      e.S[n] = w;
-      e.G[0][n] = gx;
-      e.G[1][n] = gy;
-      if constexpr (Dim == 3) e.G[2][n] = gz;
-      ++n;
-    } else {
-      g_dropped[0] += gx;
-      g_dropped[1] += gy;
-      if constexpr (Dim == 3) g_dropped[2] += gz;
-    }
-  });
-  e.count = n;
-  c.count = n;
-  c.s_kept = s_kept;
-  c.g_dropped = g_dropped;
-  // The per-window passes skip it while none of its unknowns changed (any_changed).
-  // Its unknowns as runs of numbers: the stencil lists them x fastest, so a new row starts where the
-  // number jumps by more than a row of the stencil could (the unknowns of a grid row are numbered
-  // in order). Up to kMaxRuns runs; the last takes the rest.
-  UnknownRun* runs = &unknown_runs_[k * kMaxRuns];
-  std::fill(runs, runs + kMaxRuns, UnknownRun{1, 0});
-  int r = 0;
-  for (int a = 0; a < n; ++a) {
-    const int u = e.unknown[a];
-    if (a > 0 && r + 1 < kMaxRuns && (u < runs[r].lo || u > runs[r].hi + capacity)) ++r;
-    if (runs[r].lo > runs[r].hi) runs[r] = {u, u};
-    runs[r].lo = std::min(runs[r].lo, u);
-    runs[r].hi = std::max(runs[r].hi, u);
-  }
-  quiet_[k] = 0;
-  // No conduction, or no heat capacity of its own reaches an unknown (as assemble_thermal).
-  if (!(m.conductivity > 0.0) || n == 0 || !(s_kept > 0.0)) return;
-  if (n < total) {
-    c.lumped = 1;
-    for (int a = 0; a < n; ++a) {  // lump dropped nodes
-      const double share = e.S[a] / s_kept;
-      for (int d = 0; d < Dim; ++d) e.G[d][a] += share * g_dropped[d];
-    }
-  }
-  c.conductance = volume * m.conductivity;
+void ExplicitConduction<Dim>::add_bounds(std::size_t k, const NodalThermalSystem& sys, const Expanded& e) {
+  const double conductance = conductance_[k];
+  rayleigh_[k] = 0.0;
+  if (conductance == 0.0 || !e.reaches()) return;  // no conduction (as assemble_thermal)
+  const int n = e.count;
   // Two bounds of M⁻¹K, the smaller one is used (lambda_bound): Gershgorin with |G'_i·G'_j| ≤
   // |G'_i||G'_j|, and Cauchy–Schwarz on the Rayleigh quotient, Σ_p c_p |Σ_a G'_a x_a|² ≤
   // Σ_p c_p (Σ_a |G'_a|²/M_a)(Σ_a M_a x_a²), so λ ≤ max_i Σ_{p∋i} c_p Σ_a |G'_a|²/M_a.
@@ -259,34 +337,97 @@ void ExplicitConduction<Dim>::keep(std::size_t k, const ThermalProperties& m, do
     gsum += gnorm[a];
     g2m += g2[a];
   }
-  c.rayleigh = c.conductance * g2m;
+  const double rayleigh = conductance * g2m;
+  rayleigh_[k] = rayleigh;
   for (int a = 0; a < n; ++a) {
-    row_bound_[static_cast<std::size_t>(e.unknown[a])] += c.conductance * gnorm[a] * gsum;
-    rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] += c.rayleigh;
+    row_bound_[static_cast<std::size_t>(e.unknown[a])] += conductance * gnorm[a] * gsum;
+    rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] += rayleigh;
   }
 }
 
 template <int Dim>
-void ExplicitConduction<Dim>::remove_bounds(const Kept& c, const Expanded& e) {
-  if (c.conductance == 0.0) return;  // keep() added none
+void ExplicitConduction<Dim>::remove_bounds(std::size_t k, const Expanded& e) {
+  const double conductance = conductance_[k];
+  if (conductance == 0.0 || !e.reaches()) return;  // add_bounds() added none
   double gsum = 0.0;
   double gnorm[capacity];
   for (int a = 0; a < e.count; ++a) gnorm[a] = e.g(a).norm();
   for (int a = 0; a < e.count; ++a) gsum += gnorm[a];
   for (int a = 0; a < e.count; ++a) {
-    row_bound_[static_cast<std::size_t>(e.unknown[a])] -= c.conductance * gnorm[a] * gsum;
-    rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] -= c.rayleigh;
+    row_bound_[static_cast<std::size_t>(e.unknown[a])] -= conductance * gnorm[a] * gsum;
+    rayleigh_bound_[static_cast<std::size_t>(e.unknown[a])] -= rayleigh_[k];
   }
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::add_quick_lumping(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                                                const NodalThermalSystem& sys, const Expanded& e, double sign,
+                                                const void* range) {
+  // |G'_ip| ≤ |G_ip|₁ + (S_ip / Σ S) |Σ_dropped G|, and |Σ_dropped G| ≤ A_p.
+  const double weight = quick_weight(st, conductance);
+  const double a_p = conductance > 0.0 ? weight / conductance : 0.0;
+  const NodeRange* r = static_cast<const NodeRange*>(range);
+  for (int a = 0; a < e.count; ++a) {
+    const int i = sys.grid_node[static_cast<std::size_t>(e.unknown[a])];
+    if (r && !r->holds(i)) continue;
+    quick_sum_[static_cast<std::size_t>(i)] += sign * weight * a_p * (e.S[a] / e.s_kept);
+  }
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::add_quick(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                                        const NodalThermalSystem& sys, const Expanded& e, double sign) {
+  // The gather's terms (pass 1 and 2) of one particle, in (sign 1) or out (sign −1): e its expansion.
+  if (conductance == 0.0) return;
+  const double quick = sign * quick_weight(st, conductance);
+  for_each_node(st, indexer_, [&](int i, double, double gx, double gy, double gz) {
+    quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+  });
+  if (e.reaches() && e.count < e.total) add_quick_lumping(st, conductance, sys, e, sign);
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::make_bounds(const NodalThermalSystem& sys) {
+  row_bound_.assign(sys.size(), 0.0);
+  rayleigh_bound_.assign(sys.size(), 0.0);
+  mass_peak_ = sys.mass;  // every term with M now
+  rayleigh_scale_ = 1.0;
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  Expanded e{};
+  for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
+    if (!holds_heat_[k] || conductance_[k] == 0.0) continue;
+    expand<Kernel, true>(stencils[k], sys.unknown, e);
+    add_bounds(k, sys, e);
+  }
+  bounds_ready_ = true;
+}
+
+template <int Dim>
+double ExplicitConduction<Dim>::quick_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const {
+  std::vector<char> held;
+  if (!fixed.empty()) {
+    held.assign(sys.size(), 0);
+    for (const FixedNode& f : fixed) held[static_cast<std::size_t>(f.unknown)] = 1;
+  }
+  double bound = 0.0;
+  for (std::size_t u = 0; u < sys.size(); ++u) {
+    if (!held.empty() && held[u]) continue;
+    bound = std::max(bound, quick_sum_[static_cast<std::size_t>(sys.grid_node[u])] / sys.mass[static_cast<Eigen::Index>(u)]);
+  }
+  return bound * (1.0 + 1e-6);
 }
 
 template <int Dim>
 void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
                                      mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                      const AssemblyOptions& options, NodalThermalSystem& sys,
-                                     const mechanics::StencilView<Dim>& stencils) {
+                                     const mechanics::StencilView<Dim>& stencils, bool keep_stencils) {
   kind_ = shape;
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    gather_with<decltype(kernel)>(grid, particles, materials, options, sys, stencils);
+    gather_with<decltype(kernel)>(grid, particles, materials, options, sys, stencils, keep_stencils);
   });
 }
 
@@ -296,7 +437,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
     const AssemblyOptions& opt, NodalThermalSystem& sys, double max_shift, const mechanics::StencilView<Dim>& view) {
   first_force_ready_ = false;
-  if (gathered_at_.size() != p.size() || kept_.size() != p.size() ||
+  if (!stencils_kept_ || gathered_at_.size() != p.size() || heat_capacity_.size() != p.size() ||
       stencils_.template of<Kernel>().size() != p.size())
     return Refresh::regather;
   moved_.clear();
@@ -317,7 +458,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
   now.resize(moved_.size());
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
-    const double mc = kept_[k].heat_capacity;
+    const double mc = heat_capacity_[k];
     kept_stencils[k].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
       sys.grid_mass[static_cast<std::size_t>(i)] -= mc * w;
     });
@@ -351,16 +492,30 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
   }
   rayleigh_scale_ = scale;
 
-  // The moved particles' kept state, bounds and eq. 38 sums for the next reproject(), anew.
-  Expanded e;
+  // The moved particles' kept state, bounds and eq. 38 sums for the next reproject(), anew: the
+  // exact bounds if they were made since the gather (lambda_bound), else the quick bound's sums.
+  Expanded e{};
+  StencilVector<Kernel>& kept = stencils_.template of<Kernel>();
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
-    const double mct = kept_[k].heat_capacity * p.temperature[k];
-    expand<Kernel, true>(k, sys.unknown, e);  // as its last keep(): the unknowns have not changed
+    const double mct = heat_capacity_[k] * p.temperature[k];
+    // as its last gather: the unknowns have not changed
+    if (bounds_ready_) expand<Kernel, true>(kept[k], sys.unknown, e);
+    else expand<Kernel, false>(kept[k], sys.unknown, e);
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
-    remove_bounds(kept_[k], e);
-    stencils_.template of<Kernel>()[k] = now[j];
-    keep<Kernel>(k, thermal_properties_of(materials, p.material[k]), p.volume[k], sys, e);
+    if (bounds_ready_) remove_bounds(k, e);
+    add_quick(kept[k], conductance_[k], sys, e, -1.0);
+    kept[k] = now[j];
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
+    conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
+    if (bounds_ready_) {
+      expand<Kernel, true>(kept[k], sys.unknown, e);
+      add_bounds(k, sys, e);
+    } else {
+      expand<Kernel, false>(kept[k], sys.unknown, e);
+    }
+    add_quick(kept[k], conductance_[k], sys, e, 1.0);
+    quiet_[k] = 0;  // looked at in the next sub-step
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];  // and its new ones in
     gathered_at_[k] = p.position[k];
   }
@@ -379,7 +534,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh(
 
 template <int Dim>
 void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
-  if (kept_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
+  if (heat_capacity_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
   const auto n = static_cast<Eigen::Index>(sys.size());
   if (next_mct_.size() != n) throw std::logic_error("ExplicitConduction::reproject: the sums are of other unknowns");
   first_force_ready_ = false;
@@ -388,7 +543,9 @@ void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, Noda
 }
 
 template <int Dim>
-double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const {
+double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) {
+  if (!bounds_ready_)
+    mechanics::dispatch_shape(kind_, [&](auto kernel) { make_bounds<decltype(kernel)>(sys); });
   // Rows of fixed nodes do not move (dT/dt = 0): they contribute λ = 0, as in lambda_max_gershgorin.
   std::vector<char> held;
   if (!fixed.empty()) {
@@ -406,12 +563,39 @@ double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, cons
 }
 
 template <int Dim>
-bool ExplicitConduction<Dim>::any_changed(std::size_t k) const {
-  const UnknownRun* runs = &unknown_runs_[k * kMaxRuns];
-  for (int r = 0; r < kMaxRuns; ++r)
-    if (runs[r].lo <= runs[r].hi &&
-        changed_before_[static_cast<std::size_t>(runs[r].hi) + 1] != changed_before_[static_cast<std::size_t>(runs[r].lo)])
-      return true;
+template <class Changed>
+void ExplicitConduction<Dim>::count_changed(const std::vector<int>& unknown, Changed&& changed) {
+  const std::size_t nodes = unknown.size();
+  changed_before_.resize(nodes + 1);
+  int count = 0;
+  changed_before_[0] = 0;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const int u = unknown[i];
+    count += u >= 0 && changed(u) ? 1 : 0;
+    changed_before_[i + 1] = count;
+  }
+}
+
+template <int Dim>
+template <class Kernel>
+bool ExplicitConduction<Dim>::any_changed(const mechanics::Stencil<Dim, Kernel>& st) const {
+  // The stencil's rows are runs of grid nodes (for_each_node's numbering): first to first + (K-1) s_0.
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = indexer_.stride;
+  const mechanics::IVec<Dim> b = st.first_node();
+  const int span = (K - 1) * sd[0] + 1;
+  const int* before = changed_before_.data();
+  if constexpr (Dim == 2) {
+    int row = indexer_.shift + b[1] * sd[1] + b[0] * sd[0];
+    for (int j = 0; j < K; ++j, row += sd[1])
+      if (before[row + span] != before[row]) return true;
+  } else {
+    for (int k = 0; k < K; ++k) {
+      int row = indexer_.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
+      for (int j = 0; j < K; ++j, row += sd[1])
+        if (before[row + span] != before[row]) return true;
+    }
+  }
   return false;
 }
 
@@ -445,7 +629,9 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
                      T == flux_temperature_;
   first_force_ready_ = false;
   force_.resize(n);
-  Expanded e;
+  const int threads = assembly_detail::assembly_threads(holds_heat_.size());
+  const int nodes = static_cast<int>(sys.unknown.size());
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   for (long s = 0; s < substeps; ++s) {
     if (force_ready) {
       force_ready = false;
@@ -458,37 +644,82 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
     // a particle whose nodes all kept theirs and that was quiet then is quiet now, and is passed over
     // reading a few bytes instead of its kept state.
     const bool first = flux_temperature_.size() != n;
-    changed_before_.resize(static_cast<std::size_t>(n) + 1);
-    changed_before_[0] = 0;
-    for (Eigen::Index u = 0; u < n; ++u)
-      changed_before_[static_cast<std::size_t>(u) + 1] =
-          changed_before_[static_cast<std::size_t>(u)] + (first || T[u] != flux_temperature_[u] ? 1 : 0);
+    count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
     flux_temperature_ = T;
-    for (std::size_t k = 0; k < kept_.size(); ++k) {
-      if (quiet_[k] && !any_changed(k)) continue;
-      const Kept& c = kept_[k];
-      if (c.conductance == 0.0) {
+    if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
+      Expanded e{};
+      for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
+        if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
+        if (conductance_[k] == 0.0) {
+          quiet_[k] = 1;
+          continue;
+        }
+        expand<Kernel, false>(stencils[k], sys.unknown, e);
+        if (!e.reaches()) {
+          quiet_[k] = 1;
+          continue;
+        }
+        double lo = T[e.unknown[0]], hi = lo;
+        for (int a = 1; a < e.count; ++a) {
+          lo = std::min(lo, T[e.unknown[a]]);
+          hi = std::max(hi, T[e.unknown[a]]);
+        }
+        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        if (quiet_[k]) continue;
+        expand<Kernel, true>(stencils[k], sys.unknown, e);
+        mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+        for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+        grad *= conductance_[k];
+        for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
+      }
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
+    // Each particle's look (threads by particles), then the fluxes of those that carry flux,
+    // scattered by node ranges in particle order.
+    particle_scratch_.assign(holds_heat_.size(), 0.0);  // 1: carries flux
+#pragma omp parallel num_threads(threads)
+    {
+    Expanded e{};
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
+      if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
+      if (conductance_[k] == 0.0) {
         quiet_[k] = 1;  // carries no flux whatever its nodes do
         continue;
       }
       // Nodal temperatures that agree to round-off (the re-projection's own, kQuietSpread) carry no
       // flux through the particle: its terms are left out, which keeps Σ_i f_i = 0 exactly and the
       // nodes it alone touches unchanged (their ΔT_i = 0 lets the map back pass over their particles).
-      expand<Kernel, false>(k, sys.unknown, e);
+      expand<Kernel, false>(stencils[k], sys.unknown, e);
+      if (!e.reaches()) {
+        quiet_[k] = 1;  // no heat capacity of its own reaches an unknown: no conduction
+        continue;
+      }
       double lo = T[e.unknown[0]], hi = lo;
       for (int a = 1; a < e.count; ++a) {
         lo = std::min(lo, T[e.unknown[a]]);
         hi = std::max(hi, T[e.unknown[a]]);
       }
       quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
-      if (quiet_[k]) continue;
-      expand<Kernel, true>(k, sys.unknown, e);
+      if (!quiet_[k]) particle_scratch_[k] = 1.0;
+    }
+    }
+    listed_.clear();
+    for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+      if (particle_scratch_[k] != 0.0) listed_.push_back(k);
+    scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      if (!r.meets(node_span(st, indexer_))) return;
+      expand<Kernel, true>(st, sys.unknown, e);
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
       mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
       for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
-      grad *= c.conductance;
-      for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);  // f_i = −V k G'·∇T
-    }
+      grad *= conductance_[k];
+      for (int a = 0; a < e.count; ++a)  // f_i = −V k G'·∇T
+        if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+    });
     for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
     for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
   }
@@ -497,7 +728,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
 template <int Dim>
 void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
                                        const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
-  if (kept_.size() != p.size())
+  if (heat_capacity_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
   if (next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
     throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
@@ -509,19 +740,49 @@ template <class Kernel>
 void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
                                             const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
   const bool relax = end && beta > 0.0;
-  // Unknowns whose temperature changed in the window, as a prefix count: a particle with none in the
-  // runs of its unknowns keeps its temperature (ΔT_p = 0 exactly) and is passed over.
-  const auto n = static_cast<std::size_t>(sys.size());
-  changed_before_.resize(n + 1);
-  changed_before_[0] = 0;
-  for (std::size_t u = 0; u < n; ++u)
-    changed_before_[u + 1] = changed_before_[u] + (relax || delta[static_cast<Eigen::Index>(u)] != 0.0 ? 1 : 0);
-  Expanded c;
+  // Unknowns whose temperature changed in the window, as a prefix count by grid node: a particle with
+  // none among its nodes keeps its temperature (ΔT_p = 0 exactly) and is passed over.
+  count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  const int threads = assembly_detail::assembly_threads(p.size());
+  // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
+  // scattered by node ranges in particle order.
+  if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
+    Expanded c{};
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+      expand<Kernel, false>(stencils[k], sys.unknown, c);
+      if (c.count == 0) continue;  // reaches no unknown
+      double dT = 0.0;  // design §4: the increment, not the nodal value
+      for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
+      double pic = 0.0, s = 0.0;
+      if (relax) {
+        for (int a = 0; a < c.count; ++a) {
+          pic += c.S[a] * (*end)[c.unknown[a]];
+          s += c.S[a];
+        }
+      }
+      const double before = p.temperature[k];
+      const double flip = before + dT;
+      const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+      if (T == before) continue;
+      p.temperature[k] = T;
+      const double change = heat_capacity_[k] * (T - before);
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+    }
+    return;
+  }
+  particle_scratch_.assign(p.size(), 0.0);  // m_p C_v,p ΔT_p of the particles that changed
+  std::vector<unsigned char>& changed = quiet_changed_;
+  changed.assign(p.size(), 0);
+#pragma omp parallel num_threads(threads)
+  {
+  Expanded c{};
+#pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!any_changed(k)) continue;  // also every particle that holds no heat or reaches no unknown (no run)
-    const Kept& kept = kept_[k];
-    if (kept.count == 0) continue;
-    expand<Kernel, false>(k, sys.unknown, c);
+    if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+    expand<Kernel, false>(stencils[k], sys.unknown, c);
+    if (c.count == 0) continue;  // reaches no unknown
     // design §4: the increment, not the nodal value
     double dT = 0.0;
     for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
@@ -537,10 +798,22 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
     if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
-    // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
-    const double change = kept.heat_capacity * (T - before);
-    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+    particle_scratch_[k] = heat_capacity_[k] * (T - before);
+    changed[k] = 1;
   }
+  }
+  listed_.clear();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (changed[k]) listed_.push_back(k);
+  // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(sys.unknown.size()), listed_, [&](std::size_t k, const NodeRange& r, Expanded& c) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    expand<Kernel, false>(st, sys.unknown, c);
+    const double change = particle_scratch_[k];
+    for (int a = 0; a < c.count; ++a)
+      if (r.holds(sys.grid_node[static_cast<std::size_t>(c.unknown[a])])) next_mct_[c.unknown[a]] += change * c.S[a];
+  });
 }
 
 template class ExplicitConduction<2>;

@@ -236,7 +236,8 @@ class Coupler {
   bool system_assembled_ = false;  // system_ has K and problem_ is built on it (not a matrix-free gather)
   bool system_gathered_ = false;   // system_ is explicit_'s last gather (reusable for matrix-free windows)
   ExplicitConduction<Dim> explicit_;
-  double last_lambda_bound_ = 0.0;     // Gershgorin bound of M⁻¹K at the last gather (1/s)
+  double last_lambda_bound_ = 0.0;     // bound of λ_max(M⁻¹K) of the last gather or refresh (1/s)
+  bool lambda_bound_is_quick_ = false;  // last_lambda_bound_ is ExplicitConduction::quick_bound (cruder)
   std::vector<FixedNode> fixed_nodes_;  // unknowns of the gathered system on fixed-temperature faces
   bool continuing_ = false;  // continue_thermal has been called
   /// The Arrhenius heat is part of the problem: enabled, and during loading or in the continuation.

@@ -48,10 +48,15 @@ class ExplicitConduction {
   /// like assemble_thermal for a material id without thermal properties or no conducting particle.
   /// `stencils`: the MPM step's stencils at these positions (mechanics::Simulation::current_stencils),
   /// read instead of evaluating them again (same numbers); an empty view evaluates them here.
+  /// `keep_stencils` false (no refresh() will follow: a gather every window) with `stencils` given:
+  /// the passes of this window read the step's stencils in place instead of a copy, so they must
+  /// stay as they are until map_back() (the coupler's window); the next window must gather again.
+  /// The exact bounds of M⁻¹K are made only when asked for (lambda_bound(), refresh()); the gather
+  /// makes quick_bound()'s sums.
   void gather(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& particles,
               mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
               const AssemblyOptions& options, NodalThermalSystem& sys,
-              const mechanics::StencilView<Dim>& stencils = {});
+              const mechanics::StencilView<Dim>& stencils = {}, bool keep_stencils = true);
 
   /// What refresh() did.
   enum class Refresh {
@@ -81,8 +86,22 @@ class ExplicitConduction {
   void reproject(const mechanics::Particles<Dim>& particles, NodalThermalSystem& sys);
 
   /// Upper bound of the largest eigenvalue of M⁻¹K over the free unknowns of the gathered system
-  /// (1/s); 0 without conduction.
-  double lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const;
+  /// (1/s); 0 without conduction. The first call after a gather makes the bounds (a pass over the
+  /// particles with the gather's stencils and M: call it before the window's map_back()).
+  double lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed);
+  /// A cruder upper bound of the same eigenvalue, from sums the gather makes anyway (issue 35: the
+  /// exact bounds cost a square root and a division per node and particle, and a window far below
+  /// the stable step needs only to know that one sub-step is stable):
+  ///   λ ≤ max_i Σ_{p∋i} V_p k_p A_p (|G_ip|₁ + [lumped] (S_ip / Σ_a S_ap) A_p) / M_i,
+  ///   A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j w_e,j) = Σ over the stencil of |G_ip|₁
+  /// (A_p ≥ Σ_a |G'_ap|, and |G'_ip| ≤ |G_ip|₁ + (S_ip / Σ S)|Σ_dropped G|: lumping moves the dropped
+  /// nodes' G onto the kept ones with shares S_ip / Σ S), so it is ≥ the Gershgorin bound of
+  /// lambda_bound() (at most ~3–5× above it) and hence ≥ lambda_bound(); times (1 + 1e-6) against round-off. refresh() keeps
+  /// its sums up to date (the moved particles' terms out and in), so it bounds the refreshed system.
+  double quick_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) const;
+  /// Whether lambda_bound()'s bounds are made (then refresh() keeps them up to date, as before issue
+  /// 35); made anew by lambda_bound() after a refresh, they use M now throughout.
+  bool has_exact_bounds() const { return bounds_ready_; }
 
   /// n forward-Euler sub-steps over `window` seconds from `temperature` (on the unknowns of the
   /// gathered system), with the constant source q = joules / window (W). Fixed nodes take their
@@ -102,23 +121,14 @@ class ExplicitConduction {
 
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
-  /// One heat-holding particle's state of its last gather besides its stencil (kept whole: the 1D
-  /// weights and derivatives, ~170 bytes in 3D): its nodes that are unknowns are those of its stencil
-  /// with sys.unknown >= 0, in stencil order, S_ip and G_ip are evaluated again from the kept
-  /// weights (the same products, so the same numbers) and G' lumped with s_kept and g_dropped. Each
-  /// pass thus streams ~300 bytes per particle in 3D instead of expanded lists of ~1100 (issue 35).
-  struct Kept {
-    double heat_capacity = 0.0;  // m_p C_v,p (J/K)
-    double conductance = 0.0;    // V_p k_p (W m/K): times G'·G' gives W/K; 0: carries no flux
-    double rayleigh = 0.0;       // V_p k_p Σ_a |G'_ap|²/M_a as added to rayleigh_bound_ (M of that time)
-    double s_kept = 0.0;         // Σ S_ip over its unknowns
-    mechanics::Vec<Dim> g_dropped = mechanics::Vec<Dim>::Zero();  // Σ G_ip over its other nodes
-    int count = 0;               // its nodes that are unknowns (0: holds no heat or reaches none)
-    int lumped = 0;              // some node dropped: G'_ip = G_ip + (S_ip / s_kept) g_dropped
-  };
-  /// A particle's unknowns, S_ip and (when asked) G'_ip, in stencil order: the lists of its gather.
+  /// A particle's unknowns, S_ip and (when asked) G'_ip, in stencil order, evaluated again from its
+  /// stencil of the gather and the unknowns of the gather (the same products in the same order, so
+  /// the same numbers in every pass): its nodes that are unknowns are those of its stencil with
+  /// sys.unknown >= 0, and G' lumps the dropped nodes' G_ip onto them in proportion to S_ip.
   struct Expanded {
-    int count = 0;
+    int count = 0;        // its nodes that are unknowns
+    int total = 0;        // nodes of its stencil
+    double s_kept = 0.0;  // Σ S_ip over its unknowns
     int unknown[capacity];
     double S[capacity];
     double G[Dim][capacity];  // by component (scalar stores: Vec temporaries through memory stalled)
@@ -126,6 +136,8 @@ class ExplicitConduction {
       if constexpr (Dim == 2) return mechanics::Vec<Dim>(G[0][a], G[1][a]);
       else return mechanics::Vec<Dim>(G[0][a], G[1][a], G[2][a]);
     }
+    /// Whether it conducts: some of its own heat capacity reaches an unknown (as assemble_thermal).
+    bool reaches() const { return count > 0 && s_kept > 0.0; }
   };
   template <class Kernel>
   using StencilVector = std::vector<mechanics::Stencil<Dim, Kernel>>;
@@ -145,17 +157,34 @@ class ExplicitConduction {
       return const_cast<Stencils*>(this)->template of<Kernel>();
     }
   };
-  /// Particle k's kept stencil expanded onto the unknowns of `unknown` (sys.unknown of the gather);
-  /// G' (lumped) only if WithG.
-  template <class Kernel, bool WithG>
-  void expand(std::size_t k, const std::vector<int>& unknown, Expanded& e) const;
-  /// Particle k's Kept, runs and bounds from its kept stencil and the unknowns of `sys`; its
-  /// expansion (S and G') into e.
+  /// The stencils of this window's passes: the kept ones, or the step's (gather without keep_stencils).
   template <class Kernel>
-  void keep(std::size_t k, const ThermalProperties& material, double volume, const NodalThermalSystem& sys,
-            Expanded& e);
-  /// Its bound contributions taken out again (a refresh), as keep() added them (e: its old expansion).
-  void remove_bounds(const Kept& c, const Expanded& e);
+  const mechanics::Stencil<Dim, Kernel>* window_stencils() const {
+    return static_cast<const mechanics::Stencil<Dim, Kernel>*>(window_stencils_);
+  }
+  /// Stencil st expanded onto the unknowns of `unknown` (sys.unknown of the gather); G' (lumped)
+  /// only if WithG.
+  template <class Kernel, bool WithG>
+  void expand(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown, Expanded& e) const;
+  /// Particle k's terms of the two bounds of M⁻¹K (M of sys now) added (e: its expansion with G').
+  void add_bounds(std::size_t k, const NodalThermalSystem& sys, const Expanded& e);
+  /// Its bound contributions taken out again (a refresh), as add_bounds() added them.
+  void remove_bounds(std::size_t k, const Expanded& e);
+  /// quick_bound()'s sums of one particle with stencil st and expansion e (S, no G), in (sign 1) or
+  /// out (−1); the lumping part only (pass 2 of the gather).
+  template <class Kernel>
+  void add_quick(const mechanics::Stencil<Dim, Kernel>& st, double conductance, const NodalThermalSystem& sys,
+                 const Expanded& e, double sign);
+  template <class Kernel>
+  void add_quick_lumping(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                         const NodalThermalSystem& sys, const Expanded& e, double sign, const void* range = nullptr);
+  /// Every heat-holding particle's bound terms, in particle order (as the gather made them before
+  /// issue 35: the same sums), with the window's stencils and M of the gather.
+  template <class Kernel>
+  void make_bounds(const NodalThermalSystem& sys);
+  /// Whether an unknown of the stencil's nodes changed (changed_before_ of this pass, by grid node).
+  template <class Kernel>
+  bool any_changed(const mechanics::Stencil<Dim, Kernel>& st) const;
   template <class Kernel>
   Refresh refresh_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                        const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
@@ -163,7 +192,7 @@ class ExplicitConduction {
   template <class Kernel>
   void gather_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                    const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
-                   NodalThermalSystem& sys, const mechanics::StencilView<Dim>& stencils);
+                   NodalThermalSystem& sys, const mechanics::StencilView<Dim>& stencils, bool keep_stencils);
   template <class Kernel>
   void substeps_with(const NodalThermalSystem& sys, Eigen::VectorXd& T, const Eigen::VectorXd& q,
                      const std::vector<FixedNode>& fixed, double h, long substeps);
@@ -175,8 +204,14 @@ class ExplicitConduction {
   mechanics::NodeIndexer<Dim> indexer_{};                    // the grid's node numbering
   Stencils stencils_;                     // by particle, at its gathered position (heat-holding ones)
   Stencils moved_stencils_;               // refresh scratch: the moved particles' stencils now
+  const void* window_stencils_ = nullptr;  // Stencil<Dim, Kernel of kind_>* by particle (window_stencils)
+  bool stencils_kept_ = false;             // window_stencils_ are stencils_ (a refresh may follow)
   std::vector<unsigned char> holds_heat_;  // gather: particle of a material with thermal properties
-  std::vector<Kept> kept_;                // by particle; count 0 for particles that hold no heat
+  std::vector<double> heat_capacity_;      // m_p C_v,p by particle at the gather (J/K); 0: holds no heat
+  std::vector<double> conductance_;        // V_p k_p at the gather (W m/K); 0: no conduction
+  std::vector<double> rayleigh_;           // V_p k_p Σ_a |G'_ap|²/M_a as added to rayleigh_bound_
+  bool bounds_ready_ = false;              // row_bound_, rayleigh_bound_ and rayleigh_ made since the gather
+  std::vector<double> quick_sum_;          // Σ_p V_p k_p A_p² by grid node (quick_bound)
   std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
   std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
   Eigen::VectorXd next_mct_;              // the same by unknown, kept with the T_p by refresh and map_back
@@ -190,19 +225,21 @@ class ExplicitConduction {
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
   bool first_force_ready_ = false;        // force_ holds f_i at flux_temperature_ (made by the gather)
   // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
-  // streaming every particle's kept lists): per particle the runs of its unknown numbers (row by row) and whether its
-  // nodal temperatures agreed to round-off when last looked at; per unknown the temperature of the
-  // last sub-step, and a prefix count of the nodes that changed.
-  struct UnknownRun {
-    int lo, hi;  // lo > hi: empty
-  };
-  static constexpr int kMaxRuns = Dim == 2 ? 3 : 9;  // rows of the widest stencil
-  std::vector<UnknownRun> unknown_runs_;      // kMaxRuns per particle: its unknowns, row by row
-  /// Whether an unknown of particle k changed (changed_before_ of this pass).
-  bool any_changed(std::size_t k) const;
+  // streaming every particle's kept lists): per particle whether its nodal temperatures agreed to
+  // round-off when last looked at; per unknown the temperature of the last sub-step, and per grid
+  // node a prefix count of the nodes whose unknown changed (a stencil row is a run of grid nodes).
   std::vector<unsigned char> quiet_;          // by particle
   Eigen::VectorXd flux_temperature_;          // T_i of the last sub-step (empty: look at every particle)
-  std::vector<int> changed_before_;           // scratch: changed unknowns with index < u
+  std::vector<int> changed_before_;           // scratch: changed unknowns at grid nodes < i
+  // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
+  // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
+  // in order, so every sum has the same terms in the same order on any number of threads.
+  std::vector<std::size_t> listed_;           // scratch: the particles a scatter visits, in order
+  std::vector<double> particle_scratch_;      // scratch: a per-particle value of a pass
+  std::vector<unsigned char> quiet_changed_;  // scratch: particles whose temperature the map back changed
+  /// changed_before_ from whether unknown u changed.
+  template <class Changed>
+  void count_changed(const std::vector<int>& unknown, Changed&& changed);
 };
 
 extern template class ExplicitConduction<2>;
