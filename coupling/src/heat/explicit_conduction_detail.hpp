@@ -1,0 +1,195 @@
+#pragma once
+// What the two files of ExplicitConduction share (explicit_conduction.cpp: gather, bounds, refresh;
+// explicit_conduction_passes.cpp: the sub-steps and the map back): the stencil walks, the scatter by
+// node ranges, and the member templates both call (expand, count_changed, any_changed).
+#include <frictherm/coupling/explicit_conduction.hpp>
+
+#include "conductance_rows.hpp"  // NodeRange, assembly_threads
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <stdexcept>
+#include <string>
+
+namespace frictherm::coupling {
+namespace explicit_detail {
+
+// The stencil's nodes in for_each's order with the same products (node index, S_ip and the
+// components of G_ip as scalars: passing a Vec through memory stalled the passes on store
+// forwarding). f(i, S, gx, gy, gz); gz = 0 in 2D.
+template <int Dim, class Kernel, class F>
+inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix, F&& f) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = ix.stride;
+  const mechanics::IVec<Dim> b = st.first_node();
+  if constexpr (Dim == 2) {
+    for (int j = 0; j < K; ++j) {
+      const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+      const int row = ix.shift + (b[1] + j) * sd[1] + b[0] * sd[0];
+      for (int i = 0; i < K; ++i) {
+        const double wx = st.axis[0].w[i];
+        f(row + i * sd[0], wx * wy, st.axis[0].dw[i] * wy, wx * dwy, 0.0);
+      }
+    }
+  } else {
+    for (int k = 0; k < K; ++k) {
+      const double wz = st.axis[2].w[k], dwz = st.axis[2].dw[k];
+      for (int j = 0; j < K; ++j) {
+        const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+        const int row = ix.shift + (b[2] + k) * sd[2] + (b[1] + j) * sd[1] + b[0] * sd[0];
+        for (int i = 0; i < K; ++i) {
+          const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
+          f(row + i * sd[0], wx * wy * wz, dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
+        }
+      }
+    }
+  }
+}
+
+// V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
+// (quick_bound).
+template <int Dim, class Kernel>
+inline double quick_weight(const mechanics::Stencil<Dim, Kernel>& st, double conductance) {
+  double sw[Dim], sdw[Dim];
+  for (int d = 0; d < Dim; ++d) {
+    sw[d] = 0.0;
+    sdw[d] = 0.0;
+    for (int j = 0; j < Kernel::K; ++j) {
+      sw[d] += std::fabs(st.axis[d].w[j]);
+      sdw[d] += std::fabs(st.axis[d].dw[j]);
+    }
+  }
+  double a_p = 0.0;
+  for (int d = 0; d < Dim; ++d) {
+    double t = sdw[d];
+    for (int e = 0; e < Dim; ++e)
+      if (e != d) t *= sw[e];
+    a_p += t;
+  }
+  return conductance * a_p;
+}
+
+// The lowest and highest grid node of a stencil (for_each_node's numbering).
+template <int Dim, class Kernel>
+inline std::array<int, 2> node_span(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix) {
+  const mechanics::IVec<Dim> b = st.first_node();
+  int first = ix.shift, reach = 0;
+  for (int d = 0; d < Dim; ++d) {
+    first += b[d] * ix.stride[d];
+    reach += (Kernel::K - 1) * ix.stride[d];
+  }
+  return {first, first + reach};
+}
+
+using assembly_detail::NodeRange;
+
+// body(k, range, scratch) for every particle k of `list` in order, on `threads` threads, each with
+// its own range of grid nodes (all of them on one thread) and its own Scratch: a scatter adds only
+// into the nodes (or the unknowns at the nodes) of its range, so each sum gets the same terms in the
+// same order on any number of threads (as thermal_assembly.cpp's passes).
+template <class Scratch, class Body>
+void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_t>& list, Body&& body) {
+  if (threads <= 1) {
+    const NodeRange all{0, nodes};
+    Scratch scratch{};
+    for (std::size_t k : list) body(k, all, scratch);
+    return;
+  }
+#pragma omp parallel num_threads(threads)
+  {
+    const NodeRange mine = NodeRange::of_thread(0, nodes);
+    Scratch scratch{};
+    for (std::size_t k : list) body(k, mine, scratch);
+  }
+}
+
+// Relative spread of a particle's nodal temperatures below which they are taken as equal in the
+// sub-steps: 256 ε, the order of the re-projection's own round-off (T_i = Σ m C T S / Σ m C S over
+// ~10–30 terms). At 300 K it is 1.7e-11 K.
+constexpr double kQuietSpread = 256.0 * 2.220446049250313e-16;
+
+}  // namespace explicit_detail
+
+template <int Dim>
+template <class Kernel, bool WithG>
+void ExplicitConduction<Dim>::expand(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown,
+                                     Expanded& e) const {
+  // The sums of the gather before issue 35 (keep()), in the same order: S over the unknowns, G over
+  // the other nodes.
+  double s_kept = 0.0;
+  double g_dropped[Dim] = {};
+  int n = 0, total = 0;
+  explicit_detail::for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+    ++total;
+    const int u = unknown[static_cast<std::size_t>(i)];
+    if (u < 0) {
+      if constexpr (WithG) {
+        g_dropped[0] += gx;
+        g_dropped[1] += gy;
+        if constexpr (Dim == 3) g_dropped[2] += gz;
+      }
+      return;
+    }
+    s_kept += w;
+    e.unknown[n] = u;
+    e.S[n] = w;
+    if constexpr (WithG) {
+      e.G[0][n] = gx;
+      e.G[1][n] = gy;
+      if constexpr (Dim == 3) e.G[2][n] = gz;
+    }
+    ++n;
+  });
+  e.count = n;
+  e.total = total;
+  e.s_kept = s_kept;
+  if constexpr (WithG)
+    if (n < total && e.reaches())  // lump dropped nodes (as thermal_assembly builds K)
+      for (int a = 0; a < n; ++a) {
+        const double share = e.S[a] / s_kept;
+        for (int d = 0; d < Dim; ++d) e.G[d][a] += share * g_dropped[d];
+      }
+}
+
+template <int Dim>
+template <class Changed>
+void ExplicitConduction<Dim>::count_changed(const std::vector<int>& unknown, Changed&& changed) {
+  const std::size_t nodes = unknown.size();
+  changed_before_.resize(nodes + 1);
+  int count = 0;
+  changed_before_[0] = 0;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const int u = unknown[i];
+    count += u >= 0 && changed(u) ? 1 : 0;
+    changed_before_[i + 1] = count;
+  }
+}
+
+template <int Dim>
+template <class Kernel>
+bool ExplicitConduction<Dim>::any_changed(const mechanics::Stencil<Dim, Kernel>& st) const {
+  // The stencil's rows are runs of grid nodes (explicit_detail::for_each_node's numbering): first to first + (K-1) s_0.
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = indexer_.stride;
+  const mechanics::IVec<Dim> b = st.first_node();
+  const int span = (K - 1) * sd[0] + 1;
+  const int* before = changed_before_.data();
+  if constexpr (Dim == 2) {
+    int row = indexer_.shift + b[1] * sd[1] + b[0] * sd[0];
+    for (int j = 0; j < K; ++j, row += sd[1])
+      if (before[row + span] != before[row]) return true;
+  } else {
+    for (int k = 0; k < K; ++k) {
+      int row = indexer_.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
+      for (int j = 0; j < K; ++j, row += sd[1])
+        if (before[row + span] != before[row]) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace frictherm::coupling

@@ -1,0 +1,237 @@
+// The forward-Euler sub-steps of a matrix-free conduction window and the change mapped back to the
+// particles (explicit_conduction.hpp; Nairn et al. 2018 eqs. 37–38), with the stencils of the gather
+// (explicit_conduction.cpp).
+#include "explicit_conduction_detail.hpp"
+
+namespace frictherm::coupling {
+
+using namespace explicit_detail;
+
+template <int Dim>
+Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, const Eigen::VectorXd& temperature,
+                                                 const Eigen::VectorXd& joules, const std::vector<FixedNode>& fixed,
+                                                 double window, long substeps) {
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  if (temperature.size() != n || joules.size() != n)
+    throw std::invalid_argument("ExplicitConduction::advance: " + std::to_string(temperature.size()) +
+                                " temperatures and " + std::to_string(joules.size()) + " sources for " +
+                                std::to_string(sys.size()) + " unknowns");
+  if (!(window > 0.0) || substeps < 1)
+    throw std::invalid_argument("ExplicitConduction::advance: need a window > 0 and at least one sub-step");
+  Eigen::VectorXd T = temperature;
+  for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;  // Dirichlet values first
+  const double h = window / static_cast<double>(substeps);
+  const Eigen::VectorXd q = joules / window;  // constant over the window: ∫ q dt = W (design §4)
+  mechanics::dispatch_shape(kind_, [&](auto kernel) { substeps_with<decltype(kernel)>(sys, T, q, fixed, h, substeps); });
+  return T;
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen::VectorXd& T, const Eigen::VectorXd& q,
+                                            const std::vector<FixedNode>& fixed, double h, long substeps) {
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  // The gather's f_i serve the first sub-step if it starts from the temperatures they were made at
+  // (no fixed node changed one): the same sums, the particle pass saved.
+  bool force_ready = first_force_ready_ && force_.size() == n && flux_temperature_.size() == n &&
+                     T == flux_temperature_;
+  first_force_ready_ = false;
+  force_.resize(n);
+  const int threads = assembly_detail::assembly_threads(holds_heat_.size());
+  const int nodes = static_cast<int>(sys.unknown.size());
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  for (long s = 0; s < substeps; ++s) {
+    if (force_ready) {
+      force_ready = false;
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
+    force_.setZero();
+    // Nodes whose temperature changed since the last sub-step, as a prefix count over the unknowns:
+    // a particle whose nodes all kept theirs and that was quiet then is quiet now, and is passed over
+    // reading a few bytes instead of its kept state.
+    const bool first = flux_temperature_.size() != n;
+    count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
+    flux_temperature_ = T;
+    if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
+      Expanded e{};
+      for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
+        if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
+        if (conductance_[k] == 0.0) {
+          quiet_[k] = 1;
+          continue;
+        }
+        expand<Kernel, false>(stencils[k], sys.unknown, e);
+        if (!e.reaches()) {
+          quiet_[k] = 1;
+          continue;
+        }
+        double lo = T[e.unknown[0]], hi = lo;
+        for (int a = 1; a < e.count; ++a) {
+          lo = std::min(lo, T[e.unknown[a]]);
+          hi = std::max(hi, T[e.unknown[a]]);
+        }
+        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        if (quiet_[k]) continue;
+        expand<Kernel, true>(stencils[k], sys.unknown, e);
+        mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+        for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+        grad *= conductance_[k];
+        for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
+      }
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
+    // Each particle's look (threads by particles), then the fluxes of those that carry flux,
+    // scattered by node ranges in particle order.
+    particle_scratch_.assign(holds_heat_.size(), 0.0);  // 1: carries flux
+#pragma omp parallel num_threads(threads)
+    {
+    Expanded e{};
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
+      if (!holds_heat_[k] || (quiet_[k] && !any_changed(stencils[k]))) continue;
+      if (conductance_[k] == 0.0) {
+        quiet_[k] = 1;  // carries no flux whatever its nodes do
+        continue;
+      }
+      // Nodal temperatures that agree to round-off (the re-projection's own, kQuietSpread) carry no
+      // flux through the particle: its terms are left out, which keeps Σ_i f_i = 0 exactly and the
+      // nodes it alone touches unchanged (their ΔT_i = 0 lets the map back pass over their particles).
+      expand<Kernel, false>(stencils[k], sys.unknown, e);
+      if (!e.reaches()) {
+        quiet_[k] = 1;  // no heat capacity of its own reaches an unknown: no conduction
+        continue;
+      }
+      double lo = T[e.unknown[0]], hi = lo;
+      for (int a = 1; a < e.count; ++a) {
+        lo = std::min(lo, T[e.unknown[a]]);
+        hi = std::max(hi, T[e.unknown[a]]);
+      }
+      quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+      if (!quiet_[k]) particle_scratch_[k] = 1.0;
+    }
+    }
+    listed_.clear();
+    for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+      if (particle_scratch_[k] != 0.0) listed_.push_back(k);
+    scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      if (!r.meets(node_span(st, indexer_))) return;
+      expand<Kernel, true>(st, sys.unknown, e);
+      // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p
+      mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+      for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+      grad *= conductance_[k];
+      for (int a = 0; a < e.count; ++a)  // f_i = −V k G'·∇T
+        if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+    });
+    for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+    for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+  }
+}
+
+template <int Dim>
+void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
+                                       const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+  if (heat_capacity_.size() != p.size())
+    throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
+  if (next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
+    throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
+  mechanics::dispatch_shape(kind_, [&](auto kernel) { map_back_with<decltype(kernel)>(p, sys, delta, beta, end); });
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
+                                            const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+  const bool relax = end && beta > 0.0;
+  // Unknowns whose temperature changed in the window, as a prefix count by grid node: a particle with
+  // none among its nodes keeps its temperature (ΔT_p = 0 exactly) and is passed over.
+  count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
+  const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  const int threads = assembly_detail::assembly_threads(p.size());
+  // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
+  // scattered by node ranges in particle order.
+  if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
+    Expanded c{};
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+      expand<Kernel, false>(stencils[k], sys.unknown, c);
+      if (c.count == 0) continue;  // reaches no unknown
+      double dT = 0.0;  // design §4: the increment, not the nodal value
+      for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
+      double pic = 0.0, s = 0.0;
+      if (relax) {
+        for (int a = 0; a < c.count; ++a) {
+          pic += c.S[a] * (*end)[c.unknown[a]];
+          s += c.S[a];
+        }
+      }
+      const double before = p.temperature[k];
+      const double flip = before + dT;
+      const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+      if (T == before) continue;
+      p.temperature[k] = T;
+      const double change = heat_capacity_[k] * (T - before);
+      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+    }
+    return;
+  }
+  particle_scratch_.assign(p.size(), 0.0);  // m_p C_v,p ΔT_p of the particles that changed
+  std::vector<unsigned char>& changed = quiet_changed_;
+  changed.assign(p.size(), 0);
+#pragma omp parallel num_threads(threads)
+  {
+  Expanded c{};
+#pragma omp for schedule(static)
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+    expand<Kernel, false>(stencils[k], sys.unknown, c);
+    if (c.count == 0) continue;  // reaches no unknown
+    // design §4: the increment, not the nodal value
+    double dT = 0.0;
+    for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
+    double pic = 0.0, s = 0.0;
+    if (relax) {
+      for (int a = 0; a < c.count; ++a) {
+        pic += c.S[a] * (*end)[c.unknown[a]];
+        s += c.S[a];
+      }
+    }
+    const double before = p.temperature[k];
+    const double flip = before + dT;
+    const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
+    p.temperature[k] = T;
+    particle_scratch_[k] = heat_capacity_[k] * (T - before);
+    changed[k] = 1;
+  }
+  }
+  listed_.clear();
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (changed[k]) listed_.push_back(k);
+  // The eq. 38 sums of the next window, which re-projects from them: m_p C_v,p ΔT_p S_ip added.
+  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(sys.unknown.size()), listed_, [&](std::size_t k, const NodeRange& r, Expanded& c) {
+    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+    if (!r.meets(node_span(st, indexer_))) return;
+    expand<Kernel, false>(st, sys.unknown, c);
+    const double change = particle_scratch_[k];
+    for (int a = 0; a < c.count; ++a)
+      if (r.holds(sys.grid_node[static_cast<std::size_t>(c.unknown[a])])) next_mct_[c.unknown[a]] += change * c.S[a];
+  });
+}
+
+#define FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(D)                                                                    \
+  template Eigen::VectorXd ExplicitConduction<D>::advance(const NodalThermalSystem&, const Eigen::VectorXd&,      \
+                                                          const Eigen::VectorXd&, const std::vector<FixedNode>&,  \
+                                                          double, long);                                          \
+  template void ExplicitConduction<D>::map_back(mechanics::Particles<D>&, const NodalThermalSystem&,              \
+                                                const Eigen::VectorXd&, double, const Eigen::VectorXd*);
+FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(2)
+FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(3)
+#undef FRICTHERM_INSTANTIATE_EXPLICIT_PASSES
+
+}  // namespace frictherm::coupling
