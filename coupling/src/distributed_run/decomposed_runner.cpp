@@ -145,12 +145,16 @@ class DecomposedRun {
 
   void build() {
     grid_ = std::make_unique<mechanics::Grid<Dim>>(detail::scene_grid<Dim>(s_));
+    typename Mpm::Options options = detail::decomposed_options<Dim>(s_);
+    // The particles first: the serial build resolves the loads to them.
+    std::vector<typename Mpm::Particle> particles = detail::scene_particles<Dim>(comm_, s_, options.loads);
     try {
-      mpm_ = std::make_unique<Mpm>(comm_, *grid_, s_.materials, detail::decomposed_options<Dim>(s_));
+      mpm_ = std::make_unique<Mpm>(comm_, *grid_, s_.materials, options);
     } catch (const std::invalid_argument& e) {  // thrown on every rank alike: all hold the same scene
       throw SceneError(e.what());
     }
-    mpm_->add_particles(detail::scene_particles<Dim>(comm_, s_));
+    mpm_->add_particles(particles);
+    particles = {};
     r_.particles = static_cast<std::size_t>(mpm_->global_particles());
     temperature_ = mpm_->particle_scalar_index("temperature");
     if (s_.thermal.enabled) {
@@ -224,9 +228,10 @@ class DecomposedRun {
 
   // The serial run's column names where the quantity is the same (runner_output.cpp, runner_thermal.cpp).
   std::vector<std::string> series_names() const {
-    std::vector<std::string> n{"time", "step", "dt", "kinetic_energy"};
+    std::vector<std::string> n{"time", "step", "dt", "kinetic_energy", "external_work"};
     const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
     for (int d = 0; d < Dim; ++d) n.emplace_back(axes[d]);
+    n.emplace_back("damping_work");
     if (s_.contact.enabled)
       n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
     if (heat_) {
@@ -364,8 +369,9 @@ class DecomposedRun {
       for (int d = 0; d < Dim; ++d) sums[1 + d] += p.mass[k] * vk[d];
     }
     MPI_Allreduce(MPI_IN_PLACE, sums, 1 + Dim, MPI_DOUBLE, MPI_SUM, comm_);
-    std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0]};
+    std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0], mpm_->external_work()};
     for (int d = 0; d < Dim; ++d) row.push_back(sums[1 + d]);
+    row.push_back(mpm_->damping_work());
     if (s_.contact.enabled) {
       const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
       const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);
@@ -566,6 +572,8 @@ class DecomposedRun {
     v("mechanics/time", st.time);
     v("mechanics/cumulative_work_first", st.cumulative_first);
     v("mechanics/cumulative_work_second", st.cumulative_second);
+    v("mechanics/external_work", st.external_work);
+    v("mechanics/damping_work", st.damping_work);
     v("mechanics/empty_node_mass", st.empty_node_mass);
     v("mechanics/work_first", st.work_first);
     v("mechanics/work_second", st.work_second);

@@ -9,6 +9,7 @@
 #include "distributed/decomposed_state.hpp"
 
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/transfer/pic_blend.hpp>
 
 #include <mpi.h>
@@ -140,6 +141,20 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
       }
     });
   }
+  if (loads.empty()) return;
+  // The point loads and tractions of this rank's particles, f_i += S_ip F(t) into their fields' slots
+  // (the serial kernel): a particle is on one rank, so sum_to_owners gives the owners each load once.
+  local_loads.clear();
+  for (PetscInt k = 0; k < f.n; ++k) {
+    const auto [lo, hi] = std::equal_range(load_ids.begin(), load_ids.end(), static_cast<std::int64_t>(f.id[k]));
+    for (auto j = lo; j != hi; ++j) local_loads.emplace_back(k, static_cast<std::size_t>(j - load_ids.begin()));
+  }
+  for (const auto& [k, j] : local_loads) {
+    if (rigid(f.material[k])) continue;  // as the serial step: a rigid particle's velocity is prescribed
+    const Vec<Dim> F = load_force<Dim>(loads[j].force, loads[j].scale, time);
+    add_load_to_grid<Dim>(st[static_cast<std::size_t>(k)], boxes[static_cast<std::size_t>(field_of(f.material[k]))].index, F,
+                          [&](int slot) { return Eigen::Map<Vec<Dim>>(slot_values(static_cast<std::size_t>(slot)) + force); });
+  }
 }
 
 // Phase 2, exchange: each local node's m, p, f summed over its fields' slots (in field order; one
@@ -184,27 +199,34 @@ void DecomposedMpm<Dim>::Impl::sum_to_owners(double /*dt*/) {
 }
 
 // Phase 7, owned nodes: velocity conditions of the fixed faces on p_i and f_i (the serial
-// apply_velocity_bc: fixed components of both zeroed), then p_i^{n+1} = p_i^n + f_i dt.
+// apply_velocity_bc: fixed components of both zeroed), the damping, then p_i^{n+1} = p_i^n + f_i dt.
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   constexpr int momentum = Dof::momentum, force = Dof::force;
+  const bool damped = damping_active(opt.damping_rate, opt.damping_until, time);
+  double removed = 0.0;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
   for_each_owned_field(a, [&](PetscInt q, double* node) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
-    if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0) {
+    const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
+    if (driven) {
       // Driven components end the step at the rigid velocity: the change made a force, (m v − p)/dt,
       // so that the particles' FLIP update receives it too (the serial apply_velocity_bc).
       for (int d = 0; d < Dim; ++d)
         if (driven & (1u << d))
           node[force + d] = (node[Dof::mass] * drive_velocity[static_cast<std::size_t>(q)][d] - node[momentum + d]) / dt;
     }
-    for (int d = 0; d < Dim; ++d) {
+    for (int d = 0; d < Dim; ++d)
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
-      node[momentum + d] += node[force + d] * dt;
-    }
+    // Mass-proportional damping after the velocity conditions, on the components they leave free
+    // (the serial apply_damping's kernel).
+    if (damped)
+      damp_node<Dim>(node + force, node + momentum, node[Dof::mass], driven, opt.damping_rate, dt, empty_node_mass, removed);
+    for (int d = 0; d < Dim; ++d) node[momentum + d] += node[force + d] * dt;
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
+  damping_work += removed;
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
@@ -268,6 +290,9 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
     pic_blend(vp, v, pic);
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
+  for (const auto& [k, j] : local_loads)  // the loads' work with the updated velocities (the serial pass)
+    external_work += load_work<Dim>(load_force<Dim>(loads[j].force, loads[j].scale, time),
+                                    Vec<Dim>(Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k)), dt);
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
@@ -331,6 +356,20 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
 }
 
 template <int Dim>
+double DecomposedMpm<Dim>::external_work() const {
+  double w = impl_->external_work;
+  MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
+}
+
+template <int Dim>
+double DecomposedMpm<Dim>::damping_work() const {
+  double w = impl_->damping_work;
+  MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
+}
+
+template <int Dim>
 const std::array<const char*, 14>& DecomposedMpm<Dim>::phase_names() {
   static const std::array<const char*, 14> names{
       {"particle_to_grid", "sum_to_owners", "exchange_field_ranges", "fields_to_owners", "find_contact_nodes",
@@ -376,6 +415,8 @@ void DecomposedMpm<Dim>::step(double dt) {
 #define FRICTHERM_INSTANTIATE_USL(D)                                   \
   template void DecomposedMpm<D>::step(double);                        \
   template const std::array<const char*, 14>& DecomposedMpm<D>::phase_names(); \
+  template double DecomposedMpm<D>::external_work() const;             \
+  template double DecomposedMpm<D>::damping_work() const;              \
   template void DecomposedMpm<D>::Impl::sum_to_owners(double);         \
   template void DecomposedMpm<D>::Impl::momentum_update(double);       \
   template void DecomposedMpm<D>::Impl::nodal_velocities(double);      \

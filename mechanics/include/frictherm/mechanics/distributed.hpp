@@ -19,7 +19,8 @@
 //
 //   particle_to_grid       local: stencils; rigid particles mark the nodes they drive; per velocity
 //                          field m_i, p_i, f_i (N·1–3) and, with contact, Σ S m x (or the displacement
-//                          form), Ω_i, g_i (N·4–6, 9), into the field's box of slots
+//                          form), Ω_i, g_i (N·4–6, 9), into the field's box of slots; the point
+//                          loads and tractions of the rank's particles (f_i += S_ip F)
 //   sum_to_owners          exchange: every node's m, p, f summed over its fields into the DMDA,
 //                          DMLocalToGlobal(ADD_VALUES) into the owners; the rigid drivers to the owners
 //   exchange_field_ranges  exchange (PetscSF): which materials reach each node, completed at the
@@ -29,7 +30,7 @@
 //   find_contact_nodes     owned nodes where two or more fields have mass
 //   contact_extrapolated   contact on the extrapolated momenta (N·7–18), node-local
 //   momentum_update        owned nodes: rigid drive (f = (m v_rigid − p)/dt), fixed faces (p, f
-//                          components zeroed), p_i += f_i dt
+//                          components zeroed), damping (f −= c p), p_i += f_i dt
 //   contact_updated        contact on p^{n+1} with consistent forces (N·19) and frictional work (N·27, 34, 36, 40)
 //   nodal_velocities       owned nodes: v_i = p_i/m_i, a_i = f_i/m_i; driven components v = v_rigid
 //   ghost_velocities       exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get the totals' v_i, a_i
@@ -181,6 +182,14 @@ class DecomposedMpm {
     bool contact = false;
     ContactOptions contact_options;
     std::vector<DecomposedContactPair> contact_pairs;
+    /// Point loads and tractions resolved to particles by id (Simulation::particle_loads of the
+    /// scene's serial build): the rank holding a loaded particle adds f_i += S_ip F(t) to its slots in
+    /// particle_to_grid (summed to the owners with the rest, so each load counts once) and books the
+    /// work F(t)·v_p dt in grid_to_particle (the serial kernels, loads/grid_loads.hpp).
+    std::vector<ParticleLoad<Dim>> loads;
+    /// Mass-proportional damping f_i −= c p_i while t < damping_until, at the owned nodes in
+    /// momentum_update after the velocity conditions (SimulationOptions::damping_rate, damping_until).
+    double damping_rate = 0.0, damping_until = 0.0;
     /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
     /// one swarm field, migrated with the particles, untouched by the step.
     std::vector<std::string> particle_scalars;
@@ -253,6 +262,10 @@ class DecomposedMpm {
   double stable_time_step(double cfl, double max_time_step = std::numeric_limits<double>::infinity()) const;
   /// Collective: plastic work done on all particles since the start (J; Mie-Grüneisen/J2 materials).
   double total_plastic_work() const;
+  /// Collective: the work of Options::loads and the energy removed by the damping since the start,
+  /// summed over ranks (J; as Simulation::external_work and damping_work).
+  double external_work() const;
+  double damping_work() const;
   /// Velocity-field slots this rank stores (Σ over its fields of their boxes' nodes; see the header
   /// comment) and the largest over the run's steps.
   long field_slots() const;
@@ -298,6 +311,7 @@ class DecomposedMpm {
     std::vector<std::pair<std::string, std::vector<double>>> reals;          // name, n × components
     std::vector<std::pair<std::string, std::vector<std::int64_t>>> integers;  // id, material
     double time = 0.0, cumulative_first = 0.0, cumulative_second = 0.0, empty_node_mass = 0.0;
+    double external_work = 0.0, damping_work = 0.0;  // this rank's part of the books
     std::vector<double> work_first, work_second;
     std::vector<long> stats;  // contact_nodes, multi_nodes, sliding_nodes, guarded (this rank)
   };
