@@ -42,6 +42,7 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.thickness = scene.options.thickness;
   for (int d = 0; d < Dim; ++d) o.gravity[d] = scene.options.gravity[d];
   o.pic_relaxation_time = scene.options.pic_relaxation_time;
+  o.musl = scene.options.scheme == mechanics::UpdateScheme::musl;  // usf is refused (scene_decomposed.cpp)
   o.damping_rate = scene.options.damping_rate;
   o.damping_until = scene.options.damping_until;
   o.fixed_faces = scene.fixed_faces;

@@ -30,8 +30,11 @@ std::string mechanics_refusal(const Scene& s) {
   const mechanics::SimulationOptions& o = s.options;
   if (o.shape == mechanics::ShapeKind::extended_bspline)
     return refuse("solver.shape_function", quoted("extended_bspline"), "\"linear\", \"ugimp\" or \"quadratic_bspline\"");
-  if (o.scheme != mechanics::UpdateScheme::usl)
-    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\"");
+  // USL, and MUSL without contact (DecomposedMpm: the USL phases with the remap and its exchange).
+  if (o.scheme == mechanics::UpdateScheme::usf)
+    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");
+  if (o.scheme == mechanics::UpdateScheme::musl && s.contact.enabled)
+    return refuse("solver.scheme", quoted("musl") + " with contact", "\"usl\", or \"musl\" without contact");
   if (o.particle_update != mechanics::ParticleUpdate::flip)
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
   // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).

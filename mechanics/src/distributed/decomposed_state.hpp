@@ -294,6 +294,9 @@ struct DecomposedMpm<Dim>::Impl {
   void grid_to_particle(double dt);
   template <class Kernel>
   void stress_update(double dt);
+  template <class Kernel>
+  void remap_momentum(double dt);     // MUSL
+  void velocity_from_momentum(double dt);
   void migrate(double dt);
 };
 

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <iterator>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -370,11 +371,12 @@ double DecomposedMpm<Dim>::damping_work() const {
 }
 
 template <int Dim>
-const std::array<const char*, 14>& DecomposedMpm<Dim>::phase_names() {
-  static const std::array<const char*, 14> names{
+const std::array<const char*, 16>& DecomposedMpm<Dim>::phase_names() {
+  static const std::array<const char*, 16> names{
       {"particle_to_grid", "sum_to_owners", "exchange_field_ranges", "fields_to_owners", "find_contact_nodes",
        "contact_extrapolated", "momentum_update", "contact_updated", "nodal_velocities", "ghost_velocities",
-       "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate"}};
+       "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate", "remap_momentum",
+       "velocity_from_momentum"}};
   return names;
 }
 
@@ -384,37 +386,104 @@ void DecomposedMpm<Dim>::step(double dt) {
   s.current_valid = false;  // the particles move: current_stencils() evaluates them again
   dispatch_shape(s.opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
-    using Phase = void (Impl::*)(double);
-    // The step, in order (names: phase_names()). Without contact (one velocity field) the per-field
-    // exchanges and the contact phases have nothing to do.
-    static constexpr Phase phases[14] = {&Impl::template particle_to_grid<Kernel>,
-                                         &Impl::sum_to_owners,
-                                         &Impl::exchange_field_ranges,
-                                         &Impl::fields_to_owners,
-                                         &Impl::find_contact_nodes,
-                                         &Impl::contact_extrapolated,
-                                         &Impl::momentum_update,
-                                         &Impl::contact_updated,
-                                         &Impl::nodal_velocities,
-                                         &Impl::ghost_velocities,
-                                         &Impl::fields_to_ghosts,
-                                         &Impl::template grid_to_particle<Kernel>,
-                                         &Impl::template stress_update<Kernel>,
-                                         &Impl::migrate};
-    for (std::size_t p = 0; p < 14; ++p) {
+    // A phase and the phase_names() entry that times it.
+    struct Phase {
+      void (Impl::*run)(double);
+      int name;
+    };
+    // USL, in order. Without contact (one velocity field) the per-field exchanges and the contact
+    // phases have nothing to do.
+    static constexpr Phase usl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
+                                    {&Impl::sum_to_owners, 1},
+                                    {&Impl::exchange_field_ranges, 2},
+                                    {&Impl::fields_to_owners, 3},
+                                    {&Impl::find_contact_nodes, 4},
+                                    {&Impl::contact_extrapolated, 5},
+                                    {&Impl::momentum_update, 6},
+                                    {&Impl::contact_updated, 7},
+                                    {&Impl::nodal_velocities, 8},
+                                    {&Impl::ghost_velocities, 9},
+                                    {&Impl::fields_to_ghosts, 10},
+                                    {&Impl::template grid_to_particle<Kernel>, 11},
+                                    {&Impl::template stress_update<Kernel>, 12},
+                                    {&Impl::migrate, 13}};
+    // MUSL (without contact): USL's phases up to the grid-to-particle update, then the momenta remapped
+    // from the updated particles with their exchange (sum to the owners, the velocity conditions and
+    // v_i = p_i/m_i there, the ghost update), and the stress update from those velocities (the serial
+    // MUSL list, simulation_step.cpp).
+    static constexpr Phase musl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
+                                     {&Impl::sum_to_owners, 1},
+                                     {&Impl::momentum_update, 6},
+                                     {&Impl::nodal_velocities, 8},
+                                     {&Impl::ghost_velocities, 9},
+                                     {&Impl::template grid_to_particle<Kernel>, 11},
+                                     {&Impl::template remap_momentum<Kernel>, 14},
+                                     {&Impl::sum_to_owners, 1},
+                                     {&Impl::velocity_from_momentum, 15},
+                                     {&Impl::ghost_velocities, 9},
+                                     {&Impl::template stress_update<Kernel>, 12},
+                                     {&Impl::migrate, 13}};
+    const bool is_musl = s.opt.musl;
+    const Phase* phases = is_musl ? musl : usl;
+    const std::size_t count = is_musl ? std::size(musl) : std::size(usl);
+    for (std::size_t p = 0; p < count; ++p) {
       const double t0 = MPI_Wtime();
-      (s.*phases[p])(dt);
-      s.traffic.phase_seconds[p] += MPI_Wtime() - t0;
+      (s.*phases[p].run)(dt);
+      s.traffic.phase_seconds[static_cast<std::size_t>(phases[p].name)] += MPI_Wtime() - t0;
     }
   });
   s.time += dt;
   ++s.traffic.steps;
 }
 
+// MUSL phase, local: the slots' momenta rebuilt from the updated particle velocities,
+// p_i = Σ S_ip m_p v_p^{n+1} over the start-of-step stencils of the deformable particles (the masses
+// and forces of particle_to_grid stay in the slots), as the serial remap_momentum.
+template <int Dim>
+template <class Kernel>
+void DecomposedMpm<Dim>::Impl::remap_momentum(double /*dt*/) {
+  constexpr int momentum = Dof::momentum;
+  const std::size_t slots = slot_node.size();
+  for (std::size_t sl = 0; sl < slots; ++sl)
+    for (int d = 0; d < Dim; ++d) slot_values(sl)[momentum + d] = 0.0;
+  SwarmFields f(swarm);
+  const auto& st = stencils<Kernel>();
+  for (PetscInt k = 0; k < f.n; ++k) {
+    if (rigid(f.material[k])) continue;
+    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
+    const Vec<Dim> mv = f.mass[k] * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
+    st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
+      double* node = slot_values(static_cast<std::size_t>(slot));
+      for (int d = 0; d < Dim; ++d) node[momentum + d] += S * mv[d];
+    });
+  }
+}
+
+// MUSL phase, owned nodes: the velocity conditions on the remapped momenta (driven components
+// m v_rigid, fixed ones 0), then v_i = p_i/m_i (empty nodes 0), as the serial velocity_from_momentum.
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
+  constexpr int mass = Dof::mass, momentum = Dof::momentum, velocity = Dof::velocity;
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(global, &a), "VecGetArray");
+  for_each_owned_field(a, [&](PetscInt q, double* node) {
+    const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
+    const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
+    const double m = node[mass];
+    for (int d = 0; d < Dim; ++d) {
+      if (driven & (1u << d)) node[momentum + d] = m * drive_velocity[static_cast<std::size_t>(q)][d];
+      if (fixed & (1u << d)) node[momentum + d] = 0.0;
+    }
+    for (int d = 0; d < Dim; ++d) node[velocity + d] = m > empty_node_mass ? node[momentum + d] / m : 0.0;
+  });
+  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
+}
+
 // The members defined here, for both dimensions (the phase templates are instantiated by step).
 #define FRICTHERM_INSTANTIATE_USL(D)                                   \
   template void DecomposedMpm<D>::step(double);                        \
-  template const std::array<const char*, 14>& DecomposedMpm<D>::phase_names(); \
+  template const std::array<const char*, 16>& DecomposedMpm<D>::phase_names(); \
+  template void DecomposedMpm<D>::Impl::velocity_from_momentum(double); \
   template double DecomposedMpm<D>::external_work() const;             \
   template double DecomposedMpm<D>::damping_work() const;              \
   template void DecomposedMpm<D>::Impl::sum_to_owners(double);         \

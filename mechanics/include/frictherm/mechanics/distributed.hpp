@@ -40,6 +40,14 @@
 //   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, the material's stress
 //   migrate                exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
 //
+// MUSL (Options::musl, without contact) runs particle_to_grid, sum_to_owners, momentum_update,
+// nodal_velocities, ghost_velocities, grid_to_particle, then
+//   remap_momentum         local: p_i = Σ S_ip m_p v_p^{n+1} into the slots (start-of-step stencils)
+//   sum_to_owners          exchange, as above
+//   velocity_from_momentum owned nodes: driven components p = m v_rigid, fixed ones 0; v_i = p_i/m_i
+//   ghost_velocities       exchange, as above
+// and stress_update, migrate (the serial MUSL list, simulation_step.cpp).
+//
 // Velocity fields: without contact every deformable material shares one field (as the serial
 // Simulation); with contact each material has its own. Each rank stores each field over the box of
 // local nodes its local particles' stencils reach (the serial layout_fields), so memory and work
@@ -137,7 +145,7 @@ struct DecomposedTraffic {
   long multi_ghost_nodes = 0;
   long field_entries_sent = 0;
   int field_entry_bytes = 0;
-  std::array<double, 14> phase_seconds{};  // per phase, in phase_names() order
+  std::array<double, 16> phase_seconds{};  // per phase, in phase_names() order
 };
 
 template <int Dim>
@@ -172,6 +180,10 @@ class DecomposedMpm {
     Analysis analysis = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
     double thickness = 1.0;               // 2D out-of-plane thickness (m), as SimulationOptions::thickness; unused in 3D
     Vec<Dim> gravity = Vec<Dim>::Zero();  // body force per unit mass (m/s²)
+    /// The update scheme: USL (false) or MUSL (true: after the grid-to-particle update the momenta are
+    /// remapped from the particles, p_i = Σ S_ip m_p v_p, and the stress is updated from v_i = p_i/m_i,
+    /// as the serial UpdateScheme::musl); MUSL without contact only.
+    bool musl = false;
     /// FLIP/PIC blend time τ (s), as SimulationOptions::pic_relaxation_time: after the FLIP update
     /// v_p ← (1 − α) v_p + α Σ S_ip v_i, α = 1 − e^(−dt/τ); infinity: pure FLIP.
     double pic_relaxation_time = std::numeric_limits<double>::infinity();
@@ -221,10 +233,10 @@ class DecomposedMpm {
   /// migrated to their owners. Every particle must lie inside the grid's physical region.
   void add_particles(const std::vector<Particle>& particles);
 
-  /// One USL step of size dt (collective): the phases listed above, in that order. Throws
+  /// One USL or MUSL step of size dt (collective): the phases listed above, in that order. Throws
   /// std::runtime_error on every rank when a particle is compressed past its Hugoniot's limit.
   void step(double dt);
-  static const std::array<const char*, 14>& phase_names();
+  static const std::array<const char*, 16>& phase_names();
 
   int stencil_width() const;
   /// DMDA processes per direction and this rank's owned node range [begin, end) per direction
