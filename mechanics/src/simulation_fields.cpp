@@ -1,6 +1,7 @@
 // Velocity fields and the grid momentum update: the layout of the fields' slots, the per-thread
 // buffer reduction, velocity boundary conditions, p ← p + f dt, and rigid-body motion.
 #include <frictherm/mechanics/errors.hpp>
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <cmath>
@@ -324,10 +325,11 @@ void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
 // (explicit: stable for c dt < 2; the scene checks c dt_max < 1). After the velocity conditions,
 // on the components they leave free (the same forces as damping first: the conditions replace the
 // force of the components they set, and fixed ones have p = 0), so that its work, c p²/m dt per
-// component, is the energy it removes.
+// component, is the energy it removes. The node's kernel is damp_node (loads/grid_loads.hpp), shared
+// with the decomposed step.
 template <int Dim>
 void Simulation<Dim>::apply_damping(double dt) {
-  if (!(opt_.damping_rate > 0.0 && time_ < opt_.damping_until)) return;
+  if (!damping_active(opt_.damping_rate, opt_.damping_until, time_)) return;
   const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
   double removed = 0.0;
 #pragma omp parallel num_threads(threads_) reduction(+ : removed)
@@ -339,13 +341,7 @@ void Simulation<Dim>::apply_damping(double dt) {
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
       const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(slot_node_[s])];
-      const double m = nodes_.mass[s];
-      for (int d = 0; d < Dim; ++d) {
-        if (driven & (1u << d)) continue;
-        const double p = nodes_.momentum[s][d];
-        nodes_.force[s][d] -= c * p;
-        if (m > mmin_damped) removed += c * p * p / m * dt;
-      }
+      damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
     }
   }
   damping_work_ += removed;

@@ -7,6 +7,7 @@
 // step while its position is at hand, and moves the rigid materials' particles and evaluates theirs:
 // the start of the next step and the heat hand-off after it need not pass over the particles again.
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/transfer/pic_blend.hpp>
 
@@ -201,7 +202,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     pass_split_.rebalance(material_begin_, material_end_, field_of_material_);
   }
   if constexpr (Kinematics) {
-    for (const auto& L : resolved_loads_) work += (L.force * (*L.scale)(time_)).dot(p_.velocity[L.particle]) * dt;
+    for (const auto& L : resolved_loads_) work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, time_), p_.velocity[L.particle], dt);
     external_work_ += work;
   }
   if constexpr (Stress) wave_speed_ready_ = true;

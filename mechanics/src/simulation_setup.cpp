@@ -1,4 +1,5 @@
 // Simulation set-up: materials, bodies filled with particles, boundary conditions and loads.
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/time_step/cfl_time_step.hpp>
 
@@ -245,6 +246,21 @@ void Simulation<Dim>::resolve_loads() {
 }
 
 template <int Dim>
+std::vector<ParticleLoad<Dim>> Simulation<Dim>::particle_loads() const {
+  std::vector<ParticleLoad<Dim>> loads;
+  loads.reserve(resolved_loads_.size());
+  for (const ResolvedLoad& L : resolved_loads_) {
+    int source = 0;
+    for (std::size_t i = 0; i < point_loads_.size(); ++i)
+      if (L.scale == &point_loads_[i].scale) source = static_cast<int>(i);
+    for (std::size_t j = 0; j < tractions_.size(); ++j)
+      if (L.scale == &tractions_[j].scale) source = static_cast<int>(point_loads_.size() + j);
+    loads.push_back({static_cast<std::int64_t>(L.particle), source, L.force, *L.scale});
+  }
+  return loads;
+}
+
+template <int Dim>
 double Simulation<Dim>::stable_time_step() const {
   double cmax = 0.0;
   const std::size_t n = p_.size();
@@ -270,7 +286,7 @@ double Simulation<Dim>::stable_time_step() const {
   cmax = with_rigid_speeds(cmax, materials_, time_);
   const double dt_penalty = penalty_time_step_limit(cmax);  // light nodes under contacts (simulation_penalty.cpp)
   cmax *= penalty_wave_factor();
-  const double dt_damping = opt_.damping_rate > 0.0 && time_ < opt_.damping_until
+  const double dt_damping = damping_active(opt_.damping_rate, opt_.damping_until, time_)
                                 ? damping_time_step_limit(opt_.damping_rate)
                                 : std::numeric_limits<double>::infinity();
   const double dt = cfl_time_step(opt_.cfl, grid_.min_cell_size(), cmax, opt_.max_time_step);

@@ -7,6 +7,7 @@
 // of multimaterial contact. With the extended B-spline the weights are precomputed per step
 // (simulation_ebs.cpp) and the same loops read them.
 #include <frictherm/mechanics/errors.hpp>
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include "stencil_access.hpp"
@@ -428,16 +429,18 @@ void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* 
   }
 }
 
+// Point loads and tractions into the nodal forces (the kernel shared with the decomposed step:
+// loads/grid_loads.hpp).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_external_loads(double t) {
   auto& st = stencils<Kernel>();
   for (const auto& L : resolved_loads_) {
-    const Vec<Dim> f = L.force * (*L.scale)(t);
+    const Vec<Dim> f = load_force<Dim>(L.force, *L.scale, t);
     const int fi = field_of_material_[static_cast<std::size_t>(p_.material[L.particle])];
     if (fi < 0) continue;
-    st[L.particle].for_each(fields_[static_cast<std::size_t>(fi)].index,
-                            [&](int i, double S, const Vec<Dim>&) { nodes_.force[i] += S * f; });
+    add_load_to_grid<Dim>(st[L.particle], fields_[static_cast<std::size_t>(fi)].index, f,
+                          [&](int i) -> Vec<Dim>& { return nodes_.force[i]; });
   }
 }
 

@@ -28,6 +28,7 @@ class Redistribution {
     for (auto& r : acc_.reals) r.second.clear();
     for (auto& r : acc_.integers) r.second.clear();
     acc_.cumulative_first = acc_.cumulative_second = 0.0;
+    acc_.external_work = acc_.damping_work = 0.0;
     acc_.work_first.clear();
     acc_.work_second.clear();
     acc_.stats.assign(4, 0);
@@ -61,6 +62,10 @@ class Redistribution {
       acc_.cumulative_first += w;
       r("mechanics/cumulative_work_second", w);
       acc_.cumulative_second += w;
+      r("mechanics/external_work", w);
+      acc_.external_work += w;
+      r("mechanics/damping_work", w);
+      acc_.damping_work += w;
       std::vector<long> stats;
       r("mechanics/contact_stats", stats);
       for (std::size_t k = 0; k < 4 && k < stats.size(); ++k) acc_.stats[k] += stats[k];

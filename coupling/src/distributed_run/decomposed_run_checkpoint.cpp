@@ -64,6 +64,8 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   v("mechanics/time", st.time);
   v("mechanics/cumulative_work_first", st.cumulative_first);
   v("mechanics/cumulative_work_second", st.cumulative_second);
+  v("mechanics/external_work", st.external_work);
+  v("mechanics/damping_work", st.damping_work);
   v("mechanics/empty_node_mass", st.empty_node_mass);
   v("mechanics/work_first", st.work_first);
   v("mechanics/work_second", st.work_second);

@@ -56,9 +56,10 @@ void DecomposedRun<Dim>::write_start_metadata() {
 
 template <int Dim>
 std::vector<std::string> DecomposedRun<Dim>::series_names() const {
-  std::vector<std::string> n{"time", "step", "dt", "kinetic_energy"};
+  std::vector<std::string> n{"time", "step", "dt", "kinetic_energy", "external_work"};
   const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
   for (int d = 0; d < Dim; ++d) n.emplace_back(axes[d]);
+  n.emplace_back("damping_work");
   if (s_.contact.enabled)
     n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
   if (heat_) {
@@ -84,8 +85,9 @@ void DecomposedRun<Dim>::series() {
     for (int d = 0; d < Dim; ++d) sums[1 + d] += p.mass[k] * vk[d];
   }
   MPI_Allreduce(MPI_IN_PLACE, sums, 1 + Dim, MPI_DOUBLE, MPI_SUM, comm_);
-  std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0]};
+  std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0], mpm_->external_work()};
   for (int d = 0; d < Dim; ++d) row.push_back(sums[1 + d]);
+  row.push_back(mpm_->damping_work());
   if (s_.contact.enabled) {
     const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
     const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);

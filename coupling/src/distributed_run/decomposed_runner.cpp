@@ -116,12 +116,16 @@ void DecomposedRun<Dim>::check_output_files() {
 template <int Dim>
 void DecomposedRun<Dim>::build() {
   grid_ = std::make_unique<mechanics::Grid<Dim>>(detail::scene_grid<Dim>(s_));
+  typename Mpm::Options options = detail::decomposed_options<Dim>(s_);
+  // The particles first: the serial build resolves the loads to them.
+  std::vector<typename Mpm::Particle> particles = detail::scene_particles<Dim>(comm_, s_, options.loads);
   try {
-    mpm_ = std::make_unique<Mpm>(comm_, *grid_, s_.materials, detail::decomposed_options<Dim>(s_));
+    mpm_ = std::make_unique<Mpm>(comm_, *grid_, s_.materials, options);
   } catch (const std::invalid_argument& e) {  // thrown on every rank alike: all hold the same scene
     throw SceneError(e.what());
   }
-  mpm_->add_particles(detail::scene_particles<Dim>(comm_, s_));
+  mpm_->add_particles(particles);
+  particles = {};
   r_.particles = static_cast<std::size_t>(mpm_->global_particles());
   temperature_ = mpm_->particle_scalar_index("temperature");
   if (s_.thermal.enabled) {

@@ -42,6 +42,9 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.thickness = scene.options.thickness;
   for (int d = 0; d < Dim; ++d) o.gravity[d] = scene.options.gravity[d];
   o.pic_relaxation_time = scene.options.pic_relaxation_time;
+  o.musl = scene.options.scheme == mechanics::UpdateScheme::musl;  // usf is refused (scene_decomposed.cpp)
+  o.damping_rate = scene.options.damping_rate;
+  o.damping_until = scene.options.damping_until;
   o.fixed_faces = scene.fixed_faces;
   o.contact = scene.contact.enabled;
   if (o.contact) {
@@ -55,10 +58,12 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
 }
 
 template <int Dim>
-std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MPI_Comm comm, const Scene& scene) {
+std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
+    MPI_Comm comm, const Scene& scene, std::vector<mechanics::ParticleLoad<Dim>>& loads) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> all;
+  std::vector<double> packed;  // per load: particle id, source (loads.point[i], then loads.traction[j]), force
   std::string error;
   if (rank == 0) {
     try {
@@ -83,19 +88,42 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MP
         q.scalars = {p.temperature[k], p.temperature[k]};
         if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
       }
+      for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {
+        packed.push_back(static_cast<double>(L.particle));
+        packed.push_back(static_cast<double>(L.source));
+        for (int d = 0; d < Dim; ++d) packed.push_back(L.force[d]);
+      }
     } catch (const SceneError& e) {
       error = e.what();
       if (error.empty()) error = "the particles could not be built";
     }
   }
   if (const std::string why = agreed_error(comm, error); !why.empty()) throw SceneError(why);
+  // The resolved loads on every rank (each rank applies those of the particles it holds), their time
+  // functions from the scene's load of origin.
+  long count = static_cast<long>(packed.size());
+  MPI_Bcast(&count, 1, MPI_LONG, 0, comm);
+  packed.resize(static_cast<std::size_t>(count));
+  MPI_Bcast(packed.data(), static_cast<int>(count), MPI_DOUBLE, 0, comm);
+  loads.clear();
+  const std::size_t points = scene.point_loads.size();
+  for (std::size_t a = 0; a + 2 + Dim <= packed.size(); a += 2 + Dim) {
+    mechanics::ParticleLoad<Dim> L;
+    L.particle = static_cast<std::int64_t>(packed[a]);
+    const auto source = static_cast<std::size_t>(packed[a + 1]);
+    L.source = static_cast<int>(source);
+    for (int d = 0; d < Dim; ++d) L.force[d] = packed[a + 2 + static_cast<std::size_t>(d)];
+    L.scale = source < points ? scene.point_loads[source].scale : scene.tractions[source - points].scale;
+    loads.push_back(std::move(L));
+  }
   return all;
 }
 
 #define FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(D)                                                         \
   template mechanics::Grid<D> scene_grid<D>(const Scene&);                                                \
   template mechanics::DecomposedMpm<D>::Options decomposed_options<D>(const Scene&);                      \
-  template std::vector<mechanics::DecomposedMpm<D>::Particle> scene_particles<D>(MPI_Comm, const Scene&);
+  template std::vector<mechanics::DecomposedMpm<D>::Particle> scene_particles<D>(                \
+      MPI_Comm, const Scene&, std::vector<mechanics::ParticleLoad<D>>&);
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(2)
 FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
 #undef FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP

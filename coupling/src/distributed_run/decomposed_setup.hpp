@@ -31,9 +31,11 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
 /// Collective: rank 0 builds the scene's particles (build_simulation) and returns them with id = serial
 /// index, the body temperature as the first two scalars and w_p as the third (plastic heating); the
 /// other ranks return none. A SceneError on rank 0
-/// is thrown on every rank.
+/// is thrown on every rank. `loads` gets, on every rank, the scene's point loads and tractions as the
+/// serial build resolves them to particles (Simulation::particle_loads, by particle id).
 template <int Dim>
-std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(MPI_Comm comm, const Scene& scene);
+std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
+    MPI_Comm comm, const Scene& scene, std::vector<mechanics::ParticleLoad<Dim>>& loads);
 
 /// Collective: the first rank's non-empty `error` on every rank ("" when no rank has one), so that a
 /// failure on one rank makes every rank stop instead of leaving the others waiting.

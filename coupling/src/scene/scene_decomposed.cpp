@@ -30,21 +30,20 @@ std::string mechanics_refusal(const Scene& s) {
   const mechanics::SimulationOptions& o = s.options;
   if (o.shape == mechanics::ShapeKind::extended_bspline)
     return refuse("solver.shape_function", quoted("extended_bspline"), "\"linear\", \"ugimp\" or \"quadratic_bspline\"");
-  if (o.scheme != mechanics::UpdateScheme::usl)
-    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\"");
+  // USL, and MUSL without contact (DecomposedMpm: the USL phases with the remap and its exchange).
+  if (o.scheme == mechanics::UpdateScheme::usf)
+    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");
+  if (o.scheme == mechanics::UpdateScheme::musl && s.contact.enabled)
+    return refuse("solver.scheme", quoted("musl") + " with contact", "\"usl\", or \"musl\" without contact");
   if (o.particle_update != mechanics::ParticleUpdate::flip)
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
-  if (o.damping_rate > 0.0) return refuse("solver.damping", "rate " + number(o.damping_rate), "no damping: remove the key");
+  // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).
   // Every material kind runs decomposed (DecomposedMpm: linear elastic, neo-Hookean, Mie-Grüneisen/J2,
   // rigid; docs/distributed_pbx.md), but a rigid material in contact must be a boundary wall: the
   // engine's rule, rigid contact partners stay serial.
   for (const mechanics::Material& m : s.materials)
     if (m.is_rigid() && s.contact.enabled && !m.rigid_boundary)
       return refuse("materials." + m.name + ".boundary", "false (a rigid contact partner)", "true: a rigid wall");
-  if (!s.point_loads.empty())
-    return refuse("loads.point", std::to_string(s.point_loads.size()) + " point load(s)", "no point loads");
-  if (!s.tractions.empty())
-    return refuse("loads.traction", std::to_string(s.tractions.size()) + " traction(s)", "no tractions");
   return "";
 }
 

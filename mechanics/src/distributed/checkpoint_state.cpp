@@ -66,6 +66,8 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.time = s.time;
   c.cumulative_first = s.cumulative_first;
   c.cumulative_second = s.cumulative_second;
+  c.external_work = s.external_work;
+  c.damping_work = s.damping_work;
   c.empty_node_mass = s.empty_node_mass;
   c.work_first = s.work_first;
   c.work_second = s.work_second;
@@ -136,6 +138,8 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.time = c.time;
   s.cumulative_first = c.cumulative_first;
   s.cumulative_second = c.cumulative_second;
+  s.external_work = c.external_work;
+  s.damping_work = c.damping_work;
   s.empty_node_mass = c.empty_node_mass;
   s.work_first = c.work_first;
   s.work_second = c.work_second;

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace frictherm::mechanics {
@@ -222,6 +223,12 @@ struct DecomposedMpm<Dim>::Impl {
   // step goes on at every rank (that node's contact as far as it got) and the run loop agrees on the
   // failure after it (issue 34: one rank's exception had left the others waiting in a collective).
   std::string contact_failure;
+  // Loads (Options::loads sorted by particle id, and their ids), this step's loaded local particles
+  // (swarm index, load) found by particle_to_grid for grid_to_particle, and this rank's books (J).
+  std::vector<ParticleLoad<Dim>> loads;
+  std::vector<std::int64_t> load_ids;
+  std::vector<std::pair<PetscInt, std::size_t>> local_loads;
+  double external_work = 0.0, damping_work = 0.0;
   int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
   Stencils current;                      // current_stencils(), valid until the next step or add
   bool current_valid = false;
@@ -287,6 +294,9 @@ struct DecomposedMpm<Dim>::Impl {
   void grid_to_particle(double dt);
   template <class Kernel>
   void stress_update(double dt);
+  template <class Kernel>
+  void remap_momentum(double dt);     // MUSL
+  void velocity_from_momentum(double dt);
   void migrate(double dt);
 };
 

@@ -3,6 +3,7 @@
 // fixed faces, reductions and the gather by global id.
 #include "distributed/decomposed_state.hpp"
 
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/time_step/cfl_time_step.hpp>
 
@@ -147,7 +148,16 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
     s.laws.push_back(stress_law(m, options.analysis));
     s.has_mie_gruneisen = s.has_mie_gruneisen || mg;
   }
+  if (options.musl && options.contact)
+    throw std::invalid_argument("decomposed mechanics: MUSL with contact is not supported (expected USL, or MUSL "
+                                "without contact)");
   s.opt = options;
+  // The loads by particle id (stable: a particle's loads in the serial order), found by particle_to_grid.
+  s.loads = options.loads;
+  std::stable_sort(s.loads.begin(), s.loads.end(),
+                   [](const ParticleLoad<Dim>& a, const ParticleLoad<Dim>& b) { return a.particle < b.particle; });
+  for (const ParticleLoad<Dim>& L : s.loads) s.load_ids.push_back(L.particle);
+  s.opt.loads.clear();
   s.setup_contact();  // checks the contact settings before any collective PETSc call
   s.fields = options.contact ? static_cast<int>(materials.size()) : 1;
   s.per_field = options.contact ? NodeDof<Dim>::with_contact : NodeDof<Dim>::without_contact;
@@ -530,7 +540,11 @@ double DecomposedMpm<Dim>::stable_time_step(double cfl, double max_time_step) co
   }
   MPI_Allreduce(MPI_IN_PLACE, &cmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
   cmax = with_rigid_speeds(cmax, s.materials, s.time);
-  return cfl_time_step(cfl, s.grid.min_cell_size(), cmax, max_time_step);
+  // The damping's explicit limit while it acts (as the serial step).
+  const double dt_damping = damping_active(s.opt.damping_rate, s.opt.damping_until, s.time)
+                                ? damping_time_step_limit(s.opt.damping_rate)
+                                : std::numeric_limits<double>::infinity();
+  return std::min(cfl_time_step(cfl, s.grid.min_cell_size(), cmax, max_time_step), dt_damping);
 }
 
 template <int Dim>

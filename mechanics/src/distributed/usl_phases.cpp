@@ -9,12 +9,14 @@
 #include "distributed/decomposed_state.hpp"
 
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
+#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/transfer/pic_blend.hpp>
 
 #include <mpi.h>
 
 #include <algorithm>
 #include <climits>
+#include <iterator>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -140,6 +142,20 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
       }
     });
   }
+  if (loads.empty()) return;
+  // The point loads and tractions of this rank's particles, f_i += S_ip F(t) into their fields' slots
+  // (the serial kernel): a particle is on one rank, so sum_to_owners gives the owners each load once.
+  local_loads.clear();
+  for (PetscInt k = 0; k < f.n; ++k) {
+    const auto [lo, hi] = std::equal_range(load_ids.begin(), load_ids.end(), static_cast<std::int64_t>(f.id[k]));
+    for (auto j = lo; j != hi; ++j) local_loads.emplace_back(k, static_cast<std::size_t>(j - load_ids.begin()));
+  }
+  for (const auto& [k, j] : local_loads) {
+    if (rigid(f.material[k])) continue;  // as the serial step: a rigid particle's velocity is prescribed
+    const Vec<Dim> F = load_force<Dim>(loads[j].force, loads[j].scale, time);
+    add_load_to_grid<Dim>(st[static_cast<std::size_t>(k)], boxes[static_cast<std::size_t>(field_of(f.material[k]))].index, F,
+                          [&](int slot) { return Eigen::Map<Vec<Dim>>(slot_values(static_cast<std::size_t>(slot)) + force); });
+  }
 }
 
 // Phase 2, exchange: each local node's m, p, f summed over its fields' slots (in field order; one
@@ -184,27 +200,34 @@ void DecomposedMpm<Dim>::Impl::sum_to_owners(double /*dt*/) {
 }
 
 // Phase 7, owned nodes: velocity conditions of the fixed faces on p_i and f_i (the serial
-// apply_velocity_bc: fixed components of both zeroed), then p_i^{n+1} = p_i^n + f_i dt.
+// apply_velocity_bc: fixed components of both zeroed), the damping, then p_i^{n+1} = p_i^n + f_i dt.
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   constexpr int momentum = Dof::momentum, force = Dof::force;
+  const bool damped = damping_active(opt.damping_rate, opt.damping_until, time);
+  double removed = 0.0;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
   for_each_owned_field(a, [&](PetscInt q, double* node) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
-    if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0) {
+    const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
+    if (driven) {
       // Driven components end the step at the rigid velocity: the change made a force, (m v − p)/dt,
       // so that the particles' FLIP update receives it too (the serial apply_velocity_bc).
       for (int d = 0; d < Dim; ++d)
         if (driven & (1u << d))
           node[force + d] = (node[Dof::mass] * drive_velocity[static_cast<std::size_t>(q)][d] - node[momentum + d]) / dt;
     }
-    for (int d = 0; d < Dim; ++d) {
+    for (int d = 0; d < Dim; ++d)
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
-      node[momentum + d] += node[force + d] * dt;
-    }
+    // Mass-proportional damping after the velocity conditions, on the components they leave free
+    // (the serial apply_damping's kernel).
+    if (damped)
+      damp_node<Dim>(node + force, node + momentum, node[Dof::mass], driven, opt.damping_rate, dt, empty_node_mass, removed);
+    for (int d = 0; d < Dim; ++d) node[momentum + d] += node[force + d] * dt;
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
+  damping_work += removed;
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
@@ -268,6 +291,9 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
     pic_blend(vp, v, pic);
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
+  for (const auto& [k, j] : local_loads)  // the loads' work with the updated velocities (the serial pass)
+    external_work += load_work<Dim>(load_force<Dim>(loads[j].force, loads[j].scale, time),
+                                    Vec<Dim>(Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k)), dt);
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
@@ -331,11 +357,26 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
 }
 
 template <int Dim>
-const std::array<const char*, 14>& DecomposedMpm<Dim>::phase_names() {
-  static const std::array<const char*, 14> names{
+double DecomposedMpm<Dim>::external_work() const {
+  double w = impl_->external_work;
+  MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
+}
+
+template <int Dim>
+double DecomposedMpm<Dim>::damping_work() const {
+  double w = impl_->damping_work;
+  MPI_Allreduce(MPI_IN_PLACE, &w, 1, MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
+}
+
+template <int Dim>
+const std::array<const char*, 16>& DecomposedMpm<Dim>::phase_names() {
+  static const std::array<const char*, 16> names{
       {"particle_to_grid", "sum_to_owners", "exchange_field_ranges", "fields_to_owners", "find_contact_nodes",
        "contact_extrapolated", "momentum_update", "contact_updated", "nodal_velocities", "ghost_velocities",
-       "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate"}};
+       "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate", "remap_momentum",
+       "velocity_from_momentum"}};
   return names;
 }
 
@@ -345,37 +386,106 @@ void DecomposedMpm<Dim>::step(double dt) {
   s.current_valid = false;  // the particles move: current_stencils() evaluates them again
   dispatch_shape(s.opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
-    using Phase = void (Impl::*)(double);
-    // The step, in order (names: phase_names()). Without contact (one velocity field) the per-field
-    // exchanges and the contact phases have nothing to do.
-    static constexpr Phase phases[14] = {&Impl::template particle_to_grid<Kernel>,
-                                         &Impl::sum_to_owners,
-                                         &Impl::exchange_field_ranges,
-                                         &Impl::fields_to_owners,
-                                         &Impl::find_contact_nodes,
-                                         &Impl::contact_extrapolated,
-                                         &Impl::momentum_update,
-                                         &Impl::contact_updated,
-                                         &Impl::nodal_velocities,
-                                         &Impl::ghost_velocities,
-                                         &Impl::fields_to_ghosts,
-                                         &Impl::template grid_to_particle<Kernel>,
-                                         &Impl::template stress_update<Kernel>,
-                                         &Impl::migrate};
-    for (std::size_t p = 0; p < 14; ++p) {
+    // A phase and the phase_names() entry that times it.
+    struct Phase {
+      void (Impl::*run)(double);
+      int name;
+    };
+    // USL, in order. Without contact (one velocity field) the per-field exchanges and the contact
+    // phases have nothing to do.
+    static constexpr Phase usl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
+                                    {&Impl::sum_to_owners, 1},
+                                    {&Impl::exchange_field_ranges, 2},
+                                    {&Impl::fields_to_owners, 3},
+                                    {&Impl::find_contact_nodes, 4},
+                                    {&Impl::contact_extrapolated, 5},
+                                    {&Impl::momentum_update, 6},
+                                    {&Impl::contact_updated, 7},
+                                    {&Impl::nodal_velocities, 8},
+                                    {&Impl::ghost_velocities, 9},
+                                    {&Impl::fields_to_ghosts, 10},
+                                    {&Impl::template grid_to_particle<Kernel>, 11},
+                                    {&Impl::template stress_update<Kernel>, 12},
+                                    {&Impl::migrate, 13}};
+    // MUSL (without contact): USL's phases up to the grid-to-particle update, then the momenta remapped
+    // from the updated particles with their exchange (sum to the owners, the velocity conditions and
+    // v_i = p_i/m_i there, the ghost update), and the stress update from those velocities (the serial
+    // MUSL list, simulation_step.cpp).
+    static constexpr Phase musl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
+                                     {&Impl::sum_to_owners, 1},
+                                     {&Impl::momentum_update, 6},
+                                     {&Impl::nodal_velocities, 8},
+                                     {&Impl::ghost_velocities, 9},
+                                     {&Impl::template grid_to_particle<Kernel>, 11},
+                                     {&Impl::template remap_momentum<Kernel>, 14},
+                                     {&Impl::sum_to_owners, 1},
+                                     {&Impl::velocity_from_momentum, 15},
+                                     {&Impl::ghost_velocities, 9},
+                                     {&Impl::template stress_update<Kernel>, 12},
+                                     {&Impl::migrate, 13}};
+    const bool is_musl = s.opt.musl;
+    const Phase* phases = is_musl ? musl : usl;
+    const std::size_t count = is_musl ? std::size(musl) : std::size(usl);
+    for (std::size_t p = 0; p < count; ++p) {
       const double t0 = MPI_Wtime();
-      (s.*phases[p])(dt);
-      s.traffic.phase_seconds[p] += MPI_Wtime() - t0;
+      (s.*phases[p].run)(dt);
+      s.traffic.phase_seconds[static_cast<std::size_t>(phases[p].name)] += MPI_Wtime() - t0;
     }
   });
   s.time += dt;
   ++s.traffic.steps;
 }
 
+// MUSL phase, local: the slots' momenta rebuilt from the updated particle velocities,
+// p_i = Σ S_ip m_p v_p^{n+1} over the start-of-step stencils of the deformable particles (the masses
+// and forces of particle_to_grid stay in the slots), as the serial remap_momentum.
+template <int Dim>
+template <class Kernel>
+void DecomposedMpm<Dim>::Impl::remap_momentum(double /*dt*/) {
+  constexpr int momentum = Dof::momentum;
+  const std::size_t slots = slot_node.size();
+  for (std::size_t sl = 0; sl < slots; ++sl)
+    for (int d = 0; d < Dim; ++d) slot_values(sl)[momentum + d] = 0.0;
+  SwarmFields f(swarm);
+  const auto& st = stencils<Kernel>();
+  for (PetscInt k = 0; k < f.n; ++k) {
+    if (rigid(f.material[k])) continue;
+    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
+    const Vec<Dim> mv = f.mass[k] * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
+    st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
+      double* node = slot_values(static_cast<std::size_t>(slot));
+      for (int d = 0; d < Dim; ++d) node[momentum + d] += S * mv[d];
+    });
+  }
+}
+
+// MUSL phase, owned nodes: the velocity conditions on the remapped momenta (driven components
+// m v_rigid, fixed ones 0), then v_i = p_i/m_i (empty nodes 0), as the serial velocity_from_momentum.
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
+  constexpr int mass = Dof::mass, momentum = Dof::momentum, velocity = Dof::velocity;
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(global, &a), "VecGetArray");
+  for_each_owned_field(a, [&](PetscInt q, double* node) {
+    const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
+    const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
+    const double m = node[mass];
+    for (int d = 0; d < Dim; ++d) {
+      if (driven & (1u << d)) node[momentum + d] = m * drive_velocity[static_cast<std::size_t>(q)][d];
+      if (fixed & (1u << d)) node[momentum + d] = 0.0;
+    }
+    for (int d = 0; d < Dim; ++d) node[velocity + d] = m > empty_node_mass ? node[momentum + d] / m : 0.0;
+  });
+  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
+}
+
 // The members defined here, for both dimensions (the phase templates are instantiated by step).
 #define FRICTHERM_INSTANTIATE_USL(D)                                   \
   template void DecomposedMpm<D>::step(double);                        \
-  template const std::array<const char*, 14>& DecomposedMpm<D>::phase_names(); \
+  template const std::array<const char*, 16>& DecomposedMpm<D>::phase_names(); \
+  template void DecomposedMpm<D>::Impl::velocity_from_momentum(double); \
+  template double DecomposedMpm<D>::external_work() const;             \
+  template double DecomposedMpm<D>::damping_work() const;              \
   template void DecomposedMpm<D>::Impl::sum_to_owners(double);         \
   template void DecomposedMpm<D>::Impl::momentum_update(double);       \
   template void DecomposedMpm<D>::Impl::nodal_velocities(double);      \

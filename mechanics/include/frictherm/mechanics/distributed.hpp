@@ -19,7 +19,8 @@
 //
 //   particle_to_grid       local: stencils; rigid particles mark the nodes they drive; per velocity
 //                          field m_i, p_i, f_i (N·1–3) and, with contact, Σ S m x (or the displacement
-//                          form), Ω_i, g_i (N·4–6, 9), into the field's box of slots
+//                          form), Ω_i, g_i (N·4–6, 9), into the field's box of slots; the point
+//                          loads and tractions of the rank's particles (f_i += S_ip F)
 //   sum_to_owners          exchange: every node's m, p, f summed over its fields into the DMDA,
 //                          DMLocalToGlobal(ADD_VALUES) into the owners; the rigid drivers to the owners
 //   exchange_field_ranges  exchange (PetscSF): which materials reach each node, completed at the
@@ -29,7 +30,7 @@
 //   find_contact_nodes     owned nodes where two or more fields have mass
 //   contact_extrapolated   contact on the extrapolated momenta (N·7–18), node-local
 //   momentum_update        owned nodes: rigid drive (f = (m v_rigid − p)/dt), fixed faces (p, f
-//                          components zeroed), p_i += f_i dt
+//                          components zeroed), damping (f −= c p), p_i += f_i dt
 //   contact_updated        contact on p^{n+1} with consistent forces (N·19) and frictional work (N·27, 34, 36, 40)
 //   nodal_velocities       owned nodes: v_i = p_i/m_i, a_i = f_i/m_i; driven components v = v_rigid
 //   ghost_velocities       exchange: DMGlobalToLocal(INSERT_VALUES), ghost nodes get the totals' v_i, a_i
@@ -38,6 +39,14 @@
 //                          rigid particles move with their prescribed velocity
 //   stress_update          L_p = Σ v_i ⊗ G_ip, F ← (I + L dt) F, V = det F V0, the material's stress
 //   migrate                exchange: DMSwarmMigrate, each particle to the rank owning its nearest node
+//
+// MUSL (Options::musl, without contact) runs particle_to_grid, sum_to_owners, momentum_update,
+// nodal_velocities, ghost_velocities, grid_to_particle, then
+//   remap_momentum         local: p_i = Σ S_ip m_p v_p^{n+1} into the slots (start-of-step stencils)
+//   sum_to_owners          exchange, as above
+//   velocity_from_momentum owned nodes: driven components p = m v_rigid, fixed ones 0; v_i = p_i/m_i
+//   ghost_velocities       exchange, as above
+// and stress_update, migrate (the serial MUSL list, simulation_step.cpp).
 //
 // Velocity fields: without contact every deformable material shares one field (as the serial
 // Simulation); with contact each material has its own. Each rank stores each field over the box of
@@ -136,7 +145,7 @@ struct DecomposedTraffic {
   long multi_ghost_nodes = 0;
   long field_entries_sent = 0;
   int field_entry_bytes = 0;
-  std::array<double, 14> phase_seconds{};  // per phase, in phase_names() order
+  std::array<double, 16> phase_seconds{};  // per phase, in phase_names() order
 };
 
 template <int Dim>
@@ -171,6 +180,10 @@ class DecomposedMpm {
     Analysis analysis = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
     double thickness = 1.0;               // 2D out-of-plane thickness (m), as SimulationOptions::thickness; unused in 3D
     Vec<Dim> gravity = Vec<Dim>::Zero();  // body force per unit mass (m/s²)
+    /// The update scheme: USL (false) or MUSL (true: after the grid-to-particle update the momenta are
+    /// remapped from the particles, p_i = Σ S_ip m_p v_p, and the stress is updated from v_i = p_i/m_i,
+    /// as the serial UpdateScheme::musl); MUSL without contact only.
+    bool musl = false;
     /// FLIP/PIC blend time τ (s), as SimulationOptions::pic_relaxation_time: after the FLIP update
     /// v_p ← (1 − α) v_p + α Σ S_ip v_i, α = 1 − e^(−dt/τ); infinity: pure FLIP.
     double pic_relaxation_time = std::numeric_limits<double>::infinity();
@@ -181,6 +194,14 @@ class DecomposedMpm {
     bool contact = false;
     ContactOptions contact_options;
     std::vector<DecomposedContactPair> contact_pairs;
+    /// Point loads and tractions resolved to particles by id (Simulation::particle_loads of the
+    /// scene's serial build): the rank holding a loaded particle adds f_i += S_ip F(t) to its slots in
+    /// particle_to_grid (summed to the owners with the rest, so each load counts once) and books the
+    /// work F(t)·v_p dt in grid_to_particle (the serial kernels, loads/grid_loads.hpp).
+    std::vector<ParticleLoad<Dim>> loads;
+    /// Mass-proportional damping f_i −= c p_i while t < damping_until, at the owned nodes in
+    /// momentum_update after the velocity conditions (SimulationOptions::damping_rate, damping_until).
+    double damping_rate = 0.0, damping_until = 0.0;
     /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
     /// one swarm field, migrated with the particles, untouched by the step.
     std::vector<std::string> particle_scalars;
@@ -212,10 +233,10 @@ class DecomposedMpm {
   /// migrated to their owners. Every particle must lie inside the grid's physical region.
   void add_particles(const std::vector<Particle>& particles);
 
-  /// One USL step of size dt (collective): the phases listed above, in that order. Throws
+  /// One USL or MUSL step of size dt (collective): the phases listed above, in that order. Throws
   /// std::runtime_error on every rank when a particle is compressed past its Hugoniot's limit.
   void step(double dt);
-  static const std::array<const char*, 14>& phase_names();
+  static const std::array<const char*, 16>& phase_names();
 
   int stencil_width() const;
   /// DMDA processes per direction and this rank's owned node range [begin, end) per direction
@@ -253,6 +274,10 @@ class DecomposedMpm {
   double stable_time_step(double cfl, double max_time_step = std::numeric_limits<double>::infinity()) const;
   /// Collective: plastic work done on all particles since the start (J; Mie-Grüneisen/J2 materials).
   double total_plastic_work() const;
+  /// Collective: the work of Options::loads and the energy removed by the damping since the start,
+  /// summed over ranks (J; as Simulation::external_work and damping_work).
+  double external_work() const;
+  double damping_work() const;
   /// Velocity-field slots this rank stores (Σ over its fields of their boxes' nodes; see the header
   /// comment) and the largest over the run's steps.
   long field_slots() const;
@@ -298,6 +323,7 @@ class DecomposedMpm {
     std::vector<std::pair<std::string, std::vector<double>>> reals;          // name, n × components
     std::vector<std::pair<std::string, std::vector<std::int64_t>>> integers;  // id, material
     double time = 0.0, cumulative_first = 0.0, cumulative_second = 0.0, empty_node_mass = 0.0;
+    double external_work = 0.0, damping_work = 0.0;  // this rank's part of the books
     std::vector<double> work_first, work_second;
     std::vector<long> stats;  // contact_nodes, multi_nodes, sliding_nodes, guarded (this rank)
   };

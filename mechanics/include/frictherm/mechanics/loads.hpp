@@ -5,6 +5,7 @@
 #include <frictherm/mechanics/types.hpp>
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,18 @@ struct EdgeTraction {
   int axis = 0;
   bool upper = true;
   Vec<Dim> traction = Vec<Dim>::Zero();
+  TimeFunction scale = TimeFunction::constant(1.0);
+};
+
+/// A point load or a traction resolved to one particle (Simulation::particle_loads, the decomposed
+/// run's DecomposedMpm::Options::loads): the force (N) at scale 1 on the particle with index
+/// `particle` in the finalized Simulation (the decomposed run's particle id), scaled by `scale(t)`;
+/// `source` is the load it comes from: i for the i-th point load, (point loads) + j for the j-th traction.
+template <int Dim>
+struct ParticleLoad {
+  std::int64_t particle = 0;
+  int source = 0;
+  Vec<Dim> force = Vec<Dim>::Zero();
   TimeFunction scale = TimeFunction::constant(1.0);
 };
 

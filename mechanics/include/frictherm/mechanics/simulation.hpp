@@ -155,6 +155,10 @@ class Simulation {
   void fix_face(const FixedFace& face);
   void add_point_load(const PointLoad<Dim>& load);
   void add_edge_traction(const EdgeTraction<Dim>& load);
+  /// The point loads and tractions resolved to particles (after finalize(): particle indices in the
+  /// finalized order), in the order the step applies them; what a decomposed run of the same scene
+  /// applies (DecomposedMpm::Options::loads).
+  std::vector<ParticleLoad<Dim>> particle_loads() const;
   /// Turns on contact (one velocity field per material); before finalize(), and before add_body()
   /// when the penalty boundary spacing is set.
   void enable_contact(const ContactOptions& options);

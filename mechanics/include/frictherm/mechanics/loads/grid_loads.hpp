@@ -1,0 +1,53 @@
+#pragma once
+// The loads of the grid update, written once for the serial Simulation (simulation_step.cpp
+// map_external_loads, simulation_particle_pass.cpp, simulation_fields.cpp apply_damping) and the
+// decomposed step (distributed/usl_phases.cpp): point loads and tractions resolved to particles
+// (ParticleLoad, loads.hpp) scattered into the nodal forces, their work, and the mass-proportional
+// damping of the nodal momenta. Each engine passes its own storage (accessors), the arithmetic is here.
+#include <frictherm/mechanics/time_function.hpp>
+#include <frictherm/mechanics/types.hpp>
+
+#include <cstdint>
+
+namespace frictherm::mechanics {
+
+/// The force of a load resolved to a particle at time t: F(t) = F scale(t) (N).
+template <int Dim>
+inline Vec<Dim> load_force(const Vec<Dim>& force, const TimeFunction& scale, double t) {
+  return force * scale(t);
+}
+
+/// The external force's share of the nodal forces, f_i += S_ip F(t) over the loaded particle's
+/// stencil (Nairn 2018 eq. 3 with an external force on the particle). `force_at(i)` is the nodal
+/// force (a Vec<Dim> or an Eigen::Map of one) of stencil node i in the engine's numbering.
+template <int Dim, class Stencil, class Indexer, class ForceAt>
+inline void add_load_to_grid(const Stencil& stencil, const Indexer& index, const Vec<Dim>& F, ForceAt&& force_at) {
+  stencil.for_each(index, [&](int i, double S, const Vec<Dim>&) { force_at(i) += S * F; });
+}
+
+/// The work of a load over a step, F(t) · v_p^{n+1} dt (the energy books' external work; t the step's
+/// start, v_p the particle's velocity after the grid-to-particle update).
+template <int Dim>
+inline double load_work(const Vec<Dim>& F, const Vec<Dim>& velocity, double dt) {
+  return F.dot(velocity) * dt;
+}
+
+/// Whether the mass-proportional damping acts in the step starting at t.
+inline bool damping_active(double rate, double until, double t) { return rate > 0.0 && t < until; }
+
+/// Mass-proportional damping at one node of one velocity field: f_d −= c p_d on the components a rigid
+/// material does not drive (`driven`: bit d), taken at the step's start momentum, after the velocity
+/// conditions (explicit: stable for c dt < 2). The work it removes, c p_d²/m dt per component (J), is
+/// added to `removed` where the node's mass exceeds `min_mass`.
+template <int Dim, class Force, class Momentum>
+FRICTHERM_ALWAYS_INLINE void damp_node(Force&& force, const Momentum& momentum, double mass, std::uint8_t driven,
+                                       double c, double dt, double min_mass, double& removed) {
+  for (int d = 0; d < Dim; ++d) {
+    if (driven & (1u << d)) continue;
+    const double p = momentum[d];
+    force[d] -= c * p;
+    if (mass > min_mass) removed += c * p * p / mass * dt;
+  }
+}
+
+}  // namespace frictherm::mechanics
