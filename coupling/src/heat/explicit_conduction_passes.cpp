@@ -153,6 +153,21 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   const int threads = assembly_detail::assembly_threads(p.size());
+  // A particle's temperature after the window: T_p + Σ S_ip ΔT_i (design §4: the increment, not the
+  // nodal value), relaxed towards Σ S_ip T_i / Σ S_ip with the sub-grid blend β.
+  const auto new_temperature = [&](double before, const Expanded& c) {
+    double dT = 0.0;
+    for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
+    double pic = 0.0, s = 0.0;
+    if (relax) {
+      for (int a = 0; a < c.count; ++a) {
+        pic += c.S[a] * (*end)[c.unknown[a]];
+        s += c.S[a];
+      }
+    }
+    const double flip = before + dT;
+    return (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+  };
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
   if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
@@ -161,18 +176,8 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
       if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
       expand<Kernel, false>(stencils[k], sys.unknown, c);
       if (c.count == 0) continue;  // reaches no unknown
-      double dT = 0.0;  // design §4: the increment, not the nodal value
-      for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
-      double pic = 0.0, s = 0.0;
-      if (relax) {
-        for (int a = 0; a < c.count; ++a) {
-          pic += c.S[a] * (*end)[c.unknown[a]];
-          s += c.S[a];
-        }
-      }
       const double before = p.temperature[k];
-      const double flip = before + dT;
-      const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+      const double T = new_temperature(before, c);
       if (T == before) continue;
       p.temperature[k] = T;
       const double change = heat_capacity_[k] * (T - before);
@@ -191,19 +196,8 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
     expand<Kernel, false>(stencils[k], sys.unknown, c);
     if (c.count == 0) continue;  // reaches no unknown
-    // design §4: the increment, not the nodal value
-    double dT = 0.0;
-    for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
-    double pic = 0.0, s = 0.0;
-    if (relax) {
-      for (int a = 0; a < c.count; ++a) {
-        pic += c.S[a] * (*end)[c.unknown[a]];
-        s += c.S[a];
-      }
-    }
     const double before = p.temperature[k];
-    const double flip = before + dT;
-    const double T = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    const double T = new_temperature(before, c);
     if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
     particle_scratch_[k] = heat_capacity_[k] * (T - before);
