@@ -19,6 +19,7 @@
 #include <climits>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace frictherm::mechanics {
 
@@ -80,6 +81,13 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   // block order after the pass: the same sum wherever the split's boundaries are (thread_partition.hpp).
   const bool blocked = pass_split_.threads > 1;
   if (blocked) work_blocks_.assign(pass_split_.blocks(), 0.0);
+  // The loads' work below, force · the displacement this pass gives: the loaded particles' positions
+  // before it (reused from step to step: no allocation once grown).
+  thread_local std::vector<Vec<Dim>> load_start_position;
+  if constexpr (Kinematics) {
+    load_start_position.resize(resolved_loads_.size());
+    for (std::size_t j = 0; j < resolved_loads_.size(); ++j) load_start_position[j] = p_.position[resolved_loads_[j].particle];
+  }
   double* const work_block = work_blocks_.data();
 
 #pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
@@ -202,7 +210,10 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     pass_split_.rebalance(material_begin_, material_end_, field_of_material_);
   }
   if constexpr (Kinematics) {
-    for (const auto& L : resolved_loads_) work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, time_), p_.velocity[L.particle], dt);
+    for (std::size_t j = 0; j < resolved_loads_.size(); ++j) {
+      const ResolvedLoad& L = resolved_loads_[j];
+      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, time_), p_.position[L.particle] - load_start_position[j]);
+    }
     external_work_ += work;
   }
   if constexpr (Stress) wave_speed_ready_ = true;

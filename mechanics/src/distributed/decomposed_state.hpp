@@ -228,6 +228,7 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<ParticleLoad<Dim>> loads;
   std::vector<std::int64_t> load_ids;
   std::vector<std::pair<PetscInt, std::size_t>> local_loads;
+  std::vector<Vec<Dim>> load_start_position;  // their positions before grid_to_particle (the loads' work)
   double external_work = 0.0, damping_work = 0.0;
   int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
   Stencils current;                      // current_stencils(), valid until the next step or add

@@ -270,6 +270,9 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
   const double pic = pic_blend_fraction(dt, opt.pic_relaxation_time);  // the serial FLIP/PIC blend
+  load_start_position.resize(local_loads.size());
+  for (std::size_t n = 0; n < local_loads.size(); ++n)
+    load_start_position[n] = Eigen::Map<const Vec<Dim>>(f.x + Dim * local_loads[n].first);
   for (PetscInt k = 0; k < f.n; ++k) {
     if (rigid(f.material[k])) {  // the serial move_rigid_particles: v(t), x += ½ (v(t) + v(t + dt)) dt
       const Material& m = materials[static_cast<std::size_t>(f.material[k])];
@@ -291,9 +294,11 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
     pic_blend(vp, v, pic);
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
-  for (const auto& [k, j] : local_loads)  // the loads' work with the updated velocities (the serial pass)
+  for (std::size_t n = 0; n < local_loads.size(); ++n) {  // the loads' work, F · Δx_p (the serial pass)
+    const auto& [k, j] = local_loads[n];
     external_work += load_work<Dim>(load_force<Dim>(loads[j].force, loads[j].scale, time),
-                                    Vec<Dim>(Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k)), dt);
+                                    Vec<Dim>(Eigen::Map<const Vec<Dim>>(f.x + Dim * k)) - load_start_position[n]);
+  }
   petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
 }
 
