@@ -34,7 +34,7 @@ using MpirunContact = frictherm::test::MpirunCompare;
 
 // 1e-9 of each column's scale (the figure): the decomposed step is the serial arithmetic with
 // the nodal sums split between the ranks (another summation order), the extents' maxima exact.
-// Measured ≤ 2.2e-13 on 2 ranks and ≤ 1.7e-12 on 4 (docs/distributed_run.md).
+// Measured ≤ 2.2e-13 on 2 and 4 ranks (the oscillating block's momentum_x; docs/distributed_run.md).
 constexpr double kSame = 1e-9;
 
 TEST_F(MpirunContact, ExtentSeparationMatchesSerial) {
