@@ -9,7 +9,7 @@
 // seen in contact there, where the centre-of-mass test puts it ≈ 1.25 h away.
 #include <frictherm/mechanics/simulation.hpp>
 
-#include "contact_side.hpp"
+#include "contact_extent.hpp"
 
 #include <omp.h>
 
@@ -53,16 +53,9 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
           const int c = node_field_count_[node];
           if (c < 2) return;
           const int begin = node_entry_cursor_[node] - c;  // the node's run (find_contact_nodes)
-          for (int q = begin; q < begin + c; ++q) {
-            const std::size_t qu = static_cast<std::size_t>(q);
-            const Vec<Dim>& n = entry_normal_[qu];
-            if (n.squaredNorm() == 0.0) continue;  // a sliver, or no normal
-            const double centre = x.dot(n), half = l.cwiseProduct(n).cwiseAbs().sum();
-            if (contact_entries_[qu].field == f)
-              own[qu] = std::max(own[qu], centre + half);
-            else
-              other[qu] = std::max(other[qu], half - centre);
-          }
+          const ContactEntry* run = contact_entries_.data() + begin;
+          contact_detail::add_particle_extent<Dim>(x, l, f, c, [run](int j) { return run[j].field; },
+                                                   entry_normal_.data() + begin, own + begin, other + begin);
         });
       }
     }

@@ -4,7 +4,7 @@
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
-#include "contact_pair.hpp"
+#include "contact_extent.hpp"
 
 #include <omp.h>
 
@@ -204,10 +204,8 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
       sd.rigid_velocity = field_velocity_[f];
       sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
     }
-    if (extents) {  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
-      const double own = entry_extent_own_[q], other = entry_extent_other_[q];
-      if (std::isfinite(own) && std::isfinite(other)) sd.extent_gap = -(own + other);
-    }
+    if (extents)  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
+      sd.extent_gap = contact_detail::extent_gap(entry_extent_own_[q], entry_extent_other_[q]);
     sides.push_back(sd);
     slots.push_back(slot);
     mats.push_back(fields_[f].material);
@@ -236,24 +234,13 @@ void Simulation<Dim>::compute_contact_normals() {
   {
     thread_local std::vector<ContactSide<Dim>> sides;
     thread_local std::vector<int> slots, mats, entries;
+    auto pair_of = [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); };
 #pragma omp for schedule(static)
     for (long g = 0; g < groups; ++g) {
       gather_contact_sides(static_cast<std::size_t>(g), 1.0, sides, slots, mats, entries);
-      const std::size_t count = sides.size();
-      if (count < 2) continue;
-      for (std::size_t a = 0; a < count; ++a) {
-        Vec<Dim> n;
-        bool ok;
-        if (count == 2) {
-          const std::size_t b = 1 - a;
-          ok = contact_normal(sides[a], sides[b], contact_pair(mats[a], mats[b]), n);
-        } else {
-          ContactSide<Dim> rest;
-          const std::size_t dominant = lump_partners(sides, mats, a, rest);
-          ok = dominant < count && contact_normal(sides[a], rest, contact_pair(mats[a], mats[dominant]), n);
-        }
-        if (ok) entry_normal_[static_cast<std::size_t>(entries[a])] = n;
-      }
+      contact_detail::side_normals(sides, mats, pair_of, [&](std::size_t a, const Vec<Dim>& n) {
+        entry_normal_[static_cast<std::size_t>(entries[a])] = n;
+      });
     }
   }
 }

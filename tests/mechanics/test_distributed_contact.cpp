@@ -293,9 +293,6 @@ TEST(DecomposedContact, RefusesWhatItDoesNotSupport) {
   fm::DecomposedOptions penalty = o;
   penalty.contact_options.default_pair.method = fm::ContactMethod::penalty;
   refused(penalty, "penalty");
-  fm::DecomposedOptions extent = o;
-  extent.contact_options.use_extent_detection();
-  refused(extent, "extent");
   fm::DecomposedOptions lagged = o;
   lagged.contact_options.regularization_slip_length = 1e-3;
   lagged.contact_options.regularization_time = 1e-6;

@@ -15,7 +15,8 @@
 //       (the serial rigid_boundary materials) = the serial run likewise, and a one-particle wall
 //       beside a rank cut driving the first node the other rank owns;
 //   (e) a particle compressed past its Hugoniot's limit stops every rank (a collective error);
-//   (d) what the decomposed step refuses (a rigid contact partner, plane stress with Mie-Grüneisen).
+//   (d) what the decomposed step refuses (a rigid material leaving components free outside a wall,
+//       plane stress with Mie-Grüneisen).
 // Tolerance 1e-9 of the case's scales (the figure): the measured differences are round-off
 // grown through contact decisions and plastic returns (printed).
 // No ASSERT before a collective call: a rank that returned early would leave the others waiting.
@@ -493,12 +494,6 @@ TEST(DecomposedMaterials, RefusesWhatItDoesNotSupport) {
   auto refused = [&](const std::vector<fm::Material>& mats, const fm::DecomposedOptions& o, const char* expect) {
     frictherm::test::expect_refused<2>(grid, mats, o, expect);
   };
-  fm::Material partner = wall("partner", 1.0, 0.0, true, true);
-  partner.rigid_boundary = false;  // a rigid contact partner (its own velocity field): serial only
-  partner.rigid_controls = {{true, true, true}};
-  fm::DecomposedOptions contact;
-  contact.contact = true;
-  refused({binder(), partner}, contact, "rigid_boundary = true");
   fm::Material free_component = wall("free", 1.0, 0.0, true, false);
   free_component.rigid_boundary = false;
   refused({binder(), free_component}, {}, "boundary rigid material");

@@ -39,11 +39,7 @@ std::string mechanics_refusal(const Scene& s) {
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
   // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).
   // Every material kind runs decomposed (DecomposedMpm: linear elastic, neo-Hookean, Mie-Grüneisen/J2,
-  // rigid; docs/distributed_pbx.md), but a rigid material in contact must be a boundary wall: the
-  // engine's rule, rigid contact partners stay serial.
-  for (const mechanics::Material& m : s.materials)
-    if (m.is_rigid() && s.contact.enabled && !m.rigid_boundary)
-      return refuse("materials." + m.name + ".boundary", "false (a rigid contact partner)", "true: a rigid wall");
+  // rigid walls and rigid contact partners; docs/distributed_pbx.md).
   return "";
 }
 
@@ -55,8 +51,6 @@ std::string contact_refusal(const Scene& s) {
   for (std::size_t i = 0; i < s.contact.pairs.size(); ++i)
     if (s.contact.pairs[i].settings.method == mechanics::ContactMethod::penalty)
       return refuse("contact.pairs[" + std::to_string(i) + "].method", quoted("penalty"), "\"multimaterial\"");
-  if (c.separation == mechanics::SeparationMethod::extent)
-    return refuse("contact.separation", quoted("extent"), "\"position\", \"displacement\" or \"velocity_only\"");
   if (c.regularized()) return refuse("contact.regularization", "an object", "no regularisation: remove the key");
   return "";
 }

@@ -9,7 +9,7 @@
 // above min_mass_fraction of the node's mass, in material order; slivers marked).
 #include "distributed/decomposed_state.hpp"
 
-#include "contact_pair.hpp"
+#include "contact_extent.hpp"
 
 #include <mpi.h>
 
@@ -34,9 +34,6 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
   }
   const ContactOptions& co = opt.contact_options;
   const std::string where = "decomposed mechanics: contact ";
-  if (co.separation == SeparationMethod::extent)
-    throw std::invalid_argument(where + "separation 'extent' is not supported (expected position, displacement or "
-                                        "velocity_only): it needs particle domains across ranks");
   if (co.regularized())
     throw std::invalid_argument(where + "normal-stress regularisation is not supported (expected "
                                         "regularization_slip_length = 0 or regularization_time = 0)");
@@ -49,6 +46,8 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
       throw std::invalid_argument(where + pair + ": method 'penalty' is not supported in a decomposed run (expected "
                                   "'multimaterial'; penalty contact stays serial)");
   };
+  partner_field.assign(n, 0);  // with contact, field = material
+  for (std::size_t m = 0; m < n; ++m) partner_field[m] = rigid_partner(static_cast<PetscInt>(m)) ? 1 : 0;
   multimaterial_only(co.default_pair, "default pair");
   pair_settings.assign(1, co.default_pair);
   pair_index.assign(opt.contact_pairs.empty() ? 0 : n * n, 0);
@@ -102,56 +101,75 @@ void DecomposedMpm<Dim>::Impl::contact_updated(double dt) {
   resolve_contact(true, dt);
 }
 
+// The serial gather_contact_sides on the owner's complete group g: the fields with mass, those
+// under min_mass_fraction of the node's mass left out, slivers marked, a rigid partner's prescribed
+// velocity at the step's start and its change over the step.
 template <int Dim>
-void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
+long DecomposedMpm<Dim>::Impl::gather_sides(std::size_t g, double dt, std::vector<ContactSide<Dim>>& sides,
+                                            std::vector<int>& mats, std::vector<std::size_t>& entries) const {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
   constexpr int mass_position = Dof::mass_position, domain = Dof::domain, domain_gradient = Dof::domain_gradient;
+  const ContactOptions& co = opt.contact_options;
+  const bool extents = co.separation == SeparationMethod::extent && mt_extent_own.size() == mt_field.size();
+  auto at = [&](std::size_t e) { return mt_values.data() + e * static_cast<std::size_t>(per_field); };
+  double node_mass = 0.0;
+  for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {
+    const double m = at(e)[mass];
+    if (m > empty_node_mass) node_mass += m;
+  }
+  sides.clear(), mats.clear(), entries.clear();
+  long guarded = 0;
+  for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {  // in material order
+    const double* v = at(e);
+    const double m = v[mass];
+    if (!(m > empty_node_mass)) continue;
+    if (m < co.min_mass_fraction * node_mass) {
+      ++guarded;
+      continue;
+    }
+    ContactSide<Dim> sd;
+    sd.mass = m;
+    sd.momentum = Eigen::Map<const Vec<Dim>>(v + momentum);
+    sd.force = Eigen::Map<const Vec<Dim>>(v + force);
+    sd.mass_position = Eigen::Map<const Vec<Dim>>(v + mass_position);
+    sd.domain = v[domain];
+    sd.domain_gradient = Eigen::Map<const Vec<Dim>>(v + domain_gradient);
+    sd.sliver = m < co.sliver_fraction * node_mass;
+    const int material = mt_field[e];  // with contact, field = material
+    if (partner_field[static_cast<std::size_t>(material)]) {
+      const Material& mat = materials[static_cast<std::size_t>(material)];
+      sd.rigid = true;
+      sd.rigid_velocity = mat.rigid_velocity_at(time).template head<Dim>();
+      sd.rigid_acceleration = (mat.rigid_velocity_at(time + dt).template head<Dim>() - sd.rigid_velocity) / dt;
+    }
+    if (extents)  // contact_extents.cpp: the gap between the surfaces
+      sd.extent_gap = contact_detail::extent_gap(mt_extent_own[e], mt_extent_other[e]);
+    sides.push_back(sd);
+    mats.push_back(material);
+    entries.push_back(e);
+  }
+  return guarded;
+}
+
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
+  constexpr int momentum = Dof::momentum, force = Dof::force;
   if (updated) stats = DecomposedContactStats{};
   if (!updated) contact_failure.clear();  // phase 6 opens the step's contact
   if (contact_nodes.empty()) return;
   const ContactOptions& co = opt.contact_options;
-  const std::size_t n = materials.size();
   const Vec<Dim> h = grid.cell_size();
   const double cell_volume = grid.cell_volume() * (Dim == 2 ? opt.thickness : 1.0);  // as the serial step
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
                                   co.area, dt, updated};
-  auto pair_of = [&](int x, int y) -> const ContactPairSettings& {
-    if (pair_index.empty()) return pair_settings[0];
-    return pair_settings[static_cast<std::size_t>(pair_index[static_cast<std::size_t>(x) * n + static_cast<std::size_t>(y)])];
-  };
+  auto pair_of = [this](int x, int y) -> const ContactPairSettings& { return this->pair_of(x, y); };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
   thread_local std::vector<ContactSide<Dim>> sides;
   thread_local std::vector<int> mats;
-  thread_local std::vector<double*> values;
+  thread_local std::vector<std::size_t> entries;
   thread_local std::vector<Vec<Dim>> dps;
   for (const auto& [q, g] : contact_nodes) {
-    double node_mass = 0.0;
-    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {
-      const double m = mt_at(e)[mass];
-      if (m > empty_node_mass) node_mass += m;
-    }
-    sides.clear(), mats.clear(), values.clear();
-    long guarded = 0;
-    for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {  // in material order
-      double* v = mt_at(e);
-      const double m = v[mass];
-      if (!(m > empty_node_mass)) continue;
-      if (m < co.min_mass_fraction * node_mass) {
-        ++guarded;
-        continue;
-      }
-      ContactSide<Dim> sd;
-      sd.mass = m;
-      sd.momentum = Eigen::Map<const Vec<Dim>>(v + momentum);
-      sd.force = Eigen::Map<const Vec<Dim>>(v + force);
-      sd.mass_position = Eigen::Map<const Vec<Dim>>(v + mass_position);
-      sd.domain = v[domain];
-      sd.domain_gradient = Eigen::Map<const Vec<Dim>>(v + domain_gradient);
-      sd.sliver = m < co.sliver_fraction * node_mass;
-      sides.push_back(sd);
-      mats.push_back(mt_field[e]);  // with contact, field = material
-      values.push_back(v);
-    }
+    const long guarded = gather_sides(g, dt, sides, mats, entries);
     if (updated) {
       stats.guarded += guarded;
       ++stats.contact_nodes;
@@ -162,7 +180,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
     contact_detail::resolve_contact_node(
         sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
         [&](std::size_t j, const Vec<Dim>& dp) {
-          double* v = values[j];
+          double* v = mt_at(entries[j]);
           for (int d = 0; d < Dim; ++d) {
             v[momentum + d] += dp[d];
             if (updated) v[force + d] += dp[d] / dt;  // eq. 19
@@ -222,6 +240,8 @@ DecomposedContactStats DecomposedMpm<Dim>::contact_stats() const {
   template void DecomposedMpm<D>::Impl::contact_extrapolated(double);                   \
   template void DecomposedMpm<D>::Impl::contact_updated(double);                        \
   template void DecomposedMpm<D>::Impl::resolve_contact(bool, double);                  \
+  template long DecomposedMpm<D>::Impl::gather_sides(std::size_t, double, std::vector<ContactSide<D>>&,         \
+                                                     std::vector<int>&, std::vector<std::size_t>&) const;     \
   template const std::vector<double>& DecomposedMpm<D>::frictional_work(HeatingOrder) const; \
   template double DecomposedMpm<D>::cumulative_frictional_work(HeatingOrder) const;     \
   template DecomposedContactStats DecomposedMpm<D>::contact_stats() const;               \

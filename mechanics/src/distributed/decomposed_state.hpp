@@ -6,6 +6,7 @@
 
 #include "frictherm/mechanics/distributed.hpp"
 #include "distributed/petsc_check.hpp"
+#include "contact_side.hpp"
 
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
 
@@ -113,6 +114,15 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<std::uint8_t> drive_mask;
   std::vector<Vec<Dim>> drive_velocity;
   bool rigid(PetscInt material) const { return materials[static_cast<std::size_t>(material)].is_rigid(); }
+  // A rigid material that drives the nodes it touches (every rigid one without contact, a boundary
+  // one with it), and a rigid contact partner (contact, not a boundary: a velocity field of its own
+  // that meets the others through the contact laws, as the serial rigid fields).
+  bool rigid_wall(PetscInt material) const {
+    const Material& m = materials[static_cast<std::size_t>(material)];
+    return m.is_rigid() && (!opt.contact || m.rigid_boundary);
+  }
+  bool rigid_partner(PetscInt material) const { return rigid(material) && !rigid_wall(material); }
+  std::vector<std::uint8_t> partner_field;  // per field: 1 for a rigid contact partner's field
   long beyond = -1;  // stress_update: the id of a particle compressed past its Hugoniot's limit, or −1
   /// The dilatational wave speed of a particle's state (as Simulation::stable_time_step before the
   /// first stress update).
@@ -176,15 +186,25 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<double> send_buf, recv_buf;
   std::vector<PetscInt> leaf_count, leaf_offset, root_count, entry_base;  // per local node
   std::vector<PetscSFNode> entry_remote;
-  /// visit(q, values) for every field at owned node q: the total of the DMDA (`total`: the global
-  /// vector's array) at a single-material node, each field's complete values at a multi-material one.
+  /// visit(q, values, field) for every field at owned node q: the total of the DMDA (`total`: the
+  /// global vector's array) at a single-material node (the one field reaching it, or `fields` if
+  /// none), each field's complete values at a multi-material one.
   template <class Visit>
   void for_each_owned_field(PetscScalar* total, Visit&& visit) {
     const PetscInt owned = owned_count();
-    for (PetscInt q = 0; q < owned; ++q)
-      if (!multi[static_cast<std::size_t>(owned_local[static_cast<std::size_t>(q)])]) visit(q, total + dof * q);
+    for (PetscInt q = 0; q < owned; ++q) {
+      const std::size_t l = static_cast<std::size_t>(owned_local[static_cast<std::size_t>(q)]);
+      if (!multi[l]) visit(q, total + dof * q, fields > 1 ? static_cast<int>(field_lo[l]) : 0);
+    }
     for (std::size_t g = 0; g < mt_q.size(); ++g)
-      for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) visit(mt_q[g], mt_at(e));
+      for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) visit(mt_q[g], mt_at(e), mt_field[e]);
+  }
+  /// Whether `field` is a rigid contact partner's, and its prescribed velocity at the step's start.
+  bool partner(int field) const {
+    return field >= 0 && static_cast<std::size_t>(field) < partner_field.size() && partner_field[static_cast<std::size_t>(field)];
+  }
+  Vec<Dim> partner_velocity(int field) const {
+    return materials[static_cast<std::size_t>(field)].rigid_velocity_at(time).template head<Dim>();
   }
   /// The values a particle reads at its field's slot after the exchanges: its field's at a
   /// multi-material node, else the DMDA's ghosted total `local_total`.
@@ -216,6 +236,20 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<ContactPairSettings> pair_settings;
   std::vector<int> pair_index;
   std::vector<std::array<std::size_t, 2>> contact_nodes;  // (owned node q, group of mt_*)
+  // Extent separation (contact_extents.cpp): per mt entry the normal to its partners and the maxima
+  // of its own particles' and its partners' extents along it (kNoExtent: none measured); per local
+  // node its list of (field, normal, own, other) items in extent_* (extent_start, −1: none).
+  std::vector<Vec<Dim>> mt_normal;
+  std::vector<double> mt_extent_own, mt_extent_other;
+  std::vector<int> extent_field;
+  std::vector<Vec<Dim>> extent_normal;
+  std::vector<double> extent_own, extent_other;
+  std::vector<std::size_t> extent_entry;  // at the owner: the item's mt entry
+  std::vector<PetscInt> extent_start, extent_count, extent_nodes;
+  std::vector<std::size_t> entry_group;             // per mt entry: its group
+  std::vector<double> extent_root, extent_leaf;     // exchange buffers over entry_sf
+  int extent_unit_items = 0;                        // items per unit of the datatypes below
+  MPI_Datatype extent_list_unit = MPI_DATATYPE_NULL, extent_max_unit = MPI_DATATYPE_NULL;
   std::vector<double> work_first, work_second;
   double cumulative_first = 0.0, cumulative_second = 0.0;
   DecomposedContactStats stats;
@@ -291,6 +325,19 @@ struct DecomposedMpm<Dim>::Impl {
   void ghost_velocities(double dt);
   void fields_to_ghosts(double dt);
   void resolve_contact(bool updated, double dt);
+  /// The sides of contact group g as the serial gather_contact_sides (materials above min_mass_fraction
+  /// of the node's mass, in material order, slivers marked; a rigid partner's prescribed motion), their
+  /// materials and mt entries; returns how many were left out.
+  long gather_sides(std::size_t g, double dt, std::vector<ContactSide<Dim>>& sides, std::vector<int>& mats,
+                    std::vector<std::size_t>& entries) const;
+  const ContactPairSettings& pair_of(int a, int b) const {
+    if (pair_index.empty()) return pair_settings[0];
+    const std::size_t n = materials.size();
+    return pair_settings[static_cast<std::size_t>(pair_index[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)])];
+  }
+  template <class Kernel>
+  void measure_contact_extents(double dt);  // contact_extents.cpp
+  void free_extent_units();
   template <class Kernel>
   void grid_to_particle(double dt);
   template <class Kernel>

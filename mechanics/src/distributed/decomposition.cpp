@@ -74,6 +74,7 @@ DecomposedMpm<Dim>::Impl::~Impl() {
   PetscSFDestroy(&entry_sf);
   PetscSFDestroy(&node_sf);
   if (field_unit != MPI_DATATYPE_NULL) MPI_Type_free(&field_unit);
+  free_extent_units();
   VecDestroy(&local);
   VecDestroy(&global);
   DMDestroy(&swarm);
@@ -112,9 +113,6 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
     if (material.is_rigid()) {
       if (!material.rigid_boundary && !(material.rigid_controls[0] && material.rigid_controls[1] && material.rigid_controls[2]))
         throw std::invalid_argument(where + ": only a boundary rigid material may leave velocity components free");
-      if (options.contact && !material.rigid_boundary)
-        throw std::invalid_argument(where + ": a rigid material in contact must be a boundary one in a decomposed run "
-                                            "(expected rigid_boundary = true: rigid contact partners stay serial)");
       continue;
     }
     if (material.kind == MaterialKind::mie_gruneisen) {

@@ -67,13 +67,13 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   if (has_rigid)
     for (int d = 0; d < Dim; ++d) std::fill(driver[static_cast<std::size_t>(d)].begin(), driver[static_cast<std::size_t>(d)].end(), -1);
   const NodeIndexer<Dim> local_ix = local_indexer();
-  // Evaluates particle k's stencil; a rigid particle marks the nodes it drives (the serial
+  // Evaluates particle k's stencil; a rigid wall's particle marks the nodes it drives (the serial
   // map_rigid_particles: nodes with S > 0, the components its material prescribes) and is skipped.
   const auto evaluate = [&](PetscInt k) {
     auto& s = st[static_cast<std::size_t>(k)];
     s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
     if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
-    if (!rigid(f.material[k])) return true;
+    if (!rigid_wall(f.material[k])) return true;
     const Material& m = materials[static_cast<std::size_t>(f.material[k])];
     s.for_each(local_ix, [&](int l, double S, const Vec<Dim>&) {
       if (S > 0.0)
@@ -110,10 +110,13 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   const Vec<Dim> g = opt.gravity;
   const bool contact = opt.contact;
   const bool displacement = opt.contact_options.separation == SeparationMethod::displacement;
+  // A rigid contact partner's particles mark their presence only (mass, momentum, Σ S m x, Ω, g; no
+  // force: their velocity is prescribed), as the serial map_to_grid.
   for (PetscInt k = 0; k < f.n; ++k) {
-    if (ranges ? rigid(f.material[k]) : !evaluate(k)) continue;
+    if (ranges ? rigid_wall(f.material[k]) : !evaluate(k)) continue;
     const auto& s = st[static_cast<std::size_t>(k)];
     const int field = field_of(f.material[k]);
+    const bool forces = !rigid(f.material[k]);
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field)].index;
     const double mp = f.mass[k], Vp = f.volume[k];
     const Vec<Dim> mv = mp * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
@@ -128,11 +131,11 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
         field_hi[u] = std::max<PetscInt>(field_hi[u], field);
       }
       double* node = slot_values(static_cast<std::size_t>(slot));
-      const Vec<Dim> fi = S * mg - Vsig * G;
       node[mass] += S * mp;
-      for (int d = 0; d < Dim; ++d) {
-        node[momentum + d] += S * mv[d];
-        node[force + d] += fi[d];
+      for (int d = 0; d < Dim; ++d) node[momentum + d] += S * mv[d];
+      if (forces) {
+        const Vec<Dim> fi = S * mg - Vsig * G;
+        for (int d = 0; d < Dim; ++d) node[force + d] += fi[d];
       }
       if (contact) {
         const Vec<Dim> gi = Vp * G;
@@ -208,7 +211,12 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   double removed = 0.0;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt q, double* node) {
+  for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
+    if (partner(field)) {  // a rigid partner's field: m v_rigid, no force (the serial apply_velocity_bc)
+      const Vec<Dim> v = partner_velocity(field);
+      for (int d = 0; d < Dim; ++d) node[momentum + d] = node[Dof::mass] * v[d], node[force + d] = 0.0;
+      return;
+    }
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
     const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
     if (driven) {
@@ -238,12 +246,17 @@ void DecomposedMpm<Dim>::Impl::nodal_velocities(double /*dt*/) {
   constexpr int velocity = Dof::velocity, acceleration = Dof::acceleration;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt q, double* node) {
+  for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
     const double m = node[mass];
     for (int d = 0; d < Dim; ++d) {
       const double p = node[momentum + d], f = node[force + d];
       node[velocity + d] = m > empty_node_mass ? p / m : 0.0;
       node[acceleration + d] = m > empty_node_mass ? f / m : 0.0;
+    }
+    if (partner(field)) {  // a rigid partner's field moves with it (the serial nodal_velocities)
+      const Vec<Dim> v = partner_velocity(field);
+      for (int d = 0; d < Dim; ++d) node[velocity + d] = v[d];
+      return;
     }
     if (const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0; driven && m > empty_node_mass)
       for (int d = 0; d < Dim; ++d)  // driven nodes keep the prescribed velocity (the serial nodal_velocities)
@@ -403,6 +416,7 @@ void DecomposedMpm<Dim>::step(double dt) {
                                     {&Impl::exchange_field_ranges, 2},
                                     {&Impl::fields_to_owners, 3},
                                     {&Impl::find_contact_nodes, 4},
+                                    {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
                                     {&Impl::contact_extrapolated, 5},
                                     {&Impl::momentum_update, 6},
                                     {&Impl::contact_updated, 7},
@@ -471,7 +485,7 @@ void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, velocity = Dof::velocity;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt q, double* node) {
+  for_each_owned_field(a, [&](PetscInt q, double* node, int) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
     const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
     const double m = node[mass];
