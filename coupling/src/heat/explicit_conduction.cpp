@@ -115,6 +115,34 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // sub-step's f_i, summed in particle order as substeps_with sums it, while the particle's G' is at
   // hand. The bounds of M⁻¹K wait until asked for (lambda_bound).
   force_.setZero(n);
+  if (threads <= 1) {
+    // One pass, one expansion per particle (issue 35: the look and the scatter below expanded every
+    // conducting particle twice): the same S, quiet flags, lumping terms and f_i, summed in the same
+    // particle order as the two passes below, so the same numbers.
+    Expanded e{};
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
+      if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
+      double lo = sys.temperature[e.unknown[0]], hi = lo;
+      for (int a = 1; a < e.count; ++a) {
+        lo = std::min(lo, sys.temperature[e.unknown[a]]);
+        hi = std::max(hi, sys.temperature[e.unknown[a]]);
+      }
+      quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+      if (e.count < e.total) add_quick_lumping(st, conductance_[k], sys, e, 1.0);
+      if (quiet_[k]) continue;
+      // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
+      mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+      for (int a = 0; a < e.count; ++a) grad += e.g(a) * sys.temperature[e.unknown[a]];
+      grad *= conductance_[k];
+      for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
+    }
+    flux_temperature_ = sys.temperature;
+    first_force_ready_ = true;
+    return;
+  }
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)

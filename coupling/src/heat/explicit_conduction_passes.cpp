@@ -153,6 +153,9 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   const int threads = assembly_detail::assembly_threads(p.size());
+  // The eq. 38 sums of the next reproject(): only a refresh can lead to one, and without kept
+  // stencils the next window gathers anew (and sums them anew), so they are not kept up to date.
+  const bool keep_sums = stencils_kept_;
   // A particle's temperature after the window: T_p + Σ S_ip ΔT_i (design §4: the increment, not the
   // nodal value), relaxed towards Σ S_ip T_i / Σ S_ip with the sub-grid blend β.
   const auto new_temperature = [&](double before, const Expanded& c) {
@@ -180,6 +183,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
       const double T = new_temperature(before, c);
       if (T == before) continue;
       p.temperature[k] = T;
+      if (!keep_sums) continue;
       const double change = heat_capacity_[k] * (T - before);
       for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
     }
@@ -204,6 +208,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     changed[k] = 1;
   }
   }
+  if (!keep_sums) return;
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (changed[k]) listed_.push_back(k);
