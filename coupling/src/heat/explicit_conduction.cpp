@@ -103,6 +103,9 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Unknowns: the same rule as assemble_thermal.
   sys.select_unknowns(mct_, opt.active_mass_fraction);
   const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
+  dropped_before_.resize(n_nodes + 1);
+  dropped_before_[0] = 0;
+  for (std::size_t i = 0; i < n_nodes; ++i) dropped_before_[i + 1] = dropped_before_[i] + (sys.unknown[i] < 0 ? 1 : 0);
   // The eq. 38 sums the windows re-project from, kept up to date with the particles' temperatures
   // by map_back and refresh from here on.
   next_mct_.resize(n);
@@ -123,6 +126,17 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      if (whole(st)) {  // no lumping: the stencil walked directly, the same sums
+        double lo, hi, s_kept;
+        mechanics::Vec<Dim> grad;
+        look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
+        if (!(s_kept > 0.0)) continue;  // reaches no unknown with its own heat capacity
+        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        if (quiet_[k]) continue;
+        grad *= conductance_[k];
+        scatter_whole(st, sys.unknown, grad, force_.data());
+        continue;
+      }
       expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
       if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
       double lo = sys.temperature[e.unknown[0]], hi = lo;
