@@ -28,8 +28,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   indexer_ = mechanics::NodeIndexer<Dim>{grid.strides(), 0};
   heat_capacity_.assign(p.size(), 0.0);
   conductance_.assign(p.size(), 0.0);
-  rayleigh_.assign(p.size(), 0.0);
-  bounds_ready_ = false;
+  bounds_ready_ = false;  // rayleigh_ made with the bounds (make_bounds)
   quiet_.assign(p.size(), 1);  // particles that hold no heat carry no flux
   flux_temperature_.resize(0);  // set with quiet_ at the end
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
@@ -76,12 +75,8 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
       const double mc = heat_capacity_[k];
       const double mct = mc * p.temperature[k];
-      const double quick = quick_weight(st, conductance_[k]);
-      for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
-        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
-        mct_[static_cast<std::size_t>(i)] += mct * w;
-        quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
-      });
+      scatter_gather_sums(st, indexer_, mc, mct, quick_weight(st, conductance_[k]), sys.grid_mass.data(), mct_.data(),
+                          quick_sum_.data());
     }
   } else
   scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
@@ -290,6 +285,7 @@ template <class Kernel>
 void ExplicitConduction<Dim>::make_bounds(const NodalThermalSystem& sys) {
   row_bound_.assign(sys.size(), 0.0);
   rayleigh_bound_.assign(sys.size(), 0.0);
+  rayleigh_.assign(holds_heat_.size(), 0.0);
   mass_peak_ = sys.mass;  // every term with M now
   rayleigh_scale_ = 1.0;
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();

@@ -51,6 +51,80 @@ inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mecha
   }
 }
 
+// The gather's first pass for one particle (Nairn et al. 2018 eq. 38 and quick_bound's sums):
+// M_i += mc S_ip, (M T)_i += mct S_ip, Q_i += quick |G_ip|₁, over its nodes. Along x a stencil row is
+// a run of nodes (stride 1), so two nodes at a time (SSE2): the same products in the same order as
+// for_each_node's, lane by lane ((wx wy) wz, (dwx wy) wz, (wx dwy) wz, (wx wy) dwz), and each node gets
+// one term per particle, so the same sums (2D: |gx| + |gy| without for_each_node's exact + 0).
+template <int Dim, class Kernel>
+inline void scatter_gather_sums(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix,
+                                double mc, double mct, double quick, double* M, double* MT, double* Q) {
+  constexpr int K = Kernel::K;
+#if defined(__SSE2__)
+  if (ix.stride[0] == 1) {
+    const mechanics::IVec<Dim>& sd = ix.stride;
+    const mechanics::IVec<Dim> b = st.first_node();
+    const __m128d vmc = _mm_set1_pd(mc), vmct = _mm_set1_pd(mct), vq = _mm_set1_pd(quick);
+    const __m128d absmask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
+    const auto row_pass = [&](int row, double wy, double dwy, double wz, double dwz) {
+      int i = 0;
+      for (; i + 1 < K; i += 2) {
+        const __m128d wx = _mm_loadu_pd(&st.axis[0].w[i]), dwx = _mm_loadu_pd(&st.axis[0].dw[i]);
+        const __m128d vwy = _mm_set1_pd(wy), vdwy = _mm_set1_pd(dwy);
+        __m128d w, a;
+        if constexpr (Dim == 2) {
+          w = _mm_mul_pd(wx, vwy);
+          a = _mm_add_pd(_mm_and_pd(_mm_mul_pd(dwx, vwy), absmask), _mm_and_pd(_mm_mul_pd(wx, vdwy), absmask));
+        } else {
+          const __m128d vwz = _mm_set1_pd(wz), vdwz = _mm_set1_pd(dwz);
+          const __m128d wxy = _mm_mul_pd(wx, vwy);
+          w = _mm_mul_pd(wxy, vwz);
+          const __m128d gx = _mm_mul_pd(_mm_mul_pd(dwx, vwy), vwz);
+          const __m128d gy = _mm_mul_pd(_mm_mul_pd(wx, vdwy), vwz);
+          const __m128d gz = _mm_mul_pd(wxy, vdwz);
+          a = _mm_add_pd(_mm_add_pd(_mm_and_pd(gx, absmask), _mm_and_pd(gy, absmask)), _mm_and_pd(gz, absmask));
+        }
+        double* m = M + row + i;
+        double* mt = MT + row + i;
+        double* q = Q + row + i;
+        _mm_storeu_pd(m, _mm_add_pd(_mm_loadu_pd(m), _mm_mul_pd(vmc, w)));
+        _mm_storeu_pd(mt, _mm_add_pd(_mm_loadu_pd(mt), _mm_mul_pd(vmct, w)));
+        _mm_storeu_pd(q, _mm_add_pd(_mm_loadu_pd(q), _mm_mul_pd(vq, a)));
+      }
+      for (; i < K; ++i) {
+        const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
+        double w, a;
+        if constexpr (Dim == 2) {
+          w = wx * wy;
+          a = std::fabs(dwx * wy) + std::fabs(wx * dwy);
+        } else {
+          w = wx * wy * wz;
+          a = std::fabs(dwx * wy * wz) + std::fabs(wx * dwy * wz) + std::fabs(wx * wy * dwz);
+        }
+        M[row + i] += mc * w;
+        MT[row + i] += mct * w;
+        Q[row + i] += quick * a;
+      }
+    };
+    if constexpr (Dim == 2) {
+      for (int j = 0; j < K; ++j)
+        row_pass(ix.shift + (b[1] + j) * sd[1] + b[0], st.axis[1].w[j], st.axis[1].dw[j], 0.0, 0.0);
+    } else {
+      for (int k = 0; k < K; ++k)
+        for (int j = 0; j < K; ++j)
+          row_pass(ix.shift + (b[2] + k) * sd[2] + (b[1] + j) * sd[1] + b[0], st.axis[1].w[j], st.axis[1].dw[j],
+                   st.axis[2].w[k], st.axis[2].dw[k]);
+    }
+    return;
+  }
+#endif
+  for_each_node(st, ix, [&](int i, double w, double gx, double gy, double gz) {
+    M[i] += mc * w;
+    MT[i] += mct * w;
+    Q[i] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+  });
+}
+
 // V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
 // (quick_bound).
 template <int Dim, class Kernel>
