@@ -75,8 +75,12 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
       const double mc = heat_capacity_[k];
       const double mct = mc * p.temperature[k];
-      scatter_gather_sums(st, indexer_, mc, mct, quick_weight(st, conductance_[k]), sys.grid_mass.data(), mct_.data(),
-                          quick_sum_.data());
+      const double quick = quick_weight(st, conductance_[k]);
+      for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+        mct_[static_cast<std::size_t>(i)] += mct * w;
+        quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+      });
     }
   } else
   scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
