@@ -51,8 +51,12 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
   listed_.clear();
+  const std::size_t n_materials = materials.size();
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);  // throws here
+    const int id = p.material[k];
+    const ThermalProperties& m = id >= 0 && static_cast<std::size_t>(id) < n_materials
+                                     ? materials[static_cast<std::size_t>(id)]
+                                     : thermal_properties_of(materials, id);  // throws here
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
     listed_.push_back(k);

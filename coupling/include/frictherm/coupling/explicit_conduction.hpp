@@ -114,8 +114,10 @@ class ExplicitConduction {
 
   /// T_p += Σ_i S_ip ΔT_i with the stencils of the gather (same positions), and the optional sub-grid
   /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures). Also adds
-  /// m_p C_v,p ΔT_p S_ip to the sums of the next reproject(). Particles with no unknown of ΔT_i ≠ 0
-  /// in the range of their unknowns keep their temperature exactly and are passed over.
+  /// m_p C_v,p ΔT_p S_ip to the sums of the next reproject() when the stencils are kept (a refresh,
+  /// and so a reproject(), may follow; without them the next window gathers the sums anew).
+  /// Particles with no unknown of ΔT_i ≠ 0 in the range of their unknowns keep their temperature
+  /// exactly and are passed over.
   void map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
                 double relaxation, const Eigen::VectorXd* end);
 
