@@ -28,8 +28,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   indexer_ = mechanics::NodeIndexer<Dim>{grid.strides(), 0};
   heat_capacity_.assign(p.size(), 0.0);
   conductance_.assign(p.size(), 0.0);
-  rayleigh_.assign(p.size(), 0.0);
-  bounds_ready_ = false;
+  bounds_ready_ = false;  // rayleigh_ made with the bounds (make_bounds)
   quiet_.assign(p.size(), 1);  // particles that hold no heat carry no flux
   flux_temperature_.resize(0);  // set with quiet_ at the end
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
@@ -52,8 +51,12 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
   listed_.clear();
+  const std::size_t n_materials = materials.size();
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);  // throws here
+    const int id = p.material[k];
+    const ThermalProperties& m = id >= 0 && static_cast<std::size_t>(id) < n_materials
+                                     ? materials[static_cast<std::size_t>(id)]
+                                     : thermal_properties_of(materials, id);  // throws here
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
     listed_.push_back(k);
@@ -103,6 +106,9 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Unknowns: the same rule as assemble_thermal.
   sys.select_unknowns(mct_, opt.active_mass_fraction);
   const auto n = static_cast<Eigen::Index>(sys.grid_node.size());
+  dropped_before_.resize(n_nodes + 1);
+  dropped_before_[0] = 0;
+  for (std::size_t i = 0; i < n_nodes; ++i) dropped_before_[i + 1] = dropped_before_[i] + (sys.unknown[i] < 0 ? 1 : 0);
   // The eq. 38 sums the windows re-project from, kept up to date with the particles' temperatures
   // by map_back and refresh from here on.
   next_mct_.resize(n);
@@ -115,6 +121,45 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // sub-step's f_i, summed in particle order as substeps_with sums it, while the particle's G' is at
   // hand. The bounds of M⁻¹K wait until asked for (lambda_bound).
   force_.setZero(n);
+  if (threads <= 1) {
+    // One pass, one expansion per particle (issue 35: the look and the scatter below expanded every
+    // conducting particle twice): the same S, quiet flags, lumping terms and f_i, summed in the same
+    // particle order as the two passes below, so the same numbers.
+    Expanded e{};
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      if (whole(st)) {  // no lumping: the stencil walked directly, the same sums
+        double lo, hi, s_kept;
+        mechanics::Vec<Dim> grad;
+        look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
+        if (!(s_kept > 0.0)) continue;  // reaches no unknown with its own heat capacity
+        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        if (quiet_[k]) continue;
+        grad *= conductance_[k];
+        scatter_whole(st, sys.unknown, grad, force_.data());
+        continue;
+      }
+      expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
+      if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
+      double lo = sys.temperature[e.unknown[0]], hi = lo;
+      for (int a = 1; a < e.count; ++a) {
+        lo = std::min(lo, sys.temperature[e.unknown[a]]);
+        hi = std::max(hi, sys.temperature[e.unknown[a]]);
+      }
+      quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+      if (e.count < e.total) add_quick_lumping(st, conductance_[k], sys, e, 1.0);
+      if (quiet_[k]) continue;
+      // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
+      mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+      for (int a = 0; a < e.count; ++a) grad += e.g(a) * sys.temperature[e.unknown[a]];
+      grad *= conductance_[k];
+      for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
+    }
+    flux_temperature_ = sys.temperature;
+    first_force_ready_ = true;
+    return;
+  }
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
@@ -248,6 +293,7 @@ template <class Kernel>
 void ExplicitConduction<Dim>::make_bounds(const NodalThermalSystem& sys) {
   row_bound_.assign(sys.size(), 0.0);
   rayleigh_bound_.assign(sys.size(), 0.0);
+  rayleigh_.assign(holds_heat_.size(), 0.0);
   mass_peak_ = sys.mass;  // every term with M now
   rayleigh_scale_ = 1.0;
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -169,27 +170,90 @@ void ExplicitConduction<Dim>::count_changed(const std::vector<int>& unknown, Cha
   }
 }
 
-template <int Dim>
-template <class Kernel>
-bool ExplicitConduction<Dim>::any_changed(const mechanics::Stencil<Dim, Kernel>& st) const {
-  // The stencil's rows are runs of grid nodes (explicit_detail::for_each_node's numbering): first to first + (K-1) s_0.
+namespace explicit_detail {
+
+// Whether a prefix count by grid node (before[i]: counted nodes < i) counts a node of the stencil.
+// The stencil's rows are runs of grid nodes (for_each_node's numbering): first to first + (K-1) s_0.
+template <int Dim, class Kernel>
+inline bool counts_in_rows(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix,
+                           const int* before) {
   constexpr int K = Kernel::K;
-  const mechanics::IVec<Dim>& sd = indexer_.stride;
+  const mechanics::IVec<Dim>& sd = ix.stride;
   const mechanics::IVec<Dim> b = st.first_node();
   const int span = (K - 1) * sd[0] + 1;
-  const int* before = changed_before_.data();
   if constexpr (Dim == 2) {
-    int row = indexer_.shift + b[1] * sd[1] + b[0] * sd[0];
+    int row = ix.shift + b[1] * sd[1] + b[0] * sd[0];
     for (int j = 0; j < K; ++j, row += sd[1])
       if (before[row + span] != before[row]) return true;
   } else {
     for (int k = 0; k < K; ++k) {
-      int row = indexer_.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
+      int row = ix.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
       for (int j = 0; j < K; ++j, row += sd[1])
         if (before[row + span] != before[row]) return true;
     }
   }
   return false;
+}
+
+template <int Dim>
+inline mechanics::Vec<Dim> vec_of(double x, double y, double z) {
+  if constexpr (Dim == 2) return mechanics::Vec<Dim>(x, y);
+  else return mechanics::Vec<Dim>(x, y, z);
+}
+
+}  // namespace explicit_detail
+
+template <int Dim>
+template <class Kernel>
+bool ExplicitConduction<Dim>::any_changed(const mechanics::Stencil<Dim, Kernel>& st) const {
+  return explicit_detail::counts_in_rows(st, indexer_, changed_before_.data());
+}
+
+template <int Dim>
+template <class Kernel>
+bool ExplicitConduction<Dim>::whole(const mechanics::Stencil<Dim, Kernel>& st) const {
+  return !explicit_detail::counts_in_rows(st, indexer_, dropped_before_.data());
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::look_whole(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown,
+                                         const double* T, double& lo, double& hi, double& s,
+                                         mechanics::Vec<Dim>& grad) const {
+  // As expand<Kernel, true> and the passes' loops over its lists: min/max are exact, and s and grad
+  // get the same terms in node order.
+  // The components as scalars (a Vec through memory stalls on store forwarding): each the sum
+  // Eigen's grad += G t makes, component by component.
+  const int* un = unknown.data();
+  double l = std::numeric_limits<double>::infinity(), h = -l, sum = 0.0;
+  double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+  explicit_detail::for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+    const double t = T[un[i]];
+    l = std::min(l, t);
+    h = std::max(h, t);
+    sum += w;
+    g0 += gx * t;
+    g1 += gy * t;
+    if constexpr (Dim == 3) g2 += gz * t;
+  });
+  lo = l;
+  hi = h;
+  s = sum;
+  grad = explicit_detail::vec_of<Dim>(g0, g1, g2);
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::scatter_whole(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown,
+                                            const mechanics::Vec<Dim>& g, double* force) const {
+  // G·g as Eigen's dot sums it: (x x' + y y') + z z'.
+  const int* un = unknown.data();
+  const double g0 = g[0], g1 = g[1], g2 = Dim == 3 ? g[Dim - 1] : 0.0;
+  explicit_detail::for_each_node(st, indexer_, [&](int i, double, double gx, double gy, double gz) {
+    double dot = gx * g0 + gy * g1;
+    if constexpr (Dim == 3) dot += gz * g2;
+    force[un[i]] -= dot;
+  });
 }
 
 }  // namespace frictherm::coupling

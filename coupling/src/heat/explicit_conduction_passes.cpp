@@ -62,6 +62,16 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
           quiet_[k] = 1;
           continue;
         }
+        if (whole(stencils[k])) {  // no lumping: the stencil walked directly, the same sums
+          double lo, hi, s_kept;
+          mechanics::Vec<Dim> grad;
+          look_whole(stencils[k], sys.unknown, T.data(), lo, hi, s_kept, grad);
+          quiet_[k] = !(s_kept > 0.0) || hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+          if (quiet_[k]) continue;
+          grad *= conductance_[k];
+          scatter_whole(stencils[k], sys.unknown, grad, force_.data());
+          continue;
+        }
         expand<Kernel, false>(stencils[k], sys.unknown, e);
         if (!e.reaches()) {
           quiet_[k] = 1;
@@ -153,8 +163,15 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   const int threads = assembly_detail::assembly_threads(p.size());
+  // The eq. 38 sums of the next reproject(): only a refresh can lead to one, and without kept
+  // stencils the next window gathers anew (and sums them anew), so they are not kept up to date.
+  const bool keep_sums = stencils_kept_;
   // A particle's temperature after the window: T_p + Σ S_ip ΔT_i (design §4: the increment, not the
   // nodal value), relaxed towards Σ S_ip T_i / Σ S_ip with the sub-grid blend β.
+  const auto blend = [&](double before, double dT, double pic, double s) {
+    const double flip = before + dT;
+    return (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+  };
   const auto new_temperature = [&](double before, const Expanded& c) {
     double dT = 0.0;
     for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
@@ -165,21 +182,43 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         s += c.S[a];
       }
     }
-    const double flip = before + dT;
-    return (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
+    return blend(before, dT, pic, s);
   };
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
   if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
     Expanded c{};
+    const int* un = sys.unknown.data();
+    const double* dl = delta.data();
+    const double* te = relax ? end->data() : nullptr;
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+      if (whole(stencils[k])) {  // no lumping: the stencil walked directly, the same sums
+        double dT = 0.0, pic = 0.0, s = 0.0;
+        for_each_node(stencils[k], indexer_, [&](int i, double w, double, double, double) {
+          const int u = un[i];
+          dT += w * dl[u];
+          if (relax) {
+            pic += w * te[u];
+            s += w;
+          }
+        });
+        const double before = p.temperature[k];
+        const double T = blend(before, dT, pic, s);
+        if (T == before) continue;
+        p.temperature[k] = T;
+        if (!keep_sums) continue;
+        const double change = heat_capacity_[k] * (T - before);
+        for_each_node(stencils[k], indexer_, [&](int i, double w, double, double, double) { next_mct_[un[i]] += change * w; });
+        continue;
+      }
       expand<Kernel, false>(stencils[k], sys.unknown, c);
       if (c.count == 0) continue;  // reaches no unknown
       const double before = p.temperature[k];
       const double T = new_temperature(before, c);
       if (T == before) continue;
       p.temperature[k] = T;
+      if (!keep_sums) continue;
       const double change = heat_capacity_[k] * (T - before);
       for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
     }
@@ -204,6 +243,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     changed[k] = 1;
   }
   }
+  if (!keep_sums) return;
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (changed[k]) listed_.push_back(k);

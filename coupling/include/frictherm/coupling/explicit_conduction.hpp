@@ -114,8 +114,10 @@ class ExplicitConduction {
 
   /// T_p += Σ_i S_ip ΔT_i with the stencils of the gather (same positions), and the optional sub-grid
   /// relaxation of add_nodal_change_to_particles (β, nodal end temperatures). Also adds
-  /// m_p C_v,p ΔT_p S_ip to the sums of the next reproject(). Particles with no unknown of ΔT_i ≠ 0
-  /// in the range of their unknowns keep their temperature exactly and are passed over.
+  /// m_p C_v,p ΔT_p S_ip to the sums of the next reproject() when the stencils are kept (a refresh,
+  /// and so a reproject(), may follow; without them the next window gathers the sums anew).
+  /// Particles with no unknown of ΔT_i ≠ 0 in the range of their unknowns keep their temperature
+  /// exactly and are passed over.
   void map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
                 double relaxation, const Eigen::VectorXd* end);
 
@@ -185,6 +187,21 @@ class ExplicitConduction {
   /// Whether an unknown of the stencil's nodes changed (changed_before_ of this pass, by grid node).
   template <class Kernel>
   bool any_changed(const mechanics::Stencil<Dim, Kernel>& st) const;
+  /// Whether every node of the stencil is an unknown (dropped_before_, by grid node): then S and G'
+  /// are the stencil's own S_ip and G_ip in its node order (no lumping), and the one-thread passes
+  /// walk the stencil directly instead of expanding it (issue 35: the same products and sums in the
+  /// same order, without the expansion's stores and loads).
+  template <class Kernel>
+  bool whole(const mechanics::Stencil<Dim, Kernel>& st) const;
+  /// A whole particle's look (whole()): the lowest and highest nodal temperature, Σ S_ip (as
+  /// Expanded::s_kept) and Σ_i G_ip T_i (eq. 37), with T by unknown.
+  template <class Kernel>
+  void look_whole(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown, const double* T,
+                  double& lo, double& hi, double& s, mechanics::Vec<Dim>& grad) const;
+  /// f_i −= G_ip · g over a whole particle's nodes (by unknown).
+  template <class Kernel>
+  void scatter_whole(const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown,
+                     const mechanics::Vec<Dim>& g, double* force) const;
   template <class Kernel>
   Refresh refresh_with(const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p,
                        const std::vector<ThermalProperties>& materials, const AssemblyOptions& options,
@@ -231,6 +248,7 @@ class ExplicitConduction {
   std::vector<unsigned char> quiet_;          // by particle
   Eigen::VectorXd flux_temperature_;          // T_i of the last sub-step (empty: look at every particle)
   std::vector<int> changed_before_;           // scratch: changed unknowns at grid nodes < i
+  std::vector<int> dropped_before_;           // grid nodes < i that are not unknowns (by the gather)
   // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
   // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
   // in order, so every sum has the same terms in the same order on any number of threads.
