@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Configures and builds frictherm (Release) into ./build (through ccache when it is installed).
+# Configures and builds frictherm (Release) into ./build (through ccache when it is installed; without
+# ccache, as on a fresh machine, a new build folder compiles the libraries against precompiled headers:
+# FRICTHERM_PRECOMPILED_HEADERS in CMakeLists.txt, about a third less compile CPU).
 #   scripts/build.sh            everything: library, program, tests, benchmarks, MPI parts when found
 #                               (README command 2; turns tests, benchmarks and MPI on in an existing build)
 #   scripts/build.sh --program  the `frictherm` program and what it links, nothing else (README command 1):
