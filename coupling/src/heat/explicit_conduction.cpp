@@ -134,7 +134,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
         mechanics::Vec<Dim> grad;
         look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
         if (!(s_kept > 0.0)) continue;  // reaches no unknown with its own heat capacity
-        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        quiet_[k] = quiet_spread(lo, hi);
         if (quiet_[k]) continue;
         grad *= conductance_[k];
         scatter_whole(st, sys.unknown, grad, force_.data());
@@ -142,12 +142,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       }
       expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
       if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
-      double lo = sys.temperature[e.unknown[0]], hi = lo;
-      for (int a = 1; a < e.count; ++a) {
-        lo = std::min(lo, sys.temperature[e.unknown[a]]);
-        hi = std::max(hi, sys.temperature[e.unknown[a]]);
-      }
-      quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+      quiet_[k] = quiet_temperatures(e, sys.temperature);
       if (e.count < e.total) add_quick_lumping(st, conductance_[k], sys, e, 1.0);
       if (quiet_[k]) continue;
       // (∇T)_p = Σ_j G'_jp T_j (eq. 37), times V_p k_p; f_i = −V k G'·∇T (as substeps_with)
@@ -171,12 +166,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
-    double lo = sys.temperature[e.unknown[0]], hi = lo;
-    for (int a = 1; a < e.count; ++a) {
-      lo = std::min(lo, sys.temperature[e.unknown[a]]);
-      hi = std::max(hi, sys.temperature[e.unknown[a]]);
-    }
-    quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+    quiet_[k] = quiet_temperatures(e, sys.temperature);
     particle_scratch_[k] = (e.count < e.total ? 1.0 : 0.0) + (quiet_[k] ? 0.0 : 2.0);
   }
   }

@@ -113,6 +113,23 @@ void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_
 // ~10–30 terms). At 300 K it is 1.7e-11 K.
 constexpr double kQuietSpread = 256.0 * 2.220446049250313e-16;
 
+// Whether temperatures spanning [lo, hi] are equal in that sense.
+inline bool quiet_spread(double lo, double hi) {
+  return hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+}
+
+// Whether an expanded stencil's unknowns (ExplicitConduction::Expanded, at least one) have equal
+// temperatures T (indexed by unknown).
+template <class ExpandedStencil, class Temperatures>
+bool quiet_temperatures(const ExpandedStencil& e, const Temperatures& T) {
+  double lo = T[e.unknown[0]], hi = lo;
+  for (int a = 1; a < e.count; ++a) {
+    lo = std::min(lo, T[e.unknown[a]]);
+    hi = std::max(hi, T[e.unknown[a]]);
+  }
+  return quiet_spread(lo, hi);
+}
+
 }  // namespace explicit_detail
 
 template <int Dim>

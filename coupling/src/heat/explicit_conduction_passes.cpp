@@ -66,7 +66,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
           double lo, hi, s_kept;
           mechanics::Vec<Dim> grad;
           look_whole(stencils[k], sys.unknown, T.data(), lo, hi, s_kept, grad);
-          quiet_[k] = !(s_kept > 0.0) || hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+          quiet_[k] = !(s_kept > 0.0) || quiet_spread(lo, hi);
           if (quiet_[k]) continue;
           grad *= conductance_[k];
           scatter_whole(stencils[k], sys.unknown, grad, force_.data());
@@ -77,12 +77,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
           quiet_[k] = 1;
           continue;
         }
-        double lo = T[e.unknown[0]], hi = lo;
-        for (int a = 1; a < e.count; ++a) {
-          lo = std::min(lo, T[e.unknown[a]]);
-          hi = std::max(hi, T[e.unknown[a]]);
-        }
-        quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+        quiet_[k] = quiet_temperatures(e, T);
         if (quiet_[k]) continue;
         expand<Kernel, true>(stencils[k], sys.unknown, e);
         mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
@@ -115,12 +110,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         quiet_[k] = 1;  // no heat capacity of its own reaches an unknown: no conduction
         continue;
       }
-      double lo = T[e.unknown[0]], hi = lo;
-      for (int a = 1; a < e.count; ++a) {
-        lo = std::min(lo, T[e.unknown[a]]);
-        hi = std::max(hi, T[e.unknown[a]]);
-      }
-      quiet_[k] = hi - lo <= kQuietSpread * std::max(std::fabs(lo), std::fabs(hi));
+      quiet_[k] = quiet_temperatures(e, T);
       if (!quiet_[k]) particle_scratch_[k] = 1.0;
     }
     }
