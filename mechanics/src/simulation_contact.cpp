@@ -214,14 +214,6 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
   return guarded;
 }
 
-// sides[a]'s multimaterial partners lumped into one virtual material (contact_pair.hpp).
-template <int Dim>
-std::size_t Simulation<Dim>::lump_partners(const std::vector<ContactSide<Dim>>& sides, const std::vector<int>& mats,
-                                           std::size_t a, ContactSide<Dim>& rest) const {
-  return contact_detail::lump_partners(
-      sides, mats, a, rest, [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); });
-}
-
 // Extent separation: per contact entry, the normal from its material to its partners, as
 // resolve_contact will compute it (two materials: the pair's normal; more: against the lump).
 template <int Dim>
@@ -266,8 +258,6 @@ double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order, int a, in
   template void Simulation<D>::compute_contact_normals();                             \
   template int Simulation<D>::gather_contact_sides(std::size_t, double, std::vector<ContactSide<D>>&,      \
                                                    std::vector<int>&, std::vector<int>&, std::vector<int>&) const; \
-  template std::size_t Simulation<D>::lump_partners(const std::vector<ContactSide<D>>&, const std::vector<int>&, \
-                                                    std::size_t, ContactSide<D>&) const;                      \
   template double Simulation<D>::cumulative_frictional_work(HeatingOrder) const;      \
   template double Simulation<D>::cumulative_frictional_work(HeatingOrder, int, int) const;
 FRICTHERM_INSTANTIATE_CONTACT(2)

@@ -381,8 +381,6 @@ class Simulation {
   /// their slots, materials and contact entries; returns how many slivers were left out.
   int gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides, std::vector<int>& slots,
                            std::vector<int>& mats, std::vector<int>& entries) const;
-  std::size_t lump_partners(const std::vector<ContactSide<Dim>>& sides, const std::vector<int>& mats, std::size_t a,
-                            ContactSide<Dim>& rest) const;
   void compute_contact_normals();                                // extent separation: entry_normal_
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
