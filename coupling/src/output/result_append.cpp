@@ -245,8 +245,8 @@ void check_same_run(const std::string& result, const CheckpointMarks& marks) {
   const std::string id = result_run_id(result);
   if (!id.empty() && id != marks.run_id)
     throw std::runtime_error("'" + result + "' is the result of run " + id + ", the checkpoint belongs to run " +
-                             marks.run_id + " (a later run on the same output that did not finish, or files of " +
-                             "two runs put together)");
+                             marks.run_id + " (its /marks/run_id: a later run on the same output that did not finish, or " +
+                             "files of two runs put together)");
 }
 
 void check_appendable(const std::string& original, const CheckpointMarks& marks) {

@@ -322,6 +322,8 @@ std::vector<long> longs(hid_t f, const std::string& path, const std::string& nam
 struct SceneSizes {
   long particles, nodes, materials, bodies, boundary_points, penalty_pairs;
   bool contact;
+  long series_pairs;         // contact pairs with a contact_heat_rate column (1 + this: /run/series_memory/work)
+  std::vector<bool> rigid;   // per material: its particles' wave speed is -inf
 };
 
 // The arrays' sizes against the simulation built from the scene, the index arrays' values against
@@ -362,6 +364,20 @@ void check_arrays(hid_t f, const std::string& path, const SceneSizes& z) {
   }
   in_range("mechanics/particles/material", 0, M, "the scene's materials");
   in_range("mechanics/particles/body", 0, z.bodies, "the scene's bodies");
+  // -inf (never a CFL speed) only for particles of rigid materials.
+  if (items(f, path, "mechanics/wave_speed") == P && items(f, path, "mechanics/particles/material") == P) {
+    const std::vector<long> material = longs(f, path, "mechanics/particles/material");
+    const Handle d{check_id(H5Dopen2(f, "mechanics/wave_speed", H5P_DEFAULT), path, "cannot open '/mechanics/wave_speed'"),
+                   H5Dclose};
+    std::vector<double> c(static_cast<std::size_t>(P));
+    check(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, c.data()), path,
+          "cannot read '/mechanics/wave_speed'");
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (c[i] == -std::numeric_limits<double>::infinity() && material[i] >= 0 && material[i] < M &&
+          !z.rigid[static_cast<std::size_t>(material[i])])
+        damaged("mechanics/wave_speed", "holds -inf (a rigid particle's) at particle " + std::to_string(i) +
+                                            " of a deformable material");
+  }
   const std::vector<long> ready = longs(f, path, "mechanics/wave_speed_ready");
   require("mechanics/wave_speed", P, first || (ready.size() == 1 && ready[0] == 0), "the scene's particles");
   for (const char* a : {"mechanics/work_first", "mechanics/work_second", "mechanics/contact/lagged_normal_traction",
@@ -417,6 +433,10 @@ void check_arrays(hid_t f, const std::string& path, const SceneSizes& z) {
     for (const char* a : {"run/last_series_step", "run/last_snapshot_step"})
       in_range(a, -1, step + 1, "-1 or a step up to /mechanics/step");
   in_range("run/hotspot_windows_written", -1, std::numeric_limits<long>::max(), "-1 or a count of windows");
+  // The series' memory of the last row: the cumulative frictional work, total and per contact pair.
+  const std::vector<long> has_previous = longs(f, path, "run/series_memory/has_previous");
+  require("run/series_memory/work", 1 + z.series_pairs, has_previous.size() == 1 && has_previous[0] == 0,
+          "the total and each contact pair's frictional work");
   // The marks describe this state.
   const std::vector<long> mark_step = longs(f, path, "marks/step");
   if (step >= 0 && mark_step.size() == 1 && mark_step[0] != step)
@@ -426,6 +446,8 @@ void check_arrays(hid_t f, const std::string& path, const SceneSizes& z) {
                         "pending/work", "window_start"})
     require_finite(f, path, a);
   if (!first) require_finite(f, path, "mechanics/initial_energy");  // NaN only before the first step
+  const std::vector<long> windows = longs(f, path, "books/windows");
+  if (windows.size() == 1 && windows[0] > 0) require_finite(f, path, "books/min_window");  // +inf: no window yet
 }
 
 }  // namespace
@@ -437,10 +459,13 @@ void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
   const h5detail::Quiet quiet;
   const Handle f = open_checkpoint(path, Dim);
   sim.finalize();  // penalty contact samples its boundary points here
-  const SceneSizes sizes{static_cast<long>(sim.particles().size()),    static_cast<long>(sim.grid().node_count()),
+  SceneSizes sizes{static_cast<long>(sim.particles().size()),    static_cast<long>(sim.grid().node_count()),
                          static_cast<long>(sim.materials().size()),    static_cast<long>(sim.bodies().size()),
                          static_cast<long>(sim.boundary_points().size()), static_cast<long>(sim.penalty_pairs().size()),
-                         sim.contact_enabled()};
+                         sim.contact_enabled(),
+                         static_cast<long>(sim.contact_pairs().size()),
+                         {}};
+  for (const auto& m : sim.materials()) sizes.rigid.push_back(m.is_rigid());
   check_arrays(f.get(), path, sizes);
   {
     const Handle g{check_id(H5Gopen2(f.get(), "mechanics", H5P_DEFAULT), path, "checkpoint has no /mechanics"),
@@ -471,9 +496,9 @@ CheckpointMarks checkpoint_marks(const std::string& path) {
       if (x < 0) damaged(name, "is " + std::to_string(x) + ", expected a count >= 0");
     if (m.time < 0.0) damaged("time", "is negative");
     if (H5Lexists(f.get(), "marks", H5P_DEFAULT) > 0 && H5Lexists(f.get(), "marks/run_id", H5P_DEFAULT) > 0) {
-      m.run_id = read_text(f.get(), path, "marks/run_id");  // 128 bits in hex; empty: an older version's
-      if (!(m.run_id.empty() || (m.run_id.size() == 32 && m.run_id.find_first_not_of("0123456789abcdef") == std::string::npos)))
-        damaged("run_id", "is not a run id (32 hexadecimal digits)");
+      // Any text (RunOptions::run_id; a run draws 32 hex digits); a result of another id is refused
+      // by check_appendable, an empty one is an older version's checkpoint.
+      m.run_id = read_text(f.get(), path, "marks/run_id");
     }
     const std::string names = read_text(f.get(), path, "marks/table_names");
     std::vector<long> rows;
