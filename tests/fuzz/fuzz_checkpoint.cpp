@@ -26,14 +26,17 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -70,6 +73,16 @@ constexpr const char* kScene = R"({
 struct Seed {
   std::string dir, checkpoint, bytes;
   std::vector<std::string> datasets;
+  Seed() = default;
+  Seed(const Seed&) = delete;
+  Seed(Seed&& o) noexcept : dir(std::move(o.dir)), checkpoint(std::move(o.checkpoint)), bytes(std::move(o.bytes)),
+                            datasets(std::move(o.datasets)) {
+    o.dir.clear();
+  }
+  ~Seed() {  // the folder of the seed run and of the damaged copies
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::remove_all(dir, ec);
+  }
 };
 
 herr_t collect(hid_t group, const char* name, const H5L_info_t*, void* out) {
@@ -92,7 +105,7 @@ void write_file(const std::string& path, const std::string& bytes) {
 }
 
 const Seed& seed() {
-  static const Seed s = [] {
+  static const Seed seed_checkpoint = [] {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     Seed s;
     char dir[] = "/tmp/fuzz_checkpoint_XXXXXX";
@@ -112,7 +125,7 @@ const Seed& seed() {
     if (s.datasets.empty()) throw std::runtime_error("fuzz_checkpoint: the seed checkpoint has no dataset");
     return s;
   }();
-  return s;
+  return seed_checkpoint;
 }
 
 template <class T> T take(const std::uint8_t* p) {

@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -324,7 +325,20 @@ struct SceneSizes {
   bool contact;
   long series_pairs;         // contact pairs with a contact_heat_rate column (1 + this: /run/series_memory/work)
   std::vector<bool> rigid;   // per material: its particles' wave speed is -inf
+  std::vector<double> lo, hi;        // the grid's box per direction
+  std::vector<double> max_half;      // the largest half size per direction: h/2, or a built particle's
 };
+
+// Every value of the double dataset `name` (when present; its type was checked by the caller or is
+// checked by the Reader after).
+std::vector<double> doubles(hid_t f, const std::string& path, const std::string& name) {
+  if (items(f, path, name) <= 0) return {};
+  const Handle d{check_id(H5Dopen2(f, name.c_str(), H5P_DEFAULT), path, "cannot open '/" + name + "'"), H5Dclose};
+  const Handle space{check_id(H5Dget_space(d.get()), path, "dataspace of '/" + name + "'"), H5Sclose};
+  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space.get())));
+  check(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path, "cannot read '/" + name + "'");
+  return v;
+}
 
 // The arrays' sizes against the simulation built from the scene, the index arrays' values against
 // what they index, the counters' signs and the values the next step reads for finiteness, before
@@ -361,6 +375,29 @@ void check_arrays(hid_t f, const std::string& path, const SceneSizes& z) {
     const std::string name = std::string("mechanics/particles/") + a;
     require(name, P, false, "the scene's particles");
     require_finite(f, path, name);
+  }
+  // Positions inside the grid (Grid::contains: a particle or boundary point outside has no stencil,
+  // the step refuses it as "left the grid") and half sizes within [0, h/2] (the stencil of a particle
+  // inside finds all its nodes only then; or up to the largest the scene built): a finite but absurd value, e.g. a flipped exponent, had
+  // crashed the thermal assembly of the restore (fuzz_checkpoint).
+  const std::size_t dim = z.lo.size();
+  for (const char* a : {"mechanics/particles/position", "mechanics/boundary/position"}) {
+    const std::vector<double> x = doubles(f, path, a);
+    for (std::size_t i = 0; dim > 0 && i + dim <= x.size(); i += dim)
+      for (std::size_t d = 0; d < dim; ++d)
+        if (!(x[i + d] >= z.lo[d] && x[i + d] <= z.hi[d]))
+          damaged(a, "holds a point outside the grid (" + std::to_string(x[i + d]) + " m in direction " +
+                         std::to_string(d) + " at item " + std::to_string(i / dim) + ", the grid spans " +
+                         std::to_string(z.lo[d]) + " to " + std::to_string(z.hi[d]) + " m)");
+  }
+  {
+    const std::vector<double> l = doubles(f, path, "mechanics/particles/half_size");
+    for (std::size_t i = 0; dim > 0 && i + dim <= l.size(); i += dim)
+      for (std::size_t d = 0; d < dim; ++d)
+        if (!(l[i + d] >= 0.0 && l[i + d] <= z.max_half[d] * (1.0 + 1e-12)))
+          damaged("mechanics/particles/half_size", "holds " + std::to_string(l[i + d]) + " m at item " +
+                                                       std::to_string(i / dim) + ", expected 0 to " +
+                                                       std::to_string(z.max_half[d]) + " m (half the cell size)");
   }
   in_range("mechanics/particles/material", 0, M, "the scene's materials");
   in_range("mechanics/particles/body", 0, z.bodies, "the scene's bodies");
@@ -464,8 +501,15 @@ void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
                          static_cast<long>(sim.boundary_points().size()), static_cast<long>(sim.penalty_pairs().size()),
                          sim.contact_enabled(),
                          static_cast<long>(sim.contact_pairs().size()),
-                         {}};
+                         {}, {}, {}, {}};
   for (const auto& m : sim.materials()) sizes.rigid.push_back(m.is_rigid());
+  for (int d = 0; d < Dim; ++d) {  // Grid::contains
+    sizes.lo.push_back(sim.grid().lo()[d]);
+    sizes.hi.push_back(sim.grid().lo()[d] + sim.grid().cell_size()[d] * sim.grid().cells()[d]);
+    double half = 0.5 * sim.grid().cell_size()[d];
+    for (const auto& l : sim.particles().half_size) half = std::max(half, l[d]);
+    sizes.max_half.push_back(half);
+  }
   check_arrays(f.get(), path, sizes);
   {
     const Handle g{check_id(H5Gopen2(f.get(), "mechanics", H5P_DEFAULT), path, "checkpoint has no /mechanics"),
