@@ -325,7 +325,7 @@ struct SceneSizes {
   bool contact;
   long series_pairs;         // contact pairs with a contact_heat_rate column (1 + this: /run/series_memory/work)
   std::vector<bool> rigid;   // per material: its particles' wave speed is -inf
-  std::vector<double> lo, hi;        // the grid's box per direction
+  std::vector<double> lo, hi, cell;  // the grid's box and cell size per direction
   std::vector<double> max_half;      // the largest half size per direction: h/2, or a built particle's
 };
 
@@ -381,14 +381,18 @@ void check_arrays(hid_t f, const std::string& path, const SceneSizes& z) {
   // inside finds all its nodes only then; or up to the largest the scene built): a finite but absurd value, e.g. a flipped exponent, had
   // crashed the thermal assembly of the restore (fuzz_checkpoint).
   const std::size_t dim = z.lo.size();
+  // Boundary points may lie on the grid's edge: the ghost layer of one cell, as the step allows.
   for (const char* a : {"mechanics/particles/position", "mechanics/boundary/position"}) {
+    const bool ghost = std::string(a) == "mechanics/boundary/position";
     const std::vector<double> x = doubles(f, path, a);
     for (std::size_t i = 0; dim > 0 && i + dim <= x.size(); i += dim)
-      for (std::size_t d = 0; d < dim; ++d)
-        if (!(x[i + d] >= z.lo[d] && x[i + d] <= z.hi[d]))
+      for (std::size_t d = 0; d < dim; ++d) {
+        const double lo = z.lo[d] - (ghost ? z.cell[d] : 0.0), hi = z.hi[d] + (ghost ? z.cell[d] : 0.0);
+        if (!(x[i + d] >= lo && x[i + d] <= hi))
           damaged(a, "holds a point outside the grid (" + std::to_string(x[i + d]) + " m in direction " +
-                         std::to_string(d) + " at item " + std::to_string(i / dim) + ", the grid spans " +
-                         std::to_string(z.lo[d]) + " to " + std::to_string(z.hi[d]) + " m)");
+                         std::to_string(d) + " at item " + std::to_string(i / dim) + ", expected " +
+                         std::to_string(lo) + " to " + std::to_string(hi) + " m)");
+      }
   }
   {
     const std::vector<double> l = doubles(f, path, "mechanics/particles/half_size");
@@ -501,11 +505,12 @@ void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
                          static_cast<long>(sim.boundary_points().size()), static_cast<long>(sim.penalty_pairs().size()),
                          sim.contact_enabled(),
                          static_cast<long>(sim.contact_pairs().size()),
-                         {}, {}, {}, {}};
+                         {}, {}, {}, {}, {}};
   for (const auto& m : sim.materials()) sizes.rigid.push_back(m.is_rigid());
   for (int d = 0; d < Dim; ++d) {  // Grid::contains
     sizes.lo.push_back(sim.grid().lo()[d]);
     sizes.hi.push_back(sim.grid().lo()[d] + sim.grid().cell_size()[d] * sim.grid().cells()[d]);
+    sizes.cell.push_back(sim.grid().cell_size()[d]);
     double half = 0.5 * sim.grid().cell_size()[d];
     for (const auto& l : sim.particles().half_size) half = std::max(half, l[d]);
     sizes.max_half.push_back(half);
