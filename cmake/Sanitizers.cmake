@@ -2,7 +2,7 @@
 #
 # -DFRICTHERM_SANITIZE=ON: AddressSanitizer + UndefinedBehaviorSanitizer on every target (GCC or
 # clang); undefined behaviour aborts (-fno-sanitize-recover), so a test that triggers it fails.
-# -DFRICTHERM_FUZZ=ON: the libFuzzer target tests/fuzz/fuzz_scene (clang only; other compilers get a
+# -DFRICTHERM_FUZZ=ON: the libFuzzer targets tests/fuzz/fuzz_scene and fuzz_checkpoint (clang only; other compilers get a
 # warning and no target). Every target is compiled with -fsanitize=fuzzer-no-link (coverage for the
 # fuzzer); combine with FRICTHERM_SANITIZE=ON (scripts/run_checks.sh does) so findings include
 # memory errors and undefined behaviour, not only crashes.
@@ -25,7 +25,7 @@ if(FRICTHERM_FUZZ)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
     add_compile_options(-fsanitize=fuzzer-no-link)
     set(FRICTHERM_FUZZ_TARGET ON)
-    message(STATUS "frictherm: libFuzzer target fuzz_scene")
+    message(STATUS "frictherm: libFuzzer targets fuzz_scene and fuzz_checkpoint")
   else()
     message(WARNING "FRICTHERM_FUZZ=ON needs clang (-DCMAKE_CXX_COMPILER=clang++); no fuzz target built")
   endif()

@@ -3,8 +3,9 @@
 # UndefinedBehaviorSanitizer and the libFuzzer target, in its own folder (build-checks), then
 #   1. the unit tests (ctest -L unit) under the sanitizers,
 #      (the bad-input sweep tests/robustness and the fuzz regressions included),
-#   2. the fuzzer on scene parsing and validation for FUZZ_SECONDS (default 60) from the seed corpus
-#      (examples/*.json and tests/fuzz/regressions).
+#   2. the fuzzers for FUZZ_SECONDS (default 60) in all, half each (scripts/run_fuzzer.sh): scene
+#      parsing and validation (seeds examples/*.json and tests/fuzz/regressions) and the checks resume
+#      applies to a checkpoint (seeds tests/fuzz/checkpoint_regressions).
 #   scripts/run_checks.sh [extra ctest arguments, e.g. -R Scene]; CHECKS_LABEL=verification for that label
 # Environment: FUZZ_SECONDS (0 skips the fuzzer), CHECKS_BUILD_DIR (default build-checks),
 # CHECKS_LABEL (ctest label, default unit), CHECKS_OPT (optimisation flag, default -O1; instrumented,

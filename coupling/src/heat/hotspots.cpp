@@ -241,7 +241,9 @@ void HotSpotTracker::unflatten(const std::vector<double>& scalars, const std::ve
   if (scalars.size() != n * kScalars || material_end.size() != n ||
       (n > 0 && (static_cast<std::size_t>(particle_end.back()) != particles.size() ||
                  static_cast<std::size_t>(material_end.back()) != materials.size())))
-    throw std::runtime_error("checkpoint: the hot-spot arrays do not fit together");
+    throw std::runtime_error("checkpoint: the hot-spot arrays /hotspots/current_scalars (13 per hot spot), "
+                             "/hotspots/current_particles, /hotspots/current_particle_end, /hotspots/current_materials "
+                             "and /hotspots/current_material_end do not fit together; the checkpoint is damaged");
   current_.assign(n, HotSpot{});
   long p0 = 0, m0 = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -257,7 +259,9 @@ void HotSpotTracker::unflatten(const std::vector<double>& scalars, const std::ve
     h.excess_energy = s[9];
     h.birth_time = s[10];
     h.duration = s[11];
-    if (particle_end[i] < p0 || material_end[i] < m0) throw std::runtime_error("checkpoint: bad hot-spot offsets");
+    if (particle_end[i] < p0 || material_end[i] < m0)
+      throw std::runtime_error("checkpoint: the offsets /hotspots/current_particle_end or /hotspots/current_material_end "
+                               "decrease; the checkpoint is damaged");
     h.particles.assign(particles.begin() + p0, particles.begin() + particle_end[i]);
     h.materials.assign(materials.begin() + m0, materials.begin() + material_end[i]);
     p0 = particle_end[i];

@@ -245,8 +245,8 @@ void check_same_run(const std::string& result, const CheckpointMarks& marks) {
   const std::string id = result_run_id(result);
   if (!id.empty() && id != marks.run_id)
     throw std::runtime_error("'" + result + "' is the result of run " + id + ", the checkpoint belongs to run " +
-                             marks.run_id + " (a later run on the same output that did not finish, or files of " +
-                             "two runs put together)");
+                             marks.run_id + " (its /marks/run_id: a later run on the same output that did not finish, or " +
+                             "files of two runs put together)");
 }
 
 void check_appendable(const std::string& original, const CheckpointMarks& marks) {
@@ -264,12 +264,29 @@ void check_appendable(const std::string& original, const CheckpointMarks& marks)
     const Handle d{check_id(H5Dopen2(f.get(), where.c_str(), H5P_DEFAULT), original, where), H5Dclose};
     if (rows_of(d.get(), original, where) < static_cast<hsize_t>(marks.series_rows))
       throw std::runtime_error("'" + original + "': " + where + " has fewer rows than the checkpoint counts (" +
-                               std::to_string(marks.series_rows) + ")");
+                               std::to_string(marks.series_rows) + " in its /marks/series_rows)");
+  }
+  // The tables' rows (/hotspots, /hotspot_fates) the checkpoint counts: there, before any step (issue
+  // 34: a damaged /marks/table_rows had been found only after the resumed run, by the append).
+  for (const auto& [table, rows] : marks.table_rows) {
+    if (rows == 0) continue;
+    const std::string group = "/" + table;
+    if (table.empty() || table.find('/') != std::string::npos || !exists(f.get(), group.c_str()))
+      throw std::runtime_error("'" + original + "': no table " + group + ", the checkpoint counts " + std::to_string(rows) +
+                               " rows of it (its /marks/table_names and /marks/table_rows)");
+    const Handle t{check_id(H5Gopen2(f.get(), group.c_str(), H5P_DEFAULT), original, group), H5Gclose};
+    const std::vector<std::string> columns = members(t.get());
+    if (columns.empty()) continue;
+    const std::string where = group + "/" + columns.front();
+    const Handle d{check_id(H5Dopen2(f.get(), where.c_str(), H5P_DEFAULT), original, where), H5Dclose};
+    if (rows_of(d.get(), original, where) < static_cast<hsize_t>(rows))
+      throw std::runtime_error("'" + original + "': " + where + " has fewer rows than the checkpoint counts (" +
+                               std::to_string(rows) + " in its /marks/table_rows)");
   }
   const Handle g{check_id(H5Gopen2(f.get(), "snapshots", H5P_DEFAULT), original, "/snapshots"), H5Gclose};
   if (members(g.get()).size() < static_cast<std::size_t>(marks.snapshots))
     throw std::runtime_error("'" + original + "': fewer snapshots than the checkpoint counts (" +
-                             std::to_string(marks.snapshots) + ")");
+                             std::to_string(marks.snapshots) + " in its /marks/snapshots)");
 }
 
 namespace {

@@ -4,16 +4,20 @@
 // run loop adds (the thermal coupler, series memory) under its own groups. Vectors of n items with c
 // values each are n × c (c = 1: n), scalars one-element datasets (long: int64, bool: int32).
 #include <frictherm/coupling/checkpoint.hpp>
+#include <frictherm/coupling/runner.hpp>
 
+#include "run/checkpoint_checks.hpp"
 #include "run/checkpoint_io.hpp"
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -52,17 +56,67 @@ void write_array(hid_t group, const std::string& file, const std::string& name, 
   if (n > 0) check(H5Dwrite(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, "cannot write '" + name + "'");
 }
 
-Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n) {
-  Handle d{check_id(H5Dopen2(group, name.c_str(), H5P_DEFAULT), file, "checkpoint has no '" + name + "'"), H5Dclose};
-  const Handle space{check_id(H5Dget_space(d.get()), file, "dataspace of '" + name + "'"), H5Sclose};
+namespace {
+
+std::string type_text(H5T_class_t cls, std::size_t size, H5T_sign_t sign) {
+  const std::string bits = std::to_string(8 * size) + "-bit ";
+  if (cls == H5T_FLOAT) return bits + "float";
+  if (cls == H5T_INTEGER) return bits + (sign == H5T_SGN_NONE ? "unsigned integer" : "integer");
+  if (cls == H5T_STRING) return "string";
+  return "HDF5 type class " + std::to_string(static_cast<int>(cls));
+}
+
+}  // namespace
+
+Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n,
+                  hid_t memory_type, const std::string& shown_name) {
+  const std::string shown = shown_name.empty() ? name : shown_name;
+  if (H5Lexists(group, name.c_str(), H5P_DEFAULT) <= 0)  // also false when a group on the way is missing
+    throw std::runtime_error("checkpoint '" + file + "' has no '" + shown + "'; the checkpoint is damaged");
+  Handle d{check_id(H5Dopen2(group, name.c_str(), H5P_DEFAULT), file, "checkpoint has no dataset '" + shown + "'"),
+           H5Dclose};
+  const Handle space{check_id(H5Dget_space(d.get()), file, "dataspace of '" + shown + "'"), H5Sclose};
   hsize_t dims[2] = {0, 1};
-  const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank >= 1 && rank <= 2) H5Sget_simple_extent_dims(space.get(), dims, nullptr);
   if (rank < 1 || rank > 2 || static_cast<int>(dims[1]) != (rank == 1 ? 1 : components) ||
       (rank == 1) != (components == 1))
-    throw std::runtime_error("checkpoint '" + file + "': '" + name + "' has the wrong shape (expected " +
-                             std::to_string(components) + " values per item)");
+    throw std::runtime_error("checkpoint '" + file + "': '" + shown + "' has the wrong shape (expected " +
+                             (components == 1 ? std::string("a list of values") :
+                                                "items of " + std::to_string(components) + " values") +
+                             ", found rank " + std::to_string(rank) + ")");
+  if (memory_type != H5I_INVALID_HID) {
+    const Handle t{check_id(H5Dget_type(d.get()), file, "type of '" + shown + "'"), H5Tclose};
+    const H5T_class_t cls = H5Tget_class(t.get()), want_cls = H5Tget_class(memory_type);
+    const std::size_t size = H5Tget_size(t.get()), want_size = H5Tget_size(memory_type);
+    const H5T_sign_t sign = cls == H5T_INTEGER ? H5Tget_sign(t.get()) : H5T_SGN_ERROR;
+    const H5T_sign_t want_sign = want_cls == H5T_INTEGER ? H5Tget_sign(memory_type) : H5T_SGN_ERROR;
+    if (cls != want_cls || size != want_size || sign != want_sign)
+      throw std::runtime_error("checkpoint '" + file + "': '" + shown + "' is stored as " +
+                               type_text(cls, size, sign) + ", expected " + type_text(want_cls, want_size, want_sign) +
+                               "; the checkpoint is damaged");
+  }
   n = dims[0];
   return d;
+}
+
+void require_finite(const std::string& file, const std::string& shown, const double* values, std::size_t count,
+                    bool (*allowed)(const std::string&, double)) {
+  for (std::size_t i = 0; i < count; ++i)
+    if (!std::isfinite(values[i]) && !(allowed && allowed(shown, values[i])))
+      throw std::runtime_error("checkpoint '" + file + "': '" + shown + "' holds a non-finite value (" +
+                               std::to_string(values[i]) + " at value " + std::to_string(i) +
+                               "); the checkpoint is damaged");
+}
+
+bool allowed_sentinel(const std::string& shown, double value) {
+  // EnergyBooks::min_window: +inf until a window closes; Simulation::wave_speed_: -inf for rigid
+  // particles (never a CFL speed); lagged_normal_traction_: NaN where a node had no contact yet;
+  // Simulation::initial_energy_: NaN before the first step (check_arrays requires it finite after).
+  if (value == std::numeric_limits<double>::infinity()) return shown == "/books/min_window";
+  if (value == -std::numeric_limits<double>::infinity()) return shown == "/mechanics/wave_speed";
+  return std::isnan(value) &&
+         (shown == "/mechanics/initial_energy" || shown == "/mechanics/contact/lagged_normal_traction");
 }
 
 }  // namespace ckpt
@@ -75,6 +129,23 @@ using h5detail::check;
 using h5detail::check_id;
 using h5detail::Handle;
 
+// A checkpoint that cannot be read, or does not fit, is a bad input (exit code 2, OutputError), never a
+// failed run: every reading entry point turns its errors into OutputError naming the file and the
+// dataset (issue 34). SceneError (a --set of `continue`) passes through.
+template <class F> auto refusing(const std::string& path, F&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const SceneError&) {
+    throw;
+  } catch (const OutputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw OutputError("checkpoint '" + path + "': a dataset's size is out of all proportion; the checkpoint is damaged");
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+}
+
 constexpr int kFormat = 2;  // 2: thermal coupler, penalty contact and output marks (1: mechanics only)
 
 void write_int_attribute(hid_t obj, const std::string& file, const char* name, int value) {
@@ -86,8 +157,15 @@ void write_int_attribute(hid_t obj, const std::string& file, const char* name, i
 }
 
 int read_int_attribute(hid_t obj, const std::string& file, const char* name) {
+  if (H5Aexists(obj, name) <= 0)
+    throw std::runtime_error("checkpoint '" + file + "': not a checkpoint, or damaged: no attribute '" + name + "'");
   const Handle a{check_id(H5Aopen(obj, name, H5P_DEFAULT), file, std::string("not a checkpoint: no attribute ") + name),
                  H5Aclose};
+  const Handle type{check_id(H5Aget_type(a.get()), file, std::string("attribute ") + name), H5Tclose};
+  const Handle space{check_id(H5Aget_space(a.get()), file, std::string("attribute ") + name), H5Sclose};
+  if (H5Tget_class(type.get()) != H5T_INTEGER || H5Sget_simple_extent_npoints(space.get()) != 1)
+    throw std::runtime_error("checkpoint '" + file + "': attribute '" + name +
+                             "' is not one integer; the checkpoint is damaged");
   int value = 0;
   check(H5Aread(a.get(), H5T_NATIVE_INT, &value), file, std::string("attribute ") + name);
   return value;
@@ -102,7 +180,8 @@ Handle open_checkpoint(const std::string& path, int dimension) {
   if (dimension > 0 && read_int_attribute(f.get(), path, "dimension") != dimension)
     throw std::runtime_error("checkpoint '" + path + "': written by a " +
                              std::to_string(read_int_attribute(f.get(), path, "dimension")) +
-                             "D simulation, restored into a " + std::to_string(dimension) + "D one");
+                             "D simulation (its attribute 'dimension'), restored into a " + std::to_string(dimension) +
+                             "D one");
   return f;
 }
 
@@ -112,7 +191,7 @@ void write_text(hid_t f, const std::string& file, const char* name, const std::s
 
 std::string read_text(hid_t f, const std::string& path, const char* name) {
   hsize_t n = 0;
-  const Handle d = open_array(f, path, name, 1, n);
+  const Handle d = open_array(f, path, name, 1, n, H5T_NATIVE_CHAR, std::string("/") + name);
   std::string text(n, '\0');
   if (n > 0)
     check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), path,
@@ -121,9 +200,11 @@ std::string read_text(hid_t f, const std::string& path, const char* name) {
 }
 
 std::string read_text(const std::string& path, const char* name) {
-  const h5detail::Quiet quiet;
-  const Handle f = open_checkpoint(path, 0);
-  return read_text(f.get(), path, name);
+  return refusing(path, [&] {
+    const h5detail::Quiet quiet;
+    const Handle f = open_checkpoint(path, 0);
+    return read_text(f.get(), path, name);
+  });
 }
 
 
@@ -180,10 +261,16 @@ std::string joined_overrides(const std::vector<SceneOverride>& list) {
 std::string checkpoint_path(const std::string& result_path) { return result_path + ".checkpoint"; }
 
 int checkpoint_ranks(const std::string& path) {
-  const h5detail::Quiet quiet;
-  const Handle f = open_checkpoint(path, 0);
-  if (H5Aexists(f.get(), "ranks") <= 0) return 0;
-  return read_int_attribute(f.get(), path, "ranks");
+  return refusing(path, [&] {
+    const h5detail::Quiet quiet;
+    const Handle f = open_checkpoint(path, 0);
+    if (H5Aexists(f.get(), "ranks") <= 0) return 0;
+    const int ranks = read_int_attribute(f.get(), path, "ranks");
+    if (ranks < 1)
+      throw std::runtime_error("checkpoint '" + path + "': attribute 'ranks' is " + std::to_string(ranks) +
+                               ", expected a number of ranks >= 1; the checkpoint is damaged");
+    return ranks;
+  });
 }
 
 template <int Dim>
@@ -192,119 +279,82 @@ void write_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim, 
   write_file(path, sim, scene.text, scene.source, joined_overrides(scene.overrides), marks, extra);
 }
 
-namespace {
-
-// Items (first dimension) of dataset `name`, or -1 when the checkpoint has none of that name.
-long items(hid_t f, const std::string& path, const std::string& name) {
-  if (H5Lexists(f, name.substr(0, name.find('/')).c_str(), H5P_DEFAULT) <= 0) return -1;
-  if (name.find('/') != std::string::npos && H5Lexists(f, name.c_str(), H5P_DEFAULT) <= 0) return -1;
-  const Handle d{check_id(H5Dopen2(f, name.c_str(), H5P_DEFAULT), path, "cannot open '" + name + "'"), H5Dclose};
-  const Handle space{check_id(H5Dget_space(d.get()), path, "dataspace of '" + name + "'"), H5Sclose};
-  hsize_t dims[2] = {0, 0};
-  if (H5Sget_simple_extent_ndims(space.get()) < 1) return 0;
-  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-  return static_cast<long>(dims[0]);
-}
-
-// Every value of the double dataset `name` (when present) is finite; else the first item that is not.
-void require_finite(hid_t f, const std::string& path, const std::string& name) {
-  if (items(f, path, name) <= 0) return;
-  const Handle d{check_id(H5Dopen2(f, name.c_str(), H5P_DEFAULT), path, "cannot open '" + name + "'"), H5Dclose};
-  const Handle type{check_id(H5Dget_type(d.get()), path, "type of '" + name + "'"), H5Tclose};
-  if (H5Tget_class(type.get()) != H5T_FLOAT) return;
-  const Handle space{check_id(H5Dget_space(d.get()), path, "dataspace of '" + name + "'"), H5Sclose};
-  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
-  std::vector<double> v(static_cast<std::size_t>(n));
-  check(H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path, "cannot read '" + name + "'");
-  for (std::size_t i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i]))
-      throw std::runtime_error("checkpoint '" + path + "': /" + name + " holds a non-finite value (" +
-                               std::to_string(v[i]) + " at value " + std::to_string(i) + "); the checkpoint is damaged");
-}
-
-// The arrays' sizes against the simulation built from the scene (P particles, G grid nodes, M
-// materials) and the values the next step reads for finiteness, before any state is restored
-// (issue 34: truncated, padded or NaN arrays had been accepted). Arrays a run has not filled yet
-// may be empty.
-void check_arrays(hid_t f, const std::string& path, std::size_t particles, std::size_t nodes, std::size_t materials) {
-  const long P = static_cast<long>(particles), G = static_cast<long>(nodes), M = static_cast<long>(materials);
-  auto require = [&](const std::string& name, long expected, bool may_be_empty, const char* what) {
-    const long n = items(f, path, name);
-    if (n < 0 || n == expected || (may_be_empty && n == 0)) return;
-    throw std::runtime_error("checkpoint '" + path + "': /" + name + " holds " + std::to_string(n) +
-                             " items, expected " + std::to_string(expected) + " (" + what +
-                             "); the checkpoint is damaged or belongs to another scene");
-  };
-  static const char* const kParticleArrays[] = {
-      "position", "initial_position", "velocity", "half_size", "mass", "initial_volume", "volume",
-      "deformation_gradient", "stress", "stress_zz", "temperature", "plastic_strain", "internal_energy",
-      "plastic_work", "material", "body"};
-  for (const char* a : kParticleArrays) {
-    const std::string name = std::string("mechanics/particles/") + a;
-    require(name, P, false, "the scene's particles");
-    require_finite(f, path, name);
-  }
-  require("mechanics/wave_speed", P, true, "the scene's particles");
-  for (const char* a : {"mechanics/work_first", "mechanics/work_second", "mechanics/contact/lagged_normal_traction",
-                        "mechanics/contact/lagged_normal_step", "pending/work", "system/unknown"})
-    require(a, G, true, "the scene's grid nodes");
-  for (const char* a : {"mechanics/pair_work_first", "mechanics/pair_work_second"})
-    require(a, M * M, true, "material pairs of the scene");
-  for (const char* a : {"hotspots/owner", "hotspots/reference", "reaction/particle_progress"})
-    require(a, P, true, "the scene's particles");
-  // The thermal unknowns: as many temperatures and masses as grid nodes listed, at most G.
-  const long unknowns = items(f, path, "system/grid_node");
-  if (unknowns > G)
-    throw std::runtime_error("checkpoint '" + path + "': /system/grid_node holds " + std::to_string(unknowns) +
-                             " items, expected at most " + std::to_string(G) + " (the scene's grid nodes)");
-  if (unknowns >= 0) {
-    require("nodal_temperature", unknowns, false, "the thermal unknowns listed in /system/grid_node");
-    require("system/mass", unknowns, false, "the thermal unknowns listed in /system/grid_node");
-  }
-  for (const char* a : {"mechanics/time", "mechanics/last_dt", "mechanics/work_first", "mechanics/work_second",
-                        "mechanics/pair_work_first", "mechanics/pair_work_second", "nodal_temperature", "system/mass",
-                        "pending/work", "window_start"})
-    require_finite(f, path, a);
-}
-
-}  // namespace
 
 template <int Dim>
 void read_checkpoint(const std::string& path, mechanics::Simulation<Dim>& sim,
                      const std::function<void(const ckpt::Reader&)>& extra) {
+  refusing(path, [&] {
   const h5detail::Quiet quiet;
   const Handle f = open_checkpoint(path, Dim);
-  check_arrays(f.get(), path, sim.particles().size(), sim.grid().node_count(), sim.materials().size());
+  sim.finalize();  // penalty contact samples its boundary points here
+  ckpt::SceneSizes sizes{static_cast<long>(sim.particles().size()),    static_cast<long>(sim.grid().node_count()),
+                         static_cast<long>(sim.materials().size()),    static_cast<long>(sim.bodies().size()),
+                         static_cast<long>(sim.boundary_points().size()), static_cast<long>(sim.penalty_pairs().size()),
+                         sim.contact_enabled(),
+                         static_cast<long>(sim.contact_pairs().size()),
+                         {}, {}, {}, {}, {}};
+  for (const auto& m : sim.materials()) sizes.rigid.push_back(m.is_rigid());
+  for (int d = 0; d < Dim; ++d) {  // Grid::contains
+    sizes.lo.push_back(sim.grid().lo()[d]);
+    sizes.hi.push_back(sim.grid().lo()[d] + sim.grid().cell_size()[d] * sim.grid().cells()[d]);
+    sizes.cell.push_back(sim.grid().cell_size()[d]);
+    double half = 0.5 * sim.grid().cell_size()[d];
+    for (const auto& l : sim.particles().half_size) half = std::max(half, l[d]);
+    sizes.max_half.push_back(half);
+  }
+  ckpt::check_arrays(f.get(), path, sizes);
   {
     const Handle g{check_id(H5Gopen2(f.get(), "mechanics", H5P_DEFAULT), path, "checkpoint has no /mechanics"),
                    H5Gclose};
     sim.finalize();
-    sim.visit_state(ckpt::Reader{g.get(), path, sim.particles().size()});
+    sim.visit_state(ckpt::Reader{g.get(), path, sim.particles().size(), "/mechanics/", true});
   }
-  if (extra) extra(ckpt::Reader{f.get(), path, sim.particles().size()});
+  if (extra) extra(ckpt::Reader{f.get(), path, sim.particles().size(), "/", true});
+  });
 }
 
 CheckpointMarks checkpoint_marks(const std::string& path) {
-  const h5detail::Quiet quiet;
-  const Handle f = open_checkpoint(path, 0);
-  const ckpt::Reader r{f.get(), path, 0};
-  CheckpointMarks m;
-  r("marks/step", m.step);
-  r("marks/time", m.time);
-  r("marks/series_rows", m.series_rows);
-  r("marks/snapshots", m.snapshots);
-  r("marks/end_of_loading", m.end_of_loading);
-  if (H5Lexists(f.get(), "marks/run_id", H5P_DEFAULT) > 0) m.run_id = read_text(f.get(), path, "marks/run_id");
-  const std::string names = read_text(f.get(), path, "marks/table_names");
-  std::vector<long> rows;
-  r("marks/table_rows", rows);
-  std::size_t k = 0;
-  for (std::size_t a = 0, b; a < names.size() && k < rows.size(); a = b + 1, ++k) {
-    b = names.find('\n', a);
-    if (b == std::string::npos) b = names.size();
-    m.table_rows.emplace_back(names.substr(a, b - a), rows[k]);
-  }
-  return m;
+  return refusing(path, [&] {
+    const h5detail::Quiet quiet;
+    const Handle f = open_checkpoint(path, 0);
+    const ckpt::Reader r{f.get(), path, 0, "/", true};
+    CheckpointMarks m;
+    r("marks/step", m.step);
+    r("marks/time", m.time);
+    r("marks/series_rows", m.series_rows);
+    r("marks/snapshots", m.snapshots);
+    r("marks/end_of_loading", m.end_of_loading);
+    auto damaged = [&](const char* name, const std::string& what) {
+      throw std::runtime_error("checkpoint '" + path + "': /marks/" + name + " " + what + "; the checkpoint is damaged");
+    };
+    for (auto [name, x] : {std::pair<const char*, long>{"step", m.step}, {"series_rows", m.series_rows},
+                           {"snapshots", m.snapshots}})
+      if (x < 0) damaged(name, "is " + std::to_string(x) + ", expected a count >= 0");
+    if (m.time < 0.0) damaged("time", "is negative");
+    if (H5Lexists(f.get(), "marks", H5P_DEFAULT) > 0 && H5Lexists(f.get(), "marks/run_id", H5P_DEFAULT) > 0) {
+      // Any text (RunOptions::run_id; a run draws 32 hex digits); a result of another id is refused
+      // by check_appendable, an empty one is an older version's checkpoint.
+      m.run_id = read_text(f.get(), path, "marks/run_id");
+    }
+    const std::string names = read_text(f.get(), path, "marks/table_names");
+    std::vector<long> rows;
+    r("marks/table_rows", rows);
+    std::size_t k = 0;
+    for (std::size_t a = 0, b; a < names.size(); a = b + 1, ++k) {
+      b = names.find('\n', a);
+      if (b == std::string::npos) b = names.size();
+      if (k >= rows.size()) damaged("table_names", "names more tables than /marks/table_rows counts");
+      const std::string table = names.substr(a, b - a);
+      if (table != "hotspots" && table != "hotspot_fates")
+        damaged("table_names", "names a table '" + table + "' (expected hotspots or hotspot_fates)");
+      for (const auto& [other, count] : m.table_rows)
+        if (other == table) damaged("table_names", "names " + table + " twice");
+      if (rows[k] < 0) damaged("table_rows", "counts " + std::to_string(rows[k]) + " rows of /" + names.substr(a, b - a));
+      m.table_rows.emplace_back(names.substr(a, b - a), rows[k]);
+    }
+    if (k != rows.size()) damaged("table_rows", "counts " + std::to_string(rows.size()) + " tables, /marks/table_names names " + std::to_string(k));
+    return m;
+  });
 }
 
 template <int Dim>
@@ -336,14 +386,27 @@ std::vector<SceneOverride> checkpoint_overrides(const std::string& path) {
 
 Scene checkpoint_scene(const std::string& path, const std::vector<SceneOverride>& more) {
   const std::string text = read_text(path, "scene"), source = read_text(path, "scene_source");
-  std::vector<SceneOverride> overrides = checkpoint_overrides(path);
-  overrides.insert(overrides.end(), more.begin(), more.end());
   const std::size_t slash = source.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : source.substr(0, slash));
   std::string name = slash == std::string::npos ? source : source.substr(slash + 1);
   if (const std::size_t dot = name.find_last_of('.'); dot != std::string::npos && dot > 0) name = name.substr(0, dot);
   if (name.empty()) name = "scene";
-  return parse_scene(text, source.empty() ? "<string>" : source, dir, name, overrides);
+  const std::string shown = source.empty() ? "<string>" : source;
+  // The stored scene must parse as it was run: a refusal here is a damaged checkpoint (exit code 2
+  // naming /scene), not a bad --set of `continue` (a SceneError naming the key, checked after).
+  std::vector<SceneOverride> overrides;
+  try {
+    overrides = checkpoint_overrides(path);
+    if (more.empty()) return parse_scene(text, shown, dir, name, overrides);
+    parse_scene(text, shown, dir, name, overrides);
+  } catch (const OutputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw OutputError("checkpoint '" + path + "': the scene stored in /scene with /scene_overrides does not parse (" +
+                      e.what() + "); the checkpoint is damaged");
+  }
+  overrides.insert(overrides.end(), more.begin(), more.end());
+  return parse_scene(text, shown, dir, name, overrides);
 }
 
 #define FRICTHERM_INSTANTIATE_CHECKPOINT(D)                                                                  \

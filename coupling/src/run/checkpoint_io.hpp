@@ -9,7 +9,9 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -22,22 +24,27 @@ template <class T> struct Layout {  // fixed-size Eigen vector or matrix of doub
   static_assert(std::is_same_v<typename T::Scalar, double>, "checkpoint: Eigen members must hold doubles");
   static_assert(sizeof(T) == sizeof(double) * T::SizeAtCompileTime, "checkpoint: padded Eigen type");
   static constexpr int components = T::SizeAtCompileTime;
+  using Scalar = double;
   static hid_t type() { return H5T_NATIVE_DOUBLE; }
 };
 template <> struct Layout<double> {
   static constexpr int components = 1;
+  using Scalar = double;
   static hid_t type() { return H5T_NATIVE_DOUBLE; }
 };
 template <> struct Layout<std::int32_t> {
   static constexpr int components = 1;
+  using Scalar = std::int32_t;
   static hid_t type() { return H5T_NATIVE_INT32; }
 };
 template <> struct Layout<long> {
   static constexpr int components = 1;
+  using Scalar = long;
   static hid_t type() { return H5T_NATIVE_LONG; }
 };
 template <> struct Layout<std::uint64_t> {
   static constexpr int components = 1;
+  using Scalar = std::uint64_t;
   static hid_t type() { return H5T_NATIVE_UINT64; }
 };
 
@@ -47,8 +54,18 @@ template <> struct Layout<std::uint64_t> {
 /// states give byte-equal files).
 void write_array(hid_t group, const std::string& file, const std::string& name, hid_t type, const void* data,
                  hsize_t n, int components);
-/// Opens `name`, checks that it holds items of `components` values and returns their count in `n`.
-h5detail::Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n);
+/// Opens `name`, checks that it holds items of `components` values and returns their count in `n`;
+/// with `memory_type` (not H5I_INVALID_HID) also that it is stored as that type's class, size and sign
+/// (issue 34: a float32 or integer copy of a double array had been converted silently). `shown` names
+/// the dataset in messages (its path in the file; `name` if empty).
+h5detail::Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n,
+                            hid_t memory_type = H5I_INVALID_HID, const std::string& shown = "");
+/// Refuses (std::runtime_error naming `shown`) a non-finite value among `values` unless `allowed`
+/// (a sentinel of that member: +inf "no window yet", NaN "not computed before the first step").
+void require_finite(const std::string& file, const std::string& shown, const double* values, std::size_t count,
+                    bool (*allowed)(const std::string&, double));
+/// The non-finite sentinels a serial checkpoint may hold (checkpoint.cpp).
+bool allowed_sentinel(const std::string& shown, double value);
 
 struct Writer {
   static constexpr bool reading = false;
@@ -74,40 +91,55 @@ struct Reader {
   hid_t group;
   const std::string& file;
   std::size_t particles;  // "particles/..." arrays must hold this many items
+  std::string prefix = "";  // the group's path in the file ("/mechanics/"): messages name "/mechanics/time"
+  bool finite = false;      // refuse non-finite doubles other than allowed_sentinel (serial checkpoints)
+  std::string shown(const char* name) const { return prefix.empty() ? std::string(name) : prefix + name; }
   template <class T> void operator()(const char* name, std::vector<T>& data) const {
     using L = detail::Layout<T>;
     hsize_t n = 0;
-    const h5detail::Handle d = open_array(group, file, name, L::components, n);
+    const h5detail::Handle d = open_array(group, file, name, L::components, n, L::type(), shown(name));
     const std::string key(name);
     if (key.rfind("particles/", 0) == 0 && n != particles)
-      throw std::runtime_error("checkpoint '" + file + "': '" + key + "' holds " + std::to_string(n) +
+      throw std::runtime_error("checkpoint '" + file + "': '" + shown(name) + "' holds " + std::to_string(n) +
                                " particles, the simulation built from the scene has " + std::to_string(particles));
     data.resize(n);
     if (n > 0)
       h5detail::check(H5Dread(d.get(), L::type(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file,
-                      "cannot read '" + key + "'");
+                      "cannot read '" + shown(name) + "'");
+    if constexpr (std::is_same_v<typename L::Scalar, double>)
+      if (finite && n > 0)
+        require_finite(file, shown(name), reinterpret_cast<const double*>(data.data()), n * L::components,
+                       allowed_sentinel);
   }
   template <class T> void scalar(const char* name, hid_t type, T& x) const {
     hsize_t n = 0;
-    const h5detail::Handle d = open_array(group, file, name, 1, n);
-    if (n != 1) throw std::runtime_error("checkpoint '" + file + "': '" + std::string(name) + "' is not one value");
+    const h5detail::Handle d = open_array(group, file, name, 1, n, type, shown(name));
+    if (n != 1)
+      throw std::runtime_error("checkpoint '" + file + "': '" + shown(name) + "' holds " + std::to_string(n) +
+                               " values, expected one");
     h5detail::check(H5Dread(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &x), file,
-                    "cannot read '" + std::string(name) + "'");
+                    "cannot read '" + shown(name) + "'");
   }
-  void operator()(const char* name, double& x) const { scalar(name, H5T_NATIVE_DOUBLE, x); }
+  void operator()(const char* name, double& x) const {
+    scalar(name, H5T_NATIVE_DOUBLE, x);
+    if (finite) require_finite(file, shown(name), &x, 1, allowed_sentinel);
+  }
   void operator()(const char* name, long& x) const { scalar(name, H5T_NATIVE_LONG, x); }
   void operator()(const char* name, bool& x) const {
     std::int32_t b = 0;
     scalar(name, H5T_NATIVE_INT32, b);
+    if (b != 0 && b != 1)
+      throw std::runtime_error("checkpoint '" + file + "': '" + shown(name) + "' holds " + std::to_string(b) +
+                               ", expected 0 or 1 (false or true); the checkpoint is damaged");
     x = b != 0;
   }
   void operator()(const char* name, std::string& text) const {
     hsize_t n = 0;
-    const h5detail::Handle d = open_array(group, file, name, 1, n);
+    const h5detail::Handle d = open_array(group, file, name, 1, n, H5T_NATIVE_CHAR, shown(name));
     text.assign(n, '\0');
     if (n > 0)
       h5detail::check(H5Dread(d.get(), H5T_NATIVE_CHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), file,
-                      "cannot read '" + std::string(name) + "'");
+                      "cannot read '" + shown(name) + "'");
   }
 };
 

@@ -6,6 +6,7 @@
 #include "run/runner_thermal.hpp"  // thermal coupling hooks (scenes with a `thermal` section)
 
 #include <frictherm/coupling/checkpoint.hpp>
+#include <frictherm/coupling/restore_checkpoint.hpp>
 #include <frictherm/coupling/microstructure.hpp>
 #include <frictherm/coupling/output_files.hpp>
 #include <frictherm/coupling/xdmf.hpp>
@@ -54,6 +55,14 @@ template <int Dim>
 class Run {
  public:
   Run(const Scene& scene, const RunOptions& options) : s_(scene), o_(options) {}
+
+  // What `resume` does before its first step, alone (restore_checkpoint.hpp): the simulation and the
+  // thermal run built from the scene, the checkpoint's state checked and restored.
+  void restore_only() {
+    sim_ = build_simulation<Dim>(s_);
+    if (s_.thermal.enabled) thermal_ = std::make_unique<detail::ThermalRun<Dim>>(s_, *sim_);
+    restore();
+  }
 
   RunResult execute() {
     const Clock::time_point t0 = Clock::now();
@@ -479,6 +488,16 @@ class Run {
 };
 
 }  // namespace
+
+void restore_checkpoint(const Scene& scene, const std::string& checkpoint) {
+  RunOptions o;
+  o.resume_checkpoint = checkpoint;
+  o.resume_appends = true;
+  if (scene.dimension == 2)
+    Run<2>(scene, o).restore_only();
+  else
+    Run<3>(scene, o).restore_only();
+}
 
 RunResult run_scene(const Scene& scene, const RunOptions& options) {
   if (scene.dimension == 2) return Run<2>(scene, options).execute();
