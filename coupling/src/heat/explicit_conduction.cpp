@@ -126,10 +126,13 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     // conducting particle twice): the same S, quiet flags, lumping terms and f_i, summed in the same
     // particle order as the two passes below, so the same numbers.
     Expanded e{};
+    whole_.assign(p.size(), 0);
     for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+      if (!holds_heat_[k]) continue;
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-      if (whole(st)) {  // no lumping: the stencil walked directly, the same sums
+      whole_[k] = whole(st);  // read by the sub-steps and the map back
+      if (conductance_[k] == 0.0) continue;  // quiet
+      if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
         double lo, hi, s_kept;
         mechanics::Vec<Dim> grad;
         look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
@@ -158,12 +161,15 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
+  whole_.assign(p.size(), 0);
 #pragma omp parallel num_threads(threads)
   {
   Expanded e{};
 #pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+    if (!holds_heat_[k]) continue;
+    whole_[k] = whole(stencils[k]);  // for one-thread windows that may follow (the governor)
+    if (conductance_[k] == 0.0) continue;  // quiet
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
     quiet_[k] = quiet_temperatures(e, sys.temperature);
@@ -397,6 +403,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     if (bounds_ready_) remove_bounds(k, e);
     add_quick(kept[k], conductance_[k], sys, e, -1.0);
     kept[k] = now[j];
+    whole_[k] = whole(kept[k]);
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
     if (bounds_ready_) {
