@@ -72,14 +72,13 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
           scatter_whole(stencils[k], sys.unknown, grad, force_.data());
           continue;
         }
-        expand<Kernel, false>(stencils[k], sys.unknown, e);
+        expand<Kernel, true>(stencils[k], sys.unknown, e);  // the unknowns and S of expand<false>, and G'
         if (!e.reaches()) {
           quiet_[k] = 1;
           continue;
         }
         quiet_[k] = quiet_temperatures(e, T);
         if (quiet_[k]) continue;
-        expand<Kernel, true>(stencils[k], sys.unknown, e);
         mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
         for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
         grad *= conductance_[k];
