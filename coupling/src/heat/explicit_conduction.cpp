@@ -75,16 +75,27 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   }
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   if (threads <= 1) {  // the same sums without the range checks
+    // The three sums of a node side by side (one or two cache lines per stencil row instead of three
+    // to six: the three grid arrays together outgrow L2 in 3D), copied out after the pass.
+    // (particle_scratch_, a scratch of the threaded passes, holds them: M, M T, quick by node.)
+    particle_scratch_.assign(3 * n_nodes, 0.0);
+    double* sums = particle_scratch_.data();
     for (std::size_t k : listed_) {
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
       const double mc = heat_capacity_[k];
       const double mct = mc * p.temperature[k];
       const double quick = quick_weight(st, conductance_[k]);
       for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
-        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
-        mct_[static_cast<std::size_t>(i)] += mct * w;
-        quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+        double* a = sums + 3 * static_cast<std::size_t>(i);
+        a[0] += mc * w;
+        a[1] += mct * w;
+        a[2] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
       });
+    }
+    for (std::size_t i = 0; i < n_nodes; ++i) {
+      sys.grid_mass[i] = sums[3 * i];
+      mct_[i] = sums[3 * i + 1];
+      quick_sum_[i] = sums[3 * i + 2];
     }
   } else
   scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
@@ -126,10 +137,13 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     // conducting particle twice): the same S, quiet flags, lumping terms and f_i, summed in the same
     // particle order as the two passes below, so the same numbers.
     Expanded e{};
+    whole_.assign(p.size(), 0);
     for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+      if (!holds_heat_[k]) continue;
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-      if (whole(st)) {  // no lumping: the stencil walked directly, the same sums
+      whole_[k] = whole(st);  // read by the sub-steps and the map back
+      if (conductance_[k] == 0.0) continue;  // quiet
+      if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
         double lo, hi, s_kept;
         mechanics::Vec<Dim> grad;
         look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
@@ -158,12 +172,15 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
+  whole_.assign(p.size(), 0);
 #pragma omp parallel num_threads(threads)
   {
   Expanded e{};
 #pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!holds_heat_[k] || conductance_[k] == 0.0) continue;  // quiet
+    if (!holds_heat_[k]) continue;
+    whole_[k] = whole(stencils[k]);  // for one-thread windows that may follow (the governor)
+    if (conductance_[k] == 0.0) continue;  // quiet
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
     quiet_[k] = quiet_temperatures(e, sys.temperature);
@@ -397,6 +414,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     if (bounds_ready_) remove_bounds(k, e);
     add_quick(kept[k], conductance_[k], sys, e, -1.0);
     kept[k] = now[j];
+    whole_[k] = whole(kept[k]);
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
     if (bounds_ready_) {

@@ -51,6 +51,40 @@ inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mecha
   }
 }
 
+// for_each_node over a whole stencil (every node an unknown) by unknown instead of grid node: the
+// unknowns are numbered in grid-node order (select_unknowns) and a stencil row is a run of grid nodes
+// (stride 1 along x), so a whole row's unknowns are un[first] + 0, 1, ..., K − 1: one index load per
+// row instead of one per node (Grid numbers x fastest: stride 1). The same products in the same order. f(u, S, gx, gy, gz).
+template <int Dim, class Kernel, class F>
+inline void for_each_unknown_whole(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix,
+                                   const int* un, F&& f) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = ix.stride;
+  const mechanics::IVec<Dim> b = st.first_node();
+  if constexpr (Dim == 2) {
+    for (int j = 0; j < K; ++j) {
+      const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+      const int u0 = un[ix.shift + (b[1] + j) * sd[1] + b[0] * sd[0]];
+      for (int i = 0; i < K; ++i) {
+        const double wx = st.axis[0].w[i];
+        f(u0 + i, wx * wy, st.axis[0].dw[i] * wy, wx * dwy, 0.0);
+      }
+    }
+  } else {
+    for (int k = 0; k < K; ++k) {
+      const double wz = st.axis[2].w[k], dwz = st.axis[2].dw[k];
+      for (int j = 0; j < K; ++j) {
+        const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+        const int u0 = un[ix.shift + (b[2] + k) * sd[2] + (b[1] + j) * sd[1] + b[0] * sd[0]];
+        for (int i = 0; i < K; ++i) {
+          const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
+          f(u0 + i, wx * wy * wz, dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
+        }
+      }
+    }
+  }
+}
+
 // V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
 // (quick_bound).
 template <int Dim, class Kernel>
@@ -244,8 +278,8 @@ void ExplicitConduction<Dim>::look_whole(const mechanics::Stencil<Dim, Kernel>& 
   const int* un = unknown.data();
   double l = std::numeric_limits<double>::infinity(), h = -l, sum = 0.0;
   double g0 = 0.0, g1 = 0.0, g2 = 0.0;
-  explicit_detail::for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
-    const double t = T[un[i]];
+  explicit_detail::for_each_unknown_whole(st, indexer_, un, [&](int u, double w, double gx, double gy, double gz) {
+    const double t = T[u];
     l = std::min(l, t);
     h = std::max(h, t);
     sum += w;
@@ -266,10 +300,10 @@ void ExplicitConduction<Dim>::scatter_whole(const mechanics::Stencil<Dim, Kernel
   // G·g as Eigen's dot sums it: (x x' + y y') + z z'.
   const int* un = unknown.data();
   const double g0 = g[0], g1 = g[1], g2 = Dim == 3 ? g[Dim - 1] : 0.0;
-  explicit_detail::for_each_node(st, indexer_, [&](int i, double, double gx, double gy, double gz) {
+  explicit_detail::for_each_unknown_whole(st, indexer_, un, [&](int u, double, double gx, double gy, double gz) {
     double dot = gx * g0 + gy * g1;
     if constexpr (Dim == 3) dot += gz * g2;
-    force[un[i]] -= dot;
+    force[u] -= dot;
   });
 }
 

@@ -62,7 +62,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
           quiet_[k] = 1;
           continue;
         }
-        if (whole(stencils[k])) {  // no lumping: the stencil walked directly, the same sums
+        if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
           double lo, hi, s_kept;
           mechanics::Vec<Dim> grad;
           look_whole(stencils[k], sys.unknown, T.data(), lo, hi, s_kept, grad);
@@ -72,14 +72,13 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
           scatter_whole(stencils[k], sys.unknown, grad, force_.data());
           continue;
         }
-        expand<Kernel, false>(stencils[k], sys.unknown, e);
+        expand<Kernel, true>(stencils[k], sys.unknown, e);  // the unknowns and S of expand<false>, and G'
         if (!e.reaches()) {
           quiet_[k] = 1;
           continue;
         }
         quiet_[k] = quiet_temperatures(e, T);
         if (quiet_[k]) continue;
-        expand<Kernel, true>(stencils[k], sys.unknown, e);
         mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
         for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
         grad *= conductance_[k];
@@ -183,10 +182,9 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const double* te = relax ? end->data() : nullptr;
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
-      if (whole(stencils[k])) {  // no lumping: the stencil walked directly, the same sums
+      if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
         double dT = 0.0, pic = 0.0, s = 0.0;
-        for_each_node(stencils[k], indexer_, [&](int i, double w, double, double, double) {
-          const int u = un[i];
+        for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double w, double, double, double) {
           dT += w * dl[u];
           if (relax) {
             pic += w * te[u];
@@ -199,7 +197,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         p.temperature[k] = T;
         if (!keep_sums) continue;
         const double change = heat_capacity_[k] * (T - before);
-        for_each_node(stencils[k], indexer_, [&](int i, double w, double, double, double) { next_mct_[un[i]] += change * w; });
+        for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double w, double, double, double) { next_mct_[u] += change * w; });
         continue;
       }
       expand<Kernel, false>(stencils[k], sys.unknown, c);

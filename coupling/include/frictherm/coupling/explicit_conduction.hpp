@@ -249,6 +249,7 @@ class ExplicitConduction {
   Eigen::VectorXd flux_temperature_;          // T_i of the last sub-step (empty: look at every particle)
   std::vector<int> changed_before_;           // scratch: changed unknowns at grid nodes < i
   std::vector<int> dropped_before_;           // grid nodes < i that are not unknowns (by the gather)
+  std::vector<unsigned char> whole_;          // by heat-holding particle: whole() of its window stencil
   // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
   // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
   // in order, so every sum has the same terms in the same order on any number of threads.
