@@ -31,7 +31,8 @@ namespace {
 // 1e-9 of each column's scale: the decomposed step is the serial arithmetic with the nodal and
 // particle sums split between the ranks (another summation order, a few ε per step carried by the
 // waves over the run; the other columns measured ≤ 2.2e-13, docs/distributed_run.md). A term booked
-// on ghost and owned nodes both, or not at all on one rank, differs by a share of its whole size.
+// on ghost and owned nodes both, or not at all on one rank, differs by a share of its whole size
+// (rank 0's rigid work alone, unreduced: 36 times the oscillating block's scale, 1.0 of the PBX's).
 constexpr double kSame = 1e-9;
 
 const char* const kBooks[] = {"kinetic_energy", "strain_energy",       "total_energy", "external_work",
