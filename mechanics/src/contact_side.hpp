@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <vector>
 
 namespace frictherm::mechanics {
 
@@ -39,6 +40,19 @@ struct ContactSide {
     domain_gradient += o.domain_gradient;
   }
 };
+
+/// The energy books' rigid work at a contact node (docs/output.md "Energy balance"): in the
+/// momentum-update pass every change a deformable material gets at a node with a rigid partner comes
+/// from the rigid body, whose velocity is prescribed: it does the work Δp·v_rigid, with the heaviest
+/// rigid side's velocity (the one lump_partners gives the virtual material). That side, or nullptr.
+/// One function for the serial and the decomposed contact passes.
+template <int Dim>
+inline const ContactSide<Dim>* rigid_work_side(const std::vector<ContactSide<Dim>>& sides) {
+  const ContactSide<Dim>* rigid = nullptr;
+  for (const auto& sd : sides)
+    if (sd.rigid && (!rigid || sd.mass > rigid->mass)) rigid = &sd;
+  return rigid;
+}
 
 /// The unit normal from a to b (eq. 7 and §2.3): specified, maximum or average volume gradient.
 /// False when it is undefined (no volume gradient).

@@ -107,14 +107,8 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       }
       double* lagged_normal = regularized ? &lagged_normal_traction_[static_cast<std::size_t>(node)] : nullptr;
       double* lagged_step = regularized ? &lagged_normal_step_[static_cast<std::size_t>(node)] : nullptr;
-      // The energy books' rigid work: in the momentum-update pass (the changes the particles receive)
-      // every change a deformable material gets at a node with a rigid partner comes from the rigid
-      // body, whose velocity is prescribed: it does the work Δp·v_rigid (the heaviest rigid side's
-      // velocity, the one lump_partners gives the virtual material).
-      const ContactSide<Dim>* rigid = nullptr;
-      if (forces)
-        for (const auto& sd : sides)
-          if (sd.rigid && (!rigid || sd.mass > rigid->mass)) rigid = &sd;
+      // The energy books' rigid work, in the momentum-update pass (the changes the particles receive).
+      const ContactSide<Dim>* rigid = forces ? rigid_work_side(sides) : nullptr;
       double rigid_work = 0.0;
       contact_detail::resolve_contact_node(
           sides, mats, h, ctx, lagged_normal, lagged_step, pair_of, dps,

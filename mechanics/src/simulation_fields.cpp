@@ -248,7 +248,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
     for (std::size_t s = F.first; s < F.first + F.count; ++s) {
       momentum[s] = nodes_.mass[s] * v;
       if (force) {
-        work -= (*force)[s].dot(v) * dt;
+        work += rigid_reaction_work<Dim>((*force)[s], v, dt);  // energy/energy_books.hpp
         (*force)[s].setZero();
       }
     }
@@ -269,13 +269,10 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
         // made a force, (m v_rigid − p)/dt, so that the particles' FLIP update receives it too.
         for (int d = 0; d < Dim; ++d)
           if (driven & (1u << d)) {
-            const double target = nodes_.mass[s] * rigid_velocity_[i][d];
-            if (force) {
-              work += (target - momentum[s][d] - (*force)[s][d] * dt) * rigid_velocity_[i][d];
-              (*force)[s][d] = (target - momentum[s][d]) / dt;
-            } else {
-              momentum[s][d] = target;
-            }
+            if (force)  // the kernel shared with the decomposed step (energy/energy_books.hpp)
+              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], rigid_velocity_[i][d], dt);
+            else
+              momentum[s][d] = nodes_.mass[s] * rigid_velocity_[i][d];
           }
       }
       if (const std::uint8_t mask = fixed_mask_[i]) {

@@ -28,7 +28,7 @@ class Redistribution {
     for (auto& r : acc_.reals) r.second.clear();
     for (auto& r : acc_.integers) r.second.clear();
     acc_.cumulative_first = acc_.cumulative_second = 0.0;
-    acc_.external_work = acc_.damping_work = 0.0;
+    acc_.external_work = acc_.damping_work = acc_.rigid_work = 0.0;
     acc_.work_first.clear();
     acc_.work_second.clear();
     acc_.stats.assign(4, 0);
@@ -46,6 +46,7 @@ class Redistribution {
     if (box.size() != 2 * Dim) throw std::runtime_error("rank file " + std::to_string(j) + ": no owned node range");
     r("mechanics/time", acc_.time);
     r("mechanics/empty_node_mass", acc_.empty_node_mass);
+    r("mechanics/initial_energy", acc_.initial_energy);  // the books' start: the same in every file
     if (particles) {
       for (auto& [name, values] : acc_.reals) {
         std::vector<double> v;
@@ -66,6 +67,8 @@ class Redistribution {
       acc_.external_work += w;
       r("mechanics/damping_work", w);
       acc_.damping_work += w;
+      r("mechanics/rigid_work", w);
+      acc_.rigid_work += w;
       std::vector<long> stats;
       r("mechanics/contact_stats", stats);
       for (std::size_t k = 0; k < 4 && k < stats.size(); ++k) acc_.stats[k] += stats[k];

@@ -56,10 +56,8 @@ void DecomposedRun<Dim>::write_start_metadata() {
 
 template <int Dim>
 std::vector<std::string> DecomposedRun<Dim>::series_names() const {
-  std::vector<std::string> n{"time", "step", "dt", "kinetic_energy", "external_work"};
-  const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
-  for (int d = 0; d < Dim; ++d) n.emplace_back(axes[d]);
-  n.emplace_back("damping_work");
+  // The serial run's first columns, energy books included (detail::series_names, runner_output.cpp).
+  std::vector<std::string> n = detail::series_names(Dim);
   if (s_.contact.enabled)
     n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
   if (heat_) {
@@ -75,19 +73,23 @@ template <int Dim>
 void DecomposedRun<Dim>::series() {
   const Clock::time_point c0 = Clock::now();
   const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
-  // Kinetic energy and momentum of the deformable particles, as Simulation::kinetic_energy and
-  // linear_momentum (a rigid wall's prescribed motion is not part of the body's).
-  double sums[1 + Dim] = {};
+  // Momentum of the deformable particles, as Simulation::linear_momentum (a rigid wall's prescribed
+  // motion is not part of the body's).
+  double P[Dim] = {};
   for (std::size_t k = 0; k < p.mass.size(); ++k) {
     if (s_.materials[static_cast<std::size_t>(p.material[k])].is_rigid()) continue;
-    const Eigen::Map<const mechanics::Vec<Dim>> vk(p.velocity.data() + Dim * k);
-    sums[0] += 0.5 * p.mass[k] * vk.squaredNorm();
-    for (int d = 0; d < Dim; ++d) sums[1 + d] += p.mass[k] * vk[d];
+    for (int d = 0; d < Dim; ++d) P[d] += p.mass[k] * p.velocity[Dim * k + static_cast<std::size_t>(d)];
   }
-  MPI_Allreduce(MPI_IN_PLACE, sums, 1 + Dim, MPI_DOUBLE, MPI_SUM, comm_);
-  std::vector<double> row{time_, static_cast<double>(step_), last_dt_, sums[0], mpm_->external_work()};
-  for (int d = 0; d < Dim; ++d) row.push_back(sums[1 + d]);
-  row.push_back(mpm_->damping_work());
+  MPI_Allreduce(MPI_IN_PLACE, P, Dim, MPI_DOUBLE, MPI_SUM, comm_);
+  // The energy books (the serial series_row's columns and definitions, DecomposedMpm::energy_balance),
+  // with the frictional work of the order handed to the heat (second without heat, as the serial run).
+  const mechanics::EnergyBalance books =
+      mpm_->energy_balance(heat_ ? s_.thermal.heating_order : mechanics::HeatingOrder::second);
+  std::vector<double> row{time_, static_cast<double>(step_), last_dt_, books.kinetic, books.stored,
+                          books.kinetic + books.stored, books.external_work};
+  for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
+  row.insert(row.end(), {books.rigid_work, books.damping_work, books.plastic_work, books.lost(),
+                         books.numerical_dissipation()});
   if (s_.contact.enabled) {
     const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
     const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);

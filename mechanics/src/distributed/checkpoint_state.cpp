@@ -68,6 +68,8 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.cumulative_second = s.cumulative_second;
   c.external_work = s.external_work;
   c.damping_work = s.damping_work;
+  c.rigid_work = s.rigid_work;
+  c.initial_energy = s.initial_energy;
   c.empty_node_mass = s.empty_node_mass;
   c.work_first = s.work_first;
   c.work_second = s.work_second;
@@ -140,6 +142,8 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.cumulative_second = c.cumulative_second;
   s.external_work = c.external_work;
   s.damping_work = c.damping_work;
+  s.rigid_work = c.rigid_work;
+  s.initial_energy = c.initial_energy;
   s.empty_node_mass = c.empty_node_mass;
   s.work_first = c.work_first;
   s.work_second = c.work_second;

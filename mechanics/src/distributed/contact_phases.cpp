@@ -176,6 +176,9 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
       if (sides.size() > 2) ++stats.multi_nodes;
     }
     const std::size_t uq = q;
+    // The energy books' rigid work in the updated pass, as the serial pass (contact_side.hpp): at
+    // owned nodes only, so each node's counts once over the ranks.
+    const ContactSide<Dim>* rigid_side = updated ? rigid_work_side(sides) : nullptr;
     try {
     contact_detail::resolve_contact_node(
         sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
@@ -185,6 +188,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
             v[momentum + d] += dp[d];
             if (updated) v[force + d] += dp[d] / dt;  // eq. 19
           }
+          if (rigid_side) rigid_work += dp.dot(rigid_side->rigid_velocity);
         },
         [&](int, int, double w1, double w2) {
           if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // never inject NaN heat (as the serial step)

@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -264,6 +265,13 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<std::pair<PetscInt, std::size_t>> local_loads;
   std::vector<Vec<Dim>> load_start_position;  // their positions before grid_to_particle (the loads' work)
   double external_work = 0.0, damping_work = 0.0;
+  // The energy books' rigid work (this rank's part: at its owned nodes, the momentum update's rigid
+  // drives and the updated contact pass's rigid partners) and the start energy, kinetic + stored
+  // before the first step (the same on every rank; NaN until then), energy_books.cpp.
+  double rigid_work = 0.0;
+  double initial_energy = std::numeric_limits<double>::quiet_NaN();
+  std::array<double, 3> particle_books() const;  // this rank's kinetic, stored energy and plastic work
+  void take_initial_energy();           // collective, at the start of the first step
   int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
   Stencils current;                      // current_stencils(), valid until the next step or add
   bool current_valid = false;

@@ -9,6 +9,7 @@
 #include "distributed/decomposed_state.hpp"
 
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
+#include <frictherm/mechanics/energy/energy_books.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/transfer/pic_blend.hpp>
 
@@ -208,12 +209,13 @@ template <int Dim>
 void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   constexpr int momentum = Dof::momentum, force = Dof::force;
   const bool damped = damping_active(opt.damping_rate, opt.damping_until, time);
-  double removed = 0.0;
+  double removed = 0.0, driven_work = 0.0;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
   for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
     if (partner(field)) {  // a rigid partner's field: m v_rigid, no force (the serial apply_velocity_bc)
       const Vec<Dim> v = partner_velocity(field);
+      driven_work += rigid_reaction_work<Dim>(Eigen::Map<const Vec<Dim>>(node + force), v, dt);
       for (int d = 0; d < Dim; ++d) node[momentum + d] = node[Dof::mass] * v[d], node[force + d] = 0.0;
       return;
     }
@@ -221,10 +223,12 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
     const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
     if (driven) {
       // Driven components end the step at the rigid velocity: the change made a force, (m v − p)/dt,
-      // so that the particles' FLIP update receives it too (the serial apply_velocity_bc).
+      // so that the particles' FLIP update receives it too, and the rigid material's work booked (the
+      // serial apply_velocity_bc's kernel, energy/energy_books.hpp; owned nodes: once per node).
       for (int d = 0; d < Dim; ++d)
         if (driven & (1u << d))
-          node[force + d] = (node[Dof::mass] * drive_velocity[static_cast<std::size_t>(q)][d] - node[momentum + d]) / dt;
+          driven_work += drive_component(node[Dof::mass], node[momentum + d], node[force + d],
+                                         drive_velocity[static_cast<std::size_t>(q)][d], dt);
     }
     for (int d = 0; d < Dim; ++d)
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
@@ -236,6 +240,7 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
   damping_work += removed;
+  rigid_work += driven_work;
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
@@ -401,6 +406,7 @@ const std::array<const char*, 16>& DecomposedMpm<Dim>::phase_names() {
 template <int Dim>
 void DecomposedMpm<Dim>::step(double dt) {
   Impl& s = *impl_;
+  s.take_initial_energy();  // the energy books' start, once (energy_books.cpp)
   s.current_valid = false;  // the particles move: current_stencils() evaluates them again
   dispatch_shape(s.opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);

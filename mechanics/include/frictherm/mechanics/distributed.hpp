@@ -70,6 +70,7 @@
 // ghosts (transfer.cpp).
 // Only this library needs PETSc; its header needs MPI only.
 #include <frictherm/mechanics/contact.hpp>
+#include <frictherm/mechanics/energy/energy_books.hpp>
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/loads.hpp>
 #include <frictherm/mechanics/material.hpp>
@@ -278,6 +279,12 @@ class DecomposedMpm {
   /// summed over ranks (J; as Simulation::external_work and damping_work).
   double external_work() const;
   double damping_work() const;
+  /// Collective: the mechanical energy books (J; docs/output.md "Energy balance"), the serial
+  /// Simulation::energy_balance's definitions from the same kernels (energy/energy_books.hpp): kinetic
+  /// and stored energy and plastic work summed over the particles, the rigid work over the owned nodes,
+  /// the loads' and the damping's work, the frictional work of `order`, all over ranks (one reduction);
+  /// the start energy taken at the start of the first step (before it: the current kinetic + stored).
+  EnergyBalance energy_balance(HeatingOrder order) const;
   /// Velocity-field slots this rank stores (Σ over its fields of their boxes' nodes; see the header
   /// comment) and the largest over the run's steps.
   long field_slots() const;
@@ -323,7 +330,8 @@ class DecomposedMpm {
     std::vector<std::pair<std::string, std::vector<double>>> reals;          // name, n × components
     std::vector<std::pair<std::string, std::vector<std::int64_t>>> integers;  // id, material
     double time = 0.0, cumulative_first = 0.0, cumulative_second = 0.0, empty_node_mass = 0.0;
-    double external_work = 0.0, damping_work = 0.0;  // this rank's part of the books
+    double external_work = 0.0, damping_work = 0.0, rigid_work = 0.0;  // this rank's part of the books
+    double initial_energy = std::numeric_limits<double>::quiet_NaN();  // the books' start (every rank's)
     std::vector<double> work_first, work_second;
     std::vector<long> stats;  // contact_nodes, multi_nodes, sliding_nodes, guarded (this rank)
   };

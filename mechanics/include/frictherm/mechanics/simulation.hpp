@@ -21,6 +21,7 @@
 // multimaterial heat.
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/ebs.hpp>
+#include <frictherm/mechanics/energy/energy_books.hpp>  // EnergyBalance
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/loads.hpp>
@@ -123,23 +124,6 @@ struct BodyInfo {
 
 template <int Dim>
 struct ContactSide;  // contact internals (mechanics/src/contact_side.hpp)
-
-/// The mechanical energy books of a run (J; docs/output.md, "Energy balance"). The energy the bodies
-/// lost, lost() = initial + external_work + rigid_work − kinetic − stored, pays for the damping, the
-/// plastic and the frictional work; what is left, numerical_dissipation(), is the scheme's own loss
-/// (or, if negative, its gain): the normal part of the contact impulses, FLIP/grid transfers, fixed faces.
-struct EnergyBalance {
-  double kinetic = 0.0;        // of the deformable particles
-  double stored = 0.0;         // strain_energy() (elastic and equation-of-state) + penalty springs
-  double initial = 0.0;        // kinetic + stored at the start of the first step
-  double external_work = 0.0;  // loads and gravity (external_work())
-  double rigid_work = 0.0;     // rigid materials on the deformable bodies (rigid_work())
-  double damping_work = 0.0;   // removed by the mass-proportional damping (damping_work())
-  double plastic_work = 0.0;   // Σ_p σ:Δε_p V of the particles (plastic_work())
-  double friction_work = 0.0;  // cumulative frictional work of the order asked for
-  double lost() const { return initial + external_work + rigid_work - kinetic - stored; }
-  double numerical_dissipation() const { return lost() - damping_work - plastic_work - friction_work; }
-};
 
 template <int Dim>
 class Simulation {

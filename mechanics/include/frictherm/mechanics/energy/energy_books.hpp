@@ -1,0 +1,86 @@
+#pragma once
+// The mechanical energy books' kernels (EnergyBalance, simulation.hpp; docs/output.md "Energy
+// balance"), written once for the serial Simulation (simulation_energy.cpp, simulation_fields.cpp,
+// simulation_contact.cpp) and the decomposed step (distributed/usl_phases.cpp, contact_phases.cpp):
+// the energy a particle stores, and the work a rigid material does on the deformable ones where it
+// prescribes their nodal velocity. Each engine passes its own storage; the arithmetic is here.
+#include <frictherm/mechanics/material.hpp>
+#include <frictherm/mechanics/types.hpp>
+
+namespace frictherm::mechanics {
+
+/// The mechanical energy books of a run (J; docs/output.md, "Energy balance"). The energy the bodies
+/// lost, lost() = initial + external_work + rigid_work − kinetic − stored, pays for the damping, the
+/// plastic and the frictional work; what is left, numerical_dissipation(), is the scheme's own loss
+/// (or, if negative, its gain): the normal part of the contact impulses, FLIP/grid transfers, fixed faces.
+struct EnergyBalance {
+  double kinetic = 0.0;        // of the deformable particles
+  double stored = 0.0;         // strain_energy() (elastic and equation-of-state) + penalty springs
+  double initial = 0.0;        // kinetic + stored at the start of the first step
+  double external_work = 0.0;  // loads and gravity (external_work())
+  double rigid_work = 0.0;     // rigid materials on the deformable bodies (rigid_work())
+  double damping_work = 0.0;   // removed by the mass-proportional damping (damping_work())
+  double plastic_work = 0.0;   // Σ_p σ:Δε_p V of the particles (plastic_work())
+  double friction_work = 0.0;  // cumulative frictional work of the order asked for
+  double lost() const { return initial + external_work + rigid_work - kinetic - stored; }
+  double numerical_dissipation() const { return lost() - damping_work - plastic_work - friction_work; }
+};
+
+namespace energy_detail {
+// Stored energy of a Mie-Grüneisen particle (J). The update integrates the specific internal energy
+// by the trapezoidal pressure work plus the plastic work, m Δe = −½(p_n + p_{n+1}) ΔV + σ:Δε_p V
+// (mie_gruneisen.hpp), so m e − W_p is the equation of state's share of the stress power, without a
+// pass of its own: the volumetric energy (cold compression and, through γ0, the shock's). The
+// deviatoric stress is hypoelastic, s = 2G ε_dev^e, whose elastic energy is V s:s/(4G) (plane strain:
+// s_zz included). Closed form rather than the stress power Σ V σ:D dt: a state function, so the
+// balance's remainder shows the scheme's error instead of absorbing it.
+template <int Dim>
+inline double mie_gruneisen_stored_energy(const Material& m, double mass, double volume, double energy,
+                                          double plastic_work, const Mat<Dim>& sigma, double sigma_zz) {
+  const double zz = Dim == 2 ? sigma_zz : 0.0;
+  const double p = -(sigma.trace() + zz) / 3.0;
+  Mat<Dim> s = sigma;
+  s.diagonal().array() += p;
+  const double s_zz = Dim == 2 ? zz + p : 0.0;
+  const double G = m.mie_gruneisen.shear_modulus;
+  const double shear = G > 0.0 ? volume * (s.squaredNorm() + s_zz * s_zz) / (4.0 * G) : 0.0;
+  return mass * energy - plastic_work + shear;
+}
+}  // namespace energy_detail
+
+/// One particle's share of the books' stored energy (J): ½ σ:ε V (linear elastic, ε from σ through
+/// the compliance), W(F) V0 (neo-Hookean, Kakouris 2024 eq. 46), the equation-of-state energy m e − W_p
+/// plus the shear energy V s:s/(4G) (Mie-Grüneisen); 0 for a rigid material.
+template <int Dim>
+inline double particle_stored_energy(const Material& m, Analysis analysis, double mass, double volume,
+                                     double initial_volume, const Mat<Dim>& F, const Mat<Dim>& sigma,
+                                     double sigma_zz, double internal_energy, double plastic_work) {
+  if (m.kind == MaterialKind::neo_hookean)
+    return initial_volume * neo_hookean_energy_density<Dim>(F, m.lame_lambda(), m.shear_modulus());
+  if (m.kind == MaterialKind::linear_elastic)
+    return volume * linear_elastic_energy_density<Dim>(sigma, sigma_zz, m.youngs_modulus, m.poisson_ratio, analysis);
+  if (m.kind == MaterialKind::mie_gruneisen)
+    return energy_detail::mie_gruneisen_stored_energy<Dim>(m, mass, volume, internal_energy, plastic_work, sigma,
+                                                           sigma_zz);
+  return 0.0;
+}
+
+/// One nodal momentum component driven by a rigid material to its velocity v in the momentum update:
+/// the change is made a force, f = (m v − p)/dt, so that the particles' FLIP update receives it too.
+/// Returns the work the rigid material does on the node, (m v − (p + f_old dt)) v: the impulse the
+/// condition adds beyond the node's own force, times the velocity it is given at.
+FRICTHERM_ALWAYS_INLINE double drive_component(double mass, double momentum, double& force, double v, double dt) {
+  const double target = mass * v;
+  const double work = (target - momentum - force * dt) * v;
+  force = (target - momentum) / dt;
+  return work;
+}
+
+/// A rigid field's nodal force (penalty contact: a slave's force on a rigid master) is removed, its
+/// velocity prescribed: the reaction's work on the deformable material, −f · v dt (J).
+template <int Dim, class Force>
+FRICTHERM_ALWAYS_INLINE double rigid_reaction_work(const Force& force, const Vec<Dim>& v, double dt) {
+  return -(force.dot(v) * dt);
+}
+
+}  // namespace frictherm::mechanics
