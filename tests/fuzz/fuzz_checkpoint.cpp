@@ -2,7 +2,8 @@
 // step (checkpoint_ranks, checkpoint_scene, checkpoint_marks, then restore_checkpoint: the simulation
 // and thermal run built from the stored scene, the state checked and restored), on damaged copies of
 // a valid checkpoint. Structure-aware: the seed checkpoint is written once per process by a short run
-// of a small heated penalty-contact scene (the scene of tests/robustness/damaged_checkpoints.py: hot
+// of a small heated penalty-contact scene (tests/fuzz/checkpoint_seed_scene.json, shared with
+// tests/robustness/damaged_checkpoints.py: hot
 // spots, a reaction, slip histories), stopped at step 60 of 80; the input is a list of mutations of
 // it, 12 bytes each:
 //   byte 0: which dataset (modulo their count); byte 1: what (modulo 8):
@@ -43,32 +44,7 @@ namespace {
 
 using namespace frictherm::coupling;
 
-constexpr const char* kScene = R"({
-  "dimension": 2, "analysis": "plane_strain", "thickness": 0.001,
-  "grid": {"lo": [0.0, 0.0], "hi": [0.150, 0.045], "cell_size": 0.005},
-  "materials": {
-    "base": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 2.5e9, "poisson_ratio": 0.33},
-    "block": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 2.5e9, "poisson_ratio": 0.33}},
-  "bodies": [
-    {"name": "base", "material": "base", "shape": {"type": "rectangle", "lo": [0.0, 0.0], "hi": [0.140, 0.025]}},
-    {"name": "block", "material": "block", "velocity": [5, 0],
-     "shape": {"type": "rectangle", "lo": [0.010, 0.025], "hi": [0.050, 0.040]}}],
-  "boundary": {"fixed": [{"face": "y_min"}]},
-  "loads": {"traction": [{"body": "block", "face": "y_max", "traction": [0, -146847.0],
-                          "scale": {"type": "ramp", "value": 1.0, "duration": 0.0034}}]},
-  "contact": {"method": "penalty", "pairs": [{"materials": ["base", "block"], "law": {"type": "coulomb", "mu": 0.2}}]},
-  "thermal": {"integrator": "cvode_bdf", "rtol": 1e-9, "atol": 1e-9,
-              "materials": {"base": {"heat_capacity": 200, "conductivity": 0.2},
-                            "block": {"heat_capacity": 200, "conductivity": 0.2}},
-              "reaction": {"kinetics": {"prefactor": 1e3, "activation_energy": 1e4, "heat_of_reaction": 1e3},
-                           "materials": ["block"]}},
-  "coupling": {"window": {"policy": "adaptive", "max_temperature_rise": 0.05, "max_duration": 2e-4},
-               "heating_order": "second", "continuation": {"duration": 1e-4, "intervals": 4},
-               "hotspots": {"mode": "rise", "threshold": 1e-9}},
-  "solver": {"shape_function": "ugimp", "scheme": "usl", "cfl": 0.5},
-  "run": {"end_time": 1e-4, "checkpoint_interval": 4e-5, "threads": 1},
-  "output": {"snapshot_count": 4, "series_interval": 1e-5}
-})";
+
 
 struct Seed {
   std::string dir, checkpoint, bytes;
@@ -111,7 +87,9 @@ const Seed& seed() {
     char dir[] = "/tmp/fuzz_checkpoint_XXXXXX";
     if (mkdtemp(dir) == nullptr) throw std::runtime_error("fuzz_checkpoint: cannot create a folder in /tmp");
     s.dir = dir;
-    const Scene scene = parse_scene(kScene, "fuzz.json", s.dir, "fuzz", {{"run.max_steps", "60"}});
+    const std::string scene_file = FRICTHERM_SOURCE_DIR "/tests/fuzz/checkpoint_seed_scene.json";
+    const Scene scene =
+        parse_scene(read_file(scene_file), scene_file, s.dir, "fuzz", {{"run.threads", "1"}, {"run.max_steps", "60"}});
     RunOptions o;
     o.output = s.dir + "/seed.h5";
     o.quiet = true;

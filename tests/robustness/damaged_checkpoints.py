@@ -25,6 +25,7 @@ import concurrent.futures
 import hashlib
 import json
 import os
+import pathlib
 import shutil
 import subprocess
 import sys
@@ -34,35 +35,10 @@ import time
 import h5py
 import numpy
 
-# A 2D block sliding on a base with penalty contact and Coulomb friction, frictional heat conducted
-# on the grid, hot spots above 1 nK (so hot spots are tracked at the checkpoint) and an Arrhenius
+# The seed scene, tests/fuzz/checkpoint_seed_scene.json (also the checkpoint fuzzer's): a 2D block
+# sliding on a base with penalty contact and Coulomb friction, frictional heat conducted on the grid, hot spots above 1 nK (so hot spots are tracked at the checkpoint) and an Arrhenius
 # reaction (per-particle progress): 656 particles, 176 boundary points, 80 steps; 0.2 s of CPU.
-SCENE = {
-    "dimension": 2, "analysis": "plane_strain", "thickness": 0.001,
-    "grid": {"lo": [0.0, 0.0], "hi": [0.150, 0.045], "cell_size": 0.005},
-    "materials": {
-        "base": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 2.5e9, "poisson_ratio": 0.33},
-        "block": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 2.5e9, "poisson_ratio": 0.33}},
-    "bodies": [
-        {"name": "base", "material": "base", "shape": {"type": "rectangle", "lo": [0.0, 0.0], "hi": [0.140, 0.025]}},
-        {"name": "block", "material": "block", "velocity": [5, 0],
-         "shape": {"type": "rectangle", "lo": [0.010, 0.025], "hi": [0.050, 0.040]}}],
-    "boundary": {"fixed": [{"face": "y_min"}]},
-    "loads": {"traction": [{"body": "block", "face": "y_max", "traction": [0, -146847.0],
-                            "scale": {"type": "ramp", "value": 1.0, "duration": 0.0034}}]},
-    "contact": {"method": "penalty", "pairs": [{"materials": ["base", "block"], "law": {"type": "coulomb", "mu": 0.2}}]},
-    "thermal": {"integrator": "cvode_bdf", "rtol": 1e-9, "atol": 1e-9,
-                "materials": {"base": {"heat_capacity": 200, "conductivity": 0.2},
-                              "block": {"heat_capacity": 200, "conductivity": 0.2}},
-                "reaction": {"kinetics": {"prefactor": 1e3, "activation_energy": 1e4, "heat_of_reaction": 1e3},
-                             "materials": ["block"]}},
-    "coupling": {"window": {"policy": "adaptive", "max_temperature_rise": 0.05, "max_duration": 2e-4},
-                 "heating_order": "second", "continuation": {"duration": 1e-4, "intervals": 4},
-                 "hotspots": {"mode": "rise", "threshold": 1e-9}},
-    "solver": {"shape_function": "ugimp", "scheme": "usl", "cfl": 0.5},
-    "run": {"end_time": 1e-4, "checkpoint_interval": 4e-5},
-    "output": {"snapshot_count": 4, "series_interval": 1e-5},
-}
+SCENE = json.loads((pathlib.Path(__file__).resolve().parent.parent / "fuzz" / "checkpoint_seed_scene.json").read_text())
 # Stored in /scene_overrides (so that dataset is not empty); the mid-loading checkpoint stops at step 60 of 80.
 OVERRIDES = ["--set", "run.threads=1"]
 MID_STEPS = 60
