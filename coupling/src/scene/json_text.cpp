@@ -7,11 +7,14 @@
 // longer than kMaxStringLength (messages repeat them).
 #include <frictherm/coupling/json_reader.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <iterator>
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -105,6 +108,7 @@ class SceneSax {
     if (!f.keys.insert(k).second)
       fail(path() + ": duplicate key '" + k + "' at " + here() + " (a key may appear once in an object)");
     auto& members = static_cast<Json::object_t::Container&>(stack_.back()->get_ref<Json::object_t&>());
+    if (members.size() == members.capacity()) grow(members);
     members.emplace_back(k, Json());
     member_ = &members.back().second;
     return true;
@@ -186,6 +190,17 @@ class SceneSax {
     return line_column(text_, read == 0 ? 0 : read - 1);
   }
   [[noreturn]] void fail(const std::string& message) const { throw SceneError(message); }
+
+  // Doubles the room of an object's members, moving the values: the vector's own growth copies
+  // them (a pair with a const key has no noexcept move), a deep copy of every member read so far.
+  static void grow(Json::object_t::Container& members) {
+    Json::object_t::Container larger;
+    larger.reserve(std::max<std::size_t>(8, 2 * members.capacity()));
+    for (auto& m : members)
+      larger.emplace_back(std::piecewise_construct, std::forward_as_tuple(m.first),
+                          std::forward_as_tuple(std::move(m.second)));
+    members.swap(larger);
+  }
 
   // The new value: the document, the next element of the open array or the member of the last key.
   Json* place(Json&& v) {
