@@ -7,6 +7,7 @@
 #include <petscmat.h>
 
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -42,7 +43,8 @@ DecomposedAssembledSolve::~DecomposedAssembledSolve() = default;
 
 void DecomposedAssembledSolve::advance(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept,
                                        const std::vector<double>& M, const std::vector<double>& q,
-                                       std::vector<double>& T, double t0, double t1) {
+                                       const std::vector<double>& fixed, std::vector<double>& T, double t0,
+                                       double t1) {
   const int dim = kept.dim;
   const auto n = static_cast<PetscInt>(ids.count), N = static_cast<PetscInt>(ids.global);
   // Columns per row: two nodes of one particle's stencil (at most 3 per axis for linear, uGIMP and the
@@ -155,6 +157,10 @@ void DecomposedAssembledSolve::advance(MPI_Comm comm, const UnknownNumbering& id
   thermal::DistributedProblem problem(comm, static_cast<thermal::Index>(N), static_cast<thermal::Index>(ids.first),
                                       std::move(mass), std::move(rows_k));
   problem.set_source(std::move(source));  // constant over the window: ∫ q dt = W (design §4)
+  if (!fixed.empty())  // the serial Problem::set_dirichlet of the fixed faces' unknowns
+    for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
+      if (ids.owned_id[u] >= 0 && !std::isnan(fixed[u]))
+        problem.set_dirichlet(static_cast<thermal::Index>(ids.owned_id[u]), fixed[u]);
   integrator_->advance(problem, temperature, t0, t1);
   for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
     if (ids.owned_id[u] >= 0) T[u] = temperature[static_cast<Eigen::Index>(ids.owned_id[u] - ids.first)];

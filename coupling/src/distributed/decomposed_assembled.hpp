@@ -52,10 +52,12 @@ class DecomposedAssembledSolve {
   ~DecomposedAssembledSolve();
 
   /// Collective. Assembles K from `kept`, then integrates M dT/dt = −K T + q from t0 to t1 on the
-  /// unknowns: M, q and T are per owned node (read and written on the unknowns only). Throws
-  /// thermal::SolverError / StabilityError (every rank) when the integrator fails.
+  /// unknowns: M, q and T are per owned node (read and written on the unknowns only); `fixed` per owned
+  /// node (or empty: none) the temperature of an unknown held fixed (a Dirichlet row), NaN for a free
+  /// one. Throws thermal::SolverError / StabilityError (every rank) when the integrator fails.
   void advance(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept, const std::vector<double>& M,
-               const std::vector<double>& q, std::vector<double>& T, double t0, double t1);
+               const std::vector<double>& q, const std::vector<double>& fixed, std::vector<double>& T, double t0,
+               double t1);
 
   const thermal::IntegratorStats& stats() const { return integrator_->stats(); }
   std::string name() const { return integrator_->name(); }

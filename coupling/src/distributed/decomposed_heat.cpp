@@ -5,6 +5,7 @@
 // mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal). One template on Dim for the 2D and 3D
 // mechanics; G'_ip flat, Dim values per kept entry.
 #include <frictherm/coupling/decomposed_heat.hpp>
+#include <frictherm/coupling/fixed_temperature.hpp>
 
 #include "distributed/decomposed_assembled.hpp"
 
@@ -63,14 +64,37 @@ int lattice_neighbours(const std::array<int, 2 * Dim>& own, const std::array<int
 DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<2>& mpm, DecomposedHeatOptions options)
     : mpm2_(&mpm), opt_(std::move(options)) {
   check_materials(mpm);
+  select_fixed_nodes(mpm);
 }
 
 DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<3>& mpm, DecomposedHeatOptions options)
     : mpm3_(&mpm), opt_(std::move(options)) {
   check_materials(mpm);
+  select_fixed_nodes(mpm);
 }
 
 DecomposedHeat::~DecomposedHeat() = default;
+
+// The owned nodes on fixed-temperature faces by the serial rule (for_each_fixed_node): the lattice index
+// of owned node u (x fastest over owned_nodes()) is its DMDA index less Grid<Dim>::ghost. Ownership does
+// not change during a run: the table is built once; a window holds those of its nodes that are unknowns.
+template <int Dim>
+void DecomposedHeat::select_fixed_nodes(const mechanics::DecomposedMpm<Dim>& mpm) {
+  face_temperature_.clear();
+  if (opt_.fixed_faces.empty()) return;
+  for (const FixedTemperatureFace& f : opt_.fixed_faces)
+    if (f.axis < 0 || f.axis >= Dim) throw std::invalid_argument("decomposed heat: fixed face axis out of range");
+  const std::array<int, 2 * Dim> own = mpm.owned_nodes();
+  const std::size_t no = mpm.owned_local_nodes().size();
+  const auto lattice_along = [&own](std::size_t u, int axis) {
+    for (int d = 0; d < axis; ++d) u /= static_cast<std::size_t>(own[2 * d + 1] - own[2 * d]);
+    const auto extent = static_cast<std::size_t>(own[2 * axis + 1] - own[2 * axis]);
+    return own[2 * axis] + static_cast<int>(u % extent) - mechanics::Grid<Dim>::ghost;
+  };
+  face_temperature_.assign(no, std::numeric_limits<double>::quiet_NaN());
+  for_each_fixed_node(opt_.fixed_faces, mpm.grid().cells(), no, lattice_along,
+                      [this](std::size_t u, double t) { face_temperature_[u] = t; });
+}
 
 template <int Dim>
 void DecomposedHeat::check_materials(mechanics::DecomposedMpm<Dim>& mpm) {
@@ -378,7 +402,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   mpm.sum_to_owned(local_, 2, bounds);
   double lam[2] = {0.0, 0.0};  // Gershgorin, Rayleigh: maxima over the unknowns of all ranks
   for (std::size_t q = 0; q < no; ++q) {
-    if (!unknown(M[q])) continue;
+    if (!unknown(M[q]) || is_held(q)) continue;  // rows of fixed nodes do not move: λ = 0 (as the serial bounds)
     lam[0] = std::max(lam[0], bounds[2 * q] / M[q]);
     lam[1] = std::max(lam[1], bounds[2 * q + 1]);
   }
@@ -452,6 +476,8 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
 
   std::vector<double> Tn = T0_;
   if (matrix_free) {
+    for (std::size_t u = 0; u < no; ++u)  // Dirichlet values first (ExplicitConduction::advance)
+      if (unknown(M[u]) && is_held(u)) Tn[u] = face_temperature_[u];
     // Forward-Euler sub-steps: ghost T_j from the owners, f_i = −Σ_p V_p k_p G'_ip·(∇T)_p summed at the owners.
     const double h = dt / static_cast<double>(n);
     std::vector<double> f;
@@ -474,7 +500,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
       }
       mpm.sum_to_owned(force_, 1, f);
       for (std::size_t u = 0; u < no; ++u)
-        if (unknown(M[u])) Tn[u] += h * (f[u] + q[u]) / M[u];
+        if (unknown(M[u]) && !is_held(u)) Tn[u] += h * (f[u] + q[u]) / M[u];
     }
     books_.substeps += n;
     books_.exchanges += 4 + 2 * n;  // M and Σ m C T, M back, the bounds, per sub-step T and f, ΔT
@@ -483,7 +509,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
     number_unknowns(mpm);
     KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
     for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
-    assembled_->advance(comm, *ids_, entries_of, M, q, Tn, t0, t0 + dt);
+    assembled_->advance(comm, *ids_, entries_of, M, q, face_temperature_, Tn, t0, t0 + dt);
     ++books_.assembled_windows;
     books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
   }

@@ -142,6 +142,7 @@ void DecomposedRun<Dim>::build() {
     h.window = c.window;
     h.plastic = c.plastic;
     h.subgrid_relaxation_time = c.subgrid_relaxation_time;
+    h.fixed_faces = c.fixed_faces;
     try {
       heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
     } catch (const std::invalid_argument& e) {

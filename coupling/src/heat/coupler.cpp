@@ -101,12 +101,8 @@ void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
   system_changed();
   if (problem_) problem_->reset(system_.mass, system_.conductance);  // the last window's storage
   else problem_.emplace(system_.mass, system_.conductance);
-  for (const FixedTemperatureFace& f : opt_.fixed_faces) {
-    const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
-    for (std::size_t u = 0; u < system_.size(); ++u)
-      if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
-        problem_->set_dirichlet(static_cast<Eigen::Index>(u), f.temperature);
-  }
+  for_each_fixed_node(opt_.fixed_faces, grid_.cells(), system_.size(), fixed_lattice_along(),
+                      [&](std::size_t u, double t) { problem_->set_dirichlet(static_cast<Eigen::Index>(u), t); });
   if (reaction_active()) {
     // Reacting mass and progress gathered from the particles; Q_i = q m_i (heat_sources.hpp).
     NodalReaction r = gather_reaction(grid_, p, shape_, opt_.reaction, system_, particle_progress_);
@@ -169,12 +165,8 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
     system_gathered_ = true;
     system_changed();
     fixed_nodes_.clear();
-    for (const FixedTemperatureFace& f : opt_.fixed_faces) {
-      const int face_index = f.upper ? grid_.cells()[static_cast<std::size_t>(f.axis)] : 0;
-      for (std::size_t u = 0; u < system_.size(); ++u)
-        if (grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(f.axis)] == face_index)
-          fixed_nodes_.push_back({static_cast<int>(u), f.temperature});
-    }
+    for_each_fixed_node(opt_.fixed_faces, grid_.cells(), system_.size(), fixed_lattice_along(),
+                        [&](std::size_t u, double t) { fixed_nodes_.push_back({static_cast<int>(u), t}); });
     // The quick bound first (no pass of its own); the exact bounds only if it does not show that one
     // sub-step is stable (issue 35: they cost a square root and a division per node and particle).
     last_lambda_bound_ = explicit_.quick_bound(system_, fixed_nodes_);

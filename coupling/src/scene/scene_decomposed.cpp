@@ -73,8 +73,7 @@ std::string thermal_refusal(const Scene& s) {
     return refuse("thermal.forward_euler.limit_estimate", quoted(io.fe_limit_estimate), "\"gershgorin\"");
   if (forward_euler && io.fe_max_dt > 0.0)
     return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
-  if (!c.fixed_faces.empty())
-    return refuse("thermal.fixed_temperature", std::to_string(c.fixed_faces.size()) + " face(s)", "adiabatic faces");
+  // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
   if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
   if (c.interface_temperature.enabled)
     return refuse("coupling.interface_temperature", "on", "off (the sub-cell interface temperature is serial)");

@@ -124,6 +124,10 @@ const std::vector<int>& DecomposedMpm<Dim>::owned_local_nodes() const {
 }
 
 template <int Dim>
+const Grid<Dim>& DecomposedMpm<Dim>::grid() const {
+  return impl_->grid;
+}
+template <int Dim>
 std::array<int, 2 * Dim> DecomposedMpm<Dim>::ghosted_nodes() const {
   std::array<int, 2 * Dim> r{};
   for (std::size_t d = 0; d < static_cast<std::size_t>(Dim); ++d) {
@@ -199,6 +203,7 @@ void DecomposedMpm<Dim>::owned_to_local(const std::vector<double>& owned, int co
   template const DecomposedMpm<D>::Stencils& DecomposedMpm<D>::current_stencils();                     \
   template int DecomposedMpm<D>::local_node_count() const;                                             \
   template const std::vector<int>& DecomposedMpm<D>::owned_local_nodes() const;                        \
+  template const Grid<D>& DecomposedMpm<D>::grid() const;                                               \
   template std::array<int, 2 * D> DecomposedMpm<D>::ghosted_nodes() const;                              \
   template void DecomposedMpm<D>::sum_to_owned(const std::vector<double>&, int, std::vector<double>&); \
   template void DecomposedMpm<D>::owned_to_local(const std::vector<double>&, int, std::vector<double>&);

@@ -22,6 +22,7 @@
 // and gathered at every assembly. Books: Σ_i M_i ΔT_i = frictional + plastic heat delivered +
 // reaction heat released (adiabatic edges; to the solver tolerance with a reaction).
 #include <frictherm/coupling/explicit_conduction.hpp>
+#include <frictherm/coupling/fixed_temperature.hpp>
 #include <frictherm/coupling/heat_handoff.hpp>
 #include <frictherm/coupling/heat_sources.hpp>
 #include <frictherm/coupling/hotspot_fates.hpp>
@@ -54,13 +55,6 @@ struct WindowPolicy {
   double max_temperature_rise = 1.0;
   double max_duration = std::numeric_limits<double>::infinity();  // adaptive: longest window (s)
   long max_steps = 0;                                              // adaptive: most steps (0: no limit)
-};
-
-/// A grid face held at a fixed temperature: every thermal unknown on it is a Dirichlet node.
-struct FixedTemperatureFace {
-  int axis = 0;
-  bool upper = false;
-  double temperature = 293.15;  // K
 };
 
 struct CouplerOptions {
@@ -204,6 +198,12 @@ class Coupler {
   }
   /// The checks and caches that follow a new system (assembled or gathered).
   void system_changed();
+  // Lattice index along an axis of the gathered system's unknown u (for_each_fixed_node).
+  auto fixed_lattice_along() const {
+    return [this](std::size_t u, int axis) {
+      return grid_.node_lattice(system_.grid_node[u])[static_cast<std::size_t>(axis)];
+    };
+  }
   /// Integrates the window [window_start_, time] matrix-free if it is short enough; false otherwise.
   bool matrix_free_window(mechanics::Particles<Dim>& particles, double dt);
   bool matrix_free_allowed() const;

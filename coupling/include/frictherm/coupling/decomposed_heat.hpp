@@ -38,8 +38,9 @@
 // takes the nearest unknown anywhere) it is refused with std::runtime_error on every rank. The
 // adaptive estimate of such a node takes the smallest unknown M_i of all ranks (the serial one the
 // nearest unknown's). Plastic heat and the sub-grid relaxation as the serial Coupler
-// (decomposed_sources.cpp). Differences from the serial Coupler: that refusal; fixed-temperature faces,
-// reaction heat, the reuse of matrix-free gathers, the KLU solver and the continuation are absent
+// (decomposed_sources.cpp). Fixed-temperature faces as the serial Coupler (for_each_fixed_node: the
+// same nodes, held in both paths). Differences from the serial Coupler: that refusal; reaction heat,
+// the reuse of matrix-free gathers, the KLU solver and the continuation are absent
 // (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
@@ -47,6 +48,7 @@
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/distributed.hpp>
 
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
@@ -83,6 +85,10 @@ struct DecomposedHeatOptions {
   /// CouplerOptions::subgrid_relaxation_time τ (s; infinite: none): the map back blends
   /// β = 1 − e^{−Δt/τ} of Σ_i S_ip T_i / Σ_i S_ip (the kept unknowns' end temperatures) into T_p.
   double subgrid_relaxation_time = std::numeric_limits<double>::infinity();
+  /// CouplerOptions::fixed_faces: the unknowns on these grid faces (for_each_fixed_node, the serial
+  /// rule) are held at the face's temperature: set before the window's sub-steps and after each
+  /// (matrix-free), Dirichlet rows of the distributed problem (assembled), out of the λ bounds.
+  std::vector<FixedTemperatureFace> fixed_faces;
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -175,6 +181,9 @@ class DecomposedHeat {
 
  private:
   template <int Dim> void check_materials(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void select_fixed_nodes(const mechanics::DecomposedMpm<Dim>& mpm);
+  // Owned node u held at face_temperature_[u] when it is an unknown (NaN: on no fixed face).
+  bool is_held(std::size_t u) const { return !face_temperature_.empty() && !std::isnan(face_temperature_[u]); }
   template <int Dim>
   void window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0, double dt);
   template <int Dim> void gather_mass(mechanics::DecomposedMpm<Dim>& mpm);
@@ -211,6 +220,7 @@ class DecomposedHeat {
   // The last gather: M_i and T_i (eq. 38) per owned node, M_i on the ghosted box, the unknowns'
   // threshold and smallest M_i over all ranks; the unknowns' global numbering of assembled windows.
   std::vector<double> M_, T0_, local_M_;
+  std::vector<double> face_temperature_;  // per owned node: its fixed face's temperature (K), NaN if none; empty without faces
   double threshold_ = 0.0, min_unknown_mass_ = 0.0;
   std::unique_ptr<UnknownNumbering> ids_;
   // The window: pending work per owned node, times (s), steps, the adaptive estimate (K).

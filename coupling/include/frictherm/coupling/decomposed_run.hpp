@@ -12,8 +12,9 @@
 // What a decomposed run supports (anything else is refused by decomposed_run_refusal, naming the
 // scene key and its value): 2D and 3D, linear-elastic materials, the USL update with FLIP, the
 // linear, uGIMP and quadratic B-spline shapes, fixed grid faces, gravity, multimaterial contact with
-// any friction law and the position, displacement or velocity_only separation; in 2D frictional
-// heating with forward-Euler conduction every mechanics step (matrix-free, the gather every window).
+// any friction law and the position, displacement or velocity_only separation; frictional and
+// plastic heating with conduction (DecomposedHeat), fixed-temperature faces among its boundaries. The
+// full list: docs/distributed_run.md, "What happens".
 #include <frictherm/coupling/decomposed_support.hpp>  // decomposed_run_refusal
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>

@@ -307,6 +307,8 @@ class DecomposedMpm {
   /// owned_nodes()), its local node.
   int local_node_count() const;
   const std::vector<int>& owned_local_nodes() const;
+  /// The run's grid (serial lattice index = DMDA index − Grid<Dim>::ghost).
+  const Grid<Dim>& grid() const;
   /// The ghosted box in DMDA indices, [begin, end) per direction as owned_nodes(): the local
   /// numbering is x fastest over it.
   std::array<int, 2 * Dim> ghosted_nodes() const;
