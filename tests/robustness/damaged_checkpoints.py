@@ -372,6 +372,18 @@ def decomposed_cases(seed, rank_files, full):
         raw = open(os.path.join(seed, file), "rb").read()
         for name in ("mechanics/velocity", "gather/T", "mechanics/coor") if full else (("mechanics/velocity",), ("mechanics/coor",))[k % 2]:
             cases.append((f"{file} /{name} one stored bit flipped", file, name, flip_in_chunk(raw, *stored[name])))
+    # The global file (every rank reads it): the run loop's state and the series rows.
+    def global_nan(f):
+        f["run/time"][...] = numpy.nan
+    def global_short(f):
+        replace(f, "output/series_rows", f["output/series_rows"][:-1])
+    def global_step(f):
+        f["run/last_series_step"][...] = f["run/step"][()] + 1
+    for k, (label, name, damage) in enumerate((("NaN injected", "run/time", global_nan),
+                                               ("one item short", "output/series_rows", global_short),
+                                               ("after /run/step", "run/last_series_step", global_step))):
+        if full or k < 2:
+            cases.append((f"R.h5.checkpoint /{name} {label}", "R.h5.checkpoint", name, damage))
     def strip(f):
         d = f["mechanics/velocity"][()]
         del f["mechanics/velocity"]

@@ -214,6 +214,7 @@ long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
       throw std::runtime_error("checkpoint '" + path + "' was written by " + std::to_string(ranks) +
                                " ranks, resumed on " + std::to_string(size) + ": run mpirun -n " +
                                std::to_string(ranks));
+    ckpt::check_global_file(f.get(), path);
     global_part(ckpt::Reader{f.get(), path, 0, "/", true});
     const Handle g = open_rank_file(path, generation, rank);
     const std::string file = decomposed_rank_checkpoint(path, generation, rank);
@@ -234,6 +235,7 @@ long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int d
   try {
     const h5detail::Quiet quiet;
     const Handle f = open_global(path, dim, ranks, generation);
+    ckpt::check_global_file(f.get(), path);
     global_part(ckpt::Reader{f.get(), path, 0, "/", true});
     for (int j = 0; j < static_cast<int>(ranks); ++j) {
       const Handle g = open_rank_file(path, generation, j);

@@ -302,4 +302,23 @@ void check_rank_file(hid_t f, const std::string& path, const RankSizes& z) {
                    "books/exchanges", "window/steps"});
 }
 
+// A decomposed run's global file: the run loop's counters and steps, the series rows a whole number
+// of rows, the marks of this state (as check_arrays for the serial run's).
+void check_global_file(hid_t f, const std::string& path) {
+  counts(f, path, {"run/step", "run/snapshots", "output/series_columns"});
+  const std::vector<long> step = longs(f, path, "run/step");
+  if (step.size() == 1) {
+    for (const char* a : {"run/last_series_step", "run/last_snapshot_step"})
+      in_range(f, path, a, -1, step[0] + 1, "-1 or a step up to /run/step");
+    const std::vector<long> mark_step = longs(f, path, "marks/step");
+    if (mark_step.size() == 1 && mark_step[0] != step[0])
+      damaged(path, "marks/step", "holds step " + std::to_string(mark_step[0]) + ", /run/step " + std::to_string(step[0]));
+  }
+  const std::vector<long> columns = longs(f, path, "output/series_columns");
+  const long rows = items(f, path, "output/series_rows");
+  if (columns.size() == 1 && columns[0] > 0 && rows > 0 && rows % columns[0] != 0)
+    damaged(path, "output/series_rows", "holds " + std::to_string(rows) + " values, not whole rows of " +
+                                            std::to_string(columns[0]) + " columns (/output/series_columns)");
+}
+
 }  // namespace frictherm::coupling::ckpt

@@ -44,4 +44,8 @@ struct RankSizes {
 /// file and the dataset.
 void check_rank_file(hid_t f, const std::string& path, const RankSizes& z);
 
+/// A decomposed run's global file: counters >= 0, the steps of the last row and snapshot up to
+/// /run/step, /marks/step = /run/step, whole series rows. Throws std::runtime_error naming the dataset.
+void check_global_file(hid_t f, const std::string& path);
+
 }  // namespace frictherm::coupling::ckpt
