@@ -359,7 +359,7 @@ def damage(name, change):
             data = change(numpy.array(f[name][...]))
             del f[name]
             # With a Fletcher32 checksum as frictherm writes it (format 3): the damage is what is refused.
-            f.create_dataset(name, data=data, chunks=data.shape if data.size else None, fletcher32=data.size > 0)
+            f.create_dataset(name, data=data, chunks=True if data.size else None, fletcher32=data.size > 0)
     return apply
 
 
