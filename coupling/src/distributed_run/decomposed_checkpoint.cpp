@@ -44,10 +44,7 @@ void write_text(hid_t f, const std::string& file, const char* name, const std::s
 void write_file(const std::string& file, const std::function<void(hid_t, const ckpt::Writer&)>& fill) {
   try {
     const h5detail::Quiet quiet;
-    const Handle fapl = ckpt::file_access(file);
-    const Handle f{check_id(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), file,
-                            "cannot create the checkpoint"),
-                   H5Fclose};
+    const Handle f = ckpt::create_file(file);
     fill(f.get(), ckpt::Writer{f.get(), file});
     check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), file, "cannot flush the checkpoint");
   } catch (...) {

@@ -45,8 +45,10 @@ void write_array(hid_t group, const std::string& file, const std::string& name, 
                  hsize_t n, int components) {
   const hsize_t dims[2] = {n, static_cast<hsize_t>(components)};
   const Handle space{check_id(H5Screate_simple(components == 1 ? 1 : 2, dims, nullptr), file, "dataspace"), H5Sclose};
+  // The groups on the way, without time stamps (the 1.10 object headers would store them).
+  for (std::size_t slash = name.find('/'); slash != std::string::npos; slash = name.find('/', slash + 1))
+    if (H5Lexists(group, name.substr(0, slash).c_str(), H5P_DEFAULT) <= 0) create_group(group, file, name.substr(0, slash));
   const Handle lcpl{check_id(H5Pcreate(H5P_LINK_CREATE), file, "property list"), H5Pclose};
-  check(H5Pset_create_intermediate_group(lcpl.get(), 1), file, "property list");
   const Handle dcpl{check_id(H5Pcreate(H5P_DATASET_CREATE), file, "property list"), H5Pclose};
   check(H5Pset_obj_track_times(dcpl.get(), 0), file, "property list");  // equal states give equal files
   if (n > 0) {  // a Fletcher32 checksum per chunk (chunked layout: one chunk up to kChunkBytes; issue 34)
@@ -109,6 +111,23 @@ Handle open_array(hid_t group, const std::string& file, const std::string& name,
                              "' has no checksum (Fletcher32 filter; every non-empty dataset of a checkpoint has one "
                              "since format 3); the checkpoint is damaged");
   return d;
+}
+
+Handle create_group(hid_t parent, const std::string& file, const std::string& name) {
+  const Handle gcpl{check_id(H5Pcreate(H5P_GROUP_CREATE), file, "property list"), H5Pclose};
+  check(H5Pset_obj_track_times(gcpl.get(), 0), file, "property list");  // equal states give equal files
+  return Handle{check_id(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, gcpl.get(), H5P_DEFAULT), file,
+                         "cannot create the group '" + name + "'"),
+                H5Gclose};
+}
+
+Handle create_file(const std::string& file) {
+  const Handle fcpl{check_id(H5Pcreate(H5P_FILE_CREATE), file, "property list"), H5Pclose};
+  check(H5Pset_obj_track_times(fcpl.get(), 0), file, "property list");  // the root group's
+  const Handle fapl = file_access(file);
+  return Handle{check_id(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), file,
+                         "cannot create the checkpoint"),
+                H5Fclose};
 }
 
 Handle file_access(const std::string& file) {
@@ -252,18 +271,14 @@ void write_file(const std::string& path, mechanics::Simulation<Dim>& sim, const 
   const std::string tmp = path + "." + std::to_string(static_cast<long>(getpid())) + ".tmp";
   try {
     const h5detail::Quiet quiet;
-    const Handle fapl = ckpt::file_access(tmp);
-    const Handle f{check_id(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), tmp,
-                            "cannot create the checkpoint"),
-                   H5Fclose};
+    const Handle f = ckpt::create_file(tmp);
     write_int_attribute(f.get(), tmp, "format", ckpt::kFormat);
     write_int_attribute(f.get(), tmp, "dimension", Dim);
     write_text(f.get(), tmp, "scene", scene_text);
     write_text(f.get(), tmp, "scene_source", source);
     write_text(f.get(), tmp, "scene_overrides", overrides);
     {
-      const Handle g{check_id(H5Gcreate2(f.get(), "mechanics", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp, "group"),
-                     H5Gclose};
+      const Handle g = ckpt::create_group(f.get(), tmp, "mechanics");
       sim.visit_state(ckpt::Writer{g.get(), tmp});
     }
     const ckpt::Writer root{f.get(), tmp};

@@ -68,6 +68,9 @@ h5detail::Handle open_array(hid_t group, const std::string& file, const std::str
                             hid_t memory_type = H5I_INVALID_HID, const std::string& shown = "");
 /// The file access list checkpoints are created with (the HDF5 1.10 format).
 h5detail::Handle file_access(const std::string& file);
+/// A new checkpoint file (truncated) in that format, and a group in it, without time stamps.
+h5detail::Handle create_file(const std::string& file);
+h5detail::Handle create_group(hid_t parent, const std::string& file, const std::string& name);
 /// Whether the dataset carries the Fletcher32 checksum filter (its reads then verify every chunk).
 bool has_checksum(hid_t dataset);
 /// Refuses (std::runtime_error naming `shown`) a non-finite value among `values` unless `allowed`
