@@ -176,6 +176,7 @@ Handle open_global(const std::string& path, int dim, long& ranks, long& generati
                              "; written by another frictherm version)"));
   if (H5Aexists(f.get(), "ranks") <= 0)
     throw std::runtime_error("checkpoint '" + path + "' was written by a serial run: resume it without mpirun");
+  ckpt::check_objects(f.get(), path);
   if (read_int_attribute(f.get(), path, "dimension") != dim)
     throw std::runtime_error("checkpoint '" + path + "': of another dimension than the scene");
   ranks = read_int_attribute(f.get(), path, "ranks");
@@ -191,6 +192,7 @@ Handle open_rank_file(const std::string& path, long generation, int r) {
            H5Fclose};
   if (read_int_attribute(g.get(), file, "generation") != generation || read_int_attribute(g.get(), file, "rank") != r)
     throw std::runtime_error("checkpoint '" + file + "': of another generation or rank than its name says");
+  ckpt::check_objects(g.get(), file);
   return g;
 }
 

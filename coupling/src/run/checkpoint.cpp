@@ -113,6 +113,22 @@ Handle open_array(hid_t group, const std::string& file, const std::string& name,
   return d;
 }
 
+namespace {
+herr_t note_object(hid_t, const char* name, const H5O_info_t*, void* last) {
+  *static_cast<std::string*>(last) = name;
+  return 0;
+}
+}  // namespace
+
+void check_objects(hid_t f, const std::string& file) {
+  // Every object header read (H5O_INFO_ALL loads all its chunks): the 1.10 format checksums them, so
+  // a damaged header of an object the reader would not open by name (a group's continuation chunk,
+  // an index) is found too, not only the datasets' data (Fletcher32).
+  std::string last;
+  if (H5Ovisit2(f, H5_INDEX_NAME, H5_ITER_NATIVE, note_object, &last, H5O_INFO_ALL) < 0)
+    h5detail::fail(file, "cannot read every object of the checkpoint (the last read: '/" + last + "'); the file is damaged");
+}
+
 Handle create_group(hid_t parent, const std::string& file, const std::string& name) {
   const Handle gcpl{check_id(H5Pcreate(H5P_GROUP_CREATE), file, "property list"), H5Pclose};
   check(H5Pset_obj_track_times(gcpl.get(), 0), file, "property list");  // equal states give equal files
@@ -223,6 +239,7 @@ int read_int_attribute(hid_t obj, const std::string& file, const char* name) {
 Handle open_checkpoint(const std::string& path, int dimension) {
   Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
   const int format = read_int_attribute(f.get(), path, "format");
+  if (format == ckpt::kFormat) ckpt::check_objects(f.get(), path);
   if (format == 2)  // before issue 34: no checksums, no /reaction/enabled
     throw std::runtime_error("checkpoint '" + path + "': format 2, written by a frictherm version before checkpoints "
                              "carried checksums (expected format " + std::to_string(ckpt::kFormat) +

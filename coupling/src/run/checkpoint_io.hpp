@@ -71,6 +71,9 @@ h5detail::Handle file_access(const std::string& file);
 /// A new checkpoint file (truncated) in that format, and a group in it, without time stamps.
 h5detail::Handle create_file(const std::string& file);
 h5detail::Handle create_group(hid_t parent, const std::string& file, const std::string& name);
+/// Reads every object header of the open checkpoint `f` (their metadata checksums); throws
+/// std::runtime_error naming `file` when one is damaged.
+void check_objects(hid_t f, const std::string& file);
 /// Whether the dataset carries the Fletcher32 checksum filter (its reads then verify every chunk).
 bool has_checksum(hid_t dataset);
 /// Refuses (std::runtime_error naming `shown`) a non-finite value among `values` unless `allowed`
