@@ -119,7 +119,14 @@ void rewrite(hid_t f, const std::string& name, const std::vector<double>& values
   const hid_t space = H5Screate_simple(rank, dims, nullptr);
   const hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);
   H5Pset_create_intermediate_group(lcpl, 1);
-  const hid_t d = H5Dcreate2(f, name.c_str(), type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT);
+  // With a Fletcher32 checksum as checkpoints hold them (format 3), so the mutation is what is checked.
+  const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  if (H5Sget_simple_extent_npoints(space) > 0) {
+    H5Pset_chunk(dcpl, rank, dims);
+    H5Pset_fletcher32(dcpl);
+  }
+  const hid_t d = H5Dcreate2(f, name.c_str(), type, space, lcpl, dcpl, H5P_DEFAULT);
+  H5Pclose(dcpl);
   if (d >= 0 && !values.empty()) H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
   if (d >= 0) H5Dclose(d);
   H5Pclose(lcpl);

@@ -358,7 +358,8 @@ def damage(name, change):
         with h5py.File(os.path.join(workdir, "R.h5.checkpoint"), "r+") as f:
             data = change(numpy.array(f[name][...]))
             del f[name]
-            f.create_dataset(name, data=data)
+            # With a Fletcher32 checksum as frictherm writes it (format 3): the damage is what is refused.
+            f.create_dataset(name, data=data, chunks=True if data.size else None, fletcher32=data.size > 0)
     return apply
 
 

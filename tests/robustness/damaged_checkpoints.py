@@ -52,8 +52,9 @@ HARMLESS = {
 }
 # A counter set to 2^31 - 1: a plausible count that only reports (integrator counts in /meta, the last
 # step's contact counters in series rows, window counts) or, for the id counter and the penalty call
-# counter, a valid state of another run: a checkpoint has no checksum, so a valid value cannot be
-# told from the written one (docs/robustness.md "Damaged checkpoints").
+# counter, a valid state of another run. The corpus rewrites the value with a valid checksum (as a
+# program that writes a wrong value would), so the checksum cannot tell it from the written one
+# (docs/robustness.md "Damaged checkpoints").
 PLAUSIBLE_COUNTERS = ("integrator/", "mechanics/contact_stats/", "books/windows", "books/steps",
                       "books/continuation_intervals", "hotspots/next_id", "mechanics/penalty/stamp", "window_steps",
                       "run/hotspot_windows_written")
@@ -76,18 +77,17 @@ def harmless(name, label):
     if name == "mechanics/penalty/records" and label == "emptied":
         return ("the last step's contact records (none: no contact) are only reported, in that step's series row, "
                 "already written; the next step replaces them")
-    if name == "reaction/particle_progress" and label == "emptied":
-        return ("KNOWN GAP: reads as a loading without a reaction, which `continue` with a new reaction starts "
-                "from lambda = 0; `resume` then restarts the reaction (docs/robustness.md)")
     if label == "value 2147483647" and name.startswith(PLAUSIBLE_COUNTERS):
         return "a plausible count (PLAUSIBLE_COUNTERS)"
     return None
 
 
-# A flipped byte: refused naming the file (exit code 2), or completed (exit code 0) only when the
-# damaged file still has every dataset and attribute of the seed with their types and shapes, so the
-# flip changed a stored value or an unused byte: a checkpoint has no checksum, and such a file is a
-# valid checkpoint of another state (docs/robustness.md).
+# A flipped byte outside every dataset's stored data: refused naming the file (exit code 2), or
+# completed (exit code 0) only when the damaged file still has every dataset and attribute of the
+# seed with their types and shapes, so the flip changed an unused byte (free space, padding, a
+# checksum-free header field the library does not read). A flip inside a dataset's stored data
+# (its chunk, checksum included) must be refused since checkpoints carry Fletcher32 checksums
+# (format 3; docs/robustness.md).
 FLIP_OK = "flip"
 
 
@@ -124,8 +124,38 @@ def walk(f):
 
 
 def replace(f, name, data, dtype=None):
+    """Rewrites dataset `name` with `data`, with a Fletcher32 checksum as frictherm writes them (format 3)
+    when it holds values, so that the damage itself, not the missing checksum, is what is refused."""
     del f[name]
-    f.create_dataset(name, data=data, dtype=dtype)
+    data = numpy.asarray(data, dtype=dtype)
+    if data.size > 0:
+        f.create_dataset(name, data=data, chunks=data.shape, fletcher32=True)
+    else:
+        f.create_dataset(name, data=data)
+
+
+def chunks(path):
+    """{dataset name: (byte offset, size)} of every dataset's first stored chunk (its contiguous data,
+    in a checkpoint before checksums)."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset) and obj.size > 0:
+                if obj.chunks is not None:
+                    info = obj.id.get_chunk_info(0)
+                    out[name] = (info.byte_offset, info.size)
+                elif obj.id.get_offset() is not None:
+                    out[name] = (obj.id.get_offset(), obj.id.get_storage_size())
+        f.visititems(visit)
+    return out
+
+
+def flip_in_chunk(raw, offset, size, at=None):
+    """`raw` with one bit of the chunk at `offset` flipped: the lowest bit of its middle byte (a double's
+    or an integer's value changed to another valid one; the checksum alone can tell)."""
+    damaged = bytearray(raw)
+    damaged[offset + (size // 2 if at is None else at)] ^= 0x01
+    return bytes(damaged)
 
 
 def other_type(dtype):
@@ -194,7 +224,7 @@ def attribute_damages():
         out.append((a, "a string", set_attr(a, numpy.bytes_(b"2"))))
         out.append((a, "a float 2.5", set_attr(a, numpy.float64(2.5))))
         out.append((a, "an array", set_attr(a, numpy.array([2, 2], dtype=numpy.int32))))
-    for v in (1, 3, -1, 2**31 - 1):
+    for v in (1, 2, 4, -1, 2**31 - 1):  # 2: a checkpoint before checksums (refused, docs/checkpoints.md)
         out.append(("format", f"= {v}", set_attr("format", numpy.int32(v))))
     for v in (3, 0, 1, -7):
         out.append(("dimension", f"= {v}", set_attr("dimension", numpy.int32(v))))
@@ -285,6 +315,139 @@ class Corpus:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+# The decomposed seed (--decomposed, ctest robustness.damaged_checkpoints_mpi): the heated sliding block
+# of the decomposed tests (tests/coupling/scenes/decomposed_sliding_block.json, 1280 particles, heat on
+# the grid, hot spots) under `mpirun -n 2` to 0.2 ms with a checkpoint at 0.1 ms; its rank files
+# damaged one at a time, and `mpirun -n 2 frictherm resume R.h5` (in place) run on each.
+DECOMPOSED_SCENE = pathlib.Path(__file__).resolve().parent.parent / "coupling" / "scenes" / "decomposed_sliding_block.json"
+
+
+def mpirun(ranks):
+    cmd = ["mpirun", "--oversubscribe", "-n", str(ranks)]
+    return cmd + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
+
+
+def decomposed_cases(seed, rank_files, full):
+    """(label, file, expected text, mutate or raw bytes) for the rank files of the decomposed seed."""
+    cases = []
+    floats = ["mechanics/coor", "mechanics/velocity", "mechanics/mass", "mechanics/stress", "mechanics/F",
+              "mechanics/scalars", "mechanics/time", "mechanics/work_first", "window/pending", "gather/M",
+              "gather/T", "gather/local_M", "books/heat_delivered"]
+    for k, name in enumerate(floats if full else floats[::3]):
+        file = rank_files[k % len(rank_files)]
+        values = (("NaN", numpy.nan), ("+Inf", numpy.inf), ("-Inf", -numpy.inf))
+        for label, v in values if full else values[k % 3: k % 3 + 1]:  # quick: the kinds in rotation
+            def inject(f, name=name, v=v):
+                d = f[name][()]
+                d.reshape(-1)[(d.size - 1) // 2] = v
+                f[name][...] = d
+            cases.append((f"{file} /{name} {label} injected", file, name, inject))
+    for k, (name, v) in enumerate((("mechanics/material", -2), ("mechanics/material", 2**31 - 1), ("mechanics/id", -2),
+                                   ("mechanics/id", 2**31 - 1), ("mechanics/owned_nodes", 10**6),
+                                   ("mechanics/owned_nodes", -2), ("mechanics/contact_stats", -2),
+                                   ("books/windows", -2))):
+        if not full and k % 2:
+            continue
+        file = rank_files[k % len(rank_files)]
+        def set_value(f, name=name, v=v):
+            d = f[name][()]
+            d.reshape(-1)[(d.size - 1) // 2 if name != "mechanics/owned_nodes" else (1 if v > 0 else 0)] = v
+            f[name][...] = d
+        cases.append((f"{file} /{name} value {v}", file, name, set_value))
+    for k, (name, label, cut) in enumerate((("mechanics/mass", "one item short", -1), ("mechanics/velocity", "truncated to half", 0.5),
+                                            ("mechanics/material", "one item more", +1), ("mechanics/work_first", "one item short", -1),
+                                            ("window/pending", "emptied", 0), ("gather/local_M", "one item more", +1),
+                                            ("gather/T", "one item short", -1), ("mechanics/id", "one item more", +1))):
+        if not full and k % 2:
+            continue
+        file = rank_files[k % len(rank_files)]
+        def resize(f, name=name, cut=cut):
+            d = f[name][()]
+            n = len(d)
+            d = d[: n - 1] if cut == -1 else d[: n // 2] if cut == 0.5 else d[:0] if cut == 0 else numpy.concatenate([d, d[-1:]])
+            replace(f, name, d)
+        cases.append((f"{file} /{name} {label}", file, name, resize))
+    for k, file in enumerate(rank_files):  # a valid value of another state: only the checksum tells
+        stored = chunks(os.path.join(seed, file))
+        raw = open(os.path.join(seed, file), "rb").read()
+        for name in ("mechanics/velocity", "gather/T", "mechanics/coor") if full else (("mechanics/velocity",), ("mechanics/coor",))[k % 2]:
+            cases.append((f"{file} /{name} one stored bit flipped", file, name, flip_in_chunk(raw, *stored[name])))
+    # The global file (every rank reads it): the run loop's state and the series rows.
+    def global_nan(f):
+        f["run/time"][...] = numpy.nan
+    def global_short(f):
+        replace(f, "output/series_rows", f["output/series_rows"][:-1])
+    def global_step(f):
+        f["run/last_series_step"][...] = f["run/step"][()] + 1
+    for k, (label, name, damage) in enumerate((("NaN injected", "run/time", global_nan),
+                                               ("one item short", "output/series_rows", global_short),
+                                               ("after /run/step", "run/last_series_step", global_step))):
+        if full or k < 2:
+            cases.append((f"R.h5.checkpoint /{name} {label}", "R.h5.checkpoint", name, damage))
+    def strip(f):
+        d = f["mechanics/velocity"][()]
+        del f["mechanics/velocity"]
+        f.create_dataset("mechanics/velocity", data=d)
+    cases.append((f"{rank_files[-1]} /mechanics/velocity rewritten without its checksum", rank_files[-1],
+                  "no checksum", strip))
+    return cases
+
+
+def run_decomposed(exe, top, full, verbose, jobs):
+    """The decomposed seed's corpus; returns the failures."""
+    seed = os.path.join(top, "decomposed")
+    os.makedirs(seed)
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_MCA_mpi_yield_when_idle="1")
+    p = subprocess.run(mpirun(2) + [exe, "run", str(DECOMPOSED_SCENE), "-q", "-o", "R.h5", "--set", "run.end_time=2e-4",
+                                    "--set", "run.checkpoint_interval=1e-4"], cwd=seed, env=env, capture_output=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stderr.decode(errors="replace")
+    rank_files = sorted(n for n in os.listdir(seed) if n.startswith("R.h5.checkpoint.") and ".rank" in n)
+    assert len(rank_files) == 2, rank_files
+    failures, counts = [], {}
+
+    def case(label, file, expect, damage):
+        folder = tempfile.mkdtemp(dir=top, prefix="case")
+        for n in os.listdir(seed):
+            shutil.copyfile(os.path.join(seed, n), os.path.join(folder, n))
+        if isinstance(damage, bytes):
+            with open(os.path.join(folder, file), "wb") as f:
+                f.write(damage)
+        else:
+            with h5py.File(os.path.join(folder, file), "a") as f:
+                damage(f)
+        before = {n: sha(os.path.join(folder, n)) for n in os.listdir(folder)}
+        try:
+            r = subprocess.run(mpirun(2) + [exe, "resume", "R.h5", "-q"], cwd=folder, env=env, capture_output=True,
+                               timeout=120)
+            rc, err = r.returncode, r.stderr.decode(errors="replace")
+        except subprocess.TimeoutExpired:
+            rc, err = None, "timed out"
+        problems = []
+        if rc != 2:
+            problems.append(f"exit code {rc} (expected 2)")
+        if "signal" in err.lower() or "Sanitizer" in err:
+            problems.append("a signal or sanitizer report")
+        if expect not in err or (rc == 2 and file not in err):
+            problems.append(f"message does not name '{expect}' and '{file}'")
+        after = {n: sha(os.path.join(folder, n)) for n in os.listdir(folder)}
+        if after != before:
+            problems.append("a file of the run changed, was added or removed")
+        first = next((l for l in err.splitlines() if "frictherm" in l), err.strip()[:200])
+        counts["refused" if rc == 2 else "other"] = counts.get("refused" if rc == 2 else "other", 0) + 1
+        line = f"mpirun resume {label}: exit {rc} {'ok' if not problems else 'FAIL ' + '; '.join(problems)} | {first[:240]}"
+        if problems:
+            failures.append(line)
+        if problems or verbose:
+            print(line, flush=True)
+        shutil.rmtree(folder, ignore_errors=True)
+    # Two resumes at a time: a refused resume spends most of its wall time starting MPI, not computing.
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        list(pool.map(lambda x: case(*x), decomposed_cases(seed, rank_files, full)))
+    print(f"decomposed seed: {sum(counts.values())} cases: {counts}; {len(failures)} failures", flush=True)
+    return failures
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("exe")
@@ -295,10 +458,18 @@ def main():
     ap.add_argument("--full", action="store_true", help="every damage of every dataset (docs/robustness.md counts)")
     ap.add_argument("--every", type=int, default=int(os.environ.get("DAMAGED_CHECKPOINTS_EVERY", "1")),
                     help="only every Nth case (the sanitizer build: 10-50x slower)")
+    ap.add_argument("--decomposed", action="store_true",
+                    help="the decomposed seed under mpirun -n 2 (its rank files damaged) instead of the serial one")
     a = ap.parse_args()
     t0 = time.time()
     top = a.keep or tempfile.mkdtemp(prefix="frictherm_damaged_")
     os.makedirs(top, exist_ok=True)
+    if a.decomposed:
+        failures = run_decomposed(os.path.abspath(a.exe), top, a.full, a.v, a.j)
+        print(f"{time.time() - t0:.1f} s")
+        if not a.keep:
+            shutil.rmtree(top, ignore_errors=True)
+        return 1 if failures else 0
     c = Corpus(os.path.abspath(a.exe), top, a.v)
     mid = c.seed("mid", ["--set", f"run.max_steps={MID_STEPS}"])  # a checkpoint in the loading
     eol = c.seed("eol", [])  # the end-of-loading checkpoint (frictherm continue)
@@ -326,8 +497,32 @@ def main():
             cases.append((seed, command, f"attribute {attr} {label}", attr, m, None))
     for label, m in harmless_damages():
         cases.append((mid, "resume", label, None, m, None))
+    # The reaction's datasets disagreeing (issue 34: an emptied progress had restarted the reaction on
+    # `resume`): always, through resume and continue.
+    def set_enabled(f, v):
+        f["reaction/enabled"][...] = v
+    for seed, command in ((mid, "resume"), (eol, "continue")):
+        cases.append((seed, command, "/reaction/particle_progress emptied (reaction check)", "reaction/particle_progress",
+                      lambda f: replace(f, "reaction/particle_progress", numpy.zeros(0)), None))
+        cases.append((seed, command, "/reaction/enabled 0 with the progress kept (reaction check)",
+                      "reaction/particle_progress", lambda f: set_enabled(f, 0), None))
+    # A dataset rewritten with the same values but without its checksum: refused naming the checksum.
+    for name in ("mechanics/time", "mechanics/particles/velocity", "nodal_temperature"):
+        def strip(f, name=name):
+            d = f[name][()]
+            del f[name]
+            f.create_dataset(name, data=d)
+        cases.append((mid, "resume", f"/{name} rewritten without its checksum", "no checksum", strip, None))
     raw = open(os.path.join(mid, "R.h5.checkpoint"), "rb").read()
     size = len(raw)
+    # One bit of a dataset's stored data flipped (a valid value of another state): refused by the
+    # checksum, naming the dataset. The quick corpus: every fifth dataset; --full: every one.
+    stored = chunks(os.path.join(mid, "R.h5.checkpoint"))
+    for k, (name, (offset, length)) in enumerate(sorted(stored.items())):
+        if a.full or k % 5 == 0:
+            cases.append((mid, "resume", f"/{name} one stored bit flipped", name, None,
+                          flip_in_chunk(raw, offset, length)))
+    data_bytes = [(o, o + n, name) for name, (o, n) in stored.items()]
     cuts = {0, 1, 8, 96, 512, 2048, size // 4, size // 2, 3 * size // 4, size - 1024, size - 1}
     for cut in sorted(cuts if a.full else {0, 96, 2048, size // 2, size - 1}):
         cases.append((mid, "resume", f"file cut at byte {cut} of {size}", "R.h5.checkpoint", None, raw[:cut]))
@@ -338,7 +533,10 @@ def main():
     for at in flips if a.full else flips[::3]:
         damaged = bytearray(raw)
         damaged[at] ^= 0xFF
-        cases.append((mid, "resume", f"byte {at} of {size} flipped", FLIP_OK, None, bytes(damaged)))
+        inside = [name for lo, hi, name in data_bytes if lo <= at < hi]
+        expect = inside[0] if inside else FLIP_OK  # stored data: the checksum refuses it, naming the dataset
+        cases.append((mid, "resume", f"byte {at} of {size} flipped" + (f" (in /{inside[0]})" if inside else ""),
+                      expect, None, bytes(damaged)))
     cases = [x for x in cases if a.k in x[2]][::max(1, a.every)]
     print(f"{len(cases)} damaged checkpoints ({len(datasets)} datasets, {len(groups)} groups, {size} bytes)", flush=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, a.j)) as pool:

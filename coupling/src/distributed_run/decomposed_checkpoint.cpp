@@ -2,6 +2,7 @@
 // with the serial checkpoint's HDF5 visitors (run/checkpoint_io.hpp).
 #include "distributed_run/decomposed_checkpoint.hpp"
 
+#include "run/checkpoint_checks.hpp"
 #include "run/checkpoint_io.hpp"
 #include "distributed_run/decomposed_setup.hpp"
 
@@ -18,8 +19,6 @@ namespace {
 using h5detail::check;
 using h5detail::check_id;
 using h5detail::Handle;
-
-constexpr int kFormat = 2;  // the serial checkpoint's format (checkpoint.cpp): same root layout
 
 void write_int_attribute(hid_t obj, const std::string& file, const char* name, long value) {
   const Handle space{check_id(H5Screate(H5S_SCALAR), file, "dataspace"), H5Sclose};
@@ -45,9 +44,7 @@ void write_text(hid_t f, const std::string& file, const char* name, const std::s
 void write_file(const std::string& file, const std::function<void(hid_t, const ckpt::Writer&)>& fill) {
   try {
     const h5detail::Quiet quiet;
-    const Handle f{check_id(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), file,
-                            "cannot create the checkpoint"),
-                   H5Fclose};
+    const Handle f = ckpt::create_file(file);
     fill(f.get(), ckpt::Writer{f.get(), file});
     check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), file, "cannot flush the checkpoint");
   } catch (...) {
@@ -114,7 +111,7 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
     const std::string tmp = path + "." + std::to_string(static_cast<long>(getpid())) + ".tmp";
     try {
       write_file(tmp, [&](hid_t f, const ckpt::Writer& w) {
-        write_int_attribute(f, tmp, "format", kFormat);
+        write_int_attribute(f, tmp, "format", ckpt::kFormat);  // the serial layout
         write_int_attribute(f, tmp, "dimension", dim);
         write_int_attribute(f, tmp, "ranks", size);
         write_int_attribute(f, tmp, "generation", generation);
@@ -172,10 +169,14 @@ namespace {
 // `generation` from its attributes.
 Handle open_global(const std::string& path, int dim, long& ranks, long& generation) {
   Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
-  if (read_int_attribute(f.get(), path, "format") != kFormat)
-    throw std::runtime_error("checkpoint '" + path + "': written by another frictherm version (format)");
+  if (const long format = read_int_attribute(f.get(), path, "format"); format != ckpt::kFormat)
+    throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + " (expected " +
+                             std::to_string(ckpt::kFormat) + (format == 2 ? ": format 2 was written before checkpoints "
+                             "carried checksums; resume it with the version that wrote it, or run the scene again)" :
+                             "; written by another frictherm version)"));
   if (H5Aexists(f.get(), "ranks") <= 0)
     throw std::runtime_error("checkpoint '" + path + "' was written by a serial run: resume it without mpirun");
+  ckpt::check_objects(f.get(), path);
   if (read_int_attribute(f.get(), path, "dimension") != dim)
     throw std::runtime_error("checkpoint '" + path + "': of another dimension than the scene");
   ranks = read_int_attribute(f.get(), path, "ranks");
@@ -191,12 +192,13 @@ Handle open_rank_file(const std::string& path, long generation, int r) {
            H5Fclose};
   if (read_int_attribute(g.get(), file, "generation") != generation || read_int_attribute(g.get(), file, "rank") != r)
     throw std::runtime_error("checkpoint '" + file + "': of another generation or rank than its name says");
+  ckpt::check_objects(g.get(), file);
   return g;
 }
 
 }  // namespace
 
-long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim, const ckpt::RankSizes& sizes,
                                 const std::function<void(const ckpt::Reader&)>& rank_part,
                                 const std::function<void(const ckpt::Reader&)>& global_part) {
   int rank = 0, size = 1;
@@ -211,9 +213,12 @@ long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
       throw std::runtime_error("checkpoint '" + path + "' was written by " + std::to_string(ranks) +
                                " ranks, resumed on " + std::to_string(size) + ": run mpirun -n " +
                                std::to_string(ranks));
-    global_part(ckpt::Reader{f.get(), path, 0});
+    ckpt::check_global_file(f.get(), path);
+    global_part(ckpt::Reader{f.get(), path, 0, "/", true});
     const Handle g = open_rank_file(path, generation, rank);
-    rank_part(ckpt::Reader{g.get(), decomposed_rank_checkpoint(path, generation, rank), 0});
+    const std::string file = decomposed_rank_checkpoint(path, generation, rank);
+    ckpt::check_rank_file(g.get(), file, sizes);  // this rank's file, before any state is restored
+    rank_part(ckpt::Reader{g.get(), file, 0, "/", true});
   } catch (const std::exception& e) {
     error = e.what();
   }
@@ -221,7 +226,7 @@ long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
   return generation;
 }
 
-long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int dim, const ckpt::RankSizes& sizes,
                                    const std::function<void(const ckpt::Reader&, int)>& file_part,
                                    const std::function<void(const ckpt::Reader&)>& global_part) {
   std::string error;
@@ -229,10 +234,13 @@ long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int d
   try {
     const h5detail::Quiet quiet;
     const Handle f = open_global(path, dim, ranks, generation);
-    global_part(ckpt::Reader{f.get(), path, 0});
+    ckpt::check_global_file(f.get(), path);
+    global_part(ckpt::Reader{f.get(), path, 0, "/", true});
     for (int j = 0; j < static_cast<int>(ranks); ++j) {
       const Handle g = open_rank_file(path, generation, j);
-      file_part(ckpt::Reader{g.get(), decomposed_rank_checkpoint(path, generation, j), 0}, j);
+      const std::string file = decomposed_rank_checkpoint(path, generation, j);
+      ckpt::check_rank_file(g.get(), file, sizes);  // every file this rank reads, before any state is restored
+      file_part(ckpt::Reader{g.get(), file, 0, "/", true}, j);
     }
   } catch (const std::exception& e) {
     error = e.what();

@@ -17,6 +17,8 @@
 #include <frictherm/coupling/checkpoint.hpp>
 #include <frictherm/coupling/scene.hpp>
 
+#include "run/checkpoint_checks.hpp"
+
 #include <mpi.h>
 
 #include <functional>
@@ -37,17 +39,20 @@ void write_decomposed_checkpoint(MPI_Comm comm, const std::string& path, const S
                                  const std::function<void(const ckpt::Writer&)>& global_part);
 
 /// Collective: checks the global file (format, dimension, ranks = the communicator's size), reads it
-/// on every rank with `global_part` and this rank's file with `rank_part`; returns the generation.
-/// Throws std::runtime_error on every rank if any rank failed.
-long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+/// on every rank with `global_part` and this rank's file with `rank_part` once it passed the serial
+/// checks' check_rank_file against `sizes` (issue 34); every double read must be finite but for the
+/// serial sentinels. Returns the generation. Throws std::runtime_error on every rank if any rank
+/// failed (the lowest failing rank's message, naming its file and the dataset).
+long read_decomposed_checkpoint(MPI_Comm comm, const std::string& path, int dim, const ckpt::RankSizes& sizes,
                                 const std::function<void(const ckpt::Reader&)>& rank_part,
                                 const std::function<void(const ckpt::Reader&)>& global_part);
 
 /// Collective, for a checkpoint written by another number of ranks: reads the global file on every
 /// rank with `global_part`, then every rank file j of the checkpoint with `file_part(reader, j)` (each
 /// rank takes what it needs: some files' particles, the heat of its owned nodes). Returns the
-/// generation; throws std::runtime_error on every rank if any rank failed.
-long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int dim,
+/// generation; throws std::runtime_error on every rank if any rank failed. Every file is checked as
+/// above (`sizes.ghosted_nodes` -1: the files' ghosted boxes are another decomposition's).
+long read_redistributed_checkpoint(MPI_Comm comm, const std::string& path, int dim, const ckpt::RankSizes& sizes,
                                    const std::function<void(const ckpt::Reader&, int)>& file_part,
                                    const std::function<void(const ckpt::Reader&)>& global_part);
 

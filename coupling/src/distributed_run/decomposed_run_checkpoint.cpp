@@ -32,15 +32,50 @@ void DecomposedRun<Dim>::checkpoint() {
   checkpoint_seconds_ += seconds_since(c0);
 }
 
+// Collective: what a rank file must fit (ckpt::check_rank_file), from the decomposition built from
+// the scene; `ghosted` false for the files of another decomposition.
+template <int Dim>
+ckpt::RankSizes DecomposedRun<Dim>::rank_sizes(bool ghosted) const {
+  ckpt::RankSizes z;
+  z.particles = static_cast<long>(mpm_->global_particles());
+  z.materials = static_cast<long>(s_.materials.size());
+  for (const auto& m : s_.materials) z.rigid.push_back(m.is_rigid());
+  const std::array<int, 2 * Dim> box = mpm_->ghosted_nodes();
+  z.ghosted_nodes = ghosted ? 1 : -1;
+  const typename Mpm::CheckpointState st = mpm_->checkpoint_state();  // the swarm's fields as built
+  const auto local = static_cast<long>(mpm_->local_particles());
+  std::vector<long> components;  // values per particle of each field (the largest over ranks: some may hold none)
+  std::vector<double> largest(Dim, 0.0);  // the largest half size a built particle has
+  for (const auto& [name, values] : st.reals) {
+    components.push_back(local > 0 ? static_cast<long>(values.size()) / local : 0);
+    if (name == "half_size")
+      for (std::size_t k = 0; k < values.size(); ++k) largest[k % Dim] = std::max(largest[k % Dim], values[k]);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, components.data(), static_cast<int>(components.size()), MPI_LONG, MPI_MAX, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, largest.data(), Dim, MPI_DOUBLE, MPI_MAX, comm_);
+  for (std::size_t k = 0; k < st.reals.size(); ++k) z.fields.emplace_back(st.reals[k].first, components[k]);
+  z.heat = heat_ != nullptr;
+  for (int d = 0; d < Dim; ++d) {  // Grid::contains
+    z.nodes.push_back(grid_->nodes_per_dim()[d]);
+    if (ghosted) z.ghosted_nodes *= box[2 * d + 1] - box[2 * d];
+    z.lo.push_back(grid_->lo()[d]);
+    z.hi.push_back(grid_->lo()[d] + grid_->cell_size()[d] * grid_->cells()[d]);
+    z.cell.push_back(grid_->cell_size()[d]);
+    z.max_half.push_back(std::max(0.5 * grid_->cell_size()[d], largest[static_cast<std::size_t>(d)]));
+  }
+  return z;
+}
+
 template <int Dim>
 void DecomposedRun<Dim>::restore() {
   if (const int old = checkpoint_ranks(o_.resume_checkpoint); old > 0 && old != size_) {
     redistribute(old);
     return;
   }
+  const ckpt::RankSizes sizes = rank_sizes(true);
   try {  // read errors are agreed by every rank
     generation_ = detail::read_decomposed_checkpoint(
-        comm_, o_.resume_checkpoint, Dim, [&](const ckpt::Reader& r) { visit_rank_state(r); },
+        comm_, o_.resume_checkpoint, Dim, sizes, [&](const ckpt::Reader& r) { visit_rank_state(r); },
         [&](const ckpt::Reader& r) { visit_global_state(r); });
   } catch (const std::exception& e) {
     throw OutputError(e.what());
@@ -97,9 +132,10 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
 template <int Dim>
 void DecomposedRun<Dim>::redistribute(int old) {
   detail::Redistribution<Dim> re(*mpm_, heat_ != nullptr);
+  const ckpt::RankSizes sizes = rank_sizes(false);
   try {
     generation_ = detail::read_redistributed_checkpoint(
-        comm_, o_.resume_checkpoint, Dim,
+        comm_, o_.resume_checkpoint, Dim, sizes,
         [&](const ckpt::Reader& r, int j) {
           re.take(r, j, j % size_ == rank_);
           if (heat_ && j == 0) heat_->visit_state(r);  // books and window: the same in every file

@@ -177,6 +177,8 @@ class DecomposedRun {
 
   // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's.
   void checkpoint();
+  // Collective: what a rank file must fit (decomposed_run_checkpoint.cpp).
+  ckpt::RankSizes rank_sizes(bool ghosted) const;
 
   // Collective: the state of o_.resume_checkpoint (every rank's own file and the global one; of
   // another rank count: decomposed_redistribute.hpp).

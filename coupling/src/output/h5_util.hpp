@@ -85,6 +85,8 @@ inline herr_t collect_error(unsigned n, const H5E_error2_t* err, void* out) {
 [[noreturn]] inline void fail(const std::string& file, const std::string& what) {
   std::string reason;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &reason);  // innermost cause first
+  if (reason.find("Fletcher32") != std::string::npos)  // H5Pset_fletcher32: a chunk's bytes changed since written
+    reason = "its Fletcher32 checksum does not match the stored data: the file is damaged; HDF5: " + reason;
   throw std::runtime_error("HDF5 file '" + file + "': " + what + (reason.empty() ? "" : " (" + reason + ")"));
 }
 inline hid_t check_id(hid_t id, const std::string& file, const std::string& what) {

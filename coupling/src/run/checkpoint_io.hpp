@@ -18,6 +18,12 @@
 
 namespace frictherm::coupling::ckpt {
 
+/// 3: every non-empty dataset carries a Fletcher32 checksum (chunked), /reaction/enabled (issue 34);
+/// 2: thermal coupler, penalty contact and output marks; 1: mechanics only. Serial and decomposed.
+constexpr int kFormat = 3;
+/// A checkpoint dataset is one chunk (and one checksum) up to this size, more chunks beyond.
+constexpr hsize_t kChunkBytes = hsize_t{64} << 20;
+
 namespace detail {
 
 template <class T> struct Layout {  // fixed-size Eigen vector or matrix of doubles
@@ -60,6 +66,16 @@ void write_array(hid_t group, const std::string& file, const std::string& name, 
 /// the dataset in messages (its path in the file; `name` if empty).
 h5detail::Handle open_array(hid_t group, const std::string& file, const std::string& name, int components, hsize_t& n,
                             hid_t memory_type = H5I_INVALID_HID, const std::string& shown = "");
+/// The file access list checkpoints are created with (the HDF5 1.10 format).
+h5detail::Handle file_access(const std::string& file);
+/// A new checkpoint file (truncated) in that format, and a group in it, without time stamps.
+h5detail::Handle create_file(const std::string& file);
+h5detail::Handle create_group(hid_t parent, const std::string& file, const std::string& name);
+/// Reads every object header of the open checkpoint `f` (their metadata checksums); throws
+/// std::runtime_error naming `file` when one is damaged.
+void check_objects(hid_t f, const std::string& file);
+/// Whether the dataset carries the Fletcher32 checksum filter (its reads then verify every chunk).
+bool has_checksum(hid_t dataset);
 /// Refuses (std::runtime_error naming `shown`) a non-finite value among `values` unless `allowed`
 /// (a sentinel of that member: +inf "no window yet", NaN "not computed before the first step").
 void require_finite(const std::string& file, const std::string& shown, const double* values, std::size_t count,

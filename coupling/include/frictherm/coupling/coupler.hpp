@@ -267,6 +267,10 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
   tracker_.visit_state(v);
   std::vector<double> progress = particle_progress_;  // empty without a reaction
   v("reaction/particle_progress", progress);
+  // Said explicitly (issue 34): whether the loading had a reaction, so that an emptied progress is
+  // refused instead of read as a loading without one (check_arrays compares the two).
+  bool reacting = !particle_progress_.empty();
+  v("reaction/enabled", reacting);
   if constexpr (reading) {
     // A reaction the loading did not have (frictherm continue): fresh material, λ = 0.
     if (opt_.reaction.enabled) particle_progress_ = progress.empty() ? std::vector<double>(particles.size(), 0.0) : progress;
