@@ -131,4 +131,13 @@ TEST_F(MpirunEnergyBooks, NeoHookeanRings) {
           {"kinetic_energy", "strain_energy", "energy_lost"}, false);
 }
 
+// Gravity's work (m g · v dt per particle, the serial pass's): a block sliding under 2e4 m/s² of
+// gravity with friction. Until the decomposed particle pass booked it, external_work was 0 on every
+// rank: a difference of its whole scale.
+TEST_F(MpirunEnergyBooks, GravityWorkAndFriction) {
+  compare("tests/coupling/scenes/decomposed_sliding_block.json",
+          " --set run.max_steps=300 --set output.series_interval=0 --set thermal=null --set coupling=null",
+          {"kinetic_energy", "strain_energy", "external_work", "energy_lost"}, true);
+}
+
 }  // namespace

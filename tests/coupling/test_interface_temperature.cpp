@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -203,6 +204,48 @@ TEST(InterfaceTemperature, ModelAddsAndTakesNoHeat) {
   for (std::size_t k = 0; k < on.final_particle_temperature.size(); ++k)
     ASSERT_EQ(on.final_particle_temperature[k], off.final_particle_temperature[k]);
   EXPECT_EQ(on.books_gap, off.books_gap);
+}
+
+// A hot spot of size ℓ (patch_length): the heat of the heated nodes within ℓ/2 spread over the patch
+// on their mean grid temperature. Checked on the strip: a uniform flux gives every patch inside the
+// interface its node's own value (the edge weights make the patch's nodes cover exactly ℓ, for ℓ a
+// multiple of the cell or not; to round-off, 1e-9 of the rise), and a source on one node gives the
+// patch that node's grid temperature plus its correction times h/ℓ (the heat spread over the patch).
+TEST(InterfaceTemperature, PatchIsTheMeanFluxOverTheHotSpot) {
+  const double h = 4e-6, q = 3e8, x_probe = 4 * h;
+  const auto grid = make_grid<2>({0.0, -24 * h}, h, {8, 48});  // run_strip's grid
+  for (double patch : {4 * h, 5.3 * h, 6 * h}) {
+    for (bool one_node : {false, true}) {
+      auto flux = [&](double x, double) { return !one_node || std::abs(x - x_probe) < 0.5 * h ? q : 0.0; };
+      int checked = 0;
+      run_strip(
+          kHmx, kBinder, h, fm::ShapeKind::ugimp, 5e-9, 100, 4, flux, x_probe, true, {},
+          [&](fc::CouplerOptions& o) { o.interface_temperature.patch_length = patch; },
+          [&](fc::Coupler<2>& cp, fm::Particles<2>&, double) {
+            const auto& it = cp.interface_temperature();
+            ASSERT_EQ(it.patch_temperature().size(), it.nodes().size());
+            for (std::size_t k = 0; k < it.nodes().size(); ++k) {
+              const double x = grid.node_position(it.nodes()[k])[0];
+              const double node = it.node_temperature()[k], correction = it.node_correction()[k];
+              const double patch_t = it.patch_temperature()[k];
+              ASSERT_GT(correction, 1.0);  // a sub-cell rise of more than a kelvin to compare
+              // Patches clear of the strip's end nodes (their share of the interface is half a cell, so
+              // their flux per node area is half: the model spreads a node's heat over its whole cell).
+              if (!one_node && x >= 0.5 * patch + 0.5 * h - 1e-9 * h && x <= 7.5 * h - 0.5 * patch + 1e-9 * h) {
+                EXPECT_NEAR(patch_t, node, 1e-9 * correction) << "patch " << patch / h << " h, x = " << x / h << " h";
+                ++checked;
+              }
+              if (one_node) {  // the probe is the only heated node
+                EXPECT_NEAR(patch_t, node - correction + correction * h / patch, 1e-9 * correction) << patch / h;
+                ++checked;
+              }
+            }
+            EXPECT_NEAR(it.max_temperature(), *std::max_element(it.patch_temperature().begin(), it.patch_temperature().end()),
+                        1e-12 * it.max_temperature());
+          });
+      EXPECT_GE(checked, 1) << "patch " << patch / h << " h";
+    }
+  }
 }
 
 // The Arrhenius verdict at the interface temperature (interface_reaction.hpp). A constant flux

@@ -6,6 +6,8 @@
 #include <utility>
 #include <array>
 #include <map>
+#include <stdexcept>
+#include <string>
 
 namespace frictherm::coupling {
 
@@ -37,12 +39,42 @@ void InterfaceTemperature<Dim>::start(const mechanics::Grid<Dim>& grid, double t
     sides_[m].volumetric_heat_capacity = mass[m] / volume[m] * materials[m].heat_capacity;
     heat_capacity_[m] = materials[m].heat_capacity;
   }
+  // The patch: the lattice offsets within ℓ_eff/2 of a node, and its area (node_area · ℓ_eff/h in 2D).
+  patch_offsets_.clear(), patch_weights_.clear();
+  patch_area_ = 0.0;
+  if (options.patch_length > 0.0) {
+    const double radius = 0.5 * std::max(options.patch_length, 2.0 * h_);
+    if (radius > 32.0 * h_)  // 65^Dim offsets a node: beyond that a patch is not an interface spot
+      throw std::invalid_argument("coupling.interface_temperature.patch_length: " + std::to_string(options.patch_length) +
+                                  " m is " + std::to_string(options.patch_length / h_) +
+                                  " cells across; expected at most 64 cells");
+    patch_area_ = (Dim == 2 ? 2.0 * radius * thickness : 3.141592653589793 * radius * radius);
+    mechanics::IVec<Dim> reach{};
+    int count = 1;
+    for (int d = 0; d < Dim; ++d) {
+      reach[d] = static_cast<int>(std::floor(radius / grid.cell_size()[d] + 0.5));
+      count *= 2 * reach[d] + 1;
+    }
+    for (int c = 0; c < count; ++c) {
+      mechanics::IVec<Dim> o{};
+      double distance2 = 0.0;
+      for (int d = 0, q = c; d < Dim; ++d) {
+        o[d] = q % (2 * reach[d] + 1) - reach[d];
+        q /= 2 * reach[d] + 1;
+        distance2 += std::pow(o[d] * grid.cell_size()[d], 2);
+      }
+      const double inside = std::clamp((radius - std::sqrt(distance2)) / h_ + 0.5, 0.0, 1.0);
+      if (inside > 1e-12) patch_offsets_.push_back(o), patch_weights_.push_back(inside);
+    }
+  }
   corrections_.clear();
   slot_of_node_.assign(grid.node_count(), -1);
   nodes_.clear();
   node_correction_.clear(), node_temperature_.clear();
+  patch_correction_.clear(), patch_temperature_.clear();
   particle_temperature_.assign(p.temperature.begin(), p.temperature.end());  // no heat yet: T_p
   max_temperature_ = -std::numeric_limits<double>::infinity();
+  max_node_temperature_ = max_temperature_;
   heat_recorded_ = 0.0;
 }
 
@@ -73,6 +105,8 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
   node_correction_.assign(slots, 0.0);
   node_temperature_.assign(slots, 0.0);
   max_temperature_ = -std::numeric_limits<double>::infinity();
+  max_node_temperature_ = max_temperature_;
+  patch_correction_.clear(), patch_temperature_.clear();
   if (slots == 0) return;
 
   const mechanics::Grid<Dim>& grid = *grid_;
@@ -150,15 +184,55 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
       continue;
     }
     node_temperature_[s] = nodal_temperature[u] + node_correction_[s];
-    max_temperature_ = std::max(max_temperature_, node_temperature_[s]);
+    max_node_temperature_ = std::max(max_node_temperature_, node_temperature_[s]);
   }
+  max_temperature_ = max_node_temperature_;
+  if (patch_area_ > 0.0) update_patches();
+  const std::vector<double>& correction = patch_area_ > 0.0 ? patch_correction_ : node_correction_;
 
   // Pass 2: each particle's hottest touched interface, T_p + max correction.
   std::vector<double> best(p.size(), 0.0);
   for_each_particle_node([&](std::size_t k, std::size_t, std::size_t s, double) {
-    best[k] = std::max(best[k], node_correction_[s]);
+    best[k] = std::max(best[k], correction[s]);
   });
   for (std::size_t k = 0; k < p.size(); ++k) particle_temperature_[k] += best[k];
+}
+
+// A hot spot of size ℓ: the heat of the heated nodes within ℓ/2 of node s, Σ_t A q_t ⊛ R_x, spread
+// over the patch's area on their mean grid temperature. The correction is linear in the flux, so this
+// is the flash temperature of the patch's mean flux; the total heat in a patch converges with the cell
+// as the frictional work does, where one node's flux keeps growing as the cell resolves sharper slip.
+template <int Dim>
+void InterfaceTemperature<Dim>::update_patches() {
+  const mechanics::Grid<Dim>& grid = *grid_;
+  const std::size_t slots = nodes_.size();
+  patch_correction_.assign(slots, 0.0);
+  patch_temperature_.assign(slots, std::numeric_limits<double>::quiet_NaN());
+  max_temperature_ = -std::numeric_limits<double>::infinity();
+  for (std::size_t s = 0; s < slots; ++s) {
+    if (!std::isfinite(node_temperature_[s])) continue;
+    const mechanics::IVec<Dim> centre = grid.node_lattice(nodes_[s]);
+    double heat_per_area = 0.0, grid_temperature = 0.0, weight = 0.0;
+    for (std::size_t j = 0; j < patch_offsets_.size(); ++j) {
+      const mechanics::IVec<Dim>& o = patch_offsets_[j];
+      mechanics::IVec<Dim> q{};
+      bool inside = true;
+      for (int d = 0; d < Dim; ++d) {
+        q[d] = centre[d] + o[d];
+        inside = inside && q[d] >= -mechanics::Grid<Dim>::ghost && q[d] <= grid.cells()[d] + mechanics::Grid<Dim>::ghost;
+      }
+      if (!inside) continue;
+      const int t = slot_of_node_[static_cast<std::size_t>(grid.node_index(q))];
+      if (t < 0 || !std::isfinite(node_temperature_[static_cast<std::size_t>(t)])) continue;
+      const auto u = static_cast<std::size_t>(t);
+      heat_per_area += patch_weights_[j] * node_correction_[u];
+      grid_temperature += patch_weights_[j] * (node_temperature_[u] - node_correction_[u]);
+      weight += patch_weights_[j];
+    }
+    patch_correction_[s] = heat_per_area * area_ / patch_area_;
+    patch_temperature_[s] = grid_temperature / weight + patch_correction_[s];
+    max_temperature_ = std::max(max_temperature_, patch_temperature_[s]);
+  }
 }
 
 template <int Dim>

@@ -64,6 +64,7 @@ const std::map<std::string, Entry>& catalogue() {
       {"reaction_heat", {"J", "reaction heat released"}},
       {"max_reaction_progress", {"1", "maximum reaction progress"}},
       {"max_interface_temperature", {"K", "maximum interface temperature"}},
+      {"max_node_interface_temperature", {"K", "maximum interface temperature of a single node"}},
       {"max_interface_reaction_progress", {"1", "maximum reaction progress at the interface temperature"}},
       // /hotspots and /hotspot_fates
       {"id", {"1", "id"}},

@@ -54,6 +54,8 @@ void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& na
   if (o.plastic.enabled) names.insert(names.end(), {"plastic_work", "plastic_heat"});
   if (o.reaction.enabled) names.insert(names.end(), {"reaction_heat", "max_reaction_progress"});
   if (o.interface_temperature.enabled) names.emplace_back("max_interface_temperature");
+  if (o.interface_temperature.enabled && o.interface_temperature.patch_length > 0.0)
+    names.emplace_back("max_node_interface_temperature");
   if (o.interface_temperature.enabled && o.reaction.enabled) names.emplace_back("max_interface_reaction_progress");
   out.declare_table("hotspots", hotspot_columns(Dim));
   if (spec_.continuation_duration > 0.0)
@@ -83,6 +85,10 @@ void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
   if (o.interface_temperature.enabled) {  // NaN until some node has received frictional heat
     const double t_int = coupler_.interface_temperature().max_temperature();
     row.push_back(std::isfinite(t_int) ? t_int : std::numeric_limits<double>::quiet_NaN());
+    if (o.interface_temperature.patch_length > 0.0) {
+      const double t_node = coupler_.interface_temperature().max_node_temperature();
+      row.push_back(std::isfinite(t_node) ? t_node : std::numeric_limits<double>::quiet_NaN());
+    }
   }
   if (o.interface_temperature.enabled && o.reaction.enabled) row.push_back(coupler_.interface_reaction().max_progress());
   if (windows == hotspot_windows_written_) return;

@@ -184,7 +184,7 @@ void parse_window(const JsonReader& c, WindowPolicy& w) {
   if (win->is_object()) win->finish();
 }
 
-// coupling.interface_temperature: true/false, or {"enabled": bool, "bins_per_level": n}.
+// coupling.interface_temperature: true/false, or {"enabled": bool, "bins_per_level": n, "patch_length": ℓ}.
 void parse_interface_temperature(const JsonReader& c, InterfaceTemperatureOptions& o) {
   const auto it = c.find("interface_temperature");
   if (!it) return;
@@ -194,6 +194,7 @@ void parse_interface_temperature(const JsonReader& c, InterfaceTemperatureOption
   }
   o.enabled = !it->find("enabled") || it->at("enabled").as_bool();
   o.bins_per_level = static_cast<int>(it->integer("bins_per_level", o.bins_per_level, 2, 64));
+  o.patch_length = it->number("patch_length", 0.0, Range::non_negative());
   it->finish();
 }
 

@@ -308,6 +308,7 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
       v += S * Eigen::Map<const Vec<Dim>>(node + velocity);
     });
     Eigen::Map<Vec<Dim>> vp(f.velocity + Dim * k);
+    external_work += f.mass[k] * opt.gravity.dot(vp + 0.5 * dt * acc) * dt;  // gravity's work, as the serial pass
     vp += dt * acc;
     pic_blend(vp, v, pic);
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;

@@ -37,6 +37,14 @@ struct InterfaceTemperatureOptions {
   /// Bins of each width in the flux history (interface_heating.hpp): the convolution's error falls
   /// as 1/bins_per_level², its cost grows as bins_per_level.
   int bins_per_level = 8;
+  /// Hot-spot size ℓ (m): when > 0, the interface temperature a node reports (and particles, hot
+  /// spots and the interface Arrhenius verdict read) is that of a patch of the interface of diameter
+  /// ℓ around it: the heat of the heated nodes within ℓ/2 spread over the patch's area (a length ℓ in
+  /// 2D, π ℓ²/4 in 3D) on their mean grid temperature; a node at distance d counts with the share of
+  /// its cell inside the patch, clamp((ℓ/2 − d)/h + 1/2, 0, 1), so that a uniform flux on a straight
+  /// interface gives the node's own value. The patch is at least two cells across
+  /// (ℓ_eff = max(ℓ, 2h)). 0: each node's own value.
+  double patch_length = 0.0;
 };
 
 template <int Dim>
@@ -61,8 +69,13 @@ class InterfaceTemperature {
   const std::vector<int>& nodes() const { return nodes_; }
   const std::vector<double>& node_correction() const { return node_correction_; }
   const std::vector<double>& node_temperature() const { return node_temperature_; }
-  /// The hottest interface node's temperature at the last update (−∞ before any heat).
+  /// The hottest interface temperature at the last update: of a patch when patch_length > 0, else of
+  /// a node (−∞ before any heat).
   double max_temperature() const { return max_temperature_; }
+  /// The hottest single node's interface temperature at the last update (−∞ before any heat).
+  double max_node_temperature() const { return max_node_temperature_; }
+  /// Patch interface temperatures of the heated nodes (empty unless patch_length > 0).
+  const std::vector<double>& patch_temperature() const { return patch_temperature_; }
   /// Σ over nodes of the heat per area times the area handed to the history (J): equals the
   /// frictional heat received (the books check it).
   double heat_recorded() const { return heat_recorded_; }
@@ -77,13 +90,20 @@ class InterfaceTemperature {
   std::map<std::array<int, 3>, thermal::SubcellCorrection> corrections_;
   const thermal::SubcellCorrection& correction(const std::array<int, 3>& key);
   double h_ = 0.0, area_ = 0.0;
+  double patch_area_ = 0.0;                    // the patch's interface area (× thickness in 2D), 0: off
+  std::vector<mechanics::IVec<Dim>> patch_offsets_;  // lattice offsets within the patch's radius
+  std::vector<double> patch_weights_;                 // their weights: the share of the node inside
+  /// Patch values of every slot from node_correction_ and node_temperature_ (patch_length > 0).
+  void update_patches();
   bool enabled_ = false;
   thermal::BinnedHeatHistory history_{8};
   std::vector<int> slot_of_node_;  // grid node → slot, −1 for never heated
   std::vector<int> nodes_;         // slot → grid node
   std::vector<double> node_correction_, node_temperature_, particle_temperature_;
+  std::vector<double> patch_correction_, patch_temperature_;
   std::vector<double> slot_material_mass_;  // slots × materials, scratch of update
   double max_temperature_ = -std::numeric_limits<double>::infinity();
+  double max_node_temperature_ = -std::numeric_limits<double>::infinity();
   double heat_recorded_ = 0.0;
 };
 
