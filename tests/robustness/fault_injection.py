@@ -218,7 +218,11 @@ def main():
         if os.path.exists(os.path.join(interrupted, n)):
             os.remove(os.path.join(interrupted, n))
     p = subprocess.Popen([exe, "run", "s.json", "-o", "R.h5", "-q"], cwd=interrupted, stderr=subprocess.DEVNULL)
-    while p.poll() is None and (cpu_seconds(p.pid) or 0) < 0.5 * run_cpu:
+    # Half way through the run's CPU, and only once it has opened its result (R.h5.PID.part): on a
+    # loaded machine the start-up's CPU grows, and a signal before the result is opened ends the run
+    # with nothing to resume (nothing was computed), which is not the case this input is for.
+    part = os.path.join(interrupted, "R.h5.%d.part" % p.pid)
+    while p.poll() is None and ((cpu_seconds(p.pid) or 0) < 0.5 * run_cpu or not os.path.exists(part)):
         time.sleep(0.002)
     if p.poll() is None:
         p.send_signal(signal.SIGTERM)
