@@ -4,7 +4,9 @@
 // explicit_conduction.cpp) over this rank's particles, their nodal sums completed at the owners by the
 // mechanics' transfers.
 #include <frictherm/coupling/decomposed_heat.hpp>
+#include <frictherm/coupling/fixed_temperature.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -49,18 +51,24 @@ void DecomposedHeat::collect_plastic(mechanics::DecomposedMpm<Dim>& mpm, double 
   sums[1] = heat;
 }
 
-// T_p += Σ_i S_ip ΔT_i over the particle's kept unknowns (design §4: the increment), then with a
-// sub-grid relaxation time τ the blend T_p ← T_p − β (T_p − Σ_i S_ip T_i / Σ_i S_ip), β = 1 − e^{−Δt/τ},
-// toward the unknowns' end temperatures (docs/coupling.md "Sub-grid structure"); ghost ΔT_i (and T_i)
-// from the owners in one exchange. changes: this rank's Σ_i M_i ΔT_i (owned unknowns) and
-// Σ_p m_p C_v,p ΔT_p.
+// T_p += Σ_i S_ip ΔT_i over the particle's kept unknowns (design §4: the increment; held nodes pull
+// their particles towards the face instead, FacePull in fixed_temperature.hpp, with the serial rule
+// collect_face_pull_nodes), then with a sub-grid relaxation time τ the blend
+// T_p ← T_p − β (T_p − Σ_i S_ip T_i / Σ_i S_ip), β = 1 − e^{−Δt/τ}, toward the unknowns' end
+// temperatures (docs/coupling.md "Sub-grid structure"); ghost values from the owners in one exchange
+// (two with fixed faces: the owners first read T_i of their held nodes' inward neighbours, which may
+// be ghosts). changes: this rank's Σ_i M_i ΔT_i (owned unknowns) and Σ_p m_p C_v,p ΔT_p.
 template <int Dim>
 void DecomposedHeat::map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& Tn, double dt,
                               std::vector<double>& T, double changes[2]) {
   const bool relax = std::isfinite(opt_.subgrid_relaxation_time);
   const double beta = relax ? -std::expm1(-dt / opt_.subgrid_relaxation_time) : 0.0;
-  const int c = relax ? 2 : 1;  // values per node: ΔT_i (and T_i)
+  const bool pull = !opt_.fixed_faces.empty();
+  // Values per node: ΔT_i (T_face − g·x_i at a held node), T_i with the relaxation, then with fixed
+  // faces 1 at a held node and g_i.
+  const int c = 1 + (relax ? 1 : 0) + (pull ? 1 + Dim : 0);
   const auto stride = static_cast<std::size_t>(c);
+  const std::size_t held_at = relax ? 2 : 1;
   const std::size_t no = M_.size();
   std::vector<double> owned(stride * no, 0.0);
   double nodal = 0.0;
@@ -70,18 +78,76 @@ void DecomposedHeat::map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vec
     nodal += M_[u] * owned[stride * u];
     if (relax) owned[stride * u + 1] = Tn[u];
   }
+  if (pull) {
+    std::vector<typename FacePull<Dim>::Held>& held_nodes = [this]() -> auto& {
+      if constexpr (Dim == 2) return held_nodes_2_;
+      else return held_nodes_3_;
+    }();
+    mpm.owned_to_local(Tn, 1, local_T_);
+    const std::array<int, 2 * Dim> own = mpm.owned_nodes(), box = mpm.ghosted_nodes();
+    const std::vector<int>& local_of = mpm.owned_local_nodes();
+    const mechanics::Grid<Dim>& grid = mpm.grid();
+    const auto lattice_along = [&own](std::size_t u, int axis) {  // as select_fixed_nodes
+      for (int d = 0; d < axis; ++d) u /= static_cast<std::size_t>(own[2 * d + 1] - own[2 * d]);
+      const auto extent = static_cast<std::size_t>(own[2 * axis + 1] - own[2 * axis]);
+      return own[2 * axis] + static_cast<int>(u % extent) - mechanics::Grid<Dim>::ghost;
+    };
+    const auto inward = [&](std::size_t u, int axis, bool upper, double& t_in, double& dx) {
+      int step = 1;  // the local numbering is x fastest over the ghosted box
+      for (int d = 0; d < axis; ++d) step *= box[2 * d + 1] - box[2 * d];
+      const int l = local_of[u] + (upper ? -step : step);
+      if (l < 0 || static_cast<std::size_t>(l) >= local_M_.size() || !is_unknown(local_M_[static_cast<std::size_t>(l)]))
+        return false;
+      t_in = local_T_[static_cast<std::size_t>(l)];
+      dx = upper ? -grid.cell_size()[axis] : grid.cell_size()[axis];
+      return true;
+    };
+    const auto position = [&](std::size_t u, int a) { return grid.lo()[a] + grid.cell_size()[a] * lattice_along(u, a); };
+    collect_face_pull_nodes<Dim>(opt_.fixed_faces, grid.cells(), no, lattice_along, inward, position, held_nodes);
+    for (const typename FacePull<Dim>::Held& h : held_nodes) {
+      const auto u = static_cast<std::size_t>(h.unknown);
+      if (!is_unknown(M_[u])) continue;  // a window holds the face nodes that are unknowns
+      double offset = h.temperature;
+      for (int d = 0; d < Dim; ++d) {
+        owned[stride * u + held_at + 1 + static_cast<std::size_t>(d)] = h.gradient[static_cast<std::size_t>(d)];
+        offset -= h.gradient[static_cast<std::size_t>(d)] * h.position[static_cast<std::size_t>(d)];
+      }
+      nodal -= M_[u] * owned[stride * u];  // booked as the heat its pull gives (below)
+      owned[stride * u] = offset;
+      owned[stride * u + held_at] = 1.0;
+      if (relax) owned[stride * u + 1] = 0.0;  // the blend's held term is the pull's target (FacePull::end)
+    }
+  }
   std::vector<double> local;
   mpm.owned_to_local(owned, c, local);
+  mechanics::DecomposedLocalParticles P;
+  if (pull) P = mpm.local_particle_data(true);
   double particle = 0.0;
   for (std::size_t k = 0; k < T.size(); ++k) {
-    double change = 0.0, pic = 0.0, s = 0.0;
+    double change = 0.0, held = 0.0, offset = 0.0, pic = 0.0, s = 0.0;
+    std::array<double, Dim> sg{};
     for (int a = kept_first_[k]; a < kept_first_[k + 1]; ++a) {
       const double S = kept_S_[static_cast<std::size_t>(a)];
       const std::size_t i = stride * static_cast<std::size_t>(kept_node_[static_cast<std::size_t>(a)]);
-      change += S * local[i];
       if (relax) pic += S * local[i + 1], s += S;
+      if (pull && local[i + held_at] != 0.0) {  // a held node: its pull's sums (FacePull::Sums)
+        held += S;
+        offset += S * local[i];
+        for (int d = 0; d < Dim; ++d) sg[static_cast<std::size_t>(d)] += S * local[i + held_at + 1 + static_cast<std::size_t>(d)];
+        continue;
+      }
+      change += S * local[i];
     }
-    const double before = T[k], flip = before + change;
+    const double before = T[k];
+    double flip = before + change;
+    if (pull && held != 0.0) {  // the pull Σ_held S_ip (T_face + g_i·(x_p − x_i) − T_p) (FacePull::change)
+      double pulled = offset - held * before;
+      for (int d = 0; d < Dim; ++d)
+        pulled += sg[static_cast<std::size_t>(d)] * P.position[Dim * k + static_cast<std::size_t>(d)];
+      flip = before + (change + pulled);
+      nodal += capacity_[k] * pulled;
+      if (relax) pic += FacePull<Dim>::blend_target({held, offset, sg}, before, pulled);
+    }
     T[k] = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
     particle += capacity_[k] * (T[k] - before);
   }

@@ -101,8 +101,12 @@ void Coupler<Dim>::assemble(const mechanics::Particles<Dim>& p) {
   system_changed();
   if (problem_) problem_->reset(system_.mass, system_.conductance);  // the last window's storage
   else problem_.emplace(system_.mass, system_.conductance);
+  fixed_nodes_.clear();
   for_each_fixed_node(opt_.fixed_faces, grid_.cells(), system_.size(), fixed_lattice_along(),
-                      [&](std::size_t u, double t) { problem_->set_dirichlet(static_cast<Eigen::Index>(u), t); });
+                      [&](std::size_t u, double t) {
+                        problem_->set_dirichlet(static_cast<Eigen::Index>(u), t);
+                        fixed_nodes_.push_back({static_cast<int>(u), t});
+                      });
   if (reaction_active()) {
     // Reacting mass and progress gathered from the particles; Q_i = q m_i (heat_sources.hpp).
     NodalReaction r = gather_reaction(grid_, p, shape_, opt_.reaction, system_, particle_progress_);
@@ -204,11 +208,42 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
   const double beta = std::isfinite(opt_.subgrid_relaxation_time)
                           ? -std::expm1(-dt / opt_.subgrid_relaxation_time)
                           : 0.0;
-  explicit_.map_back(p, system_, delta, beta, beta > 0.0 ? &nodal_temperature_ : nullptr);
-  books_.nodal_energy_change += system_.mass.dot(delta);
+  const auto* held = face_pull_nodes(nodal_temperature_);
+  const double face_heat =
+      explicit_.map_back(p, system_, delta, beta, beta > 0.0 ? &nodal_temperature_ : nullptr, held);
+  books_.nodal_energy_change += nodal_change(delta, held, face_heat);
   ++books_.matrix_free_windows;
   books_.matrix_free_substeps += n;
   return true;
+}
+
+template <int Dim>
+const std::vector<typename FacePull<Dim>::Held>* Coupler<Dim>::face_pull_nodes(const Eigen::VectorXd& T) {
+  if (opt_.fixed_faces.empty()) return nullptr;
+  // The unknown one cell inward from node u along the face's axis, and its offset.
+  const auto inward = [&](std::size_t u, int axis, bool upper, double& t_in, double& dx) {
+    mechanics::IVec<Dim> li = grid_.node_lattice(system_.grid_node[u]);
+    li[axis] += upper ? -1 : 1;
+    if (li[axis] < 0 || li[axis] > grid_.cells()[axis]) return false;
+    const int v = system_.unknown[static_cast<std::size_t>(grid_.node_index(li))];
+    if (v < 0) return false;
+    t_in = T[v];
+    dx = upper ? -grid_.cell_size()[axis] : grid_.cell_size()[axis];
+    return true;
+  };
+  const auto position = [&](std::size_t u, int a) { return grid_.node_position(system_.grid_node[u])[a]; };
+  collect_face_pull_nodes<Dim>(opt_.fixed_faces, grid_.cells(), system_.size(), fixed_lattice_along(), inward, position,
+                       face_pull_);
+  return &face_pull_;
+}
+
+template <int Dim>
+double Coupler<Dim>::nodal_change(const Eigen::VectorXd& delta, const std::vector<typename FacePull<Dim>::Held>* held,
+                                  double face_heat) const {
+  double change = system_.mass.dot(delta);
+  if (!held) return change;
+  for (const typename FacePull<Dim>::Held& h : *held) change -= system_.mass[h.unknown] * delta[h.unknown];
+  return change + face_heat;
 }
 
 template <int Dim>
@@ -298,7 +333,7 @@ bool Coupler<Dim>::close_window(mechanics::Particles<Dim>& p, double time) {
     books_.plastic_heat_delivered += pending_plastic_;
     books_.heat_relocated += heat.relocated;
     nodal_temperature_ = system_.temperature;
-    advance_and_map(p, window_start_, time);
+    advance_and_map(p, window_start_, time, true);
   }
   pending_.clear();
   pending_plastic_ = 0.0;
@@ -323,15 +358,17 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
     integrator_ = thermal::make_integrator(opt_.assembled_integrator(), opt_.integrator_options);
   }
   continuing_ = true;
+  bool gathered = false;  // this interval starts from the particles' temperatures
   if (!system_assembled_ || reaction_starts) {  // a reaction held back during loading joins the problem now
     assemble(p);
     nodal_temperature_ = system_.temperature;
+    gathered = true;
   }
   problem_->clear_source();
   if (!fates_.started()) fates_.begin(tracker_, window_start_);  // the hot spots at the end of loading
   if (interface_.enabled() && opt_.reaction.enabled && !interface_reaction_.started())
     interface_reaction_.start(p.size(), window_start_);  // a reaction held back until the continuation
-  advance_and_map(p, window_start_, time);
+  advance_and_map(p, window_start_, time, gathered);
   ++books_.continuation_intervals;
   window_start_ = time;
   window_steps_ = 0;
@@ -345,7 +382,7 @@ void Coupler<Dim>::continue_thermal(mechanics::Particles<Dim>& p, double time) {
 }
 
 template <int Dim>
-void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, double t1) {
+void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, double t1, bool from_gathered) {
   const Eigen::VectorXd start = nodal_temperature_;
   if (reaction_active()) {
     const double released0 = problem_->released_heat(nodal_progress_);
@@ -360,9 +397,10 @@ void Coupler<Dim>::advance_and_map(mechanics::Particles<Dim>& p, double t0, doub
   const double beta = std::isfinite(opt_.subgrid_relaxation_time)
                           ? -std::expm1(-(t1 - t0) / opt_.subgrid_relaxation_time)
                           : 0.0;
-  add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta, &nodal_temperature_,
-                                step_stencils());  // design §4
-  books_.nodal_energy_change += system_.mass.dot(delta);
+  const auto* held = from_gathered ? face_pull_nodes(nodal_temperature_) : nullptr;
+  const double face_heat = add_nodal_change_to_particles(grid_, p, shape_, opt_.materials, system_, delta, beta,
+                                                         &nodal_temperature_, step_stencils(), held);  // design §4
+  books_.nodal_energy_change += nodal_change(delta, held, face_heat);
 }
 
 template <int Dim>

@@ -1,6 +1,7 @@
 // The forward-Euler sub-steps of a matrix-free conduction window and the change mapped back to the
 // particles (explicit_conduction.hpp; Nairn et al. 2018 eqs. 37–38), with the stencils of the gather
 // (explicit_conduction.cpp).
+#include <array>
 #include "explicit_conduction_detail.hpp"
 
 namespace frictherm::coupling {
@@ -133,13 +134,17 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
 }
 
 template <int Dim>
-void ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
-                                       const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
+double ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
+                                         const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end,
+                                         const std::vector<typename FacePull<Dim>::Held>* held) {
   if (heat_capacity_.size() != p.size())
     throw std::logic_error("ExplicitConduction::map_back: the particles changed since the gather");
   if (next_mct_.size() != static_cast<Eigen::Index>(sys.size()))
     throw std::logic_error("ExplicitConduction::map_back: no re-projection for these unknowns");
+  face_pull_.build(delta.data(), end && beta > 0.0 ? end->data() : nullptr, sys.size(), held);
+  face_heat_ = 0.0;
   mechanics::dispatch_shape(kind_, [&](auto kernel) { map_back_with<decltype(kernel)>(p, sys, delta, beta, end); });
+  return face_heat_;
 }
 
 template <int Dim>
@@ -147,52 +152,72 @@ template <class Kernel>
 void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
                                             const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end) {
   const bool relax = end && beta > 0.0;
+  // Held nodes pull their particles towards the face (FacePull, fixed_temperature.hpp).
+  const bool pull = face_pull_.active();
+  const double* const dl = face_pull_.increment(delta.data());
   // Unknowns whose temperature changed in the window, as a prefix count by grid node: a particle with
   // none among its nodes keeps its temperature (ΔT_p = 0 exactly) and is passed over.
-  count_changed(sys.unknown, [&](int u) { return relax || delta[u] != 0.0; });
+  count_changed(sys.unknown, [&](int u) {
+    return relax || delta[u] != 0.0 || (pull && face_pull_.held(static_cast<std::size_t>(u)));
+  });
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   const int threads = assembly_detail::assembly_threads(p.size());
   // The eq. 38 sums of the next reproject(): only a refresh can lead to one, and without kept
   // stencils the next window gathers anew (and sums them anew), so they are not kept up to date.
   const bool keep_sums = stencils_kept_;
   // A particle's temperature after the window: T_p + Σ S_ip ΔT_i (design §4: the increment, not the
-  // nodal value), relaxed towards Σ S_ip T_i / Σ S_ip with the sub-grid blend β.
-  const auto blend = [&](double before, double dT, double pic, double s) {
-    const double flip = before + dT;
+  // nodal value) plus the held nodes' pull, relaxed towards Σ S_ip T_i / Σ S_ip with the sub-grid blend β.
+  const auto blend = [&](double before, double dT, double pulled, double pic, double s) {
+    const double flip = pull ? before + (dT + pulled) : before + dT;
     return (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
   };
-  const auto new_temperature = [&](double before, const Expanded& c) {
+  const double* const te = relax ? face_pull_.end(end->data()) : nullptr;
+  // The pull's change of particle k (0 without held nodes), the heat it brings and its held nodes'
+  // term of the blend's Σ S_ip T_i (FacePull).
+  const auto pulled_change = [&](const typename FacePull<Dim>::Sums& q, std::size_t k, double& heat, double& pic) {
+    if (!pull || q.weight == 0.0) return 0.0;
+    const double change = FacePull<Dim>::change(q, p.temperature[k], p.position[k]);
+    heat += heat_capacity_[k] * change;
+    if (relax) pic += FacePull<Dim>::blend_target(q, p.temperature[k], change);
+    return change;
+  };
+  const auto new_temperature = [&](double before, const Expanded& c, std::size_t k, double& heat) {
     double dT = 0.0;
-    for (int a = 0; a < c.count; ++a) dT += c.S[a] * delta[c.unknown[a]];
+    for (int a = 0; a < c.count; ++a) dT += c.S[a] * dl[c.unknown[a]];
+    typename FacePull<Dim>::Sums q;
+    if (pull)
+      for (int a = 0; a < c.count; ++a) face_pull_.add(q, static_cast<std::size_t>(c.unknown[a]), c.S[a]);
     double pic = 0.0, s = 0.0;
     if (relax) {
       for (int a = 0; a < c.count; ++a) {
-        pic += c.S[a] * (*end)[c.unknown[a]];
+        pic += c.S[a] * te[c.unknown[a]];
         s += c.S[a];
       }
     }
-    return blend(before, dT, pic, s);
+    const double pulled = pulled_change(q, k, heat, pic);
+    return blend(before, dT, pulled, pic, s);
   };
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
   if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
     Expanded c{};
     const int* un = sys.unknown.data();
-    const double* dl = delta.data();
-    const double* te = relax ? end->data() : nullptr;
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
       if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
         double dT = 0.0, pic = 0.0, s = 0.0;
+        typename FacePull<Dim>::Sums q;
         for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double w, double, double, double) {
           dT += w * dl[u];
+          if (pull) face_pull_.add(q, static_cast<std::size_t>(u), w);
           if (relax) {
             pic += w * te[u];
             s += w;
           }
         });
         const double before = p.temperature[k];
-        const double T = blend(before, dT, pic, s);
+        const double pulled = pulled_change(q, k, face_heat_, pic);
+        const double T = blend(before, dT, pulled, pic, s);
         if (T == before) continue;
         p.temperature[k] = T;
         if (!keep_sums) continue;
@@ -203,7 +228,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
       expand<Kernel, false>(stencils[k], sys.unknown, c);
       if (c.count == 0) continue;  // reaches no unknown
       const double before = p.temperature[k];
-      const double T = new_temperature(before, c);
+      const double T = new_temperature(before, c, k, face_heat_);
       if (T == before) continue;
       p.temperature[k] = T;
       if (!keep_sums) continue;
@@ -215,22 +240,24 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   particle_scratch_.assign(p.size(), 0.0);  // m_p C_v,p ΔT_p of the particles that changed
   std::vector<unsigned char>& changed = quiet_changed_;
   changed.assign(p.size(), 0);
+  double face_heat = 0.0;
 #pragma omp parallel num_threads(threads)
   {
   Expanded c{};
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) reduction(+ : face_heat)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
     expand<Kernel, false>(stencils[k], sys.unknown, c);
     if (c.count == 0) continue;  // reaches no unknown
     const double before = p.temperature[k];
-    const double T = new_temperature(before, c);
+    const double T = new_temperature(before, c, k, face_heat);
     if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
     particle_scratch_[k] = heat_capacity_[k] * (T - before);
     changed[k] = 1;
   }
   }
+  face_heat_ = face_heat;
   if (!keep_sums) return;
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
@@ -250,8 +277,9 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   template Eigen::VectorXd ExplicitConduction<D>::advance(const NodalThermalSystem&, const Eigen::VectorXd&,      \
                                                           const Eigen::VectorXd&, const std::vector<FixedNode>&,  \
                                                           double, long);                                          \
-  template void ExplicitConduction<D>::map_back(mechanics::Particles<D>&, const NodalThermalSystem&,              \
-                                                const Eigen::VectorXd&, double, const Eigen::VectorXd*);
+  template double ExplicitConduction<D>::map_back(mechanics::Particles<D>&, const NodalThermalSystem&,            \
+                                                const Eigen::VectorXd&, double, const Eigen::VectorXd*,         \
+                                                const std::vector<FacePull<D>::Held>*);
 FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(2)
 FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(3)
 #undef FRICTHERM_INSTANTIATE_EXPLICIT_PASSES

@@ -259,15 +259,19 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 }
 
 template <int Dim, class Kernel>
-void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
+double add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& p,
                      const std::vector<ThermalProperties>& materials, const NodalThermalSystem& sys,
-                     const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end,
+                     const Eigen::VectorXd& delta, const FacePull<Dim>& pull, double beta, const Eigen::VectorXd* end,
                      const mechanics::StencilView<Dim>& view) {
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
   const StencilCache<Dim, Kernel>& cache = StencilCache<Dim, Kernel>::local();  // the calling thread's
   for (std::size_t k = 0; k < p.size(); ++k) thermal_properties_of(materials, p.material[k]);  // throws here
+  const bool pulls = pull.active();  // held nodes pull their particles towards the face (FacePull)
+  const double* const increment = pull.increment(delta.data());
+  const double* const target = end ? pull.end(end->data()) : nullptr;  // the blend's (FacePull::end)
+  double face_heat = 0.0;
   // Each particle's temperature from its own nodes: the particles shared between threads.
-#pragma omp parallel for num_threads(assembly_threads(p.size())) schedule(static)
+#pragma omp parallel for num_threads(assembly_threads(p.size())) schedule(static) reduction(+ : face_heat)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!materials[static_cast<std::size_t>(p.material[k])].conducts) continue;
     NodeList<Dim, Kernel> fresh;
@@ -275,18 +279,27 @@ void add_change_with(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>
     if (!cached) fresh.fill(grid, p, k, step_stencils);
     const NodeList<Dim, Kernel>& nl = cached ? *cached : fresh;
     double dT = 0.0, pic = 0.0, s = 0.0;
+    typename FacePull<Dim>::Sums q;
     for (int a = 0; a < nl.count; ++a) {
       const int u = sys.unknown[static_cast<std::size_t>(nl.node[a])];
       if (u < 0) continue;
-      dT += nl.S[a] * delta[u];  // design §4: the increment, not the nodal value
+      dT += nl.S[a] * increment[u];  // design §4: the increment, not the nodal value
+      if (pulls) pull.add(q, static_cast<std::size_t>(u), nl.S[a]);
       if (end) {
-        pic += nl.S[a] * (*end)[u];
+        pic += nl.S[a] * target[u];
         s += nl.S[a];
       }
     }
-    const double flip = p.temperature[k] + dT;
+    double flip = p.temperature[k] + dT;
+    if (pulls && q.weight != 0.0) {  // the held nodes' pull (FacePull) and the heat it brings
+      const double change = FacePull<Dim>::change(q, p.temperature[k], p.position[k]);
+      flip = p.temperature[k] + (dT + change);
+      face_heat += p.mass[k] * materials[static_cast<std::size_t>(p.material[k])].heat_capacity * change;
+      if (end) pic += FacePull<Dim>::blend_target(q, p.temperature[k], change);
+    }
     p.temperature[k] = (end && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
   }
+  return face_heat;
 }
 
 }  // namespace
@@ -350,11 +363,12 @@ NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mech
 }
 
 template <int Dim>
-void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
+double add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                    const NodalThermalSystem& system, const Eigen::VectorXd& delta,
                                    double relaxation, const Eigen::VectorXd* end,
-                                   const mechanics::StencilView<Dim>& stencils) {
+                                   const mechanics::StencilView<Dim>& stencils,
+                                   const std::vector<typename FacePull<Dim>::Held>* held) {
   const auto n = static_cast<Eigen::Index>(system.size());
   if (delta.size() != n || (end && end->size() != n))
     throw std::invalid_argument("add_nodal_change_to_particles: " + std::to_string(delta.size()) +
@@ -362,9 +376,14 @@ void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::
   if (!(relaxation >= 0.0 && relaxation <= 1.0))
     throw std::invalid_argument("add_nodal_change_to_particles: relaxation must be in [0, 1]");
   const Eigen::VectorXd* pic = relaxation > 0.0 ? end : nullptr;
+  FacePull<Dim> pull;
+  pull.build(delta.data(), pic ? pic->data() : nullptr, system.size(), held);
+  double face_heat = 0.0;
   mechanics::dispatch_shape(shape, [&](auto kernel) {
-    add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, relaxation, pic, stencils);
+    face_heat = add_change_with<Dim, decltype(kernel)>(grid, particles, materials, system, delta, pull, relaxation,
+                                                       pic, stencils);
   });
+  return face_heat;
 }
 
 template <int Dim>
@@ -381,10 +400,11 @@ double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::ve
   template NodalThermalSystem assemble_thermal<D>(const mechanics::Grid<D>&, const mechanics::Particles<D>&,   \
                                                   mechanics::ShapeKind, const std::vector<ThermalProperties>&, \
                                                   const AssemblyOptions&, const mechanics::StencilView<D>&);   \
-  template void add_nodal_change_to_particles<D>(const mechanics::Grid<D>&, mechanics::Particles<D>&,          \
+  template double add_nodal_change_to_particles<D>(const mechanics::Grid<D>&, mechanics::Particles<D>&,          \
                                                  mechanics::ShapeKind, const std::vector<ThermalProperties>&,  \
                                                  const NodalThermalSystem&, const Eigen::VectorXd&, double,    \
-                                                 const Eigen::VectorXd*, const mechanics::StencilView<D>&);    \
+                                                 const Eigen::VectorXd*, const mechanics::StencilView<D>&,     \
+                                                 const std::vector<FacePull<D>::Held>*);                       \
   template double particle_thermal_energy<D>(const mechanics::Particles<D>&, const std::vector<ThermalProperties>&);
 FRICTHERM_INSTANTIATE_ASSEMBLY(2)
 FRICTHERM_INSTANTIATE_ASSEMBLY(3)

@@ -207,7 +207,15 @@ class Coupler {
   /// Integrates the window [window_start_, time] matrix-free if it is short enough; false otherwise.
   bool matrix_free_window(mechanics::Particles<Dim>& particles, double dt);
   bool matrix_free_allowed() const;
-  void advance_and_map(mechanics::Particles<Dim>& particles, double t0, double t1);
+  // FacePull's held unknowns of the system after a window that ends at nodal temperatures T (null
+  // without fixed faces).
+  const std::vector<typename FacePull<Dim>::Held>* face_pull_nodes(const Eigen::VectorXd& T);
+  // The window's Σ M_i ΔT_i for the books, the held unknowns' terms replaced by the heat their pull
+  // gave the particles (FacePull).
+  double nodal_change(const Eigen::VectorXd& delta, const std::vector<typename FacePull<Dim>::Held>* held,
+                      double face_heat) const;
+  // from_gathered: the window started from the particles' temperatures (held nodes pull, FacePull).
+  void advance_and_map(mechanics::Particles<Dim>& particles, double t0, double t1, bool from_gathered);
   double mass_estimate(std::size_t node) const;
 
   mechanics::Grid<Dim> grid_;
@@ -239,6 +247,7 @@ class Coupler {
   double last_lambda_bound_ = 0.0;     // bound of λ_max(M⁻¹K) of the last gather or refresh (1/s)
   bool lambda_bound_is_quick_ = false;  // last_lambda_bound_ is ExplicitConduction::quick_bound (cruder)
   std::vector<FixedNode> fixed_nodes_;  // unknowns of the gathered system on fixed-temperature faces
+  std::vector<typename FacePull<Dim>::Held> face_pull_;  // face_pull_nodes' storage
   bool continuing_ = false;  // continue_thermal has been called
   /// The Arrhenius heat is part of the problem: enabled, and during loading or in the continuation.
   bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }

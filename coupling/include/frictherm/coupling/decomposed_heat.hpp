@@ -220,6 +220,8 @@ class DecomposedHeat {
   // The last gather: M_i and T_i (eq. 38) per owned node, M_i on the ghosted box, the unknowns'
   // threshold and smallest M_i over all ranks; the unknowns' global numbering of assembled windows.
   std::vector<double> M_, T0_, local_M_;
+  std::vector<FacePull<2>::Held> held_nodes_2_;  // map_back's held nodes (FacePull), by dimension
+  std::vector<FacePull<3>::Held> held_nodes_3_;
   std::vector<double> face_temperature_;  // per owned node: its fixed face's temperature (K), NaN if none; empty without faces
   double threshold_ = 0.0, min_unknown_mass_ = 0.0;
   std::unique_ptr<UnknownNumbering> ids_;

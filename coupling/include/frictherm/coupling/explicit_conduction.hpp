@@ -20,6 +20,7 @@
 // different number of sub-steps here.
 // Energy: Σ_i M_i ΔT_i = Σ_i q_i window + Σ_i h f_i, and Σ_i f_i = −Σ_p V_p k_p (Σ_i G'_ip)·(∇T)_p
 // vanishes to round-off (Σ_i G'_ip = 0: partition of unity, the lumping keeps it).
+#include <frictherm/coupling/fixed_temperature.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/particles.hpp>
@@ -32,12 +33,6 @@
 #include <vector>
 
 namespace frictherm::coupling {
-
-/// A node held at a fixed temperature (an unknown on a fixed-temperature face).
-struct FixedNode {
-  int unknown = 0;
-  double temperature = 0.0;  // K
-};
 
 template <int Dim>
 class ExplicitConduction {
@@ -117,9 +112,12 @@ class ExplicitConduction {
   /// m_p C_v,p ΔT_p S_ip to the sums of the next reproject() when the stencils are kept (a refresh,
   /// and so a reproject(), may follow; without them the next window gathers the sums anew).
   /// Particles with no unknown of ΔT_i ≠ 0 in the range of their unknowns keep their temperature
-  /// exactly and are passed over.
-  void map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
-                double relaxation, const Eigen::VectorXd* end);
+  /// exactly and are passed over. `held`: the window's held unknowns, which pull their particles
+  /// towards the face (FacePull; the window started from the gathered temperatures). Returns the heat
+  /// the pull gave the particles, Σ_p m_p C_v,p (pull's ΔT_p) (J; 0 without held unknowns).
+  double map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
+                double relaxation, const Eigen::VectorXd* end,
+                const std::vector<typename FacePull<Dim>::Held>* held = nullptr);
 
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
@@ -232,6 +230,8 @@ class ExplicitConduction {
   std::vector<mechanics::Vec<Dim>> gathered_at_;  // positions at the gather
   std::vector<double> mct_;               // Σ_p m_p C_v,p T_p S_ip by grid node (gather)
   Eigen::VectorXd next_mct_;              // the same by unknown, kept with the T_p by refresh and map_back
+  double face_heat_ = 0.0;                 // map_back's heat from the pull
+  FacePull<Dim> face_pull_;                   // map_back's held nodes (built per window, storage kept)
   std::vector<double> row_bound_;         // Σ_j |K_ij| bound by unknown (W/K)
   std::vector<double> rayleigh_bound_;    // Σ_{p∋i} V_p k_p Σ_a |G'_ap|²/M_a by unknown (1/s)
   // Refreshes: each particle's terms of rayleigh_bound_ used M of their time; M_peak_a / M_a bounds

@@ -12,6 +12,7 @@
 // so every particle still contributes V_p k_p |Σ_i G'_ip T_i|² (K stays symmetric PSD) and K·1 = 0.
 // Nodal temperature changes go back incrementally, T_p += Σ_i S_ip ΔT_i (design §4), which
 // conserves Σ_p m_p C_v,p T_p exactly: Σ_p m_p C_v,p ΔT_p = Σ_i M_i ΔT_i (partition of unity).
+#include <frictherm/coupling/fixed_temperature.hpp>
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/particles.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
@@ -92,13 +93,16 @@ NodalThermalSystem assemble_thermal(const mechanics::Grid<Dim>& grid, const mech
 /// window): T_p ← (1 − β) (T_p + Σ_i S_ip ΔT_i) + β Σ_i S_ip T_i,end / Σ_i S_ip, a FLIP/PIC blend that
 /// damps particle-scale structure the grid cannot see (it never decays with β = 0). A uniform β keeps
 /// Σ_p m_p C_v,p T_p exact wherever every node of a particle is an unknown. `stencils` as for
-/// assemble_thermal.
+/// assemble_thermal. `held`: held unknowns of a window that started from the gathered temperatures;
+/// they pull their particles towards the face (FacePull, fixed_temperature.hpp). Returns the heat the
+/// pull gave the particles (J; 0 without held unknowns).
 template <int Dim>
-void add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
+double add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics::Particles<Dim>& particles,
                                    mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                                    const NodalThermalSystem& system, const Eigen::VectorXd& delta,
                                    double relaxation = 0.0, const Eigen::VectorXd* end = nullptr,
-                                   const mechanics::StencilView<Dim>& stencils = {});
+                                   const mechanics::StencilView<Dim>& stencils = {},
+                                   const std::vector<typename FacePull<Dim>::Held>* held = nullptr);
 
 /// Σ_p m_p C_v,p T_p over the particles of conducting materials (J).
 template <int Dim>
@@ -111,14 +115,16 @@ extern template NodalThermalSystem assemble_thermal<2>(const mechanics::Grid<2>&
 extern template NodalThermalSystem assemble_thermal<3>(const mechanics::Grid<3>&, const mechanics::Particles<3>&,
                                                        mechanics::ShapeKind, const std::vector<ThermalProperties>&,
                                                        const AssemblyOptions&, const mechanics::StencilView<3>&);
-extern template void add_nodal_change_to_particles<2>(const mechanics::Grid<2>&, mechanics::Particles<2>&,
+extern template double add_nodal_change_to_particles<2>(const mechanics::Grid<2>&, mechanics::Particles<2>&,
                                                       mechanics::ShapeKind, const std::vector<ThermalProperties>&,
                                                       const NodalThermalSystem&, const Eigen::VectorXd&, double,
-                                                      const Eigen::VectorXd*, const mechanics::StencilView<2>&);
-extern template void add_nodal_change_to_particles<3>(const mechanics::Grid<3>&, mechanics::Particles<3>&,
+                                                      const Eigen::VectorXd*, const mechanics::StencilView<2>&,
+                                                      const std::vector<FacePull<2>::Held>*);
+extern template double add_nodal_change_to_particles<3>(const mechanics::Grid<3>&, mechanics::Particles<3>&,
                                                       mechanics::ShapeKind, const std::vector<ThermalProperties>&,
                                                       const NodalThermalSystem&, const Eigen::VectorXd&, double,
-                                                      const Eigen::VectorXd*, const mechanics::StencilView<3>&);
+                                                      const Eigen::VectorXd*, const mechanics::StencilView<3>&,
+                                                      const std::vector<FacePull<3>::Held>*);
 extern template double particle_thermal_energy<2>(const mechanics::Particles<2>&,
                                                   const std::vector<ThermalProperties>&);
 extern template double particle_thermal_energy<3>(const mechanics::Particles<3>&,
