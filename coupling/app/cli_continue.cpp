@@ -63,6 +63,7 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
   q.quiet = a.has("quiet");
   q.force = a.has("force");
   q.command_line = command_line;
+  q.new_thermal_settings = true;  // e.g. a reaction the loading did not have: columns joined (issue 34)
   std::vector<coupling::SceneOverride> overrides;
   if (a.lists.count("set"))
     for (const auto& assignment : a.lists.at("set")) {
