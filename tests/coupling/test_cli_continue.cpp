@@ -119,6 +119,40 @@ TEST(CliContinue, AReactionTheLoadingDidNotHaveStartsFromZeroAndTheBooksClose) {
   // The joined result continues in turn: its checkpoint has the reaction, the columns now agree.
   EXPECT_EQ(sh(exe + " continue " + d + "reacting.h5 -o " + d + "again.h5 --quiet --set thermal.rtol=1e-7"), 0);
   EXPECT_EQ(coupling::read_series(d + "again.h5").column("reaction_heat").size(), rows);
+  // Hot spots judged by the interface temperature need the loading's: refused by the key (exit 2),
+  // not as a damaged checkpoint ("has no '/interface/boundaries'", before), nothing written.
+  EXPECT_EQ(WEXITSTATUS(sh(exe + " continue " + d + "inert.h5 -o " + d + "iface.h5 --quiet"
+                                 " --set coupling.hotspots.temperature=interface 2>" + d + "err.txt")),
+            2);
+  std::ifstream in(d + "err.txt");
+  const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(err.find("coupling.hotspots.temperature"), std::string::npos) << err;
+  EXPECT_EQ(err.find("damaged"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(d + "iface.h5"));
+  fs::remove_all(dir);
+}
+
+// The other way (issue 34): a loading whose hot spots were judged by the interface temperature,
+// continued by the grid temperature, had failed at the append too (max_interface_temperature only in
+// the loading). Its loading rows are kept, the continuation's are NaN (not computed there).
+TEST(CliContinue, AColumnOnlyTheLoadingHasIsKeptWithNaNAfterIt) {
+  const fs::path dir = fs::temp_directory_path() / ("frictherm_continue_grid_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string exe = FRICTHERM_EXE, d = dir.string() + "/";
+  const std::string scene = std::string(FRICTHERM_SOURCE_DIR) + "/examples/pbx_microstructure_small.json";
+  ASSERT_EQ(sh(exe + " run " + scene + " -o " + d + "iface.h5 --quiet --force --set run.threads=1 --set run.end_time=1e-6"
+                    " --set thermal.reaction=null --set coupling.hotspots.temperature=interface"
+                    " --set 'coupling.continuation={\"duration\": 5e-6, \"intervals\": 5}'"),
+            0);
+  ASSERT_EQ(sh(exe + " continue " + d + "iface.h5 -o " + d + "grid.h5 --quiet --set coupling.hotspots.temperature=grid"), 0);
+  const std::size_t loading = static_cast<std::size_t>(coupling::checkpoint_marks(d + "iface.h5.checkpoint").series_rows);
+  const std::vector<double> a = coupling::read_series(d + "iface.h5").column("max_interface_temperature"),
+                            b = coupling::read_series(d + "grid.h5").column("max_interface_temperature");
+  ASSERT_EQ(b.size(), loading + 5);
+  ASSERT_GT(a[loading - 1], 300.0) << "the loading heated the interfaces";
+  for (std::size_t r = 0; r < loading; ++r) ASSERT_TRUE(a[r] == b[r] || (std::isnan(a[r]) && std::isnan(b[r]))) << r;
+  for (std::size_t r = loading; r < b.size(); ++r) EXPECT_TRUE(std::isnan(b[r])) << r;
   fs::remove_all(dir);
 }
 
