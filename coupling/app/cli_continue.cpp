@@ -20,7 +20,9 @@ const char* const kContinueHelp =
     "parameters and hot-spot thresholds on one loading. OUT.h5 holds RUN.h5's loading (series, hot\n"
     "spots, snapshots up to the end of loading) followed by the new continuation and its hot-spot fates;\n"
     "its metadata (wall_time, thermal_*) are the continuation's. A changed hot-spot threshold finds the\n"
-    "end-of-loading hot spots again (ids from 0). OUT.h5.checkpoint is its end-of-loading checkpoint.\n"
+    "end-of-loading hot spots again (ids from 0). A reaction the loading did not have starts from\n"
+    "lambda = 0; series columns only one part has are kept (0 or NaN in the other's rows:\n"
+    "docs/checkpoints.md). OUT.h5.checkpoint is its end-of-loading checkpoint.\n"
     "\n"
     "  -o, --output FILE     result (default RUN.continued.h5)\n"
     "  -f, --force           replace FILE if it exists (else refused; never RUN.h5 itself)\n"
@@ -63,6 +65,7 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
   q.quiet = a.has("quiet");
   q.force = a.has("force");
   q.command_line = command_line;
+  q.new_thermal_settings = true;  // e.g. a reaction the loading did not have: columns joined (issue 34)
   std::vector<coupling::SceneOverride> overrides;
   if (a.lists.count("set"))
     for (const auto& assignment : a.lists.at("set")) {
@@ -89,6 +92,13 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
     if (!std::filesystem::exists(q.checkpoint))
       throw coupling::OutputError("no checkpoint " + q.checkpoint + " (runs with coupling.continuation write one at the end of loading)");
     q.scene = checkpoint_scene_or_refuse(q.checkpoint, overrides);  // first: refuses an unreadable checkpoint
+    // The sub-cell interface temperature is the loading's frictional heat kept below the cell: a
+    // loading without it has none to continue from (its checkpoint had been called damaged, issue 34).
+    if (q.scene.thermal.coupler.interface_temperature.enabled &&
+        !checkpoint_scene_or_refuse(q.checkpoint).thermal.coupler.interface_temperature.enabled)
+      throw coupling::SceneError("coupling.hotspots.temperature: \"interface\" needs the sub-cell interface temperature "
+                                 "of the loading, which " + q.run + " ran without (coupling.interface_temperature off); "
+                                 "expected \"grid\", or rerun the scene with coupling.interface_temperature");
     const coupling::CheckpointMarks marks = coupling::checkpoint_marks(q.checkpoint);
     if (!marks.end_of_loading)
       throw coupling::OutputError(q.checkpoint + " was taken at t = " + std::to_string(marks.time) +

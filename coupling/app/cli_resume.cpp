@@ -126,19 +126,21 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
       remove_quietly(continuation);
       remove_quietly(coupling::xdmf_path_for(continuation));
       remove_quietly(coupling::xdmf_reference_path_for(continuation));
+      remove_quietly(coupling::xdmf_nodes_path_for(continuation));
       remove_quietly(opt.checkpoint_file);
     }
     throw;
   }
   if (append) {
     try {
-      coupling::append_result(q.run, continuation, marks, q.output);
+      coupling::append_result(q.run, continuation, marks, q.output, q.new_thermal_settings);
     } catch (const std::exception& e) {
       throw std::runtime_error(std::string(e.what()) + " (the resumed part is kept in " + continuation + ")");
     }
     remove_quietly(continuation);
     remove_quietly(coupling::xdmf_path_for(continuation));
     remove_quietly(coupling::xdmf_reference_path_for(continuation));
+    remove_quietly(coupling::xdmf_nodes_path_for(continuation));
     // Now that the rows it counts are in the published result: the resumed run's last checkpoint.
     if (exists(opt.checkpoint_file) && std::rename(opt.checkpoint_file.c_str(), coupling::checkpoint_path(q.output).c_str()) != 0)
       throw std::runtime_error("cannot rename '" + opt.checkpoint_file + "' to '" + coupling::checkpoint_path(q.output) +

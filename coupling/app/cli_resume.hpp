@@ -18,6 +18,7 @@ struct ResumeRequest {
   double checkpoint_wall_interval = 0.0;  // --checkpoint-every (resume)
   bool quiet = false;
   bool force = false;      // replace an existing output that is not `run`
+  bool new_thermal_settings = false;  // continue: series columns may differ from the loading's (append_result)
   std::string command_line;
 };
 

@@ -95,6 +95,26 @@ TEST_F(Limits, ResourceBombsRefusedBeforeAllocation) {
   expect_refused("--set 'extra[9999999999999999999]9=1'", "--set extra[9999999999999999999]9", "beyond the end");
 }
 
+// Contact keeps materials x materials tables (pair settings index, pair work books; per contact
+// thread again): 50,000 materials had ended validate with std::bad_alloc (exit 1) and 20,000 took
+// 7.9 GB (issue 34). The estimate counts them (20 B + 17 B per thread and pair): 3000 materials in
+// contact need 333 MB, over a 200 MB run.max_memory, refused naming `materials` before the tables
+// exist; the same materials without contact (no tables) validate.
+TEST_F(Limits, MaterialPairTablesCountedBeforeAllocation) {
+  std::string materials;
+  for (int i = 0; i < 3000; ++i)
+    materials += ", \"m" + std::to_string(i) +
+                 "\": {\"type\": \"linear_elastic\", \"density\": 1000, \"youngs_modulus\": 1e6, \"poisson_ratio\": 0.3}";
+  std::string scene = kBase;
+  const std::string soft = "\"poisson_ratio\": 0.3}}";
+  scene.insert(scene.find(soft) + soft.size() - 1, materials);
+  std::ofstream(scene_) << scene;
+  expect_refused("--set run.max_memory=2e8 --set contact={}", "materials: 3001 materials in contact",
+                 "the limit is 200 MB (run.max_memory)");
+  const Result r = validate(scene_, "--set run.max_memory=2e8");
+  EXPECT_EQ(r.code, 0) << r.output;
+}
+
 TEST_F(Limits, EndlessRunsRefusedWithTheirNumbers) {
   expect_refused("--set output.snapshot_count=null --set output.snapshot_interval=1e-300", "output",
                  "2e+297 snapshots");

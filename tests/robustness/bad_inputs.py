@@ -264,6 +264,18 @@ def many_materials(n):
     return scene(materials=mats)
 
 
+def many_materials_in_contact(n):
+    """n valid materials in contact: contact's dense materials x materials tables (37 B per pair on one
+    thread) refused by the cost estimate before they exist (issue 34: 50,000 ended in std::bad_alloc).
+    run.max_memory makes the refusal independent of the machine's memory."""
+    mats = {"m%d" % k: BASE["materials"]["soft"] for k in range(n)}
+    s = json.loads(scene(materials=mats))
+    s["bodies"][0]["material"] = "m0"
+    s["contact"] = {}
+    s["run"]["max_memory"] = 1e9
+    return json.dumps(s)
+
+
 def many_constants(n):
     """An expression law with n named constants whose expression names an unknown variable."""
     soft = BASE["materials"]["soft"]
@@ -318,6 +330,8 @@ CASES += [
     ("key holding \\u0000", json.dumps(dict(json.loads(scene()), **{"ru\x00n": 1})), {}, ["validate", "SCENE"],
      "ru\\u0000n: unknown key"),
     ("50,000 materials", many_materials(50000), {}, ["validate", "SCENE"], "materials.m49999.poisson_ratio"),
+    ("20,000 materials in contact", many_materials_in_contact(20000), {}, ["validate", "SCENE"],
+     "materials: 20000 materials in contact need about 14.8 GB"),
     ("expression law with 200,000 constants", many_constants(200000), {}, ["validate", "SCENE"],
      "contact.pairs[0].law.constants: expected at most 1000 named constants, got 200000"),
     ("expression law with 1,000 constants", many_constants(1000), {}, ["validate", "SCENE"],

@@ -15,6 +15,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
+#include <algorithm>
 #include <filesystem>
 #include <utility>
 #include <stdexcept>
@@ -51,9 +53,71 @@ hsize_t rows_of(hid_t d, const std::string& file, const std::string& where) {
   return n;
 }
 
-// /<group>/<column>: the original's first `keep` rows, then all of the continuation's rows.
+void copy_object(hid_t from, const std::string& src, hid_t to, const std::string& dst, const std::string& file) {
+  check(H5Ocopy(from, src.c_str(), to, dst.c_str(), H5P_DEFAULT, H5P_DEFAULT), file, "cannot copy " + src + " to " + dst);
+}
+
+// The names in a column group's `columns` attribute (the order the writer declared), or none.
+std::vector<std::string> declared_columns(hid_t group, const std::string& file, const std::string& where) {
+  std::vector<std::string> names;
+  if (H5Aexists(group, "columns") <= 0) return names;
+  const std::string attr = where + " attribute columns";
+  const Handle a{check_id(H5Aopen(group, "columns", H5P_DEFAULT), file, attr), H5Aclose};
+  const Handle t{check_id(H5Aget_type(a.get()), file, "type of " + attr), H5Tclose};
+  const Handle s{check_id(H5Aget_space(a.get()), file, attr), H5Sclose};
+  const std::size_t size = H5Tget_size(t.get());
+  const hssize_t count = H5Sget_simple_extent_npoints(s.get());
+  if (H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) > 0 || size == 0 || count < 0)
+    throw std::runtime_error("'" + file + "': " + attr + " is not a fixed-length string array");
+  std::string packed(size * static_cast<std::size_t>(count), '\0');
+  check(H5Aread(a.get(), t.get(), packed.data()), file, "cannot read " + attr);
+  for (hssize_t i = 0; i < count; ++i) {
+    std::string name = packed.substr(static_cast<std::size_t>(i) * size, size);
+    name.resize(std::min(name.size(), name.find('\0')));
+    names.push_back(name);
+  }
+  return names;
+}
+
+// Replaces the `columns` attribute of `group` (fixed-length, NUL-padded, as H5Output writes it).
+void declare_columns(hid_t group, const std::vector<std::string>& names, const std::string& file, const std::string& where) {
+  std::size_t longest = 1;
+  for (const std::string& n : names) longest = std::max(longest, n.size());
+  std::string packed(names.size() * longest, '\0');
+  for (std::size_t i = 0; i < names.size(); ++i) packed.replace(i * longest, names[i].size(), names[i]);
+  if (H5Aexists(group, "columns") > 0) check(H5Adelete(group, "columns"), file, "cannot replace " + where + " attribute columns");
+  const Handle t{check_id(H5Tcopy(H5T_C_S1), file, "string type"), H5Tclose};
+  check(H5Tset_size(t.get(), longest), file, "string type");
+  check(H5Tset_strpad(t.get(), H5T_STR_NULLPAD), file, "string type");
+  check(H5Tset_cset(t.get(), H5T_CSET_UTF8), file, "string type");
+  const hsize_t n = names.size();
+  const Handle s{check_id(H5Screate_simple(1, &n, nullptr), file, "dataspace"), H5Sclose};
+  const Handle a{check_id(H5Acreate2(group, "columns", t.get(), s.get(), H5P_DEFAULT, H5P_DEFAULT), file,
+                          "cannot create " + where + " attribute columns"),
+                 H5Aclose};
+  check(H5Awrite(a.get(), t.get(), packed.data()), file, "cannot write " + where + " attribute columns");
+}
+
+// What a joined column holds in the rows of the part that did not write it (`continue` with other
+// thermal settings, issue 34). The loading's rows of a column only the continuation has: 0 for the
+// quantities that were exactly 0 there (a reaction or plastic heating the loading did not have:
+// nothing released, λ = 0, which is where the continuation starts), NaN (undefined) for the others,
+// e.g. an interface temperature. The continuation's rows of a column only the loading has: NaN (not
+// computed by the continuation).
+double absent_value(const std::string& column, bool in_loading_rows) {
+  if (in_loading_rows)
+    for (const char* zero : {"reaction_heat", "max_reaction_progress", "max_interface_reaction_progress", "plastic_work",
+                             "plastic_heat"})
+      if (column == zero) return 0.0;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// /<group>/<column>: the original's first `keep` rows, then all of the continuation's rows. With
+// `join_columns` (continue) a column only one of them has is kept, filled with absent_value in the
+// other's rows, and the group's `columns` attribute becomes the continuation's order followed by the
+// original's own columns; without it (resume: the same scene) differing columns are refused.
 void append_columns(hid_t out, hid_t cont, const std::string& group, long keep, const std::string& file,
-                    const std::string& cont_file) {
+                    const std::string& cont_file, bool join_columns) {
   const bool in_out = exists(out, "/" + group), in_cont = exists(cont, "/" + group);
   if (!in_out && !in_cont) return;
   if (!in_out || !in_cont)
@@ -61,36 +125,69 @@ void append_columns(hid_t out, hid_t cont, const std::string& group, long keep, 
   const Handle go{check_id(H5Gopen2(out, group.c_str(), H5P_DEFAULT), file, "/" + group), H5Gclose};
   const Handle gc{check_id(H5Gopen2(cont, group.c_str(), H5P_DEFAULT), cont_file, "/" + group), H5Gclose};
   const std::vector<std::string> cols = members(go.get()), cont_cols = members(gc.get());
-  if (cols != cont_cols)
+  if (cols != cont_cols && !join_columns)
     throw std::runtime_error("'" + file + "': the columns of /" + group + " differ from those of the resumed run");
-  for (const std::string& c : cols) {
+  std::vector<std::string> all = cont_cols;  // sorted by name, as members() lists them
+  for (const std::string& c : cols)
+    if (!std::binary_search(cont_cols.begin(), cont_cols.end(), c)) all.push_back(c);
+  for (const std::string& c : all) {
     const std::string where = "/" + group + "/" + c;
+    const bool mine = std::binary_search(cols.begin(), cols.end(), c), theirs = std::binary_search(cont_cols.begin(), cont_cols.end(), c);
+    hsize_t add = 0;
+    Handle e;
+    if (theirs) {
+      e = Handle{check_id(H5Dopen2(gc.get(), c.c_str(), H5P_DEFAULT), cont_file, where), H5Dclose};
+      add = rows_of(e.get(), cont_file, where);
+    } else {  // as many rows as the continuation's other columns
+      if (!cont_cols.empty()) {
+        const std::string first = "/" + group + "/" + cont_cols.front();
+        const Handle f{check_id(H5Dopen2(gc.get(), cont_cols.front().c_str(), H5P_DEFAULT), cont_file, first), H5Dclose};
+        add = rows_of(f.get(), cont_file, first);
+      }
+    }
+    // A column only the continuation has: its dataset (type, chunks, units) copied, then moved down
+    // below `keep` filled rows.
+    if (!mine) copy_object(gc.get(), c, go.get(), c, file);
     const Handle d{check_id(H5Dopen2(go.get(), c.c_str(), H5P_DEFAULT), file, where), H5Dclose};
-    const Handle e{check_id(H5Dopen2(gc.get(), c.c_str(), H5P_DEFAULT), cont_file, where), H5Dclose};
-    const hsize_t have = rows_of(d.get(), file, where), add = rows_of(e.get(), cont_file, where);
+    const hsize_t have = mine ? rows_of(d.get(), file, where) : static_cast<hsize_t>(keep);
     if (have < static_cast<hsize_t>(keep))
       throw std::runtime_error("'" + file + "': " + where + " has " + std::to_string(have) +
                                " rows, the checkpoint counts " + std::to_string(keep) +
                                " (the result was written after the checkpoint by another run?)");
     const Handle type{check_id(H5Dget_type(d.get()), file, "type of " + where), H5Tclose};
     const bool integer = H5Tget_class(type.get()) == H5T_INTEGER;
+    if (integer && !(mine && theirs))
+      throw std::runtime_error("'" + file + "' and '" + cont_file + "': only one of them has the count column " + where +
+                               " (no value stands for its absence)");
     const hid_t mem = integer ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
-    std::vector<double> vd(integer ? 0 : add);
-    std::vector<std::int64_t> vi(integer ? add : 0);
+    // Rows written from `start`: the continuation's after the kept ones, or all of them with the
+    // filled rows first for a column the original lacks.
+    const hsize_t start = mine ? static_cast<hsize_t>(keep) : 0, count = mine ? add : add + static_cast<hsize_t>(keep);
+    std::vector<double> vd(integer ? 0 : count);
+    std::vector<std::int64_t> vi(integer ? count : 0);
+    if (!mine) std::fill(vd.begin(), vd.begin() + keep, absent_value(c, true));
+    if (!theirs) std::fill(vd.begin(), vd.end(), absent_value(c, false));
+    const hsize_t offset = mine ? 0 : static_cast<hsize_t>(keep);
+    void* at = integer ? static_cast<void*>(vi.data() + offset) : static_cast<void*>(vd.data() + offset);
+    if (theirs && add > 0) {
+      const Handle ms{check_id(H5Screate_simple(1, &add, nullptr), cont_file, "dataspace"), H5Sclose};
+      check(H5Dread(e.get(), mem, ms.get(), H5S_ALL, H5P_DEFAULT, at), cont_file, "cannot read " + where);
+    }
     void* buf = integer ? static_cast<void*>(vi.data()) : static_cast<void*>(vd.data());
-    if (add > 0) check(H5Dread(e.get(), mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf), cont_file, "cannot read " + where);
-    const hsize_t start = static_cast<hsize_t>(keep), total = start + add;
+    const hsize_t total = static_cast<hsize_t>(keep) + add;
     check(H5Dset_extent(d.get(), &total), file, "cannot resize " + where);
-    if (add == 0) continue;
+    if (count == 0) continue;
     const Handle fs{check_id(H5Dget_space(d.get()), file, "dataspace of " + where), H5Sclose};
-    check(H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, &start, nullptr, &add, nullptr), file, "rows of " + where);
-    const Handle ms{check_id(H5Screate_simple(1, &add, nullptr), file, "dataspace"), H5Sclose};
+    check(H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr), file, "rows of " + where);
+    const Handle ms{check_id(H5Screate_simple(1, &count, nullptr), file, "dataspace"), H5Sclose};
     check(H5Dwrite(d.get(), mem, ms.get(), fs.get(), H5P_DEFAULT, buf), file, "cannot write " + where);
   }
-}
-
-void copy_object(hid_t from, const std::string& src, hid_t to, const std::string& dst, const std::string& file) {
-  check(H5Ocopy(from, src.c_str(), to, dst.c_str(), H5P_DEFAULT, H5P_DEFAULT), file, "cannot copy " + src + " to " + dst);
+  if (cols == cont_cols) return;
+  // The declared order: the continuation's, then the columns only the original has, in its order.
+  std::vector<std::string> order = declared_columns(gc.get(), cont_file, "/" + group);
+  for (const std::string& c : declared_columns(go.get(), file, "/" + group))
+    if (std::find(order.begin(), order.end(), c) == order.end()) order.push_back(c);
+  if (!order.empty()) declare_columns(go.get(), order, file, "/" + group);
 }
 
 std::string snapshot_name(std::size_t k) {
@@ -324,14 +421,15 @@ void copy_bytes(const std::string& from, const std::string& to) {
 
 // The joined result in `tmp`: the original's rows up to the marks, then the continuation's.
 void append_into(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
-                 const std::string& tmp) {
+                 const std::string& tmp, bool join_columns) {
   copy_bytes(original, tmp);
   const h5detail::Quiet quiet;
   const Handle out{check_id(H5Fopen(tmp.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), tmp, "cannot open the copy"), H5Fclose};
   const Handle cont{check_id(H5Fopen(continuation.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), continuation, "cannot open"),
                     H5Fclose};
-  append_columns(out.get(), cont.get(), "series", marks.series_rows, original, continuation);
-  for (const auto& [table, rows] : marks.table_rows) append_columns(out.get(), cont.get(), table, rows, original, continuation);
+  append_columns(out.get(), cont.get(), "series", marks.series_rows, original, continuation, join_columns);
+  for (const auto& [table, rows] : marks.table_rows)
+    append_columns(out.get(), cont.get(), table, rows, original, continuation, join_columns);
   append_snapshots(out.get(), cont.get(), marks.snapshots, original, continuation);
   replace_meta(out.get(), cont.get(), original, continuation);
   check(H5Fflush(out.get(), H5F_SCOPE_GLOBAL), tmp, "cannot flush");
@@ -341,21 +439,21 @@ void append_into(const std::string& original, const std::string& continuation, c
 // fails under it, a full disk or the file-size limit (issue 34, found by the fault injection). The
 // child's message comes back through a pipe; a crash is reported as a failed write.
 void append_in_child(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
-                     const std::string& tmp) {
+                     const std::string& tmp, bool join_columns) {
   int fds[2];
-  if (::pipe(fds) != 0) return append_into(original, continuation, marks, tmp);
+  if (::pipe(fds) != 0) return append_into(original, continuation, marks, tmp, join_columns);
   std::fflush(nullptr);
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]);
     ::close(fds[1]);
-    return append_into(original, continuation, marks, tmp);
+    return append_into(original, continuation, marks, tmp, join_columns);
   }
   if (pid == 0) {
     ::close(fds[0]);
     int code = 0;
     try {
-      append_into(original, continuation, marks, tmp);
+      append_into(original, continuation, marks, tmp, join_columns);
     } catch (const std::exception& e) {
       const std::string what = e.what();
       for (std::size_t done = 0; done < what.size();) {
@@ -390,10 +488,10 @@ void append_in_child(const std::string& original, const std::string& continuatio
 }  // namespace
 
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
-                   const std::string& output) {
+                   const std::string& output, bool join_columns) {
   const std::string tmp = temporary_path(output);
   try {
-    append_in_child(original, continuation, marks, tmp);
+    append_in_child(original, continuation, marks, tmp, join_columns);
     const std::size_t slash = output.find_last_of('/');
     const std::string name = slash == std::string::npos ? output : output.substr(slash + 1);
     const XdmfDocuments xdmf = xdmf_documents_of_result(tmp, name);

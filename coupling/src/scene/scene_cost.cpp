@@ -36,6 +36,15 @@ constexpr double kMinBoundarySpacingPerCell = 0.01;
 double bytes_per_particle(int dim) { return dim == 2 ? 420.0 : 520.0; }
 double bytes_per_node(int dim) { return dim == 2 ? 115.0 : 165.0; }
 double thermal_bytes_per_node(int dim) { return dim == 2 ? 300.0 : 700.0; }
+// Contact keeps dense materials x materials tables (Simulation: pair_index_ 4 B, pair_work_first_ and
+// pair_work_second_ 8 B each; each contact thread's pair books 8 + 8 + 1 B): 50,000 materials asked
+// for 50 GB and ended validate with std::bad_alloc (issue 34; 20,000 took 7.9 GB and 18 s).
+constexpr double kPairBytes = 20.0, kPairBytesPerThread = 17.0;
+double pair_table_bytes(const Scene& s, int threads) {
+  if (!s.contact.enabled) return 0.0;
+  const double n = static_cast<double>(s.materials.size());
+  return n * n * (kPairBytes + threads * kPairBytesPerThread);
+}
 
 std::string bytes_text(double b) {
   if (b >= 1e9) return format_number(std::round(b / 1e8) / 10.0) + " GB";
@@ -84,7 +93,7 @@ SceneCost estimate_scene_cost(const Scene& s) {
   c.memory_bytes = kBaseBytes + c.particles * bytes_per_particle(dim) + c.grid_nodes * bytes_per_node(dim) +
                    (c.threads - 1) * c.grid_nodes * 8.0 * (1 + 2 * dim) +
                    (s.thermal.enabled ? c.grid_nodes * thermal_bytes_per_node(dim) : 0.0) +
-                   c.boundary_points * kBytesPerBoundaryPoint;
+                   c.boundary_points * kBytesPerBoundaryPoint + pair_table_bytes(s, c.threads);
   if (s.max_memory > 0.0) {
     c.memory_limit = s.max_memory;
     c.memory_limit_source = "run.max_memory";
@@ -178,9 +187,17 @@ void check_scene_cost(const Scene& s, const SceneCost& c) {
                      format_number(kMaxNodesPerParticle) + " nodes per particle above " + format_number(kMaxEmptyGridNodes) +
                      " nodes), or set run.max_memory (bytes) to accept it");
   if (!(c.memory_bytes <= c.memory_limit)) {
-    // Blame the larger part: the particles (the body with most of them) or the grid.
+    // Blame the largest part: the materials' contact pair tables, the particles (the body with most of
+    // them) or the grid.
     std::string key = "grid";
     const double particle_bytes = c.particles * bytes_per_particle(s.dimension);
+    const double pair_bytes = pair_table_bytes(s, c.threads);
+    if (pair_bytes > 0.5 * c.memory_bytes)
+      throw SceneError("materials: " + std::to_string(s.materials.size()) + " materials in contact need about " +
+                       bytes_text(pair_bytes) + " of materials x materials pair tables (of " + bytes_text(c.memory_bytes) +
+                       " in all, " + std::to_string(c.threads) + (c.threads == 1 ? " thread" : " threads") + "); the limit is " + bytes_text(c.memory_limit) +
+                       " (" + c.memory_limit_source + "); expected fewer materials (grains of one kind can share a " +
+                       "material when friction between them is not needed), or a larger run.max_memory (bytes)");
     if (particle_bytes > c.grid_nodes * bytes_per_node(s.dimension)) {
       std::size_t worst = 0;
       double most = -1.0;

@@ -15,9 +15,13 @@ namespace frictherm::coupling {
 /// "<output>.<pid>.part" (a copy of `original`) and renamed onto `output` only when complete, so
 /// `original` (which may be `output` itself) stays whole if anything fails; `output`'s XDMF files
 /// (RUN.xdmf, RUN_reference.xdmf and RUN_nodes.xdmf, xdmf_documents_of_result) are rebuilt. Throws std::runtime_error naming the file and what does not fit (columns differ, fewer
-/// rows than the marks).
+/// rows than the marks). `join_columns` (frictherm continue, whose thermal settings may differ from
+/// the loading's, issue 34): a series or table column only one part has (a reaction switched on adds
+/// reaction_heat and max_reaction_progress) is kept instead of refused, filled in the other part's
+/// rows: 0 in the loading's rows for the reaction and plastic-heat columns (nothing released there,
+/// λ = 0), NaN otherwise; the group's `columns` attribute lists the union.
 void append_result(const std::string& original, const std::string& continuation, const CheckpointMarks& marks,
-                   const std::string& output);
+                   const std::string& output, bool join_columns = false);
 
 /// /meta/run_id of the result `result` ("" for results of older versions, which have none); throws
 /// std::runtime_error naming the file when it does not open.
