@@ -150,6 +150,7 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   out.write_metadata("thermal_rhs_evals", st.rhs_evals);
   out.write_metadata("thermal_linear_iters", st.linear_iters);
   out.write_metadata("thermal_error_test_failures", st.error_test_failures);
+  out.write_metadata("thermal_reinits", st.reinits);
   out.write_metadata("thermal_wall_time", st.wall_seconds);
   out.write_metadata("work_received", b.work_received);
   out.write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
