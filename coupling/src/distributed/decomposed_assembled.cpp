@@ -32,19 +32,33 @@ struct MatHolder {
 }  // namespace
 
 DecomposedAssembledSolve::DecomposedAssembledSolve(const std::string& name, const thermal::IntegratorOptions& options,
-                                                   const std::string& preconditioner) {
-  thermal::DistributedOptions o;
-  o.integrator = options;
-  o.preconditioner = preconditioner;
-  integrator_ = thermal::make_distributed_integrator(name, o);
+                                                   const std::string& preconditioner)
+    : name_(name), preconditioner_(preconditioner), options_(options) {
+  restart_integrator();
+  stats_offset_ = thermal::IntegratorStats{};
 }
 
 DecomposedAssembledSolve::~DecomposedAssembledSolve() = default;
+
+void DecomposedAssembledSolve::restart_integrator() {
+  if (integrator_) stats_offset_ += integrator_->stats();
+  thermal::DistributedOptions o;
+  o.integrator = options_;
+  o.preconditioner = preconditioner_;
+  integrator_ = thermal::make_distributed_integrator(name_, o);
+}
 
 void DecomposedAssembledSolve::advance(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept,
                                        const std::vector<double>& M, const std::vector<double>& q,
                                        const std::vector<double>& fixed, std::vector<double>& T, double t0,
                                        double t1) {
+  assemble(comm, ids, kept, M, fixed);
+  integrate(ids, &q, T, t0, t1);
+}
+
+void DecomposedAssembledSolve::assemble(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept,
+                                        const std::vector<double>& M, const std::vector<double>& fixed) {
+  problem_.reset();
   const int dim = kept.dim;
   const auto n = static_cast<PetscInt>(ids.count), N = static_cast<PetscInt>(ids.global);
   // Columns per row: two nodes of one particle's stencil (at most 3 per axis for linear, uGIMP and the
@@ -144,24 +158,34 @@ void DecomposedAssembledSolve::advance(MPI_Comm comm, const UnknownNumbering& id
   thermal::SparseMatrix rows_k(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(N));
   rows_k.setFromTriplets(entries.begin(), entries.end());
 
-  // M, T, q on the owned unknowns (compact, in global-id order) and the window's integration.
-  Eigen::VectorXd mass(n), temperature(n), source(n);
+  // M on the owned unknowns (compact, in global-id order): the window's problem, kept.
+  Eigen::VectorXd mass(n);
+  for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
+    if (ids.owned_id[u] >= 0) mass[static_cast<Eigen::Index>(ids.owned_id[u] - ids.first)] = M[u];
+  problem_ = std::make_unique<thermal::DistributedProblem>(comm, static_cast<thermal::Index>(N),
+                                                           static_cast<thermal::Index>(ids.first), std::move(mass),
+                                                           std::move(rows_k));
+  if (!fixed.empty())  // the serial Problem::set_dirichlet of the fixed faces' unknowns
+    for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
+      if (ids.owned_id[u] >= 0 && !std::isnan(fixed[u]))
+        problem_->set_dirichlet(static_cast<thermal::Index>(ids.owned_id[u]), fixed[u]);
+}
+
+void DecomposedAssembledSolve::integrate(const UnknownNumbering& ids, const std::vector<double>* q,
+                                         std::vector<double>& T, double t0, double t1) {
+  if (!problem_) throw std::logic_error("decomposed heat: integrate before assemble");
+  const auto n = static_cast<Eigen::Index>(ids.count);
+  // T and q on the owned unknowns (compact, in global-id order), then the window's integration.
+  Eigen::VectorXd temperature(n), source = Eigen::VectorXd::Zero(n);
   for (std::size_t u = 0; u < ids.owned_id.size(); ++u) {
     const long id = ids.owned_id[u];
     if (id < 0) continue;
     const auto i = static_cast<Eigen::Index>(id - ids.first);
-    mass[i] = M[u];
     temperature[i] = T[u];
-    source[i] = q[u];
+    if (q) source[i] = (*q)[u];
   }
-  thermal::DistributedProblem problem(comm, static_cast<thermal::Index>(N), static_cast<thermal::Index>(ids.first),
-                                      std::move(mass), std::move(rows_k));
-  problem.set_source(std::move(source));  // constant over the window: ∫ q dt = W (design §4)
-  if (!fixed.empty())  // the serial Problem::set_dirichlet of the fixed faces' unknowns
-    for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
-      if (ids.owned_id[u] >= 0 && !std::isnan(fixed[u]))
-        problem.set_dirichlet(static_cast<thermal::Index>(ids.owned_id[u]), fixed[u]);
-  integrator_->advance(problem, temperature, t0, t1);
+  problem_->set_source(std::move(source));  // constant over the window: ∫ q dt = W (design §4); zero: none
+  integrator_->advance(*problem_, temperature, t0, t1);
   for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
     if (ids.owned_id[u] >= 0) T[u] = temperature[static_cast<Eigen::Index>(ids.owned_id[u] - ids.first)];
 }

@@ -58,14 +58,34 @@ class DecomposedAssembledSolve {
   void advance(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept, const std::vector<double>& M,
                const std::vector<double>& q, const std::vector<double>& fixed, std::vector<double>& T, double t0,
                double t1);
+  /// advance()'s two halves. assemble: the problem (M, K, Dirichlet rows) of the window, kept until
+  /// the next assemble (the continuation integrates on the last one, as the serial Coupler keeps its
+  /// Problem). integrate: from t0 to t1 on the kept problem with the source q per owned node (nullptr:
+  /// none); the integrator keeps its history when t0 and T are where its last integrate left them.
+  void assemble(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept, const std::vector<double>& M,
+                const std::vector<double>& fixed);
+  void integrate(const UnknownNumbering& ids, const std::vector<double>* q, std::vector<double>& T, double t0,
+                 double t1);
+  bool assembled() const { return problem_ != nullptr; }
+  /// A fresh integrator of the same name and options (the continuation's, as Coupler::continue_thermal):
+  /// the counts so far stay in stats().
+  void restart_integrator();
 
-  const thermal::IntegratorStats& stats() const { return integrator_->stats(); }
+  thermal::IntegratorStats stats() const {
+    thermal::IntegratorStats s = stats_offset_;
+    s += integrator_->stats();
+    return s;
+  }
   std::string name() const { return integrator_->name(); }
   /// Stored entries of K's owned rows in the last window (this rank).
   long last_entries() const { return entries_; }
 
  private:
+  std::string name_, preconditioner_;
+  thermal::IntegratorOptions options_;
   std::unique_ptr<thermal::DistributedIntegrator> integrator_;
+  thermal::IntegratorStats stats_offset_;  // of the integrators replaced by restart_integrator
+  std::unique_ptr<thermal::DistributedProblem> problem_;  // the last window's
   long entries_ = 0;
 };
 

@@ -326,22 +326,19 @@ void DecomposedHeat::number_unknowns(mechanics::DecomposedMpm<Dim>& mpm) {
   mpm.owned_to_local(id, 1, n.local_id);
 }
 
+// Pass 1 (gather_mass) and pass 2: each heat-holding particle's kept nodes (unknowns), the lumped
+// gradients G' and V_p k_p, and the bound of λ_max(M⁻¹K) over all ranks (the smaller of the two bounds
+// of ExplicitConduction::keep). What a window and the continuation's first assembly start from.
 template <int Dim>
-void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0,
-                               double dt) {
+double DecomposedHeat::gather_window(mechanics::DecomposedMpm<Dim>& mpm) {
   using Vec = mechanics::Vec<Dim>;
   using GMap = Eigen::Map<Vec>;
   const MPI_Comm comm = mpm.communicator();
   const std::size_t no = mpm.owned_local_nodes().size(), nl = static_cast<std::size_t>(mpm.local_node_count());
-  if (joules.size() != no)
-    throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
-                                std::to_string(no) + " owned nodes");
-  if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
   gather_mass(mpm);  // pass 1: M_, T0_, local_M_, capacity_
   const typename mechanics::DecomposedMpm<Dim>::Stencils& st = mpm.current_stencils();
   const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
-  std::vector<double> T = mpm.particle_scalar(scalar_);
-  const std::size_t np = T.size();
+  const std::size_t np = capacity_.size();
   const std::vector<double>& M = M_;
   auto unknown = [this](double m) { return is_unknown(m); };
 
@@ -407,7 +404,26 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
     lam[1] = std::max(lam[1], bounds[2 * q + 1]);
   }
   MPI_Allreduce(MPI_IN_PLACE, lam, 2, MPI_DOUBLE, MPI_MAX, comm);
-  const double lambda = std::min(lam[0], lam[1]);
+  return std::min(lam[0], lam[1]);
+}
+
+template <int Dim>
+void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0,
+                               double dt) {
+  using Vec = mechanics::Vec<Dim>;
+  using GMap = Eigen::Map<Vec>;
+  const MPI_Comm comm = mpm.communicator();
+  const std::size_t no = mpm.owned_local_nodes().size(), nl = static_cast<std::size_t>(mpm.local_node_count());
+  if (joules.size() != no)
+    throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
+                                std::to_string(no) + " owned nodes");
+  if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
+  const double lambda = gather_window(mpm);  // passes 1 and 2: M_, T0_, local_M_, capacity_, kept entries
+  std::vector<double> T = mpm.particle_scalar(scalar_);
+  const std::size_t np = T.size();
+  const std::vector<double>& M = M_;
+  auto unknown = [this](double m) { return is_unknown(m); };
+  auto G = [this](std::size_t a) { return GMap(kept_G_.data() + Dim * a); };
 
   // The serial Coupler's choice (close_window, matrix_free_window): matrix-free forward Euler for
   // "forward_euler" and "auto" when the window needs at most matrix_free_max_substeps stable sub-steps
@@ -518,12 +534,62 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   double changes[2];
   map_back(mpm, Tn, dt, T, changes);
   mpm.set_particle_scalar(scalar_, T);
+  last_T_ = std::move(Tn);  // where a continuation goes on from (the serial Coupler's nodal_temperature_)
+  last_assembled_ = !matrix_free;
   double b[3] = {delivered * dt, changes[0], changes[1]};
   MPI_Allreduce(MPI_IN_PLACE, b, 3, MPI_DOUBLE, MPI_SUM, comm);
   books_.heat_delivered += b[0];
   books_.nodal_energy_change += b[1];
   books_.particle_energy_change += b[2];
   ++books_.windows;
+}
+
+void DecomposedHeat::continue_thermal(double time) {
+  if (mpm3_) continue_on(*mpm3_, time);
+  else continue_on(*mpm2_, time);
+}
+
+// Coupler::continue_thermal on the decomposed grid: no source, the mechanics frozen. The first interval
+// takes a fresh integrator and, as the serial Coupler, the last window's problem and its end
+// temperatures when that window was assembled; after a matrix-free window (or none) it gathers and
+// assembles afresh (gather_window, the assembled path's numbering and K) and starts from the gathered
+// T_i. Each interval integrates on that problem from where the last left off (the integrator keeps its
+// history) and maps ΔT_i back to the particles (map_back, with the sub-grid relaxation).
+template <int Dim>
+void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time) {
+  if (pending_heat() != 0.0)
+    throw std::logic_error("DecomposedHeat::continue_thermal: close the window with pending heat first");
+  if (!(time > window_start_)) return;
+  const MPI_Comm comm = mpm.communicator();
+  if (!continuing_) {
+    assembled_->restart_integrator();  // the continuation depends only on the end-of-loading state
+    if (!last_assembled_ || !assembled_->assembled()) {
+      gather_window(mpm);
+      number_unknowns(mpm);
+      const std::array<int, 2 * Dim> box = mpm.ghosted_nodes();
+      KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
+      for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
+      assembled_->assemble(comm, *ids_, entries_of, M_, face_temperature_);
+      last_T_ = T0_;
+      books_.exchanges += 4;  // M and Σ m C T, M back, the bounds, the ids
+    }
+    continuing_ = true;
+  }
+  T0_ = last_T_;  // the interval's start: ΔT_i = T_i(t1) − T_i(t0)
+  std::vector<double> Tn = last_T_;
+  assembled_->integrate(*ids_, nullptr, Tn, window_start_, time);
+  std::vector<double> T = mpm.particle_scalar(scalar_);
+  double changes[2];
+  map_back(mpm, Tn, time - window_start_, T, changes);
+  mpm.set_particle_scalar(scalar_, T);
+  last_T_ = std::move(Tn);
+  MPI_Allreduce(MPI_IN_PLACE, changes, 2, MPI_DOUBLE, MPI_SUM, comm);
+  books_.nodal_energy_change += changes[0];
+  books_.particle_energy_change += changes[1];
+  ++books_.continuation_intervals;
+  ++books_.exchanges;  // ΔT_i to the ghosts
+  time_ = window_start_ = time;
+  window_steps_ = 0;
 }
 
 DecomposedSnapshot DecomposedHeat::snapshot() const {

@@ -12,6 +12,7 @@ template <int Dim>
 DecomposedHotSpots<Dim>::DecomposedHotSpots(const Scene& scene, const mechanics::DecomposedMpm<Dim>& mpm)
     : materials_(scene.thermal.coupler.materials),
       tracker_(Dim, scene.thermal.coupler.hotspots, scene.thermal.coupler.thickness),
+      fates_(scene.thermal.coupler.fates),
       temperature_(mpm.particle_scalar_index("temperature")),
       reference_(mpm.particle_scalar_index("reference_temperature")),
       particle_count_(static_cast<std::size_t>(mpm.global_particles())) {}
@@ -35,6 +36,31 @@ void DecomposedHotSpots<Dim>::update(const mechanics::DecomposedMpm<Dim>& mpm, d
   update_hot_spots_across_ranks<Dim>(mpm.communicator(), tracker_, local_, ids_, mpm.particle_scalar(reference_),
                                      materials_, particle_count_, time);
   ++updates_;
+}
+
+template <int Dim>
+void DecomposedHotSpots<Dim>::update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time) {
+  const mechanics::DecomposedLocalParticles p = mpm.local_particle_data();
+  const std::vector<double> T = mpm.particle_scalar(temperature_), T0 = mpm.particle_scalar(reference_);
+  std::vector<long> local_of(particle_count_, -1);  // global id -> this rank's index
+  for (std::size_t k = 0; k < p.id.size(); ++k) local_of[static_cast<std::size_t>(p.id[k])] = static_cast<long>(k);
+  const std::vector<HotSpotFateRecord>& records = fates_.records();
+  std::vector<double> v(3 * records.size());  // per spot: peak, progress, hot (maxima over ranks)
+  for (std::size_t j = 0; j < records.size(); ++j) {
+    HotSpotFateMeasure m;
+    for (std::size_t id : records[j].particles) {
+      const long k = id < particle_count_ ? local_of[id] : -1;
+      if (k < 0) continue;
+      const auto uk = static_cast<std::size_t>(k);
+      m.add(T[uk], 0.0, tracker_.is_hot_against(T[uk], T0[uk]));  // no reaction in a decomposed run
+    }
+    v[3 * j] = m.peak_temperature, v[3 * j + 1] = m.progress, v[3 * j + 2] = m.hot ? 1.0 : 0.0;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_MAX, mpm.communicator());
+  std::vector<HotSpotFateMeasure> measures(records.size());
+  for (std::size_t j = 0; j < records.size(); ++j)
+    measures[j].peak_temperature = v[3 * j], measures[j].progress = v[3 * j + 1], measures[j].hot = v[3 * j + 2] > 0.0;
+  fates_.decide(measures, time);
 }
 
 template <int Dim>

@@ -4,6 +4,7 @@
 // every heat window, and its series columns and /hotspots rows written as the serial run writes them
 // (runner_thermal.cpp).
 #include <frictherm/coupling/h5_output.hpp>
+#include <frictherm/coupling/hotspot_fates.hpp>
 #include <frictherm/coupling/hotspots.hpp>
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/mechanics/distributed.hpp>
@@ -33,6 +34,14 @@ class DecomposedHotSpots {
   void append_table_rows(H5Output& out, double time);
 
   const HotSpotTracker& tracker() const { return tracker_; }
+
+  /// The continuation's hot-spot fates (hotspot_fates.hpp): begin follows the hot spots of the last
+  /// update from `time`; update_fates (collective) measures each followed spot on this rank's particles
+  /// (T_p and T0_p from the swarm), reduces the measures over ranks (MPI_MAX) and lets the serial rules
+  /// decide (HotSpotFates::decide), so every rank holds the same fates.
+  void begin_fates(double time) { fates_.begin(tracker_, time); }
+  void update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time);
+  HotSpotFates& fates() { return fates_; }
   /// Checkpoints: the tracker's state (the same on every rank) and the update counters of /hotspots.
   template <class V> void visit_state(V&& v) {
     tracker_.visit_state(v);
@@ -47,6 +56,7 @@ class DecomposedHotSpots {
  private:
   std::vector<ThermalProperties> materials_;
   HotSpotTracker tracker_;
+  HotSpotFates fates_;
   int temperature_ = 0, reference_ = 0;
   std::size_t particle_count_ = 0;
   long updates_ = 0, updates_written_ = -1;

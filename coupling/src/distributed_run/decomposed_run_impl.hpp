@@ -69,6 +69,7 @@ class DecomposedRun {
 
  private:
   bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
+  bool heat_continuation() const { return s_.thermal.enabled && s_.thermal.continuation_duration > 0.0; }
 
   bool show_progress() const {
     if (o_.quiet || o_.progress == RunOptions::Progress::never) return false;
@@ -100,8 +101,14 @@ class DecomposedRun {
   // step's stable Δt, the interrupt flag and the state check (before the heat reads the particles).
   void loop(detail::ProgressLine& progress);
 
-  // Collective: one row; rank 0 appends it.
-  void series();
+  // Collective: one row; rank 0 appends it. `time` (NaN: the run's) replaces the time column, the
+  // mechanics columns staying at their last values (the continuation's rows, as the serial run's).
+  void series(double time = std::numeric_limits<double>::quiet_NaN());
+
+  // Collective: the thermal-only continuation after the loading (coupling.continuation; the serial
+  // ThermalRun::continuation): one interval of DecomposedHeat::continue_thermal, one hot-spot update and
+  // one update of their fates per series row; then the fates and a snapshot at its end.
+  void continuation();
 
   // Collective: the failing state under /failure of OUT.h5 as the serial run writes it (every
   // particle, gathered by id: position, velocity, material; a failed run's cost is not a concern),
@@ -120,8 +127,8 @@ class DecomposedRun {
   // (MPI_Abort) rather than waiting for ever (issue 34).
   std::string agreed(const std::string& what);
 
-  // Collective: every rank writes its particles; rank 0 rewrites OUT.xdmf.
-  void snapshot();
+  // Collective: every rank writes its particles; rank 0 rewrites OUT.xdmf. `time` as series().
+  void snapshot(double time = std::numeric_limits<double>::quiet_NaN());
 
   void record_phase_seconds();
 
@@ -159,7 +166,7 @@ class DecomposedRun {
   double time_ = 0.0, last_dt_ = 0.0;
   long step_ = 0, snapshots_ = 0;
   long last_series_step_ = -1, last_snapshot_step_ = -1;
-  double heating_seconds_ = 0.0, output_seconds_ = 0.0;
+  double heating_seconds_ = 0.0, output_seconds_ = 0.0, continuation_seconds_ = 0.0;
   double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
   Clock::time_point last_flush_ = Clock::now();
   // Checkpoints: whether this run writes them, where, the generation of the last one, the clock of

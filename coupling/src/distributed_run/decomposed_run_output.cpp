@@ -18,6 +18,7 @@ void DecomposedRun<Dim>::open_output() {
       write_start_metadata();
       out_->declare_series(series_names());
       if (hot_) hot_->declare_table(*out_);
+      if (hot_ && s_.thermal.continuation_duration > 0.0) out_->declare_table("hotspot_fates", hotspot_fate_columns());
       if (resuming_) rewrite_rows();
     } catch (const std::exception& e) {
       error = e.what();
@@ -70,8 +71,9 @@ std::vector<std::string> DecomposedRun<Dim>::series_names() const {
 }
 
 template <int Dim>
-void DecomposedRun<Dim>::series() {
+void DecomposedRun<Dim>::series(double time) {
   const Clock::time_point c0 = Clock::now();
+  const double row_time = std::isnan(time) ? time_ : time;
   const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
   // Momentum of the deformable particles, as Simulation::linear_momentum (a rigid wall's prescribed
   // motion is not part of the body's).
@@ -85,7 +87,7 @@ void DecomposedRun<Dim>::series() {
   // with the frictional work of the order handed to the heat (second without heat, as the serial run).
   const mechanics::EnergyBalance books =
       mpm_->energy_balance(heat_ ? s_.thermal.heating_order : mechanics::HeatingOrder::second);
-  std::vector<double> row{time_, static_cast<double>(step_), last_dt_, books.kinetic, books.stored,
+  std::vector<double> row{row_time, static_cast<double>(step_), last_dt_, books.kinetic, books.stored,
                           books.kinetic + books.stored, books.external_work};
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   row.insert(row.end(), {books.rigid_work, books.damping_work, books.plastic_work, books.lost(),
@@ -101,7 +103,8 @@ void DecomposedRun<Dim>::series() {
     // The highest temperature of the conducting particles over all ranks, from the last update.
     row.insert(row.end(), {b.heat_delivered, b.particle_energy_change, hot_->tracker().max_temperature()});
     hot_->extend_series_row(row);
-    row.insert(row.end(), {static_cast<double>(b.windows), b.work_received, b.nodal_energy_change});
+    row.insert(row.end(), {static_cast<double>(b.windows + b.continuation_intervals), b.work_received,
+                           b.nodal_energy_change});
     if (s_.thermal.coupler.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
   }
   std::string error;  // rank 0's write failure, agreed below so that no rank goes on alone
@@ -110,7 +113,7 @@ void DecomposedRun<Dim>::series() {
     series_columns_ = static_cast<long>(row.size());
     try {
       out_->append_series(row);
-      if (hot_) hot_->append_table_rows(*out_, time_);
+      if (hot_) hot_->append_table_rows(*out_, row_time);
       if (seconds_since(last_flush_) >= o_.flush_interval) {
         out_->flush();
         last_flush_ = Clock::now();
@@ -126,7 +129,7 @@ void DecomposedRun<Dim>::series() {
 }
 
 template <int Dim>
-void DecomposedRun<Dim>::snapshot() {
+void DecomposedRun<Dim>::snapshot(double time) {
   const Clock::time_point c0 = Clock::now();
   const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
   DecomposedSnapshot snap;
@@ -135,7 +138,7 @@ void DecomposedRun<Dim>::snapshot() {
   snap.velocity = p.velocity;
   snap.material = p.material;
   snap.temperature = mpm_->particle_scalar(temperature_);
-  snapshots_out_->write(step_, time_, snap);
+  snapshots_out_->write(step_, std::isnan(time) ? time_ : time, snap);
   ++snapshots_;
   last_snapshot_step_ = step_;
   output_seconds_ += seconds_since(c0);
@@ -218,8 +221,8 @@ void DecomposedRun<Dim>::rewrite_rows() {
   template void DecomposedRun<D>::open_output(); \
   template void DecomposedRun<D>::write_start_metadata(); \
   template std::vector<std::string> DecomposedRun<D>::series_names() const; \
-  template void DecomposedRun<D>::series(); \
-  template void DecomposedRun<D>::snapshot(); \
+  template void DecomposedRun<D>::series(double); \
+  template void DecomposedRun<D>::snapshot(double); \
   template void DecomposedRun<D>::finish_output(); \
   template std::string DecomposedRun<D>::publish(); \
   template void DecomposedRun<D>::write_end_metadata(); \

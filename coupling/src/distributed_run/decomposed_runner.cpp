@@ -35,6 +35,10 @@ RunResult DecomposedRun<Dim>::execute() {
   r_.output = o_.output.empty() ? s_.output.file : o_.output;
   resuming_ = !o_.resume_checkpoint.empty();
   checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
+  if (checkpoints_ && heat_continuation())  // run.checkpoint_interval: decomposed_run_refusal
+    throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
+                     "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
+                     "it");
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
   if (checkpoints_ && !resuming_) generation_ = detail::committed_generation(comm_, checkpoint_file_);
@@ -54,6 +58,11 @@ RunResult DecomposedRun<Dim>::execute() {
       snapshot();
     }
     loop(progress);
+    if (heat_ && r_.status == RunResult::Status::completed && s_.thermal.continuation_duration > 0.0) {
+      const Clock::time_point c0 = Clock::now();
+      continuation();
+      continuation_seconds_ = seconds_since(c0);
+    }
   } catch (const mechanics::SimulationError& e) {  // agreed by every rank (one reduction)
     fail(e.step(), e.time(), e.what());
   } catch (const std::exception& e) {  // agreed (an output's, a checkpoint's, the heat's) or this rank's alone
@@ -262,12 +271,61 @@ void DecomposedRun<Dim>::loop(detail::ProgressLine& progress) {
 }
 
 template <int Dim>
+void DecomposedRun<Dim>::continuation() {
+  const ThermalSceneSpec& spec = s_.thermal;
+  const auto thermal_failure = [this](const char* what, const std::exception& e, double t) {
+    return mechanics::SimulationError(std::string(what) + e.what(), step_, t, -1);
+  };
+  heat_->close_window();  // a no-op after the loading's last step (closed at the end)
+  const double t0 = time_;
+  const long n = spec.continuation_intervals;
+  double t = t0;
+  for (long k = 1; k <= n; ++k) {
+    t = t0 + spec.continuation_duration * static_cast<double>(k) / static_cast<double>(n);
+    if (k == 1) hot_->begin_fates(t0);  // the hot spots at the end of loading
+    try {
+      heat_->continue_thermal(t);
+    } catch (const thermal::SolverError& e) {  // on every rank (the integrator's agreement)
+      throw thermal_failure("thermal solver failed: ", e, t);
+    } catch (const thermal::StabilityError& e) {
+      throw thermal_failure("thermal integration unstable: ", e, t);
+    }
+    hot_->update(*mpm_, t);
+    hot_->update_fates(*mpm_, t);
+    series(t);  // the mechanics columns stay at their final values
+    const HotSpotFates& f = hot_->fates();
+    if (spec.stop_when_decided && !f.records().empty() && f.all_decided()) break;
+    int signal = detail::interrupt_signal();  // SIGINT/SIGTERM on any rank: every rank ends with this interval
+    MPI_Allreduce(MPI_IN_PLACE, &signal, 1, MPI_INT, MPI_MAX, comm_);
+    if (signal != 0) {
+      r_.status = RunResult::Status::interrupted;
+      r_.signal = signal;
+      break;
+    }
+  }
+  hot_->fates().finish();
+  std::string error;
+  if (out_) {
+    try {
+      for (const HotSpotFateRecord& r : hot_->fates().records())
+        out_->append_table_row("hotspot_fates", hotspot_fate_row(r));
+    } catch (const std::exception& e) {
+      note_write_error(e.what());
+      error = std::string("writing '") + out_->live_path() + "': " + e.what();
+    }
+  }
+  if (const std::string why = detail::agreed_error(comm_, error); !why.empty()) throw std::runtime_error(why);
+  snapshot(t);
+}
+
+template <int Dim>
 void DecomposedRun<Dim>::record_phase_seconds() {
   const mechanics::DecomposedTraffic& tr = mpm_->traffic();
   auto& ph = r_.phase_seconds;
   ph.clear();
   for (std::size_t i = 0; i < tr.phase_seconds.size(); ++i) ph.emplace_back(Mpm::phase_names()[i], tr.phase_seconds[i]);
   ph.emplace_back("heating", heating_seconds_);
+  if (continuation_seconds_ > 0.0) ph.emplace_back("continuation", continuation_seconds_);
   ph.emplace_back("output", output_seconds_);
   double accounted = 0.0;
   for (const auto& x : ph) accounted += x.second;
@@ -282,6 +340,7 @@ void DecomposedRun<Dim>::record_phase_seconds() {
   template void DecomposedRun<D>::build(); \
   template void DecomposedRun<D>::stable_time_step(double& dt, int& signal, bool& checkpoint_due) const; \
   template void DecomposedRun<D>::loop(detail::ProgressLine& progress); \
+  template void DecomposedRun<D>::continuation(); \
   template void DecomposedRun<D>::record_phase_seconds();
 FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(2)
 FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(3)

@@ -139,6 +139,7 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   out.write_metadata("thermal_window_policy", to_string(c.window.kind));
   out.write_metadata("heating_order", mechanics::to_string(scene.thermal.heating_order));
   out.write_metadata("thermal_windows", b.windows);
+  out.write_metadata("thermal_continuation_intervals", b.continuation_intervals);
   out.write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
   out.write_metadata("thermal_matrix_free_substeps", b.substeps);
   out.write_metadata("thermal_assembled_windows", b.assembled_windows);
@@ -149,6 +150,7 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   out.write_metadata("thermal_rhs_evals", st.rhs_evals);
   out.write_metadata("thermal_linear_iters", st.linear_iters);
   out.write_metadata("thermal_error_test_failures", st.error_test_failures);
+  out.write_metadata("thermal_reinits", st.reinits);
   out.write_metadata("thermal_wall_time", st.wall_seconds);
   out.write_metadata("work_received", b.work_received);
   out.write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");

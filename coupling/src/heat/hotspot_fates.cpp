@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 namespace frictherm::coupling {
 
@@ -13,6 +14,20 @@ const char* to_string(HotSpotFate fate) {
     case HotSpotFate::runaway: return "runaway";
   }
   return "?";
+}
+
+std::vector<std::string> hotspot_fate_columns() {
+  return {"id",           "fate",          "particle_count",      "start_time",
+          "initial_peak_temperature", "final_peak_temperature", "max_peak_temperature",
+          "max_reaction_progress",    "decision_time", "runaway_time", "time_to_runaway"};
+}
+
+std::vector<double> hotspot_fate_row(const HotSpotFateRecord& r) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {static_cast<double>(r.id), static_cast<double>(r.fate), static_cast<double>(r.particles.size()),
+          r.start_time, r.initial_peak_temperature, r.peak_temperature, r.max_peak_temperature,
+          r.max_progress, r.decision_time, r.runaway_time,
+          r.fate == HotSpotFate::runaway ? r.runaway_time - r.start_time : nan};
 }
 
 HotSpotFates::HotSpotFates(HotSpotFateOptions options) : opt_(options) {
@@ -43,18 +58,29 @@ void HotSpotFates::update(const mechanics::Particles<Dim>& p, const std::vector<
                           const std::vector<double>* criterion_progress) {
   if (criterion && criterion->size() != p.size()) criterion = nullptr;
   if (criterion_progress && criterion_progress->size() != p.size()) criterion_progress = nullptr;
-  last_time_ = time;
-  for (HotSpotFateRecord& r : records_) {
-    double peak = 0.0, lam = 0.0;
-    bool hot = false;
-    for (std::size_t k : r.particles) {
+  std::vector<HotSpotFateMeasure> measures(records_.size());
+  for (std::size_t j = 0; j < records_.size(); ++j) {
+    HotSpotFateMeasure& m = measures[j];
+    for (std::size_t k : records_[j].particles) {
       if (k >= p.size()) continue;
       const double T = criterion ? (*criterion)[k] : p.temperature[k];
-      peak = std::max(peak, T);
-      if (k < progress.size()) lam = std::max(lam, progress[k]);
+      double lam = k < progress.size() ? progress[k] : 0.0;
       if (criterion_progress) lam = std::max(lam, (*criterion_progress)[k]);
-      hot = hot || tracker.is_hot(k, T);
+      m.add(T, lam, tracker.is_hot(k, T));
     }
+  }
+  decide(measures, time);
+}
+
+void HotSpotFates::decide(const std::vector<HotSpotFateMeasure>& measures, double time) {
+  if (measures.size() != records_.size())
+    throw std::invalid_argument("HotSpotFates::decide: " + std::to_string(measures.size()) + " measures for " +
+                                std::to_string(records_.size()) + " hot spots");
+  last_time_ = time;
+  for (std::size_t j = 0; j < records_.size(); ++j) {
+    HotSpotFateRecord& r = records_[j];
+    const double peak = measures[j].peak_temperature, lam = measures[j].progress;
+    const bool hot = measures[j].hot;
     r.previous_peak_temperature = r.peak_temperature;
     r.peak_temperature = peak;
     r.max_peak_temperature = std::max(r.max_peak_temperature, peak);

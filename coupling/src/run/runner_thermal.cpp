@@ -29,10 +29,6 @@ std::vector<std::string> hotspot_columns(int dim) {
   return c;
 }
 
-const char* const kFateColumns[] = {"id",           "fate",          "particle_count",      "start_time",
-                                    "initial_peak_temperature", "final_peak_temperature", "max_peak_temperature",
-                                    "max_reaction_progress",    "decision_time", "runaway_time", "time_to_runaway"};
-
 }  // namespace
 
 template <int Dim>
@@ -59,7 +55,7 @@ void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& na
   if (o.interface_temperature.enabled && o.reaction.enabled) names.emplace_back("max_interface_reaction_progress");
   out.declare_table("hotspots", hotspot_columns(Dim));
   if (spec_.continuation_duration > 0.0)
-    out.declare_table("hotspot_fates", std::vector<std::string>(std::begin(kFateColumns), std::end(kFateColumns)));
+    out.declare_table("hotspot_fates", hotspot_fate_columns());
 }
 
 template <int Dim>
@@ -146,14 +142,7 @@ void ThermalRun<Dim>::continuation(H5Output& out, mechanics::Simulation<Dim>& si
     if (interrupt_signal() != 0) break;  // SIGINT/SIGTERM: end with this interval's state (run_signals.hpp)
   }
   coupler_.finish_continuation();
-  for (const HotSpotFateRecord& r : coupler_.fates().records()) {
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    out.append_table_row("hotspot_fates",
-                         {static_cast<double>(r.id), static_cast<double>(r.fate), static_cast<double>(r.particles.size()),
-                          r.start_time, r.initial_peak_temperature, r.peak_temperature, r.max_peak_temperature,
-                          r.max_progress, r.decision_time, r.runaway_time,
-                          r.fate == HotSpotFate::runaway ? r.runaway_time - r.start_time : nan});
-  }
+  for (const HotSpotFateRecord& r : coupler_.fates().records()) out.append_table_row("hotspot_fates", hotspot_fate_row(r));
   out.begin_snapshot(sim.step_count(), t);
   detail::write_fields<Dim>(out, sim, fields);
   write_fields(out);

@@ -40,7 +40,7 @@
 // nearest unknown's). Plastic heat and the sub-grid relaxation as the serial Coupler
 // (decomposed_sources.cpp). Fixed-temperature faces as the serial Coupler (for_each_fixed_node: the
 // same nodes, held in both paths). Differences from the serial Coupler: that refusal; reaction heat,
-// the reuse of matrix-free gathers, the KLU solver and the continuation are absent
+// the reuse of matrix-free gathers and the KLU solver are absent
 // (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
@@ -103,6 +103,7 @@ struct DecomposedHeatBooks {
   double plastic_heat_received = 0.0;   // Σ over steps of Σ_i β Δw_p S_ip (part of the pending heat)
   double plastic_heat_delivered = 0.0;  // of it, handed to closed windows
   long windows = 0;
+  long continuation_intervals = 0;      // thermal-only intervals (continue_thermal)
   long substeps = 0;                    // matrix-free forward-Euler sub-steps
   long assembled_windows = 0;           // windows integrated by the distributed integrator
   long steps = 0;                       // mechanics steps seen (after_step)
@@ -130,6 +131,10 @@ class DecomposedHeat {
   /// One window of `dt` seconds with `joules` on the owned nodes (x fastest over owned_nodes()), the
   /// pending heat left alone.
   void window(const std::vector<double>& joules, double dt);
+  /// Thermal-only continuation after the mechanics (Coupler::continue_thermal): one interval from the
+  /// end of the last window or interval to `time` (s) without a source, the mechanics frozen; ΔT_i back
+  /// to the particles. Close the window first (no pending heat; else std::logic_error).
+  void continue_thermal(double time);
   /// Σ of the pending work over ranks (J).
   double pending_heat() const;
   /// The distributed integrator's global counts (zero before the first assembled window).
@@ -187,6 +192,8 @@ class DecomposedHeat {
   template <int Dim>
   void window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0, double dt);
   template <int Dim> void gather_mass(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> double gather_window(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time);
   template <int Dim> double mass_estimate(const mechanics::DecomposedMpm<Dim>& mpm, std::size_t owned) const;
   template <int Dim> double rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& work) const;
   template <int Dim> void number_unknowns(mechanics::DecomposedMpm<Dim>& mpm);
@@ -232,6 +239,10 @@ class DecomposedHeat {
   long window_steps_ = 0;
   double last_lambda_ = 0.0;  // λ bound of the last matrix-free decision (Coupler::last_lambda_bound_)
   std::unique_ptr<DecomposedAssembledSolve> assembled_;  // the distributed integrator (assembled path)
+  // The last window's (or interval's) end T_i per owned node and whether it was assembled (its problem
+  // kept in assembled_): where the continuation starts (Coupler::nodal_temperature_, system_assembled_).
+  std::vector<double> last_T_;
+  bool last_assembled_ = false, continuing_ = false;
 };
 
 }  // namespace frictherm::coupling

@@ -18,7 +18,9 @@
 // A decided fate never changes.
 #include <frictherm/coupling/hotspots.hpp>
 
+#include <algorithm>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -45,6 +47,24 @@ struct HotSpotFateRecord {
   double runaway_time = std::numeric_limits<double>::quiet_NaN();   // s (absolute)
 };
 
+/// What one update reads of a followed spot over some of its particles: the largest temperature and
+/// progress and whether any is hot. Maxima and "any": a decomposed run measures on each rank and
+/// reduces the measures over ranks (MPI_MAX) before the one verdict (HotSpotFates::decide).
+struct HotSpotFateMeasure {
+  double peak_temperature = 0.0;  // K
+  double progress = 0.0;
+  bool hot = false;
+  void add(double temperature, double lam, bool is_hot) {
+    peak_temperature = std::max(peak_temperature, temperature);
+    progress = std::max(progress, lam);
+    hot = hot || is_hot;
+  }
+};
+
+/// The /hotspot_fates table (docs/output.md): its columns and one record's row.
+std::vector<std::string> hotspot_fate_columns();
+std::vector<double> hotspot_fate_row(const HotSpotFateRecord& record);
+
 class HotSpotFates {
  public:
   explicit HotSpotFates(HotSpotFateOptions options = {});
@@ -60,6 +80,9 @@ class HotSpotFates {
   void update(const mechanics::Particles<Dim>& particles, const std::vector<double>& progress,
               const HotSpotTracker& tracker, double time, const std::vector<double>* criterion = nullptr,
               const std::vector<double>* criterion_progress = nullptr);
+  /// The verdict of one update from each record's measure (records() order) at `time`: what update()
+  /// does after measuring; a decomposed run calls it with the measures reduced over ranks.
+  void decide(const std::vector<HotSpotFateMeasure>& measures, double time);
   /// End of the continuation: the falling-and-below-start rule for undecided spots.
   void finish();
   /// Every followed spot has a fate (true with no spot).

@@ -108,9 +108,11 @@ class HotSpotTracker {
   /// Whether particle k at `temperature` counts as hot (threshold and mode; the reference is the one of
   /// set_reference, none counting as 0 K).
   bool is_hot(std::size_t k, double temperature) const {
-    const double level = opt_.mode == HotSpotOptions::Mode::absolute
-                             ? temperature
-                             : temperature - (k < reference_.size() ? reference_[k] : 0.0);
+    return is_hot_against(temperature, k < reference_.size() ? reference_[k] : 0.0);
+  }
+  /// The same with the reference T0_p given (a decomposed run carries it with the particles).
+  bool is_hot_against(double temperature, double reference) const {
+    const double level = opt_.mode == HotSpotOptions::Mode::absolute ? temperature : temperature - reference;
     return level > opt_.threshold;
   }
 
