@@ -532,7 +532,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
 
   // Back to the particles incrementally (design §4), with the sub-grid relaxation (decomposed_sources.cpp).
   double changes[2];
-  map_back(mpm, Tn, dt, T, changes);
+  map_back(mpm, Tn, dt, T, changes, true);
   mpm.set_particle_scalar(scalar_, T);
   last_T_ = std::move(Tn);  // where a continuation goes on from (the serial Coupler's nodal_temperature_)
   last_assembled_ = !matrix_free;
@@ -561,9 +561,11 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
     throw std::logic_error("DecomposedHeat::continue_thermal: close the window with pending heat first");
   if (!(time > window_start_)) return;
   const MPI_Comm comm = mpm.communicator();
+  bool gathered = false;  // this interval starts from the particles' temperatures (as the serial Coupler)
   if (!continuing_) {
     assembled_->restart_integrator();  // the continuation depends only on the end-of-loading state
     if (!last_assembled_ || !assembled_->assembled()) {
+      gathered = true;
       gather_window(mpm);
       number_unknowns(mpm);
       const std::array<int, 2 * Dim> box = mpm.ghosted_nodes();
@@ -580,7 +582,7 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
   assembled_->integrate(*ids_, nullptr, Tn, window_start_, time);
   std::vector<double> T = mpm.particle_scalar(scalar_);
   double changes[2];
-  map_back(mpm, Tn, time - window_start_, T, changes);
+  map_back(mpm, Tn, time - window_start_, T, changes, gathered);
   mpm.set_particle_scalar(scalar_, T);
   last_T_ = std::move(Tn);
   MPI_Allreduce(MPI_IN_PLACE, changes, 2, MPI_DOUBLE, MPI_SUM, comm);

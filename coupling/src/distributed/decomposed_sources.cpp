@@ -60,10 +60,10 @@ void DecomposedHeat::collect_plastic(mechanics::DecomposedMpm<Dim>& mpm, double 
 // be ghosts). changes: this rank's Σ_i M_i ΔT_i (owned unknowns) and Σ_p m_p C_v,p ΔT_p.
 template <int Dim>
 void DecomposedHeat::map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& Tn, double dt,
-                              std::vector<double>& T, double changes[2]) {
+                              std::vector<double>& T, double changes[2], bool from_gathered) {
   const bool relax = std::isfinite(opt_.subgrid_relaxation_time);
   const double beta = relax ? -std::expm1(-dt / opt_.subgrid_relaxation_time) : 0.0;
-  const bool pull = !opt_.fixed_faces.empty();
+  const bool pull = !opt_.fixed_faces.empty() && from_gathered;
   // Values per node: ΔT_i (T_face − g·x_i at a held node), T_i with the relaxation, then with fixed
   // faces 1 at a held node and g_i.
   const int c = 1 + (relax ? 1 : 0) + (pull ? 1 + Dim : 0);
@@ -158,7 +158,7 @@ void DecomposedHeat::map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vec
 #define FRICTHERM_INSTANTIATE_DECOMPOSED_SOURCES(D)                                                             \
   template void DecomposedHeat::collect_plastic<D>(mechanics::DecomposedMpm<D>&, double[2]);                   \
   template void DecomposedHeat::map_back<D>(mechanics::DecomposedMpm<D>&, const std::vector<double>&, double, \
-                                            std::vector<double>&, double[2]);
+                                            std::vector<double>&, double[2], bool);
 FRICTHERM_INSTANTIATE_DECOMPOSED_SOURCES(2)
 FRICTHERM_INSTANTIATE_DECOMPOSED_SOURCES(3)
 #undef FRICTHERM_INSTANTIATE_DECOMPOSED_SOURCES

@@ -202,8 +202,9 @@ class DecomposedHeat {
   // `changes`: Σ_i M_i ΔT_i and Σ_p m_p C_v,p ΔT_p of this rank).
   template <int Dim> void collect_plastic(mechanics::DecomposedMpm<Dim>& mpm, double sums[2]);
   template <int Dim>
+  // from_gathered: the window started from the gathered T_i (held nodes pull, FacePull).
   void map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& Tn, double dt, std::vector<double>& T,
-                double changes[2]);
+                double changes[2], bool from_gathered);
   bool is_unknown(double M) const { return M > threshold_ && M > 0.0; }
   template <int Dim>
   void hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker, const std::string& reference,
