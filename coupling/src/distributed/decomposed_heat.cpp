@@ -544,56 +544,6 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   ++books_.windows;
 }
 
-void DecomposedHeat::continue_thermal(double time) {
-  if (mpm3_) continue_on(*mpm3_, time);
-  else continue_on(*mpm2_, time);
-}
-
-// Coupler::continue_thermal on the decomposed grid: no source, the mechanics frozen. The first interval
-// takes a fresh integrator and, as the serial Coupler, the last window's problem and its end
-// temperatures when that window was assembled; after a matrix-free window (or none) it gathers and
-// assembles afresh (gather_window, the assembled path's numbering and K) and starts from the gathered
-// T_i. Each interval integrates on that problem from where the last left off (the integrator keeps its
-// history) and maps ΔT_i back to the particles (map_back, with the sub-grid relaxation).
-template <int Dim>
-void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time) {
-  if (pending_heat() != 0.0)
-    throw std::logic_error("DecomposedHeat::continue_thermal: close the window with pending heat first");
-  if (!(time > window_start_)) return;
-  const MPI_Comm comm = mpm.communicator();
-  bool gathered = false;  // this interval starts from the particles' temperatures (as the serial Coupler)
-  if (!continuing_) {
-    assembled_->restart_integrator();  // the continuation depends only on the end-of-loading state
-    if (!last_assembled_ || !assembled_->assembled()) {
-      gathered = true;
-      gather_window(mpm);
-      number_unknowns(mpm);
-      const std::array<int, 2 * Dim> box = mpm.ghosted_nodes();
-      KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
-      for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
-      assembled_->assemble(comm, *ids_, entries_of, M_, face_temperature_);
-      last_T_ = T0_;
-      books_.exchanges += 4;  // M and Σ m C T, M back, the bounds, the ids
-    }
-    continuing_ = true;
-  }
-  T0_ = last_T_;  // the interval's start: ΔT_i = T_i(t1) − T_i(t0)
-  std::vector<double> Tn = last_T_;
-  assembled_->integrate(*ids_, nullptr, Tn, window_start_, time);
-  std::vector<double> T = mpm.particle_scalar(scalar_);
-  double changes[2];
-  map_back(mpm, Tn, time - window_start_, T, changes, gathered);
-  mpm.set_particle_scalar(scalar_, T);
-  last_T_ = std::move(Tn);
-  MPI_Allreduce(MPI_IN_PLACE, changes, 2, MPI_DOUBLE, MPI_SUM, comm);
-  books_.nodal_energy_change += changes[0];
-  books_.particle_energy_change += changes[1];
-  ++books_.continuation_intervals;
-  ++books_.exchanges;  // ΔT_i to the ghosts
-  time_ = window_start_ = time;
-  window_steps_ = 0;
-}
-
 DecomposedSnapshot DecomposedHeat::snapshot() const {
   mechanics::DecomposedLocalParticles P =
       mpm3_ ? mpm3_->local_particle_data(true) : mpm2_->local_particle_data(true);  // with x_p, v_p

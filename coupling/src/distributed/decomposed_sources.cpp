@@ -107,13 +107,10 @@ void DecomposedHeat::map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vec
     for (const typename FacePull<Dim>::Held& h : held_nodes) {
       const auto u = static_cast<std::size_t>(h.unknown);
       if (!is_unknown(M_[u])) continue;  // a window holds the face nodes that are unknowns
-      double offset = h.temperature;
-      for (int d = 0; d < Dim; ++d) {
+      for (int d = 0; d < Dim; ++d)
         owned[stride * u + held_at + 1 + static_cast<std::size_t>(d)] = h.gradient[static_cast<std::size_t>(d)];
-        offset -= h.gradient[static_cast<std::size_t>(d)] * h.position[static_cast<std::size_t>(d)];
-      }
       nodal -= M_[u] * owned[stride * u];  // booked as the heat its pull gives (below)
-      owned[stride * u] = offset;
+      owned[stride * u] = FacePull<Dim>::offset(h);
       owned[stride * u + held_at] = 1.0;
       if (relax) owned[stride * u + 1] = 0.0;  // the blend's held term is the pull's target (FacePull::end)
     }
@@ -124,29 +121,28 @@ void DecomposedHeat::map_back(mechanics::DecomposedMpm<Dim>& mpm, const std::vec
   if (pull) P = mpm.local_particle_data(true);
   double particle = 0.0;
   for (std::size_t k = 0; k < T.size(); ++k) {
-    double change = 0.0, held = 0.0, offset = 0.0, pic = 0.0, s = 0.0;
-    std::array<double, Dim> sg{};
+    double change = 0.0, pic = 0.0, s = 0.0;
+    typename FacePull<Dim>::Sums q;  // the held nodes' sums, from the exchanged channels
     for (int a = kept_first_[k]; a < kept_first_[k + 1]; ++a) {
       const double S = kept_S_[static_cast<std::size_t>(a)];
       const std::size_t i = stride * static_cast<std::size_t>(kept_node_[static_cast<std::size_t>(a)]);
       if (relax) pic += S * local[i + 1], s += S;
       if (pull && local[i + held_at] != 0.0) {  // a held node: its pull's sums (FacePull::Sums)
-        held += S;
-        offset += S * local[i];
-        for (int d = 0; d < Dim; ++d) sg[static_cast<std::size_t>(d)] += S * local[i + held_at + 1 + static_cast<std::size_t>(d)];
+        q.weight += S;
+        q.offset += S * local[i];
+        for (int d = 0; d < Dim; ++d)
+          q.gradient[static_cast<std::size_t>(d)] += S * local[i + held_at + 1 + static_cast<std::size_t>(d)];
         continue;
       }
       change += S * local[i];
     }
     const double before = T[k];
     double flip = before + change;
-    if (pull && held != 0.0) {  // the pull Σ_held S_ip (T_face + g_i·(x_p − x_i) − T_p) (FacePull::change)
-      double pulled = offset - held * before;
-      for (int d = 0; d < Dim; ++d)
-        pulled += sg[static_cast<std::size_t>(d)] * P.position[Dim * k + static_cast<std::size_t>(d)];
+    if (pull && q.weight != 0.0) {  // the pull Σ_held S_ip (T_face + g_i·(x_p − x_i) − T_p)
+      const double pulled = FacePull<Dim>::change(q, before, P.position.data() + Dim * k);
       flip = before + (change + pulled);
       nodal += capacity_[k] * pulled;
-      if (relax) pic += FacePull<Dim>::blend_target({held, offset, sg}, before, pulled);
+      if (relax) pic += FacePull<Dim>::blend_target(q, before, pulled);
     }
     T[k] = (relax && s > 0.0) ? flip - beta * (flip - pic / s) : flip;
     particle += capacity_[k] * (T[k] - before);

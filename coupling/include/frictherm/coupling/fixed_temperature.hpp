@@ -85,16 +85,18 @@ class FacePull {
     gradient_.assign(count * Dim, 0.0);
     for (const Held& h : *held) {
       const auto u = static_cast<std::size_t>(h.unknown);
-      double offset = h.temperature;
-      for (int a = 0; a < Dim; ++a) {
-        gradient_[u * Dim + static_cast<std::size_t>(a)] = h.gradient[static_cast<std::size_t>(a)];
-        offset -= h.gradient[static_cast<std::size_t>(a)] * h.position[static_cast<std::size_t>(a)];
-      }
+      for (int a = 0; a < Dim; ++a) gradient_[u * Dim + static_cast<std::size_t>(a)] = h.gradient[static_cast<std::size_t>(a)];
       increment_[u] = 0.0;  // the pull replaces the increment
       if (end) end_[u] = 0.0;  // and the blend's target (blend_target)
-      offset_[u] = offset;
+      offset_[u] = offset(h);
       held_[u] = 1;
     }
+  }
+  /// T_face − g·x_i of a held unknown.
+  static double offset(const Held& h) {
+    double v = h.temperature;
+    for (int a = 0; a < Dim; ++a) v -= h.gradient[static_cast<std::size_t>(a)] * h.position[static_cast<std::size_t>(a)];
+    return v;
   }
   bool active() const { return active_; }
   /// The increments to weight with S_ip: ΔT_i, 0 at held unknowns when active.
