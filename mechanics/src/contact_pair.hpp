@@ -146,7 +146,6 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   else if (c.separation == SeparationMethod::extent)  // particle domains, contact_extents.cpp
     separation = std::isnan(a.extent_gap) ? -1.0 : a.extent_gap - c.extent_tolerance * h_perp;
   const bool touching = separation < 0.0;
-  const bool in_contact = approaching && touching;
 
   // Stick momentum change and reduced mass (eqs. 12–14); a rigid b has v_c = v_b, m_red = m_a.
   Vec<Dim> dp_stick;
@@ -157,8 +156,16 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     dp_stick = (a.mass * b.momentum - b.mass * a.momentum) / (a.mass + b.mass);
     out.reduced_mass = a.mass * b.mass / (a.mass + b.mass);
   }
-  const double d_n = dp_stick.dot(n);  // eq. 15
-  const Vec<Dim> t_vec = dp_stick - d_n * n;
+  // Extent detection lets the surfaces close an open gap g ≥ 0 this step: the stop leaves them the
+  // normal approach g/dt (an impulse m_red g/dt), so they end the step touching instead of held apart.
+  // A full stop anywhere in the tolerance band held the surfaces up to 0.01 h⊥ apart, and under sliding
+  // the interface's grid-scale vibration pumped the block up to it (Coulomb mu = 0.2 at 5 mm: 18.9 um;
+  // docs/contact.md, "Extent detection"). The approach is stopped in full where the domains overlap.
+  const double closing = c.separation == SeparationMethod::extent && a.extent_gap > 0.0
+                             ? out.reduced_mass * a.extent_gap / c.dt : 0.0;
+  const double d_n = dp_stick.dot(n) + closing;  // eq. 15, less the closing approach
+  const bool in_contact = approaching && touching && d_n < 0.0;
+  const Vec<Dim> t_vec = dp_stick - dp_stick.dot(n) * n;
   const double d_t = t_vec.norm();
   // Eq. 11 with Ω_i = Σ_j Ω_{i,j}, the node's total extrapolated domain (a volume, so the 2D thickness
   // is already in it).
@@ -186,23 +193,24 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     return out;
   }
   if (!in_contact) {  // separated: only an adhesive interface with tensile strength may hold (eq. 25)
-    const double N = -d_n / (area * c.dt), S_stick = d_t / (area * c.dt);
+    const double N = -dp_stick.dot(n) / (area * c.dt), S_stick = d_t / (area * c.dt);
     if (s.law.holds_when_separated(S_stick, N)) {
       out.changed = true;
       out.dp = dp_stick;
       return out;
     }
-    // Extent detection: domains that touch but move apart this step still rub through the law's area
-    // term (adhesion S_a A_c, eq. 24 with N = 0); no normal change. Without it an area law loses its
-    // traction at every touching node whose normal velocity noise points outward that step.
+    // Extent detection: domains that touch (gap below the tolerance) but move apart this step, or
+    // approach too slowly to close their gap, still rub through the law's area term (adhesion S_a A_c,
+    // eq. 24 with N = 0); no normal change. Without it an area law loses its traction at every touching node whose normal
+    // velocity noise points outward that step.
     if (c.separation == SeparationMethod::extent && touching && s.law.needs_area() && d_t > 0.0)
       apply_friction(a, b, s.law.in_contact(ContactImpulse{0.0, d_t, out.reduced_mass, area, c.dt}), t_vec, 0.0,
                      n, t_vec, d_t, c, out);
     return out;
   }
   const double d_n_law = regularized_normal(d_n, d_t, out.reduced_mass, area, c);
-  apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n_law, d_t, out.reduced_mass, area, c.dt}), dp_stick, d_n,
-                 n, t_vec, d_t, c, out);
+  apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n_law, d_t, out.reduced_mass, area, c.dt}),
+                 Vec<Dim>(dp_stick + closing * n), d_n, n, t_vec, d_t, c, out);
   return out;
 }
 

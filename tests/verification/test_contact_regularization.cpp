@@ -82,11 +82,14 @@ TEST_P(AdhesionRefinement, AdhesionBlockConvergesWithRefinement) {
     s.regularization_slip_length = kSlipLength, s.regularization_time = kTime;
     m.push_back(measure(s, r, "adhesion, lagged N"));
   }
-  EXPECT_LT(m[1].velocity_error, m[0].velocity_error);
-  EXPECT_LT(m[2].velocity_error, m[1].velocity_error);
-  EXPECT_LT(m[2].velocity_error, 0.02);  // the target at 1.25 mm
-  EXPECT_LT(m[2].work_error, 0.02);
-  for (const Measured& x : m) EXPECT_LT(x.max_lift, 1e-6);
+  // With the gap-closing stop of extent detection every cell is within 1 % of v_max and of the work
+  // (USL 0.31 / 0.13 / 0.19 %, MUSL 0.16 / 0.11 / 0.76 % at 5 / 2.5 / 1.25 mm): the errors no longer
+  // fall monotonically, they sit at the interface vibration's scatter. The target is 2 %.
+  for (const Measured& x : m) {
+    EXPECT_LT(x.velocity_error, 0.01);
+    EXPECT_LT(x.work_error, 0.01);
+    EXPECT_LT(x.max_lift, 1e-6);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(ContactRegularization, AdhesionRefinement,

@@ -155,21 +155,15 @@ mechanics::FrictionLaw parse_friction_law(const JsonReader& law) {
   return out;
 }
 
-// Contact detection (docs/contact.md, "Contact detection"). Without a "separation" key a scene whose
-// multimaterial laws have an area term (adhesion, composite with S_a, expressions using A) gets extent
-// detection, which keeps S_a A_c on every node whose particle domains touch (measured on the adhesion
-// sliding block: 3.9 / 2.0 / 13 % of v_max at 5 / 2.5 / 1.25 mm against 7.1 / 1.5 / 56 % with position
-// separation); every other scene keeps position separation, the better choice for Coulomb-type laws
-// on the oscillating block.
+// Contact detection (docs/contact.md, "Contact detection"). Without a "separation" key every scene
+// gets extent detection: the normal stop where the particle domains overlap, a law's area term where
+// they touch. Position separation floated the Coulomb sliding block by 21 / 4.2 / 2.4 um at 5 / 2.5 /
+// 1.25 mm (extent: under 1 um, 0.5 ms means) and lost an area law's traction (adhesion sliding block
+// 7.1 / 1.5 / 56 % of v_max against 0.3 / 0.2 / 0.8 %).
 static void parse_detection(const JsonReader& c, ContactSpec& spec) {
   mechanics::ContactOptions& o = spec.options;
-  auto area_law = [](const mechanics::ContactPairSettings& ps) {
-    return ps.method == mechanics::ContactMethod::multimaterial && ps.law.needs_area();
-  };
-  bool any_area_law = area_law(o.default_pair);
-  for (const ContactPairSpec& p : spec.pairs) any_area_law = any_area_law || area_law(p.settings);
-  o.separation = mechanics::separation_method_from_string(c.choice(
-      "separation", {"position", "displacement", "velocity_only", "extent"}, any_area_law ? "extent" : "position"));
+  o.separation = mechanics::separation_method_from_string(
+      c.choice("separation", {"position", "displacement", "velocity_only", "extent"}, "extent"));
   o.position_correction = c.number("position_correction", 0.8, Range{0.0, 2.0, false, true});
   // Extent detection handles slivers itself (normal contact only, see docs/contact.md), so by default
   // it drops no material; the other detections drop slivers below 1e-6 of the node's mass.
