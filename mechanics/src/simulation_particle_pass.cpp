@@ -61,6 +61,20 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   const Vec<Dim>* const acceleration = nodes_.acceleration.data();
   const Vec<Dim>* const velocity = nodes_.velocity.data();
   const Vec<Dim>* const filtered_v = transfer_.filtered.data();  // v* of XPIC/FMPM (transfer.hpp)
+  // The particles' arrays the same way: the velocity and position stores below are Eigen packet stores.
+  Vec<Dim>* const xp = p_.position.data();
+  Vec<Dim>* const vp = p_.velocity.data();
+  const Vec<Dim>* const lp = p_.half_size.data();
+  const double* const mp = p_.mass.data();
+  Mat<Dim>* const Fp = p_.deformation_gradient.data();
+  Mat<Dim>* const sigma_p = p_.stress.data();
+  double* const Vp = p_.volume.data();
+  const double* const V0p = p_.initial_volume.data();
+  double* const szz_p = p_.stress_zz.data();
+  double* const ep_p = p_.plastic_strain.data();
+  double* const e_p = p_.internal_energy.data();
+  double* const wp_p = p_.plastic_work.data();
+  double* const cp = wave_speed_.data();
   decltype(auto) stk = step_detail::indexable(st);
   // The next step's stencils (refresh): Stencil arrays only; EBS builds its weights per step.
   constexpr bool refreshable = Kinematics && !std::is_same_v<Stencils, PrecomputedStencils<Dim>>;
@@ -104,7 +118,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     // Particle k at its new position: its stencil for the next step, and its material's box.
     [[maybe_unused]] auto refresh_stencil = [&](std::size_t k, IVec<Dim>& lo, IVec<Dim>& hi) {
       if constexpr (refreshable) {
-        next_stencils[k].evaluate(grid, p_.position[k], p_.half_size[k]);
+        next_stencils[k].evaluate(grid, xp[k], lp[k]);
         boxes.extend(next_stencils[k], lo, hi);
       }
     };
@@ -134,20 +148,20 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           });
         }
         if constexpr (Kinematics) {
-          const Vec<Dim> v_old = p_.velocity[k];
+          const Vec<Dim> v_old = vp[k];
           if (flip) {
-            add_work(k, p_.mass[k] * g.dot(v_old + 0.5 * dt * a) * dt);
-            p_.velocity[k] += dt * a;
-            pic_blend(p_.velocity[k], v, pic);
+            add_work(k, mp[k] * g.dot(v_old + 0.5 * dt * a) * dt);
+            vp[k] += dt * a;
+            pic_blend(vp[k], v, pic);
           } else if (update == ParticleUpdate::xpic) {
-            p_.velocity[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
+            vp[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
           } else {
-            p_.velocity[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
+            vp[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
             v = vf;
           }
-          if (!flip) add_work(k, p_.mass[k] * g.dot(0.5 * (v_old + p_.velocity[k])) * dt);
-          p_.position[k] += dt * v;
-          const bool ok = p_.velocity[k].allFinite() && grid_.contains(p_.position[k]);
+          if (!flip) add_work(k, mp[k] * g.dot(0.5 * (v_old + vp[k])) * dt);
+          xp[k] += dt * v;
+          const bool ok = vp[k].allFinite() && grid.contains(xp[k]);
           if (!ok) bad = std::min(bad, static_cast<long>(k));
           else if (refresh) refresh_stencil(k, lo, hi);  // (a bad particle stops the run: check_particle)
         }
@@ -166,7 +180,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
         const std::size_t b = material_begin_[m], n = material_end_[m] - b, T = static_cast<std::size_t>(pass_split_.threads);
         const std::size_t tt = static_cast<std::size_t>(t);
         for (std::size_t k = b + n * tt / T; k < b + n * (tt + 1) / T; ++k) {
-          if (mat.is_rigid()) rigid_motion_[m].move(p_.velocity[k], p_.position[k]);
+          if (mat.is_rigid()) rigid_motion_[m].move(vp[k], xp[k]);
           refresh_stencil(k, boxes.lo[m], boxes.hi[m]);
         }
         continue;
@@ -180,9 +194,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
       }
       const StressLaw law = stress_law(mat, an);  // per material, not per particle
       const auto state = [&](std::size_t k) {
-        return StressState<Dim>{p_.deformation_gradient[k], p_.volume[k], p_.initial_volume[k],
-                                p_.stress[k], p_.stress_zz[k], p_.plastic_strain[k],
-                                p_.internal_energy[k], p_.plastic_work[k], wave_speed_[k]};
+        return StressState<Dim>{Fp[k], Vp[k], V0p[k], sigma_p[k], szz_p[k], ep_p[k], e_p[k], wp_p[k], cp[k]};
       };
       if constexpr (Dim == 2) {
         if (law.mie_gruneisen()) {  // the PBX materials: plane_strain_update.hpp, on scalars (same arithmetic)
@@ -191,6 +203,14 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           const MieGruneisenParams params = mat.mie_gruneisen;
           run(ix, kb, ke, VelocityGradient2{}, [&](std::size_t k, const VelocityGradient2& L) {
             return update_stress_plane_strain(params, law.min_J, L, dt, state(k));
+          });
+          continue;
+        }
+        if (law.kind == MaterialKind::linear_elastic) {  // the sliding blocks: the same arithmetic on scalars
+          const StressLaw le = law;  // a local copy, as params above
+          run(ix, kb, ke, VelocityGradient2{}, [&](std::size_t k, const VelocityGradient2& L) {
+            update_stress_linear_elastic_2d(le, an, L, dt, state(k));
+            return true;
           });
           continue;
         }

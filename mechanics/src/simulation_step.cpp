@@ -16,8 +16,10 @@
 
 #include <climits>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 namespace frictherm::mechanics {
 
@@ -209,12 +211,43 @@ void Simulation<Dim>::prepare_step(double t) {
   }
 }
 
-// Multimaterial contact after the momentum extrapolation: the contact nodes, the extents (extent
-// separation) and the first contact pass.
+// Multimaterial contact after the momentum extrapolation: the contact nodes, their contact terms, the
+// extents (extent separation) and the first contact pass.
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::contact_at_extrapolated(double dt) {
   find_contact_nodes();
+  // The contact terms of multimaterial contact, Σ S_ip m_p x_p (or the displacement x_p − x_p^(0)),
+  // Ω = Σ S_ip V_p and g = Σ G_ip V_p per material (Nairn 2018 eqs. 4–6, 9). Contact reads them at
+  // the contact nodes' slots only (gather_contact_sides), so only the particles whose stencil reaches
+  // such a slot scatter them: each of those slots gets the same particles' terms in the same order as
+  // a scatter by every particle would give it (the same bits); other slots hold partial sums or 0.
+  thread_local std::vector<std::uint8_t> at_contact;  // per slot: 1 at a contact node (no allocation once grown)
+  at_contact.assign(nodes_.mass.size(), 0);
+  for (const ContactEntry& c : contact_entries_) at_contact[static_cast<std::size_t>(c.slot)] = 1;
+  const std::uint8_t* const flag = at_contact.data();
+  auto& st = stencils<Kernel>();
+  const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
+  scatter_phase(Accumulated{false, false, false, true}, true,
+                [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
+    double* const domain = acc.domain.data();
+    Vec<Dim>* const mass_position = acc.mass_position.data();
+    Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
+    decltype(auto) stk = indexable(st);
+    const NodeIndexer<Dim> index = ix;
+    for (std::size_t k = kb; k < ke; ++k) {
+      int reaches = 0;
+      stk[k].for_each(index, [&](int i, double, const Vec<Dim>&) { reaches |= flag[i]; });
+      if (!reaches) continue;
+      const double mp = p_.mass[k], Vp = p_.volume[k];
+      const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
+      stk[k].for_each(index, [&](int i, double S, const Vec<Dim>& G) {
+        mass_position[i] += S * mx;
+        domain[i] += S * Vp;
+        domain_gradient[i] += Vp * G;
+      });
+    }
+  });
   if (contact_opt_.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
   resolve_contact(ContactPass::extrapolated, dt);
 }
@@ -321,18 +354,16 @@ void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatt
 }
 
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:
-// m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p, f_i = Σ (−V_p σ_p G_ip + S_ip m_p g) (Nairn 2018 eqs. 1–3);
-// with contact also Σ S_ip m_p x_p (or the displacement x_p − x_p^(0)), Ω = Σ S_ip V_p and
-// g = Σ G_ip V_p per material (eqs. 4–6, 9). Rigid materials only mark their presence (mass,
-// position, domain): their velocity is prescribed.
+// m_i = Σ S_ip m_p, p_i = Σ S_ip m_p v_p, f_i = Σ (−V_p σ_p G_ip + S_ip m_p g) (Nairn 2018 eqs. 1–3).
+// Rigid materials only mark their presence (mass; with contact, position and domain): their velocity
+// is prescribed. The contact terms follow once the contact nodes are known (contact_at_extrapolated).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
-  const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
   const bool prepared = stencils_current_;  // by current_stencils() since the last step
-  scatter_phase(Accumulated{true, true, true, contact_}, true,
+  scatter_phase(Accumulated{true, true, true, false}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t m, std::size_t kb, std::size_t ke) {
     if (!contact_) {
       for (std::size_t k = kb; k < ke; ++k) {
@@ -362,27 +393,26 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
     // Plain pointers, held in registers: Eigen's vector stores may alias anything, so through the
     // std::vectors every store would reload every array's address.
     double* const mass = acc.mass.data();
-    double* const domain = acc.domain.data();
     Vec<Dim>* const momentum = acc.momentum.data();
     Vec<Dim>* const force = acc.force.data();
-    Vec<Dim>* const mass_position = acc.mass_position.data();
-    Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
     decltype(auto) stk = indexable(st);
-    for (std::size_t k = kb; k < ke; ++k) {
-      const double mp = p_.mass[k], Vp = p_.volume[k];
-      const Vec<Dim> mv = mp * p_.velocity[k];
-      const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
-      const Mat<Dim> Vsig = Vp * p_.stress[k];
-      const Vec<Dim> mg = mp * g;
-      stk[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
-        mass[i] += S * mp;
-        momentum[i] += S * mv;
-        if (forces) force[i] += S * mg - Vsig * G;
-        mass_position[i] += S * mx;
-        domain[i] += S * Vp;
-        domain_gradient[i] += Vp * G;
-      });
-    }
+    const NodeIndexer<Dim> index = ix;  // a local copy, kept in registers
+    // The loop twice, with and without the forces (a rigid material's particles): no test per node.
+    const auto scatter = [&](auto with_forces_here) {
+      for (std::size_t k = kb; k < ke; ++k) {
+        const double mp = p_.mass[k];
+        const Vec<Dim> mv = mp * p_.velocity[k];
+        const Mat<Dim> Vsig = p_.volume[k] * p_.stress[k];
+        const Vec<Dim> mg = mp * g;
+        stk[k].for_each(index, [&](int i, double S, const Vec<Dim>& G) {
+          mass[i] += S * mp;
+          momentum[i] += S * mv;
+          if constexpr (decltype(with_forces_here)::value) force[i] += S * mg - Vsig * G;
+        });
+      }
+    };
+    if (forces) scatter(std::true_type{});
+    else scatter(std::false_type{});
   });
 }
 

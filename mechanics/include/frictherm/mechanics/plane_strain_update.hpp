@@ -1,8 +1,9 @@
 #pragma once
-// The plane-strain (2D) particle kinematics and Mie-Grüneisen / J2 update of Simulation::update_stress,
-// written on scalars. The Eigen forms (mie_gruneisen.hpp, material.hpp) build 2×2 temporaries on the
-// stack element by element and read them back as SSE pairs, which stalls store forwarding in the
-// hottest loop of a PBX run; these functions keep every value in registers.
+// The plane-strain (2D) particle kinematics and the Mie-Grüneisen / J2 and linear elastic (plane strain
+// and plane stress) updates of Simulation::update_stress, written on scalars. The Eigen forms
+// (mie_gruneisen.hpp, material.hpp) build 2×2 temporaries on the stack element by element and read
+// them back as SSE pairs (GCC keeps the products out of line), which stalls store forwarding in the
+// hottest loop of a PBX or sliding-block run; these functions keep every value in registers.
 //
 // They perform the same floating-point operations in the same order as the Eigen forms (no FMA
 // contraction on baseline x86-64; two-term sums are exact to reorder as a + b = b + a), so results are
@@ -44,6 +45,31 @@ FRICTHERM_ALWAYS_INLINE double deformation_update_2d(const VelocityGradient2& L,
 
 /// det F of a 2×2 (as Eigen's determinant).
 inline double determinant_2d(const Mat<2>& F) { return F(0, 0) * F(1, 1) - F(1, 0) * F(0, 1); }
+
+/// linear_elastic_update<2>(L, dt, lambda, mu, a, σ, σ_zz) (material.hpp) on scalars: the Jaumann-rotated
+/// hypoelastic increment σ += (w σ − σ w) + 2μ dε + λ tr(dε) I, dε = sym(L) dt, w = skew(L) dt; plane
+/// stress with λ* = 2λμ/(λ + 2μ) and σ_zz untouched, plane strain σ_zz += λ tr(dε). Same operations in
+/// the same order as the Eigen form (tests/mechanics/test_plane_strain_update.cpp checks it bitwise).
+FRICTHERM_ALWAYS_INLINE void linear_elastic_update_2d(const VelocityGradient2& L, double dt, double lambda, double mu,
+                                                      Analysis a, Mat<2>& sigma, double& sigma_zz) {
+  const double de00 = 0.5 * (L.l00 + L.l00) * dt, de01 = 0.5 * (L.l01 + L.l10) * dt;
+  const double de10 = 0.5 * (L.l10 + L.l01) * dt, de11 = 0.5 * (L.l11 + L.l11) * dt;
+  const double w00 = 0.5 * (L.l00 - L.l00) * dt, w01 = 0.5 * (L.l01 - L.l10) * dt;
+  const double w10 = 0.5 * (L.l10 - L.l01) * dt, w11 = 0.5 * (L.l11 - L.l11) * dt;
+  const double tr = de00 + de11;
+  const double lam = (a == Analysis::plane_stress) ? 2.0 * lambda * mu / (lambda + 2.0 * mu) : lambda;
+  double s00 = sigma(0, 0), s01 = sigma(0, 1), s10 = sigma(1, 0), s11 = sigma(1, 1);
+  const double r00 = (w00 * s00 + w01 * s10) - (s00 * w00 + s01 * w10);  // (w σ − σ w)_ij
+  const double r01 = (w00 * s01 + w01 * s11) - (s00 * w01 + s01 * w11);
+  const double r10 = (w10 * s00 + w11 * s10) - (s10 * w00 + s11 * w10);
+  const double r11 = (w10 * s01 + w11 * s11) - (s10 * w01 + s11 * w11);
+  s00 += r00, s01 += r01, s10 += r10, s11 += r11;
+  const double two_mu = 2.0 * mu;
+  s00 += two_mu * de00, s01 += two_mu * de01, s10 += two_mu * de10, s11 += two_mu * de11;
+  s00 += lam * tr, s11 += lam * tr;
+  sigma(0, 0) = s00, sigma(1, 0) = s10, sigma(0, 1) = s01, sigma(1, 1) = s11;
+  if (a == Analysis::plane_strain) sigma_zz += lambda * tr;
+}
 
 /// mie_gruneisen_update<2>(L, dt, J, m, min_J, ...) on scalars; det_A = det(I + dt L) from
 /// deformation_update_2d. Same contract: nothing changes and beyond_hugoniot_limit is returned when

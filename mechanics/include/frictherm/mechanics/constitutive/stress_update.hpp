@@ -8,6 +8,7 @@
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/mie_gruneisen.hpp>
 #include <frictherm/mechanics/plane_strain_update.hpp>
+#include <frictherm/mechanics/small_products.hpp>
 
 namespace frictherm::mechanics {
 
@@ -52,7 +53,7 @@ FRICTHERM_ALWAYS_INLINE bool update_stress(const Material& mat, const StressLaw&
                                            double dt, const StressState<Dim>& s) {
   const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
   Mat<Dim> F_new;
-  F_new.noalias() = A * s.F;  // (no aliasing temporary, no out-of-line product)
+  product_into<Dim>(A, s.F, F_new);  // F_new = A F, inlined (small_products.hpp)
   s.F = F_new;
   s.volume = s.F.determinant() * s.initial_volume;
   if (law.kind == MaterialKind::mie_gruneisen) {
@@ -87,6 +88,16 @@ FRICTHERM_ALWAYS_INLINE bool update_stress_plane_strain(const MieGruneisenParams
                                         s.plastic_strain, s.internal_energy, wp, s.wave_speed);
   s.plastic_work += wp * s.volume;
   return status == MieGruneisenStatus::ok;
+}
+
+/// The 2D linear elastic update on scalars (plane_strain_update.hpp, the same arithmetic as
+/// update_stress<2> for a linear elastic material, plane strain or plane stress).
+FRICTHERM_ALWAYS_INLINE void update_stress_linear_elastic_2d(const StressLaw& law, Analysis an, const VelocityGradient2& L,
+                                                             double dt, const StressState<2>& s) {
+  deformation_update_2d(L, dt, s.F);
+  s.volume = determinant_2d(s.F) * s.initial_volume;
+  linear_elastic_update_2d(L, dt, law.lambda, law.mu, an, s.stress, s.stress_zz);
+  s.wave_speed = law.c0;
 }
 
 }  // namespace frictherm::mechanics
