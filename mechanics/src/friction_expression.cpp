@@ -17,7 +17,7 @@ namespace frictherm::mechanics {
 
 namespace {
 
-std::string num(double x) {
+std::string number_text(double x) {
   std::ostringstream o;
   o << x;
   return o.str();
@@ -105,7 +105,7 @@ void check_constants(const std::map<std::string, double>& constants) {
   for (const auto& [name, value] : constants) {
     const std::string key = "constants." + name;
     if (is_variable(name)) refuse(key, "the name '" + name + "' is a variable (N, A, v): choose another name");
-    if (!std::isfinite(value)) refuse(key, "expected a finite number, got " + num(value));
+    if (!std::isfinite(value)) refuse(key, "expected a finite number, got " + number_text(value));
     try {
       mu::Parser p;
       p.DefineConst(name, value);
@@ -151,13 +151,13 @@ void check_expression(const std::string& expression, const std::map<std::string,
         for (double s : vs) {
           N = n, A = a, v = s;
           const double S = p.Eval();
-          const std::string at = "N = " + num(n) + " Pa, A = " + num(a) + " m^2, v = " + num(s) + " m/s";
+          const std::string at = "N = " + number_text(n) + " Pa, A = " + number_text(a) + " m^2, v = " + number_text(s) + " m/s";
           if (p.GetNumResults() != 1)
             refuse(key, "expected one expression, got " + std::to_string(p.GetNumResults()) +
                             " separated by commas in \"" + expression + "\"");
           if (N != n || A != a || v != s) refuse(key, "the expression \"" + expression + "\" assigns to a variable");
           if (!(std::isfinite(S) && S >= 0.0))
-            refuse(key, "the sliding traction \"" + expression + "\" gives S = " + num(S) + " Pa at " + at +
+            refuse(key, "the sliding traction \"" + expression + "\" gives S = " + number_text(S) + " Pa at " + at +
                             " (expected finite and >= 0 at the sample points N in {0, 1, 1e6, 1e9} Pa, A in "
                             "{1e-10, 1e-6, 1} m^2, v in {0, 1e-3, 1, 1e3} m/s)");
         }
@@ -175,7 +175,7 @@ FrictionLaw expression_friction_law(const std::string& sliding_traction, const s
   auto pool = std::make_shared<const ParserPool>(sliding_traction, constants);
   std::string name = "expression: S = " + sliding_traction;
   std::string c;
-  for (const auto& [n, value] : constants) c += (c.empty() ? "; " : ", ") + n + " = " + num(value);
+  for (const auto& [n, value] : constants) c += (c.empty() ? "; " : ", ") + n + " = " + number_text(value);
   return FrictionLaw::user([pool](double N, double A, double v) { return (*pool)(N, A, v); }, name + c);
 }
 
