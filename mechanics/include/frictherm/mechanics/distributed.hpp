@@ -177,6 +177,8 @@ class DecomposedMpm {
 
   struct Options {
     ShapeKind shape = ShapeKind::linear;
+    /// Extended B-splines (shape extended_bspline): C_c, as SimulationOptions::ebs_occupation.
+    double ebs_occupation = 0.75;
     /// 2D: plane_strain or plane_stress; 3D: three_d (as the serial Simulation<3> sets it).
     Analysis analysis = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
     double thickness = 1.0;               // 2D out-of-plane thickness (m), as SimulationOptions::thickness; unused in 3D
