@@ -57,7 +57,9 @@ class MpirunEbs : public frictherm::test::MpirunCompare {
       double scale = 0.0, diff = 0.0;
       for (double x : a) scale = std::max(scale, std::fabs(x));
       for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) diff = std::max(diff, std::fabs(a[k] - b[k]));
-      EXPECT_LE(diff, tolerance * scale) << c;
+      // A column below 1e-6 in magnitude is zero up to round-off in this scene (the momenta of the
+      // symmetric pair, ~1e-16 kg m/s; the strain energy's first rows): bounded as if it were 1e-6.
+      EXPECT_LE(diff, tolerance * std::max(scale, 1e-6)) << c;
       const double rel = scale > 0.0 ? diff / scale : diff;
       worst = std::max(worst, rel);
       std::printf("  %-34s max |serial - split| = %.3g of %.6g\n", c.c_str(), rel, scale);
@@ -101,12 +103,14 @@ class MpirunEbs : public frictherm::test::MpirunCompare {
 // The decomposed step is the serial arithmetic with the nodal sums split between the ranks (another
 // summation order) and the EBS bases rebuilt from the same particles in the serial order (the same
 // volume fractions, classification and extension bit for bit): differences are round-off, grown over
-// 1250 steps. Measured: BOUND_MEASURED; bound 1e-9 of each column's scale, positions 1e-9 of a cell.
+// 1240 steps. Measured (2 and 4 ranks): kinetic energy 3.5e-14, external work 6.3e-13, energy_lost
+// 4.7e-10 of its own scale (a difference of ~2.7 J terms: 1.6e-12 J), positions 2.7e-20 m; bound 1e-8
+// of each column's scale, positions 1e-9 of a cell.
 TEST_F(MpirunEbs, HertzDisksWithGridContactEqualTheSerialRun) {
   run_both("examples/hertz_disks.json",
            " --set run.end_time=2e-5 --set contact.method=multimaterial --set output.series_interval=1e-6", 2);
   if (HasFatalFailure()) return;
-  EXPECT_GE(compare_series(1e-9), 10);
+  EXPECT_GE(compare_series(1e-8), 10);
   EXPECT_LE(compare_positions(2), 1e-9 * 1e-3);
 }
 
