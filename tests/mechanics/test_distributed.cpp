@@ -86,7 +86,10 @@ TEST(DecomposedMechanics, StencilWidthIsTheKernelsReachBeyondTheNearestNode) {
   EXPECT_EQ(fm::stencil_reach(fm::ShapeKind::linear), 1);
   EXPECT_EQ(fm::stencil_reach(fm::ShapeKind::ugimp), 1);
   EXPECT_EQ(fm::stencil_reach(fm::ShapeKind::quadratic_bspline), 1);
-  EXPECT_THROW(fm::stencil_reach(fm::ShapeKind::extended_bspline), std::invalid_argument);
+  // The extended B-spline: a degenerate node of the block (nearest ± 1) is extended from the three
+  // B-splines on its nearest interior cell, within search_radius (3) of it: 1 + 3 + 1 nodes.
+  EXPECT_EQ(fm::stencil_reach(fm::ShapeKind::extended_bspline), fm::EbsOptions{}.search_radius + 2);
+  EXPECT_EQ(fm::stencil_reach(fm::ShapeKind::extended_bspline), 5);
   const fm::Grid<2> grid(V2(0.0, 0.0), V2(1e-3, 1e-3), {8, 8});
   fm::Material rigid = elastic(1e6, 0.3, 1000.0);  // (materials: test_distributed_materials.cpp)
   rigid.kind = fm::MaterialKind::rigid;

@@ -40,6 +40,7 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.shape = scene.options.shape;
   o.analysis = scene.options.analysis;
   o.thickness = scene.options.thickness;
+  o.ebs_occupation = scene.options.ebs_occupation;  // C_c of the extended B-spline (docs/ebs.md)
   for (int d = 0; d < Dim; ++d) o.gravity[d] = scene.options.gravity[d];
   o.pic_relaxation_time = scene.options.pic_relaxation_time;
   o.musl = scene.options.scheme == mechanics::UpdateScheme::musl;  // usf is refused (scene_decomposed.cpp)

@@ -28,8 +28,8 @@ std::string refuse(const std::string& key, const std::string& value, const std::
 
 std::string mechanics_refusal(const Scene& s) {
   const mechanics::SimulationOptions& o = s.options;
-  if (o.shape == mechanics::ShapeKind::extended_bspline)
-    return refuse("solver.shape_function", quoted("extended_bspline"), "\"linear\", \"ugimp\" or \"quadratic_bspline\"");
+  // Every shape function runs decomposed, the extended B-spline too (the serial EbsBasis on the
+  // particles gathered from all ranks, a ghost layer of its reach: mechanics/src/distributed/extended_bsplines.cpp).
   // USL, and MUSL without contact (DecomposedMpm: the USL phases with the remap and its exchange).
   if (o.scheme == mechanics::UpdateScheme::usf)
     return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");

@@ -178,7 +178,8 @@ void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
   template void DecomposedMpm<D>::Impl::free_extent_units();                                         \
   template void DecomposedMpm<D>::Impl::measure_contact_extents<LinearKernel>(double);               \
   template void DecomposedMpm<D>::Impl::measure_contact_extents<UGIMPKernel>(double);                \
-  template void DecomposedMpm<D>::Impl::measure_contact_extents<QuadraticBSplineKernel>(double);
+  template void DecomposedMpm<D>::Impl::measure_contact_extents<QuadraticBSplineKernel>(double);     \
+  template void DecomposedMpm<D>::Impl::measure_contact_extents<ExtendedBSplineKernel>(double);
 FRICTHERM_INSTANTIATE_EXTENTS(2)
 FRICTHERM_INSTANTIATE_EXTENTS(3)
 #undef FRICTHERM_INSTANTIATE_EXTENTS

@@ -9,6 +9,7 @@
 #include "contact_side.hpp"
 
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
+#include <frictherm/mechanics/ebs.hpp>
 
 #include <petscdmda.h>
 #include <petscdmswarm.h>
@@ -55,6 +56,37 @@ struct NodeDof {
   static constexpr int mass = 0, momentum = 1, force = 1 + Dim, velocity = momentum, acceleration = force;
   static constexpr int mass_position = 1 + 2 * Dim, domain = 1 + 3 * Dim, domain_gradient = 2 + 3 * Dim;
   static constexpr int without_contact = 1 + 2 * Dim, with_contact = 2 + 4 * Dim;  // values per field
+};
+
+/// One particle's extended B-spline entries (LatticeStencils): the nodes as DMDA lattice coordinates
+/// (the serial lattice counted from the first ghost node, as Stencil::first_node), so that the same
+/// for_each call as Stencil's maps them through any indexer (a field's slots, the ghosted box).
+template <int Dim>
+struct LatticeStencil {
+  const IVec<Dim>* node;
+  const double* S;
+  const Vec<Dim>* G;
+  std::size_t begin, end;
+  template <class F>
+  void for_each(const NodeIndexer<Dim>& ix, F&& f) const {
+    for (std::size_t e = begin; e < end; ++e) {
+      int i = ix.shift;
+      for (int d = 0; d < Dim; ++d) i += node[e][d] * ix.stride[d];
+      f(i, S[e], G[e]);
+    }
+  }
+};
+
+/// N^e_I(x_p), ∇N^e_I(x_p) of every local particle this step (Kakouris 2024 eqs. 25–26), flattened as
+/// the serial PrecomputedStencils (same entries, same order) but with lattice nodes instead of slots:
+/// particle k owns entries begin[k] .. begin[k+1]−1 (none for a rigid wall's particle).
+template <int Dim>
+struct LatticeStencils {
+  std::vector<std::size_t> begin{0};
+  std::vector<IVec<Dim>> node;
+  std::vector<double> S;
+  std::vector<Vec<Dim>> G;
+  LatticeStencil<Dim> operator[](std::size_t k) const { return {node.data(), S.data(), G.data(), begin[k], begin[k + 1]}; }
 };
 
 /// Every registered field of the swarm, gotten for the object's lifetime (no migration meanwhile).
@@ -279,12 +311,26 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<Stencil<Dim, LinearKernel>> stencils_linear;
   std::vector<Stencil<Dim, UGIMPKernel>> stencils_ugimp;
   std::vector<Stencil<Dim, QuadraticBSplineKernel>> stencils_quadratic;
+  // Extended B-splines (extended_bsplines.cpp): one serial EbsBasis per velocity field, rebuilt every
+  // step on every rank from the field's particles gathered from all ranks in the serial order; the
+  // kept nodes (fixed faces, rigid drives) over the whole grid; the gather's buffers.
+  LatticeStencils<Dim> stencils_extended;
+  std::vector<EbsBasis<Dim>> ebs;
+  std::vector<std::uint8_t> ebs_kept;
+  bool ebs_keeps = false;  // fixed faces or rigid walls: kept nodes to reduce
+  std::vector<double> ebs_send, ebs_all;
+  std::vector<Vec<Dim>> ebs_position;
+  std::vector<double> ebs_volume;
+  std::vector<std::size_t> ebs_order;
+  void prepare_extended(SwarmFields& f);
 
   ~Impl();
 
+  /// The kernel's stencils of the step: a Stencil per particle, or the extended entries (LatticeStencils).
   template <class Kernel>
-  std::vector<Stencil<Dim, Kernel>>& stencils() {
-    if constexpr (std::is_same_v<Kernel, LinearKernel>) return stencils_linear;
+  auto& stencils() {
+    if constexpr (std::is_same_v<Kernel, ExtendedBSplineKernel>) return stencils_extended;
+    else if constexpr (std::is_same_v<Kernel, LinearKernel>) return stencils_linear;
     else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return stencils_ugimp;
     else return stencils_quadratic;
   }

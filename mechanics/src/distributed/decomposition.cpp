@@ -38,10 +38,11 @@ DecomposedPetscSession::~DecomposedPetscSession() {
 // Reach of a kernel's stencil beyond the particle's nearest node n = round(s): the node choice
 // (Weights1D::base) is piecewise constant with break points at s = j and j + 1/2, so samples on
 // both sides of each within one cell give the largest reach.
+// The extended B-spline of a particle in boundary cell c (its nearest node) adds to the block
+// c − 1 .. c + 1 the stencils of its degenerate nodes J: Q_J − 1 .. Q_J + 1 with Q_J within
+// search_radius of J (docs/ebs.md, eqs. 22–26), so it reaches search_radius + 2 nodes.
 int stencil_reach(ShapeKind kind) {
-  if (kind == ShapeKind::extended_bspline)
-    throw std::invalid_argument("decomposed mechanics: shape 'extended_bspline' is not supported (expected linear, "
-                                "ugimp or quadratic_bspline)");
+  if (kind == ShapeKind::extended_bspline) return EbsOptions{}.search_radius + 2;
   return dispatch_shape(kind, [](auto kernel) {
     using Kernel = decltype(kernel);
     constexpr double eps = 1e-9;
@@ -134,6 +135,9 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
     throw std::invalid_argument(std::string("decomposed mechanics: analysis ") +
                                 (options.analysis == Analysis::three_d ? "three_d" : "plane_strain/plane_stress") +
                                 (Dim == 2 ? " in 2D (expected plane_strain or plane_stress)" : " in 3D (expected three_d)"));
+  if (options.shape == ShapeKind::extended_bspline && !(options.ebs_occupation >= 0.0 && options.ebs_occupation <= 1.0))
+    throw std::invalid_argument("decomposed mechanics: ebs_occupation " + std::to_string(options.ebs_occupation) +
+                                " (expected a number in [0, 1])");
   s.width = stencil_reach(options.shape);
   s.comm = comm;
   MPI_Comm_rank(comm, &s.rank);

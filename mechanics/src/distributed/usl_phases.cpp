@@ -58,9 +58,10 @@ template <class Kernel>
 void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
   constexpr int mass_position = Dof::mass_position, domain = Dof::domain, domain_gradient = Dof::domain_gradient;
+  constexpr bool extended = std::is_same_v<Kernel, ExtendedBSplineKernel>;
   SwarmFields f(swarm);
   auto& st = stencils<Kernel>();
-  st.resize(static_cast<std::size_t>(f.n));
+  if constexpr (!extended) st.resize(static_cast<std::size_t>(f.n));
   IVec<Dim> none_lo, none_hi;
   none_lo.fill(INT_MAX), none_hi.fill(INT_MIN);
   box_lo.assign(static_cast<std::size_t>(fields), none_lo);
@@ -68,13 +69,9 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   if (has_rigid)
     for (int d = 0; d < Dim; ++d) std::fill(driver[static_cast<std::size_t>(d)].begin(), driver[static_cast<std::size_t>(d)].end(), -1);
   const NodeIndexer<Dim> local_ix = local_indexer();
-  // Evaluates particle k's stencil; a rigid wall's particle marks the nodes it drives (the serial
-  // map_rigid_particles: nodes with S > 0, the components its material prescribes) and is skipped.
-  const auto evaluate = [&](PetscInt k) {
-    auto& s = st[static_cast<std::size_t>(k)];
-    s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
-    if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
-    if (!rigid_wall(f.material[k])) return true;
+  // A rigid wall's particle marks the nodes it drives (the serial map_rigid_particles: nodes with
+  // S > 0, the components its material prescribes).
+  const auto mark_drives = [&](PetscInt k, const auto& s) {
     const Material& m = materials[static_cast<std::size_t>(f.material[k])];
     s.for_each(local_ix, [&](int l, double S, const Vec<Dim>&) {
       if (S > 0.0)
@@ -84,7 +81,34 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
             w = std::max<PetscInt>(w, f.material[k]);
           }
     });
-    return false;
+  };
+  // Extended B-splines: the rigid walls mark their drives with the plain quadratic B-spline (the serial
+  // map_rigid_particles with ExtendedBSplineKernel's Stencil), then the bases over all ranks and every
+  // other particle's entries (extended_bsplines.cpp).
+  if constexpr (extended) {
+    if (has_rigid) {
+      Stencil<Dim, QuadraticBSplineKernel> plain;
+      for (PetscInt k = 0; k < f.n; ++k) {
+        if (!rigid_wall(f.material[k])) continue;
+        plain.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
+        if (!in_box(plain)) outside_box(plain, box_start, box_size, f.id[k]);
+        mark_drives(k, plain);
+      }
+    }
+    prepare_extended(f);
+  }
+  // Evaluates particle k's stencil (a rigid wall's particle marks its drives and is skipped).
+  const auto evaluate = [&](PetscInt k) {
+    if constexpr (extended) {
+      return !rigid_wall(f.material[k]);
+    } else {
+      auto& s = st[static_cast<std::size_t>(k)];
+      s.evaluate(grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
+      if (!in_box(s)) outside_box(s, box_start, box_size, f.id[k]);
+      if (!rigid_wall(f.material[k])) return true;
+      mark_drives(k, s);
+      return false;
+    }
   };
   // One field (no contact): it covers the ghosted box and the stencils are evaluated in the scatter
   // loop. Several: each field's box from its particles' stencils first.
@@ -98,10 +122,20 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
     for (PetscInt k = 0; k < f.n; ++k) {
       if (!evaluate(k)) continue;
       const std::size_t field = static_cast<std::size_t>(field_of(f.material[k]));
-      const IVec<Dim> b = st[static_cast<std::size_t>(k)].first_node();
-      for (int d = 0; d < Dim; ++d) {
-        box_lo[field][d] = std::min(box_lo[field][d], b[d]);
-        box_hi[field][d] = std::max(box_hi[field][d], b[d] + Kernel::K - 1);
+      if constexpr (extended) {  // the nodes of its entries
+        const auto& e = st;
+        for (std::size_t q = e.begin[static_cast<std::size_t>(k)]; q < e.begin[static_cast<std::size_t>(k) + 1]; ++q)
+          for (int d = 0; d < Dim; ++d) {
+            box_lo[field][d] = std::min(box_lo[field][d], e.node[q][d]);
+            box_hi[field][d] = std::max(box_hi[field][d], e.node[q][d]);
+          }
+        continue;
+      } else {
+        const IVec<Dim> b = st[static_cast<std::size_t>(k)].first_node();
+        for (int d = 0; d < Dim; ++d) {
+          box_lo[field][d] = std::min(box_lo[field][d], b[d]);
+          box_hi[field][d] = std::max(box_hi[field][d], b[d] + Kernel::K - 1);
+        }
       }
     }
     std::fill(field_lo.begin(), field_lo.end(), fields);
@@ -341,7 +375,7 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
       const Material& mat = materials[m];
       if (mat.is_rigid()) continue;
       const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
-      const Stencil<Dim, Kernel>& sk = st[static_cast<std::size_t>(k)];
+      const auto& sk = st[static_cast<std::size_t>(k)];
       // The particle's F and σ in locals, updated by the serial kernel, then stored.
       Mat<Dim> F = Eigen::Map<const Mat<Dim>>(f.F + Dim * Dim * k);
       Mat<Dim> sigma = Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k);
@@ -409,7 +443,9 @@ void DecomposedMpm<Dim>::step(double dt) {
   Impl& s = *impl_;
   s.take_initial_energy();  // the energy books' start, once (energy_books.cpp)
   s.current_valid = false;  // the particles move: current_stencils() evaluates them again
-  dispatch_shape(s.opt.shape, [&](auto kernel) {
+  // The kernel's phases: dispatch_shape names the quadratic B-spline for extended_bspline (the kernel
+  // outside the step), so the extended one is chosen here (as the serial build_phases).
+  const auto run = [&](auto kernel) {
     using Kernel = decltype(kernel);
     // A phase and the phase_names() entry that times it.
     struct Phase {
@@ -457,7 +493,11 @@ void DecomposedMpm<Dim>::step(double dt) {
       (s.*phases[p].run)(dt);
       s.traffic.phase_seconds[static_cast<std::size_t>(phases[p].name)] += MPI_Wtime() - t0;
     }
-  });
+  };
+  if (s.opt.shape == ShapeKind::extended_bspline)
+    run(ExtendedBSplineKernel{});
+  else
+    dispatch_shape(s.opt.shape, run);
   s.time += dt;
   ++s.traffic.steps;
 }

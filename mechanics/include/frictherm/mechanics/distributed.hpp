@@ -60,8 +60,10 @@
 // cell [x_n − h/2, x_n + h/2) along every axis). With that rule the stencil of the linear, uGIMP
 // (l_p ≤ h/2) and quadratic B-spline kernels reaches one node beyond the nearest node on either side
 // along each axis, so the DMDA's stencil width is 1 in 2D and 3D; it is measured from the kernel's
-// own evaluation (stencil_reach), not assumed. The extended B-spline is refused (its weights are
-// built per body, not per particle).
+// own evaluation (stencil_reach), not assumed. The extended B-spline reaches search_radius + 2
+// nodes (its extension stencils sit on the nearest interior cell); its per-body bases are the serial
+// EbsBasis rebuilt on every rank from the body's particles gathered from all ranks
+// (mechanics/src/distributed/extended_bsplines.cpp).
 // Contact is resolved at owned nodes only, after the one exchange that completes their sums, by the
 // serial module's node-local code (mechanics/src/contact_pair.hpp, templated on Dim).
 // For coupled physics (the coupling's decomposed heat conduction, 2D and 3D) the run also carries named
@@ -177,6 +179,8 @@ class DecomposedMpm {
 
   struct Options {
     ShapeKind shape = ShapeKind::linear;
+    /// Extended B-splines (shape extended_bspline): C_c, as SimulationOptions::ebs_occupation.
+    double ebs_occupation = 0.75;
     /// 2D: plane_strain or plane_stress; 3D: three_d (as the serial Simulation<3> sets it).
     Analysis analysis = Dim == 2 ? Analysis::plane_strain : Analysis::three_d;
     double thickness = 1.0;               // 2D out-of-plane thickness (m), as SimulationOptions::thickness; unused in 3D
