@@ -169,6 +169,7 @@ int export_csv_command(const std::vector<std::string>& args) {
   try {
     if (a.has("output")) {
       const std::string& out_path = a.options.at("output");
+      coupling::check_not_of_input(out_path, path, "export-csv", true);  // --force or not (issue 34)
       coupling::check_output_path(out_path, {path}, a.has("force"), "--force");
       const std::string live = coupling::temporary_path(out_path);  // renamed onto out_path when complete
       std::ofstream out(live);

@@ -85,10 +85,7 @@ int continue_command(const std::vector<std::string>& args, const std::string& co
   return run_from_checkpoint(q, "continue", [&] {
     // The continued run is a new result: it never replaces RUN.h5 or its checkpoint, --force or not
     // (resume appends in place; continue would lose the continuation it started from).
-    if (q.output == q.run || coupling::same_file(q.output, q.run))
-      throw coupling::OutputError("refusing to write '" + q.output + "': it is the input of continue ('" + q.run +
-                                  "', with its checkpoint " + q.checkpoint + "), which is never replaced; choose "
-                                  "another output file (default RUN.continued.h5)");
+    coupling::check_not_of_input(q.output, q.run, "continue", false);
     if (!std::filesystem::exists(q.checkpoint))
       throw coupling::OutputError("no checkpoint " + q.checkpoint + " (runs with coupling.continuation write one at the end of loading)");
     q.scene = checkpoint_scene_or_refuse(q.checkpoint, overrides);  // first: refuses an unreadable checkpoint

@@ -91,7 +91,11 @@ ResumeOutcome resume_from_checkpoint(const ResumeRequest& q) {
   coupling::RunOptions opt = resume_run_options(q);
   opt.checkpoint_file = coupling::checkpoint_path(q.output);
   const bool in_place = coupling::same_file(q.run, q.output);
-  if (!in_place) coupling::check_output_path(q.output, {q.run, q.checkpoint}, q.force, "--force");
+  // Onto RUN.h5 itself: appended in place, or written anew under its name when it does not exist.
+  if (!in_place && !coupling::same_path(q.run, q.output)) {  // RUN.h5's checkpoint and XDMF files, or any checkpoint: never, --force or not (issue 34)
+    coupling::check_not_of_input(q.output, q.run, "resume", false);
+    coupling::check_output_path(q.output, {q.run, q.checkpoint}, q.force, "--force");
+  }
   const bool append = exists(q.run);
   out.appended = append;
   std::string continuation = q.output;

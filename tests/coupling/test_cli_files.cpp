@@ -122,6 +122,62 @@ TEST_F(Files, InputsAreNeverWrittenOverEvenWithForce) {
   EXPECT_EQ(frictherm("export-csv " + path("run.h5") + " -o " + path("s.csv") + " --force").code, 0);
 }
 
+// A run's checkpoint and XDMF files belong to it (issue 34): export-csv, continue and resume never
+// write over them, nor over the result itself under another spelling (./run.h5, a symbolic link), nor
+// over any run's checkpoint, whatever its name; export-csv (a CSV) replaces no HDF5 file at all
+// (another run's result, found by its content). --force changes none of that, and every file is
+// byte-equal after the refusal. Before (a47c20f), `export-csv R.h5 -o R.h5.checkpoint --force`
+// replaced the checkpoint with the CSV (exit 0), and so did every case below but the first.
+TEST_F(Files, ResultCheckpointAndXdmfAreNeverOutputsOfTheCommandsReadingThem) {
+  const std::string scene = write("tiny.json", kTinyScene), run = path("run.h5"), other = path("other.h5");
+  const std::string every = " --quiet --set run.checkpoint_interval=1e-3";
+  ASSERT_EQ(frictherm("run " + scene + " -o " + run + every).code, 0);
+  ASSERT_EQ(frictherm("run " + scene + " -o " + other + every).code, 0);
+  fs::create_symlink(run, path("link.h5"));
+  fs::copy_file(other + ".checkpoint", path("renamed.bin"));  // a checkpoint under a name that does not say so
+  const std::vector<std::string> kept = {run, run + ".checkpoint", path("run.xdmf"), other, other + ".checkpoint",
+                                         path("other.xdmf"), path("renamed.bin")};
+  std::vector<std::string> before;
+  for (const std::string& f : kept) before.push_back(slurp(f));
+  ASSERT_GT(before[1].size(), 1000u) << "the setup run wrote a checkpoint";
+  struct Case {
+    std::string command, output, why;
+  };
+  const std::vector<Case> cases = {
+      {"export-csv " + run, run + ".checkpoint", "it is the checkpoint of"},
+      {"export-csv " + run, dir_.string() + "/./run.h5", "it is the input of"},
+      {"export-csv " + path("link.h5"), run, "it is the input of"},
+      {"export-csv " + path("link.h5"), run + ".checkpoint", "it is the checkpoint of"},
+      {"export-csv " + run, path("run.xdmf"), "it is the XDMF file of"},
+      {"export-csv " + run, other, "it is a result of frictherm"},
+      {"export-csv " + run, other + ".checkpoint", "it is a checkpoint of frictherm"},
+      {"export-csv " + run, path("renamed.bin"), "it is a checkpoint of frictherm"},
+      {"continue " + run, run + ".checkpoint", "it is the checkpoint of"},
+      {"continue " + run, path("run.xdmf"), "it is the XDMF file of"},
+      {"continue " + run, other + ".checkpoint", "it is a checkpoint of frictherm"},
+      {"resume " + run, path("run.xdmf"), "it is the XDMF file of"},
+      {"resume " + run, path("renamed.bin"), "it is a checkpoint of frictherm"},
+  };
+  for (const Case& c : cases) {
+    const bool csv = c.command.rfind("export-csv", 0) == 0;  // export-csv has no --quiet
+    const Result r = frictherm(c.command + " -o '" + c.output + "' --force" + (csv ? "" : " --quiet"));
+    EXPECT_EQ(r.code, 2) << c.command << " -o " << c.output << ": " << r.output;
+    EXPECT_THAT(r.output, HasSubstr("refusing to write '" + c.output + "': " + c.why)) << c.command;
+    EXPECT_THAT(r.output, HasSubstr("--force or not")) << c.command;
+    for (std::size_t k = 0; k < kept.size(); ++k)
+      EXPECT_TRUE(slurp(kept[k]) == before[k]) << kept[k] << " changed by " << c.command << " -o " << c.output;
+  }
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_NE(e.path().extension(), ".part") << e.path();
+  // What is not the input's and holds no HDF5 is written as before: a new CSV, an existing one with --force.
+  EXPECT_EQ(frictherm("export-csv " + path("link.h5") + " -o " + path("s.csv")).code, 0);
+  EXPECT_EQ(frictherm("export-csv " + run + " -o " + path("s.csv") + " --force").code, 0);
+  EXPECT_THAT(slurp(path("s.csv")), HasSubstr("time"));
+  // resume onto another run's result with --force replaces it, as run --force does.
+  const Result onto = frictherm("resume " + run + " -o " + other + " --force --quiet");
+  EXPECT_EQ(onto.code, 0) << onto.output;
+  EXPECT_EQ(status_of(other), "completed");
+}
+
 // A result is published by renaming over its name, which would turn a device or a pipe (-o /dev/null
 // as root) into a regular file: such a name is refused even with --force, and left as it was. A named
 // pipe in the scratch folder stands for them (the test must not risk /dev/null).

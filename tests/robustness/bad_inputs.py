@@ -360,6 +360,23 @@ CASES += [
      "refusing to write 'R.h5.checkpoint'", RESULT_SETUP),
     ("export-csv -o its input --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "R.h5", "--force"],
      "refusing to write 'R.h5'", RESULT_SETUP),
+    # A run's checkpoint and XDMF belong to it; by canonical path; by content (issue 34 leftover).
+    ("export-csv -o its checkpoint --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "R.h5.checkpoint", "--force"],
+     "refusing to write 'R.h5.checkpoint': it is the checkpoint of 'R.h5'", RESULT_SETUP),
+    ("export-csv -o ./its input --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "./R.h5", "--force"],
+     "refusing to write './R.h5': it is the input of 'R.h5'", RESULT_SETUP),
+    ("export-csv -o its XDMF --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "R.xdmf", "--force"],
+     "refusing to write 'R.xdmf': it is the XDMF file of 'R.h5'", RESULT_SETUP),
+    ("export-csv -o another run's result --force", THERMAL, {}, ["export-csv", "R.h5", "-o", "S.h5", "--force"],
+     "refusing to write 'S.h5': it is a result of frictherm", RESULT_SETUP + [["run", "SCENE", "-o", "S.h5", "-q"]]),
+    ("export-csv -o another run's checkpoint --force", THERMAL, {},
+     ["export-csv", "R.h5", "-o", "S.bin", "--force"], "refusing to write 'S.bin': it is a checkpoint of frictherm",
+     RESULT_SETUP + [["run", "SCENE", "-o", "S.h5", "-q"],
+                     lambda d: shutil.copyfile(os.path.join(d, "S.h5.checkpoint"), os.path.join(d, "S.bin"))]),
+    ("continue -o its XDMF --force", THERMAL, {}, ["continue", "R.h5", "-o", "R.xdmf", "--force"],
+     "refusing to write 'R.xdmf': it is the XDMF file of 'R.h5'", RESULT_SETUP),
+    ("resume -o another run's checkpoint --force", THERMAL, {}, ["resume", "R.h5", "-o", "S.h5.checkpoint", "--force"],
+     "refusing to write 'S.h5.checkpoint': it is a checkpoint of frictherm", RESULT_SETUP + [["run", "SCENE", "-o", "S.h5", "-q"]]),
 ]
 
 

@@ -41,7 +41,8 @@ RunResult DecomposedRun<Dim>::execute() {
                      "it");
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
-  if (checkpoints_ && !resuming_) generation_ = detail::committed_generation(comm_, checkpoint_file_);
+  // An interrupted run writes one too (below), so the generation is known whether or not it checkpoints.
+  if (!resuming_ && !heat_continuation()) generation_ = detail::committed_generation(comm_, checkpoint_file_);
   build();
   if (resuming_) restore();
   if (rank_ == 0)  // the result's identity (/meta/run_id, every checkpoint's marks): a resume keeps its checkpoint's
@@ -72,8 +73,12 @@ RunResult DecomposedRun<Dim>::execute() {
   if (r_.status != RunResult::Status::failed) {  // as the serial run: no row or snapshot of a failed state
     // At the end, a stop at run.max_steps or an interruption: before the off-schedule row and
     // snapshot below, which an uninterrupted run does not have (a resume drops them).
+    // Interrupted (SIGINT/SIGTERM): a checkpoint also without run.checkpoint_interval, so that `mpirun
+    // -n K frictherm resume` goes on (issue 34, as the serial run); not with a continuation, which a
+    // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
+    const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      if (checkpoints_) checkpoint();
+      if (checkpoints_ || (interrupted && !heat_continuation())) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {
@@ -115,6 +120,7 @@ void DecomposedRun<Dim>::check_output_files() {
       claim_ = std::make_unique<OutputClaim>(r_.output);
       for (const std::string& f : decomposed_output_files(r_.output, size_))
         check_output_path(f, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
+      check_output_path(checkpoint_file_, inputs, true, "");  // every run may write one: an interrupted run does
     } catch (const std::exception& e) {
       error = e.what();
     }

@@ -19,10 +19,27 @@ std::vector<std::string> scene_input_files(const Scene& scene);
 /// links and different spellings of one path count as the same file).
 bool same_file(const std::string& a, const std::string& b);
 
+/// same_file, or the same path once symbolic links, "." and ".." are resolved as far as it exists
+/// ("./RUN.h5" and "RUN.h5" before RUN.h5 exists).
+bool same_path(const std::string& a, const std::string& b);
+
 /// Refuses (OutputError) to write `path` when it is one of `inputs`, when it is a folder, or when it
 /// exists and `overwrite` is false; `how_to_overwrite` is said in that last message (e.g. "--force").
 void check_output_path(const std::string& path, const std::vector<std::string>& inputs, bool overwrite,
                        const std::string& how_to_overwrite);
+
+/// What an existing file holds, read from its content (not its name): a checkpoint of frictherm
+/// (root attribute "format" with /marks or /mechanics), a result (root "format" with /meta or
+/// /series), another HDF5 file (a decomposed run's rank file, a foreign file), or none of these.
+enum class StoredFileKind { none, hdf5, result, checkpoint };
+StoredFileKind stored_file_kind(const std::string& path);
+
+/// The output of `command` (continue, resume, export-csv) reading the result `run` (issue 34):
+/// refused (OutputError naming the path and why), --force or not, when it is `run` itself or one of
+/// the files that belong to it (RUN.h5.checkpoint, RUN.xdmf, RUN_reference.xdmf, RUN_nodes.xdmf;
+/// compared as canonical paths and by inode, so "./RUN.h5" and links count), when it is an existing
+/// checkpoint of any run, and, with `csv`, when it is any existing HDF5 file (a result, a rank file).
+void check_not_of_input(const std::string& output, const std::string& run, const std::string& command, bool csv);
 
 /// A name in the folder of `path` that no file has yet: "<path>.<pid>.part" (a counter is added if
 /// that exists).
