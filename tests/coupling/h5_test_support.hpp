@@ -24,6 +24,21 @@ inline std::vector<double> read_doubles(const std::string& file, const std::stri
   return out;
 }
 
+/// The names of the links in `group` of `file`, in name order (empty when the file is absent).
+inline std::vector<std::string> names_in(const std::string& file, const std::string& group) {
+  std::vector<std::string> names;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return names;
+  auto add = [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
+    static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+    return 0;
+  };
+  hsize_t idx = 0;
+  H5Literate_by_name(f, group.c_str(), H5_INDEX_NAME, H5_ITER_INC, &idx, add, &names, H5P_DEFAULT);
+  H5Fclose(f);
+  return names;
+}
+
 /// A string dataset (/meta/status, /meta/failure, /meta/run_id) or a checkpoint's text (an array of
 /// chars: /marks/run_id), "" when absent.
 inline std::string read_text(const std::string& file, const std::string& path) {

@@ -31,6 +31,7 @@
 
 namespace {
 
+using frictherm::test::names_in;
 using frictherm::test::read_doubles;
 
 const char* const kScene = "tests/coupling/scenes/decomposed_sliding_block.json";
@@ -38,20 +39,6 @@ const char* const kContinuation =
     " --set 'coupling.continuation={\"duration\":2e-3,\"intervals\":20}'"
     " --set 'coupling.hotspots={\"mode\":\"rise\",\"threshold\":0.7}'";
 
-// The names of the datasets in `group` of `file`.
-std::vector<std::string> names_in(const std::string& file, const std::string& group) {
-  std::vector<std::string> names;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return names;
-  auto add = [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
-    static_cast<std::vector<std::string>*>(out)->emplace_back(name);
-    return 0;
-  };
-  hsize_t idx = 0;
-  H5Literate_by_name(f, group.c_str(), H5_INDEX_NAME, H5_ITER_INC, &idx, add, &names, H5P_DEFAULT);
-  H5Fclose(f);
-  return names;
-}
 
 class MpirunContinuation : public frictherm::test::MpirunCompare {
  protected:
