@@ -23,6 +23,8 @@
 // it both are right (tests/verification/test_penalty_*). EBS never needs it: its degenerate nodes
 // have no mass. Weighting by nodal mass instead (S_I m_I / Σ S m) is just as stable but moves the
 // contact force into the body: the stacked bars' contact rows then lost the whole contact stress.
+#include "penalty_weights.hpp"
+
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
@@ -36,61 +38,7 @@ namespace frictherm::mechanics {
 
 namespace {
 
-/// Slot of grid node `node` in a field's box, or −1 outside it.
-template <int Dim>
-int slot_of(const Grid<Dim>& grid, const FieldNodes<Dim>& F, int node) {
-  const IVec<Dim> L = grid.node_lattice(node);
-  int slot = F.index.shift;
-  for (int d = 0; d < Dim; ++d) {
-    const int l = L[d] + Grid<Dim>::ghost;
-    if (l < F.lo[d] || l >= F.lo[d] + F.extent[d]) return -1;
-    slot += l * F.index.stride[d];
-  }
-  return slot;
-}
-
-/// The boundary points' weights in the step: GridWeights (the step's kernel, renormalised over the
-/// nodes where the field has mass), or with EBS the field's extended basis where it is defined.
-template <int Dim>
-struct StepWeights {
-  GridWeights<Dim> plain;
-  const std::vector<EbsBasis<Dim>>* ebs = nullptr;
-
-  template <class Visit>
-  void operator()(int field, const Vec<Dim>& x, const Vec<Dim>& half_size, Visit&& visit) const {
-    if (ebs && try_extended(field, x, visit)) return;
-    plain(field, x, half_size, visit);
-  }
-
- private:
-  static constexpr int kMax = 64;  // largest stencil taken from the extended basis (2D: 9 plain, ~16 extended)
-
-  template <class Visit>
-  bool try_extended(int field, const Vec<Dim>& x, Visit& visit) const {
-    EbsStencil<Dim> s;
-    (*ebs)[static_cast<std::size_t>(field)].evaluate(x, s);
-    if (s.table == EbsStencil<Dim>::empty || s.size() > kMax) return false;
-    const FieldNodes<Dim>& F = plain.fields[static_cast<std::size_t>(field)];
-    int slot[kMax], node[kMax];
-    double S[kMax];
-    int m = 0;
-    double sum = 0.0;
-    s.for_each([&](int nd, double w, const Vec<Dim>&) {
-      if (w == 0.0) return;
-      const int sl = slot_of(*plain.grid, F, nd);
-      if (sl < 0 || !plain.keeps(field, static_cast<std::size_t>(sl), w)) return;
-      slot[m] = sl, node[m] = nd, S[m] = w;
-      sum += w;
-      ++m;
-    });
-    // N^e sums to one over the stable nodes, which all have mass; a sum far from one means the point
-    // sits where the extension does not describe the field (fall back to the plain spline).
-    if (m == 0 || !(sum > 0.5)) return false;
-    const double inv = 1.0 / sum;
-    for (int a = 0; a < m; ++a) visit(slot[a], node[a], S[a] * inv);
-    return true;
-  }
-};
+using namespace penalty_kernels;
 
 /// The step's weights over the fields' current node boxes, for apply_penalty_forces and
 /// move_boundary_points. The boxes are copied into `home` (kept between steps, so nothing is
@@ -122,11 +70,6 @@ struct LentStepWeights {
   LentStepWeights& operator=(const LentStepWeights&) = delete;
   ~LentStepWeights() { boxes.swap(w.plain.fields); }
 };
-
-double modulus_for_penalty(const Material& m) {
-  if (m.is_rigid()) return std::numeric_limits<double>::infinity();
-  return m.youngs_modulus;  // mie_gruneisen: 0 unless given, then the partner's E (or set the penalty)
-}
 
 }  // namespace
 
@@ -256,20 +199,8 @@ void Simulation<Dim>::apply_penalty_forces() {
   if (!penalty_) return;
   LentStepWeights<Dim> lent(penalty_fields_, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
                             penalty_reference_mass_, penalty_sliver_, ebs_);
-  const StepWeights<Dim>& w = lent.w;
-  // Step 1 (K·27): a slave point is a candidate if its stencil reaches a node where the master has mass.
-  const auto master_has_mass = [&](int field, int node) {
-    const int s = slot_of(grid_, w.plain.fields[static_cast<std::size_t>(field)], node);
-    return s >= 0 && nodes_.mass[static_cast<std::size_t>(s)] > empty_node_mass_;
-  };
-  PenaltyContact<Dim>& pc = *penalty_;
-  pc.compute(boundary_, [&](int k, int i) {
-    return touches_field(boundary_, i, w, pc.pair(static_cast<std::size_t>(k)).master, master_has_mass);
-  });
-  pc.scatter_forces(boundary_, w, nodes_.force);  // K·36; rigid fields drop theirs in nodal_velocities
-  pc.scatter_heat(boundary_, w, work_first_);     // penalty heat has no first/second-order split
-  pc.scatter_heat(boundary_, w, work_second_);
-  pc.update_frequency_bound(boundary_, w, nodes_.mass, empty_node_mass_);  // for the next time step
+  apply_penalty(*penalty_, boundary_, lent.w, nodes_.mass, empty_node_mass_, nodes_.force, work_first_, work_second_);
+  const PenaltyContact<Dim>& pc = *penalty_;
   for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
     const auto a = static_cast<std::size_t>(std::min(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
     const auto b = static_cast<std::size_t>(std::max(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
@@ -295,34 +226,24 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
   if (!penalty_) return;
   LentStepWeights<Dim> lent(penalty_fields_, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
                             penalty_reference_mass_, penalty_sliver_, ebs_);  // USF: before apply_penalty_forces
-  const StepWeights<Dim>& w = lent.w;
   BoundaryPoints<Dim>& bp = boundary_;
-  for (std::size_t i = 0; i < bp.size(); ++i) {
-    const auto f = static_cast<std::size_t>(bp.field[i]);
-    Vec<Dim> v = Vec<Dim>::Zero();
-    if (fields_[f].rigid) {
-      const Material& m = materials_[static_cast<std::size_t>(fields_[f].material)];
-      v = (0.5 * (m.rigid_velocity_at(t) + m.rigid_velocity_at(t + dt))).template head<Dim>();
-    } else {
-      w(bp.field[i], bp.position[i], bp.half_size[i],
-        [&](int slot, int, double S) { v += S * nodes_.velocity[static_cast<std::size_t>(slot)]; });
-    }
-    bp.velocity[i] = v;
+  const long bad = move_points(bp, lent.w, grid_, dt, [&](int field, Vec<Dim>& v) {
+    const auto f = static_cast<std::size_t>(field);
+    if (!fields_[f].rigid) return false;
+    const Material& m = materials_[static_cast<std::size_t>(fields_[f].material)];
+    v = (0.5 * (m.rigid_velocity_at(t) + m.rigid_velocity_at(t + dt))).template head<Dim>();
+    return true;
+  }, [&](int slot) -> const Vec<Dim>& { return nodes_.velocity[static_cast<std::size_t>(slot)]; });
+  if (bad >= 0) {
+    const auto i = static_cast<std::size_t>(bad);
+    const int m = fields_[static_cast<std::size_t>(bp.field[i])].material;
+    std::ostringstream msg;
+    msg << "step " << step_ << ", t = " << time_ << " s: boundary point " << i << " of material '"
+        << materials_[static_cast<std::size_t>(m)].name << "' "
+        << (bp.position[i].allFinite() ? "left the grid" : "has a non-finite position")
+        << " (penalty contact; the step blew up: try a smaller CFL factor or penalty)";
+    throw SimulationError(msg.str(), step_, time_, -1);
   }
-  for (std::size_t i = 0; i < bp.size(); ++i) bp.position[i] += dt * bp.velocity[i];
-  // Boundary points may lie on the grid's edge (a body against a fixed face): allow the ghost layer.
-  const Vec<Dim> lo = grid_.lo() - grid_.cell_size(), hi = grid_.hi() + grid_.cell_size();
-  for (std::size_t i = 0; i < bp.size(); ++i)
-    if (!bp.position[i].allFinite() || (bp.position[i].array() < lo.array()).any() ||
-        (bp.position[i].array() > hi.array()).any()) {
-      const int m = fields_[static_cast<std::size_t>(bp.field[i])].material;
-      std::ostringstream msg;
-      msg << "step " << step_ << ", t = " << time_ << " s: boundary point " << i << " of material '"
-          << materials_[static_cast<std::size_t>(m)].name << "' "
-          << (bp.position[i].allFinite() ? "left the grid" : "has a non-finite position")
-          << " (penalty contact; the step blew up: try a smaller CFL factor or penalty)";
-      throw SimulationError(msg.str(), step_, time_, -1);
-    }
   contact_stats_.penalty_contacts = contact_stats_.penalty_sliding = 0;
   for (std::size_t k = 0; k < penalty_->pair_count(); ++k) {
     contact_stats_.penalty_contacts += penalty_->books(k).active;
@@ -336,19 +257,7 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
 template <int Dim>
 double Simulation<Dim>::penalty_wave_factor() const {
   if (!penalty_) return 1.0;
-  double factor = 1.0;
-  const double h = grid_.min_cell_size();
-  for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
-    const PenaltyPairSettings& s = penalty_->pair(k);
-    double E = std::numeric_limits<double>::infinity();
-    for (int m : {penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material}) {
-      const double Em = modulus_for_penalty(materials_[static_cast<std::size_t>(m)]);
-      if (Em > 0.0) E = std::min(E, Em);
-    }
-    if (!std::isfinite(E)) continue;
-    factor = std::max(factor, std::sqrt(std::max(s.normal_penalty, s.tangential_penalty) / (E / h)));
-  }
-  return factor;
+  return penalty_kernels::penalty_wave_factor(*penalty_, penalty_pairs_, materials_, grid_.min_cell_size());
 }
 
 // Time-step guard (docs/penalty_contact.md, "Stability"): forward Euler on the bodies plus the
@@ -361,10 +270,7 @@ double Simulation<Dim>::penalty_wave_factor() const {
 template <int Dim>
 double Simulation<Dim>::penalty_time_step_limit(double wave_speed) const {
   if (!penalty_) return std::numeric_limits<double>::infinity();
-  const double wp2 = penalty_->frequency_bound_squared();
-  if (!(wp2 > 0.0)) return std::numeric_limits<double>::infinity();
-  const double wel = 2.0 * wave_speed / grid_.min_cell_size();
-  return 2.0 / std::sqrt(wel * wel + wp2);
+  return penalty_kernels::penalty_time_step_limit(penalty_->frequency_bound_squared(), wave_speed, grid_.min_cell_size());
 }
 
 #define FRICTHERM_INSTANTIATE_PENALTY(D)                                                              \

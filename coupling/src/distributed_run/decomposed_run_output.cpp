@@ -61,6 +61,11 @@ std::vector<std::string> DecomposedRun<Dim>::series_names() const {
   std::vector<std::string> n = detail::series_names(Dim);
   if (s_.contact.enabled)
     n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
+  if (const mechanics::PenaltyContact<Dim>* pc = mpm_->penalty_contact()) {  // the serial run's penalty columns
+    std::vector<mechanics::PenaltyPairInfo> pairs;
+    for (std::size_t k = 0; k < pc->pair_count(); ++k) pairs.push_back({pc->pair(k).master, pc->pair(k).slave});
+    detail::append_penalty_series_names(n, pairs, s_.materials);  // decomposed fields are materials
+  }
   if (heat_) {
     n.insert(n.end(), {"heat_delivered", "thermal_energy_change", "max_temperature"});
     for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
@@ -87,8 +92,12 @@ void DecomposedRun<Dim>::series(double time) {
   // with the frictional work of the order handed to the heat (second without heat, as the serial run).
   const mechanics::EnergyBalance books =
       mpm_->energy_balance(heat_ ? s_.thermal.heating_order : mechanics::HeatingOrder::second);
-  std::vector<double> row{row_time, static_cast<double>(step_), last_dt_, books.kinetic, books.stored,
-                          books.kinetic + books.stored, books.external_work};
+  // The serial strain_energy and total_energy columns leave out the penalty springs' energy, which
+  // the books' stored energy holds (the same on every rank).
+  const mechanics::PenaltyContact<Dim>* pc = mpm_->penalty_contact();
+  const double strain = pc ? books.stored - pc->stored_energy() : books.stored;
+  std::vector<double> row{row_time, static_cast<double>(step_), last_dt_, books.kinetic, strain,
+                          books.kinetic + strain, books.external_work};
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   row.insert(row.end(), {books.rigid_work, books.damping_work, books.plastic_work, books.lost(),
                          books.numerical_dissipation()});
@@ -98,6 +107,7 @@ void DecomposedRun<Dim>::series(double time) {
     const mechanics::DecomposedContactStats cs = mpm_->contact_stats();
     row.insert(row.end(), {w1, w2, static_cast<double>(cs.contact_nodes), static_cast<double>(cs.sliding_nodes)});
   }
+  if (pc) detail::append_penalty_row(row, *pc, mpm_->boundary_points());
   if (heat_) {
     const DecomposedHeatBooks& b = heat_->books();
     // The highest temperature of the conducting particles over all ranks, from the last update.

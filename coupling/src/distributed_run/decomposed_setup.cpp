@@ -25,6 +25,13 @@ std::string agreed_error(MPI_Comm comm, const std::string& error) {
   return text;
 }
 
+bool penalty_contact_scene(const Scene& scene) {
+  if (!scene.contact.enabled) return false;
+  bool penalty = scene.contact.options.default_pair.method == mechanics::ContactMethod::penalty;
+  for (const ContactPairSpec& p : scene.contact.pairs) penalty = penalty || p.settings.method == mechanics::ContactMethod::penalty;
+  return penalty;
+}
+
 bool plastic_heating(const Scene& scene) { return scene.thermal.enabled && scene.thermal.coupler.plastic.enabled; }
 
 template <int Dim>
@@ -33,6 +40,44 @@ mechanics::Grid<Dim> scene_grid(const Scene& scene) {
   for (int d = 0; d < Dim; ++d) cells[static_cast<std::size_t>(d)] = scene.cells[static_cast<std::size_t>(d)];
   return mechanics::Grid<Dim>(to_vec<Dim>(scene.grid_lo), to_vec<Dim>(scene.cell_size), cells);
 }
+
+namespace {
+
+// Penalty contact: the serial build's boundary points and pairs (Simulation::setup_penalty: the bodies'
+// boundary loops, master/slave choice, penalties), with its velocity fields renamed as the decomposed
+// ones (a field per material), and each material's mean particle mass, the serial
+// penalty_reference_mass_ (Σ m_p over the material's particles in the serial order, over their count).
+// Every rank builds the scene (the penalty scenes are small: the EBS benchmarks).
+template <int Dim>
+void add_penalty(const Scene& scene, typename mechanics::DecomposedMpm<Dim>::Options& o) {
+  if (!penalty_contact_scene(scene)) return;
+  const auto sim = build_simulation<Dim>(scene);
+  const mechanics::PenaltyContact<Dim>* pc = sim->penalty_contact();
+  if (!pc) return;  // no two present materials in penalty contact
+  const auto material_of = [&](int field) { return sim->fields()[static_cast<std::size_t>(field)].material; };
+  o.penalty_points = sim->boundary_points();
+  for (auto& f : o.penalty_points.field) f = material_of(f);
+  for (auto& f : o.penalty_points.loop_field) f = material_of(f);
+  for (std::size_t k = 0; k < pc->pair_count(); ++k) {
+    mechanics::PenaltyPairSettings ps = pc->pair(k);
+    ps.master = material_of(ps.master);
+    ps.slave = material_of(ps.slave);
+    o.penalty_pairs.push_back(ps);
+    o.penalty_materials.push_back({sim->penalty_pairs()[k].master_material, sim->penalty_pairs()[k].slave_material});
+  }
+  const mechanics::Particles<Dim>& p = sim->particles();
+  std::vector<double> mass(scene.materials.size(), 0.0);
+  std::vector<std::size_t> count(scene.materials.size(), 0);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    mass[static_cast<std::size_t>(p.material[k])] += p.mass[k];
+    ++count[static_cast<std::size_t>(p.material[k])];
+  }
+  o.penalty_reference_mass.assign(mass.size(), 0.0);
+  for (std::size_t m = 0; m < mass.size(); ++m)
+    if (count[m] > 0) o.penalty_reference_mass[m] = mass[m] / static_cast<double>(count[m]);
+}
+
+}  // namespace
 
 template <int Dim>
 typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& scene) {
@@ -52,6 +97,7 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
     o.contact_options = scene.contact.options;
     for (const ContactPairSpec& p : scene.contact.pairs) o.contact_pairs.push_back({p.material_a, p.material_b, p.settings});
   }
+  if (o.contact) add_penalty<Dim>(scene, o);
   o.particle_scalars = {"temperature", "reference_temperature"};  // T_p and T0_p (hot spots' reference)
   // The plastic work already handed to the heat (DecomposedHeatOptions::plastic_work_heated).
   if (plastic_heating(scene)) o.particle_scalars.emplace_back("plastic_work_heated");

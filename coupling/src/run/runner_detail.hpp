@@ -21,6 +21,15 @@ std::vector<std::string> series_names(int dim);
 template <int Dim>
 void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim);
 
+/// Penalty contact (docs/penalty_contact.md), serial and decomposed runs: penalty_energy (the springs'
+/// energy), then per pair (master.slave) penalty_force, penalty_contacts, penalty_min_gap and
+/// penalty_contact_length (the summed length of the penetrated master segments) of the last step.
+void append_penalty_series_names(std::vector<std::string>& names, const std::vector<mechanics::PenaltyPairInfo>& pairs,
+                                 const std::vector<mechanics::Material>& materials);
+template <int Dim>
+void append_penalty_row(std::vector<double>& row, const mechanics::PenaltyContact<Dim>& contact,
+                        const mechanics::BoundaryPoints<Dim>& points);
+
 /// Every run: each body's mass-weighted mean temperature and mean displacement,
 /// mean_temperature.<body>, mean_displacement_x.<body>, _y (, _z).
 template <int Dim>

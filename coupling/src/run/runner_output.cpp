@@ -43,8 +43,13 @@ void append_contact_series_names(std::vector<std::string>& names, const mechanic
   // Penalty contact (docs/penalty_contact.md): the springs' energy, and per pair (master.slave) the
   // normal force, active contacts, deepest gap and the summed length of the penetrated master segments.
   if (!sim.penalty_contact()) return;
+  append_penalty_series_names(names, sim.penalty_pairs(), mats);
+}
+
+void append_penalty_series_names(std::vector<std::string>& names, const std::vector<mechanics::PenaltyPairInfo>& pairs,
+                                 const std::vector<mechanics::Material>& mats) {
   names.emplace_back("penalty_energy");
-  for (const auto& pp : sim.penalty_pairs()) {
+  for (const auto& pp : pairs) {
     const std::string pair =
         mats[static_cast<std::size_t>(pp.master_material)].name + "." + mats[static_cast<std::size_t>(pp.slave_material)].name;
     for (const char* what : {"penalty_force.", "penalty_contacts.", "penalty_min_gap.", "penalty_contact_length."})
@@ -131,10 +136,15 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
   for (std::size_t b = 0; b < mv.size(); ++b)
     for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mv[b][d] / m[b] : 0.0);
   append_heat_rates(row, sim, memory, order);
-  const mechanics::PenaltyContact<Dim>* pc = sim.penalty_contact();
-  if (!pc) return row;
+  if (const mechanics::PenaltyContact<Dim>* pc = sim.penalty_contact()) append_penalty_row(row, *pc, sim.boundary_points());
+  return row;
+}
+
+template <int Dim>
+void append_penalty_row(std::vector<double>& row, const mechanics::PenaltyContact<Dim>& contact,
+                        const mechanics::BoundaryPoints<Dim>& bp) {
+  const mechanics::PenaltyContact<Dim>* pc = &contact;
   row.push_back(pc->stored_energy());
-  const auto& bp = sim.boundary_points();
   std::vector<int> segments;
   for (std::size_t k = 0; k < pc->pair_count(); ++k) {
     double gap = 0.0;
@@ -153,7 +163,6 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
     row.push_back(gap);
     row.push_back(length);
   }
-  return row;
 }
 
 // Snapshot fields in the shapes VTK (ParaView's XDMF reader, Warp By Vector, Calculator) expects:
@@ -292,6 +301,8 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
   template void append_contact_series_names<D>(std::vector<std::string>&, const mechanics::Simulation<D>&);      \
   template void append_body_series_names<D>(std::vector<std::string>&, const mechanics::Simulation<D>&);         \
   template std::vector<double> series_row<D>(const mechanics::Simulation<D>&, SeriesMemory&, mechanics::HeatingOrder); \
+  template void append_penalty_row<D>(std::vector<double>&, const mechanics::PenaltyContact<D>&,            \
+                                      const mechanics::BoundaryPoints<D>&);                                   \
   template void write_fields<D>(H5Output&, const mechanics::Simulation<D>&, const std::vector<std::string>&); \
   template void write_start_metadata<D>(H5Output&, const Scene&, const mechanics::Simulation<D>&, const RunOptions&);
 FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(2)

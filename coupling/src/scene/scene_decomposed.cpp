@@ -33,8 +33,10 @@ std::string mechanics_refusal(const Scene& s) {
   // USL, and MUSL without contact (DecomposedMpm: the USL phases with the remap and its exchange).
   if (o.scheme == mechanics::UpdateScheme::usf)
     return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");
-  if (o.scheme == mechanics::UpdateScheme::musl && s.contact.enabled)
-    return refuse("solver.scheme", quoted("musl") + " with contact", "\"usl\", or \"musl\" without contact");
+  if (o.scheme == mechanics::UpdateScheme::musl && s.contact.enabled &&
+      s.contact.options.default_pair.method != mechanics::ContactMethod::penalty)
+    return refuse("solver.scheme", quoted("musl") + " with multimaterial contact",
+                  "\"usl\", or \"musl\" without contact or with penalty contact");
   if (o.particle_update != mechanics::ParticleUpdate::flip)
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
   // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).
@@ -46,11 +48,18 @@ std::string mechanics_refusal(const Scene& s) {
 std::string contact_refusal(const Scene& s) {
   if (!s.contact.enabled) return "";
   const mechanics::ContactOptions& c = s.contact.options;
-  if (c.default_pair.method == mechanics::ContactMethod::penalty)
-    return refuse("contact.method", quoted("penalty"), "\"multimaterial\"");
+  // Penalty contact runs (DecomposedMpm: the serial kernels on the points replicated on every rank,
+  // mechanics/src/distributed/penalty_phases.cpp) when every pair uses it, without checkpoints.
+  const bool penalty = c.default_pair.method == mechanics::ContactMethod::penalty;
   for (std::size_t i = 0; i < s.contact.pairs.size(); ++i)
-    if (s.contact.pairs[i].settings.method == mechanics::ContactMethod::penalty)
-      return refuse("contact.pairs[" + std::to_string(i) + "].method", quoted("penalty"), "\"multimaterial\"");
+    if ((s.contact.pairs[i].settings.method == mechanics::ContactMethod::penalty) != penalty)
+      return refuse("contact.pairs[" + std::to_string(i) + "].method",
+                    quoted(mechanics::to_string(s.contact.pairs[i].settings.method)) + " beside contact.method " +
+                        quoted(mechanics::to_string(c.default_pair.method)),
+                    "every pair with the same method");
+  if (penalty && s.checkpoint_interval > 0.0)
+    return refuse("run.checkpoint_interval", number(s.checkpoint_interval) + " with penalty contact",
+                  "no checkpoints with penalty contact");
   if (c.regularized()) return refuse("contact.regularization", "an object", "no regularisation: remove the key");
   return "";
 }

@@ -41,10 +41,16 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
     throw std::invalid_argument(where + "position_correction must be in [0, 2) cell sizes");
   if (!(co.min_mass_fraction >= 0.0 && co.min_mass_fraction < 0.5))
     throw std::invalid_argument(where + "min_mass_fraction must be in [0, 0.5)");
+  // Either every pair multimaterial, or every pair penalty with the penalty contact given
+  // (Options::penalty_pairs; then no grid contact, as the serial step without multimaterial pairs).
+  const bool penalty_run = !opt.penalty_pairs.empty();
   auto multimaterial_only = [&](const ContactPairSettings& s, const std::string& pair) {
-    if (s.method == ContactMethod::penalty)
-      throw std::invalid_argument(where + pair + ": method 'penalty' is not supported in a decomposed run (expected "
-                                  "'multimaterial'; penalty contact stays serial)");
+    if (s.method == ContactMethod::penalty && !penalty_run)
+      throw std::invalid_argument(where + pair + ": method 'penalty' needs the penalty contact's points and pairs "
+                                  "(Options::penalty_pairs)");
+    if (s.method != ContactMethod::penalty && penalty_run)
+      throw std::invalid_argument(where + pair + ": multimaterial and penalty pairs together are not supported in a "
+                                  "decomposed run (expected every pair 'penalty')");
   };
   partner_field.assign(n, 0);  // with contact, field = material
   for (std::size_t m = 0; m < n; ++m) partner_field[m] = rigid_partner(static_cast<PetscInt>(m)) ? 1 : 0;
@@ -80,7 +86,7 @@ void DecomposedMpm<Dim>::Impl::find_contact_nodes(double /*dt*/) {
   work_first.assign(static_cast<std::size_t>(owned), 0.0);
   work_second.assign(static_cast<std::size_t>(owned), 0.0);
   contact_nodes.clear();
-  if (!opt.contact) return;
+  if (!opt.contact || !opt.penalty_pairs.empty()) return;  // penalty contact only: no grid contact
   for (std::size_t g = 0; g < mt_q.size(); ++g) {
     int present = 0;
     for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e)

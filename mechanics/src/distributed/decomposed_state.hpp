@@ -10,6 +10,7 @@
 
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
 #include <frictherm/mechanics/ebs.hpp>
+#include <frictherm/mechanics/penalty_contact.hpp>
 
 #include <petscdmda.h>
 #include <petscdmswarm.h>
@@ -18,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -323,6 +325,26 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<double> ebs_volume;
   std::vector<std::size_t> ebs_order;
   void prepare_extended(SwarmFields& f);
+
+  // Penalty contact (penalty_phases.cpp): the serial PenaltyContact and boundary points, the same on
+  // every rank; the complete per-field nodal mass and velocity over the whole grid (slot f·N + node,
+  // the serial FieldNodes::whole_grid layout) gathered from the owners; the forces and heat the
+  // serial kernels scatter into them.
+  std::optional<PenaltyContact<Dim>> penalty;
+  BoundaryPoints<Dim> boundary;
+  std::vector<FieldNodes<Dim>> penalty_boxes;
+  std::vector<double> penalty_mass, penalty_heat_first, penalty_heat_second;
+  std::vector<Vec<Dim>> penalty_force, penalty_velocity;
+  std::vector<double> penalty_gather;
+  std::vector<std::size_t> owned_grid_node;  // per owned node q: its grid node (serial numbering)
+  std::vector<double> p2g_values;            // MUSL with several fields: the slots after particle_to_grid
+  void setup_penalty();
+  void penalty_forces(double dt);
+  void move_boundary_points(double dt);
+  double penalty_time_step(double& cmax) const;  // the springs' limit; cmax times the penalty's wave factor
+  void keep_grid_values(double dt);              // MUSL with several fields: p2g_values = field_values
+  template <class Visit>
+  void gather_owned_fields(int components, std::vector<double>& dense, Visit&& value);
 
   ~Impl();
 

@@ -150,9 +150,9 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
     s.laws.push_back(stress_law(m, options.analysis));
     s.has_mie_gruneisen = s.has_mie_gruneisen || mg;
   }
-  if (options.musl && options.contact)
-    throw std::invalid_argument("decomposed mechanics: MUSL with contact is not supported (expected USL, or MUSL "
-                                "without contact)");
+  if (options.musl && options.contact && options.penalty_pairs.empty())
+    throw std::invalid_argument("decomposed mechanics: MUSL with multimaterial contact is not supported (expected "
+                                "USL, or MUSL without contact or with penalty contact)");
   s.opt = options;
   // The loads by particle id (stable: a particle's loads in the serial order), found by particle_to_grid.
   s.loads = options.loads;
@@ -161,6 +161,7 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   for (const ParticleLoad<Dim>& L : s.loads) s.load_ids.push_back(L.particle);
   s.opt.loads.clear();
   s.setup_contact();  // checks the contact settings before any collective PETSc call
+  s.setup_penalty();  // penalty_phases.cpp
   s.fields = options.contact ? static_cast<int>(materials.size()) : 1;
   s.per_field = options.contact ? NodeDof<Dim>::with_contact : NodeDof<Dim>::without_contact;
   const IVec<Dim>& nodes = grid.nodes_per_dim();
@@ -542,11 +543,15 @@ double DecomposedMpm<Dim>::stable_time_step(double cfl, double max_time_step) co
   }
   MPI_Allreduce(MPI_IN_PLACE, &cmax, 1, MPI_DOUBLE, MPI_MAX, s.comm);
   cmax = with_rigid_speeds(cmax, s.materials, s.time);
+  // Penalty contact: the springs' limit and the stiffer penalty's wave factor (as the serial step).
+  const double dt_penalty = s.penalty_time_step(cmax);
   // The damping's explicit limit while it acts (as the serial step).
   const double dt_damping = damping_active(s.opt.damping_rate, s.opt.damping_until, s.time)
                                 ? damping_time_step_limit(s.opt.damping_rate)
                                 : std::numeric_limits<double>::infinity();
-  return std::min(cfl_time_step(cfl, s.grid.min_cell_size(), cmax, max_time_step), dt_damping);
+  const double dt = cfl_time_step(cfl, s.grid.min_cell_size(), cmax, max_time_step);
+  if (cmax <= 0.0) return std::min(dt, dt_damping);
+  return std::min({dt, dt_penalty, dt_damping});
 }
 
 template <int Dim>

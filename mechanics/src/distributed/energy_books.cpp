@@ -43,7 +43,7 @@ void DecomposedMpm<Dim>::Impl::take_initial_energy() {
   const std::array<double, 3> p = particle_books();
   double e = p[0] + p[1];
   MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_DOUBLE, MPI_SUM, comm);
-  initial_energy = e;
+  initial_energy = e + (penalty ? penalty->stored_energy() : 0.0);  // the springs' (the same on every rank)
 }
 
 template <int Dim>
@@ -60,7 +60,7 @@ EnergyBalance DecomposedMpm<Dim>::energy_balance(HeatingOrder order) const {
   MPI_Allreduce(MPI_IN_PLACE, v, 7, MPI_DOUBLE, MPI_SUM, s.comm);
   EnergyBalance b;
   b.kinetic = v[0];
-  b.stored = v[1];
+  b.stored = v[1] + (s.penalty ? s.penalty->stored_energy() : 0.0);  // + the penalty springs' (every rank's)
   b.initial = std::isnan(s.initial_energy) ? b.kinetic + b.stored : s.initial_energy;
   b.plastic_work = v[2];
   b.external_work = v[3];

@@ -429,12 +429,12 @@ double DecomposedMpm<Dim>::damping_work() const {
 }
 
 template <int Dim>
-const std::array<const char*, 16>& DecomposedMpm<Dim>::phase_names() {
-  static const std::array<const char*, 16> names{
+const std::array<const char*, 18>& DecomposedMpm<Dim>::phase_names() {
+  static const std::array<const char*, 18> names{
       {"particle_to_grid", "sum_to_owners", "exchange_field_ranges", "fields_to_owners", "find_contact_nodes",
        "contact_extrapolated", "momentum_update", "contact_updated", "nodal_velocities", "ghost_velocities",
        "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate", "remap_momentum",
-       "velocity_from_momentum"}};
+       "velocity_from_momentum", "penalty_forces", "move_boundary_points"}};
   return names;
 }
 
@@ -461,28 +461,41 @@ void DecomposedMpm<Dim>::step(double dt) {
                                     {&Impl::find_contact_nodes, 4},
                                     {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
                                     {&Impl::contact_extrapolated, 5},
+                                    {&Impl::penalty_forces, 16},  // penalty contact (penalty_phases.cpp)
                                     {&Impl::momentum_update, 6},
                                     {&Impl::contact_updated, 7},
                                     {&Impl::nodal_velocities, 8},
                                     {&Impl::ghost_velocities, 9},
                                     {&Impl::fields_to_ghosts, 10},
                                     {&Impl::template grid_to_particle<Kernel>, 11},
+                                    {&Impl::move_boundary_points, 17},  // with v^{n+1}, as the serial USL
                                     {&Impl::template stress_update<Kernel>, 12},
                                     {&Impl::migrate, 13}};
-    // MUSL (without contact): USL's phases up to the grid-to-particle update, then the momenta remapped
-    // from the updated particles with their exchange (sum to the owners, the velocity conditions and
-    // v_i = p_i/m_i there, the ghost update), and the stress update from those velocities (the serial
-    // MUSL list, simulation_step.cpp).
+    // MUSL: USL's phases up to the grid-to-particle update (with several velocity fields the slots of
+    // particle_to_grid kept), then the momenta remapped from the updated particles with their exchange
+    // (sum to the owners, the per-field entries to the owners, the velocity conditions and
+    // v_i = p_i/m_i there, the ghost update), the penalty contact's points moved with those velocities
+    // and the stress update from them (the serial MUSL list, simulation_step.cpp). Multimaterial grid
+    // contact on the remapped momenta is not here (refused: DecomposedMpm's constructor).
     static constexpr Phase musl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
+                                     {&Impl::keep_grid_values, 0},
                                      {&Impl::sum_to_owners, 1},
+                                     {&Impl::exchange_field_ranges, 2},
+                                     {&Impl::fields_to_owners, 3},
+                                     {&Impl::find_contact_nodes, 4},
+                                     {&Impl::penalty_forces, 16},
                                      {&Impl::momentum_update, 6},
                                      {&Impl::nodal_velocities, 8},
                                      {&Impl::ghost_velocities, 9},
+                                     {&Impl::fields_to_ghosts, 10},
                                      {&Impl::template grid_to_particle<Kernel>, 11},
                                      {&Impl::template remap_momentum<Kernel>, 14},
                                      {&Impl::sum_to_owners, 1},
+                                     {&Impl::fields_to_owners, 3},
                                      {&Impl::velocity_from_momentum, 15},
+                                     {&Impl::move_boundary_points, 17},
                                      {&Impl::ghost_velocities, 9},
+                                     {&Impl::fields_to_ghosts, 10},
                                      {&Impl::template stress_update<Kernel>, 12},
                                      {&Impl::migrate, 13}};
     const bool is_musl = s.opt.musl;
@@ -509,6 +522,9 @@ template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::remap_momentum(double /*dt*/) {
   constexpr int momentum = Dof::momentum;
+  // Several fields: fields_to_ghosts wrote the groups' complete values into the slots at multi-material
+  // nodes; this rank's own sums of particle_to_grid come back, so that the exchange sums them again.
+  if (fields > 1) field_values = p2g_values;
   const std::size_t slots = slot_node.size();
   for (std::size_t sl = 0; sl < slots; ++sl)
     for (int d = 0; d < Dim; ++d) slot_values(sl)[momentum + d] = 0.0;
@@ -525,6 +541,13 @@ void DecomposedMpm<Dim>::Impl::remap_momentum(double /*dt*/) {
   }
 }
 
+// MUSL phase, local: with several velocity fields this rank's slots as particle_to_grid left them,
+// for remap_momentum (fields_to_ghosts overwrites those at multi-material nodes).
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::keep_grid_values(double /*dt*/) {
+  if (fields > 1) p2g_values = field_values;
+}
+
 // MUSL phase, owned nodes: the velocity conditions on the remapped momenta (driven components
 // m v_rigid, fixed ones 0), then v_i = p_i/m_i (empty nodes 0), as the serial velocity_from_momentum.
 template <int Dim>
@@ -532,13 +555,18 @@ void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
   constexpr int mass = Dof::mass, momentum = Dof::momentum, velocity = Dof::velocity;
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt q, double* node, int) {
+  for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
     const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
     const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
     const double m = node[mass];
-    for (int d = 0; d < Dim; ++d) {
-      if (driven & (1u << d)) node[momentum + d] = m * drive_velocity[static_cast<std::size_t>(q)][d];
-      if (fixed & (1u << d)) node[momentum + d] = 0.0;
+    if (partner(field)) {  // a rigid partner's field: m v_rigid (the serial apply_velocity_bc)
+      const Vec<Dim> v = partner_velocity(field);
+      for (int d = 0; d < Dim; ++d) node[momentum + d] = m * v[d];
+    } else {
+      for (int d = 0; d < Dim; ++d) {
+        if (driven & (1u << d)) node[momentum + d] = m * drive_velocity[static_cast<std::size_t>(q)][d];
+        if (fixed & (1u << d)) node[momentum + d] = 0.0;
+      }
     }
     for (int d = 0; d < Dim; ++d) node[velocity + d] = m > empty_node_mass ? node[momentum + d] / m : 0.0;
   });
@@ -548,7 +576,8 @@ void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
 // The members defined here, for both dimensions (the phase templates are instantiated by step).
 #define FRICTHERM_INSTANTIATE_USL(D)                                   \
   template void DecomposedMpm<D>::step(double);                        \
-  template const std::array<const char*, 16>& DecomposedMpm<D>::phase_names(); \
+  template const std::array<const char*, 18>& DecomposedMpm<D>::phase_names(); \
+  template void DecomposedMpm<D>::Impl::keep_grid_values(double); \
   template void DecomposedMpm<D>::Impl::velocity_from_momentum(double); \
   template double DecomposedMpm<D>::external_work() const;             \
   template double DecomposedMpm<D>::damping_work() const;              \

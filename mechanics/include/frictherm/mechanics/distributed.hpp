@@ -76,6 +76,7 @@
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/loads.hpp>
 #include <frictherm/mechanics/material.hpp>
+#include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
 #include <frictherm/mechanics/types.hpp>
 
@@ -148,7 +149,7 @@ struct DecomposedTraffic {
   long multi_ghost_nodes = 0;
   long field_entries_sent = 0;
   int field_entry_bytes = 0;
-  std::array<double, 16> phase_seconds{};  // per phase, in phase_names() order
+  std::array<double, 18> phase_seconds{};  // per phase, in phase_names() order
 };
 
 template <int Dim>
@@ -207,6 +208,15 @@ class DecomposedMpm {
     /// Mass-proportional damping f_i −= c p_i while t < damping_until, at the owned nodes in
     /// momentum_update after the velocity conditions (SimulationOptions::damping_rate, damping_until).
     double damping_rate = 0.0, damping_until = 0.0;
+    /// Penalty contact (ContactMethod::penalty, Kakouris 2024 §3.4–3.7; 2D; every present pair penalty):
+    /// the serial build's boundary points (Simulation::boundary_points, field = material), its pairs
+    /// (PenaltyContact::pair, master and slave fields = materials), each pair's (master, slave) materials
+    /// and each material's mean particle mass (the sliver test of the points' weights). Every rank holds
+    /// every point and runs the serial kernels on the complete nodal fields (penalty_phases.cpp).
+    BoundaryPoints<Dim> penalty_points;
+    std::vector<PenaltyPairSettings> penalty_pairs;
+    std::vector<std::array<int, 2>> penalty_materials;
+    std::vector<double> penalty_reference_mass;
     /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
     /// one swarm field, migrated with the particles, untouched by the step.
     std::vector<std::string> particle_scalars;
@@ -241,7 +251,11 @@ class DecomposedMpm {
   /// One USL or MUSL step of size dt (collective): the phases listed above, in that order. Throws
   /// std::runtime_error on every rank when a particle is compressed past its Hugoniot's limit.
   void step(double dt);
-  static const std::array<const char*, 16>& phase_names();
+  static const std::array<const char*, 18>& phase_names();
+  /// Penalty contact (Options::penalty_pairs): the contact of the last step, the same on every rank
+  /// (nullptr without penalty pairs), and the boundary points.
+  const PenaltyContact<Dim>* penalty_contact() const;
+  const BoundaryPoints<Dim>& boundary_points() const;
 
   int stencil_width() const;
   /// DMDA processes per direction and this rank's owned node range [begin, end) per direction
