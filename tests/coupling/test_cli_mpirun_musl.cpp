@@ -58,12 +58,15 @@ TEST_F(MpirunMusl, RigidPushAndSphere3dMatchSerial) {
   for (const char* c : {"time", "kinetic_energy", "momentum_z"}) expect_same_column(c, 1e-9);
 }
 
-// MUSL with contact stays serial: the refusal names the key.
+// MUSL with multimaterial contact stays serial: the refusal names the key (MUSL with penalty contact
+// runs decomposed: test_cli_mpirun_ebs.cpp).
 TEST_F(MpirunMusl, MuslWithContactIsRefused) {
   const Result v = shell(exe() + " validate " + source("examples/sliding_block.json") + " --set solver.scheme=musl");
   EXPECT_EQ(v.code, 0) << v.output;
-  EXPECT_THAT(v.output, HasSubstr("serial only (solver.scheme: \"musl\" with contact is not supported in a decomposed run"));
-  for (const char* scene : {"examples/bars_impact.json", "examples/rigid_push.json", "examples/sphere_3d.json"}) {
+  EXPECT_THAT(v.output, HasSubstr("serial only (solver.scheme: \"musl\" with multimaterial contact is not supported in a decomposed run"));
+  for (const char* scene : {"examples/bars_impact.json", "examples/rigid_push.json", "examples/sphere_3d.json",
+                            "examples/granular_waves.json", "examples/half_disk_plane.json", "examples/hertz_disks.json",
+                            "examples/neo_hookean_rings.json"}) {
     const Result ok = shell(exe() + " validate " + source(scene));
     EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it")) << scene;
   }

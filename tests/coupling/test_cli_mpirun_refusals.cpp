@@ -1,6 +1,6 @@
 // Refusals of `mpirun -n 2 frictherm run` and `validate` (issue 16, issue 34; coupling/app/cli_run_mpi.cpp,
 // coupling/src/scene/scene_decomposed.cpp, coupling/src/distributed_run/decomposed_runner.cpp):
-//   * a scene the decomposed engine does not support (penalty contact, checkpoints of a run with a
+//   * a scene the decomposed engine does not support (checkpoints of a run with penalty contact or with a
 //     continuation, the KLU solver) is refused with exit code 2 naming the scene key, before any
 //     file is written, and `validate` says so;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
@@ -27,7 +27,8 @@ using CliMpirun = CliMpirunTest;
 
 TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
   const std::pair<const char*, const char*> cases[] = {
-      {"--set contact.method=penalty", "contact.method: \"penalty\" is not supported in a decomposed run"},
+      {"--set contact.method=penalty --set run.checkpoint_interval=1e-4",
+       "run.checkpoint_interval: 0.0001 with penalty contact is not supported in a decomposed run"},
       {"--set 'coupling.continuation={\"duration\":1e-4}' --set run.checkpoint_interval=1e-4",
        "run.checkpoint_interval: 0.0001 with coupling.continuation is not supported in a decomposed run"},
       {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
@@ -41,9 +42,10 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
     EXPECT_TRUE(fs::is_empty(dir_)) << set << ": nothing may be written";
   }
   // It is a valid scene: `validate` accepts it and says that it runs serially only, and why.
-  const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") + " --set contact.method=penalty");
+  const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") +
+                         " --set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu");
   EXPECT_EQ(v.code, 0) << v.output;
-  EXPECT_THAT(v.output, HasSubstr("serial only (contact.method: \"penalty\" is not supported in a decomposed run"));
+  EXPECT_THAT(v.output, HasSubstr("serial only (thermal.linear_solver: \"klu\" is not supported in a decomposed run"));
   const Result ok = shell(exe() + " validate " + scene("decomposed_sliding_block.json"));
   EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it"));
 }
