@@ -66,7 +66,7 @@ const char* const kRunHelp =
     "the PIC blend (pic_relaxation_time), every shape function (extended_bspline too), fixed faces,\n"
     "gravity, point loads, tractions, damping, multimaterial contact with any friction law\n"
     "and every separation (position, displacement, velocity_only, extent), penalty contact (2D, every\n"
-    "pair penalty, no checkpoints); frictional and plastic heating\n"
+    "pair penalty); frictional and plastic heating\n"
     "(coupling.plastic_heating) in 2D and 3D with every thermal.integrator and coupling.window\n"
     "(thermal.preconditioner jacobi, bjacobi, hypre) and coupling.subgrid_relaxation_time.\n"
     "Refused before any step, naming the scene key (exit code 2; the serial run supports them):\n"

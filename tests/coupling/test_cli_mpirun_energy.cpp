@@ -9,8 +9,8 @@
 //     momentum update's rigid drive), 300 steps;
 //   * examples/pbx_compaction.json (Mie-Grüneisen grains with J2 plasticity, rigid boundary walls and a
 //     piston with contact), its first steps with the piston sped up so that the grains yield.
-//   * examples/neo_hookean_rings.json in one velocity field (no penalty contact, which a decomposed run
-//     does not support; quadratic B-splines) with the rings started 1.5 mm apart: the neo-Hookean
+//   * examples/neo_hookean_rings.json in one velocity field (no penalty contact, which this test
+//     predates: test_cli_mpirun_ebs.cpp runs it; quadratic B-splines) with the rings started 1.5 mm apart: the neo-Hookean
 //     stored energy of their impact, 400 steps.
 // Every energy column within 1e-9 of its scale (the serial column's largest magnitude; for
 // energy_lost and numerical_dissipation, differences of the energies, that of the energies they are

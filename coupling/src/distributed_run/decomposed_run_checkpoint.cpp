@@ -114,6 +114,21 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   if (heat_) heat_->visit_state(v);
 }
 
+namespace {
+
+// A checkpoint visitor naming every member under penalty_contact/.
+template <class V>
+struct PenaltyState {
+  static constexpr bool reading = V::reading;
+  const V& v;
+  template <class T>
+  void operator()(const char* name, T& member) const {
+    v(("penalty_contact/" + std::string(name)).c_str(), member);
+  }
+};
+
+}  // namespace
+
 template <int Dim>
 template <class V>
 void DecomposedRun<Dim>::visit_global_state(const V& v) {
@@ -127,6 +142,20 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
   v("output/series_columns", series_columns_);
   v("output/xdmf_grids", xdmf_grids_);
   if (hot_) hot_->visit_state(v);
+  // Penalty contact: the boundary points and PenaltyContact::visit_state (slip histories, books, the
+  // frequency bound of the next step), the same on every rank, so once, in the global file that every
+  // rank reads, under penalty_contact/ (the serial checkpoint's names below it).
+  if (mechanics::PenaltyContact<Dim>* pc = mpm_->penalty_contact()) {
+    const PenaltyState<V> p{v};
+    mechanics::BoundaryPoints<Dim>& bp = mpm_->boundary_points();
+    p("boundary/position", bp.position);
+    p("boundary/velocity", bp.velocity);
+    pc->visit_state(p);
+    if constexpr (V::reading)
+      if (bp.position.size() != bp.field.size() || bp.velocity.size() != bp.field.size())
+        throw std::runtime_error("checkpoint: penalty_contact/boundary holds " + std::to_string(bp.position.size()) +
+                                 " points, the scene has " + std::to_string(bp.field.size()));
+  }
 }
 
 template <int Dim>

@@ -39,13 +39,10 @@ RunResult DecomposedRun<Dim>::execute() {
     throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
                      "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
                      "it");
-  if (checkpoints_ && detail::penalty_contact_scene(s_))  // run.checkpoint_interval: decomposed_run_refusal
-    throw SceneError("--checkpoint-every: checkpoints with penalty contact are not supported in a decomposed run "
-                     "(expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports it");
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
   // An interrupted run writes one too (below), so the generation is known whether or not it checkpoints.
-  if (!resuming_ && !heat_continuation() && !detail::penalty_contact_scene(s_)) generation_ = detail::committed_generation(comm_, checkpoint_file_);
+  if (!resuming_ && !heat_continuation()) generation_ = detail::committed_generation(comm_, checkpoint_file_);
   build();
   if (resuming_) restore();
   if (rank_ == 0)  // the result's identity (/meta/run_id, every checkpoint's marks): a resume keeps its checkpoint's
@@ -81,7 +78,7 @@ RunResult DecomposedRun<Dim>::execute() {
     // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      if (checkpoints_ || (interrupted && !heat_continuation() && !detail::penalty_contact_scene(s_))) checkpoint();
+      if (checkpoints_ || (interrupted && !heat_continuation())) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {

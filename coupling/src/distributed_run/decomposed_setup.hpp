@@ -41,8 +41,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
 /// failure on one rank makes every rank stop instead of leaving the others waiting.
 std::string agreed_error(MPI_Comm comm, const std::string& error);
 
-/// Whether the scene uses penalty contact (contact.method or a pair's): its points and slip histories
-/// are not in the decomposed checkpoints, so none is written (not even at an interruption).
+/// Whether the scene uses penalty contact (contact.method or a pair's).
 bool penalty_contact_scene(const Scene& scene);
 
 /// Rank 0's log line of the energy books summed over `ranks` (J) and how well they close (relative to

@@ -49,7 +49,7 @@ std::string contact_refusal(const Scene& s) {
   if (!s.contact.enabled) return "";
   const mechanics::ContactOptions& c = s.contact.options;
   // Penalty contact runs (DecomposedMpm: the serial kernels on the points replicated on every rank,
-  // mechanics/src/distributed/penalty_phases.cpp) when every pair uses it, without checkpoints.
+  // mechanics/src/distributed/penalty_phases.cpp) when every pair uses it.
   const bool penalty = c.default_pair.method == mechanics::ContactMethod::penalty;
   for (std::size_t i = 0; i < s.contact.pairs.size(); ++i)
     if ((s.contact.pairs[i].settings.method == mechanics::ContactMethod::penalty) != penalty)
@@ -57,9 +57,7 @@ std::string contact_refusal(const Scene& s) {
                     quoted(mechanics::to_string(s.contact.pairs[i].settings.method)) + " beside contact.method " +
                         quoted(mechanics::to_string(c.default_pair.method)),
                     "every pair with the same method");
-  if (penalty && s.checkpoint_interval > 0.0)
-    return refuse("run.checkpoint_interval", number(s.checkpoint_interval) + " with penalty contact",
-                  "no checkpoints with penalty contact");
+
   if (c.regularized()) return refuse("contact.regularization", "an object", "no regularisation: remove the key");
   return "";
 }

@@ -185,13 +185,25 @@ const BoundaryPoints<Dim>& DecomposedMpm<Dim>::boundary_points() const {
   return impl_->boundary;
 }
 
+template <int Dim>
+PenaltyContact<Dim>* DecomposedMpm<Dim>::penalty_contact() {
+  return impl_->penalty ? &*impl_->penalty : nullptr;
+}
+
+template <int Dim>
+BoundaryPoints<Dim>& DecomposedMpm<Dim>::boundary_points() {
+  return impl_->boundary;
+}
+
 #define FRICTHERM_INSTANTIATE_PENALTY_PHASES(D)                                   \
   template void DecomposedMpm<D>::Impl::setup_penalty();                          \
   template void DecomposedMpm<D>::Impl::penalty_forces(double);                   \
   template void DecomposedMpm<D>::Impl::move_boundary_points(double);             \
   template double DecomposedMpm<D>::Impl::penalty_time_step(double&) const;       \
   template const PenaltyContact<D>* DecomposedMpm<D>::penalty_contact() const;    \
-  template const BoundaryPoints<D>& DecomposedMpm<D>::boundary_points() const;
+  template const BoundaryPoints<D>& DecomposedMpm<D>::boundary_points() const;  \
+  template PenaltyContact<D>* DecomposedMpm<D>::penalty_contact();              \
+  template BoundaryPoints<D>& DecomposedMpm<D>::boundary_points();
 FRICTHERM_INSTANTIATE_PENALTY_PHASES(2)
 FRICTHERM_INSTANTIATE_PENALTY_PHASES(3)
 #undef FRICTHERM_INSTANTIATE_PENALTY_PHASES

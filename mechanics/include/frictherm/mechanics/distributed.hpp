@@ -256,6 +256,10 @@ class DecomposedMpm {
   /// (nullptr without penalty pairs), and the boundary points.
   const PenaltyContact<Dim>* penalty_contact() const;
   const BoundaryPoints<Dim>& boundary_points() const;
+  /// The same for checkpoints (PenaltyContact::visit_state; the points' positions and velocities):
+  /// restored on every rank alike.
+  PenaltyContact<Dim>* penalty_contact();
+  BoundaryPoints<Dim>& boundary_points();
 
   int stencil_width() const;
   /// DMDA processes per direction and this rank's owned node range [begin, end) per direction
