@@ -193,8 +193,10 @@ TEST_F(CliMpirunCheckpoint, InterruptedAndResumedRunEqualsTheUninterruptedRun) {
 // block with contact.method penalty (17 points sliding, the penalty heat handed to the heat solve)
 // interrupted after its first checkpoint and resumed on 2 ranks equals the uninterrupted run bit for
 // bit (every series column, the penalty columns among them); resumed on 3 ranks within 1e-9 of each
-// column's scale. Without the penalty state in the checkpoint the resumed run starts from the scene's
-// points (the bodies' boundary at t = 0) with no slip history: its penalty force differs at once.
+// column's scale (measured: ≤ 4.3e-13, the contact counts equal). Without the penalty state in the
+// checkpoint (tried by hand) the resumed run starts from the scene's points (the bodies' boundary at
+// t = 0) with no slip history and no frequency bound, and writes 1004 rows where the uninterrupted run
+// writes 992.
 TEST_F(CliMpirunCheckpoint, PenaltyContactResumesToTheUninterruptedRun) {
   const std::string penalty = " --set contact.method=penalty";
   run_full("2e-4", "3e-3", penalty);
