@@ -60,6 +60,7 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
   ++books_.exchanges;  // ΔT_i to the ghosts
   time_ = window_start_ = time;
   window_steps_ = 0;
+  interface_update(mpm);  // as the serial Coupler::continue_thermal
 }
 
 }  // namespace frictherm::coupling

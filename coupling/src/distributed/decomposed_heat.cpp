@@ -65,12 +65,14 @@ DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<2>& mpm, DecomposedHeatO
     : mpm2_(&mpm), opt_(std::move(options)) {
   check_materials(mpm);
   select_fixed_nodes(mpm);
+  interface_start(mpm);
 }
 
 DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<3>& mpm, DecomposedHeatOptions options)
     : mpm3_(&mpm), opt_(std::move(options)) {
   check_materials(mpm);
   select_fixed_nodes(mpm);
+  interface_start(mpm);
 }
 
 DecomposedHeat::~DecomposedHeat() = default;
@@ -184,6 +186,8 @@ bool DecomposedHeat::after_step(double dt, bool must_close) {
   books_.plastic_heat_received += sums[2];
   pending_plastic_ += sums[2];
   time_ += dt;
+  if (mpm3_) interface_step<3>(work);  // the frictional heat's flux history (off unless asked)
+  else interface_step<2>(work);
   ++books_.steps;
   ++window_steps_;
   const WindowPolicy& p = opt_.window;
@@ -216,6 +220,8 @@ bool DecomposedHeat::close_window() {
   window_start_ = time_;
   window_steps_ = 0;
   max_rise_ = 0.0;
+  if (mpm3_) interface_update(*mpm3_);  // as the serial Coupler::update_interface_and_hotspots
+  else interface_update(*mpm2_);
   return true;
 }
 

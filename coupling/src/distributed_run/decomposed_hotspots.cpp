@@ -15,6 +15,10 @@ DecomposedHotSpots<Dim>::DecomposedHotSpots(const Scene& scene, const mechanics:
       fates_(scene.thermal.coupler.fates),
       temperature_(mpm.particle_scalar_index("temperature")),
       reference_(mpm.particle_scalar_index("reference_temperature")),
+      // hotspots.temperature "interface": judged by T_int,p (the serial Coupler::hotspot_temperature)
+      criterion_(scene.thermal.coupler.hotspots_by_interface_temperature
+                     ? mpm.particle_scalar_index("interface_temperature")
+                     : -1),
       particle_count_(static_cast<std::size_t>(mpm.global_particles())) {}
 
 template <int Dim>
@@ -33,15 +37,18 @@ void DecomposedHotSpots<Dim>::update(const mechanics::DecomposedMpm<Dim>& mpm, d
   local_.material.assign(p.material.begin(), p.material.end());
   local_.temperature = mpm.particle_scalar(temperature_);
   ids_ = p.id;
+  const std::vector<double> criterion = criterion_ >= 0 ? mpm.particle_scalar(criterion_) : std::vector<double>{};
   update_hot_spots_across_ranks<Dim>(mpm.communicator(), tracker_, local_, ids_, mpm.particle_scalar(reference_),
-                                     materials_, particle_count_, time);
+                                     materials_, particle_count_, time, criterion_ >= 0 ? &criterion : nullptr);
   ++updates_;
 }
 
 template <int Dim>
 void DecomposedHotSpots<Dim>::update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time) {
   const mechanics::DecomposedLocalParticles p = mpm.local_particle_data();
-  const std::vector<double> T = mpm.particle_scalar(temperature_), T0 = mpm.particle_scalar(reference_);
+  // The temperature a spot is judged by: T_int,p with hotspots.temperature "interface" (HotSpotFates::update).
+  const std::vector<double> T = mpm.particle_scalar(criterion_ >= 0 ? criterion_ : temperature_),
+                            T0 = mpm.particle_scalar(reference_);
   std::vector<long> local_of(particle_count_, -1);  // global id -> this rank's index
   for (std::size_t k = 0; k < p.id.size(); ++k) local_of[static_cast<std::size_t>(p.id[k])] = static_cast<long>(k);
   const std::vector<HotSpotFateRecord>& records = fates_.records();

@@ -57,7 +57,7 @@ class DecomposedHotSpots {
   std::vector<ThermalProperties> materials_;
   HotSpotTracker tracker_;
   HotSpotFates fates_;
-  int temperature_ = 0, reference_ = 0;
+  int temperature_ = 0, reference_ = 0, criterion_ = -1;  // criterion_: T_int,p's scalar (-1: T_p)
   std::size_t particle_count_ = 0;
   long updates_ = 0, updates_written_ = -1;
   mechanics::Particles<Dim> local_;  // scratch: this rank's particles as the tracker reads them

@@ -66,6 +66,7 @@ std::vector<std::string> DecomposedRun<Dim>::series_names() const {
     for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
     n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
     if (s_.thermal.coupler.plastic.enabled) n.insert(n.end(), {"plastic_work", "plastic_heat"});
+    if (heat_->interface_enabled()) n.emplace_back("max_interface_temperature");  // the serial column
   }
   return n;
 }
@@ -106,6 +107,10 @@ void DecomposedRun<Dim>::series(double time) {
     row.insert(row.end(), {static_cast<double>(b.windows + b.continuation_intervals), b.work_received,
                            b.nodal_energy_change});
     if (s_.thermal.coupler.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
+    if (heat_->interface_enabled()) {  // NaN until some node has received frictional heat, as the serial run
+      const double t_int = heat_->max_interface_temperature();
+      row.push_back(std::isfinite(t_int) ? t_int : std::numeric_limits<double>::quiet_NaN());
+    }
   }
   std::string error;  // rank 0's write failure, agreed below so that no rank goes on alone
   if (out_) {
@@ -138,6 +143,9 @@ void DecomposedRun<Dim>::snapshot(double time) {
   snap.velocity = p.velocity;
   snap.material = p.material;
   snap.temperature = mpm_->particle_scalar(temperature_);
+  if (heat_ && heat_->interface_enabled())  // T_int,p of the last update, as the serial snapshot field
+    snap.fields.emplace_back("interface_temperature",
+                             mpm_->particle_scalar(mpm_->particle_scalar_index("interface_temperature")));
   snapshots_out_->write(step_, std::isnan(time) ? time_ : time, snap);
   ++snapshots_;
   last_snapshot_step_ = step_;

@@ -35,6 +35,10 @@ RunResult DecomposedRun<Dim>::execute() {
   r_.output = o_.output.empty() ? s_.output.file : o_.output;
   resuming_ = !o_.resume_checkpoint.empty();
   checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
+  if (checkpoints_ && detail::interface_temperature(s_))  // run.checkpoint_interval: decomposed_run_refusal
+    throw SceneError("--checkpoint-every: checkpoints with coupling.interface_temperature are not supported in a "
+                     "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
+                     "supports it");
   if (checkpoints_ && heat_continuation())  // run.checkpoint_interval: decomposed_run_refusal
     throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
                      "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
@@ -78,7 +82,8 @@ RunResult DecomposedRun<Dim>::execute() {
     // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      if (checkpoints_ || (interrupted && !heat_continuation())) checkpoint();
+      // Nor with the interface temperature, whose flux histories a decomposed checkpoint does not hold.
+      if (checkpoints_ || (interrupted && !heat_continuation() && !detail::interface_temperature(s_))) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {
@@ -158,6 +163,8 @@ void DecomposedRun<Dim>::build() {
     h.plastic = c.plastic;
     h.subgrid_relaxation_time = c.subgrid_relaxation_time;
     h.fixed_faces = c.fixed_faces;
+    h.interface_temperature = c.interface_temperature;
+    h.thickness = c.thickness;
     try {
       heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
     } catch (const std::invalid_argument& e) {

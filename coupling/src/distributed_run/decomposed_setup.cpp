@@ -27,6 +27,10 @@ std::string agreed_error(MPI_Comm comm, const std::string& error) {
 
 bool plastic_heating(const Scene& scene) { return scene.thermal.enabled && scene.thermal.coupler.plastic.enabled; }
 
+bool interface_temperature(const Scene& scene) {
+  return scene.thermal.enabled && scene.thermal.coupler.interface_temperature.enabled;
+}
+
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene) {
   mechanics::IVec<Dim> cells{};
@@ -55,6 +59,8 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.particle_scalars = {"temperature", "reference_temperature"};  // T_p and T0_p (hot spots' reference)
   // The plastic work already handed to the heat (DecomposedHeatOptions::plastic_work_heated).
   if (plastic_heating(scene)) o.particle_scalars.emplace_back("plastic_work_heated");
+  // T_int,p of the sub-cell interface temperature (DecomposedHeatOptions::interface_scalar).
+  if (interface_temperature(scene)) o.particle_scalars.emplace_back("interface_temperature");
   return o;
 }
 
@@ -88,6 +94,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
         q.plastic_work = p.plastic_work[k];
         q.scalars = {p.temperature[k], p.temperature[k]};
         if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
+        if (interface_temperature(scene)) q.scalars.push_back(p.temperature[k]);  // T_p before any heat
       }
       for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {
         packed.push_back(static_cast<double>(L.particle));
@@ -164,6 +171,8 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   out.write_metadata("particle_energy_change", b.particle_energy_change);
   out.write_metadata("max_capacity_residual", b.max_capacity_residual);
   out.write_metadata("hotspots_seen", hotspots_seen);
+  // The interface temperature's flux histories, summed over ranks at the last update (= work received).
+  if (heat.interface_enabled()) out.write_metadata("interface_heat_recorded", heat.interface_heat_recorded());
 }
 
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {

@@ -89,6 +89,12 @@ struct DecomposedHeatOptions {
   /// rule) are held at the face's temperature: set before the window's sub-steps and after each
   /// (matrix-free), Dirichlet rows of the distributed problem (assembled), out of the λ bounds.
   std::vector<FixedTemperatureFace> fixed_faces;
+  /// CouplerOptions::interface_temperature (patch_length 0 only): the sub-cell interface temperature
+  /// of the nodes this rank owns (decomposed_interface.cpp), each particle's T_int,p in the particle
+  /// scalar named below; `thickness` the 2D out-of-plane thickness (CouplerOptions::thickness).
+  InterfaceTemperatureOptions interface_temperature;
+  std::string interface_scalar = "interface_temperature";
+  double thickness = 1.0;
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -141,6 +147,12 @@ class DecomposedHeat {
   thermal::IntegratorStats integrator_stats() const;
 
   const DecomposedHeatBooks& books() const { return books_; }
+  /// The sub-cell interface temperature (options.interface_temperature): the hottest node's over all
+  /// ranks at the last window or interval (−∞ before any heat), as InterfaceTemperature::max_temperature;
+  /// Σ over ranks of the heat its histories recorded by then (J; equals the frictional work received).
+  bool interface_enabled() const { return opt_.interface_temperature.enabled; }
+  double max_interface_temperature() const { return interface_max_; }
+  double interface_heat_recorded() const { return interface_heat_; }
   /// Σ_p m_p C_v,p T_p over all ranks (J).
   double heat_content() const;
 
@@ -209,6 +221,12 @@ class DecomposedHeat {
   template <int Dim>
   void hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker, const std::string& reference,
                     double time) const;
+  // decomposed_interface.cpp: InterfaceTemperature on the owned nodes (start, each step's heat, the
+  // update after each window or interval, which writes T_int,p into the particle scalar).
+  template <int Dim> InterfaceTemperature<Dim>* interface_model();
+  template <int Dim> void interface_start(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void interface_step(const std::vector<double>& work);
+  template <int Dim> void interface_update(mechanics::DecomposedMpm<Dim>& mpm);
   MPI_Comm communicator() const;
   mechanics::DecomposedLocalParticles local_particles() const;
   std::vector<double> temperatures() const;
@@ -244,6 +262,13 @@ class DecomposedHeat {
   // kept in assembled_): where the continuation starts (Coupler::nodal_temperature_, system_assembled_).
   std::vector<double> last_T_;
   bool last_assembled_ = false, continuing_ = false;
+  // The interface temperature's state of the owned nodes (one of the two, with the option), its
+  // particle scalar, owned node -> grid node and back (-1: not owned), the last maximum over ranks.
+  std::unique_ptr<InterfaceTemperature<2>> interface2_;
+  std::unique_ptr<InterfaceTemperature<3>> interface3_;
+  int interface_scalar_ = -1;
+  std::vector<int> owned_grid_node_, owned_of_grid_;
+  double interface_max_ = -std::numeric_limits<double>::infinity(), interface_heat_ = 0.0;
 };
 
 }  // namespace frictherm::coupling
