@@ -144,15 +144,19 @@ TEST_F(MpirunInterface, PbxHotSpotsByInterfaceTemperatureEqualTheSerialRun) {
                            column("split.h5", "hottest_hotspot_temperature"), "hottest"),
             bound);
   expect_same_column("hottest_hotspot_size", 1e-12);
-  for (const char* c : {"time", "id", "particle_count"})  // the same spots of the same particles
+  for (const char* c : {"id", "particle_count"})  // the same spots of the same particles
     EXPECT_EQ(read_doubles(path("serial.h5"), std::string("/hotspots/") + c),
               read_doubles(path("split.h5"), std::string("/hotspots/") + c))
         << c;
-  const std::vector<double> a = read_doubles(path("serial.h5"), "/hotspots/size");
-  const std::vector<double> b = read_doubles(path("split.h5"), "/hotspots/size");
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_FALSE(a.empty());
-  for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], b[k], 1e-12 * a[k]) << "hot spot row " << k;
+  // Times and sizes to round-off (the decomposed steps' times agree to an ulp or so; the particles'
+  // volumes to the mechanics' round-off).
+  for (const char* c : {"time", "size"}) {
+    const std::vector<double> a = read_doubles(path("serial.h5"), std::string("/hotspots/") + c);
+    const std::vector<double> b = read_doubles(path("split.h5"), std::string("/hotspots/") + c);
+    ASSERT_EQ(a.size(), b.size()) << c;
+    ASSERT_FALSE(a.empty()) << c;
+    for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], b[k], 1e-12 * std::fabs(a[k])) << c << " row " << k;
+  }
   // The continuation's fates, judged by the interface temperature: the same spots, fates and times.
   for (const char* c : {"id", "fate", "particle_count", "start_time", "decision_time"}) {
     const std::vector<double> x = read_doubles(path("serial.h5"), std::string("/hotspot_fates/") + c);
