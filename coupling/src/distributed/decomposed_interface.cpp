@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -157,6 +158,13 @@ void DecomposedHeat::interface_update(mechanics::DecomposedMpm<Dim>& mpm) {
     t_int[k] += best;
   }
   mpm.set_particle_scalar(interface_scalar_, t_int);
+  // The interface reaction at T_int,p (Coupler::update_interface_and_hotspots), this rank's particles.
+  if (interface_reaction_.started()) {
+    const std::vector<std::int32_t> material(P.material.begin(), P.material.end());
+    interface_reaction_.advance(material, opt_.reaction, t_int, time_);
+    interface_reaction_max_ = interface_reaction_.max_progress();
+    MPI_Allreduce(MPI_IN_PLACE, &interface_reaction_max_, 1, MPI_DOUBLE, MPI_MAX, mpm.communicator());
+  }
 }
 
 #define FRICTHERM_DECOMPOSED_INTERFACE(D)                                                      \

@@ -109,6 +109,7 @@ RunResult DecomposedRun<Dim>::execute() {
   }
   r_.snapshots = static_cast<std::size_t>(snapshots_);
   if (heat_) pending_heat_ = heat_->pending_heat();  // collective
+  if (heat_) particle_reaction_heat_ = heat_->particle_reaction_heat();  // collective
   finish_output();  // agreed by every rank
   snapshots_out_->close();
   if (heat_ && rank_ == 0 && !o_.quiet) detail::print_decomposed_books(o_.log ? *o_.log : std::cerr, heat_->books(), size_);
@@ -164,6 +165,7 @@ void DecomposedRun<Dim>::build() {
     h.subgrid_relaxation_time = c.subgrid_relaxation_time;
     h.fixed_faces = c.fixed_faces;
     h.interface_temperature = c.interface_temperature;
+    h.reaction = c.reaction;
     h.thickness = c.thickness;
     try {
       heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
@@ -304,7 +306,7 @@ void DecomposedRun<Dim>::continuation() {
       throw thermal_failure("thermal integration unstable: ", e, t);
     }
     hot_->update(*mpm_, t);
-    hot_->update_fates(*mpm_, t);
+    hot_->update_fates(*mpm_, t, heat_->interface_reaction().started() ? &heat_->interface_reaction().progress() : nullptr);
     series(t);  // the mechanics columns stay at their final values
     const HotSpotFates& f = hot_->fates();
     if (spec.stop_when_decided && !f.records().empty() && f.all_decided()) break;

@@ -61,6 +61,8 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   if (plastic_heating(scene)) o.particle_scalars.emplace_back("plastic_work_heated");
   // T_int,p of the sub-cell interface temperature (DecomposedHeatOptions::interface_scalar).
   if (interface_temperature(scene)) o.particle_scalars.emplace_back("interface_temperature");
+  // λ_p of the reaction (DecomposedHeatOptions::progress_scalar).
+  if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) o.particle_scalars.emplace_back("reaction_progress");
   return o;
 }
 
@@ -95,6 +97,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
         q.scalars = {p.temperature[k], p.temperature[k]};
         if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
         if (interface_temperature(scene)) q.scalars.push_back(p.temperature[k]);  // T_p before any heat
+        if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) q.scalars.push_back(0.0);  // fresh
       }
       for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {
         packed.push_back(static_cast<double>(L.particle));
@@ -173,20 +176,32 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   out.write_metadata("hotspots_seen", hotspots_seen);
   // The interface temperature's flux histories, summed over ranks at the last update (= work received).
   if (heat.interface_enabled()) out.write_metadata("interface_heat_recorded", heat.interface_heat_recorded());
+  if (c.reaction.enabled) {  // as the serial ThermalRun::write_metadata (particle_reaction_heat: the caller)
+    out.write_metadata("reaction_heat_released", b.reaction_heat_released);
+    out.write_metadata("reaction_kinetics", c.reaction.kinetics_name);
+    out.write_metadata("reaction_prefactor", c.reaction.kinetics.prefactor);
+    out.write_metadata("reaction_activation_temperature", c.reaction.kinetics.activation_temperature);
+    out.write_metadata("reaction_heat_of_reaction", c.reaction.kinetics.specific_heat_of_reaction);
+  }
 }
 
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {
-  // Relative to the heat received: frictional work plus plastic heat.
+  // Relative to the heat received: frictional work plus plastic heat; the energy changes also hold
+  // the reaction's heat.
   const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
-  char line[640];
+  const double e = w + b.reaction_heat_released;
+  char line[760];
   std::snprintf(line, sizeof line,
                 "frictherm: energy books over %d ranks: frictional work received %.9g J, plastic heat received %.9g J, "
-                "heat delivered %.9g J, nodal energy change %.9g J, particle energy change %.9g J (largest "
+                "heat delivered %.9g J,%s nodal energy change %.9g J, particle energy change %.9g J (largest "
                 "difference %.2g of the heat received)\n",
-                ranks, b.work_received, b.plastic_heat_received, b.heat_delivered, b.nodal_energy_change,
-                b.particle_energy_change,
-                std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
-                          std::fabs(b.particle_energy_change - w)}) / scale);
+                ranks, b.work_received, b.plastic_heat_received, b.heat_delivered,
+                b.reaction_heat_released != 0.0
+                    ? (" reaction heat released " + std::to_string(b.reaction_heat_released) + " J,").c_str()
+                    : "",
+                b.nodal_energy_change, b.particle_energy_change,
+                std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - e),
+                          std::fabs(b.particle_energy_change - e)}) / scale);
   log << line;
 }
 

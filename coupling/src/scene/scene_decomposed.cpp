@@ -74,7 +74,14 @@ std::string thermal_refusal(const Scene& s) {
   if (forward_euler && io.fe_max_dt > 0.0)
     return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
-  if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
+  // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed
+  // integrators carry λ), not with forward Euler; its interface reaction from the continuation on.
+  if (c.reaction.enabled && c.integrator == "forward_euler")
+    return refuse("thermal.integrator", quoted("forward_euler") + " with thermal.reaction",
+                  "\"cvode_bdf\", \"auto\" or another implicit integrator");
+  if (c.reaction.enabled && c.reaction.during_loading && c.interface_temperature.enabled)
+    return refuse("thermal.reaction.during_loading", "true with coupling.interface_temperature",
+                  "false (the interface reaction from the continuation on)");
   // The interface temperature runs on the owned nodes (decomposed_interface.cpp), without the patch
   // (it reads other nodes' histories) and without checkpoints (they do not hold the histories).
   if (c.interface_temperature.enabled && c.interface_temperature.patch_length > 0.0)

@@ -44,6 +44,7 @@
 // (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
+#include <frictherm/coupling/interface_reaction.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/distributed.hpp>
@@ -95,6 +96,11 @@ struct DecomposedHeatOptions {
   InterfaceTemperatureOptions interface_temperature;
   std::string interface_scalar = "interface_temperature";
   double thickness = 1.0;
+  /// CouplerOptions::reaction: Arrhenius heat in the reacting materials (decomposed_reaction.cpp),
+  /// every window (during_loading) or from the continuation on; λ_p in the particle scalar named
+  /// below. Reacting windows are assembled (cvode_bdf for "auto"; not forward_euler).
+  ReactionOptions reaction;
+  std::string progress_scalar = "reaction_progress";
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -108,6 +114,7 @@ struct DecomposedHeatBooks {
   double plastic_work_received = 0.0;   // Σ over steps of Δw_p of the particles with β > 0
   double plastic_heat_received = 0.0;   // Σ over steps of Σ_i β Δw_p S_ip (part of the pending heat)
   double plastic_heat_delivered = 0.0;  // of it, handed to closed windows
+  double reaction_heat_released = 0.0;  // Σ over windows and intervals of Σ_i Q_i Δλ_i
   long windows = 0;
   long continuation_intervals = 0;      // thermal-only intervals (continue_thermal)
   long substeps = 0;                    // matrix-free forward-Euler sub-steps
@@ -153,6 +160,15 @@ class DecomposedHeat {
   bool interface_enabled() const { return opt_.interface_temperature.enabled; }
   double max_interface_temperature() const { return interface_max_; }
   double interface_heat_recorded() const { return interface_heat_; }
+  /// The reaction (options.reaction): the largest λ_p over ranks (collective; 0 without particles
+  /// of reacting materials), q Σ_p m_p λ_p over ranks (collective; Coupler::particle_reaction_heat).
+  bool reaction_enabled() const { return opt_.reaction.enabled; }
+  double max_reaction_progress() const;
+  double particle_reaction_heat() const;
+  /// The interface reaction (interface temperature and reaction, from the continuation on: the serial
+  /// InterfaceReaction on this rank's particles, swarm order); its largest λ_int,p over ranks.
+  const InterfaceReaction& interface_reaction() const { return interface_reaction_; }
+  double max_interface_reaction_progress() const { return interface_reaction_max_; }
   /// Σ_p m_p C_v,p T_p over all ranks (J).
   double heat_content() const;
 
@@ -180,6 +196,7 @@ class DecomposedHeat {
                            {"books/plastic_work_received", &b.plastic_work_received},
                            {"books/plastic_heat_received", &b.plastic_heat_received},
                            {"books/plastic_heat_delivered", &b.plastic_heat_delivered},
+                           {"books/reaction_heat_released", &b.reaction_heat_released},
                            {"window/pending_plastic", &pending_plastic_},
                            {"window/time", &time_}, {"window/start", &window_start_}, {"window/max_rise", &max_rise_},
                            {"window/last_lambda", &last_lambda_}, {"gather/threshold", &threshold_},
@@ -227,6 +244,11 @@ class DecomposedHeat {
   template <int Dim> void interface_start(mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> void interface_step(const std::vector<double>& work);
   template <int Dim> void interface_update(mechanics::DecomposedMpm<Dim>& mpm);
+  // decomposed_reaction.cpp: the reacting mass and λ_i gathered from the particles (gather_reaction),
+  // and the unreacted ratio scattered back (scatter_progress), as the serial heat_sources.cpp.
+  bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }
+  template <int Dim> void reaction_gather(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void reaction_scatter(mechanics::DecomposedMpm<Dim>& mpm);
   MPI_Comm communicator() const;
   mechanics::DecomposedLocalParticles local_particles() const;
   std::vector<double> temperatures() const;
@@ -269,6 +291,12 @@ class DecomposedHeat {
   int interface_scalar_ = -1;
   std::vector<int> owned_grid_node_, owned_of_grid_;
   double interface_max_ = -std::numeric_limits<double>::infinity(), interface_heat_ = 0.0;
+  // The reaction: λ_p's scalar (-1: none), the last gather's reacting mass and λ_i per owned node,
+  // λ_i now, and the particles' λ_p at the gather (swarm order; the particles do not move in between).
+  int progress_scalar_ = -1;
+  std::vector<double> reacting_mass_, nodal_progress_ref_, nodal_progress_, particle_progress_ref_;
+  InterfaceReaction interface_reaction_;
+  double interface_reaction_max_ = 0.0;
 };
 
 }  // namespace frictherm::coupling
