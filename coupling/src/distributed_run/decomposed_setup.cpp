@@ -190,15 +190,16 @@ void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int
   // the reaction's heat.
   const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
   const double e = w + b.reaction_heat_released;
+  char reaction[96] = "";
+  if (b.reaction_heat_released != 0.0)
+    std::snprintf(reaction, sizeof reaction, " reaction heat released %.9g J,", b.reaction_heat_released);
   char line[760];
   std::snprintf(line, sizeof line,
                 "frictherm: energy books over %d ranks: frictional work received %.9g J, plastic heat received %.9g J, "
                 "heat delivered %.9g J,%s nodal energy change %.9g J, particle energy change %.9g J (largest "
                 "difference %.2g of the heat received)\n",
                 ranks, b.work_received, b.plastic_heat_received, b.heat_delivered,
-                b.reaction_heat_released != 0.0
-                    ? (" reaction heat released " + std::to_string(b.reaction_heat_released) + " J,").c_str()
-                    : "",
+                reaction,
                 b.nodal_energy_change, b.particle_energy_change,
                 std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - e),
                           std::fabs(b.particle_energy_change - e)}) / scale);
