@@ -39,9 +39,11 @@
 // adaptive estimate of such a node takes the smallest unknown M_i of all ranks (the serial one the
 // nearest unknown's). Plastic heat and the sub-grid relaxation as the serial Coupler
 // (decomposed_sources.cpp). Fixed-temperature faces as the serial Coupler (for_each_fixed_node: the
-// same nodes, held in both paths). Differences from the serial Coupler: that refusal; reaction heat,
-// the reuse of matrix-free gathers and the KLU solver are absent
-// (docs/distributed_coupling.md, docs/distributed_run.md).
+// same nodes, held in both paths). The sub-cell interface temperature on the owned nodes
+// (decomposed_interface.cpp) and the Arrhenius reaction with λ_p as a particle scalar
+// (decomposed_reaction.cpp), as the serial Coupler. Differences from the serial Coupler: that
+// refusal; the reuse of matrix-free gathers, the KLU solver, the interface temperature's patch and
+// forward Euler's reacting sub-steps are absent (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
 #include <frictherm/coupling/interface_reaction.hpp>
