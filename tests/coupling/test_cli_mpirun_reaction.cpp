@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -137,6 +138,29 @@ TEST_F(MpirunReaction, PbxReactionDuringLoadingEqualsTheSerialRun) {
            2);
   if (HasFatalFailure()) return;
   compare(false);
+}
+
+// What a decomposed run does not take with a reaction, said by `frictherm validate` (the same check,
+// decomposed_run_refusal, refuses `mpirun -n K frictherm run`: CliMpirun.Refusals): forward Euler
+// (its reacting sub-steps are not distributed) and the interface temperature with the reaction during
+// loading (the interface reaction starts with the continuation).
+TEST_F(MpirunReaction, ValidateNamesWhatIsNotDecomposed) {
+  const std::string scene = source("tests/coupling/scenes/decomposed_sliding_block.json");
+  const std::string reaction =
+      " --set 'thermal.reaction={\"kinetics\":\"hmx_rogers1975\",\"materials\":[\"block\"]}'";
+  const std::pair<std::string, std::string> cases[] = {
+      {reaction, "serial only (thermal.integrator: \"forward_euler\" with thermal.reaction is not supported"},
+      {reaction + " --set thermal.integrator=cvode_bdf --set coupling.interface_temperature=true",
+       "serial only (thermal.reaction.during_loading: true with coupling.interface_temperature is not supported"},
+      {reaction + " --set thermal.integrator=cvode_bdf", "mpirun -n K frictherm run decomposes it"},
+      {reaction + " --set thermal.integrator=auto --set coupling.interface_temperature=true"
+                  " --set thermal.reaction.during_loading=false",
+       "mpirun -n K frictherm run decomposes it"}};
+  for (const auto& [sets, expected] : cases) {
+    const frictherm::test::Result r = frictherm::test::shell(exe() + " validate " + scene + sets);
+    EXPECT_EQ(r.code, 0) << sets << ": " << r.output;
+    EXPECT_NE(r.output.find(expected), std::string::npos) << sets << ": " << r.output;
+  }
 }
 
 }  // namespace
