@@ -30,7 +30,12 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
       {"--set 'coupling.continuation={\"duration\":1e-4}' --set run.checkpoint_interval=1e-4",
        "run.checkpoint_interval: 0.0001 with coupling.continuation is not supported in a decomposed run"},
       {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
-       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"}};
+       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"},
+      // The interface temperature runs decomposed, but not its patch nor checkpoints (no histories in them).
+      {"--set 'coupling.interface_temperature={\"patch_length\":1e-3}'",
+       "coupling.interface_temperature.patch_length: 0.001 is not supported in a decomposed run"},
+      {"--set coupling.interface_temperature=true --set run.checkpoint_interval=1e-4",
+       "run.checkpoint_interval: 0.0001 with coupling.interface_temperature is not supported in a decomposed run"}};
   for (const auto& [set, message] : cases) {
     const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
                            " -o '" + path("refused.h5") + "'");

@@ -66,6 +66,14 @@ class DecomposedAssembledSolve {
                 const std::vector<double>& fixed);
   void integrate(const UnknownNumbering& ids, const std::vector<double>* q, std::vector<double>& T, double t0,
                  double t1);
+  /// The kept problem's Arrhenius reaction (the serial Coupler::assemble's set_reaction): Q_i = q m_i
+  /// with the reacting mass m_i per owned node (thermal::make_reaction; collective).
+  void set_reaction(const UnknownNumbering& ids, const thermal::ArrheniusKinetics& kinetics,
+                    const std::vector<double>& reacting_mass);
+  /// integrate() with the reaction's progress λ_i per owned node (read and written on the unknowns);
+  /// returns the heat the reaction released over the interval, Σ_i Q_i Δλ_i over ranks (J).
+  double integrate_reacting(const UnknownNumbering& ids, const std::vector<double>* q, std::vector<double>& T,
+                            std::vector<double>& progress, double t0, double t1);
   bool assembled() const { return problem_ != nullptr; }
   /// A fresh integrator of the same name and options (the continuation's, as Coupler::continue_thermal):
   /// the counts so far stay in stats().

@@ -32,7 +32,9 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
   bool gathered = false;  // this interval starts from the particles' temperatures (as the serial Coupler)
   if (!continuing_) {
     assembled_->restart_integrator();  // the continuation depends only on the end-of-loading state
-    if (!last_assembled_ || !assembled_->assembled()) {
+    continuing_ = true;  // a reaction held back during loading is active from here (reaction_active)
+    // As the serial reaction_starts: with a reaction the continuation assembles afresh (its Q_i, λ_i).
+    if (!last_assembled_ || !assembled_->assembled() || opt_.reaction.enabled) {
       gathered = true;
       gather_window(mpm);
       number_unknowns(mpm);
@@ -42,12 +44,23 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
       assembled_->assemble(comm, *ids_, entries_of, M_, face_temperature_);
       last_T_ = T0_;
       books_.exchanges += 4;  // M and Σ m C T, M back, the bounds, the ids
+      if (reaction_active()) {
+        reaction_gather(mpm);
+        assembled_->set_reaction(*ids_, opt_.reaction.kinetics, reacting_mass_);
+      }
     }
-    continuing_ = true;
+    // The interface reaction held back until the continuation (Coupler::continue_thermal).
+    if (interface_enabled() && opt_.reaction.enabled && !interface_reaction_.started())
+      interface_reaction_.start(mpm.local_particle_data().mass.size(), window_start_);
   }
   T0_ = last_T_;  // the interval's start: ΔT_i = T_i(t1) − T_i(t0)
   std::vector<double> Tn = last_T_;
-  assembled_->integrate(*ids_, nullptr, Tn, window_start_, time);
+  if (reaction_active()) {
+    books_.reaction_heat_released += assembled_->integrate_reacting(*ids_, nullptr, Tn, nodal_progress_, window_start_, time);
+    reaction_scatter(mpm);
+  } else {
+    assembled_->integrate(*ids_, nullptr, Tn, window_start_, time);
+  }
   std::vector<double> T = mpm.particle_scalar(scalar_);
   double changes[2];
   map_back(mpm, Tn, time - window_start_, T, changes, gathered);
@@ -60,6 +73,7 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
   ++books_.exchanges;  // ΔT_i to the ghosts
   time_ = window_start_ = time;
   window_steps_ = 0;
+  interface_update(mpm);  // as the serial Coupler::continue_thermal
 }
 
 }  // namespace frictherm::coupling

@@ -65,12 +65,14 @@ DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<2>& mpm, DecomposedHeatO
     : mpm2_(&mpm), opt_(std::move(options)) {
   check_materials(mpm);
   select_fixed_nodes(mpm);
+  interface_start(mpm);
 }
 
 DecomposedHeat::DecomposedHeat(mechanics::DecomposedMpm<3>& mpm, DecomposedHeatOptions options)
     : mpm3_(&mpm), opt_(std::move(options)) {
   check_materials(mpm);
   select_fixed_nodes(mpm);
+  interface_start(mpm);
 }
 
 DecomposedHeat::~DecomposedHeat() = default;
@@ -184,6 +186,8 @@ bool DecomposedHeat::after_step(double dt, bool must_close) {
   books_.plastic_heat_received += sums[2];
   pending_plastic_ += sums[2];
   time_ += dt;
+  if (mpm3_) interface_step<3>(work);  // the frictional heat's flux history (off unless asked)
+  else interface_step<2>(work);
   ++books_.steps;
   ++window_steps_;
   const WindowPolicy& p = opt_.window;
@@ -216,6 +220,8 @@ bool DecomposedHeat::close_window() {
   window_start_ = time_;
   window_steps_ = 0;
   max_rise_ = 0.0;
+  if (mpm3_) interface_update(*mpm3_);  // as the serial Coupler::update_interface_and_hotspots
+  else interface_update(*mpm2_);
   return true;
 }
 
@@ -430,7 +436,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   // (skipped without looking when the last bound puts it beyond twice that), else the assembled path.
   const bool fe = opt_.integrator == "forward_euler" || opt_.integrator == "auto";
   const auto limit = static_cast<double>(opt_.matrix_free_max_substeps);
-  bool matrix_free = fe && opt_.matrix_free_max_substeps > 0 &&
+  bool matrix_free = fe && opt_.matrix_free_max_substeps > 0 && !reaction_active() &&
                      !(last_lambda_ > 0.0 && dt / (opt_.fe_safety * 2.0 / last_lambda_) > 2.0 * limit);
   long n = 1;
   if (matrix_free) {
@@ -525,7 +531,15 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
     number_unknowns(mpm);
     KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
     for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
-    assembled_->advance(comm, *ids_, entries_of, M, q, face_temperature_, Tn, t0, t0 + dt);
+    if (reaction_active()) {  // the serial assemble's reaction, advance_and_map's T and λ, scatter_progress
+      assembled_->assemble(comm, *ids_, entries_of, M, face_temperature_);
+      reaction_gather(mpm);
+      assembled_->set_reaction(*ids_, opt_.reaction.kinetics, reacting_mass_);
+      books_.reaction_heat_released += assembled_->integrate_reacting(*ids_, &q, Tn, nodal_progress_, t0, t0 + dt);
+      reaction_scatter(mpm);
+    } else {
+      assembled_->advance(comm, *ids_, entries_of, M, q, face_temperature_, Tn, t0, t0 + dt);
+    }
     ++books_.assembled_windows;
     books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
   }

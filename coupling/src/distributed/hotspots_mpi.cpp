@@ -45,13 +45,15 @@ void update_hot_spots_across_ranks(MPI_Comm comm, HotSpotTracker& tracker, const
                                    const std::vector<std::int64_t>& global_ids,
                                    const std::vector<double>& reference_temperature,
                                    const std::vector<ThermalProperties>& materials,
-                                   std::size_t global_particle_count, double time) {
+                                   std::size_t global_particle_count, double time,
+                                   const std::vector<double>* criterion) {
   for (std::int64_t id : global_ids)
     if (id < 0 || static_cast<std::size_t>(id) >= global_particle_count)
       throw std::invalid_argument("hot spots across ranks: particle id " + std::to_string(id) + " outside [0, " +
                                   std::to_string(global_particle_count) + ")");
   double local_max = 0.0;
-  const std::vector<HotCandidate> mine = tracker.candidates(local, materials, local_max, &global_ids, &reference_temperature);
+  const std::vector<HotCandidate> mine = tracker.candidates(local, materials, local_max, &global_ids, &reference_temperature,
+                                                            criterion);
   double max_temperature = -std::numeric_limits<double>::infinity();
   mpi_check(MPI_Allreduce(&local_max, &max_temperature, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
   // In global-id order: the clustering's order (hence the hot spots' order, new ids and sums) is then
@@ -64,7 +66,8 @@ void update_hot_spots_across_ranks(MPI_Comm comm, HotSpotTracker& tracker, const
 #define FRICTHERM_HOT_SPOTS_ACROSS_RANKS(D)                                                                           \
   template void update_hot_spots_across_ranks<D>(MPI_Comm, HotSpotTracker&, const mechanics::Particles<D>&,          \
                                                  const std::vector<std::int64_t>&, const std::vector<double>&,       \
-                                                 const std::vector<ThermalProperties>&, std::size_t, double);
+                                                 const std::vector<ThermalProperties>&, std::size_t, double,  \
+                                                 const std::vector<double>*);
 FRICTHERM_HOT_SPOTS_ACROSS_RANKS(2)
 FRICTHERM_HOT_SPOTS_ACROSS_RANKS(3)
 #undef FRICTHERM_HOT_SPOTS_ACROSS_RANKS

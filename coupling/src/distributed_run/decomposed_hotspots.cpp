@@ -3,6 +3,7 @@
 
 #include <frictherm/coupling/distributed.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -15,7 +16,13 @@ DecomposedHotSpots<Dim>::DecomposedHotSpots(const Scene& scene, const mechanics:
       fates_(scene.thermal.coupler.fates),
       temperature_(mpm.particle_scalar_index("temperature")),
       reference_(mpm.particle_scalar_index("reference_temperature")),
-      particle_count_(static_cast<std::size_t>(mpm.global_particles())) {}
+      // hotspots.temperature "interface": judged by T_int,p (the serial Coupler::hotspot_temperature)
+      criterion_(scene.thermal.coupler.hotspots_by_interface_temperature
+                     ? mpm.particle_scalar_index("interface_temperature")
+                     : -1),
+      particle_count_(static_cast<std::size_t>(mpm.global_particles())) {
+  if (scene.thermal.coupler.reaction.enabled) progress_ = mpm.particle_scalar_index("reaction_progress");
+}
 
 template <int Dim>
 void DecomposedHotSpots<Dim>::update(const mechanics::DecomposedMpm<Dim>& mpm, double time) {
@@ -33,15 +40,20 @@ void DecomposedHotSpots<Dim>::update(const mechanics::DecomposedMpm<Dim>& mpm, d
   local_.material.assign(p.material.begin(), p.material.end());
   local_.temperature = mpm.particle_scalar(temperature_);
   ids_ = p.id;
+  const std::vector<double> criterion = criterion_ >= 0 ? mpm.particle_scalar(criterion_) : std::vector<double>{};
   update_hot_spots_across_ranks<Dim>(mpm.communicator(), tracker_, local_, ids_, mpm.particle_scalar(reference_),
-                                     materials_, particle_count_, time);
+                                     materials_, particle_count_, time, criterion_ >= 0 ? &criterion : nullptr);
   ++updates_;
 }
 
 template <int Dim>
-void DecomposedHotSpots<Dim>::update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time) {
+void DecomposedHotSpots<Dim>::update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time,
+                                           const std::vector<double>* interface_progress) {
   const mechanics::DecomposedLocalParticles p = mpm.local_particle_data();
-  const std::vector<double> T = mpm.particle_scalar(temperature_), T0 = mpm.particle_scalar(reference_);
+  // The temperature a spot is judged by: T_int,p with hotspots.temperature "interface" (HotSpotFates::update).
+  const std::vector<double> T = mpm.particle_scalar(criterion_ >= 0 ? criterion_ : temperature_),
+                            T0 = mpm.particle_scalar(reference_);
+  const std::vector<double> lambda = progress_ >= 0 ? mpm.particle_scalar(progress_) : std::vector<double>{};
   std::vector<long> local_of(particle_count_, -1);  // global id -> this rank's index
   for (std::size_t k = 0; k < p.id.size(); ++k) local_of[static_cast<std::size_t>(p.id[k])] = static_cast<long>(k);
   const std::vector<HotSpotFateRecord>& records = fates_.records();
@@ -52,7 +64,9 @@ void DecomposedHotSpots<Dim>::update_fates(const mechanics::DecomposedMpm<Dim>& 
       const long k = id < particle_count_ ? local_of[id] : -1;
       if (k < 0) continue;
       const auto uk = static_cast<std::size_t>(k);
-      m.add(T[uk], 0.0, tracker_.is_hot_against(T[uk], T0[uk]));  // no reaction in a decomposed run
+      double lam = progress_ >= 0 ? lambda[uk] : 0.0;  // λ_p, and λ_int,p when judged by T_int (HotSpotFates::update)
+      if (criterion_ >= 0 && interface_progress && uk < interface_progress->size()) lam = std::max(lam, (*interface_progress)[uk]);
+      m.add(T[uk], lam, tracker_.is_hot_against(T[uk], T0[uk]));
     }
     v[3 * j] = m.peak_temperature, v[3 * j + 1] = m.progress, v[3 * j + 2] = m.hot ? 1.0 : 0.0;
   }

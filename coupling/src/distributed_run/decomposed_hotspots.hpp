@@ -40,7 +40,10 @@ class DecomposedHotSpots {
   /// (T_p and T0_p from the swarm), reduces the measures over ranks (MPI_MAX) and lets the serial rules
   /// decide (HotSpotFates::decide), so every rank holds the same fates.
   void begin_fates(double time) { fates_.begin(tracker_, time); }
-  void update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time);
+  /// `interface_progress`: λ_int,p of this rank's particles (swarm order) when the interface reaction
+  /// runs, read with hot spots judged by the interface temperature (HotSpotFates::update).
+  void update_fates(const mechanics::DecomposedMpm<Dim>& mpm, double time,
+                    const std::vector<double>* interface_progress = nullptr);
   HotSpotFates& fates() { return fates_; }
   /// Checkpoints: the tracker's state (the same on every rank) and the update counters of /hotspots.
   template <class V> void visit_state(V&& v) {
@@ -57,7 +60,8 @@ class DecomposedHotSpots {
   std::vector<ThermalProperties> materials_;
   HotSpotTracker tracker_;
   HotSpotFates fates_;
-  int temperature_ = 0, reference_ = 0;
+  int temperature_ = 0, reference_ = 0, criterion_ = -1;  // criterion_: T_int,p's scalar (-1: T_p)
+  int progress_ = -1;  // λ_p's scalar (-1: no reaction)
   std::size_t particle_count_ = 0;
   long updates_ = 0, updates_written_ = -1;
   mechanics::Particles<Dim> local_;  // scratch: this rank's particles as the tracker reads them

@@ -168,6 +168,7 @@ class DecomposedRun {
   long last_series_step_ = -1, last_snapshot_step_ = -1;
   double heating_seconds_ = 0.0, output_seconds_ = 0.0, continuation_seconds_ = 0.0;
   double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
+  double particle_reaction_heat_ = 0.0;  // q Σ m_p λ_p over ranks at the end (J)
   Clock::time_point last_flush_ = Clock::now();
   // Checkpoints: whether this run writes them, where, the generation of the last one, the clock of
   // --checkpoint-every; rank 0: every series row so far (flat) and OUT.xdmf's grids (from a resume).

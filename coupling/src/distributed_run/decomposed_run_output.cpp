@@ -71,6 +71,9 @@ std::vector<std::string> DecomposedRun<Dim>::series_names() const {
     for (const std::string& c : detail::DecomposedHotSpots<Dim>::series_names()) n.push_back(c);
     n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
     if (s_.thermal.coupler.plastic.enabled) n.insert(n.end(), {"plastic_work", "plastic_heat"});
+    if (heat_->reaction_enabled()) n.insert(n.end(), {"reaction_heat", "max_reaction_progress"});
+    if (heat_->interface_enabled()) n.emplace_back("max_interface_temperature");  // the serial column
+    if (heat_->interface_enabled() && heat_->reaction_enabled()) n.emplace_back("max_interface_reaction_progress");
   }
   return n;
 }
@@ -116,6 +119,12 @@ void DecomposedRun<Dim>::series(double time) {
     row.insert(row.end(), {static_cast<double>(b.windows + b.continuation_intervals), b.work_received,
                            b.nodal_energy_change});
     if (s_.thermal.coupler.plastic.enabled) row.insert(row.end(), {b.plastic_work_received, b.plastic_heat_received});
+    if (heat_->reaction_enabled()) row.insert(row.end(), {b.reaction_heat_released, heat_->max_reaction_progress()});
+    if (heat_->interface_enabled()) {  // NaN until some node has received frictional heat, as the serial run
+      const double t_int = heat_->max_interface_temperature();
+      row.push_back(std::isfinite(t_int) ? t_int : std::numeric_limits<double>::quiet_NaN());
+    }
+    if (heat_->interface_enabled() && heat_->reaction_enabled()) row.push_back(heat_->max_interface_reaction_progress());
   }
   std::string error;  // rank 0's write failure, agreed below so that no rank goes on alone
   if (out_) {
@@ -148,6 +157,13 @@ void DecomposedRun<Dim>::snapshot(double time) {
   snap.velocity = p.velocity;
   snap.material = p.material;
   snap.temperature = mpm_->particle_scalar(temperature_);
+  if (heat_ && heat_->interface_enabled())  // T_int,p of the last update, as the serial snapshot field
+    snap.fields.emplace_back("interface_temperature",
+                             mpm_->particle_scalar(mpm_->particle_scalar_index("interface_temperature")));
+  if (heat_ && heat_->reaction_enabled())  // λ_p, as the serial snapshot field
+    snap.fields.emplace_back("reaction_progress", mpm_->particle_scalar(mpm_->particle_scalar_index("reaction_progress")));
+  if (heat_ && heat_->interface_reaction().started())  // from the continuation on (no migration since)
+    snap.fields.emplace_back("interface_reaction_progress", heat_->interface_reaction().progress());
   snapshots_out_->write(step_, std::isnan(time) ? time_ : time, snap);
   ++snapshots_;
   last_snapshot_step_ = step_;
@@ -201,6 +217,7 @@ void DecomposedRun<Dim>::write_end_metadata() {
   for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
   if (heat_)
     detail::write_decomposed_heat_metadata(*out_, s_, *heat_, pending_heat_, hot_->tracker().ids_issued());
+  if (heat_ && heat_->reaction_enabled()) out_->write_metadata("particle_reaction_heat", particle_reaction_heat_);
   const char* status = r_.status == RunResult::Status::failed                 ? "failed"
                        : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
                        : r_.status == RunResult::Status::interrupted          ? "interrupted"

@@ -35,6 +35,10 @@ RunResult DecomposedRun<Dim>::execute() {
   r_.output = o_.output.empty() ? s_.output.file : o_.output;
   resuming_ = !o_.resume_checkpoint.empty();
   checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
+  if (checkpoints_ && detail::interface_temperature(s_))  // run.checkpoint_interval: decomposed_run_refusal
+    throw SceneError("--checkpoint-every: checkpoints with coupling.interface_temperature are not supported in a "
+                     "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
+                     "supports it");
   if (checkpoints_ && heat_continuation())  // run.checkpoint_interval: decomposed_run_refusal
     throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
                      "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
@@ -78,7 +82,8 @@ RunResult DecomposedRun<Dim>::execute() {
     // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      if (checkpoints_ || (interrupted && !heat_continuation())) checkpoint();
+      // Nor with the interface temperature, whose flux histories a decomposed checkpoint does not hold.
+      if (checkpoints_ || (interrupted && !heat_continuation() && !detail::interface_temperature(s_))) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {
@@ -104,6 +109,7 @@ RunResult DecomposedRun<Dim>::execute() {
   }
   r_.snapshots = static_cast<std::size_t>(snapshots_);
   if (heat_) pending_heat_ = heat_->pending_heat();  // collective
+  if (heat_) particle_reaction_heat_ = heat_->particle_reaction_heat();  // collective
   finish_output();  // agreed by every rank
   snapshots_out_->close();
   if (heat_ && rank_ == 0 && !o_.quiet) detail::print_decomposed_books(o_.log ? *o_.log : std::cerr, heat_->books(), size_);
@@ -158,6 +164,9 @@ void DecomposedRun<Dim>::build() {
     h.plastic = c.plastic;
     h.subgrid_relaxation_time = c.subgrid_relaxation_time;
     h.fixed_faces = c.fixed_faces;
+    h.interface_temperature = c.interface_temperature;
+    h.reaction = c.reaction;
+    h.thickness = c.thickness;
     try {
       heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
     } catch (const std::invalid_argument& e) {
@@ -297,7 +306,7 @@ void DecomposedRun<Dim>::continuation() {
       throw thermal_failure("thermal integration unstable: ", e, t);
     }
     hot_->update(*mpm_, t);
-    hot_->update_fates(*mpm_, t);
+    hot_->update_fates(*mpm_, t, heat_->interface_reaction().started() ? &heat_->interface_reaction().progress() : nullptr);
     series(t);  // the mechanics columns stay at their final values
     const HotSpotFates& f = hot_->fates();
     if (spec.stop_when_decided && !f.records().empty() && f.all_decided()) break;

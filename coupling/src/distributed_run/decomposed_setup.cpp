@@ -34,6 +34,10 @@ bool penalty_contact_scene(const Scene& scene) {
 
 bool plastic_heating(const Scene& scene) { return scene.thermal.enabled && scene.thermal.coupler.plastic.enabled; }
 
+bool interface_temperature(const Scene& scene) {
+  return scene.thermal.enabled && scene.thermal.coupler.interface_temperature.enabled;
+}
+
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene) {
   mechanics::IVec<Dim> cells{};
@@ -101,6 +105,10 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.particle_scalars = {"temperature", "reference_temperature"};  // T_p and T0_p (hot spots' reference)
   // The plastic work already handed to the heat (DecomposedHeatOptions::plastic_work_heated).
   if (plastic_heating(scene)) o.particle_scalars.emplace_back("plastic_work_heated");
+  // T_int,p of the sub-cell interface temperature (DecomposedHeatOptions::interface_scalar).
+  if (interface_temperature(scene)) o.particle_scalars.emplace_back("interface_temperature");
+  // λ_p of the reaction (DecomposedHeatOptions::progress_scalar).
+  if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) o.particle_scalars.emplace_back("reaction_progress");
   return o;
 }
 
@@ -134,6 +142,8 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
         q.plastic_work = p.plastic_work[k];
         q.scalars = {p.temperature[k], p.temperature[k]};
         if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
+        if (interface_temperature(scene)) q.scalars.push_back(p.temperature[k]);  // T_p before any heat
+        if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) q.scalars.push_back(0.0);  // fresh
       }
       for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {
         packed.push_back(static_cast<double>(L.particle));
@@ -210,20 +220,35 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   out.write_metadata("particle_energy_change", b.particle_energy_change);
   out.write_metadata("max_capacity_residual", b.max_capacity_residual);
   out.write_metadata("hotspots_seen", hotspots_seen);
+  // The interface temperature's flux histories, summed over ranks at the last update (= work received).
+  if (heat.interface_enabled()) out.write_metadata("interface_heat_recorded", heat.interface_heat_recorded());
+  if (c.reaction.enabled) {  // as the serial ThermalRun::write_metadata (particle_reaction_heat: the caller)
+    out.write_metadata("reaction_heat_released", b.reaction_heat_released);
+    out.write_metadata("reaction_kinetics", c.reaction.kinetics_name);
+    out.write_metadata("reaction_prefactor", c.reaction.kinetics.prefactor);
+    out.write_metadata("reaction_activation_temperature", c.reaction.kinetics.activation_temperature);
+    out.write_metadata("reaction_heat_of_reaction", c.reaction.kinetics.specific_heat_of_reaction);
+  }
 }
 
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {
-  // Relative to the heat received: frictional work plus plastic heat.
+  // Relative to the heat received: frictional work plus plastic heat; the energy changes also hold
+  // the reaction's heat.
   const double w = b.work_received + b.plastic_heat_received, scale = w != 0.0 ? std::fabs(w) : 1.0;
-  char line[640];
+  const double e = w + b.reaction_heat_released;
+  char reaction[96] = "";
+  if (b.reaction_heat_released != 0.0)
+    std::snprintf(reaction, sizeof reaction, " reaction heat released %.9g J,", b.reaction_heat_released);
+  char line[760];
   std::snprintf(line, sizeof line,
                 "frictherm: energy books over %d ranks: frictional work received %.9g J, plastic heat received %.9g J, "
-                "heat delivered %.9g J, nodal energy change %.9g J, particle energy change %.9g J (largest "
+                "heat delivered %.9g J,%s nodal energy change %.9g J, particle energy change %.9g J (largest "
                 "difference %.2g of the heat received)\n",
-                ranks, b.work_received, b.plastic_heat_received, b.heat_delivered, b.nodal_energy_change,
-                b.particle_energy_change,
-                std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - w),
-                          std::fabs(b.particle_energy_change - w)}) / scale);
+                ranks, b.work_received, b.plastic_heat_received, b.heat_delivered,
+                reaction,
+                b.nodal_energy_change, b.particle_energy_change,
+                std::max({std::fabs(b.heat_delivered - w), std::fabs(b.nodal_energy_change - e),
+                          std::fabs(b.particle_energy_change - e)}) / scale);
   log << line;
 }
 

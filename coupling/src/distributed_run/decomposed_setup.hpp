@@ -21,6 +21,8 @@ mechanics::Grid<Dim> scene_grid(const Scene& scene);
 
 /// Whether the scene heats with plastic work (thermal on, coupling.plastic_heating).
 bool plastic_heating(const Scene& scene);
+/// Whether the scene has the sub-cell interface temperature (thermal on, coupling.interface_temperature).
+bool interface_temperature(const Scene& scene);
 
 /// The decomposed engine's options for a supported scene; the particles carry two scalars,
 /// "temperature" and "reference_temperature" (T_p and its initial value T0_p, K), and with plastic

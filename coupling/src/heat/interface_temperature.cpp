@@ -18,6 +18,23 @@ void InterfaceTemperature<Dim>::start(const mechanics::Grid<Dim>& grid, double t
                                       const InterfaceTemperatureOptions& options, double time) {
   enabled_ = options.enabled;
   if (!enabled_) return;
+  // Density per material from its particles now (ρ = Σ m / Σ V).
+  std::vector<double> mass(materials.size(), 0.0), volume(materials.size(), 0.0);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const auto m = static_cast<std::size_t>(p.material[k]);
+    if (m < materials.size()) mass[m] += p.mass[k], volume[m] += p.volume[k];
+  }
+  start_sides(grid, thickness, mass, volume, materials, options, time);
+  particle_temperature_.assign(p.temperature.begin(), p.temperature.end());  // no heat yet: T_p
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::start_sides(const mechanics::Grid<Dim>& grid, double thickness,
+                                            const std::vector<double>& mass, const std::vector<double>& volume,
+                                            const std::vector<ThermalProperties>& materials,
+                                            const InterfaceTemperatureOptions& options, double time) {
+  enabled_ = options.enabled;
+  if (!enabled_) return;
   grid_.emplace(grid);
   if (options.bins_per_level < 2)
     throw std::invalid_argument("interface temperature: bins_per_level must be at least 2");
@@ -25,12 +42,8 @@ void InterfaceTemperature<Dim>::start(const mechanics::Grid<Dim>& grid, double t
   history_.reset(time);
   h_ = grid.min_cell_size();
   area_ = grid.cell_volume() / h_ * (Dim == 2 ? thickness : 1.0);  // h^{Dim−1} (× t in 2D)
-  // Density per material from its particles now (ρ = Σ m / Σ V).
-  std::vector<double> mass(materials.size(), 0.0), volume(materials.size(), 0.0);
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const auto m = static_cast<std::size_t>(p.material[k]);
-    if (m < materials.size()) mass[m] += p.mass[k], volume[m] += p.volume[k];
-  }
+  if (mass.size() != materials.size() || volume.size() != materials.size())
+    throw std::invalid_argument("interface temperature: mass and volume sums per material expected");
   sides_.assign(materials.size(), thermal::HalfSpace{});
   heat_capacity_.assign(materials.size(), 0.0);
   for (std::size_t m = 0; m < materials.size(); ++m) {
@@ -72,7 +85,7 @@ void InterfaceTemperature<Dim>::start(const mechanics::Grid<Dim>& grid, double t
   nodes_.clear();
   node_correction_.clear(), node_temperature_.clear();
   patch_correction_.clear(), patch_temperature_.clear();
-  particle_temperature_.assign(p.temperature.begin(), p.temperature.end());  // no heat yet: T_p
+  particle_temperature_.clear();
   max_temperature_ = -std::numeric_limits<double>::infinity();
   max_node_temperature_ = max_temperature_;
   heat_recorded_ = 0.0;
@@ -81,17 +94,24 @@ void InterfaceTemperature<Dim>::start(const mechanics::Grid<Dim>& grid, double t
 template <int Dim>
 void InterfaceTemperature<Dim>::add_step(const std::vector<double>& nodal_work, double time) {
   if (!enabled_) return;
-  for (std::size_t i = 0; i < nodal_work.size(); ++i) {
-    const double w = nodal_work[i];
-    if (!(w > 0.0)) continue;  // heat only (the books guard against non-finite work upstream)
-    int& slot = slot_of_node_[i];
-    if (slot < 0) {
-      slot = static_cast<int>(history_.add_slot());
-      nodes_.push_back(static_cast<int>(i));
-    }
-    history_.add(static_cast<std::size_t>(slot), w / area_);
-    heat_recorded_ += w;
+  for (std::size_t i = 0; i < nodal_work.size(); ++i) add_node_heat(static_cast<int>(i), nodal_work[i]);
+  end_step(time);
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::add_node_heat(int node, double w) {
+  if (!(w > 0.0)) return;  // heat only (the books guard against non-finite work upstream)
+  int& slot = slot_of_node_[static_cast<std::size_t>(node)];
+  if (slot < 0) {
+    slot = static_cast<int>(history_.add_slot());
+    nodes_.push_back(node);
   }
+  history_.add(static_cast<std::size_t>(slot), w / area_);
+  heat_recorded_ += w;
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::end_step(double time) {
   if (time > history_.boundaries().back()) history_.close(time);
 }
 
@@ -100,14 +120,12 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
                                        const mechanics::StencilView<Dim>& stencils, const NodalThermalSystem& system,
                                        const Eigen::VectorXd& nodal_temperature, double time) {
   if (!enabled_) return;
-  const std::size_t slots = nodes_.size(), nm = sides_.size();
+  const std::size_t slots = nodes_.size();
   particle_temperature_.assign(p.temperature.begin(), p.temperature.end());
-  node_correction_.assign(slots, 0.0);
-  node_temperature_.assign(slots, 0.0);
-  max_temperature_ = -std::numeric_limits<double>::infinity();
-  max_node_temperature_ = max_temperature_;
-  patch_correction_.clear(), patch_temperature_.clear();
-  if (slots == 0) return;
+  if (slots == 0) {
+    update_slots({}, {}, time);
+    return;
+  }
 
   const mechanics::Grid<Dim>& grid = *grid_;
   auto for_each_particle_node = [&](auto&& f) {
@@ -117,7 +135,7 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
       mechanics::Stencil<Dim, Kernel> own;
       for (std::size_t k = 0; k < p.size(); ++k) {
         const auto m = static_cast<std::size_t>(p.material[k]);
-        if (m >= nm || !(sides_[m].volumetric_heat_capacity > 0.0) || !(sides_[m].conductivity > 0.0)) continue;
+        if (!conducting(m)) continue;
         if (!step) own.evaluate(grid, p.position[k], p.half_size[k]);
         const mechanics::Stencil<Dim, Kernel>& st = step ? step[k] : own;
         st.for_each(grid, [&](int i, double w, const mechanics::Vec<Dim>&) {
@@ -128,22 +146,52 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
     });
   };
 
-  // Pass 1: each heated node's two heaviest conducting materials (Σ_p S_ip m_p per material) and its
-  // projection factor f = (Σ S² m c / Σ S m c)^{1/Dim} (per axis; exact for a regular lattice).
-  slot_material_mass_.assign(slots * (nm + 2), 0.0);
-  const std::size_t stride = nm + 2;
+  // Pass 1: each heated node's Σ_p S_ip m_p per conducting material, Σ S m c and Σ S² m c.
+  const std::size_t stride = row_size();
+  slot_material_mass_.assign(slots * stride, 0.0);
   for_each_particle_node([&](std::size_t k, std::size_t m, std::size_t s, double w) {
-    double* row = &slot_material_mass_[s * stride];
-    const double mc = p.mass[k] * heat_capacity_[m];
-    row[m] += w * p.mass[k];
-    row[nm] += w * mc;
-    row[nm + 1] += w * w * mc;
+    add_to_row(&slot_material_mass_[s * stride], m, p.mass[k], w);
   });
+  std::vector<double> grid_temperature(slots, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t s = 0; s < slots; ++s) {
+    const auto node = static_cast<std::size_t>(nodes_[s]);
+    const int u = node < system.unknown.size() ? system.unknown[node] : -1;
+    if (u >= 0) grid_temperature[s] = nodal_temperature[u];
+  }
+  update_slots(slot_material_mass_, grid_temperature, time);
+  const std::vector<double>& correction = slot_correction();
+
+  // Pass 2: each particle's hottest touched interface, T_p + max correction.
+  std::vector<double> best(p.size(), 0.0);
+  for_each_particle_node([&](std::size_t k, std::size_t, std::size_t s, double) {
+    best[k] = std::max(best[k], correction[s]);
+  });
+  for (std::size_t k = 0; k < p.size(); ++k) particle_temperature_[k] += best[k];
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::update_slots(const std::vector<double>& rows, const std::vector<double>& grid_temperature,
+                                             double time) {
+  const std::size_t slots = nodes_.size(), nm = sides_.size();
+  node_correction_.assign(slots, 0.0);
+  node_temperature_.assign(slots, 0.0);
+  max_temperature_ = -std::numeric_limits<double>::infinity();
+  max_node_temperature_ = max_temperature_;
+  patch_correction_.clear(), patch_temperature_.clear();
+  if (slots == 0) return;
+  const std::size_t stride = nm + 2;
+  if (rows.size() != slots * stride || grid_temperature.size() != slots)
+    throw std::invalid_argument("interface temperature: " + std::to_string(rows.size()) + " row values and " +
+                                std::to_string(grid_temperature.size()) + " grid temperatures for " +
+                                std::to_string(slots) + " heated nodes");
+
+  // Each heated node's two heaviest conducting materials (Σ_p S_ip m_p per material) and its
+  // projection factor f = (Σ S² m c / Σ S m c)^{1/Dim} (per axis; exact for a regular lattice).
   std::vector<int> group_of_slot(slots, -1);
   std::vector<const thermal::SubcellCorrection*> groups;
   std::map<std::array<int, 3>, int> group_index;
   for (std::size_t s = 0; s < slots; ++s) {
-    const double* row = &slot_material_mass_[s * stride];
+    const double* row = &rows[s * stride];
     int first = -1, second = -1;
     for (std::size_t m = 0; m < nm; ++m) {
       const double x = row[m];
@@ -177,25 +225,15 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
   history_.convolve(responses, group_of_slot, node_correction_);
 
   for (std::size_t s = 0; s < slots; ++s) {
-    const auto node = static_cast<std::size_t>(nodes_[s]);
-    const int u = node < system.unknown.size() ? system.unknown[node] : -1;
-    if (u < 0 || group_of_slot[s] == static_cast<int>(groups.size())) {
+    if (std::isnan(grid_temperature[s]) || group_of_slot[s] == static_cast<int>(groups.size())) {
       node_temperature_[s] = std::numeric_limits<double>::quiet_NaN();  // not a thermal node now
       continue;
     }
-    node_temperature_[s] = nodal_temperature[u] + node_correction_[s];
+    node_temperature_[s] = grid_temperature[s] + node_correction_[s];
     max_node_temperature_ = std::max(max_node_temperature_, node_temperature_[s]);
   }
   max_temperature_ = max_node_temperature_;
   if (patch_area_ > 0.0) update_patches();
-  const std::vector<double>& correction = patch_area_ > 0.0 ? patch_correction_ : node_correction_;
-
-  // Pass 2: each particle's hottest touched interface, T_p + max correction.
-  std::vector<double> best(p.size(), 0.0);
-  for_each_particle_node([&](std::size_t k, std::size_t, std::size_t s, double) {
-    best[k] = std::max(best[k], correction[s]);
-  });
-  for (std::size_t k = 0; k < p.size(); ++k) particle_temperature_[k] += best[k];
 }
 
 // A hot spot of size ℓ: the heat of the heated nodes within ℓ/2 of node s, Σ_t A q_t ⊛ R_x, spread

@@ -81,9 +81,22 @@ std::string thermal_refusal(const Scene& s) {
   if (forward_euler && io.fe_max_dt > 0.0)
     return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
-  if (c.reaction.enabled) return refuse("thermal.reaction", "a reaction", "no reaction");
-  if (c.interface_temperature.enabled)
-    return refuse("coupling.interface_temperature", "on", "off (the sub-cell interface temperature is serial)");
+  // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed
+  // integrators carry λ), not with forward Euler; its interface reaction from the continuation on.
+  if (c.reaction.enabled && c.integrator == "forward_euler")
+    return refuse("thermal.integrator", quoted("forward_euler") + " with thermal.reaction",
+                  "\"cvode_bdf\", \"auto\" or another implicit integrator");
+  if (c.reaction.enabled && c.reaction.during_loading && c.interface_temperature.enabled)
+    return refuse("thermal.reaction.during_loading", "true with coupling.interface_temperature",
+                  "false (the interface reaction from the continuation on)");
+  // The interface temperature runs on the owned nodes (decomposed_interface.cpp), without the patch
+  // (it reads other nodes' histories) and without checkpoints (they do not hold the histories).
+  if (c.interface_temperature.enabled && c.interface_temperature.patch_length > 0.0)
+    return refuse("coupling.interface_temperature.patch_length", number(c.interface_temperature.patch_length),
+                  "0 or no key");
+  if (c.interface_temperature.enabled && s.checkpoint_interval > 0.0)
+    return refuse("run.checkpoint_interval", number(s.checkpoint_interval) + " with coupling.interface_temperature",
+                  "no checkpoints with the interface temperature");
   // Every window policy runs (every_step, every_n_steps, adaptive: DecomposedHeat::after_step). Matrix-free
   // windows gather every window: the serial reuse of the last gather is not decomposed. The default
   // reuse distance is a speed-up of the serial run, so a scene that does not set it runs (gathering

@@ -68,6 +68,22 @@ void DistributedIntegrator::advance(const DistributedProblem& problem, Eigen::Ve
   comm_.neighbours = after.neighbours;
 }
 
+void DistributedIntegrator::advance(const DistributedProblem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress,
+                                    double t0, double t1) {
+  const bool bad = problem.has_reaction() && progress.size() != problem.local_size();
+  if (!all_ranks(problem.comm(), !bad))
+    throw std::invalid_argument(name() + " (distributed, rank " + std::to_string(problem.rank()) + "): " +
+                                (bad ? "progress has " + std::to_string(progress.size()) + " entries for " +
+                                           std::to_string(problem.local_size()) + " owned nodes"
+                                     : std::string("another rank rejected its input")));
+  struct Reset {
+    Eigen::VectorXd*& p;
+    ~Reset() { p = nullptr; }
+  } reset{progress_};
+  progress_ = problem.has_reaction() ? &progress : nullptr;
+  advance(problem, T, t0, t1);
+}
+
 namespace detail {
 namespace {
 
@@ -80,6 +96,9 @@ class DistForwardEuler final : public DistributedIntegrator {
  protected:
   void advance_impl(const DistributedProblem& problem, Eigen::VectorXd& T, double t0, double t1) override {
     const auto start = std::chrono::steady_clock::now();
+    if (problem.has_reaction())  // the same on every rank (set_reaction is collective)
+      throw std::invalid_argument("forward_euler (distributed): the reaction is not distributed for forward Euler "
+                                  "(use cvode_bdf, cvode_adams, arkode_erk or arkode_dirk)");
     if (problem.revision() != revision_) {
       const double lam = problem.lambda_max_gershgorin();  // global (MPI_MAX)
       dt_limit_ = lam > 0.0 ? 2.0 / lam : std::numeric_limits<double>::infinity();
@@ -177,7 +196,7 @@ class DistSundials final : public DistributedIntegrator {
   bool built_ = false;
   std::uint64_t revision_ = 0;
   double t_last_ = std::numeric_limits<double>::quiet_NaN();
-  Eigen::VectorXd t_state_last_;
+  Eigen::VectorXd t_state_last_, progress_last_;
   IntegratorStats base_, offset_;
   long reinits_ = 0;
   double wall_ = 0.0;
@@ -222,13 +241,16 @@ void DistSundials::create(double t0) {
     check(CVodeSetNonlinearSolver(mem, nls_.get()), "CVodeSetNonlinearSolver");
     return;
   }
-  // Krylov: exact J·v (one ghost exchange), left preconditioner from PETSc.
-  ls_ = LinSolPtr(lin_ == Linear::Pcg ? SUNLinSol_PCG(y, SUN_PREC_LEFT, opt_.krylov_maxl, ctx)
-                                      : SUNLinSol_SPGMR(y, SUN_PREC_LEFT, opt_.krylov_maxl, ctx));
-  check_ptr(ls_.get(), lin_ == Linear::Pcg ? "SUNLinSol_PCG" : "SUNLinSol_SPGMR", name_);
+  // Krylov: exact J·v (one ghost exchange), left preconditioner from PETSc (with a reaction: the
+  // serial 2×2 block Jacobi). A consuming reaction makes the Newton matrix non-symmetric: GMRES, as
+  // the serial make_krylov_solver.
+  const bool pcg = lin_ == Linear::Pcg && !sys_.nonsymmetric();
+  ls_ = LinSolPtr(pcg ? SUNLinSol_PCG(y, SUN_PREC_LEFT, opt_.krylov_maxl, ctx)
+                      : SUNLinSol_SPGMR(y, SUN_PREC_LEFT, opt_.krylov_maxl, ctx));
+  check_ptr(ls_.get(), pcg ? "SUNLinSol_PCG" : "SUNLinSol_SPGMR", name_);
   if (sys_.conserves()) {  // insulated: keep Σ M T exact whatever the preconditioner
     NVectorPtr c(N_VClone(y));
-    sys_.to_y(Eigen::VectorXd::Ones(sys_.nodes()), c.get());  // c = M^{1/2}·1
+    sys_.to_y(Eigen::VectorXd::Ones(sys_.nodes()), nullptr, c.get());  // c = M^{1/2}·1
     ls_ = make_conservative_krylov(std::move(ls_), c.get(), ctx);
   }
   if (cvode) {
@@ -239,7 +261,7 @@ void DistSundials::create(double t0) {
     check(ARKStepSetLinearSolver(mem, ls_.get(), nullptr), "ARKStepSetLinearSolver");
     check(ARKStepSetJacTimes(mem, nullptr, &DistributedOde::jtimes), "ARKStepSetJacTimes");
     check(ARKStepSetPreconditioner(mem, &DistributedOde::psetup, &DistributedOde::psolve), "ARKStepSetPreconditioner");
-    check(ARKStepSetLinear(mem, 0), "ARKStepSetLinear");  // f linear in y, constant J
+    if (!sys_.reacts()) check(ARKStepSetLinear(mem, 0), "ARKStepSetLinear");  // f linear in y, constant J
   }
 }
 
@@ -317,10 +339,14 @@ void DistSundials::advance_impl(const DistributedProblem& problem, Eigen::Vector
     if (!ctx_) ctx_ = make_context();
     sys_.build(problem, krylov(), krylov() ? pc_ : std::string());  // Krylov: symmetric form
     const MPI_Comm comm = problem.comm();
-    y_ = make_parallel_vector(comm, problem.local_size(), problem.global_size(), ctx_.get());
-    abstol_ = make_parallel_vector(comm, problem.local_size(), problem.global_size(), ctx_.get());
-    sys_.fill_abstol(opt_.atol, abstol_.get());  // s_i·atol (√M_i·atol on the symmetric form)
-    sys_.to_y(T, y_.get());
+    long local = static_cast<long>(sys_.state_size()), global = 0;  // [s ⊙ T; λ of the reacting nodes]
+    MPI_Allreduce(&local, &global, 1, MPI_LONG, MPI_SUM, comm);
+    DistributedProblem::count_reductions(1);
+    y_ = make_parallel_vector(comm, sys_.state_size(), static_cast<Index>(global), ctx_.get());
+    abstol_ = make_parallel_vector(comm, sys_.state_size(), static_cast<Index>(global), ctx_.get());
+    // s_i·atol (√M_i·atol on the symmetric form) on T, progress_atol on λ
+    sys_.fill_abstol(opt_.atol, opt_.progress_atol, abstol_.get());
+    sys_.to_y(T, progress_, y_.get());
     sink_.last_message.clear();
     create(t0);
     built_ = true;
@@ -330,10 +356,11 @@ void DistSundials::advance_impl(const DistributedProblem& problem, Eigen::Vector
   } else {
     sys_.bind(problem);
     // Continue with the history when the state is the one this integrator left (all ranks agree).
-    const bool mine = t0 == t_last_ && T.size() == t_state_last_.size() && T == t_state_last_;
+    bool mine = t0 == t_last_ && T.size() == t_state_last_.size() && T == t_state_last_;
+    if (progress_) mine = mine && progress_->size() == progress_last_.size() && *progress_ == progress_last_;
     if (opt_.reinit_every_window || !all_ranks(problem.comm(), mine)) {
       absorb();
-      sys_.to_y(T, y_.get());
+      sys_.to_y(T, progress_, y_.get());
       sink_.last_message.clear();
       reinit(t0);
       offset_ = counters();
@@ -357,10 +384,11 @@ void DistSundials::advance_impl(const DistributedProblem& problem, Eigen::Vector
     check(flag, c.c_str());
   }
   Eigen::VectorXd out;
-  sys_.to_T(y_.get(), out);
+  sys_.to_T(y_.get(), out, progress_);
   problem.apply_dirichlet(out);  // exact fixed values (y/s round trip)
   T = std::move(out);
   t_state_last_ = T;
+  if (progress_) progress_last_ = *progress_;
   t_last_ = t1;
 }
 

@@ -116,10 +116,11 @@ void DistributedOde::build(const DistributedProblem& problem, bool symmetric, co
   }
   MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, problem.comm());
   DistributedProblem::count_reductions(1);
-  conserves_ = all == 1;
+  conserves_ = all == 1 && !problem.has_reaction();  // the reaction adds heat: Σ M T is not invariant
 
   destroy_petsc();
-  if (preconditioner.empty()) return;
+  build_reaction(problem);
+  if (preconditioner.empty() || reacts_) return;  // a reaction: the serial block Jacobi (psolve)
   // P = I − γJ with K's pattern plus an explicit diagonal: rows owned, columns global.
   const Index first = problem.first_row();
   p_start_.assign(1, 0);
@@ -191,25 +192,58 @@ void DistributedOde::assemble(double gamma) {
   ++setups_;
 }
 
-void DistributedOde::to_y(const Eigen::VectorXd& T, N_Vector y) const { view(y) = s_.cwiseProduct(T); }
+void DistributedOde::to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y) {
+  const Index n = nodes();
+  auto v = view(y);
+  v.head(n) = s_.cwiseProduct(T);
+  frozen_.setZero(reacting());
+  for (Index r = 0; r < reacting(); ++r) {
+    const double lam = progress != nullptr ? (*progress)[rx_node_[static_cast<std::size_t>(r)]] : 0.0;
+    if (consume_) v[n + r] = lam;
+    else frozen_[r] = lam;  // zero-order: λ a fixed parameter of the window
+  }
+}
 
-void DistributedOde::to_T(N_Vector y, Eigen::VectorXd& T) const { T = view(y).cwiseQuotient(s_); }
+void DistributedOde::to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const {
+  const Index n = nodes();
+  const auto v = view(y);
+  T = v.head(n).cwiseQuotient(s_);
+  if (progress == nullptr || !consume_) return;
+  for (Index r = 0; r < reacting(); ++r) (*progress)[rx_node_[static_cast<std::size_t>(r)]] = std::clamp(v[n + r], 0.0, 1.0);
+}
 
-void DistributedOde::fill_abstol(double atol, N_Vector out) const { view(out) = atol * s_; }
+void DistributedOde::fill_abstol(double atol, double progress_atol, N_Vector out) const {
+  auto v = view(out);
+  v.head(nodes()) = atol * s_;
+  v.tail(state_size() - nodes()).setConstant(progress_atol);
+}
 
 int DistributedOde::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* self = static_cast<DistributedOde*>(user_data);
   try {
-    self->t_work_ = view(y).cwiseQuotient(self->s_);
+    const Index n = self->nodes();
+    const auto yv = view(y);
+    auto out = view(ydot);
+    self->t_work_ = yv.head(n).cwiseQuotient(self->s_);
     self->problem_->heat_rate(t, self->t_work_.data(), self->w_work_.data());
-    view(ydot) = self->fscale_.cwiseProduct(self->w_work_);
+    if (self->reacts_) {  // as OdeSystem::rhs
+      const Reaction& rx = self->problem_->reaction();
+      for (Index r = 0; r < self->reacting(); ++r) {
+        const Index i = self->rx_node_[static_cast<std::size_t>(r)];
+        const double remaining = 1.0 - (self->consume_ ? yv[n + r] : self->frozen_[r]);
+        const double rate = remaining * rx.rate_constant(self->t_work_[i]);  // (1 − λ) k(T)
+        self->w_work_[i] += self->rx_q_[r] * rate;
+        if (self->consume_) out[n + r] = rate;
+      }
+    }
+    out.head(n) = self->fscale_.cwiseProduct(self->w_work_);
     return 0;
   } catch (...) {
     return -1;  // unrecoverable
   }
 }
 
-int DistributedOde::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector, N_Vector, void* user_data, N_Vector) {
+int DistributedOde::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector y, N_Vector, void* user_data, N_Vector) {
   auto* self = static_cast<DistributedOde*>(user_data);
   try {
     const double* in = N_VGetArrayPointer(v);
@@ -226,16 +260,30 @@ int DistributedOde::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector, N_Vec
       }
       out[i] = acc;
     }
+    if (!self->reacts_) return 0;
+    self->reaction_blocks(N_VGetArrayPointer(y));  // exact J·v at the current iterate (OdeSystem::jtimes)
+    for (Index r = 0; r < self->reacting(); ++r) {
+      const Index i = self->rx_node_[static_cast<std::size_t>(r)];
+      out[i] += self->d_tt_[r] * in[i];
+      if (!self->consume_) continue;
+      out[i] += self->d_tl_[r] * in[n + r];
+      out[n + r] = self->d_lt_[r] * in[i] + self->d_ll_[r] * in[n + r];
+    }
     return 0;
   } catch (...) {
     return -1;
   }
 }
 
-int DistributedOde::psetup(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
+int DistributedOde::psetup(sunrealtype, N_Vector y, N_Vector, sunbooleantype, sunbooleantype* jcur, sunrealtype gamma,
                            void* user_data) {
   auto* self = static_cast<DistributedOde*>(user_data);
   try {
+    if (self->reacts_) {  // the blocks at y; psolve inverts them with its γ (OdeSystem::psetup)
+      self->reaction_blocks(N_VGetArrayPointer(y));
+      *jcur = SUNTRUE;
+      return 0;
+    }
     // J is constant: only a new γ changes P (the jok flag carries no information here).
     if (gamma != self->gamma_) self->assemble(gamma);
     *jcur = SUNTRUE;
@@ -245,10 +293,18 @@ int DistributedOde::psetup(sunrealtype, N_Vector, N_Vector, sunbooleantype, sunb
   }
 }
 
-int DistributedOde::psolve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, sunrealtype, sunrealtype, int,
+int DistributedOde::psolve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, sunrealtype gamma, sunrealtype, int,
                            void* user_data) {
   auto* self = static_cast<DistributedOde*>(user_data);
   try {
+    if (self->reacts_) {
+      // A non-positive pivot on any rank (the step too long for the self-heating): a recoverable
+      // failure on every rank alike, so that no rank goes on alone into the next collective call.
+      int ok = self->block_jacobi(N_VGetArrayPointer(r), N_VGetArrayPointer(z), gamma) == 0 ? 1 : 0, all = 0;
+      MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, self->problem_->comm());
+      DistributedProblem::count_reductions(1);
+      return all == 1 ? 0 : 1;
+    }
     petsc_check(VecPlaceArray(self->r_vec_, N_VGetArrayPointer(r)), "VecPlaceArray");
     petsc_check(VecPlaceArray(self->z_vec_, N_VGetArrayPointer(z)), "VecPlaceArray");
     const PetscErrorCode code = KSPSolve(self->ksp_, self->r_vec_, self->z_vec_);
@@ -259,6 +315,70 @@ int DistributedOde::psolve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector
   } catch (...) {
     return -1;
   }
+}
+
+// The free nodes with Q_i > 0 (OdeSystem::build), their Q_i, and the diagonal of J for the block Jacobi.
+void DistributedOde::build_reaction(const DistributedProblem& problem) {
+  reacts_ = problem.has_reaction();
+  consume_ = problem.reaction_consumes();
+  rx_node_.clear();
+  if (!reacts_) return;
+  const Index n = nodes();
+  for (Index i = 0; i < n; ++i)
+    if (problem.reaction().heat[i] > 0.0 && !problem.is_dirichlet_local(i)) rx_node_.push_back(i);
+  const Index nr = reacting();
+  rx_q_.resize(nr);
+  for (Index r = 0; r < nr; ++r) rx_q_[r] = problem.reaction().heat[rx_node_[static_cast<std::size_t>(r)]];
+  frozen_.setZero(nr);
+  d_tt_.setZero(nr), d_tl_.setZero(nr), d_lt_.setZero(nr), d_ll_.setZero(nr);
+  jdiag_.setZero(n);
+  const auto& start = problem.row_start();
+  const auto& col = problem.local_col();
+  for (Index i = 0; i < n; ++i)
+    for (Index e = start[static_cast<std::size_t>(i)]; e < start[static_cast<std::size_t>(i) + 1]; ++e)
+      if (col[static_cast<std::size_t>(e)] == i) jdiag_[i] += jval_[static_cast<std::size_t>(e)];
+}
+
+// OdeSystem::reaction_blocks: ∂f_T/∂y, ∂f_T/∂λ, ∂f_λ/∂y, ∂f_λ/∂λ at the reacting nodes (T = y/s).
+void DistributedOde::reaction_blocks(const double* y) {
+  const Index n = nodes();
+  const Reaction& rx = problem_->reaction();
+  for (Index r = 0; r < reacting(); ++r) {
+    const Index i = rx_node_[static_cast<std::size_t>(r)];
+    const double temp = y[i] / s_[i];
+    const double lam = consume_ ? y[n + r] : frozen_[r];
+    const double k = rx.rate_constant(temp);
+    const double dk = rx.rate_constant_derivative(temp);
+    const double c = fscale_[i] * rx_q_[r];
+    d_tt_[r] = c * (1.0 - lam) * dk / s_[i];
+    d_tl_[r] = -c * k;
+    d_lt_[r] = (1.0 - lam) * dk / s_[i];
+    d_ll_[r] = -k;
+  }
+}
+
+// OdeSystem::psolve: z = diag(I − γJ)⁻¹ r, the reacting nodes' 2×2 blocks (1×1 zero-order) inverted
+// exactly; 1 for a non-positive pivot.
+int DistributedOde::block_jacobi(const double* r, double* z, double gamma) const {
+  const Index n = nodes();
+  for (Index i = 0; i < n; ++i) z[i] = r[i] / (1.0 - gamma * jdiag_[i]);
+  for (Index q = 0; q < reacting(); ++q) {
+    const Index i = rx_node_[static_cast<std::size_t>(q)];
+    const double a11 = 1.0 - gamma * (jdiag_[i] + d_tt_[q]);
+    if (!consume_) {
+      if (!(a11 > 0.0)) return 1;
+      z[i] = r[i] / a11;
+      continue;
+    }
+    const double a12 = -gamma * d_tl_[q];
+    const double a21 = -gamma * d_lt_[q];
+    const double a22 = 1.0 - gamma * d_ll_[q];
+    const double det = a11 * a22 - a12 * a21;
+    if (!(det > 0.0) || !(a22 > 0.0)) return 1;
+    z[i] = (a22 * r[i] - a12 * r[n + q]) / det;
+    z[n + q] = (a11 * r[n + q] - a21 * r[i]) / det;
+  }
+  return 0;
 }
 
 }  // namespace frictherm::thermal::detail

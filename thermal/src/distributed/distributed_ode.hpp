@@ -4,7 +4,11 @@
 //   symmetric  y = M^{1/2} T,  f = M^{-1/2}(−K T + q),      J = −M^{-1/2} K M^{-1/2}  (PCG)
 // over the owned rows, Dirichlet rows and columns of J dropped. J·v and the preconditioner
 // P = I − γJ (a parallel PETSc AIJ matrix, owned rows, global columns) use the ghost values of
-// v fetched by the problem's VecScatter. Internal header; callbacks take this object as user_data.
+// v fetched by the problem's VecScatter. With the problem's reaction, the serial OdeSystem's state
+// and blocks (ode_system.hpp): y = [s ⊙ T; λ_r of this rank's free reacting nodes] when it consumes,
+// f_T,i += fscale_i Q_i (1 − λ) k(T_i), f_λ,r = (1 − λ_r) k(T_i), the 2×2 block per reacting node in
+// J·v, and the serial preconditioner: P = I − γJ block-Jacobi (1/(1 − γJ_ii), the 2×2 blocks inverted
+// exactly), no PETSc PC. Internal header; callbacks take this object as user_data.
 #pragma once
 
 #include "../sundials_support.hpp"
@@ -33,10 +37,17 @@ class DistributedOde {
   void build(const DistributedProblem& problem, bool symmetric, const std::string& preconditioner);
   void bind(const DistributedProblem& problem) { problem_ = &problem; }
   Index nodes() const { return s_.size(); }
+  Index reacting() const { return static_cast<Index>(rx_node_.size()); }
+  Index state_size() const { return nodes() + (consume_ ? reacting() : 0); }
+  // The problem has a reaction (the same on every rank); it consumes: J is not symmetric (GMRES).
+  bool reacts() const { return reacts_; }
+  bool nonsymmetric() const { return reacts_ && consume_; }
 
-  void to_y(const Eigen::VectorXd& T, N_Vector y) const;
-  void to_T(N_Vector y, Eigen::VectorXd& T) const;
-  void fill_abstol(double atol, N_Vector out) const;  // s_i·atol
+  // progress: λ per owned node (nullptr: 0); to_T writes it back on the reacting nodes (consuming),
+  // clamped to [0, 1], as OdeSystem::to_T.
+  void to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y);
+  void to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const;
+  void fill_abstol(double atol, double progress_atol, N_Vector out) const;  // s_i·atol, progress_atol on λ
 
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data);
   static int jtimes(N_Vector v, N_Vector jv, sunrealtype t, N_Vector y, N_Vector fy, void* user_data, N_Vector tmp);
@@ -55,6 +66,13 @@ class DistributedOde {
  private:
   void destroy_petsc();
   void assemble(double gamma);
+  void build_reaction(const DistributedProblem& problem);
+  void reaction_blocks(const double* y);  // the 2×2 blocks at y (OdeSystem::reaction_blocks)
+  int block_jacobi(const double* r, double* z, double gamma) const;
+
+  bool reacts_ = false, consume_ = false;
+  std::vector<Index> rx_node_;  // this rank's free reacting nodes (local), r = 0..R−1
+  Eigen::VectorXd rx_q_, frozen_, d_tt_, d_tl_, d_lt_, d_ll_, jdiag_;
 
   const DistributedProblem* problem_ = nullptr;
   bool symmetric_ = false;

@@ -227,6 +227,36 @@ void DistributedProblem::set_dirichlet(Index global_node, double temperature) {
   revision_ = next_revision++;
 }
 
+void DistributedProblem::set_reaction(Reaction reaction) {
+  std::string bad;
+  if (reaction.heat.size() != local_size())
+    bad = "set_reaction: " + std::to_string(reaction.heat.size()) + " heats Q_i for " + std::to_string(local_size()) +
+          " owned nodes";
+  else if (!reaction.heat.allFinite() || (reaction.heat.size() > 0 && reaction.heat.minCoeff() < 0.0))
+    bad = "set_reaction: the heats Q_i must be finite and >= 0 (J)";
+  else if (!(reaction.prefactor > 0.0 && reaction.activation_temperature > 0.0) || !std::isfinite(reaction.prefactor) ||
+           !std::isfinite(reaction.activation_temperature))
+    bad = "set_reaction: need finite Z > 0 and Θ > 0";
+  int local_bad = bad.empty() ? 0 : 1, any_bad = 0;
+  MPI_Allreduce(&local_bad, &any_bad, 1, MPI_INT, MPI_MAX, comm_);
+  if (local_bad) fail(bad);
+  if (any_bad) fail("another rank rejected its part of the reaction");
+  reaction_ = std::move(reaction);
+  has_reaction_ = true;
+  revision_ = next_revision++;
+}
+
+double DistributedProblem::released_heat(const Eigen::VectorXd& progress) const {
+  double local = 0.0, global = 0.0;
+  if (has_reaction_) {
+    if (progress.size() != local_size()) fail("released_heat: progress has the wrong size");
+    local = reaction_.heat.dot(progress);
+  }
+  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  count_reductions(1);
+  return global;
+}
+
 void DistributedProblem::apply_dirichlet(Eigen::Ref<Eigen::VectorXd> temperature) const {
   for (Index d : dirichlet_local_) temperature[d] = fixed_value_[d];
 }

@@ -39,11 +39,14 @@
 // adaptive estimate of such a node takes the smallest unknown M_i of all ranks (the serial one the
 // nearest unknown's). Plastic heat and the sub-grid relaxation as the serial Coupler
 // (decomposed_sources.cpp). Fixed-temperature faces as the serial Coupler (for_each_fixed_node: the
-// same nodes, held in both paths). Differences from the serial Coupler: that refusal; reaction heat,
-// the reuse of matrix-free gathers and the KLU solver are absent
-// (docs/distributed_coupling.md, docs/distributed_run.md).
+// same nodes, held in both paths). The sub-cell interface temperature on the owned nodes
+// (decomposed_interface.cpp) and the Arrhenius reaction with λ_p as a particle scalar
+// (decomposed_reaction.cpp), as the serial Coupler. Differences from the serial Coupler: that
+// refusal; the reuse of matrix-free gathers, the KLU solver, the interface temperature's patch and
+// forward Euler's reacting sub-steps are absent (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
+#include <frictherm/coupling/interface_reaction.hpp>
 #include <frictherm/coupling/thermal_assembly.hpp>
 #include <frictherm/mechanics/contact.hpp>
 #include <frictherm/mechanics/distributed.hpp>
@@ -89,6 +92,17 @@ struct DecomposedHeatOptions {
   /// rule) are held at the face's temperature: set before the window's sub-steps and after each
   /// (matrix-free), Dirichlet rows of the distributed problem (assembled), out of the λ bounds.
   std::vector<FixedTemperatureFace> fixed_faces;
+  /// CouplerOptions::interface_temperature (patch_length 0 only): the sub-cell interface temperature
+  /// of the nodes this rank owns (decomposed_interface.cpp), each particle's T_int,p in the particle
+  /// scalar named below; `thickness` the 2D out-of-plane thickness (CouplerOptions::thickness).
+  InterfaceTemperatureOptions interface_temperature;
+  std::string interface_scalar = "interface_temperature";
+  double thickness = 1.0;
+  /// CouplerOptions::reaction: Arrhenius heat in the reacting materials (decomposed_reaction.cpp),
+  /// every window (during_loading) or from the continuation on; λ_p in the particle scalar named
+  /// below. Reacting windows are assembled (cvode_bdf for "auto"; not forward_euler).
+  ReactionOptions reaction;
+  std::string progress_scalar = "reaction_progress";
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -102,6 +116,7 @@ struct DecomposedHeatBooks {
   double plastic_work_received = 0.0;   // Σ over steps of Δw_p of the particles with β > 0
   double plastic_heat_received = 0.0;   // Σ over steps of Σ_i β Δw_p S_ip (part of the pending heat)
   double plastic_heat_delivered = 0.0;  // of it, handed to closed windows
+  double reaction_heat_released = 0.0;  // Σ over windows and intervals of Σ_i Q_i Δλ_i
   long windows = 0;
   long continuation_intervals = 0;      // thermal-only intervals (continue_thermal)
   long substeps = 0;                    // matrix-free forward-Euler sub-steps
@@ -141,6 +156,21 @@ class DecomposedHeat {
   thermal::IntegratorStats integrator_stats() const;
 
   const DecomposedHeatBooks& books() const { return books_; }
+  /// The sub-cell interface temperature (options.interface_temperature): the hottest node's over all
+  /// ranks at the last window or interval (−∞ before any heat), as InterfaceTemperature::max_temperature;
+  /// Σ over ranks of the heat its histories recorded by then (J; equals the frictional work received).
+  bool interface_enabled() const { return opt_.interface_temperature.enabled; }
+  double max_interface_temperature() const { return interface_max_; }
+  double interface_heat_recorded() const { return interface_heat_; }
+  /// The reaction (options.reaction): the largest λ_p over ranks (collective; 0 without particles
+  /// of reacting materials), q Σ_p m_p λ_p over ranks (collective; Coupler::particle_reaction_heat).
+  bool reaction_enabled() const { return opt_.reaction.enabled; }
+  double max_reaction_progress() const;
+  double particle_reaction_heat() const;
+  /// The interface reaction (interface temperature and reaction, from the continuation on: the serial
+  /// InterfaceReaction on this rank's particles, swarm order); its largest λ_int,p over ranks.
+  const InterfaceReaction& interface_reaction() const { return interface_reaction_; }
+  double max_interface_reaction_progress() const { return interface_reaction_max_; }
   /// Σ_p m_p C_v,p T_p over all ranks (J).
   double heat_content() const;
 
@@ -168,6 +198,7 @@ class DecomposedHeat {
                            {"books/plastic_work_received", &b.plastic_work_received},
                            {"books/plastic_heat_received", &b.plastic_heat_received},
                            {"books/plastic_heat_delivered", &b.plastic_heat_delivered},
+                           {"books/reaction_heat_released", &b.reaction_heat_released},
                            {"window/pending_plastic", &pending_plastic_},
                            {"window/time", &time_}, {"window/start", &window_start_}, {"window/max_rise", &max_rise_},
                            {"window/last_lambda", &last_lambda_}, {"gather/threshold", &threshold_},
@@ -209,6 +240,17 @@ class DecomposedHeat {
   template <int Dim>
   void hot_spots_on(const mechanics::DecomposedMpm<Dim>& mpm, HotSpotTracker& tracker, const std::string& reference,
                     double time) const;
+  // decomposed_interface.cpp: InterfaceTemperature on the owned nodes (start, each step's heat, the
+  // update after each window or interval, which writes T_int,p into the particle scalar).
+  template <int Dim> InterfaceTemperature<Dim>* interface_model();
+  template <int Dim> void interface_start(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void interface_step(const std::vector<double>& work);
+  template <int Dim> void interface_update(mechanics::DecomposedMpm<Dim>& mpm);
+  // decomposed_reaction.cpp: the reacting mass and λ_i gathered from the particles (gather_reaction),
+  // and the unreacted ratio scattered back (scatter_progress), as the serial heat_sources.cpp.
+  bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }
+  template <int Dim> void reaction_gather(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void reaction_scatter(mechanics::DecomposedMpm<Dim>& mpm);
   MPI_Comm communicator() const;
   mechanics::DecomposedLocalParticles local_particles() const;
   std::vector<double> temperatures() const;
@@ -244,6 +286,19 @@ class DecomposedHeat {
   // kept in assembled_): where the continuation starts (Coupler::nodal_temperature_, system_assembled_).
   std::vector<double> last_T_;
   bool last_assembled_ = false, continuing_ = false;
+  // The interface temperature's state of the owned nodes (one of the two, with the option), its
+  // particle scalar, owned node -> grid node and back (-1: not owned), the last maximum over ranks.
+  std::unique_ptr<InterfaceTemperature<2>> interface2_;
+  std::unique_ptr<InterfaceTemperature<3>> interface3_;
+  int interface_scalar_ = -1;
+  std::vector<int> owned_grid_node_, owned_of_grid_;
+  double interface_max_ = -std::numeric_limits<double>::infinity(), interface_heat_ = 0.0;
+  // The reaction: λ_p's scalar (-1: none), the last gather's reacting mass and λ_i per owned node,
+  // λ_i now, and the particles' λ_p at the gather (swarm order; the particles do not move in between).
+  int progress_scalar_ = -1;
+  std::vector<double> reacting_mass_, nodal_progress_ref_, nodal_progress_, particle_progress_ref_;
+  InterfaceReaction interface_reaction_;
+  double interface_reaction_max_ = 0.0;
 };
 
 }  // namespace frictherm::coupling

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -27,12 +28,15 @@ std::vector<HotCandidate> gather_hot_candidates(MPI_Comm comm, const std::vector
 /// One tracker update of a decomposed run (collective): this rank's particles with their global ids
 /// (below `global_particle_count`) and reference temperatures T0_p; the tracker then holds the hot
 /// spots of all ranks (particles named by global id) and the highest temperature over all ranks.
+/// `criterion` (this rank's particles, or nullptr): the temperature each particle is judged by instead
+/// of T_p (HotSpotTracker::candidates: the sub-cell interface temperature).
 template <int Dim>
 void update_hot_spots_across_ranks(MPI_Comm comm, HotSpotTracker& tracker, const mechanics::Particles<Dim>& local,
                                    const std::vector<std::int64_t>& global_ids,
                                    const std::vector<double>& reference_temperature,
                                    const std::vector<ThermalProperties>& materials,
-                                   std::size_t global_particle_count, double time);
+                                   std::size_t global_particle_count, double time,
+                                   const std::vector<double>* criterion = nullptr);
 
 /// One rank's particles for a snapshot of a decomposed run (n particles).
 struct DecomposedSnapshot {
@@ -41,6 +45,9 @@ struct DecomposedSnapshot {
   std::vector<double> velocity;     // n × dim, m/s
   std::vector<double> temperature;  // n, K (empty: not written)
   std::vector<int> material;        // n
+  /// More per-particle scalars by name (n each; the same names on every rank), e.g. the interface
+  /// temperature: datasets beside `temperature` and XDMF attributes.
+  std::vector<std::pair<std::string, std::vector<double>>> fields;
 };
 
 /// Particle snapshots of a decomposed run (issue 16 item 3): one HDF5 file per rank,

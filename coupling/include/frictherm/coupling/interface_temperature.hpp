@@ -54,9 +54,41 @@ class InterfaceTemperature {
   void start(const mechanics::Grid<Dim>& grid, double thickness, const mechanics::Particles<Dim>& particles,
              const std::vector<ThermalProperties>& materials, const InterfaceTemperatureOptions& options,
              double time);
+  /// start() with the per-material sums Σ m_p and Σ V_p given (a decomposed run reduces them over
+  /// ranks); the particles' interface temperatures are left to the caller (T_p until the first update).
+  void start_sides(const mechanics::Grid<Dim>& grid, double thickness, const std::vector<double>& mass,
+                   const std::vector<double>& volume, const std::vector<ThermalProperties>& materials,
+                   const InterfaceTemperatureOptions& options, double time);
   bool enabled() const { return enabled_; }
   /// One mechanics step's frictional heat (J by grid node), ending at `time`.
   void add_step(const std::vector<double>& nodal_work, double time);
+  /// add_step's two halves for a caller holding some nodes only (a rank's owned nodes): the heat W
+  /// (J) of grid node `node` in this step (nothing unless W > 0), then the step's end.
+  void add_node_heat(int node, double w);
+  void end_step(double time);
+
+  // update()'s node-side pieces, for a caller that sums over its particles itself (a decomposed run:
+  // the rows summed over ranks at the nodes' owners).
+  /// Materials whose particles enter the passes (conducting, with a heat capacity).
+  bool conducting(std::size_t m) const {
+    return m < sides_.size() && sides_[m].volumetric_heat_capacity > 0.0 && sides_[m].conductivity > 0.0;
+  }
+  /// Values per row of pass 1: Σ S m per material, then Σ S m c and Σ S² m c.
+  std::size_t row_size() const { return sides_.size() + 2; }
+  /// Pass 1's term of a particle of (conducting) material m with mass `mass` and weight S > 0.
+  void add_to_row(double* row, std::size_t m, double mass, double w) const {
+    const std::size_t nm = sides_.size();
+    const double mc = mass * heat_capacity_[m];
+    row[m] += w * mass;
+    row[nm] += w * mc;
+    row[nm + 1] += w * w * mc;
+  }
+  /// From pass 1's rows (slots × row_size(), slot order of nodes()) and each slot's grid temperature
+  /// T_i at the end of the window (NaN: not a thermal unknown now): the corrections, the nodes'
+  /// interface temperatures and the maxima at `time`.
+  void update_slots(const std::vector<double>& rows, const std::vector<double>& grid_temperature, double time);
+  /// The correction a particle reads per slot after update_slots (the patch's when patch_length > 0).
+  const std::vector<double>& slot_correction() const { return patch_area_ > 0.0 ? patch_correction_ : node_correction_; }
   /// After a window or continuation interval ending at the last add_step (or later, `time`):
   /// interface temperatures of the heated nodes and of the particles.
   void update(const mechanics::Particles<Dim>& particles, mechanics::ShapeKind shape,

@@ -8,11 +8,14 @@
 // (jacobi, bjacobi, hypre BoomerAMG) on P = I − γJ assembled as a parallel PETSc matrix.
 //
 // Built only when MPI, PETSc and SUNDIALS' nvecparallel are found (target frictherm::thermal_mpi,
-// compile definition FRICTHERM_THERMAL_MPI). Not distributed yet: convection and flux boundaries
-// and the Arrhenius reaction (serial Problem only).
+// compile definition FRICTHERM_THERMAL_MPI). The Arrhenius reaction (reaction.hpp) of the owned
+// nodes is carried by the SUNDIALS integrators with the serial state [s ⊙ T; λ of the free reacting
+// nodes] (ode_system.hpp), GMRES and the serial 2×2 block-Jacobi preconditioner when it consumes
+// its reactant; not by forward_euler. Not distributed yet: convection and flux boundaries.
 #pragma once
 
 #include "frictherm/thermal/integrator.hpp"
+#include "frictherm/thermal/reaction.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -86,6 +89,15 @@ class DistributedProblem {
   bool is_dirichlet_local(Index local) const { return fixed_[static_cast<std::size_t>(local)] != 0; }
   void apply_dirichlet(Eigen::Ref<Eigen::VectorXd> temperature) const;
 
+  // ---- Arrhenius reaction (reaction.hpp): Q_i per owned node (heat.size() == local_size()) ----
+  // Collective (the same kinetics on every rank; a rank's bad Q throws on every rank).
+  void set_reaction(Reaction reaction);
+  bool has_reaction() const { return has_reaction_; }
+  bool reaction_consumes() const { return has_reaction_ && reaction_.consume; }
+  const Reaction& reaction() const { return reaction_; }
+  // Σ_i Q_i λ_i over all ranks [J] (collective; progress per owned node; 0 without a reaction).
+  double released_heat(const Eigen::VectorXd& progress) const;
+
   // ---- evaluation (collective: each call exchanges ghosts once) ----
   // w = −K T + q(t) on owned free nodes, 0 on Dirichlet nodes [W]. T, w: owned values.
   void heat_rate(double t, const double* temperature, double* w) const;
@@ -123,6 +135,8 @@ class DistributedProblem {
   bool has_source_ = false;
   Eigen::VectorXd q0_, q1_;
   double ramp_t0_ = 0.0, ramp_t1_ = 0.0;
+  bool has_reaction_ = false;
+  Reaction reaction_;
   std::vector<unsigned char> fixed_;
   std::vector<Index> dirichlet_local_;
   Eigen::VectorXd fixed_value_;
@@ -168,6 +182,11 @@ class DistributedIntegrator {
   // with the Dirichlet values first). Throws std::invalid_argument for bad input, SolverError /
   // StabilityError on failure (on every rank; T is then left unchanged).
   void advance(const DistributedProblem& problem, Eigen::VectorXd& T, double t0, double t1);
+  // The same with the reaction's progress λ per owned node (read and written on the free reacting
+  // nodes; the serial Integrator::advance with progress). Without it a reacting problem starts from
+  // fresh material (λ = 0) every window.
+  void advance(const DistributedProblem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress, double t0,
+               double t1);
   virtual std::string name() const = 0;
 
   const IntegratorStats& stats() const { return stats_; }  // global counts (same on all ranks)
@@ -178,6 +197,7 @@ class DistributedIntegrator {
  protected:
   virtual void advance_impl(const DistributedProblem& problem, Eigen::VectorXd& T, double t0, double t1) = 0;
   IntegratorStats stats_;
+  Eigen::VectorXd* progress_ = nullptr;  // the progress of the advance() in course (nullptr: λ = 0)
 
  private:
   EnergyBooks books_;
