@@ -8,11 +8,11 @@
 // Measured (J per metre of thickness; the reference is the second order at C = 0.05; frictionless
 // velocity-boundary walls, contact min_mass_fraction 0.02 and extent separation as in the scene):
 //   C      W1        W2        error W1   error W2
-//   1      0.0831    0.0597     240 %      144 %
-//   0.5    0.0382    0.0312      56 %       28 %
-//   0.25   0.0280    0.0249      15 %      1.7 %
-//   0.1    0.0251    0.0232     2.5 %      5.0 %
-//   0.05   0.0258    0.0245
+//   1      0.0669    0.0472     180 %       98 %
+//   0.5    0.0382    0.0313      60 %       31 %
+//   0.25   0.0280    0.0249      17 %      4.1 %
+//   0.1    0.0250    0.0232     4.7 %      2.8 %
+//   0.05   0.0252    0.0239
 // (displacement separation, the scene's choice before issue 31: 240 / 128, 117 / 60, 24 / 5.8,
 // 3.2 / 6.2 %; the same findings.)
 // Below C = 0.25 both orders sit within a few per cent of each other and of the reference (the
@@ -91,7 +91,7 @@ TEST(PbxCompaction, SecondOrderHeatingConvergesFasterWithC) {
 
 // The issue's target on the example's own combination (USL, FLIP/PIC blend τ = 30 ns): over five
 // packings, the median second-order work at C = 0.5 within 10 % of its value at C = 0.1. Measured
-// (J/m), extent separation: C = 0.5 median 0.0150, C = 0.1 median 0.0163 (−7.8 %; displacement
+// (J/m), extent separation: C = 0.5 median 0.0150, C = 0.1 median 0.0163 (−7.9 %; displacement
 // separation 0.0138 against 0.0151, −8.3 %); MUSL with pure FLIP gives +68 %, the
 // work growing linearly with C (docs/transfer.md). The seeds scatter the work by ±15 %, so one seed
 // alone would not show the trend.
