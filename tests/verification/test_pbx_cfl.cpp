@@ -6,13 +6,15 @@
 // 240 µm specimen is examples/pbx_compaction.json with examples/pbx_figures.py --cfl-sweep.
 //
 // Measured (J per metre of thickness; the reference is the second order at C = 0.05; frictionless
-// velocity-boundary walls, contact min_mass_fraction 0.02 as in the scene):
+// velocity-boundary walls, contact min_mass_fraction 0.02 and extent separation as in the scene):
 //   C      W1        W2        error W1   error W2
-//   1      0.0689    0.0463     240 %      128 %
-//   0.5    0.0440    0.0325     117 %       60 %
-//   0.25   0.0252    0.0215      24 %      5.8 %
-//   0.1    0.0209    0.0190     3.2 %      6.2 %
-//   0.05   0.0218    0.0203
+//   1      0.0669    0.0472     180 %       98 %
+//   0.5    0.0382    0.0313      60 %       31 %
+//   0.25   0.0280    0.0249      17 %      4.1 %
+//   0.1    0.0250    0.0232     4.7 %      2.8 %
+//   0.05   0.0252    0.0239
+// (displacement separation, the scene's choice before issue 31: 240 / 128, 117 / 60, 24 / 5.8,
+// 3.2 / 6.2 %; the same findings.)
 // Below C = 0.25 both orders sit within a few per cent of each other and of the reference (the
 // run-to-run scatter of this partly chaotic compaction); above it the second order is the closer one,
 // by a factor two to four: the paper's finding, second-order heating is accurate at a larger C.
@@ -89,7 +91,8 @@ TEST(PbxCompaction, SecondOrderHeatingConvergesFasterWithC) {
 
 // The issue's target on the example's own combination (USL, FLIP/PIC blend τ = 30 ns): over five
 // packings, the median second-order work at C = 0.5 within 10 % of its value at C = 0.1. Measured
-// (J/m): C = 0.5 median 0.0145, C = 0.1 median 0.0154 (−5.4 %); MUSL with pure FLIP gives +68 %, the
+// (J/m), extent separation: C = 0.5 median 0.0150, C = 0.1 median 0.0163 (−7.9 %; displacement
+// separation 0.0138 against 0.0151, −8.3 %); MUSL with pure FLIP gives +68 %, the
 // work growing linearly with C (docs/transfer.md). The seeds scatter the work by ±15 %, so one seed
 // alone would not show the trend.
 TEST(PbxCompaction, MedianWorkOfFivePackingsAtHalfCflWithinTenPercentOfSmallCfl) {
