@@ -1,5 +1,6 @@
 // A scene run by `frictherm run` and by `mpirun -n K frictherm run`, and their series compared column
-// by column (tests/coupling/test_cli_mpirun_loads.cpp, test_cli_mpirun_musl.cpp).
+// by column, and the last snapshot's particles by id (tests/coupling/test_cli_mpirun_loads.cpp,
+// test_cli_mpirun_musl.cpp, test_cli_mpirun_ebs.cpp).
 #pragma once
 
 #include "cli_test_support.hpp"
@@ -51,6 +52,66 @@ class MpirunCompare : public MpirunScratchTest {
     EXPECT_LE(diff, tolerance * scale) << name;
     std::printf("  %-22s max |serial - split| = %.3g of %.6g\n", name.c_str(), diff / scale, scale);
     return diff / scale;
+  }
+
+  // Every column both files hold within `tolerance` of the serial column's largest magnitude (a column
+  // that is 0 throughout in the serial run must be 0 in the split one); returns how many were compared.
+  int compare_series(double tolerance, double floor = 1e-6) {
+    const std::vector<std::string> serial = names_in(path("serial.h5"), "/series");
+    int compared = 0;
+    double worst = 0.0;
+    for (const std::string& c : names_in(path("split.h5"), "/series")) {
+      if (std::find(serial.begin(), serial.end(), c) == serial.end()) continue;
+      const std::vector<double> a = column("serial.h5", c), b = column("split.h5", c);
+      EXPECT_EQ(a.size(), b.size()) << c;
+      double scale = 0.0, diff = 0.0;
+      for (double x : a) scale = std::max(scale, std::fabs(x));
+      // energy_lost and numerical_dissipation are differences of the energies: their round-off is the
+      // total energy's.
+      if (c == "energy_lost" || c == "numerical_dissipation")
+        for (double x : column("serial.h5", "total_energy")) scale = std::max(scale, std::fabs(x));
+      for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) diff = std::max(diff, std::fabs(a[k] - b[k]));
+      // A column below `floor` in magnitude is zero up to round-off in the scene (the EBS Hertz disks:
+      // the momenta of the symmetric pair, ~1e-16 kg m/s; the strain energy's first rows): bounded as
+      // if it were `floor`.
+      EXPECT_LE(diff, tolerance * std::max(scale, floor)) << c;
+      const double rel = scale > 0.0 ? diff / scale : diff;
+      worst = std::max(worst, rel);
+      std::printf("  %-34s max |serial - split| = %.3g of %.6g\n", c.c_str(), rel, scale);
+      ++compared;
+    }
+    std::printf("  largest relative difference over %d columns: %.3g\n", compared, worst);
+    return compared;
+  }
+
+  // The last snapshot's positions over the rank files against serial.h5's, by id: every particle held
+  // once, the largest difference (m).
+  double compare_positions(int ranks) {
+    const std::vector<std::string> snaps = names_in(path("serial.h5"), "/snapshots");
+    EXPECT_FALSE(snaps.empty());
+    if (snaps.empty()) return std::nan("");
+    const std::string snap = "/snapshots/" + snaps.back() + "/";
+    const std::vector<double> xs = read_doubles(path("serial.h5"), snap + "position");
+    const std::size_t n = xs.size() / 2;
+    std::vector<int> seen(n, 0);
+    double dx = 0.0;
+    for (int r = 0; r < ranks; ++r) {
+      const std::string f = "split.rank" + std::to_string(r) + ".h5";
+      const std::vector<double> id = read_doubles(path(f), snap + "id");
+      const std::vector<double> x = read_doubles(path(f), snap + "position");
+      EXPECT_EQ(x.size(), 2 * id.size()) << f;
+      if (x.size() != 2 * id.size()) return std::nan("");
+      for (std::size_t k = 0; k < id.size(); ++k) {
+        const auto i = static_cast<std::size_t>(id[k]);
+        EXPECT_LT(i, n) << f;
+        if (i >= n) return std::nan("");
+        ++seen[i];
+        for (std::size_t d = 0; d < 2; ++d) dx = std::max(dx, std::fabs(x[2 * k + d] - xs[2 * i + d]));
+      }
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n)) << "every particle once in " << snap;
+    std::printf("  %s: %zu particles, largest position difference %.3g m\n", snap.c_str(), n, dx);
+    return dx;
   }
 };
 

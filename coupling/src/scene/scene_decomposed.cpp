@@ -30,13 +30,10 @@ std::string mechanics_refusal(const Scene& s) {
   const mechanics::SimulationOptions& o = s.options;
   // Every shape function runs decomposed, the extended B-spline too (the serial EbsBasis on the
   // particles gathered from all ranks, a ghost layer of its reach: mechanics/src/distributed/extended_bsplines.cpp).
-  // USL, and MUSL without contact (DecomposedMpm: the USL phases with the remap and its exchange).
+  // USL, and MUSL with or without contact (DecomposedMpm: the USL phases with the remap, its
+  // exchange and, with multimaterial contact, the contact pass on the remapped momenta).
   if (o.scheme == mechanics::UpdateScheme::usf)
     return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");
-  if (o.scheme == mechanics::UpdateScheme::musl && s.contact.enabled &&
-      s.contact.options.default_pair.method != mechanics::ContactMethod::penalty)
-    return refuse("solver.scheme", quoted("musl") + " with multimaterial contact",
-                  "\"usl\", or \"musl\" without contact or with penalty contact");
   if (o.particle_update != mechanics::ParticleUpdate::flip)
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
   // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).

@@ -95,9 +95,10 @@ void DecomposedMpm<Dim>::Impl::find_contact_nodes(double /*dt*/) {
   }
 }
 
-// Phase 6: contact on the extrapolated momenta (momentum changes only).
+// Phase 6: contact on the extrapolated momenta (momentum changes only); it opens the step's contact.
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::contact_extrapolated(double dt) {
+  contact_failure.clear();
   resolve_contact(false, dt);
 }
 
@@ -105,6 +106,16 @@ void DecomposedMpm<Dim>::Impl::contact_extrapolated(double dt) {
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::contact_updated(double dt) {
   resolve_contact(true, dt);
+}
+
+// MUSL: contact on the momenta remapped from the updated particles, after their exchange to the owners
+// (the serial ContactPass::remapped: momentum changes only, as phase 6). The contact nodes and groups
+// are those of phase 5: the remap refills the same slots (particle_to_grid's masses, forces and
+// contact terms with the new momenta), so fields_to_owners rebuilds the same groups with the same
+// sums of m, Σ S m x, Ω, g, and the extents measured for them still apply.
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::contact_remapped(double dt) {
+  resolve_contact(false, dt);
 }
 
 // The serial gather_contact_sides on the owner's complete group g: the fields with mass, those
@@ -161,7 +172,6 @@ template <int Dim>
 void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   constexpr int momentum = Dof::momentum, force = Dof::force;
   if (updated) stats = DecomposedContactStats{};
-  if (!updated) contact_failure.clear();  // phase 6 opens the step's contact
   if (contact_nodes.empty()) return;
   const ContactOptions& co = opt.contact_options;
   const Vec<Dim> h = grid.cell_size();
@@ -249,6 +259,7 @@ DecomposedContactStats DecomposedMpm<Dim>::contact_stats() const {
   template void DecomposedMpm<D>::Impl::find_contact_nodes(double);                     \
   template void DecomposedMpm<D>::Impl::contact_extrapolated(double);                   \
   template void DecomposedMpm<D>::Impl::contact_updated(double);                        \
+  template void DecomposedMpm<D>::Impl::contact_remapped(double);                       \
   template void DecomposedMpm<D>::Impl::resolve_contact(bool, double);                  \
   template long DecomposedMpm<D>::Impl::gather_sides(std::size_t, double, std::vector<ContactSide<D>>&,         \
                                                      std::vector<int>&, std::vector<std::size_t>&) const;     \

@@ -397,6 +397,7 @@ struct DecomposedMpm<Dim>::Impl {
   void contact_extrapolated(double dt);
   void momentum_update(double dt);
   void contact_updated(double dt);
+  void contact_remapped(double dt);  // MUSL: contact on the remapped momenta
   void nodal_velocities(double dt);
   void ghost_velocities(double dt);
   void fields_to_ghosts(double dt);

@@ -150,9 +150,6 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
     s.laws.push_back(stress_law(m, options.analysis));
     s.has_mie_gruneisen = s.has_mie_gruneisen || mg;
   }
-  if (options.musl && options.contact && options.penalty_pairs.empty())
-    throw std::invalid_argument("decomposed mechanics: MUSL with multimaterial contact is not supported (expected "
-                                "USL, or MUSL without contact or with penalty contact)");
   s.opt = options;
   // The loads by particle id (stable: a particle's loads in the serial order), found by particle_to_grid.
   s.loads = options.loads;

@@ -473,18 +473,22 @@ void DecomposedMpm<Dim>::step(double dt) {
                                     {&Impl::migrate, 13}};
     // MUSL: USL's phases up to the grid-to-particle update (with several velocity fields the slots of
     // particle_to_grid kept), then the momenta remapped from the updated particles with their exchange
-    // (sum to the owners, the per-field entries to the owners, the velocity conditions and
-    // v_i = p_i/m_i there, the ghost update), the penalty contact's points moved with those velocities
-    // and the stress update from them (the serial MUSL list, simulation_step.cpp). Multimaterial grid
-    // contact on the remapped momenta is not here (refused: DecomposedMpm's constructor).
+    // (sum to the owners, the per-field entries to the owners, multimaterial contact on the remapped
+    // momenta there, the velocity conditions and v_i = p_i/m_i, the ghost update), the penalty
+    // contact's points moved with those velocities and the stress update from them (the serial MUSL
+    // list, simulation_step.cpp: contact_extrapolated, contact_updated, contact_remapped). The
+    // remapped pass is timed with the extrapolated one (both momentum changes only).
     static constexpr Phase musl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
                                      {&Impl::keep_grid_values, 0},
                                      {&Impl::sum_to_owners, 1},
                                      {&Impl::exchange_field_ranges, 2},
                                      {&Impl::fields_to_owners, 3},
                                      {&Impl::find_contact_nodes, 4},
+                                     {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
+                                     {&Impl::contact_extrapolated, 5},
                                      {&Impl::penalty_forces, 16},
                                      {&Impl::momentum_update, 6},
+                                     {&Impl::contact_updated, 7},
                                      {&Impl::nodal_velocities, 8},
                                      {&Impl::ghost_velocities, 9},
                                      {&Impl::fields_to_ghosts, 10},
@@ -492,6 +496,7 @@ void DecomposedMpm<Dim>::step(double dt) {
                                      {&Impl::template remap_momentum<Kernel>, 14},
                                      {&Impl::sum_to_owners, 1},
                                      {&Impl::fields_to_owners, 3},
+                                     {&Impl::contact_remapped, 5},
                                      {&Impl::velocity_from_momentum, 15},
                                      {&Impl::move_boundary_points, 17},
                                      {&Impl::ghost_velocities, 9},
