@@ -10,7 +10,10 @@
 // about the run being resumable, not about the summation order).
 //   * `kill -TERM` to mpirun twice, 50 ms apart;
 //   * SIGTERM to `timeout`, which sends it to mpirun and then to its whole process group, as it does
-//     when its time is up (the ranks are not in that group: Open MPI starts each in its own).
+//     when its time is up (the ranks are not in that group: Open MPI starts each in its own);
+//   * `kill -USR1` to mpirun twice: mpirun forwards SIGUSR1 to every rank each time and goes on, and the
+//     ranks take it as SIGTERM (run_signals.cpp), so this one must end as one SIGTERM does: OUT.h5 published
+//     with status `interrupted`, "interrupted by SIGUSR1", the final checkpoint, exit code 128 + 10.
 // Signalled once the first checkpoint is committed (the run is in its steps: no timing assumption).
 // Skipped when mpirun is not installed. Labels verification;mpi.
 #include <gmock/gmock.h>
@@ -33,14 +36,16 @@ using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, re
 
 namespace {
 
-// About 3300 steps, a checkpoint every 330 of them.
-const std::string kSets = " --set run.end_time=1e-2 --set run.checkpoint_interval=1e-3";
+// About 1650 steps, a checkpoint every 165 of them.
+const std::string kSets = " --set run.end_time=5e-3 --set run.checkpoint_interval=5e-4";
 
 class CliMpirunSignals : public MpirunScratchTest {
  protected:
   CliMpirunSignals() : MpirunScratchTest("frictherm_mpirun_signals_") {}
 
-  std::string text(const std::string& name) const {
+ public:
+  std::string file(const std::string& name) const { return path(name); }
+  std::string log(const std::string& name) const {
     std::ifstream in(path(name));
     std::stringstream s;
     s << in.rdbuf();
@@ -48,7 +53,22 @@ class CliMpirunSignals : public MpirunScratchTest {
   }
 };
 
+// The uninterrupted run, then each way of signalling in `hows` followed by `resume`.
+void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows);
+
 TEST_F(CliMpirunSignals, TwoSigtermsLeaveACheckpointThatResumesToTheUninterruptedRun) {
+  check_signalled_runs_resume(*this, {"mpirun"});
+}
+
+TEST_F(CliMpirunSignals, TimeoutLeavesACheckpointThatResumesToTheUninterruptedRun) {
+  check_signalled_runs_resume(*this, {"timeout"});
+}
+
+TEST_F(CliMpirunSignals, TwoSigusr1sEndAsOneSigterm) { check_signalled_runs_resume(*this, {"usr1"}); }
+
+void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows) {
+  const auto path = [&t](const std::string& name) { return t.file(name); };
+  const auto text = [&t](const std::string& name) { return t.log(name); };
   const std::string mpirun = frictherm::test::mpirun_command(2) + " " + exe();
   const std::string whole = path("whole.h5");
   const Result w = shell("timeout -s TERM 240 " + mpirun + " run " + scene("decomposed_sliding_block.json") + kSets +
@@ -56,22 +76,28 @@ TEST_F(CliMpirunSignals, TwoSigtermsLeaveACheckpointThatResumesToTheUninterrupte
   ASSERT_EQ(w.code, 0) << w.output;
   const std::vector<double> whole_time = read_doubles(whole, "/series/time");
 
-  for (const std::string how : {"mpirun", "timeout"}) {
+  for (const std::string& how : hows) {
     const std::string out = path(how + ".h5"), log = how + ".log";
     const std::string run = mpirun + " run " + scene("decomposed_sliding_block.json") + kSets + " -q -o '" + out +
                             "' > '" + path(log) + "' 2>&1";
     // Until the first checkpoint is committed (renamed into place), then the two signals.
     const std::string started = "for i in $(seq 1 1200); do [ -e '" + out + ".checkpoint' ] && break; sleep 0.1; done; ";
-    const std::string twice = how == "mpirun"
-        ? "kill -TERM $pid; sleep 0.05; kill -TERM $pid; "  // $pid is mpirun (sh and env exec it)
+    const std::string sig = how == "usr1" ? "USR1" : "TERM";
+    const std::string twice = how != "timeout"
+        ? "kill -" + sig + " $pid; sleep 0.05; kill -" + sig + " $pid; "  // $pid is mpirun (sh and env exec it)
         : "kill -TERM $pid; ";  // timeout: to mpirun, then to its process group (mpirun again)
-    const Result r = shell((how == "mpirun" ? "sh -c \"exec " + run + "\"" : "timeout -s TERM 600 " + run) +
+    const Result r = shell((how != "timeout" ? "sh -c \"exec " + run + "\"" : "timeout -s TERM 600 " + run) +
                            " & pid=$!; " + started + twice + "wait $pid");
     const std::string said = text(log);
     EXPECT_NE(r.code, 0) << how << ": " << said;
     // Never nothing: a committed checkpoint whatever mpirun did to the ranks.
     ASSERT_TRUE(fs::exists(out + ".checkpoint")) << how << ": " << said;
     const bool published = fs::exists(out);
+    if (how == "usr1") {
+      EXPECT_EQ(r.code, 128 + 10) << said;
+      EXPECT_TRUE(published) << said;
+      EXPECT_THAT(said, ::testing::HasSubstr("interrupted by SIGUSR1"));
+    }
     std::cout << how << ": mpirun exit " << r.code << ", " << (published ? "OUT.h5 published, status " + read_text(out, "/meta/status")
                                                                          : std::string("OUT.h5 not published (killed)"))
               << "\n";
