@@ -191,7 +191,8 @@ TEST_F(CliMpirunFaults, SigtermLeavesACheckpointThatResumesToTheUninterruptedRun
   ASSERT_EQ(whole.code, 0) << whole.output;
   // Twice (`timeout` signalled) is left out: 1 run of 2 failed, mpirun itself killed the ranks when the
   // second SIGTERM reached it after it had handled the first (Open MPI forces the job down on a repeated
-  // signal), leaving only twice.h5.<pid>.part; see docs/robustness.md, "Signals".
+  // signal), leaving only twice.h5.<pid>.part; see docs/robustness.md, "Two signals under mpirun", and
+  // test_cli_mpirun_signals.cpp (what holds then: the earlier committed checkpoint resumes).
   for (const bool twice : {false}) {
     const std::string out = path(twice ? "twice.h5" : "once.h5"), log = path(twice ? "twice.log" : "once.log");
     const std::string run = frictherm::test::mpirun_command(2) + " " + exe() + " run " + scene() + end + " -q -o '" +

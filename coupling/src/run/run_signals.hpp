@@ -1,5 +1,5 @@
 #pragma once
-// SIGINT / SIGTERM during a run: the first one asks the run loop to stop after the current step
+// SIGINT / SIGTERM / SIGUSR1 during a run: the first one asks the run loop to stop after the current step
 // (final checkpoint, flush, status `interrupted`, exit code 128 + signal); a second one is absorbed
 // (`timeout` sends two), a third ends the process at once (the file keeps what its last flush held).
 namespace frictherm::coupling::detail {
@@ -17,10 +17,10 @@ class InterruptGuard {
   bool enabled_;
 };
 
-/// The signal received since the guard was installed (SIGINT, SIGTERM), or 0.
+/// The signal received since the guard was installed (SIGINT, SIGTERM, SIGUSR1), or 0.
 int interrupt_signal();
 
-/// "SIGINT" / "SIGTERM" / "signal N".
+/// "SIGINT" / "SIGTERM" / "SIGUSR1" / "a signal".
 const char* signal_name(int signal);
 
 }  // namespace frictherm::coupling::detail

@@ -1,0 +1,125 @@
+// Two SIGTERMs to `mpirun -n 2 frictherm run` (issue 34 item 5; docs/robustness.md, "Signals";
+// docs/distributed_run.md item 9): the run must never be lost. Open MPI 4.1's mpirun answers its first
+// SIGTERM by signalling the ranks (which stop after the same step and write a final checkpoint) and a
+// second one within 5 s by exit(1), after which the ranks die with it, possibly while writing. What must
+// hold either way: a committed checkpoint — the final one, or the earlier one of run.checkpoint_interval,
+// which a kill mid-write does not damage (rank files first, then the global file renamed over the
+// previous one: docs/checkpoints.md, "Atomic over the ranks") — and `mpirun -n 2 frictherm resume OUT.h5`
+// completing to the uninterrupted run's series (within 1e-9 of each column's largest magnitude: the
+// resumed steps are the same arithmetic, bit for bit in the measured runs; the margin only keeps the test
+// about the run being resumable, not about the summation order).
+//   * `kill -TERM` to mpirun twice, 50 ms apart;
+//   * SIGTERM to `timeout`, which sends it to mpirun and then to its whole process group, as it does
+//     when its time is up (the ranks are not in that group: Open MPI starts each in its own);
+//   * `kill -USR1` to mpirun twice: mpirun forwards SIGUSR1 to every rank each time and goes on, and the
+//     ranks take it as SIGTERM (run_signals.cpp), so this one must end as one SIGTERM does: OUT.h5 published
+//     with status `interrupted`, "interrupted by SIGUSR1", the final checkpoint, exit code 128 + 10.
+// Signalled once the first checkpoint is committed (the run is in its steps: no timing assumption).
+// Skipped when mpirun is not installed. Labels verification;mpi.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "cli_mpirun_test_support.hpp"
+#include "h5_test_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, read_text, ...
+
+namespace {
+
+// About 1650 steps, a checkpoint every 165 of them.
+const std::string kSets = " --set run.end_time=5e-3 --set run.checkpoint_interval=5e-4";
+
+class CliMpirunSignals : public MpirunScratchTest {
+ protected:
+  CliMpirunSignals() : MpirunScratchTest("frictherm_mpirun_signals_") {}
+
+ public:
+  std::string file(const std::string& name) const { return path(name); }
+  std::string log(const std::string& name) const {
+    std::ifstream in(path(name));
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+};
+
+// The uninterrupted run, then each way of signalling in `hows` followed by `resume`.
+void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows);
+
+TEST_F(CliMpirunSignals, TwoSigtermsLeaveACheckpointThatResumesToTheUninterruptedRun) {
+  check_signalled_runs_resume(*this, {"mpirun"});
+}
+
+TEST_F(CliMpirunSignals, TimeoutLeavesACheckpointThatResumesToTheUninterruptedRun) {
+  check_signalled_runs_resume(*this, {"timeout"});
+}
+
+TEST_F(CliMpirunSignals, TwoSigusr1sEndAsOneSigterm) { check_signalled_runs_resume(*this, {"usr1"}); }
+
+void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows) {
+  const auto path = [&t](const std::string& name) { return t.file(name); };
+  const auto text = [&t](const std::string& name) { return t.log(name); };
+  const std::string mpirun = frictherm::test::mpirun_command(2) + " " + exe();
+  const std::string whole = path("whole.h5");
+  const Result w = shell("timeout -s TERM 240 " + mpirun + " run " + scene("decomposed_sliding_block.json") + kSets +
+                         " -q -o '" + whole + "'");
+  ASSERT_EQ(w.code, 0) << w.output;
+  const std::vector<double> whole_time = read_doubles(whole, "/series/time");
+
+  for (const std::string& how : hows) {
+    const std::string out = path(how + ".h5"), log = how + ".log";
+    const std::string run = mpirun + " run " + scene("decomposed_sliding_block.json") + kSets + " -q -o '" + out +
+                            "' > '" + path(log) + "' 2>&1";
+    // Until the first checkpoint is committed (renamed into place), then the two signals.
+    const std::string started = "for i in $(seq 1 1200); do [ -e '" + out + ".checkpoint' ] && break; sleep 0.1; done; ";
+    const std::string sig = how == "usr1" ? "USR1" : "TERM";
+    const std::string twice = how != "timeout"
+        ? "kill -" + sig + " $pid; sleep 0.05; kill -" + sig + " $pid; "  // $pid is mpirun (sh and env exec it)
+        : "kill -TERM $pid; ";  // timeout: to mpirun, then to its process group (mpirun again)
+    const Result r = shell((how != "timeout" ? "sh -c \"exec " + run + "\"" : "timeout -s TERM 600 " + run) +
+                           " & pid=$!; " + started + twice + "wait $pid");
+    const std::string said = text(log);
+    EXPECT_NE(r.code, 0) << how << ": " << said;
+    // Never nothing: a committed checkpoint whatever mpirun did to the ranks.
+    ASSERT_TRUE(fs::exists(out + ".checkpoint")) << how << ": " << said;
+    const bool published = fs::exists(out);
+    if (how == "usr1") {
+      EXPECT_EQ(r.code, 128 + 10) << said;
+      EXPECT_TRUE(published) << said;
+      EXPECT_THAT(said, ::testing::HasSubstr("interrupted by SIGUSR1"));
+    }
+    std::cout << how << ": mpirun exit " << r.code << ", " << (published ? "OUT.h5 published, status " + read_text(out, "/meta/status")
+                                                                         : std::string("OUT.h5 not published (killed)"))
+              << "\n";
+    if (published) {  // the ranks finished their final checkpoint: the interrupted result is readable
+      EXPECT_EQ(read_text(out, "/meta/status"), "interrupted") << how << ": " << said;
+      EXPECT_LT(read_doubles(out, "/series/time").back(), whole_time.back()) << how;
+    }
+    const Result resumed = shell("timeout -s TERM 240 " + mpirun + " resume '" + out + "' -q");
+    ASSERT_EQ(resumed.code, 0) << how << ": " << resumed.output;
+    EXPECT_EQ(read_text(out, "/meta/status"), "completed") << how;
+    for (const char* column : {"/series/time", "/series/kinetic_energy", "/series/friction_work_first",
+                               "/series/max_temperature"}) {
+      const std::vector<double> a = read_doubles(out, column), b = read_doubles(whole, column);
+      ASSERT_EQ(a.size(), b.size()) << how << " " << column;
+      double scale = 0.0, diff = 0.0;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        scale = std::max(scale, std::abs(b[i]));
+        diff = std::max(diff, std::abs(a[i] - b[i]));
+      }
+      EXPECT_LE(diff, 1e-9 * scale) << how << " " << column;
+    }
+  }
+}
+
+}  // namespace
