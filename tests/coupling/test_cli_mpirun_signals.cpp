@@ -23,12 +23,14 @@
 #include "h5_test_support.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -36,8 +38,10 @@ using namespace frictherm::test;  // exe, scene, shell, Result, read_doubles, re
 
 namespace {
 
-// About 1650 steps, a checkpoint every 165 of them.
-const std::string kSets = " --set run.end_time=5e-3 --set run.checkpoint_interval=5e-4";
+// About 5000 steps (3-4 s on 2 ranks), a checkpoint every 330 of them: mpirun hands a signal on to the
+// ranks only after odls_base_sigkill_timeout (1 s), so the run must last well beyond its first checkpoint
+// (5e-3 s, 1.5 s, ended first: "OUT.h5 published, status completed").
+const std::string kSets = " --set run.end_time=1.5e-2 --set run.checkpoint_interval=1e-3";
 
 class CliMpirunSignals : public MpirunScratchTest {
  protected:
@@ -52,6 +56,29 @@ class CliMpirunSignals : public MpirunScratchTest {
     return s.str();
   }
 };
+
+// Waits (up to `seconds`) until no process's command line names `path`: when mpirun exits at the second
+// SIGTERM its ranks are orphaned and die a moment later; until then they hold OUT.rank<r>.h5 locked, and
+// a resume started at once is refused ("unable to lock file"). Reads /proc (procps is not everywhere).
+bool wait_until_no_process_names(const std::string& path, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (true) {
+    bool found = false;
+    for (const auto& e : fs::directory_iterator("/proc")) {
+      const std::string pid = e.path().filename().string();
+      if (pid.empty() || !std::all_of(pid.begin(), pid.end(), ::isdigit)) continue;
+      std::ifstream in(e.path() / "cmdline", std::ios::binary);
+      std::string cmdline((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (cmdline.find(path) != std::string::npos && cmdline.find("frictherm") != std::string::npos) {
+        found = true;
+        break;
+      }
+    }
+    if (!found) return true;
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+}
 
 // The uninterrupted run, then each way of signalling in `hows` followed by `resume`.
 void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows);
@@ -105,6 +132,7 @@ void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<st
       EXPECT_EQ(read_text(out, "/meta/status"), "interrupted") << how << ": " << said;
       EXPECT_LT(read_doubles(out, "/series/time").back(), whole_time.back()) << how;
     }
+    ASSERT_TRUE(wait_until_no_process_names(out, 60.0)) << how << ": the ranks outlived mpirun by a minute";
     const Result resumed = shell("timeout -s TERM 240 " + mpirun + " resume '" + out + "' -q");
     ASSERT_EQ(resumed.code, 0) << how << ": " << resumed.output;
     EXPECT_EQ(read_text(out, "/meta/status"), "completed") << how;
