@@ -175,14 +175,8 @@ int OdeSystem::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
     auto out = view(ydot);
     self->t_work_ = yv.head(n).cwiseQuotient(self->s_);
     self->problem_->transport_heat_rate(t, self->t_work_, self->w_work_);
-    const Reaction& rx = self->problem_->reaction();
-    for (Index r = 0; r < self->reacting(); ++r) {
-      const Index i = self->rx_node_[static_cast<std::size_t>(r)];
-      const double remaining = 1.0 - (self->consume_ ? yv[n + r] : self->frozen_[r]);
-      const double rate = remaining * rx.rate_constant(self->t_work_[i]);  // (1 − λ) k(T)
-      self->w_work_[i] += self->rx_q_[r] * rate;
-      if (self->consume_) out[n + r] = rate;
-    }
+    add_reaction_rates(self->problem_->reaction(), self->reaction_nodes(), self->t_work_.data(), yv.data() + n,
+                       self->w_work_.data(), out.data() + n);
     out.head(n) = self->fscale_.cwiseProduct(self->w_work_);
     return 0;
   } catch (...) {
@@ -203,19 +197,9 @@ void OdeSystem::reaction_blocks(N_Vector y) {
     if (same) return;
   }
   cache_key_.resize(nkey);
-  const Reaction& rx = problem_->reaction();
+  evaluate_reaction_blocks(problem_->reaction(), reaction_nodes(), yv.data(), n, s_, fscale_, reaction_blocks());
   for (Index r = 0; r < nr; ++r) {
-    const Index i = rx_node_[static_cast<std::size_t>(r)];
-    const double temp = yv[i] / s_[i];
-    const double lam = consume_ ? yv[n + r] : frozen_[r];
-    const double k = rx.rate_constant(temp);
-    const double dk = rx.rate_constant_derivative(temp);
-    const double c = fscale_[i] * rx_q_[r];
-    d_tt_[r] = c * (1.0 - lam) * dk / s_[i];
-    d_tl_[r] = -c * k;
-    d_lt_[r] = (1.0 - lam) * dk / s_[i];
-    d_ll_[r] = -k;
-    cache_key_[r] = yv[i];
+    cache_key_[r] = yv[rx_node_[static_cast<std::size_t>(r)]];
     if (consume_) cache_key_[nr + r] = yv[n + r];
   }
   cache_valid_ = true;
@@ -256,14 +240,7 @@ int OdeSystem::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector y, N_Vector
   out.noalias() = self->jac_ * in;  // exact stencil apply
   if (!self->has_reaction()) return 0;
   self->reaction_blocks(y);  // exact J·v at the current iterate
-  const Index n = self->nodes();
-  for (Index r = 0; r < self->reacting(); ++r) {
-    const Index i = self->rx_node_[static_cast<std::size_t>(r)];
-    out[i] += self->d_tt_[r] * in[i];
-    if (!self->consume_) continue;
-    out[i] += self->d_tl_[r] * in[n + r];
-    out[n + r] = self->d_lt_[r] * in[i] + self->d_ll_[r] * in[n + r];
-  }
+  add_reaction_jv(self->reaction_nodes(), self->reaction_blocks_view(), in.data(), out.data(), self->nodes());
   return 0;
 }
 
@@ -285,24 +262,8 @@ int OdeSystem::psolve(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, s
   if (!self->has_reaction()) return 0;
   // Reacting nodes: exact inverse of the 2×2 block of I − γJ (1×1 when zero-order). A
   // non-positive pivot means the step is too long for the self-heating: recoverable failure.
-  const Index n = self->nodes();
-  for (Index q = 0; q < self->reacting(); ++q) {
-    const Index i = self->rx_node_[static_cast<std::size_t>(q)];
-    const double a11 = 1.0 - gamma * (self->jdiag_[i] + self->d_tt_[q]);
-    if (!self->consume_) {
-      if (!(a11 > 0.0)) return 1;
-      zv[i] = rv[i] / a11;
-      continue;
-    }
-    const double a12 = -gamma * self->d_tl_[q];
-    const double a21 = -gamma * self->d_lt_[q];
-    const double a22 = 1.0 - gamma * self->d_ll_[q];
-    const double det = a11 * a22 - a12 * a21;
-    if (!(det > 0.0) || !(a22 > 0.0)) return 1;
-    zv[i] = (a22 * rv[i] - a12 * rv[n + q]) / det;
-    zv[n + q] = (a11 * rv[n + q] - a21 * rv[i]) / det;
-  }
-  return 0;
+  return invert_reaction_blocks(self->reaction_nodes(), self->reaction_blocks_view(), self->jdiag_.data(), gamma,
+                                rv.data(), zv.data(), self->nodes());
 }
 
 }  // namespace frictherm::thermal::detail

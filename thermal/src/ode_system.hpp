@@ -19,6 +19,7 @@
 #pragma once
 
 #include "frictherm/thermal/problem.hpp"
+#include "reaction_blocks.hpp"
 #include "sundials_support.hpp"
 
 #include <sundials/sundials_types.h>
@@ -64,6 +65,9 @@ class OdeSystem {
  private:
   // Reaction Jacobian entries at y into d_tt_ … d_ll_ (cached on the reacting entries of y).
   void reaction_blocks(N_Vector y);
+  ReactionNodes reaction_nodes() const { return {rx_node_, rx_q_, frozen_, consume_}; }
+  ReactionBlocks reaction_blocks() { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
+  ReactionBlocksView reaction_blocks_view() const { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
   bool copy_conductance_pattern(const SparseMatrix& k, const Eigen::VectorXd& ha);  // build's fast path
   void finish_build(Index n, Index nr);  // after jac_: its diagonal and the reaction entries' positions
 

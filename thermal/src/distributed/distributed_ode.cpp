@@ -226,16 +226,9 @@ int DistributedOde::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_dat
     auto out = view(ydot);
     self->t_work_ = yv.head(n).cwiseQuotient(self->s_);
     self->problem_->heat_rate(t, self->t_work_.data(), self->w_work_.data());
-    if (self->reacts_) {  // as OdeSystem::rhs
-      const Reaction& rx = self->problem_->reaction();
-      for (Index r = 0; r < self->reacting(); ++r) {
-        const Index i = self->rx_node_[static_cast<std::size_t>(r)];
-        const double remaining = 1.0 - (self->consume_ ? yv[n + r] : self->frozen_[r]);
-        const double rate = remaining * rx.rate_constant(self->t_work_[i]);  // (1 − λ) k(T)
-        self->w_work_[i] += self->rx_q_[r] * rate;
-        if (self->consume_) out[n + r] = rate;
-      }
-    }
+    if (self->reacts_)  // as OdeSystem::rhs
+      add_reaction_rates(self->problem_->reaction(), self->reaction_nodes(), self->t_work_.data(), yv.data() + n,
+                         self->w_work_.data(), out.data() + n);
     out.head(n) = self->fscale_.cwiseProduct(self->w_work_);
     return 0;
   } catch (...) {
@@ -262,13 +255,7 @@ int DistributedOde::jtimes(N_Vector v, N_Vector jv, sunrealtype, N_Vector y, N_V
     }
     if (!self->reacts_) return 0;
     self->reaction_blocks(N_VGetArrayPointer(y));  // exact J·v at the current iterate (OdeSystem::jtimes)
-    for (Index r = 0; r < self->reacting(); ++r) {
-      const Index i = self->rx_node_[static_cast<std::size_t>(r)];
-      out[i] += self->d_tt_[r] * in[i];
-      if (!self->consume_) continue;
-      out[i] += self->d_tl_[r] * in[n + r];
-      out[n + r] = self->d_lt_[r] * in[i] + self->d_ll_[r] * in[n + r];
-    }
+    add_reaction_jv(self->reaction_nodes(), self->reaction_blocks_view(), in, out, n);
     return 0;
   } catch (...) {
     return -1;
@@ -341,20 +328,8 @@ void DistributedOde::build_reaction(const DistributedProblem& problem) {
 
 // OdeSystem::reaction_blocks: ∂f_T/∂y, ∂f_T/∂λ, ∂f_λ/∂y, ∂f_λ/∂λ at the reacting nodes (T = y/s).
 void DistributedOde::reaction_blocks(const double* y) {
-  const Index n = nodes();
-  const Reaction& rx = problem_->reaction();
-  for (Index r = 0; r < reacting(); ++r) {
-    const Index i = rx_node_[static_cast<std::size_t>(r)];
-    const double temp = y[i] / s_[i];
-    const double lam = consume_ ? y[n + r] : frozen_[r];
-    const double k = rx.rate_constant(temp);
-    const double dk = rx.rate_constant_derivative(temp);
-    const double c = fscale_[i] * rx_q_[r];
-    d_tt_[r] = c * (1.0 - lam) * dk / s_[i];
-    d_tl_[r] = -c * k;
-    d_lt_[r] = (1.0 - lam) * dk / s_[i];
-    d_ll_[r] = -k;
-  }
+  evaluate_reaction_blocks(problem_->reaction(), reaction_nodes(), y, nodes(), s_, fscale_,
+                           {d_tt_, d_tl_, d_lt_, d_ll_});
 }
 
 // OdeSystem::psolve: z = diag(I − γJ)⁻¹ r, the reacting nodes' 2×2 blocks (1×1 zero-order) inverted
@@ -362,23 +337,7 @@ void DistributedOde::reaction_blocks(const double* y) {
 int DistributedOde::block_jacobi(const double* r, double* z, double gamma) const {
   const Index n = nodes();
   for (Index i = 0; i < n; ++i) z[i] = r[i] / (1.0 - gamma * jdiag_[i]);
-  for (Index q = 0; q < reacting(); ++q) {
-    const Index i = rx_node_[static_cast<std::size_t>(q)];
-    const double a11 = 1.0 - gamma * (jdiag_[i] + d_tt_[q]);
-    if (!consume_) {
-      if (!(a11 > 0.0)) return 1;
-      z[i] = r[i] / a11;
-      continue;
-    }
-    const double a12 = -gamma * d_tl_[q];
-    const double a21 = -gamma * d_lt_[q];
-    const double a22 = 1.0 - gamma * d_ll_[q];
-    const double det = a11 * a22 - a12 * a21;
-    if (!(det > 0.0) || !(a22 > 0.0)) return 1;
-    z[i] = (a22 * r[i] - a12 * r[n + q]) / det;
-    z[n + q] = (a11 * r[n + q] - a21 * r[i]) / det;
-  }
-  return 0;
+  return invert_reaction_blocks(reaction_nodes(), reaction_blocks_view(), jdiag_.data(), gamma, r, z, n);
 }
 
 }  // namespace frictherm::thermal::detail

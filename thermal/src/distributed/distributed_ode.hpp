@@ -11,6 +11,7 @@
 // exactly), no PETSc PC. Internal header; callbacks take this object as user_data.
 #pragma once
 
+#include "../reaction_blocks.hpp"
 #include "../sundials_support.hpp"
 #include "frictherm/thermal/distributed.hpp"
 
@@ -38,6 +39,8 @@ class DistributedOde {
   void bind(const DistributedProblem& problem) { problem_ = &problem; }
   Index nodes() const { return s_.size(); }
   Index reacting() const { return static_cast<Index>(rx_node_.size()); }
+  ReactionNodes reaction_nodes() const { return {rx_node_, rx_q_, frozen_, consume_}; }
+  ReactionBlocksView reaction_blocks_view() const { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
   Index state_size() const { return nodes() + (consume_ ? reacting() : 0); }
   // The problem has a reaction (the same on every rank); it consumes: J is not symmetric (GMRES).
   bool reacts() const { return reacts_; }
