@@ -37,6 +37,22 @@ constexpr double kSliver = 0.25;
 
 }  // namespace
 
+// The step's penalty weights over every field's whole grid, as the serial step builds them: the
+// field boxes are lent to it (give them back with w.plain.fields.swap(s.penalty_boxes) after use).
+template <int Dim, class State>
+penalty_kernels::StepWeights<Dim> lend_penalty_weights(State& s) {
+  penalty_kernels::StepWeights<Dim> w;
+  w.plain.grid = &s.grid;
+  w.plain.shape = s.opt.shape;
+  w.plain.fields.swap(s.penalty_boxes);
+  w.plain.slot_mass = &s.penalty_mass;
+  w.plain.min_mass = s.empty_node_mass;
+  w.plain.reference_mass = &s.opt.penalty_reference_mass;
+  w.plain.sliver = kSliver;
+  if (s.opt.shape == ShapeKind::extended_bspline) w.ebs = &s.ebs;
+  return w;
+}
+
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::setup_penalty() {
   if (opt.penalty_pairs.empty()) return;
@@ -98,15 +114,7 @@ void DecomposedMpm<Dim>::Impl::penalty_forces(double /*dt*/) {
     penalty_force.assign(static_cast<std::size_t>(fields) * N, Vec<Dim>::Zero());
     penalty_heat_first.assign(N, 0.0);
     penalty_heat_second.assign(N, 0.0);
-    penalty_kernels::StepWeights<Dim> w;
-    w.plain.grid = &grid;
-    w.plain.shape = opt.shape;
-    w.plain.fields.swap(penalty_boxes);
-    w.plain.slot_mass = &penalty_mass;
-    w.plain.min_mass = empty_node_mass;
-    w.plain.reference_mass = &opt.penalty_reference_mass;
-    w.plain.sliver = kSliver;
-    if (opt.shape == ShapeKind::extended_bspline) w.ebs = &ebs;
+    penalty_kernels::StepWeights<Dim> w = lend_penalty_weights<Dim>(*this);
     penalty_kernels::apply_penalty(*penalty, boundary, w, penalty_mass, empty_node_mass, penalty_force,
                                    penalty_heat_first, penalty_heat_second);
     w.plain.fields.swap(penalty_boxes);
@@ -134,15 +142,7 @@ void DecomposedMpm<Dim>::Impl::move_boundary_points(double dt) {
   if (!penalty) return;
   if constexpr (Dim == 2) {
     gather_owned_fields(Dim, penalty_gather, [](const double* node, int d) { return node[Dof::velocity + d]; });
-    penalty_kernels::StepWeights<Dim> w;
-    w.plain.grid = &grid;
-    w.plain.shape = opt.shape;
-    w.plain.fields.swap(penalty_boxes);
-    w.plain.slot_mass = &penalty_mass;
-    w.plain.min_mass = empty_node_mass;
-    w.plain.reference_mass = &opt.penalty_reference_mass;
-    w.plain.sliver = kSliver;
-    if (opt.shape == ShapeKind::extended_bspline) w.ebs = &ebs;
+    penalty_kernels::StepWeights<Dim> w = lend_penalty_weights<Dim>(*this);
     const long bad = penalty_kernels::move_points(boundary, w, grid, dt, [&](int field, Vec<Dim>& v) {
       const Material& m = materials[static_cast<std::size_t>(field)];
       if (!m.is_rigid()) return false;
