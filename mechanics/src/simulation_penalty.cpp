@@ -202,10 +202,9 @@ void Simulation<Dim>::apply_penalty_forces() {
   apply_penalty(*penalty_, boundary_, lent.w, nodes_.mass, empty_node_mass_, nodes_.force, work_first_, work_second_);
   const PenaltyContact<Dim>& pc = *penalty_;
   for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
-    const auto a = static_cast<std::size_t>(std::min(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
-    const auto b = static_cast<std::size_t>(std::max(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material));
-    pair_work_first_[a * materials_.size() + b] += pc.books(k).heat_step;
-    pair_work_second_[a * materials_.size() + b] += pc.books(k).heat_step;
+    const std::size_t i = pair_book_index(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material, materials_.size());
+    pair_work_first_[i] += pc.books(k).heat_step;
+    pair_work_second_[i] += pc.books(k).heat_step;
   }
 }
 

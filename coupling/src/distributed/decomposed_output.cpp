@@ -181,7 +181,9 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
     error = "temperatures given on some ranks but not on this one";
   else if (s.position.size() != dim * n || s.velocity.size() != dim * n || s.material.size() != n ||
            (!s.temperature.empty() && s.temperature.size() != n) ||
-           std::any_of(s.fields.begin(), s.fields.end(), [n](const auto& f) { return f.second.size() != n; }))
+           std::any_of(s.fields.begin(), s.fields.end(),
+                       [n](const auto& f) { return f.components < 1 || f.values.size() != n * static_cast<std::size_t>(f.components); }) ||
+           std::any_of(s.integer_fields.begin(), s.integer_fields.end(), [n](const auto& f) { return f.second.size() != n; }))
     error = "snapshot arrays of different lengths (" + std::to_string(n) + " ids)";
   const std::string index = [&] {
     char b[16];
@@ -208,8 +210,10 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
       write_dataset(g.get(), file, "velocity", H5T_NATIVE_DOUBLE, v.data(), n, 3);
       // Every rank's group holds the same datasets (a rank without particles: 0 rows).
       if (any_temperature) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
-      for (const auto& [name, values] : s.fields)
-        write_dataset(g.get(), file, name.c_str(), H5T_NATIVE_DOUBLE, values.data(), n, 1);
+      for (const DecomposedSnapshot::Field& f : s.fields)
+        write_dataset(g.get(), file, f.name, H5T_NATIVE_DOUBLE, f.values.data(), n, static_cast<hsize_t>(f.components));
+      for (const auto& [name, values] : s.integer_fields)
+        write_dataset(g.get(), file, name, H5T_NATIVE_INT, values.data(), n, 1);
       write_dataset(g.get(), file, "material", H5T_NATIVE_INT, s.material.data(), n, 1);
       h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
     } catch (const std::exception& e) {
@@ -243,7 +247,8 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
         // serial particle index across ranks.
         grid.fields = {{"position", dim_, false}, {"id", 1, true, 8}, {"velocity", 3, false}, {"material", 1, true}};
         if (any_temperature) grid.fields.push_back({"temperature", 1, false});
-        for (const auto& f : s.fields) grid.fields.push_back({f.first, 1, false});
+        for (const auto& f : s.fields) grid.fields.push_back({f.name, f.components, false});
+        for (const auto& f : s.integer_fields) grid.fields.push_back({f.first, 1, true});
         std::string g = xdmf_grid_xml(grid, base_name(rank_file(r)), dim_);
         // Indented one level deeper: inside this snapshot's spatial collection.
         std::string indented;

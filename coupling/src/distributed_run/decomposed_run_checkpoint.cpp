@@ -106,6 +106,8 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   v("mechanics/empty_node_mass", st.empty_node_mass);
   v("mechanics/work_first", st.work_first);
   v("mechanics/work_second", st.work_second);
+  v("mechanics/pair_work_first", st.pair_first);  // this rank's part of the per-pair books
+  v("mechanics/pair_work_second", st.pair_second);
   v("mechanics/contact_stats", st.stats);
   std::vector<long> owned;  // this rank's owned nodes (DMDA indices, [begin, end) per axis): redistribution
   if constexpr (!V::reading) for (int b : mpm_->owned_nodes()) owned.push_back(b);
@@ -140,6 +142,9 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
   v("run/last_snapshot_step", last_snapshot_step_);
   v("output/series_rows", series_rows_);
   v("output/series_columns", series_columns_);
+  v("run/series_memory/time", series_memory_.time);  // the serial checkpoint's names
+  v("run/series_memory/has_previous", series_memory_.has_previous);
+  v("run/series_memory/work", series_memory_.work);
   v("output/xdmf_grids", xdmf_grids_);
   if (hot_) hot_->visit_state(v);
   // Penalty contact: the boundary points and PenaltyContact::visit_state (slip histories, books, the

@@ -45,9 +45,19 @@ struct DecomposedSnapshot {
   std::vector<double> velocity;     // n × dim, m/s
   std::vector<double> temperature;  // n, K (empty: not written)
   std::vector<int> material;        // n
-  /// More per-particle scalars by name (n each; the same names on every rank), e.g. the interface
-  /// temperature: datasets beside `temperature` and XDMF attributes.
-  std::vector<std::pair<std::string, std::vector<double>>> fields;
+  /// More per-particle fields by name (n × components each; the same names on every rank), e.g. the
+  /// interface temperature or the serial snapshot's displacement and stress: datasets beside
+  /// `temperature` and XDMF attributes.
+  struct Field {
+    Field(std::string field_name, std::vector<double> field_values, int field_components = 1)
+        : name(std::move(field_name)), values(std::move(field_values)), components(field_components) {}
+    std::string name;
+    std::vector<double> values;
+    int components = 1;
+  };
+  std::vector<Field> fields;
+  /// Integer per-particle fields (n each), e.g. the body index.
+  std::vector<std::pair<std::string, std::vector<int>>> integer_fields;
 };
 
 /// Particle snapshots of a decomposed run (issue 16 item 3): one HDF5 file per rank,
