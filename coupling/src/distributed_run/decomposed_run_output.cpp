@@ -156,7 +156,7 @@ void DecomposedRun<Dim>::series(double time) {
     bodies.append_velocities(row);
     // The work handed to the heat (second order without heat, as the energy books above).
     const bool first = heat_ && s_.thermal.heating_order == mechanics::HeatingOrder::first;
-    detail::append_heat_rates(row, work[first ? 0 : 1], row_time, series_memory_);
+    detail::append_heat_rates(row, work[first ? 0 : 1], time_, series_memory_);  // the serial sim.time()
   }
   if (pc) detail::append_penalty_row(row, *pc, mpm_->boundary_points());
   if (heat_) {
