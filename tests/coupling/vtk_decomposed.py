@@ -22,7 +22,9 @@ Asserted for every snapshot:
 * at the last snapshot the set of (id, position) equals the serial run's (`frictherm run` without
   mpirun; id = serial row) to 1e-12 of the box size, and the temperatures to 1e-9 of the largest
   rise, the CliMpirun tolerance (they measure 7e-18 m on 1 mm cells and 1e-13 K: the engines add
-  the same terms in another order).
+  the same terms in another order);
+* OUT_reference.xdmf (issue 32, the serial RUN_reference.xdmf) is published with the result and VTK
+  reads it as OUT.xdmf with the points at each particle's `initial_position`, the same checks.
 
     vtk_decomposed.py FRICTHERM_EXE SCENES_DIR WORK_DIR [--mpirun MPIRUN] [--png docs/figures/decomposed_xdmf.png]
 
@@ -96,8 +98,9 @@ def run(cmd, out):
     subprocess.run(cmd + ["-o", out, "--force", "-q"], check=True, env=env, stdout=subprocess.DEVNULL)
 
 
-def rank_snapshots(base, ranks, dim):
-    """Per snapshot (in file order): time, step and per rank the rows of every field (position padded to 3)."""
+def rank_snapshots(base, ranks, dim, geometry="position"):
+    """Per snapshot (in file order): time, step and per rank the rows of every field (the points: `geometry`
+    padded to 3)."""
     snaps = []
     for r in range(ranks):
         with h5py.File(f"{base}.rank{r}.h5", "r") as f:
@@ -109,7 +112,7 @@ def rank_snapshots(base, ranks, dim):
                 check(float(g.attrs["time"]) == s["time"] and int(g.attrs["step"]) == s["step"],
                       f"{base}: rank {r} snapshot {g.name} at the time and step of rank 0's")
                 x = np.zeros((g["id"].shape[0], 3))
-                x[:, :dim] = g["position"][()]
+                x[:, :dim] = g[geometry][()]
                 rows = {"position": x, **{k: g[k][()] for k in fields_for(dim)}}
                 if len(x):
                     s["ranks"][r] = rows
@@ -237,6 +240,10 @@ def check_scene(a, name, dim, sets, rank_counts):
         check(total == len(serial_x), f"{label}: {total} particles, serial {len(serial_x)}")
         check([s["time"] for s in snaps] == serial_times, f"{label}: snapshot times are the serial run's")
         merged = check_vtk(base + ".xdmf", snaps, total, label, dim)
+        # OUT_reference.xdmf (issue 32, the serial RUN_reference.xdmf): the same grids at initial_position.
+        if check(os.path.exists(base + "_reference.xdmf"), f"{label}: the reference XDMF is published"):
+            check_vtk(base + "_reference.xdmf", rank_snapshots(base, ranks, dim, "initial_position"), total,
+                      label + " (reference)", dim)
         if pv is not None:
             check_paraview(base + ".xdmf", snaps, total, label, dim)
         if len(merged) == len(snaps) and total == len(serial_x):

@@ -17,6 +17,7 @@ void DecomposedRun<Dim>::checkpoint() {
   m.run_id = run_id_;  // rank 0 writes the marks
   if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
   xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
+  xdmf_reference_grids_ = detail::join_grids(snapshots_out_->reference_grids());
   try {
     detail::write_decomposed_checkpoint(
         comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
@@ -146,6 +147,7 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
   v("run/series_memory/has_previous", series_memory_.has_previous);
   v("run/series_memory/work", series_memory_.work);
   v("output/xdmf_grids", xdmf_grids_);
+  v("output/xdmf_reference_grids", xdmf_reference_grids_);
   if (hot_) hot_->visit_state(v);
   // Penalty contact: the boundary points and PenaltyContact::visit_state (slip histories, books, the
   // frequency bound of the next step), the same on every rank, so once, in the global file that every

@@ -33,6 +33,7 @@ void DecomposedRun<Dim>::open_output() {
                                                                     redistributed_from_ > 0, false)
                                : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite(),
                                                                     false);
+    if (resuming_) snapshots_out_->restore_reference_grids(detail::split_grids(xdmf_reference_grids_));
   } catch (const std::exception& e) {
     throw OutputError(e.what());
   }
@@ -295,7 +296,8 @@ std::string DecomposedRun<Dim>::publish() {
   try {
     if (!write_error_.empty()) throw std::runtime_error(write_error_);
     write_end_metadata();
-    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text());  // OUT.xdmf with OUT.h5, as the serial run's
+    // OUT.xdmf (and OUT_reference.xdmf) with OUT.h5, as the serial run's
+    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text(), snapshots_out_->reference_xdmf_text());
     out_->sync();  // before the name: the published result is on disk
   } catch (const std::exception& e) {
     const std::string live = out_->live_path();

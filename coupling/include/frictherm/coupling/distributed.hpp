@@ -85,6 +85,12 @@ class DecomposedOutput {
   const std::vector<std::string>& xdmf_grids() const { return grids_; }
   /// Rank 0: the XDMF document joining every snapshot so far (what BASE.xdmf holds).
   std::string xdmf_text() const;
+  /// Rank 0: the same grids drawn at the particles' reference positions (geometry initial_position,
+  /// the serial RUN_reference.xdmf) for the snapshots that hold initial_position; "" without any.
+  /// Checkpoints store reference_grids(); a resumed run gives them back (restore_reference_grids).
+  const std::vector<std::string>& reference_grids() const { return reference_grids_; }
+  void restore_reference_grids(std::vector<std::string> grids) { reference_grids_ = std::move(grids); }
+  std::string reference_xdmf_text() const;
   long snapshots() const { return snapshots_; }
   ~DecomposedOutput();
   DecomposedOutput(const DecomposedOutput&) = delete;
@@ -106,6 +112,7 @@ class DecomposedOutput {
   std::string base_, xdmf_path_;
   long long file_ = -1;              // hid_t of this rank's file
   std::vector<std::string> grids_;  // rank 0: the XDMF text of every snapshot so far
+  std::vector<std::string> reference_grids_;  // rank 0: the same at the reference positions
   bool write_xdmf_ = true;          // rank 0 rewrites BASE.xdmf after every snapshot
   long snapshots_ = 0;
 };
