@@ -46,7 +46,7 @@ void Simulation<Dim>::prepare_extended_stencils() {
   // 2. Contact: a material's field covers the nodes its plain B-spline stencils reach. The extension
   //    only moves weight from degenerate nodes to stable ones, whose supports hold an interior cell
   //    of the body and so lie in that box: the box is the same as with the plain quadratic B-spline.
-  if (contact_) {
+  if (contact_setup_.enabled) {
     for (std::size_t f = 0; f < fields_.size(); ++f) {
       const auto m = static_cast<std::size_t>(fields_[f].material);
       ebs_[f].node_box(box_lo_[m], box_hi_[m]);
@@ -87,7 +87,7 @@ void Simulation<Dim>::prepare_extended_stencils() {
     if (f < 0) continue;
     const EbsBasis<Dim>& basis = ebs_[static_cast<std::size_t>(f)];
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-    const bool whole_grid = !contact_;  // the shared field: slot = grid node index
+    const bool whole_grid = !contact_setup_.enabled;  // the shared field: slot = grid node index
     const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
 #pragma omp parallel for num_threads(threads_) schedule(static)
     for (long kk = b; kk < e; ++kk) {

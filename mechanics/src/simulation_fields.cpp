@@ -45,17 +45,17 @@ void Simulation<Dim>::enable_contact(const ContactOptions& options) {
   if (!(options.boundary_spacing >= 0.0) || !std::isfinite(options.boundary_spacing))
     throw std::invalid_argument("contact boundary_spacing must be finite and >= 0 (0: half the cell size)");
   check_penalty_settings(options.default_pair, -1, -1);
-  contact_ = true;
-  contact_opt_ = options;
-  pair_settings_.assign(1, options.default_pair);
+  contact_setup_.enabled = true;
+  contact_setup_.options = options;
+  contact_setup_.pair_settings.assign(1, options.default_pair);
 }
 
 template <int Dim>
 void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& settings) {
-  if (!contact_) throw std::logic_error("enable_contact() must come before set_contact_pair()");
+  if (!contact_setup_.enabled) throw std::logic_error("enable_contact() must come before set_contact_pair()");
   const int n = static_cast<int>(materials_.size());
   if (a < 0 || b < 0 || a >= n || b >= n || a == b) throw std::invalid_argument("contact pair needs two different materials");
-  if (pair_index_.size() != static_cast<std::size_t>(n * n)) pair_index_.assign(static_cast<std::size_t>(n * n), 0);
+  if (contact_setup_.pair_index.size() != static_cast<std::size_t>(n * n)) contact_setup_.pair_index.assign(static_cast<std::size_t>(n * n), 0);
   ContactPairSettings s = settings;
   check_penalty_settings(s, a, b);
   if (s.method == ContactMethod::multimaterial && s.normal == NormalMethod::specified) {
@@ -63,21 +63,21 @@ void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& 
     if (!(len > 0.0)) throw std::invalid_argument("a specified contact normal must be non-zero");
     s.normal_vector /= len;
   }
-  pair_settings_.push_back(s);
+  contact_setup_.pair_settings.push_back(s);
   ContactPairSettings flipped = s;  // the same pair seen from b: the normal points from b to a
   flipped.normal_vector = -s.normal_vector;
-  pair_settings_.push_back(flipped);
-  const int k = static_cast<int>(pair_settings_.size());
-  pair_index_[static_cast<std::size_t>(a * n + b)] = k - 2;
-  pair_index_[static_cast<std::size_t>(b * n + a)] = k - 1;
-  explicit_pairs_.emplace_back(a, b);
+  contact_setup_.pair_settings.push_back(flipped);
+  const int k = static_cast<int>(contact_setup_.pair_settings.size());
+  contact_setup_.pair_index[static_cast<std::size_t>(a * n + b)] = k - 2;
+  contact_setup_.pair_index[static_cast<std::size_t>(b * n + a)] = k - 1;
+  contact_setup_.explicit_pairs.emplace_back(a, b);
 }
 
 template <int Dim>
 const ContactPairSettings& Simulation<Dim>::contact_pair(int a, int b) const {
   const std::size_t n = materials_.size();
-  if (pair_index_.size() != n * n) return pair_settings_.at(0);
-  return pair_settings_.at(static_cast<std::size_t>(pair_index_[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)]));
+  if (contact_setup_.pair_index.size() != n * n) return contact_setup_.pair_settings.at(0);
+  return contact_setup_.pair_settings.at(static_cast<std::size_t>(contact_setup_.pair_index[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)]));
 }
 
 // Without contact: one field over the whole grid shared by every deformable material (slot = node),
@@ -87,7 +87,7 @@ void Simulation<Dim>::init_fields() {
   const std::size_t nm = materials_.size();
   fields_.clear();
   field_of_material_.assign(nm, -1);
-  if (!contact_) {
+  if (!contact_setup_.enabled) {
     VelocityField<Dim> f;
     f.extent = grid_.nodes_per_dim();
     f.count = grid_.node_count();
@@ -108,19 +108,19 @@ void Simulation<Dim>::init_fields() {
       field_of_material_[m] = static_cast<int>(fields_.size());
       fields_.push_back(f);
     }
-    if (pair_index_.size() != nm * nm) pair_index_.assign(nm * nm, 0);
+    if (contact_setup_.pair_index.size() != nm * nm) contact_setup_.pair_index.assign(nm * nm, 0);
     slot_node_valid_ = false;
     box_lo_.assign(nm, IVec<Dim>{});
     box_hi_.assign(nm, IVec<Dim>{});
-    node_field_count_.assign(grid_.node_count(), 0);
-    node_entry_cursor_.assign(grid_.node_count(), -1);
-    pair_work_first_.assign(nm * nm, 0.0);
-    pair_work_second_.assign(nm * nm, 0.0);
+    contact_nodes_.node_field_count.assign(grid_.node_count(), 0);
+    contact_nodes_.node_entry_cursor.assign(grid_.node_count(), -1);
+    contact_books_.pair_work_first.assign(nm * nm, 0.0);
+    contact_books_.pair_work_second.assign(nm * nm, 0.0);
   }
-  work_first_.assign(grid_.node_count(), 0.0);
-  work_second_.assign(grid_.node_count(), 0.0);
+  contact_books_.work_first.assign(grid_.node_count(), 0.0);
+  contact_books_.work_second.assign(grid_.node_count(), 0.0);
   field_velocity_.assign(fields_.size(), Vec<Dim>::Zero());
-  if (contact_) setup_penalty();
+  if (contact_setup_.enabled) setup_penalty();
 }
 
 // Each material's field covers the box [lo, hi] of nodes its particles reach, stored contiguously:

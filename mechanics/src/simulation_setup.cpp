@@ -135,12 +135,12 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
   int body_mat = p_.material[before];
   for (std::size_t k = before; k < p_.size(); ++k)
     if (p_.material[k] != body_mat) body_mat = -1;
-  const double spacing = contact_opt_.boundary_point_spacing(grid_.min_cell_size());
-  body_loops_.push_back(Dim == 2 ? region.boundary_loops(spacing) : std::vector<std::vector<Vec<2>>>{});
-  body_loop_spacing_.push_back(spacing);
-  body_material_.push_back(body_mat);
-  body_half_size_.push_back(lp);
-  body_velocity_.push_back(velocity);
+  const double spacing = contact_setup_.options.boundary_point_spacing(grid_.min_cell_size());
+  body_loops_.loops.push_back(Dim == 2 ? region.boundary_loops(spacing) : std::vector<std::vector<Vec<2>>>{});
+  body_loops_.spacing.push_back(spacing);
+  body_loops_.material.push_back(body_mat);
+  body_loops_.half_size.push_back(lp);
+  body_loops_.velocity.push_back(velocity);
   return body_id;
 }
 

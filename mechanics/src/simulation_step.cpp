@@ -49,7 +49,7 @@ double Simulation<Dim>::step(double dt_limit) {
   finalize();
   // The energy books' start (EnergyBalance::initial): once, before the first step moves anything.
   if (std::isnan(initial_energy_))
-    initial_energy_ = kinetic_energy() + strain_energy() + (penalty_ ? penalty_->stored_energy() : 0.0);
+    initial_energy_ = kinetic_energy() + strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
   if (phases_.empty() || phases_key_ != phase_key()) build_phases();
   StepContext ctx;
   ctx.dt_limit = dt_limit;
@@ -66,9 +66,9 @@ long Simulation<Dim>::phase_key() const {
   key = key * 4 + static_cast<long>(opt_.scheme);
   key = key * 8 + static_cast<long>(opt_.particle_update);
   key = key * 2 + (opt_.damping_rate > 0.0);
-  key = key * 2 + contact_;
-  key = key * 2 + (contact_ && contact_opt_.separation == SeparationMethod::extent);
-  key = key * 2 + penalty_.has_value();
+  key = key * 2 + contact_setup_.enabled;
+  key = key * 2 + (contact_setup_.enabled && contact_setup_.options.separation == SeparationMethod::extent);
+  key = key * 2 + penalty_state_.contact.has_value();
   key = key * 2 + !resolved_loads_.empty();
   return key;
 }
@@ -105,11 +105,11 @@ void Simulation<Dim>::build_phases() {
   PhaseList& P = phases_;
   const UpdateScheme scheme = opt_.scheme;
   const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
-  const bool penalty = penalty_.has_value();
+  const bool penalty = penalty_state_.contact.has_value();
   const bool flip = opt_.particle_update == ParticleUpdate::flip;
   // USL with contact: the particle pass also evaluates the next step's stencils and boxes and moves
   // the rigid particles (nothing after it in the step needs this step's stencils).
-  const bool refresh = usl && contact_ && !is_extended<Kernel>;
+  const bool refresh = usl && contact_setup_.enabled && !is_extended<Kernel>;
 
   P.add("time_step", &T::time_step, [this](StepContext& c) {
     c.dt = std::min(stable_time_step(), c.dt_limit);
@@ -121,7 +121,7 @@ void Simulation<Dim>::build_phases() {
   });
   P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
   P.add("particle_to_grid", &T::particle_to_grid, [this, usf](StepContext& c) { map_to_grid<Kernel>(c.dt, !usf); });
-  if (contact_)
+  if (contact_setup_.enabled)
     P.add("contact_extrapolated", &T::contact, [this](StepContext& c) { contact_at_extrapolated<Kernel>(c.dt); });
   if (usf) {
     P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
@@ -139,7 +139,7 @@ void Simulation<Dim>::build_phases() {
   P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
   if (opt_.damping_rate > 0.0) P.add("damping", &T::grid_update, [this](StepContext& c) { apply_damping(c.dt); });
   P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
-  if (contact_)
+  if (contact_setup_.enabled)
     P.add("contact_updated", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::updated, c.dt); });
   P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
   if (!flip)  // XPIC/FMPM
@@ -161,7 +161,7 @@ void Simulation<Dim>::build_phases() {
   P.add("end_particle_update", &T::grid_to_particle, [this, refresh](StepContext& c) { end_particle_update(c, refresh); });
   if (musl) {
     P.add("remap_momentum", &T::particle_to_grid, [this](StepContext&) { remap_momentum<Kernel>(); });
-    if (contact_)
+    if (contact_setup_.enabled)
       P.add("contact_remapped", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::remapped, c.dt); });
     P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
     if (penalty)  // with the remapped velocity, as the stress update
@@ -182,7 +182,7 @@ void Simulation<Dim>::prepare_step(double t) {
   threads_ = threads_for_particles(p_.size(), max_threads);
   if (static_cast<int>(thread_nodes_.size()) != threads_ - 1) {
     thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
-    for (auto& tn : thread_nodes_) tn.resize(nodes_.mass.size(), contact_);
+    for (auto& tn : thread_nodes_) tn.resize(nodes_.mass.size(), contact_setup_.enabled);
   }
   update_partition();
   for (std::size_t f = 0; f < fields_.size(); ++f)
@@ -196,7 +196,7 @@ void Simulation<Dim>::prepare_step(double t) {
   } else {
     auto& st = stencils<Kernel>();
     if (st.size() != p_.size()) st.resize(p_.size()), stencils_current_ = false;
-    if (contact_) {
+    if (contact_setup_.enabled) {
       // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
       if (!stencils_current_) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
       layout_fields(box_lo_, box_hi_);
@@ -205,9 +205,9 @@ void Simulation<Dim>::prepare_step(double t) {
       map_rigid_particles<Kernel>(t, nullptr);
     }
   }
-  if (contact_) {
-    std::fill(work_first_.begin(), work_first_.end(), 0.0);
-    std::fill(work_second_.begin(), work_second_.end(), 0.0);
+  if (contact_setup_.enabled) {
+    std::fill(contact_books_.work_first.begin(), contact_books_.work_first.end(), 0.0);
+    std::fill(contact_books_.work_second.begin(), contact_books_.work_second.end(), 0.0);
   }
 }
 
@@ -224,10 +224,10 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
   // a scatter by every particle would give it (the same bits); other slots hold partial sums or 0.
   thread_local std::vector<std::uint8_t> at_contact;  // per slot: 1 at a contact node (no allocation once grown)
   at_contact.assign(nodes_.mass.size(), 0);
-  for (const ContactEntry& c : contact_entries_) at_contact[static_cast<std::size_t>(c.slot)] = 1;
+  for (const ContactEntry& c : contact_nodes_.entries) at_contact[static_cast<std::size_t>(c.slot)] = 1;
   const std::uint8_t* const flag = at_contact.data();
   auto& st = stencils<Kernel>();
-  const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
+  const bool displacement = contact_setup_.options.separation == SeparationMethod::displacement;
   scatter_phase(Accumulated{false, false, false, true}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
     double* const domain = acc.domain.data();
@@ -248,7 +248,7 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
       });
     }
   });
-  if (contact_opt_.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
+  if (contact_setup_.options.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
   resolve_contact(ContactPass::extrapolated, dt);
 }
 
@@ -284,7 +284,7 @@ void Simulation<Dim>::evaluate_stencils() {
   Stencil<Dim, Kernel>* const stk = st.data();
   const Vec<Dim>* const position = p_.position.data();
   const Vec<Dim>* const half_size = p_.half_size.data();
-  if (!contact_) {
+  if (!contact_setup_.enabled) {
 #pragma omp parallel for num_threads(threads_) schedule(static)
     for (std::size_t k = 0; k < p_.size(); ++k) stk[k].evaluate(grid, position[k], half_size[k]);
     return;
@@ -365,7 +365,7 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   const bool prepared = stencils_current_;  // by current_stencils() since the last step
   scatter_phase(Accumulated{true, true, true, false}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t m, std::size_t kb, std::size_t ke) {
-    if (!contact_) {
+    if (!contact_setup_.enabled) {
       for (std::size_t k = kb; k < ke; ++k) {
         if constexpr (!is_extended<Kernel>)
           if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);

@@ -29,6 +29,11 @@
 #include <frictherm/mechanics/particles.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/state/body_loops.hpp>
+#include <frictherm/mechanics/state/contact_books.hpp>
+#include <frictherm/mechanics/state/contact_node_state.hpp>
+#include <frictherm/mechanics/state/contact_setup.hpp>
+#include <frictherm/mechanics/state/penalty_contact_state.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
@@ -102,21 +107,6 @@ struct VelocityField {
   NodeIndexer<Dim> index;     // lattice -> slot
 };
 
-/// Counters of the last step's contact resolution.
-struct ContactStats {
-  long contact_nodes = 0;     // nodes with two or more materials
-  long multi_nodes = 0;       // of which with three or more (lumped virtual material, eqs. 39–40)
-  long sliding_nodes = 0;     // node-pairs sliding in the momentum-update pass
-  long guarded = 0;           // materials left out because their mass fraction was below min_mass_fraction
-  long penalty_contacts = 0;  // penalty contact: active slave point – master segment contacts
-  long penalty_sliding = 0;   // of which sliding
-};
-
-/// A material pair in penalty contact: master and slave materials, index into penalty_contact()'s pairs.
-struct PenaltyPairInfo {
-  int master_material = -1, slave_material = -1;
-};
-
 struct BodyInfo {
   std::string name;
   std::size_t particle_count = 0;
@@ -172,24 +162,24 @@ class Simulation {
   const std::vector<VelocityField<Dim>>& fields() const { return fields_; }
   /// Grid node of each slot of nodes().
   const std::vector<int>& slot_nodes() const { return slot_node_; }
-  bool contact_enabled() const { return contact_; }
-  const ContactOptions& contact_options() const { return contact_opt_; }
+  bool contact_enabled() const { return contact_setup_.enabled; }
+  const ContactOptions& contact_options() const { return contact_setup_.options; }
   const ContactPairSettings& contact_pair(int material_a, int material_b) const;
-  const ContactStats& contact_stats() const { return contact_stats_; }
+  const ContactStats& contact_stats() const { return contact_books_.stats; }
   /// The pairs given settings with set_contact_pair, in call order.
-  const std::vector<std::pair<int, int>>& contact_pairs() const { return explicit_pairs_; }
+  const std::vector<std::pair<int, int>>& contact_pairs() const { return contact_setup_.explicit_pairs; }
   /// Penalty contact (after finalize()): nullptr without penalty pairs; pair k of it is
   /// penalty_pairs()[k]. Its books hold the last step's forces and the heat per pair.
-  const PenaltyContact<Dim>* penalty_contact() const { return penalty_ ? &*penalty_ : nullptr; }
-  const std::vector<PenaltyPairInfo>& penalty_pairs() const { return penalty_pairs_; }
+  const PenaltyContact<Dim>* penalty_contact() const { return penalty_state_.contact ? &*penalty_state_.contact : nullptr; }
+  const std::vector<PenaltyPairInfo>& penalty_pairs() const { return penalty_state_.pairs; }
   /// Boundary material points of the bodies in penalty pairs (field = velocity field index). The
   /// mutable access is for set-up (e.g. shifting a body with its particles before the first step).
-  const BoundaryPoints<Dim>& boundary_points() const { return boundary_; }
-  BoundaryPoints<Dim>& boundary_points() { return boundary_; }
+  const BoundaryPoints<Dim>& boundary_points() const { return penalty_state_.boundary; }
+  BoundaryPoints<Dim>& boundary_points() { return penalty_state_.boundary; }
   /// Frictional work of the last step per grid node (J), added once per contact node (eqs. 27, 34,
   /// 36, 40): what the coupling hands to the thermal solver. All zeros without contact.
   const std::vector<double>& frictional_work(HeatingOrder order) const {
-    return order == HeatingOrder::first ? work_first_ : work_second_;
+    return order == HeatingOrder::first ? contact_books_.work_first : contact_books_.work_second;
   }
   /// Frictional work since the start (J): all pairs, or the unordered pair (a, b).
   double cumulative_frictional_work(HeatingOrder order) const;
@@ -270,32 +260,35 @@ class Simulation {
     v("rigid_work", rigid_work_);
     v("damping_work", damping_work_);
     v("initial_energy", initial_energy_);
-    v("work_first", work_first_);
-    v("work_second", work_second_);
-    v("pair_work_first", pair_work_first_);
-    v("pair_work_second", pair_work_second_);
+    v("work_first", contact_books_.work_first);
+    v("work_second", contact_books_.work_second);
+    v("pair_work_first", contact_books_.pair_work_first);
+    v("pair_work_second", contact_books_.pair_work_second);
     v("wave_speed", wave_speed_);
     v("wave_speed_ready", wave_speed_ready_);
-    if (contact_opt_.regularized()) {
-      v("contact/lagged_normal_traction", lagged_normal_traction_);
-      v("contact/lagged_normal_step", lagged_normal_step_);
+    if (contact_setup_.options.regularized()) {
+      v("contact/lagged_normal_traction", contact_nodes_.lagged_normal_traction);
+      v("contact/lagged_normal_step", contact_nodes_.lagged_normal_step);
     }
     // The last step's contact counters: only reported (series rows of a thermal continuation).
-    for (auto [name, x] : {std::pair<const char*, long*>{"contact_stats/contact_nodes", &contact_stats_.contact_nodes},
-                           {"contact_stats/multi_nodes", &contact_stats_.multi_nodes},
-                           {"contact_stats/sliding_nodes", &contact_stats_.sliding_nodes},
-                           {"contact_stats/guarded", &contact_stats_.guarded},
-                           {"contact_stats/penalty_contacts", &contact_stats_.penalty_contacts},
-                           {"contact_stats/penalty_sliding", &contact_stats_.penalty_sliding}})
+    for (auto [name, x] : {std::pair<const char*, long*>{"contact_stats/contact_nodes", &contact_books_.stats.contact_nodes},
+                           {"contact_stats/multi_nodes", &contact_books_.stats.multi_nodes},
+                           {"contact_stats/sliding_nodes", &contact_books_.stats.sliding_nodes},
+                           {"contact_stats/guarded", &contact_books_.stats.guarded},
+                           {"contact_stats/penalty_contacts", &contact_books_.stats.penalty_contacts},
+                           {"contact_stats/penalty_sliding", &contact_books_.stats.penalty_sliding}})
       v(name, *x);
-    if (penalty_) {  // penalty contact: the boundary points move with the bodies; slip histories
-      v("boundary/position", boundary_.position);
-      v("boundary/velocity", boundary_.velocity);
-      penalty_->visit_state(v);
+    if (penalty_state_.contact) {  // penalty contact: the boundary points move with the bodies; slip histories
+      v("boundary/position", penalty_state_.boundary.position);
+      v("boundary/velocity", penalty_state_.boundary.velocity);
+      penalty_state_.contact->visit_state(v);
     }
   }
 
  private:
+  using ContactEntry = typename ContactNodeState<Dim>::Entry;
+  using ContactNodeListing = typename ContactNodeState<Dim>::Listing;
+  using ContactThreadWork = typename ContactNodeState<Dim>::ThreadWork;
   // The step as phase lists (step/phase_list.hpp; simulation_step.cpp): built by the first step and
   // again when a setting they depend on changes (phase_key()).
   template <class Kernel> void build_phases();
@@ -365,7 +358,7 @@ class Simulation {
   /// their slots, materials and contact entries; returns how many slivers were left out.
   int gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides, std::vector<int>& slots,
                            std::vector<int>& mats, std::vector<int>& entries) const;
-  void compute_contact_normals();                                // extent separation: entry_normal_
+  void compute_contact_normals();                                // extent separation: contact_nodes_.entry_normal
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
   struct RigidMotion {
@@ -396,78 +389,14 @@ class Simulation {
   std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
   std::vector<int> slot_node_;
   bool slot_node_valid_ = false;  // slot_node_ matches the per-material layout of fields_ (layout_fields)
-  // One thread's share of find_contact_nodes (a range of grid nodes), per field: its slots
-  // [slot_begin, slot_end), the end of those with mass in `occupied`, the entries and nodes of the
-  // contact nodes that first have mass in that field, and where they go in contact_entries_/_groups_.
-  struct ContactNodeListing {
-    std::vector<int> occupied;
-    std::vector<std::size_t> slot_begin, slot_end, field_end, entries, groups, entry_base, group_base;
-  };
-  std::vector<ContactNodeListing> contact_node_listing_;
   std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
   std::vector<RigidMotion> rigid_motion_;  // per material, for particle_pass(refresh)
   std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
-  bool contact_ = false;
-  ContactOptions contact_opt_;
-  std::vector<ContactPairSettings> pair_settings_;  // [0] = default
-  std::vector<int> pair_index_;                     // materials² -> pair_settings_ index
-  std::vector<std::pair<int, int>> explicit_pairs_;
-  struct ContactEntry {  // one field with mass at a multi-material node
-    int node, slot, field;
-  };
-  std::vector<ContactEntry> contact_entries_;  // grouped by node; within a node in material order
-  std::vector<std::size_t> contact_groups_;     // start of each node's entries, then the end
-  struct ContactThreadWork {                    // per-thread contact stats and pair books of one pass
-    ContactStats stats;
-    // Material pair k = min·nm + max: the pass's work, zero outside `touched` (the pairs it added
-    // to, marked in `marked`), so a pass clears and sums only those, not all nm² pairs of a PBX.
-    // Only the first thread's are summed into: the threads list their node groups' entries, and the
-    // pass adds the lists in thread order, which is group order (resolve_contact).
-    std::vector<double> pair_first, pair_second;
-    std::vector<std::uint8_t> marked;
-    std::vector<std::size_t> touched;
-    struct PairEntry {
-      std::size_t k;
-      double w1, w2;
-    };
-    std::vector<PairEntry> entries;
-    std::vector<double> rigid_work;  // Δp·v_rigid of each change a rigid partner made, in group order
-    void add(std::size_t k, double w1, double w2) {
-      if (!marked[k]) marked[k] = 1, touched.push_back(k);
-      pair_first[k] += w1;
-      pair_second[k] += w2;
-    }
-  };
-  std::vector<ContactThreadWork> contact_thread_work_;
-  // Normal-stress regularisation (ContactOptions::regularized): per grid node the lagged normal
-  // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
-  // in contact on the previous step starts again from σ).
-  std::vector<double> lagged_normal_traction_, lagged_normal_step_;
-  std::vector<std::uint16_t> node_field_count_;  // per grid node: fields with mass (find_contact_nodes)
-  std::vector<int> node_entry_cursor_;           // per grid node: next entry of its run, −1: none
-  // Extent separation, per contact entry: the normal from its material to its partners, and the
-  // largest extents of its own particle domains along it and of its partners' along its reverse.
-  std::vector<Vec<Dim>> entry_normal_;
-  std::vector<double> entry_extent_own_, entry_extent_other_;
-  std::vector<std::vector<double>> extent_thread_;  // per-thread maxima (threads 1..n-1), own then other
-  std::vector<double> work_first_, work_second_;    // per grid node, last step
-  std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
-  ContactStats contact_stats_;
-  bool any_multimaterial_ = true;               // some present material pair uses multimaterial contact
-  // Penalty contact: per body its boundary loops (from its region, or set_body_boundary), the spacing
-  // they were sampled with (−1: given by the user), its material (−1: several) and particle half-size.
-  std::vector<std::vector<std::vector<Vec<2>>>> body_loops_;
-  std::vector<double> body_loop_spacing_;
-  std::vector<int> body_material_;
-  std::vector<Vec<Dim>> body_half_size_, body_velocity_;
-  BoundaryPoints<Dim> boundary_;
-  std::optional<PenaltyContact<Dim>> penalty_;
-  std::vector<PenaltyPairInfo> penalty_pairs_;
-  std::vector<FieldNodes<Dim>> penalty_fields_;  // the fields' node boxes, refreshed each step
-  std::vector<double> penalty_reference_mass_;   // per field: its mean particle mass (sliver test)
-  // A boundary point leaves out a node of its field holding less than 0.25 S m_p (a sliver of the
-  // body beside its edge, see simulation_penalty.cpp).
-  static constexpr double penalty_sliver_ = 0.25;
+  ContactSetup contact_setup_;
+  ContactNodeState<Dim> contact_nodes_;
+  ContactBooks contact_books_;
+  PenaltyContactState<Dim> penalty_state_;
+  BodyLoops<Dim> body_loops_;
   std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1), shared fields only
   ThreadPartition partition_;  // each thread's particles, the fields threads share
   PassSplit pass_split_;       // each thread's particles in the particle passes (timed, rebalanced)
