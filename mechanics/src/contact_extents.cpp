@@ -27,8 +27,8 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   contact_nodes_.entry_extent_own.assign(entries, none);
   contact_nodes_.entry_extent_other.assign(entries, none);
   if (entries == 0) return;
-  if (static_cast<int>(contact_nodes_.extent_thread.size()) < threads_ - 1) contact_nodes_.extent_thread.resize(static_cast<std::size_t>(threads_ - 1));
-#pragma omp parallel num_threads(threads_)
+  if (static_cast<int>(contact_nodes_.extent_thread.size()) < threads_.count - 1) contact_nodes_.extent_thread.resize(static_cast<std::size_t>(threads_.count - 1));
+#pragma omp parallel num_threads(threads_.count)
   {
     const int tid = omp_get_thread_num();
     double* own = contact_nodes_.entry_extent_own.data();
@@ -40,16 +40,16 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
       other = buf.data() + entries;
     }
     for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const int f = field_of_material_[m];
+      const int f = layout_.field_of_material[m];
       if (f < 0) continue;
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
-      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+      for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
         const Vec<Dim>& x = p_.position[k];
         const Vec<Dim>& l = p_.half_size[k];
         st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
           if (!(S > 0.0)) return;
-          const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(slot)]);
+          const std::size_t node = static_cast<std::size_t>(layout_.slot_node[static_cast<std::size_t>(slot)]);
           const int c = contact_nodes_.node_field_count[node];
           if (c < 2) return;
           const int begin = contact_nodes_.node_entry_cursor[node] - c;  // the node's run (find_contact_nodes)
@@ -60,7 +60,7 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
       }
     }
   }
-  for (int t = 0; t + 1 < threads_; ++t) {
+  for (int t = 0; t + 1 < threads_.count; ++t) {
     const std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(t)];
     for (std::size_t q = 0; q < entries; ++q) {
       contact_nodes_.entry_extent_own[q] = std::max(contact_nodes_.entry_extent_own[q], buf[q]);

@@ -31,8 +31,8 @@ void Simulation<Dim>::find_contact_nodes() {
   int span_lo = INT_MAX, span_hi = INT_MIN;  // the grid nodes some field covers: [span_lo, span_hi)
   for (const VelocityField<Dim>& F : fields_)
     if (F.count > 0) {
-      span_lo = std::min(span_lo, slot_node_[F.first]);
-      span_hi = std::max(span_hi, slot_node_[F.first + F.count - 1] + 1);
+      span_lo = std::min(span_lo, layout_.slot_node[F.first]);
+      span_hi = std::max(span_hi, layout_.slot_node[F.first + F.count - 1] + 1);
     }
   if (span_lo >= span_hi) {
     contact_nodes_.entries.clear();
@@ -40,7 +40,7 @@ void Simulation<Dim>::find_contact_nodes() {
     return;
   }
   // Below a few thousand slots the fork and the barriers cost more than the work they share.
-  const int threads = nodes_.mass.size() >= 8192 ? threads_ : 1;
+  const int threads = nodes_.mass.size() >= 8192 ? threads_.count : 1;
   if (contact_nodes_.listing.size() < static_cast<std::size_t>(threads))
     contact_nodes_.listing.resize(static_cast<std::size_t>(threads));
   const double mmin = empty_node_mass_;
@@ -55,10 +55,10 @@ void Simulation<Dim>::find_contact_nodes() {
     w.slot_begin.resize(nf), w.slot_end.resize(nf), w.field_end.resize(nf);
     w.entries.assign(nf, 0), w.groups.assign(nf, 0), w.entry_base.resize(nf), w.group_base.resize(nf);
     for (std::size_t f = 0; f < nf; ++f) {
-      const int* b = slot_node_.data() + fields_[f].first;
+      const int* b = layout_.slot_node.data() + fields_[f].first;
       const int* e = b + fields_[f].count;
-      w.slot_begin[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_lo) - slot_node_.data());
-      w.slot_end[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_hi) - slot_node_.data());
+      w.slot_begin[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_lo) - layout_.slot_node.data());
+      w.slot_end[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_hi) - layout_.slot_node.data());
     }
     // 1. Reset this range's counts and cursors (over the range or slot by slot, whichever is shorter).
     if (reset_whole_range) {
@@ -67,7 +67,7 @@ void Simulation<Dim>::find_contact_nodes() {
     } else {
       for (std::size_t f = 0; f < nf; ++f)
         for (std::size_t s = w.slot_begin[f]; s < w.slot_end[f]; ++s) {
-          const auto node = static_cast<std::size_t>(slot_node_[s]);
+          const auto node = static_cast<std::size_t>(layout_.slot_node[s]);
           contact_nodes_.node_field_count[node] = 0;
           contact_nodes_.node_entry_cursor[node] = -1;
         }
@@ -76,7 +76,7 @@ void Simulation<Dim>::find_contact_nodes() {
     for (std::size_t f = 0; f < nf; ++f) {
       for (std::size_t s = w.slot_begin[f]; s < w.slot_end[f]; ++s)
         if (nodes_.mass[s] > mmin) {
-          ++contact_nodes_.node_field_count[static_cast<std::size_t>(slot_node_[s])];
+          ++contact_nodes_.node_field_count[static_cast<std::size_t>(layout_.slot_node[s])];
           w.occupied.push_back(static_cast<int>(s));
         }
       w.field_end[f] = w.occupied.size();
@@ -85,7 +85,7 @@ void Simulation<Dim>::find_contact_nodes() {
     //    block's offset is known).
     for (std::size_t f = 0, o = 0; f < nf; ++f)
       for (; o < w.field_end[f]; ++o) {
-        const auto node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(w.occupied[o])]);
+        const auto node = static_cast<std::size_t>(layout_.slot_node[static_cast<std::size_t>(w.occupied[o])]);
         if (contact_nodes_.node_field_count[node] >= 2 && contact_nodes_.node_entry_cursor[node] == -1) {
           contact_nodes_.node_entry_cursor[node] = -2 - static_cast<int>(w.entries[f]);
           w.entries[f] += contact_nodes_.node_field_count[node];
@@ -111,7 +111,7 @@ void Simulation<Dim>::find_contact_nodes() {
       std::size_t group = w.group_base[f];
       for (; o < w.field_end[f]; ++o) {
         const int s = w.occupied[o];
-        const int node = slot_node_[static_cast<std::size_t>(s)];
+        const int node = layout_.slot_node[static_cast<std::size_t>(s)];
         if (contact_nodes_.node_field_count[static_cast<std::size_t>(node)] < 2) continue;
         int& cursor = contact_nodes_.node_entry_cursor[static_cast<std::size_t>(node)];
         if (cursor <= -2) {

@@ -52,7 +52,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   // however many threads share the groups. (Handing the groups out in chunks as threads came free, schedule
   // dynamic, made the PBX's contact phase slower: 22.1 % of the wall time against 20.0 %.)
   const long groups = static_cast<long>(contact_nodes_.groups.size()) - 1;
-  const int threads = groups >= 256 ? threads_ : 1;
+  const int threads = groups >= 256 ? threads_.count : 1;
   contact_nodes_.thread_work.resize(static_cast<std::size_t>(threads));
   for (auto& t : contact_nodes_.thread_work) {
     t.stats = ContactStats{};
@@ -195,8 +195,8 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
     sd.sliver = nodes_.mass[su] < contact_setup_.options.sliver_fraction * node_mass;
     if (sd.rigid) {
       const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
-      sd.rigid_velocity = field_velocity_[f];
-      sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
+      sd.rigid_velocity = layout_.field_velocity[f];
+      sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - layout_.field_velocity[f]) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
       sd.extent_gap = contact_detail::extent_gap(contact_nodes_.entry_extent_own[q], contact_nodes_.entry_extent_other[q]);
@@ -215,7 +215,7 @@ void Simulation<Dim>::compute_contact_normals() {
   contact_nodes_.entry_normal.assign(contact_nodes_.entries.size(), Vec<Dim>::Zero());
   contact_nodes_.entry_extent_own.clear();  // no gap while the normals are gathered
   const long groups = static_cast<long>(contact_nodes_.groups.size()) - 1;
-  const int threads = groups >= 256 ? threads_ : 1;
+  const int threads = groups >= 256 ? threads_.count : 1;
 #pragma omp parallel num_threads(threads)
   {
     thread_local std::vector<ContactSide<Dim>> sides;

@@ -86,7 +86,7 @@ template <int Dim>
 void Simulation<Dim>::init_fields() {
   const std::size_t nm = materials_.size();
   fields_.clear();
-  field_of_material_.assign(nm, -1);
+  layout_.field_of_material.assign(nm, -1);
   if (!contact_setup_.enabled) {
     VelocityField<Dim> f;
     f.extent = grid_.nodes_per_dim();
@@ -94,10 +94,10 @@ void Simulation<Dim>::init_fields() {
     f.index = NodeIndexer<Dim>{grid_.strides(), 0};
     fields_.push_back(f);
     for (std::size_t m = 0; m < nm; ++m)
-      if (!materials_[m].is_rigid()) field_of_material_[m] = 0;
-    slot_node_.resize(grid_.node_count());
-    for (std::size_t i = 0; i < slot_node_.size(); ++i) slot_node_[i] = static_cast<int>(i);
-    slot_node_valid_ = false;  // (the per-material layout is not this one)
+      if (!materials_[m].is_rigid()) layout_.field_of_material[m] = 0;
+    layout_.slot_node.resize(grid_.node_count());
+    for (std::size_t i = 0; i < layout_.slot_node.size(); ++i) layout_.slot_node[i] = static_cast<int>(i);
+    layout_.slot_node_valid = false;  // (the per-material layout is not this one)
     nodes_.resize(grid_.node_count(), false);
   } else {
     for (std::size_t m = 0; m < nm; ++m) {
@@ -105,13 +105,13 @@ void Simulation<Dim>::init_fields() {
       VelocityField<Dim> f;
       f.material = static_cast<int>(m);
       f.rigid = materials_[m].is_rigid();
-      field_of_material_[m] = static_cast<int>(fields_.size());
+      layout_.field_of_material[m] = static_cast<int>(fields_.size());
       fields_.push_back(f);
     }
     if (contact_setup_.pair_index.size() != nm * nm) contact_setup_.pair_index.assign(nm * nm, 0);
-    slot_node_valid_ = false;
-    box_lo_.assign(nm, IVec<Dim>{});
-    box_hi_.assign(nm, IVec<Dim>{});
+    layout_.slot_node_valid = false;
+    layout_.box_lo.assign(nm, IVec<Dim>{});
+    layout_.box_hi.assign(nm, IVec<Dim>{});
     contact_nodes_.node_field_count.assign(grid_.node_count(), 0);
     contact_nodes_.node_entry_cursor.assign(grid_.node_count(), -1);
     contact_books_.pair_work_first.assign(nm * nm, 0.0);
@@ -119,7 +119,7 @@ void Simulation<Dim>::init_fields() {
   }
   contact_books_.work_first.assign(grid_.node_count(), 0.0);
   contact_books_.work_second.assign(grid_.node_count(), 0.0);
-  field_velocity_.assign(fields_.size(), Vec<Dim>::Zero());
+  layout_.field_velocity.assign(fields_.size(), Vec<Dim>::Zero());
   if (contact_setup_.enabled) setup_penalty();
 }
 
@@ -136,7 +136,7 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
     const std::size_t m = static_cast<std::size_t>(F.material);
     changed = changed || F.first != total;
     F.first = total;
-    if (material_end_[m] == material_begin_[m]) {
+    if (layout_.material_end[m] == layout_.material_begin[m]) {
       changed = changed || F.count != 0;
       F.count = 0;
       F.extent = IVec<Dim>{};
@@ -152,11 +152,11 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
   }
   if (nodes_.mass.size() != total) {
     nodes_.resize_slots(total, true);
-    for (auto& t : thread_nodes_) t.resize_slots(total, true);
+    for (auto& t : threads_.nodes) t.resize_slots(total, true);
   }
-  if (!changed && slot_node_.size() == total && slot_node_valid_) return;
-  slot_node_valid_ = true;
-  slot_node_.resize(total);
+  if (!changed && layout_.slot_node.size() == total && layout_.slot_node_valid) return;
+  layout_.slot_node_valid = true;
+  layout_.slot_node.resize(total);
   const IVec<Dim>& gs = grid_.strides();
   for (const VelocityField<Dim>& F : fields_) {
     for (std::size_t s = 0; s < F.count; ++s) {
@@ -167,16 +167,16 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
         r /= static_cast<std::size_t>(F.extent[d]);
         node += (F.lo[d] + local) * gs[d];
       }
-      slot_node_[F.first + s] = node;
+      layout_.slot_node[F.first + s] = node;
     }
   }
 }
 
 template <int Dim>
 void Simulation<Dim>::update_partition() {
-  if (!partition_.matches(threads_, fields_.size(), p_.size()))
-    partition_.build(threads_, material_begin_, material_end_, field_of_material_, fields_.size(), p_.size());
-  if (!pass_split_.matches(threads_, p_.size())) pass_split_.reset(partition_);
+  if (!threads_.partition.matches(threads_.count, fields_.size(), p_.size()))
+    threads_.partition.build(threads_.count, layout_.material_begin, layout_.material_end, layout_.field_of_material, fields_.size(), p_.size());
+  if (!threads_.pass_split.matches(threads_.count, p_.size())) threads_.pass_split.reset(threads_.partition);
 }
 
 // Each thread clears the slots it scatters into: in the nodes, the fields whose first thread it is;
@@ -197,11 +197,11 @@ void Simulation<Dim>::clear_scatter_targets(int tid, Accumulated which) {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.count == 0) continue;
-    const int first = partition_.first_thread[f], last = partition_.last_thread[f];
+    const int first = threads_.partition.first_thread[f], last = threads_.partition.last_thread[f];
     if (tid == first)
       clear(nodes_, F.first, F.first + F.count);
     else if (tid > first && tid <= last)
-      clear(thread_nodes_[static_cast<std::size_t>(tid - 1)], F.first, F.first + F.count);
+      clear(threads_.nodes[static_cast<std::size_t>(tid - 1)], F.first, F.first + F.count);
   }
 }
 
@@ -209,16 +209,16 @@ void Simulation<Dim>::clear_scatter_targets(int tid, Accumulated which) {
 // worksharing loop per shared field (a scatter phase calls it after its barrier).
 template <int Dim>
 void Simulation<Dim>::sum_shared_fields(Accumulated which) {
-  for (const int f : partition_.shared_fields) {
+  for (const int f : threads_.partition.shared_fields) {
     const VelocityField<Dim>& F = fields_[static_cast<std::size_t>(f)];
-    const std::size_t t0 = static_cast<std::size_t>(partition_.first_thread[static_cast<std::size_t>(f)]);
-    const std::size_t t1 = static_cast<std::size_t>(partition_.last_thread[static_cast<std::size_t>(f)]);
+    const std::size_t t0 = static_cast<std::size_t>(threads_.partition.first_thread[static_cast<std::size_t>(f)]);
+    const std::size_t t1 = static_cast<std::size_t>(threads_.partition.last_thread[static_cast<std::size_t>(f)]);
     const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
 #pragma omp for schedule(static) nowait
     for (long ii = b; ii < e; ++ii) {
       const std::size_t i = static_cast<std::size_t>(ii);
       for (std::size_t t = t0 + 1; t <= t1; ++t) {
-        const NodalFields<Dim>& buf = thread_nodes_[t - 1];
+        const NodalFields<Dim>& buf = threads_.nodes[t - 1];
         if (which.mass) nodes_.mass[i] += buf.mass[i];
         if (which.momentum) nodes_.momentum[i] += buf.momentum[i];
         if (which.force) nodes_.force[i] += buf.force[i];
@@ -244,7 +244,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (!F.rigid) continue;
-    const Vec<Dim> v = field_velocity_[f];
+    const Vec<Dim> v = layout_.field_velocity[f];
     for (std::size_t s = F.first; s < F.first + F.count; ++s) {
       momentum[s] = nodes_.mass[s] * v;
       if (force) {
@@ -255,7 +255,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   }
   // One parallel region over the deformable fields (one per grain in a PBX: a region each would
   // cost more than their few hundred slots).
-#pragma omp parallel num_threads(threads_) reduction(+ : work)
+#pragma omp parallel num_threads(threads_.count) reduction(+ : work)
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -263,7 +263,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
 #pragma omp for schedule(static) nowait
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
-      const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
+      const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
       if (const std::uint8_t driven = rigid_mask_[i]) {
         // Driven components end the step at the rigid velocity. In the momentum update the change is
         // made a force, (m v_rigid − p)/dt, so that the particles' FLIP update receives it too.
@@ -292,7 +292,7 @@ template <int Dim>
 void Simulation<Dim>::velocity_from_momentum() {
   apply_velocity_bc(nodes_.momentum, nullptr, 0.0);
   const double mmin = empty_node_mass_;
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
     nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
 }
@@ -308,7 +308,7 @@ void Simulation<Dim>::save_start_velocity() {
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
   transfer_.start.resize(n);
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t i = 0; i < n; ++i)
     transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
 }
@@ -329,7 +329,7 @@ void Simulation<Dim>::apply_damping(double dt) {
   if (!damping_active(opt_.damping_rate, opt_.damping_until, time_)) return;
   const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
   double removed = 0.0;
-#pragma omp parallel num_threads(threads_) reduction(+ : removed)
+#pragma omp parallel num_threads(threads_.count) reduction(+ : removed)
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -337,7 +337,7 @@ void Simulation<Dim>::apply_damping(double dt) {
 #pragma omp for schedule(static) nowait
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
-      const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(slot_node_[s])];
+      const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(layout_.slot_node[s])];
       damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
     }
   }
@@ -347,7 +347,7 @@ void Simulation<Dim>::apply_damping(double dt) {
 template <int Dim>
 void Simulation<Dim>::advance_grid_momentum(double dt) {
   const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
 }
 
@@ -357,13 +357,13 @@ void Simulation<Dim>::nodal_velocities() {
   const std::size_t n = nodes_.mass.size();
   // Nodes driven by a rigid boundary material keep its prescribed velocity components (the force was
   // zeroed consistently, so only the velocity needs resetting when the prescribed velocity changes).
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t s = 0; s < n; ++s) {
     const double m = nodes_.mass[s];
     if (m > mmin) {
       nodes_.velocity[s] = nodes_.momentum[s] / m;
       nodes_.acceleration[s] = nodes_.force[s] / m;
-      const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
+      const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
       if (const std::uint8_t driven = rigid_mask_[i])
         for (int d = 0; d < Dim; ++d)
           if (driven & (1u << d)) nodes_.velocity[s][d] = rigid_velocity_[i][d];
@@ -374,7 +374,7 @@ void Simulation<Dim>::nodal_velocities() {
   }
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
-      for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) nodes_.velocity[s] = field_velocity_[f];
+      for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) nodes_.velocity[s] = layout_.field_velocity[f];
 }
 
 template <int Dim>
@@ -389,7 +389,7 @@ void Simulation<Dim>::move_rigid_particles(double dt, double t) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid()) continue;
     const RigidMotion r = rigid_motion(m, t, dt);
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) r.move(p_.velocity[k], p_.position[k]);
+    for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) r.move(p_.velocity[k], p_.position[k]);
   }
 }
 
@@ -400,7 +400,7 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   // materials' ranges are visited, and the first one found is the lowest index as before.
   for (std::size_t m = 0; k < 0 && m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid()) continue;
-    for (std::size_t j = material_begin_[m]; j < material_end_[m]; ++j)
+    for (std::size_t j = layout_.material_begin[m]; j < layout_.material_end[m]; ++j)
       if (!grid_.contains(p_.position[j]) && (k < 0 || static_cast<long>(j) < k)) {
         k = static_cast<long>(j);
         break;

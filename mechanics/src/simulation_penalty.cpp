@@ -113,7 +113,7 @@ void Simulation<Dim>::setup_penalty() {
   const std::size_t nm = materials_.size();
   std::vector<double> mass(nm, 0.0);
   for (std::size_t k = 0; k < p_.size(); ++k) mass[static_cast<std::size_t>(p_.material[k])] += p_.mass[k];
-  const auto present = [&](std::size_t m) { return field_of_material_[m] >= 0 && material_end_[m] > material_begin_[m]; };
+  const auto present = [&](std::size_t m) { return layout_.field_of_material[m] >= 0 && layout_.material_end[m] > layout_.material_begin[m]; };
   contact_setup_.any_multimaterial = false;
   std::vector<std::uint8_t> in_penalty(nm, 0);
   std::vector<PenaltyPairSettings> settings;
@@ -137,8 +137,8 @@ void Simulation<Dim>::setup_penalty() {
       }
       const int slave = master == static_cast<int>(a) ? static_cast<int>(b) : static_cast<int>(a);
       PenaltyPairSettings ps;
-      ps.master = field_of_material_[static_cast<std::size_t>(master)];
-      ps.slave = field_of_material_[static_cast<std::size_t>(slave)];
+      ps.master = layout_.field_of_material[static_cast<std::size_t>(master)];
+      ps.slave = layout_.field_of_material[static_cast<std::size_t>(slave)];
       ps.mu = s.law.kind() == FrictionKind::coulomb ? s.law.mu() : 0.0;
       ps.normal_penalty = s.penalty.normal_penalty;
       if (ps.normal_penalty == 0.0) {
@@ -161,7 +161,7 @@ void Simulation<Dim>::setup_penalty() {
   penalty_state_.reference_mass.assign(fields_.size(), 0.0);
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const auto m = static_cast<std::size_t>(fields_[f].material);
-    const std::size_t n = material_end_[m] - material_begin_[m];
+    const std::size_t n = layout_.material_end[m] - layout_.material_begin[m];
     if (n > 0) penalty_state_.reference_mass[f] = mass[m] / static_cast<double>(n);
   }
   penalty_state_.contact.emplace(grid_, PenaltyOptions{Dim == 2 ? opt_.thickness : 1.0});
@@ -187,7 +187,7 @@ void Simulation<Dim>::setup_penalty() {
       throw std::logic_error("body '" + name + "': the contact boundary spacing changed after the body was added "
                              "(enable_contact must come before add_body)");
     try {
-      penalty_state_.boundary.add_loops(field_of_material_[static_cast<std::size_t>(m)], body_loops_.loops[i], body_loops_.half_size[i], body_loops_.velocity[i]);
+      penalty_state_.boundary.add_loops(layout_.field_of_material[static_cast<std::size_t>(m)], body_loops_.loops[i], body_loops_.half_size[i], body_loops_.velocity[i]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("body '" + name + "': " + e.what());
     }
@@ -198,7 +198,7 @@ template <int Dim>
 void Simulation<Dim>::apply_penalty_forces() {
   if (!penalty_state_.contact) return;
   LentStepWeights<Dim> lent(penalty_state_.fields, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
-                            penalty_state_.reference_mass, penalty_state_.sliver, ebs_);
+                            penalty_state_.reference_mass, penalty_state_.sliver, ebs_.bases);
   apply_penalty(*penalty_state_.contact, penalty_state_.boundary, lent.w, nodes_.mass, empty_node_mass_, nodes_.force, contact_books_.work_first, contact_books_.work_second);
   const PenaltyContact<Dim>& pc = *penalty_state_.contact;
   for (std::size_t k = 0; k < penalty_state_.pairs.size(); ++k) {
@@ -225,7 +225,7 @@ template <int Dim>
 void Simulation<Dim>::move_boundary_points(double dt, double t) {
   if (!penalty_state_.contact) return;
   LentStepWeights<Dim> lent(penalty_state_.fields, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
-                            penalty_state_.reference_mass, penalty_state_.sliver, ebs_);  // USF: before apply_penalty_forces
+                            penalty_state_.reference_mass, penalty_state_.sliver, ebs_.bases);  // USF: before apply_penalty_forces
   BoundaryPoints<Dim>& bp = penalty_state_.boundary;
   const long bad = move_points(bp, lent.w, grid_, dt, [&](int field, Vec<Dim>& v) {
     const auto f = static_cast<std::size_t>(field);

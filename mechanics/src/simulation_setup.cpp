@@ -182,12 +182,12 @@ void Simulation<Dim>::finalize() {
   std::stable_sort(order.begin(), order.end(),
                    [this](std::size_t a, std::size_t b) { return p_.material[a] < p_.material[b]; });
   p_.permute(order);
-  material_begin_.assign(materials_.size(), 0);
-  material_end_.assign(materials_.size(), 0);
+  layout_.material_begin.assign(materials_.size(), 0);
+  layout_.material_end.assign(materials_.size(), 0);
   for (std::size_t m = 0, k = 0; m < materials_.size(); ++m) {
-    material_begin_[m] = k;
+    layout_.material_begin[m] = k;
     while (k < p_.size() && p_.material[k] == static_cast<int>(m)) ++k;
-    material_end_[m] = k;
+    layout_.material_end[m] = k;
   }
   taken_.clear();
   taken_.shrink_to_fit();
@@ -266,14 +266,14 @@ double Simulation<Dim>::stable_time_step() const {
   const std::size_t n = p_.size();
   if (finalized_ && wave_speed_ready_ && wave_speed_.size() == n) {
     // The wave speeds of the last stress update (rigid particles: −∞; the rigid loop below counts them).
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(max : cmax)
+#pragma omp parallel for num_threads(threads_.count) schedule(static) reduction(max : cmax)
     for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speed_[k] + p_.velocity[k].norm());
   } else {
     // One parallel region for all materials (grains are small: see evaluate_stencils).
-#pragma omp parallel num_threads(threads_) reduction(max : cmax)
+#pragma omp parallel num_threads(threads_.count) reduction(max : cmax)
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const Material& mat = materials_[m];
-      const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
+      const std::size_t b = finalized_ ? layout_.material_begin[m] : 0, e = finalized_ ? layout_.material_end[m] : n;
       if (mat.is_rigid()) continue;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = b; k < e; ++k) {

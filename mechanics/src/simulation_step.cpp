@@ -3,7 +3,7 @@
 // phase; the phases read no clock. The particle loops are templated on the shape-function kernel
 // (static dispatch) and threaded with OpenMP; scatters go to per-thread nodal buffers that are summed
 // afterwards. Every particle scatters into the slots of its material's velocity field
-// (field_of_material_), so the same loops serve the shared single field and the per-material fields
+// (layout_.field_of_material), so the same loops serve the shared single field and the per-material fields
 // of multimaterial contact. With the extended B-spline the weights are precomputed per step
 // (simulation_ebs.cpp) and the same loops read them.
 #include <frictherm/mechanics/errors.hpp>
@@ -38,10 +38,10 @@ void for_each_part(const ThreadPartition& partition, Fn&& fn) {
 template <int Dim>
 template <class Kernel>
 auto& Simulation<Dim>::stencils() {
-  if constexpr (std::is_same_v<Kernel, LinearKernel>) return st_linear_;
-  else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return st_ugimp_;
-  else if constexpr (is_extended<Kernel>) return st_extended_;
-  else return st_quadratic_;
+  if constexpr (std::is_same_v<Kernel, LinearKernel>) return stencil_store_.linear;
+  else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return stencil_store_.ugimp;
+  else if constexpr (is_extended<Kernel>) return stencil_store_.extended;
+  else return stencil_store_.quadratic;
 }
 
 template <int Dim>
@@ -179,15 +179,15 @@ void Simulation<Dim>::prepare_step(double t) {
   // Below ~2000 particles per thread the fork/join and the scatter-buffer reduction cost more than
   // the particle work they share.
   const int max_threads = omp_get_max_threads();
-  threads_ = threads_for_particles(p_.size(), max_threads);
-  if (static_cast<int>(thread_nodes_.size()) != threads_ - 1) {
-    thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
-    for (auto& tn : thread_nodes_) tn.resize(nodes_.mass.size(), contact_setup_.enabled);
+  threads_.count = threads_for_particles(p_.size(), max_threads);
+  if (static_cast<int>(threads_.nodes.size()) != threads_.count - 1) {
+    threads_.nodes.resize(static_cast<std::size_t>(std::max(0, threads_.count - 1)));
+    for (auto& tn : threads_.nodes) tn.resize(nodes_.mass.size(), contact_setup_.enabled);
   }
   update_partition();
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
-      field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
+      layout_.field_velocity[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
   // Nodes driven by rigid boundary materials (EBS keeps them); with contact from the stencils the step
   // evaluates anyway.
   if constexpr (is_extended<Kernel>) {
@@ -195,11 +195,11 @@ void Simulation<Dim>::prepare_step(double t) {
     prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
   } else {
     auto& st = stencils<Kernel>();
-    if (st.size() != p_.size()) st.resize(p_.size()), stencils_current_ = false;
+    if (st.size() != p_.size()) st.resize(p_.size()), stencil_store_.current = false;
     if (contact_setup_.enabled) {
       // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
-      if (!stencils_current_) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
-      layout_fields(box_lo_, box_hi_);
+      if (!stencil_store_.current) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
+      layout_fields(layout_.box_lo, layout_.box_hi);
       map_rigid_particles<Kernel>(t, st.data());
     } else {
       map_rigid_particles<Kernel>(t, nullptr);
@@ -264,11 +264,11 @@ void Simulation<Dim>::stress_pass(double dt) {
 // The stencils are current again only if the particle pass evaluated them (refreshed).
 template <int Dim>
 void Simulation<Dim>::end_particle_update(StepContext& ctx, bool refreshed) {
-  stencils_current_ = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
+  stencil_store_.current = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
   time_ += ctx.dt;
   ++step_;
   check_particle(ctx.bad, ctx.dt);
-  stencils_current_ = refreshed;  // every particle inside the grid: the pass evaluated every stencil
+  stencil_store_.current = refreshed;  // every particle inside the grid: the pass evaluated every stencil
   throw_beyond_hugoniot(ctx.beyond);
 }
 
@@ -285,22 +285,22 @@ void Simulation<Dim>::evaluate_stencils() {
   const Vec<Dim>* const position = p_.position.data();
   const Vec<Dim>* const half_size = p_.half_size.data();
   if (!contact_setup_.enabled) {
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
     for (std::size_t k = 0; k < p_.size(); ++k) stk[k].evaluate(grid, position[k], half_size[k]);
     return;
   }
   const std::size_t nm = materials_.size();
   update_partition();
-  step_detail::StencilBoxes<Dim>::clear(box_lo_, box_hi_);
+  step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
   // One parallel region for all materials (a grain is a few hundred particles: a region per
   // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_.count)
   {
     thread_local step_detail::StencilBoxes<Dim> boxes;
     boxes.reset(nm);
-    for_each_part(partition_, [&](int t) {
+    for_each_part(threads_.partition, [&](int t) {
       for (std::size_t m = 0; m < nm; ++m) {
-        const std::size_t kb = partition_.even_lo(t, material_begin_[m]), ke = partition_.even_hi(t, material_end_[m]);
+        const std::size_t kb = threads_.partition.even_lo(t, layout_.material_begin[m]), ke = threads_.partition.even_hi(t, layout_.material_end[m]);
         for (std::size_t k = kb; k < ke; ++k) {
           stk[k].evaluate(grid, position[k], half_size[k]);
           boxes.extend(stk[k], boxes.lo[m], boxes.hi[m]);
@@ -308,7 +308,7 @@ void Simulation<Dim>::evaluate_stencils() {
       }
     });
 #pragma omp critical(frictherm_stencil_boxes)
-    boxes.merge_into(box_lo_, box_hi_);
+    boxes.merge_into(layout_.box_lo, layout_.box_hi);
   }
 }
 
@@ -318,10 +318,10 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
   return dispatch_shape(opt_.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
     auto& st = stencils<Kernel>();
-    if (!stencils_current_ || st.size() != p_.size()) {
+    if (!stencil_store_.current || st.size() != p_.size()) {
       PhaseLap lap;  // outside the step: timed with the step's shape_functions phase
       evaluate_stencils<Kernel>();
-      stencils_current_ = true;
+      stencil_store_.current = true;
       lap.to(phase_times_.shape_functions);
     }
     return StencilView<Dim>{opt_.shape, static_cast<const void*>(st.data()), st.size()};
@@ -334,19 +334,19 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
 template <int Dim>
 template <class Scatter>
 void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter) {
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_.count)
   {
-    for_each_part(partition_, [&](int t) {
+    for_each_part(threads_.partition, [&](int t) {
       clear_scatter_targets(t, which);
       for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const int f = field_of_material_[m];
+        const int f = layout_.field_of_material[m];
         if (f < 0 || (!include_rigid && materials_[m].is_rigid())) continue;
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        const std::size_t kb = threads_.partition.lo(t, layout_.material_begin[m]), ke = threads_.partition.hi(t, layout_.material_end[m]);
         if (kb >= ke) continue;
         scatter(scatter_target(t, f), fields_[static_cast<std::size_t>(f)].index, m, kb, ke);
       }
     });
-    if (!partition_.shared_fields.empty()) {
+    if (!threads_.partition.shared_fields.empty()) {
 #pragma omp barrier
       sum_shared_fields(which);
     }
@@ -362,7 +362,7 @@ template <class Kernel>
 void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
-  const bool prepared = stencils_current_;  // by current_stencils() since the last step
+  const bool prepared = stencil_store_.current;  // by current_stencils() since the last step
   scatter_phase(Accumulated{true, true, true, false}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t m, std::size_t kb, std::size_t ke) {
     if (!contact_setup_.enabled) {
@@ -439,13 +439,13 @@ template <class Kernel>
 void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated) {
   std::fill(rigid_mask_.begin(), rigid_mask_.end(), std::uint8_t{0});
   for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (!materials_[m].is_rigid() || field_of_material_[m] >= 0) continue;
+    if (!materials_[m].is_rigid() || layout_.field_of_material[m] >= 0) continue;
     const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
     std::uint8_t bits = 0;
     for (int d = 0; d < Dim; ++d)
       if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
     Stencil<Dim, Kernel> own;
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+    for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
       if (!evaluated) own.evaluate(grid_, p_.position[k], p_.half_size[k]);
       const Stencil<Dim, Kernel>& s = evaluated ? evaluated[k] : own;
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
@@ -467,7 +467,7 @@ void Simulation<Dim>::map_external_loads(double t) {
   auto& st = stencils<Kernel>();
   for (const auto& L : resolved_loads_) {
     const Vec<Dim> f = load_force<Dim>(L.force, *L.scale, t);
-    const int fi = field_of_material_[static_cast<std::size_t>(p_.material[L.particle])];
+    const int fi = layout_.field_of_material[static_cast<std::size_t>(p_.material[L.particle])];
     if (fi < 0) continue;
     add_load_to_grid<Dim>(st[L.particle], fields_[static_cast<std::size_t>(fi)].index, f,
                           [&](int i) -> Vec<Dim>& { return nodes_.force[i]; });

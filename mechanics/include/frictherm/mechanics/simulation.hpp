@@ -33,7 +33,12 @@
 #include <frictherm/mechanics/state/contact_books.hpp>
 #include <frictherm/mechanics/state/contact_node_state.hpp>
 #include <frictherm/mechanics/state/contact_setup.hpp>
+#include <frictherm/mechanics/state/ebs_state.hpp>
+#include <frictherm/mechanics/state/field_layout.hpp>
+#include <frictherm/mechanics/state/nodal_fields.hpp>
 #include <frictherm/mechanics/state/penalty_contact_state.hpp>
+#include <frictherm/mechanics/state/stencil_store.hpp>
+#include <frictherm/mechanics/state/step_threads.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
@@ -74,37 +79,6 @@ struct SimulationOptions {
   double damping_until = 0.0;  // s
   double max_time_step = std::numeric_limits<double>::infinity();
   Vec<3> gravity = Vec<3>::Zero();             // body force per unit mass (m/s^2)
-};
-
-/// Nodal fields, one entry per slot: a grid node of one velocity field (without contact the single
-/// field covers the whole grid and slot = node index).
-template <int Dim>
-struct NodalFields {
-  std::vector<double> mass;
-  std::vector<Vec<Dim>> momentum;
-  std::vector<Vec<Dim>> force;
-  std::vector<Vec<Dim>> velocity;      // v_i^{n+1} after the momentum update
-  std::vector<Vec<Dim>> acceleration;  // (p^{n+1} - p^n) / (m dt), boundary conditions applied
-  // Contact only (empty otherwise): Σ S m x (or Σ S m (x − x0)), Ω = Σ S V, g = Σ G V (eqs. 4–6, 9).
-  std::vector<Vec<Dim>> mass_position;
-  std::vector<double> domain;
-  std::vector<Vec<Dim>> domain_gradient;
-  void resize(std::size_t n, bool with_contact = false);
-  /// To n slots without clearing the ones kept (a layout change of the step: the step's scatter
-  /// clears every slot of a field before adding to it and nodal_velocities sets every velocity and
-  /// acceleration, so no slot is read before it is written).
-  void resize_slots(std::size_t n, bool with_contact);
-};
-
-/// One velocity field: the nodes of a box of the grid, stored in slots first .. first + count − 1.
-template <int Dim>
-struct VelocityField {
-  int material = -1;          // -1: the shared field of all deformable materials (no contact)
-  bool rigid = false;
-  IVec<Dim> lo{};             // first node of the box (lattice counted from the first ghost node)
-  IVec<Dim> extent{};         // nodes per direction
-  std::size_t first = 0, count = 0;
-  NodeIndexer<Dim> index;     // lattice -> slot
 };
 
 struct BodyInfo {
@@ -161,7 +135,7 @@ class Simulation {
   const NodalFields<Dim>& nodes() const { return nodes_; }
   const std::vector<VelocityField<Dim>>& fields() const { return fields_; }
   /// Grid node of each slot of nodes().
-  const std::vector<int>& slot_nodes() const { return slot_node_; }
+  const std::vector<int>& slot_nodes() const { return layout_.slot_node; }
   bool contact_enabled() const { return contact_setup_.enabled; }
   const ContactOptions& contact_options() const { return contact_setup_.options; }
   const ContactPairSettings& contact_pair(int material_a, int material_b) const;
@@ -188,7 +162,7 @@ class Simulation {
   const std::vector<BodyInfo>& bodies() const { return bodies_; }
   /// extended_bspline: the extended basis of each velocity field (fields()[f]) as rebuilt at the
   /// start of the last step (classification, counts); empty for the other shape functions.
-  const std::vector<EbsBasis<Dim>>& extended_bases() const { return ebs_; }
+  const std::vector<EbsBasis<Dim>>& extended_bases() const { return ebs_.bases; }
   double time() const { return time_; }
   long step_count() const { return step_; }
   double last_time_step() const { return last_dt_; }
@@ -206,7 +180,7 @@ class Simulation {
   /// inside the step) and before finalize().
   StencilView<Dim> current_stencils();
   /// Drops the stencils current_stencils() evaluated (the next step evaluates its own).
-  void forget_stencils() { stencils_current_ = false; }
+  void forget_stencils() { stencil_store_.current = false; }
 
   double kinetic_energy() const;  // of deformable particles (J)
   /// Energy stored in the deformable materials (J): elastic strain energy (linear elastic, neo-Hookean)
@@ -236,7 +210,7 @@ class Simulation {
   /// bases, contact nodes and nodal fields are rebuilt each step from these.
   template <class Visitor> void visit_state(Visitor&& v) {
     if (!finalized_) finalize();
-    if constexpr (std::decay_t<Visitor>::reading) stencils_current_ = false;  // positions may change
+    if constexpr (std::decay_t<Visitor>::reading) stencil_store_.current = false;  // positions may change
     v("particles/position", p_.position);
     v("particles/initial_position", p_.initial_position);
     v("particles/velocity", p_.velocity);
@@ -311,26 +285,26 @@ class Simulation {
     long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
   };
   /// `refresh` (grid-to-particle with Stencil arrays): also the next step's stencils at the moved
-  /// positions, the rigid materials moved (move_rigid_particles) and box_lo_/box_hi_, in the same pass.
+  /// positions, the rigid materials moved (move_rigid_particles) and layout_.box_lo/layout_.box_hi, in the same pass.
   template <bool Kinematics, bool Stress, class Stencils>
   ParticlePassResult particle_pass(double dt, Stencils& st, bool refresh = false);
   void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
-  template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
+  template <class Kernel> void evaluate_stencils();  // all particles; with contact also layout_.box_lo/layout_.box_hi
   void prepare_extended_stencils();  // EBS: rebuild per field, lay out the fields, flatten the weights
   template <class Kernel> void map_rigid_fields();
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
-  // Scatters under the thread partition (partition_, thread_partition.hpp; simulation_fields.cpp):
+  // Scatters under the thread partition (threads_.partition, thread_partition.hpp; simulation_fields.cpp):
   // which arrays a scatter accumulates.
   struct Accumulated {
     bool mass = false, momentum = false, force = false, contact_terms = false;
   };
-  void update_partition();  // partition_ for threads_ and the current fields
+  void update_partition();  // threads_.partition for threads_.count and the current fields
   /// Where thread tid scatters field f's values: the nodes themselves, or its buffer when it shares f.
   NodalFields<Dim>& scatter_target(int tid, int field) {
-    return tid == partition_.first_thread[static_cast<std::size_t>(field)] ? nodes_
-                                                                            : thread_nodes_[static_cast<std::size_t>(tid - 1)];
+    return tid == threads_.partition.first_thread[static_cast<std::size_t>(field)] ? nodes_
+                                                                            : threads_.nodes[static_cast<std::size_t>(tid - 1)];
   }
   void clear_scatter_targets(int tid, Accumulated which);  // inside a parallel region, before the scatter
   void sum_shared_fields(Accumulated which);  // inside a parallel region, after a barrier
@@ -361,13 +335,7 @@ class Simulation {
   void compute_contact_normals();                                // extent separation: contact_nodes_.entry_normal
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
-  struct RigidMotion {
-    Vec<Dim> velocity, displacement;  // at t, and over [t, t + dt] (trapezoid)
-    void move(Vec<Dim>& particle_velocity, Vec<Dim>& particle_position) const {
-      particle_velocity = velocity;
-      particle_position += displacement;
-    }
-  };
+  using RigidMotion = RigidBodyMotion<Dim>;
   RigidMotion rigid_motion(std::size_t material, double t, double dt) const;
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
   void setup_penalty();                          // finalize(): penalty pairs and boundary points
@@ -383,24 +351,15 @@ class Simulation {
   Particles<Dim> p_;
   std::vector<Material> materials_;
   std::vector<BodyInfo> bodies_;
-  std::vector<std::size_t> material_begin_, material_end_;  // particle ranges after finalize()
   NodalFields<Dim> nodes_;
   std::vector<VelocityField<Dim>> fields_;
-  std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
-  std::vector<int> slot_node_;
-  bool slot_node_valid_ = false;  // slot_node_ matches the per-material layout of fields_ (layout_fields)
-  std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
-  std::vector<RigidMotion> rigid_motion_;  // per material, for particle_pass(refresh)
-  std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
+  FieldLayout<Dim> layout_;
   ContactSetup contact_setup_;
   ContactNodeState<Dim> contact_nodes_;
   ContactBooks contact_books_;
   PenaltyContactState<Dim> penalty_state_;
   BodyLoops<Dim> body_loops_;
-  std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1), shared fields only
-  ThreadPartition partition_;  // each thread's particles, the fields threads share
-  PassSplit pass_split_;       // each thread's particles in the particle passes (timed, rebalanced)
-  std::vector<double> work_blocks_;  // the particle pass's external work per PassSplit block (threads > 1)
+  StepThreads<Dim> threads_;
   struct TransferScratch {  // XPIC/FMPM, per slot
     std::vector<Vec<Dim>> start;     // XPIC: lumped v^n at the momentum update
     std::vector<Vec<Dim>> filtered;  // v* (the series' sum)
@@ -423,13 +382,8 @@ class Simulation {
   std::vector<ResolvedLoad> resolved_loads_;
   std::vector<std::uint8_t> taken_;  // fine lattice points already filled by a body
   int taken_ppc_ = 0;
-  std::vector<Stencil<Dim, LinearKernel>> st_linear_;
-  std::vector<Stencil<Dim, UGIMPKernel>> st_ugimp_;
-  std::vector<Stencil<Dim, QuadraticBSplineKernel>> st_quadratic_;
-  PrecomputedStencils<Dim> st_extended_;   // EBS: N^e, ∇N^e of every particle, this step
-  std::vector<EbsBasis<Dim>> ebs_;         // EBS: one per velocity field
-  std::vector<std::pair<std::size_t, std::size_t>> ebs_ranges_;  // rebuild scratch: a field's particle ranges
-  std::vector<std::uint8_t> ebs_kept_;     // EBS: nodes never made degenerate (velocity conditions)
+  StencilStore<Dim> stencil_store_;
+  EbsState<Dim> ebs_;
   bool finalized_ = false;
   double time_ = 0.0;
   long step_ = 0;
@@ -445,10 +399,6 @@ class Simulation {
   StepPhaseTimes phase_times_;
   PhaseList phases_;     // the step (build_phases)
   long phases_key_ = -1;  // phase_key() the list was built for
-  // The stencils of st_linear_/st_ugimp_/st_quadratic_ were evaluated at the current positions (and,
-  // with contact, box_lo_/box_hi_ from them) by current_stencils(): the next step starts from them.
-  bool stencils_current_ = false;
-  int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves
 };
 
 extern template class Simulation<2>;
