@@ -73,7 +73,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     ContactThreadWork& acc = contact_nodes_.thread_work[static_cast<std::size_t>(omp_get_thread_num())];
     PairContext ctx{nullptr, contact_setup_.options.separation, contact_setup_.options.position_correction, contact_setup_.options.extent_tolerance,
                     cell_volume, contact_setup_.options.area, dt, heat};
-    ctx.step = static_cast<double>(step_);
+    ctx.step = static_cast<double>(clock_.step);
     ctx.slip_length = contact_setup_.options.regularization_slip_length;
     ctx.relaxation_time = contact_setup_.options.regularization_time;
     // Per-node scratch, reused from call to call (no allocation per step once grown).
@@ -128,7 +128,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   if (failure.group >= 0) {  // "step S, t = T s: contact.pairs[0].law (materials 'a' and 'b') at node ..."
     std::ostringstream msg;
     msg.precision(6);
-    msg << "step " << step_ << ", t = " << time_ << " s: ";
+    msg << "step " << clock_.step << ", t = " << clock_.time << " s: ";
     if (failure.material_a >= 0) {
       const std::string& origin = contact_pair(failure.material_a, failure.material_b).origin;
       msg << (origin.empty() ? std::string("contact") : origin) << " (materials '"
@@ -141,7 +141,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     msg << " at node " << failure.node << " (";
     for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << x[d];
     msg << ") m: " << failure.what;
-    throw SimulationError(msg.str(), step_, time_, -1);
+    throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
   }
   if (!heat) return;
   for (const auto& t : contact_nodes_.thread_work) {
@@ -156,7 +156,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   ContactThreadWork& books = contact_nodes_.thread_work.front();
   for (const auto& t : contact_nodes_.thread_work) {
     for (const auto& e : t.entries) books.add(e.k, e.w1, e.w2);
-    for (const double w : t.rigid_work) rigid_work_ += w;  // group order too: the same sum on any thread count
+    for (const double w : t.rigid_work) work_books_.rigid += w;  // group order too: the same sum on any thread count
   }
   for (const std::size_t k : books.touched) {  // (the others add zero)
     contact_books_.pair_work_first[k] += books.pair_first[k], contact_books_.pair_work_second[k] += books.pair_second[k];
@@ -196,7 +196,7 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
     if (sd.rigid) {
       const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
       sd.rigid_velocity = layout_.field_velocity[f];
-      sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - layout_.field_velocity[f]) / dt;
+      sd.rigid_acceleration = (mat.rigid_velocity_at(clock_.time + dt).template head<Dim>() - layout_.field_velocity[f]) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
       sd.extent_gap = contact_detail::extent_gap(contact_nodes_.entry_extent_own[q], contact_nodes_.entry_extent_other[q]);

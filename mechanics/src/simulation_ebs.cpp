@@ -24,7 +24,7 @@ void Simulation<Dim>::prepare_extended_stencils() {
   // Nodes with a velocity condition (fixed faces, rigid boundary materials) keep their own
   // B-spline: a degenerate node has no weight, so a condition on it would not reach the body.
   ebs_.kept.resize(grid_.node_count());
-  for (std::size_t i = 0; i < ebs_.kept.size(); ++i) ebs_.kept[i] = fixed_mask_[i] | rigid_mask_[i];
+  for (std::size_t i = 0; i < ebs_.kept.size(); ++i) ebs_.kept[i] = conditions_.fixed_mask[i] | conditions_.rigid_mask[i];
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     ebs_.ranges.clear();
     for (std::size_t m = 0; m < materials_.size(); ++m)
@@ -36,10 +36,10 @@ void Simulation<Dim>::prepare_extended_stencils() {
       ebs_.bases[f].rebuild(grid_, p_.position, p_.volume, ebs_.ranges);
     } catch (const std::exception& e) {
       std::ostringstream msg;
-      msg << "step " << step_ << ", t = " << time_ << " s: extended B-spline of velocity field " << f;
+      msg << "step " << clock_.step << ", t = " << clock_.time << " s: extended B-spline of velocity field " << f;
       if (fields_[f].material >= 0) msg << " (material '" << materials_[static_cast<std::size_t>(fields_[f].material)].name << "')";
       msg << ": " << e.what();
-      throw SimulationError(msg.str(), step_, time_, -1);
+      throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
     }
   }
 
@@ -55,7 +55,7 @@ void Simulation<Dim>::prepare_extended_stencils() {
   }
 
   // 3. Flatten: entries per particle, prefix sum, then slots, N^e and ∇N^e. Particles without a
-  //    field (rigid materials acting through rigid_mask_) get no entries.
+  //    field (rigid materials acting through conditions_.rigid_mask) get no entries.
   PrecomputedStencils<Dim>& st = stencil_store_.extended;
   const std::size_t n = p_.size();
   st.begin.resize(n + 1);

@@ -81,7 +81,7 @@ const ContactPairSettings& Simulation<Dim>::contact_pair(int a, int b) const {
 }
 
 // Without contact: one field over the whole grid shared by every deformable material (slot = node),
-// rigid materials act through rigid_mask_. With contact: one field per material, laid out each step.
+// rigid materials act through conditions_.rigid_mask. With contact: one field per material, laid out each step.
 template <int Dim>
 void Simulation<Dim>::init_fields() {
   const std::size_t nm = materials_.size();
@@ -101,7 +101,7 @@ void Simulation<Dim>::init_fields() {
     nodes_.resize(grid_.node_count(), false);
   } else {
     for (std::size_t m = 0; m < nm; ++m) {
-      if (materials_[m].is_rigid() && materials_[m].rigid_boundary) continue;  // acts through rigid_mask_
+      if (materials_[m].is_rigid() && materials_[m].rigid_boundary) continue;  // acts through conditions_.rigid_mask
       VelocityField<Dim> f;
       f.material = static_cast<int>(m);
       f.rigid = materials_[m].is_rigid();
@@ -264,18 +264,18 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
       const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
-      if (const std::uint8_t driven = rigid_mask_[i]) {
+      if (const std::uint8_t driven = conditions_.rigid_mask[i]) {
         // Driven components end the step at the rigid velocity. In the momentum update the change is
         // made a force, (m v_rigid − p)/dt, so that the particles' FLIP update receives it too.
         for (int d = 0; d < Dim; ++d)
           if (driven & (1u << d)) {
             if (force)  // the kernel shared with the decomposed step (energy/energy_books.hpp)
-              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], rigid_velocity_[i][d], dt);
+              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], conditions_.rigid_velocity[i][d], dt);
             else
-              momentum[s][d] = nodes_.mass[s] * rigid_velocity_[i][d];
+              momentum[s][d] = nodes_.mass[s] * conditions_.rigid_velocity[i][d];
           }
       }
-      if (const std::uint8_t mask = fixed_mask_[i]) {
+      if (const std::uint8_t mask = conditions_.fixed_mask[i]) {
         for (int d = 0; d < Dim; ++d)
           if (mask & (1u << d)) {
             momentum[s][d] = 0.0;
@@ -315,7 +315,7 @@ void Simulation<Dim>::save_start_velocity() {
 
 template <int Dim>
 void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
-  rigid_work_ += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
+  work_books_.rigid += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
 }
 
 // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
@@ -326,7 +326,7 @@ void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
 // with the decomposed step.
 template <int Dim>
 void Simulation<Dim>::apply_damping(double dt) {
-  if (!damping_active(opt_.damping_rate, opt_.damping_until, time_)) return;
+  if (!damping_active(opt_.damping_rate, opt_.damping_until, clock_.time)) return;
   const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
   double removed = 0.0;
 #pragma omp parallel num_threads(threads_.count) reduction(+ : removed)
@@ -337,11 +337,11 @@ void Simulation<Dim>::apply_damping(double dt) {
 #pragma omp for schedule(static) nowait
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
-      const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(layout_.slot_node[s])];
+      const std::uint8_t driven = conditions_.rigid_mask[static_cast<std::size_t>(layout_.slot_node[s])];
       damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
     }
   }
-  damping_work_ += removed;
+  work_books_.damping += removed;
 }
 
 template <int Dim>
@@ -364,9 +364,9 @@ void Simulation<Dim>::nodal_velocities() {
       nodes_.velocity[s] = nodes_.momentum[s] / m;
       nodes_.acceleration[s] = nodes_.force[s] / m;
       const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
-      if (const std::uint8_t driven = rigid_mask_[i])
+      if (const std::uint8_t driven = conditions_.rigid_mask[i])
         for (int d = 0; d < Dim; ++d)
-          if (driven & (1u << d)) nodes_.velocity[s][d] = rigid_velocity_[i][d];
+          if (driven & (1u << d)) nodes_.velocity[s][d] = conditions_.rigid_velocity[i][d];
     } else {
       nodes_.velocity[s].setZero();
       nodes_.acceleration[s].setZero();
@@ -411,8 +411,8 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   std::ostringstream msg;
   msg.precision(6);
   const bool finite = p_.velocity[u].allFinite() && p_.position[u].allFinite();
-  msg << "step " << step_ << ", t = " << time_ << " s: particle " << k << " of body '"
-      << bodies_[static_cast<std::size_t>(p_.body[u])].name << "' ";
+  msg << "step " << clock_.step << ", t = " << clock_.time << " s: particle " << k << " of body '"
+      << bodies_.info[static_cast<std::size_t>(p_.body[u])].name << "' ";
   if (!finite) {
     msg << "has a non-finite velocity or position (the step blew up; try a smaller CFL factor)";
   } else {
@@ -424,7 +424,7 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
     for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << grid_.hi()[d];
     msg << ") m";
   }
-  throw SimulationError(msg.str(), step_, time_, k);
+  throw SimulationError(msg.str(), clock_.step, clock_.time, k);
 }
 
 // A particle compressed past the limit of its Hugoniot in the stress update (simulation_step.cpp).
@@ -433,11 +433,11 @@ void Simulation<Dim>::throw_beyond_hugoniot(long beyond) const {
   if (beyond >= 0) {
     const std::size_t k = static_cast<std::size_t>(beyond);
     std::ostringstream msg;
-    msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '"
+    msg << "step " << clock_.step << ", t = " << clock_.time << " s: particle " << beyond << " of material '"
         << materials_[static_cast<std::size_t>(p_.material[k])].name
         << "' is compressed past the limit of its Hugoniot (J = " << p_.volume[k] / p_.initial_volume[k]
         << "; try a smaller CFL factor)";
-    throw SimulationError(msg.str(), step_, time_, beyond);
+    throw SimulationError(msg.str(), clock_.step, clock_.time, beyond);
   }
 }
 

@@ -55,8 +55,8 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   const ParticleUpdate update = opt_.particle_update;
   const bool flip = update == ParticleUpdate::flip;
   const Analysis an = opt_.analysis;
-  if (Stress && wave_speed_.size() != p_.size())
-    wave_speed_.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
+  if (Stress && wave_speeds_.speed.size() != p_.size())
+    wave_speeds_.speed.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
   // Plain pointers (see map_to_grid): the particle stores below would otherwise reload them.
   const Vec<Dim>* const acceleration = nodes_.acceleration.data();
   const Vec<Dim>* const velocity = nodes_.velocity.data();
@@ -74,7 +74,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   double* const ep_p = p_.plastic_strain.data();
   double* const e_p = p_.internal_energy.data();
   double* const wp_p = p_.plastic_work.data();
-  double* const cp = wave_speed_.data();
+  double* const cp = wave_speeds_.speed.data();
   decltype(auto) stk = step_detail::indexable(st);
   // The next step's stencils (refresh): Stencil arrays only; EBS builds its weights per step.
   constexpr bool refreshable = Kinematics && !std::is_same_v<Stencils, PrecomputedStencils<Dim>>;
@@ -84,7 +84,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     layout_.rigid_motion.resize(nm);
     step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
     for (std::size_t m = 0; m < nm; ++m)
-      if (materials_[m].is_rigid()) layout_.rigid_motion[m] = rigid_motion(m, time_, dt);
+      if (materials_[m].is_rigid()) layout_.rigid_motion[m] = rigid_motion(m, clock_.time, dt);
   }
   const Grid<Dim> grid = grid_;  // a local copy (see evaluate_stencils)
   [[maybe_unused]] const auto next_stencils = [&] {
@@ -99,8 +99,8 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   // before it (reused from step to step: no allocation once grown).
   thread_local std::vector<Vec<Dim>> load_start_position;
   if constexpr (Kinematics) {
-    load_start_position.resize(resolved_loads_.size());
-    for (std::size_t j = 0; j < resolved_loads_.size(); ++j) load_start_position[j] = p_.position[resolved_loads_[j].particle];
+    load_start_position.resize(conditions_.resolved_loads.size());
+    for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) load_start_position[j] = p_.position[conditions_.resolved_loads[j].particle];
   }
   double* const work_block = threads_.work_blocks.data();
 
@@ -230,13 +230,13 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     threads_.pass_split.rebalance(layout_.material_begin, layout_.material_end, layout_.field_of_material);
   }
   if constexpr (Kinematics) {
-    for (std::size_t j = 0; j < resolved_loads_.size(); ++j) {
-      const ResolvedLoad& L = resolved_loads_[j];
-      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, time_), p_.position[L.particle] - load_start_position[j]);
+    for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) {
+      const ResolvedLoad& L = conditions_.resolved_loads[j];
+      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, clock_.time), p_.position[L.particle] - load_start_position[j]);
     }
-    external_work_ += work;
+    work_books_.external += work;
   }
-  if constexpr (Stress) wave_speed_ready_ = true;
+  if constexpr (Stress) wave_speeds_.ready = true;
   return {bad == std::numeric_limits<long>::max() ? -1 : bad, beyond};
 }
 

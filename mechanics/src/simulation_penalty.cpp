@@ -96,9 +96,9 @@ void Simulation<Dim>::check_penalty_settings(const ContactPairSettings& s, int a
 template <int Dim>
 void Simulation<Dim>::set_body_boundary(int body, const std::vector<std::vector<Vec<2>>>& loops) {
   if (finalized_) throw std::logic_error("body boundaries must be set before the simulation is finalized");
-  if (body < 0 || body >= static_cast<int>(bodies_.size())) throw std::invalid_argument("set_body_boundary: no such body");
+  if (body < 0 || body >= static_cast<int>(bodies_.info.size())) throw std::invalid_argument("set_body_boundary: no such body");
   for (const auto& l : loops)
-    if (l.size() < 3) throw std::invalid_argument("body '" + bodies_[static_cast<std::size_t>(body)].name + "': a boundary loop needs at least 3 points");
+    if (l.size() < 3) throw std::invalid_argument("body '" + bodies_.info[static_cast<std::size_t>(body)].name + "': a boundary loop needs at least 3 points");
   body_loops_.loops[static_cast<std::size_t>(body)] = loops;
   body_loops_.spacing[static_cast<std::size_t>(body)] = -1.0;  // given, not sampled
 }
@@ -168,9 +168,9 @@ void Simulation<Dim>::setup_penalty() {
   for (const PenaltyPairSettings& ps : settings) penalty_state_.contact->add_pair(ps);
 
   const double spacing = contact_setup_.options.boundary_point_spacing(h);
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+  for (std::size_t i = 0; i < bodies_.info.size(); ++i) {
     const int m = body_loops_.material[i];
-    const std::string& name = bodies_[i].name;
+    const std::string& name = bodies_.info[i].name;
     if (m < 0) {
       bool any = false;  // a body of several materials: does one of them use penalty contact?
       for (std::size_t k = 0; k < p_.size() && !any; ++k)
@@ -238,11 +238,11 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
     const auto i = static_cast<std::size_t>(bad);
     const int m = fields_[static_cast<std::size_t>(bp.field[i])].material;
     std::ostringstream msg;
-    msg << "step " << step_ << ", t = " << time_ << " s: boundary point " << i << " of material '"
+    msg << "step " << clock_.step << ", t = " << clock_.time << " s: boundary point " << i << " of material '"
         << materials_[static_cast<std::size_t>(m)].name << "' "
         << (bp.position[i].allFinite() ? "left the grid" : "has a non-finite position")
         << " (penalty contact; the step blew up: try a smaller CFL factor or penalty)";
-    throw SimulationError(msg.str(), step_, time_, -1);
+    throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
   }
   contact_books_.stats.penalty_contacts = contact_books_.stats.penalty_sliding = 0;
   for (std::size_t k = 0; k < penalty_state_.contact->pair_count(); ++k) {

@@ -48,14 +48,14 @@ template <int Dim>
 double Simulation<Dim>::step(double dt_limit) {
   finalize();
   // The energy books' start (EnergyBalance::initial): once, before the first step moves anything.
-  if (std::isnan(initial_energy_))
-    initial_energy_ = kinetic_energy() + strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
-  if (phases_.empty() || phases_key_ != phase_key()) build_phases();
+  if (std::isnan(work_books_.initial_energy))
+    work_books_.initial_energy = kinetic_energy() + strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
+  if (schedule_.phases.empty() || schedule_.key != phase_key()) build_phases();
   StepContext ctx;
   ctx.dt_limit = dt_limit;
-  ctx.t = time_;
-  phases_.run(ctx, phase_times_);
-  last_dt_ = ctx.dt;
+  ctx.t = clock_.time;
+  schedule_.phases.run(ctx, schedule_.times);
+  clock_.last_dt = ctx.dt;
   return ctx.dt;
 }
 
@@ -69,26 +69,26 @@ long Simulation<Dim>::phase_key() const {
   key = key * 2 + contact_setup_.enabled;
   key = key * 2 + (contact_setup_.enabled && contact_setup_.options.separation == SeparationMethod::extent);
   key = key * 2 + penalty_state_.contact.has_value();
-  key = key * 2 + !resolved_loads_.empty();
+  key = key * 2 + !conditions_.resolved_loads.empty();
   return key;
 }
 
 template <int Dim>
 void Simulation<Dim>::build_phases() {
-  phases_.clear();
+  schedule_.phases.clear();
   if (opt_.shape == ShapeKind::extended_bspline)
     build_phases<ExtendedBSplineKernel>();
   else
     dispatch_shape(opt_.shape, [&](auto kernel) { build_phases<decltype(kernel)>(); });
-  phases_key_ = phase_key();
+  schedule_.key = phase_key();
 }
 
 template <int Dim>
 std::vector<const char*> Simulation<Dim>::step_phase_names() {
   finalize();
-  if (phases_.empty() || phases_key_ != phase_key()) build_phases();
+  if (schedule_.phases.empty() || schedule_.key != phase_key()) build_phases();
   std::vector<const char*> names;
-  for (const StepPhase& p : phases_.phases()) names.push_back(p.name);
+  for (const StepPhase& p : schedule_.phases.phases()) names.push_back(p.name);
   return names;
 }
 
@@ -102,7 +102,7 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
   using T = StepPhaseTimes;
-  PhaseList& P = phases_;
+  PhaseList& P = schedule_.phases;
   const UpdateScheme scheme = opt_.scheme;
   const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
   const bool penalty = penalty_state_.contact.has_value();
@@ -115,8 +115,8 @@ void Simulation<Dim>::build_phases() {
     c.dt = std::min(stable_time_step(), c.dt_limit);
     if (!(c.dt > 0.0) || !std::isfinite(c.dt)) {
       std::ostringstream msg;
-      msg << "step " << step_ << ", t = " << time_ << " s: time step " << c.dt << " s is not positive and finite";
-      throw SimulationError(msg.str(), step_, time_, -1);
+      msg << "step " << clock_.step << ", t = " << clock_.time << " s: time step " << c.dt << " s is not positive and finite";
+      throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
     }
   });
   P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
@@ -130,7 +130,7 @@ void Simulation<Dim>::build_phases() {
     if (penalty)  // the points move with the velocity the stress update used
       P.add("move_boundary_points", &T::contact, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
   }
-  if (!resolved_loads_.empty())
+  if (!conditions_.resolved_loads.empty())
     P.add("external_loads", &T::particle_to_grid, [this](StepContext& c) { map_external_loads<Kernel>(c.t); });
   if (penalty)  // point forces into the nodal forces (Kakouris 2024 eq. 36), before the velocity conditions
     P.add("penalty_forces", &T::contact, [this](StepContext&) { apply_penalty_forces(); });
@@ -265,8 +265,8 @@ void Simulation<Dim>::stress_pass(double dt) {
 template <int Dim>
 void Simulation<Dim>::end_particle_update(StepContext& ctx, bool refreshed) {
   stencil_store_.current = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
-  time_ += ctx.dt;
-  ++step_;
+  clock_.time += ctx.dt;
+  ++clock_.step;
   check_particle(ctx.bad, ctx.dt);
   stencil_store_.current = refreshed;  // every particle inside the grid: the pass evaluated every stencil
   throw_beyond_hugoniot(ctx.beyond);
@@ -322,7 +322,7 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
       PhaseLap lap;  // outside the step: timed with the step's shape_functions phase
       evaluate_stencils<Kernel>();
       stencil_store_.current = true;
-      lap.to(phase_times_.shape_functions);
+      lap.to(schedule_.times.shape_functions);
     }
     return StencilView<Dim>{opt_.shape, static_cast<const void*>(st.data()), st.size()};
   });
@@ -437,7 +437,7 @@ void Simulation<Dim>::add_internal_forces() {
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated) {
-  std::fill(rigid_mask_.begin(), rigid_mask_.end(), std::uint8_t{0});
+  std::fill(conditions_.rigid_mask.begin(), conditions_.rigid_mask.end(), std::uint8_t{0});
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid() || layout_.field_of_material[m] >= 0) continue;
     const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
@@ -450,9 +450,9 @@ void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* 
       const Stencil<Dim, Kernel>& s = evaluated ? evaluated[k] : own;
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
         if (S > 0.0) {
-          rigid_mask_[static_cast<std::size_t>(i)] |= bits;
+          conditions_.rigid_mask[static_cast<std::size_t>(i)] |= bits;
           for (int d = 0; d < Dim; ++d)
-            if (bits & (1u << d)) rigid_velocity_[static_cast<std::size_t>(i)][d] = v[d];
+            if (bits & (1u << d)) conditions_.rigid_velocity[static_cast<std::size_t>(i)][d] = v[d];
         }
       });
     }
@@ -465,7 +465,7 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_external_loads(double t) {
   auto& st = stencils<Kernel>();
-  for (const auto& L : resolved_loads_) {
+  for (const auto& L : conditions_.resolved_loads) {
     const Vec<Dim> f = load_force<Dim>(L.force, *L.scale, t);
     const int fi = layout_.field_of_material[static_cast<std::size_t>(p_.material[L.particle])];
     if (fi < 0) continue;

@@ -48,7 +48,7 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
       const double ms = nodes_.mass[s];
       Vec<Dim> next = ms > mmin ? Vec<Dim>(X.term[s] - rt / ms) : Vec<Dim>(Vec<Dim>::Zero());
       const std::size_t node = static_cast<std::size_t>(layout_.slot_node[s]);
-      if (const std::uint8_t bc = static_cast<std::uint8_t>(fixed_mask_[node] | rigid_mask_[node]))
+      if (const std::uint8_t bc = static_cast<std::uint8_t>(conditions_.fixed_mask[node] | conditions_.rigid_mask[node]))
         for (int d = 0; d < Dim; ++d)
           if (bc & (1u << d)) next[d] = 0.0;
       X.term[s] = next;

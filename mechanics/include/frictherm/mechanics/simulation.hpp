@@ -29,16 +29,22 @@
 #include <frictherm/mechanics/particles.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/state/body_list.hpp>
 #include <frictherm/mechanics/state/body_loops.hpp>
 #include <frictherm/mechanics/state/contact_books.hpp>
 #include <frictherm/mechanics/state/contact_node_state.hpp>
 #include <frictherm/mechanics/state/contact_setup.hpp>
 #include <frictherm/mechanics/state/ebs_state.hpp>
 #include <frictherm/mechanics/state/field_layout.hpp>
+#include <frictherm/mechanics/state/loads_and_conditions.hpp>
 #include <frictherm/mechanics/state/nodal_fields.hpp>
 #include <frictherm/mechanics/state/penalty_contact_state.hpp>
 #include <frictherm/mechanics/state/stencil_store.hpp>
+#include <frictherm/mechanics/state/step_clock.hpp>
+#include <frictherm/mechanics/state/step_schedule.hpp>
 #include <frictherm/mechanics/state/step_threads.hpp>
+#include <frictherm/mechanics/state/wave_speeds.hpp>
+#include <frictherm/mechanics/state/work_books.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
@@ -81,10 +87,6 @@ struct SimulationOptions {
   Vec<3> gravity = Vec<3>::Zero();             // body force per unit mass (m/s^2)
 };
 
-struct BodyInfo {
-  std::string name;
-  std::size_t particle_count = 0;
-};
 
 template <int Dim>
 struct ContactSide;  // contact internals (mechanics/src/contact_side.hpp)
@@ -159,15 +161,15 @@ class Simulation {
   double cumulative_frictional_work(HeatingOrder order) const;
   double cumulative_frictional_work(HeatingOrder order, int material_a, int material_b) const;
   const std::vector<Material>& materials() const { return materials_; }
-  const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  const std::vector<BodyInfo>& bodies() const { return bodies_.info; }
   /// extended_bspline: the extended basis of each velocity field (fields()[f]) as rebuilt at the
   /// start of the last step (classification, counts); empty for the other shape functions.
   const std::vector<EbsBasis<Dim>>& extended_bases() const { return ebs_.bases; }
-  double time() const { return time_; }
-  long step_count() const { return step_; }
-  double last_time_step() const { return last_dt_; }
+  double time() const { return clock_.time; }
+  long step_count() const { return clock_.step; }
+  double last_time_step() const { return clock_.last_dt; }
   /// Wall time spent in each phase of step() since the start.
-  const StepPhaseTimes& phase_times() const { return phase_times_; }
+  const StepPhaseTimes& phase_times() const { return schedule_.times; }
   /// The names of the step's phases in order, for this scene's scheme and options (finalizes).
   std::vector<const char*> step_phase_names();
   /// The shape functions of every particle at the current positions, read-only, for code outside the
@@ -189,13 +191,13 @@ class Simulation {
   double strain_energy() const;
   Vec<Dim> linear_momentum() const;  // of deformable particles (kg m/s)
   /// Work done by external loads and body force so far (J), accumulated each step.
-  double external_work() const { return external_work_; }
+  double external_work() const { return work_books_.external; }
   /// Work done by rigid materials (walls, pistons) on the deformable bodies so far (J): per step the
   /// momentum the rigid fields and rigid velocity conditions give the deformable material in the
   /// momentum update (what the particles receive) times the rigid velocity.
-  double rigid_work() const { return rigid_work_; }
+  double rigid_work() const { return work_books_.rigid; }
   /// Energy removed by the mass-proportional damping so far (J, ≥ 0): c |p_i|²/m_i dt per node and step.
-  double damping_work() const { return damping_work_; }
+  double damping_work() const { return work_books_.damping; }
   /// Plastic work of the particles so far, Σ_p σ:Δε_p V (J).
   double plastic_work() const;
   /// The energy books now (frictional work of `order`). Before the first step initial = kinetic + stored.
@@ -227,19 +229,19 @@ class Simulation {
     v("particles/plastic_work", p_.plastic_work);
     v("particles/material", p_.material);
     v("particles/body", p_.body);
-    v("time", time_);
-    v("step", step_);
-    v("last_dt", last_dt_);
-    v("external_work", external_work_);
-    v("rigid_work", rigid_work_);
-    v("damping_work", damping_work_);
-    v("initial_energy", initial_energy_);
+    v("time", clock_.time);
+    v("step", clock_.step);
+    v("last_dt", clock_.last_dt);
+    v("external_work", work_books_.external);
+    v("rigid_work", work_books_.rigid);
+    v("damping_work", work_books_.damping);
+    v("initial_energy", work_books_.initial_energy);
     v("work_first", contact_books_.work_first);
     v("work_second", contact_books_.work_second);
     v("pair_work_first", contact_books_.pair_work_first);
     v("pair_work_second", contact_books_.pair_work_second);
-    v("wave_speed", wave_speed_);
-    v("wave_speed_ready", wave_speed_ready_);
+    v("wave_speed", wave_speeds_.speed);
+    v("wave_speed_ready", wave_speeds_.ready);
     if (contact_setup_.options.regularized()) {
       v("contact/lagged_normal_traction", contact_nodes_.lagged_normal_traction);
       v("contact/lagged_normal_step", contact_nodes_.lagged_normal_step);
@@ -336,6 +338,7 @@ class Simulation {
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
   using RigidMotion = RigidBodyMotion<Dim>;
+  using ResolvedLoad = typename LoadsAndConditions<Dim>::ResolvedLoad;
   RigidMotion rigid_motion(std::size_t material, double t, double dt) const;
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
   void setup_penalty();                          // finalize(): penalty pairs and boundary points
@@ -350,7 +353,7 @@ class Simulation {
   SimulationOptions opt_;
   Particles<Dim> p_;
   std::vector<Material> materials_;
-  std::vector<BodyInfo> bodies_;
+  BodyList bodies_;
   NodalFields<Dim> nodes_;
   std::vector<VelocityField<Dim>> fields_;
   FieldLayout<Dim> layout_;
@@ -367,38 +370,15 @@ class Simulation {
     std::vector<Vec<Dim>> round_trip;  // S⁺S term
     std::vector<std::vector<Vec<Dim>>> thread_acc;  // per-thread scatter buffers (threads 1..n-1)
   } transfer_;
-  std::vector<std::uint8_t> fixed_mask_;        // bit d set: velocity component d fixed to 0
-  std::vector<std::uint8_t> rigid_mask_;        // bit d set: velocity component d driven by a rigid material
-  std::vector<Vec<Dim>> rigid_velocity_;
-  std::vector<FixedFace> faces_;
-  std::vector<PointLoad<Dim>> point_loads_;
-  std::vector<EdgeTraction<Dim>> tractions_;
-  // Resolved loads: particle index, force at scale 1, and which TimeFunction scales it.
-  struct ResolvedLoad {
-    std::size_t particle;
-    Vec<Dim> force;
-    const TimeFunction* scale;
-  };
-  std::vector<ResolvedLoad> resolved_loads_;
-  std::vector<std::uint8_t> taken_;  // fine lattice points already filled by a body
-  int taken_ppc_ = 0;
+  LoadsAndConditions<Dim> conditions_;
   StencilStore<Dim> stencil_store_;
   EbsState<Dim> ebs_;
   bool finalized_ = false;
-  double time_ = 0.0;
-  long step_ = 0;
-  double last_dt_ = 0.0;
-  double external_work_ = 0.0;
-  double rigid_work_ = 0.0, damping_work_ = 0.0;  // energy books (rigid_work(), damping_work())
-  double initial_energy_ = std::numeric_limits<double>::quiet_NaN();  // kinetic + stored before the first step
+  StepClock clock_;
+  WorkBooks work_books_;
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
-  // Per particle: the dilatational wave speed of its state (J, e change only in the stress update,
-  // which refreshes it); −∞ for rigid particles. stable_time_step adds |v_p| to it.
-  std::vector<double> wave_speed_;
-  bool wave_speed_ready_ = false;  // set by the first stress update
-  StepPhaseTimes phase_times_;
-  PhaseList phases_;     // the step (build_phases)
-  long phases_key_ = -1;  // phase_key() the list was built for
+  WaveSpeeds wave_speeds_;
+  StepSchedule schedule_;
 };
 
 extern template class Simulation<2>;
