@@ -353,16 +353,16 @@ class Simulation {
   SimulationOptions opt_;
   Particles<Dim> p_;
   std::vector<Material> materials_;
-  BodyList bodies_;
+  BodyList bodies_;                         // the bodies and the fill lattice they took
   NodalFields<Dim> nodes_;
   std::vector<VelocityField<Dim>> fields_;
-  FieldLayout<Dim> layout_;
-  ContactSetup contact_setup_;
-  ContactNodeState<Dim> contact_nodes_;
-  ContactBooks contact_books_;
-  PenaltyContactState<Dim> penalty_state_;
-  BodyLoops<Dim> body_loops_;
-  StepThreads<Dim> threads_;
+  FieldLayout<Dim> layout_;                 // materials -> particle ranges, fields, node boxes; slot -> node
+  ContactSetup contact_setup_;              // contact on/off, options, per-pair settings
+  ContactNodeState<Dim> contact_nodes_;     // the step's contact nodes, extents, lagged normal traction
+  ContactBooks contact_books_;              // frictional work per node and per pair, contact counters
+  PenaltyContactState<Dim> penalty_state_;  // boundary points, penalty pairs and their histories
+  BodyLoops<Dim> body_loops_;               // per body: boundary loops the boundary points come from
+  StepThreads<Dim> threads_;                // thread count, partition, pass split, scatter buffers
   struct TransferScratch {  // XPIC/FMPM, per slot
     std::vector<Vec<Dim>> start;     // XPIC: lumped v^n at the momentum update
     std::vector<Vec<Dim>> filtered;  // v* (the series' sum)
@@ -370,15 +370,15 @@ class Simulation {
     std::vector<Vec<Dim>> round_trip;  // S⁺S term
     std::vector<std::vector<Vec<Dim>>> thread_acc;  // per-thread scatter buffers (threads 1..n-1)
   } transfer_;
-  LoadsAndConditions<Dim> conditions_;
-  StencilStore<Dim> stencil_store_;
-  EbsState<Dim> ebs_;
-  bool finalized_ = false;
-  StepClock clock_;
-  WorkBooks work_books_;
+  LoadsAndConditions<Dim> conditions_;      // fixed/rigid node masks, faces, loads, resolved loads
+  StencilStore<Dim> stencil_store_;         // S_ip, G_ip of every particle for the scene's kernel
+  EbsState<Dim> ebs_;                       // extended B-spline basis per field
+  bool finalized_ = false;                  // finalize() has run
+  StepClock clock_;                         // time, step count, last dt
+  WorkBooks work_books_;                    // external, rigid and damping work; initial energy
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
-  WaveSpeeds wave_speeds_;
-  StepSchedule schedule_;
+  WaveSpeeds wave_speeds_;                  // per-particle wave speed for the CFL step
+  StepSchedule schedule_;                   // the step's phase list and phase timers
 };
 
 extern template class Simulation<2>;

@@ -11,7 +11,7 @@ namespace frictherm::mechanics {
 /// The thread partition of the step and each thread's share of the particle passes.
 template <int Dim>
 struct StepThreads {
-  int count = 1;                   // threads of this step: 1 for small problems, where threading costs more than it saves
+  int count = 1;                    // threads of this step: 1 for small problems (threading would cost more)
   ThreadPartition partition;       // each thread's particles, the fields threads share
   PassSplit pass_split;            // each thread's particles in the particle passes (timed, rebalanced)
   std::vector<double> work_blocks;  // the particle pass's external work per PassSplit block (threads > 1)
