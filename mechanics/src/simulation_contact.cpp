@@ -88,7 +88,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
       contact_books_.work_first[static_cast<std::size_t>(node)] += w1;
       contact_books_.work_second[static_cast<std::size_t>(node)] += w2;
-      const std::size_t k = static_cast<std::size_t>(std::min(ma, mb)) * nm + static_cast<std::size_t>(std::max(ma, mb));
+      const std::size_t k = pair_book_index(ma, mb, nm);
       acc.entries.push_back({k, w1, w2});
     };
     ContactStats& stats = acc.stats;
@@ -244,7 +244,7 @@ double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order, int a, in
   const auto& w = order == HeatingOrder::first ? contact_books_.pair_work_first : contact_books_.pair_work_second;
   const std::size_t nm = materials_.size();
   if (w.size() != nm * nm || a < 0 || b < 0 || static_cast<std::size_t>(a) >= nm || static_cast<std::size_t>(b) >= nm) return 0.0;
-  return w[static_cast<std::size_t>(std::min(a, b)) * nm + static_cast<std::size_t>(std::max(a, b))];
+  return w[pair_book_index(a, b, nm)];
 }
 
 #define FRICTHERM_INSTANTIATE_CONTACT(D)                                              \

@@ -202,10 +202,9 @@ void Simulation<Dim>::apply_penalty_forces() {
   apply_penalty(*penalty_state_.contact, penalty_state_.boundary, lent.w, nodes_.mass, empty_node_mass_, nodes_.force, contact_books_.work_first, contact_books_.work_second);
   const PenaltyContact<Dim>& pc = *penalty_state_.contact;
   for (std::size_t k = 0; k < penalty_state_.pairs.size(); ++k) {
-    const auto a = static_cast<std::size_t>(std::min(penalty_state_.pairs[k].master_material, penalty_state_.pairs[k].slave_material));
-    const auto b = static_cast<std::size_t>(std::max(penalty_state_.pairs[k].master_material, penalty_state_.pairs[k].slave_material));
-    contact_books_.pair_work_first[a * materials_.size() + b] += pc.books(k).heat_step;
-    contact_books_.pair_work_second[a * materials_.size() + b] += pc.books(k).heat_step;
+    const std::size_t i = pair_book_index(penalty_state_.pairs[k].master_material, penalty_state_.pairs[k].slave_material, materials_.size());
+    contact_books_.pair_work_first[i] += pc.books(k).heat_step;
+    contact_books_.pair_work_second[i] += pc.books(k).heat_step;
   }
 }
 

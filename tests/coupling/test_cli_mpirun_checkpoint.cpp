@@ -6,7 +6,7 @@
 //     series column, the /hotspots table, the energy books and every snapshot of every rank file equal
 //     an uninterrupted run's bit-for-bit (each rank restores its particles in their swarm order, so
 //     every sum runs in the same order), and the books close;
-//   * the same 2-rank checkpoint resumed on 3 ranks (the particles redistributed by the swarm's
+//   * the same 2-rank checkpoint resumed on 4 ranks (the particles redistributed by the swarm's
 //     migration, the heat per node copied from its old owner): the series within 1e-9 of each column's
 //     largest magnitude (temperatures: of the largest rise) of the uninterrupted 2-rank run, as
 //     test_cli_mpirun's decomposed-against-serial bound (the same arithmetic, sums over particles and
@@ -149,22 +149,22 @@ TEST_F(CliMpirunCheckpoint, InterruptedAndResumedRunEqualsTheUninterruptedRun) {
   EXPECT_THAT(serial.output, HasSubstr("written by a decomposed run on 2 ranks: resume it with mpirun -n 2"));
   EXPECT_EQ(fs::last_write_time(path("part.h5.checkpoint")), before);
 
-  // A copy resumed on 3 ranks: the particles migrate to the new owners.
-  fs::create_directory(path("three"));
+  // A copy resumed on 4 ranks: the particles migrate to the new owners.
+  fs::create_directory(path("four"));
   for (const auto& e : fs::directory_iterator(path("")))
     if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
-      fs::copy_file(e.path(), path("three/" + e.path().filename().string()));
-  const Result three = shell(mpirun(3) + " " + exe() + " resume '" + path("three/part.h5") + "'");
-  ASSERT_EQ(three.code, 0) << three.output;
-  EXPECT_THAT(three.output, HasSubstr("written by 2 ranks, resumed on 3: the particles are redistributed"));
-  EXPECT_EQ(read_doubles(path("three/part.h5"), "/meta/resumed_from_ranks"), std::vector<double>{2.0});
+      fs::copy_file(e.path(), path("four/" + e.path().filename().string()));
+  const Result four = shell(mpirun(4) + " " + exe() + " resume '" + path("four/part.h5") + "'");
+  ASSERT_EQ(four.code, 0) << four.output;
+  EXPECT_THAT(four.output, HasSubstr("written by 2 ranks, resumed on 4: the particles are redistributed"));
+  EXPECT_EQ(read_doubles(path("four/part.h5"), "/meta/resumed_from_ranks"), std::vector<double>{2.0});
   // energy_lost reads the books' start kept in every rank file (/mechanics/initial_energy).
   for (const char* c : {"time", "kinetic_energy", "strain_energy", "energy_lost", "momentum_x", "momentum_y",
                         "friction_work_first", "friction_work_second", "heat_delivered", "max_temperature",
                         "hottest_hotspot_temperature"}) {
     const bool temperature = std::string(c).find("temperature") != std::string::npos;
     const std::vector<double> a = read_doubles(path("full.h5"), std::string("/series/") + c);
-    const std::vector<double> b = read_doubles(path("three/part.h5"), std::string("/series/") + c);
+    const std::vector<double> b = read_doubles(path("four/part.h5"), std::string("/series/") + c);
     ASSERT_EQ(a.size(), b.size()) << c;
     double scale = 0.0, diff = 0.0;
     for (std::size_t k = 0; k < a.size(); ++k) {
@@ -176,12 +176,12 @@ TEST_F(CliMpirunCheckpoint, InterruptedAndResumedRunEqualsTheUninterruptedRun) {
       diff = std::max(diff, std::fabs(a[k] - b[k]));
     }
     EXPECT_LE(diff, 1e-9 * scale) << c;
-    std::printf("  3 ranks from the 2-rank checkpoint: %-28s max |difference| %.3g of %.6g\n", c, diff / scale, scale);
+    std::printf("  4 ranks from the 2-rank checkpoint: %-28s max |difference| %.3g of %.6g\n", c, diff / scale, scale);
   }
-  const double w3 = read_doubles(path("three/part.h5"), "/meta/work_received").at(0);
+  const double w4 = read_doubles(path("four/part.h5"), "/meta/work_received").at(0);
   for (const char* k : {"heat_delivered", "nodal_energy_change", "particle_energy_change"})
-    EXPECT_NEAR(read_doubles(path("three/part.h5"), std::string("/meta/") + k).at(0), w3, 1e-9 * w3) << k;
-  EXPECT_TRUE(fs::exists(path("three/part.rank2.h5")));
+    EXPECT_NEAR(read_doubles(path("four/part.h5"), std::string("/meta/") + k).at(0), w4, 1e-9 * w4) << k;
+  EXPECT_TRUE(fs::exists(path("four/part.rank3.h5")));
 
   const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + path("part.h5") + "'");
   ASSERT_EQ(resumed.code, 0) << resumed.output;

@@ -13,15 +13,18 @@ Asserted for every snapshot:
   snapshot times, exactly (the XDMF holds the shortest text that reads back to the same double);
 * VTK: one multiblock of one vtkUnstructuredGrid per rank that has particles, block `rank<r>` holding
   rank r's rows in the file's order: points (z = 0 in 2D), `id` (64-bit), `velocity` (3 components),
-  `temperature`, `material` equal to the HDF5 rows exactly (doubles are read as doubles), one vertex
-  cell per particle;
+  `temperature`, `material` and the serial snapshot's `displacement` (3), `stress` (9, a tensor),
+  `stress_zz`, `mass`, `volume`, `body` equal to the HDF5 rows exactly (doubles are read as doubles),
+  one vertex cell per particle;
 * both readers' merged data set (vtkAppendFilter of the blocks / ParaView's MergeBlocks) has exactly
   the total particle count, every id 0..N-1 once, and by id the same points and fields as the rank
   files, exactly;
 * at the last snapshot the set of (id, position) equals the serial run's (`frictherm run` without
   mpirun; id = serial row) to 1e-12 of the box size, and the temperatures to 1e-9 of the largest
   rise, the CliMpirun tolerance (they measure 7e-18 m on 1 mm cells and 1e-13 K: the engines add
-  the same terms in another order).
+  the same terms in another order);
+* OUT_reference.xdmf (issue 32, the serial RUN_reference.xdmf) is published with the result and VTK
+  reads it as OUT.xdmf with the points at each particle's `initial_position`, the same checks.
 
     vtk_decomposed.py FRICTHERM_EXE SCENES_DIR WORK_DIR [--mpirun MPIRUN] [--png docs/figures/decomposed_xdmf.png]
 
@@ -63,7 +66,14 @@ SCENES = {2: "decomposed_sliding_block.json", 3: "decomposed_heated_block_3d.jso
 CASES = [("2D", 2, [], (2, 3)),
          ("2D, block 2 mm back", 2, ["bodies[1].shape.lo=[0.004,0.004]", "bodies[1].shape.hi=[0.012,0.008]"], (4,)),
          ("3D", 3, [], (2, 3))]
-FIELDS = {"id": 1, "velocity": 3, "temperature": 1, "material": 1}
+# With the serial snapshot's other fields (issue 32): displacement, the stress tensor, mass, volume, body.
+FIELDS = {"id": 1, "velocity": 3, "temperature": 1, "material": 1, "displacement": 3, "stress": 9, "stress_zz": 1,
+          "mass": 1, "volume": 1, "body": 1}
+
+
+def fields_for(dim):
+    """The fields of a snapshot in `dim` D (stress_zz, the out-of-plane stress, is 2D's)."""
+    return {k: c for k, c in FIELDS.items() if not (k == "stress_zz" and dim == 3)}
 
 failures = []
 
@@ -88,8 +98,9 @@ def run(cmd, out):
     subprocess.run(cmd + ["-o", out, "--force", "-q"], check=True, env=env, stdout=subprocess.DEVNULL)
 
 
-def rank_snapshots(base, ranks, dim):
-    """Per snapshot (in file order): time, step and per rank the rows of every field (position padded to 3)."""
+def rank_snapshots(base, ranks, dim, geometry="position"):
+    """Per snapshot (in file order): time, step and per rank the rows of every field (the points: `geometry`
+    padded to 3)."""
     snaps = []
     for r in range(ranks):
         with h5py.File(f"{base}.rank{r}.h5", "r") as f:
@@ -101,8 +112,8 @@ def rank_snapshots(base, ranks, dim):
                 check(float(g.attrs["time"]) == s["time"] and int(g.attrs["step"]) == s["step"],
                       f"{base}: rank {r} snapshot {g.name} at the time and step of rank 0's")
                 x = np.zeros((g["id"].shape[0], 3))
-                x[:, :dim] = g["position"][()]
-                rows = {"position": x, **{k: g[k][()] for k in FIELDS}}
+                x[:, :dim] = g[geometry][()]
+                rows = {"position": x, **{k: g[k][()] for k in fields_for(dim)}}
                 if len(x):
                     s["ranks"][r] = rows
     return snaps
@@ -117,10 +128,10 @@ def by_id(parts, total):
     return {k: np.concatenate([p[k] for p in parts])[order] for k in parts[0]}
 
 
-def dataset_rows(data):
+def dataset_rows(data, dim):
     pd = data.GetPointData()
     rows = {"position": vtk_to_numpy(data.GetPoints().GetData())}
-    for name, comps in FIELDS.items():
+    for name, comps in fields_for(dim).items():
         a = pd.GetArray(name)
         if not check(a is not None and a.GetNumberOfComponents() == comps, f"VTK array {name} with {comps} component(s)"):
             return None
@@ -142,7 +153,7 @@ def vertex_cells(data, tag):
           f"{tag}: {data.GetNumberOfCells()} cells of types {types} for {n} particles (one vertex each)")
 
 
-def check_vtk(xdmf, snaps, total, label):
+def check_vtk(xdmf, snaps, total, label, dim):
     reader = vtkXdmf3Reader()
     reader.SetFileName(os.path.abspath(xdmf))  # Xdmf3 resolves the rank files against the folder of this path
     reader.UpdateInformation()
@@ -167,13 +178,13 @@ def check_vtk(xdmf, snaps, total, label):
             append.AddInputData(data)
         check(sorted(blocks) == sorted(s["ranks"]), f"{tag}: blocks of ranks {sorted(blocks)}, ranks with particles {sorted(s['ranks'])}")
         for r, data in blocks.items():
-            rows = dataset_rows(data)
+            rows = dataset_rows(data, dim)
             if rows is not None and r in s["ranks"]:
                 same_rows(rows, s["ranks"][r], f"{tag} rank {r}")
             vertex_cells(data, f"{tag} rank {r}")
         append.Update()
         one = append.GetOutput()
-        rows = dataset_rows(one)
+        rows = dataset_rows(one, dim)
         got = by_id([rows], total) if rows is not None else None
         if check(got is not None, f"{tag}: the merged data set holds every id 0..{total - 1} once"):
             same_rows(got, by_id(list(s["ranks"].values()), total), f"{tag} merged")
@@ -182,7 +193,7 @@ def check_vtk(xdmf, snaps, total, label):
     return merged
 
 
-def check_paraview(xdmf, snaps, total, label):
+def check_paraview(xdmf, snaps, total, label, dim):
     source = pv.OpenDataFile(os.path.abspath(xdmf))
     check(source.GetXMLName() == "Xdmf3ReaderS", f"{label}: ParaView picks {source.GetXMLName()}")
     times = list(source.TimestepValues)
@@ -193,7 +204,7 @@ def check_paraview(xdmf, snaps, total, label):
         merge.UpdatePipeline(s["time"])
         one = servermanager.Fetch(merge)
         check(one.GetNumberOfPoints() == total, f"{tag}: {one.GetNumberOfPoints()} points, {total} particles")
-        rows = dataset_rows(one)
+        rows = dataset_rows(one, dim)
         got = by_id([rows], total) if rows is not None else None
         if check(got is not None, f"{tag}: every id 0..{total - 1} once"):
             same_rows(got, by_id(list(s["ranks"].values()), total), tag)
@@ -228,9 +239,13 @@ def check_scene(a, name, dim, sets, rank_counts):
         total = sum(len(rows["id"]) for rows in snaps[0]["ranks"].values())
         check(total == len(serial_x), f"{label}: {total} particles, serial {len(serial_x)}")
         check([s["time"] for s in snaps] == serial_times, f"{label}: snapshot times are the serial run's")
-        merged = check_vtk(base + ".xdmf", snaps, total, label)
+        merged = check_vtk(base + ".xdmf", snaps, total, label, dim)
+        # OUT_reference.xdmf (issue 32, the serial RUN_reference.xdmf): the same grids at initial_position.
+        if check(os.path.exists(base + "_reference.xdmf"), f"{label}: the reference XDMF is published"):
+            check_vtk(base + "_reference.xdmf", rank_snapshots(base, ranks, dim, "initial_position"), total,
+                      label + " (reference)", dim)
         if pv is not None:
-            check_paraview(base + ".xdmf", snaps, total, label)
+            check_paraview(base + ".xdmf", snaps, total, label, dim)
         if len(merged) == len(snaps) and total == len(serial_x):
             dx = float(np.max(np.abs(merged[-1]["position"] - serial_x)))
             dT = float(np.max(np.abs(merged[-1]["temperature"] - serial_T)))

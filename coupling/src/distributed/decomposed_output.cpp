@@ -163,6 +163,10 @@ DecomposedOutput::~DecomposedOutput() { close(); }
 
 std::string DecomposedOutput::xdmf_text() const { return xdmf_document(grids_); }
 
+std::string DecomposedOutput::reference_xdmf_text() const {
+  return reference_grids_.empty() ? std::string() : xdmf_document(reference_grids_, "particles_reference");
+}
+
 void DecomposedOutput::close() {
   if (file_ >= 0) H5Fclose(file_);
   file_ = -1;
@@ -181,7 +185,9 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
     error = "temperatures given on some ranks but not on this one";
   else if (s.position.size() != dim * n || s.velocity.size() != dim * n || s.material.size() != n ||
            (!s.temperature.empty() && s.temperature.size() != n) ||
-           std::any_of(s.fields.begin(), s.fields.end(), [n](const auto& f) { return f.second.size() != n; }))
+           std::any_of(s.fields.begin(), s.fields.end(),
+                       [n](const auto& f) { return f.components < 1 || f.values.size() != n * static_cast<std::size_t>(f.components); }) ||
+           std::any_of(s.integer_fields.begin(), s.integer_fields.end(), [n](const auto& f) { return f.second.size() != n; }))
     error = "snapshot arrays of different lengths (" + std::to_string(n) + " ids)";
   const std::string index = [&] {
     char b[16];
@@ -208,8 +214,10 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
       write_dataset(g.get(), file, "velocity", H5T_NATIVE_DOUBLE, v.data(), n, 3);
       // Every rank's group holds the same datasets (a rank without particles: 0 rows).
       if (any_temperature) write_dataset(g.get(), file, "temperature", H5T_NATIVE_DOUBLE, s.temperature.data(), n, 1);
-      for (const auto& [name, values] : s.fields)
-        write_dataset(g.get(), file, name.c_str(), H5T_NATIVE_DOUBLE, values.data(), n, 1);
+      for (const DecomposedSnapshot::Field& f : s.fields)
+        write_dataset(g.get(), file, f.name, H5T_NATIVE_DOUBLE, f.values.data(), n, static_cast<hsize_t>(f.components));
+      for (const auto& [name, values] : s.integer_fields)
+        write_dataset(g.get(), file, name, H5T_NATIVE_INT, values.data(), n, 1);
       write_dataset(g.get(), file, "material", H5T_NATIVE_INT, s.material.data(), n, 1);
       h5::check(H5Fflush(file_, H5F_SCOPE_GLOBAL), file, "cannot flush");
     } catch (const std::exception& e) {
@@ -225,38 +233,48 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
   error.clear();
   if (rank_ == 0) {
     try {
-      std::string xml = "    <Grid Name=\"" + index + "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
-      // The shortest text that reads back to the same double (as every rank's grid's time).
-      char time_text[32];
-      const auto printed = std::to_chars(time_text, time_text + sizeof time_text, time);
-      xml += "      <Time Value=\"" + std::string(time_text, printed.ptr) + "\"/>\n";
-      for (int r = 0; r < size_; ++r) {
-        if (counts[static_cast<std::size_t>(r)] == 0) continue;
-        XdmfGrid grid;
-        grid.name = "rank" + std::to_string(r);
-        grid.h5_group = "/snapshots/" + index;
-        grid.connectivity = grid.h5_group + "/connectivity";
-        grid.step = step;
-        grid.time = time;
-        grid.points = static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
-        // The global id (int64: Int Precision 8) so ParaView can colour, select and threshold by the
-        // serial particle index across ranks.
-        grid.fields = {{"position", dim_, false}, {"id", 1, true, 8}, {"velocity", 3, false}, {"material", 1, true}};
-        if (any_temperature) grid.fields.push_back({"temperature", 1, false});
-        for (const auto& f : s.fields) grid.fields.push_back({f.first, 1, false});
-        std::string g = xdmf_grid_xml(grid, base_name(rank_file(r)), dim_);
-        // Indented one level deeper: inside this snapshot's spatial collection.
-        std::string indented;
-        std::size_t at = 0;
-        while (at < g.size()) {
-          const std::size_t end = g.find('\n', at);
-          indented += "  " + g.substr(at, end - at + 1);
-          at = end + 1;
+      // One spatial collection of the ranks' grids drawn at `geometry` (position; initial_position for
+      // the reference document, as the serial RUN_reference.xdmf).
+      auto collection = [&](const std::string& geometry) {
+        std::string xml = "    <Grid Name=\"" + index + "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+        // The shortest text that reads back to the same double (as every rank's grid's time).
+        char time_text[32];
+        const auto printed = std::to_chars(time_text, time_text + sizeof time_text, time);
+        xml += "      <Time Value=\"" + std::string(time_text, printed.ptr) + "\"/>\n";
+        for (int r = 0; r < size_; ++r) {
+          if (counts[static_cast<std::size_t>(r)] == 0) continue;
+          XdmfGrid grid;
+          grid.name = "rank" + std::to_string(r);
+          grid.h5_group = "/snapshots/" + index;
+          grid.connectivity = grid.h5_group + "/connectivity";
+          grid.step = step;
+          grid.time = time;
+          grid.geometry = geometry;
+          grid.points = static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+          // The global id (int64: Int Precision 8) so ParaView can colour, select and threshold by the
+          // serial particle index across ranks.
+          grid.fields = {{"position", dim_, false}, {"id", 1, true, 8}, {"velocity", 3, false}, {"material", 1, true}};
+          if (any_temperature) grid.fields.push_back({"temperature", 1, false});
+          for (const auto& f : s.fields) grid.fields.push_back({f.name, f.components, false});
+          for (const auto& f : s.integer_fields) grid.fields.push_back({f.first, 1, true});
+          std::string g = xdmf_grid_xml(grid, base_name(rank_file(r)), dim_);
+          // Indented one level deeper: inside this snapshot's spatial collection.
+          std::string indented;
+          std::size_t at = 0;
+          while (at < g.size()) {
+            const std::size_t end = g.find('\n', at);
+            indented += "  " + g.substr(at, end - at + 1);
+            at = end + 1;
+          }
+          xml += indented;
         }
-        xml += indented;
-      }
-      xml += "    </Grid>\n";
-      grids_.push_back(xml);
+        xml += "    </Grid>\n";
+        return xml;
+      };
+      grids_.push_back(collection("position"));
+      if (std::any_of(s.fields.begin(), s.fields.end(),
+                      [&](const DecomposedSnapshot::Field& f) { return f.name == "initial_position" && f.components == dim_; }))
+        reference_grids_.push_back(collection("initial_position"));
       if (write_xdmf_) write_text_atomically(xdmf_path_, xdmf_document(grids_));
     } catch (const std::exception& e) {
       error = e.what();

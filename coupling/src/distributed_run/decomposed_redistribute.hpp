@@ -31,6 +31,8 @@ class Redistribution {
     acc_.external_work = acc_.damping_work = acc_.rigid_work = 0.0;
     acc_.work_first.clear();
     acc_.work_second.clear();
+    acc_.pair_first.clear();
+    acc_.pair_second.clear();
     acc_.stats.assign(4, 0);
     std::size_t n = 1;
     for (int d = 0; d < Dim; ++d) n *= static_cast<std::size_t>(mine_[2 * d + 1] - mine_[2 * d]);
@@ -69,6 +71,13 @@ class Redistribution {
       acc_.damping_work += w;
       r("mechanics/rigid_work", w);
       acc_.rigid_work += w;
+      for (auto [name, sum] : {std::pair<const char*, std::vector<double>*>{"mechanics/pair_work_first", &acc_.pair_first},
+                               {"mechanics/pair_work_second", &acc_.pair_second}}) {
+        std::vector<double> pw;
+        r(name, pw);
+        if (sum->size() < pw.size()) sum->resize(pw.size(), 0.0);
+        for (std::size_t k = 0; k < pw.size(); ++k) (*sum)[k] += pw[k];
+      }
       std::vector<long> stats;
       r("mechanics/contact_stats", stats);
       for (std::size_t k = 0; k < 4 && k < stats.size(); ++k) acc_.stats[k] += stats[k];

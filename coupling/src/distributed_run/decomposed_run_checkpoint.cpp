@@ -17,6 +17,7 @@ void DecomposedRun<Dim>::checkpoint() {
   m.run_id = run_id_;  // rank 0 writes the marks
   if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
   xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
+  xdmf_reference_grids_ = detail::join_grids(snapshots_out_->reference_grids());
   try {
     detail::write_decomposed_checkpoint(
         comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
@@ -106,6 +107,8 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   v("mechanics/empty_node_mass", st.empty_node_mass);
   v("mechanics/work_first", st.work_first);
   v("mechanics/work_second", st.work_second);
+  v("mechanics/pair_work_first", st.pair_first);  // this rank's part of the per-pair books
+  v("mechanics/pair_work_second", st.pair_second);
   v("mechanics/contact_stats", st.stats);
   std::vector<long> owned;  // this rank's owned nodes (DMDA indices, [begin, end) per axis): redistribution
   if constexpr (!V::reading) for (int b : mpm_->owned_nodes()) owned.push_back(b);
@@ -140,7 +143,11 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
   v("run/last_snapshot_step", last_snapshot_step_);
   v("output/series_rows", series_rows_);
   v("output/series_columns", series_columns_);
+  v("run/series_memory/time", series_memory_.time);  // the serial checkpoint's names
+  v("run/series_memory/has_previous", series_memory_.has_previous);
+  v("run/series_memory/work", series_memory_.work);
   v("output/xdmf_grids", xdmf_grids_);
+  v("output/xdmf_reference_grids", xdmf_reference_grids_);
   if (hot_) hot_->visit_state(v);
   // Penalty contact: the boundary points and PenaltyContact::visit_state (slip histories, books, the
   // frequency bound of the next step), the same on every rank, so once, in the global file that every

@@ -12,6 +12,7 @@
 #include "distributed_run/decomposed_setup.hpp"
 #include "run/checkpoint_io.hpp"
 #include "run/run_signals.hpp"
+#include "run/particle_output.hpp"
 #include "run/runner_detail.hpp"
 
 #include <frictherm/coupling/decomposed_heat.hpp>
@@ -89,6 +90,11 @@ class DecomposedRun {
 
   // The serial run's column names where the quantity is the same (runner_output.cpp, runner_thermal.cpp).
   std::vector<std::string> series_names() const;
+  // The scene's body names and contact pairs (the serial Simulation's bodies() and contact_pairs()).
+  std::vector<std::string> body_names() const;
+  std::vector<std::pair<int, int>> contact_pairs() const;
+  // Collective: each body's mass-weighted sums over all ranks' particles (p: this rank's, kinematics).
+  detail::BodySums<Dim> body_sums(const mechanics::DecomposedLocalParticles& p) const;
 
   // Collective: one reduction for whether any rank caught SIGINT/SIGTERM and the lowest id of a
   // particle with a non-finite state or outside the grid (the serial step's check), which becomes a
@@ -104,6 +110,8 @@ class DecomposedRun {
   // Collective: one row; rank 0 appends it. `time` (NaN: the run's) replaces the time column, the
   // mechanics columns staying at their last values (the continuation's rows, as the serial run's).
   void series(double time = std::numeric_limits<double>::quiet_NaN());
+  // The serial snapshot's other particle fields (scene output.fields) into `snap`.
+  void snapshot_fields(const mechanics::DecomposedLocalParticles& p, DecomposedSnapshot& snap) const;
 
   // Collective: the thermal-only continuation after the loading (coupling.continuation; the serial
   // ThermalRun::continuation): one interval of DecomposedHeat::continue_thermal, one hot-spot update and
@@ -179,7 +187,8 @@ class DecomposedRun {
   Clock::time_point last_checkpoint_ = Clock::now();
   std::vector<double> series_rows_;
   long series_columns_ = 0;
-  std::string xdmf_grids_;
+  detail::SeriesMemory series_memory_;  // the previous series row, for the contact_heat_rate columns
+  std::string xdmf_grids_, xdmf_reference_grids_;
   typename Mpm::CheckpointState restored_;
   int redistributed_from_ = 0;  // ranks of a checkpoint resumed on another number of ranks
 

@@ -3,6 +3,8 @@
 // OUT.xdmf joining the rank files (issue 34: the XDMF goes with its result, never before it).
 #include "distributed_run/decomposed_run_impl.hpp"
 
+#include "run/particle_output.hpp"
+
 namespace frictherm::coupling::decomposed {
 
 template <int Dim>
@@ -31,6 +33,7 @@ void DecomposedRun<Dim>::open_output() {
                                                                     redistributed_from_ > 0, false)
                                : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite(),
                                                                     false);
+    if (resuming_) snapshots_out_->restore_reference_grids(detail::split_grids(xdmf_reference_grids_));
   } catch (const std::exception& e) {
     throw OutputError(e.what());
   }
@@ -56,11 +59,43 @@ void DecomposedRun<Dim>::write_start_metadata() {
 }
 
 template <int Dim>
+std::vector<std::string> DecomposedRun<Dim>::body_names() const {
+  std::vector<std::string> names;  // the serial Simulation's bodies: the scene's, in order
+  for (const BodySpec& b : s_.bodies) names.push_back(b.name);
+  return names;
+}
+
+template <int Dim>
+std::vector<std::pair<int, int>> DecomposedRun<Dim>::contact_pairs() const {
+  std::vector<std::pair<int, int>> pairs;  // the serial Simulation::contact_pairs: the scene's, in order
+  for (const ContactPairSpec& p : s_.contact.pairs) pairs.emplace_back(p.material_a, p.material_b);
+  return pairs;
+}
+
+// Each body's mass-weighted sums over this rank's particles, then over the ranks (one reduction):
+// the serial series_row's kernel (particle_output.hpp) on the local particles.
+template <int Dim>
+detail::BodySums<Dim> DecomposedRun<Dim>::body_sums(const mechanics::DecomposedLocalParticles& p) const {
+  detail::BodySums<Dim> sums(s_.bodies.size());
+  const std::vector<double> T = mpm_->particle_scalar(temperature_);
+  const std::vector<double> body = mpm_->particle_scalar(mpm_->particle_scalar_index("body"));
+  using V = mechanics::Vec<Dim>;
+  for (std::size_t k = 0; k < p.mass.size(); ++k)
+    sums.add(static_cast<std::size_t>(body[k]), p.mass[k], T[k], Eigen::Map<const V>(&p.position[Dim * k]),
+             Eigen::Map<const V>(&p.initial_position[Dim * k]), Eigen::Map<const V>(&p.velocity[Dim * k]));
+  std::vector<double> flat = sums.flat();
+  MPI_Allreduce(MPI_IN_PLACE, flat.data(), static_cast<int>(flat.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  sums.assign(flat);
+  return sums;
+}
+
+template <int Dim>
 std::vector<std::string> DecomposedRun<Dim>::series_names() const {
   // The serial run's first columns, energy books included (detail::series_names, runner_output.cpp).
   std::vector<std::string> n = detail::series_names(Dim);
-  if (s_.contact.enabled)
-    n.insert(n.end(), {"friction_work_first", "friction_work_second", "contact_nodes", "sliding_nodes"});
+  // Then the serial run's per-body and contact columns in its order (issue 32).
+  detail::append_body_series_names(n, body_names(), Dim);
+  if (s_.contact.enabled) detail::append_contact_series_names(n, body_names(), s_.materials, contact_pairs(), Dim);
   if (const mechanics::PenaltyContact<Dim>* pc = mpm_->penalty_contact()) {  // the serial run's penalty columns
     std::vector<mechanics::PenaltyPairInfo> pairs;
     for (std::size_t k = 0; k < pc->pair_count(); ++k) pairs.push_back({pc->pair(k).master, pc->pair(k).slave});
@@ -104,11 +139,25 @@ void DecomposedRun<Dim>::series(double time) {
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   row.insert(row.end(), {books.rigid_work, books.damping_work, books.plastic_work, books.lost(),
                          books.numerical_dissipation()});
-  if (s_.contact.enabled) {
-    const double w1 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::first);
-    const double w2 = mpm_->cumulative_frictional_work(mechanics::HeatingOrder::second);
+  const detail::BodySums<Dim> bodies = body_sums(p);
+  bodies.append_means(row);
+  if (s_.contact.enabled) {  // the serial series_row's contact columns, from sums over ranks
+    const std::size_t nm = s_.materials.size();
+    const std::vector<std::pair<int, int>> pairs = contact_pairs();
+    std::vector<double> work[2];  // per order: the total, then per pair
+    for (const auto each : {mechanics::HeatingOrder::first, mechanics::HeatingOrder::second}) {
+      std::vector<double>& w = work[each == mechanics::HeatingOrder::first ? 0 : 1];
+      w.push_back(mpm_->cumulative_frictional_work(each));
+      const std::vector<double> pair_work = mpm_->cumulative_pair_work(each);
+      for (const auto& [a, b] : pairs) w.push_back(pair_work[mechanics::pair_book_index(a, b, nm)]);
+      row.insert(row.end(), w.begin(), w.end());
+    }
     const mechanics::DecomposedContactStats cs = mpm_->contact_stats();
-    row.insert(row.end(), {w1, w2, static_cast<double>(cs.contact_nodes), static_cast<double>(cs.sliding_nodes)});
+    row.insert(row.end(), {static_cast<double>(cs.contact_nodes), static_cast<double>(cs.sliding_nodes)});
+    bodies.append_velocities(row);
+    // The work handed to the heat (second order without heat, as the energy books above).
+    const bool first = heat_ && s_.thermal.heating_order == mechanics::HeatingOrder::first;
+    detail::append_heat_rates(row, work[first ? 0 : 1], time_, series_memory_);  // the serial sim.time()
   }
   if (pc) detail::append_penalty_row(row, *pc, mpm_->boundary_points());
   if (heat_) {
@@ -147,6 +196,57 @@ void DecomposedRun<Dim>::series(double time) {
   output_seconds_ += seconds_since(c0);
 }
 
+namespace {
+
+// The decomposed rank file as write_particle_fields's output (particle_output.hpp).
+struct SnapshotFields {
+  DecomposedSnapshot& snap;
+  void snapshot_field(const std::string& name, const double* data, std::size_t n, int components) {
+    snap.fields.emplace_back(name, std::vector<double>(data, data + n * static_cast<std::size_t>(components)), components);
+  }
+  void snapshot_field(const std::string& name, const std::int32_t* data, std::size_t n) {
+    snap.integer_fields.emplace_back(name, std::vector<int>(data, data + n));
+  }
+};
+
+}  // namespace
+
+// The serial snapshot's fields besides those DecomposedOutput writes itself (position, velocity,
+// temperature, material): displacement and initial_position, stress, stress_zz, mass, volume, body,
+// as the scene's output.fields lists them, by the serial kernel on this rank's particles (issue 32).
+template <int Dim>
+void DecomposedRun<Dim>::snapshot_fields(const mechanics::DecomposedLocalParticles& p, DecomposedSnapshot& snap) const {
+  using V = mechanics::Vec<Dim>;
+  using M = mechanics::Mat<Dim>;
+  const std::size_t n = p.mass.size();
+  std::vector<V> x(n), X(n), v(n);
+  std::vector<M> stress(n);
+  std::vector<std::int32_t> body(n);
+  const std::vector<double> b = mpm_->particle_scalar(mpm_->particle_scalar_index("body"));
+  for (std::size_t k = 0; k < n; ++k) {
+    x[k] = Eigen::Map<const V>(&p.position[Dim * k]);
+    X[k] = Eigen::Map<const V>(&p.initial_position[Dim * k]);
+    v[k] = Eigen::Map<const V>(&p.velocity[Dim * k]);
+    stress[k] = Eigen::Map<const M>(&p.stress[Dim * Dim * k]);
+    body[k] = static_cast<std::int32_t>(b[k]);
+  }
+  detail::ParticleArrays<Dim> a;
+  a.n = n;
+  a.position = x.data();
+  a.velocity = v.data();
+  a.initial_position = X.data();
+  a.stress = stress.data();
+  a.stress_zz = &p.stress_zz;
+  a.mass = &p.mass;
+  a.volume = &p.volume;
+  a.body = body.data();
+  std::vector<std::string> fields;
+  for (const std::string& f : s_.output.fields)
+    if (f != "position" && f != "velocity" && f != "temperature" && f != "material") fields.push_back(f);
+  SnapshotFields out{snap};
+  detail::write_particle_fields(out, a, fields);
+}
+
 template <int Dim>
 void DecomposedRun<Dim>::snapshot(double time) {
   const Clock::time_point c0 = Clock::now();
@@ -157,6 +257,7 @@ void DecomposedRun<Dim>::snapshot(double time) {
   snap.velocity = p.velocity;
   snap.material = p.material;
   snap.temperature = mpm_->particle_scalar(temperature_);
+  snapshot_fields(p, snap);
   if (heat_ && heat_->interface_enabled())  // T_int,p of the last update, as the serial snapshot field
     snap.fields.emplace_back("interface_temperature",
                              mpm_->particle_scalar(mpm_->particle_scalar_index("interface_temperature")));
@@ -195,7 +296,8 @@ std::string DecomposedRun<Dim>::publish() {
   try {
     if (!write_error_.empty()) throw std::runtime_error(write_error_);
     write_end_metadata();
-    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text());  // OUT.xdmf with OUT.h5, as the serial run's
+    // OUT.xdmf (and OUT_reference.xdmf) with OUT.h5, as the serial run's
+    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text(), snapshots_out_->reference_xdmf_text());
     out_->sync();  // before the name: the published result is on disk
   } catch (const std::exception& e) {
     const std::string live = out_->live_path();
@@ -250,6 +352,10 @@ void DecomposedRun<Dim>::rewrite_rows() {
   template std::vector<std::string> DecomposedRun<D>::series_names() const; \
   template void DecomposedRun<D>::series(double); \
   template void DecomposedRun<D>::snapshot(double); \
+  template void DecomposedRun<D>::snapshot_fields(const mechanics::DecomposedLocalParticles&, DecomposedSnapshot&) const; \
+  template std::vector<std::string> DecomposedRun<D>::body_names() const; \
+  template std::vector<std::pair<int, int>> DecomposedRun<D>::contact_pairs() const; \
+  template detail::BodySums<D> DecomposedRun<D>::body_sums(const mechanics::DecomposedLocalParticles&) const; \
   template void DecomposedRun<D>::finish_output(); \
   template std::string DecomposedRun<D>::publish(); \
   template void DecomposedRun<D>::write_end_metadata(); \

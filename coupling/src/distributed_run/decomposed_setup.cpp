@@ -109,6 +109,9 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   if (interface_temperature(scene)) o.particle_scalars.emplace_back("interface_temperature");
   // λ_p of the reaction (DecomposedHeatOptions::progress_scalar).
   if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) o.particle_scalars.emplace_back("reaction_progress");
+  // The particle's body (the serial Particles::body; exact as a double): the series' per-body means
+  // and the snapshots' body field (issue 32).
+  o.particle_scalars.emplace_back("body");
   return o;
 }
 
@@ -144,6 +147,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
         if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
         if (interface_temperature(scene)) q.scalars.push_back(p.temperature[k]);  // T_p before any heat
         if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) q.scalars.push_back(0.0);  // fresh
+        q.scalars.push_back(static_cast<double>(p.body[k]));
       }
       for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {
         packed.push_back(static_cast<double>(L.particle));

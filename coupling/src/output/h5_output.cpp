@@ -201,7 +201,10 @@ void H5Output::close() {
   if (m.io.file != m.final_path) m.publish();
 }
 
-void H5Output::publish_xdmf_with_result(std::string text) { live().given_xdmf = std::move(text); }
+void H5Output::publish_xdmf_with_result(std::string text, std::string reference) {
+  live().given_xdmf = std::move(text);
+  live().given_reference_xdmf = std::move(reference);
+}
 
 std::size_t H5Output::snapshot_count() const { return impl_ ? impl_->count : 0; }
 const std::string& H5Output::path() const { return impl_->final_path; }

@@ -124,6 +124,7 @@ struct H5Output::Impl {
     closed = true;
   }
   std::string given_xdmf;  // publish_xdmf_with_result: published with the result (write_xdmf off)
+  std::string given_reference_xdmf;  // and its reference document ("" if none)
   void write_xdmf();
   // The result renamed onto its name with its XDMF files (publish_with_xdmf, output_files.hpp).
   void publish();

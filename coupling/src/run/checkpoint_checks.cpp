@@ -290,6 +290,11 @@ void check_rank_file(hid_t f, const std::string& path, const RankSizes& z) {
     if (owned > 0) require(f, path, a, owned, true, "the nodes of /mechanics/owned_nodes");
   require(f, path, "mechanics/contact_stats", 4, false, "contact, multi-material, sliding and guarded nodes");
   counts(f, path, {"mechanics/contact_stats"});
+  // This rank's part of the frictional work per material pair (empty before any contact work).
+  for (const char* a : {"mechanics/pair_work_first", "mechanics/pair_work_second"}) {
+    require(f, path, a, z.materials * z.materials, true, "one per pair of the scene's materials");
+    require_finite(f, path, a);
+  }
   if (!z.heat) return;
   // The heat: pending work and the last gather per owned node, M_i on the ghosted box.
   for (const char* a : {"window/pending", "gather/M", "gather/T"}) {
@@ -306,6 +311,7 @@ void check_rank_file(hid_t f, const std::string& path, const RankSizes& z) {
 // of rows, the marks of this state (as check_arrays for the serial run's).
 void check_global_file(hid_t f, const std::string& path) {
   counts(f, path, {"run/step", "run/snapshots", "output/series_columns"});
+  for (const char* a : {"run/series_memory/time", "run/series_memory/work"}) require_finite(f, path, a);
   const std::vector<long> step = longs(f, path, "run/step");
   if (step.size() == 1) {
     for (const char* a : {"run/last_series_step", "run/last_snapshot_step"})

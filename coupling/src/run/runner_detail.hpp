@@ -8,6 +8,7 @@
 #include <cmath>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace frictherm::coupling::detail {
@@ -20,6 +21,11 @@ std::vector<std::string> series_names(int dim);
 /// sliding node counts, each body's mean velocity and the contact heat rate (total and per pair).
 template <int Dim>
 void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim);
+/// The same from the bodies' names, the materials and the scene's contact pairs (without the penalty
+/// columns): the serial run's and the decomposed run's names.
+void append_contact_series_names(std::vector<std::string>& names, const std::vector<std::string>& bodies,
+                                 const std::vector<mechanics::Material>& materials,
+                                 const std::vector<std::pair<int, int>>& pairs, int dim);
 
 /// Penalty contact (docs/penalty_contact.md), serial and decomposed runs: penalty_energy (the springs'
 /// energy), then per pair (master.slave) penalty_force, penalty_contacts, penalty_min_gap and
@@ -34,6 +40,7 @@ void append_penalty_row(std::vector<double>& row, const mechanics::PenaltyContac
 /// mean_temperature.<body>, mean_displacement_x.<body>, _y (, _z).
 template <int Dim>
 void append_body_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim);
+void append_body_series_names(std::vector<std::string>& names, const std::vector<std::string>& bodies, int dim);
 
 /// What the rate columns remember from the previous series row.
 struct SeriesMemory {
@@ -41,6 +48,12 @@ struct SeriesMemory {
   bool has_previous = false;
   std::vector<double> work;  // cumulative frictional work: total, then per contact pair
 };
+
+/// The contact_heat_rate columns: the increase of the cumulative frictional work `work` (total, then
+/// per contact pair; of the order handed to the thermal solver) since the previous series row over
+/// the time between them, W. The rates times the row intervals add up to the frictional work exactly
+/// (a telescoping sum); 0 in the first row. Updates `memory` (serial and decomposed runs).
+void append_heat_rates(std::vector<double>& row, std::vector<double> work, double time, SeriesMemory& memory);
 
 /// One series row in the order of series_names + append_body_series_names +
 /// append_contact_series_names. contact_heat_rate(.pair) columns use the frictional work of `order`

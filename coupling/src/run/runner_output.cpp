@@ -1,6 +1,8 @@
 // What the run loop writes: snapshot fields, series rows and run metadata.
 #include "run/runner_detail.hpp"
 
+#include "run/particle_output.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -21,29 +23,36 @@ std::vector<std::string> series_names(int dim) {
   return n;
 }
 
-template <int Dim>
-void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim) {
-  if (!sim.contact_enabled()) return;
-  const auto& mats = sim.materials();
+void append_contact_series_names(std::vector<std::string>& names, const std::vector<std::string>& bodies,
+                                 const std::vector<mechanics::Material>& mats,
+                                 const std::vector<std::pair<int, int>>& pairs, int dim) {
   for (const char* order : {"first", "second"}) {
     names.push_back(std::string("friction_work_") + order);
-    for (const auto& [a, b] : sim.contact_pairs())
+    for (const auto& [a, b] : pairs)
       names.push_back(std::string("friction_work_") + order + "." + mats[static_cast<std::size_t>(a)].name + "." +
                       mats[static_cast<std::size_t>(b)].name);
   }
   names.emplace_back("contact_nodes");
   names.emplace_back("sliding_nodes");
   const char* axes[3] = {"x", "y", "z"};
-  for (const auto& body : sim.bodies())
-    for (int d = 0; d < Dim; ++d) names.push_back(std::string("mean_velocity_") + axes[d] + "." + body.name);
+  for (const auto& body : bodies)
+    for (int d = 0; d < dim; ++d) names.push_back(std::string("mean_velocity_") + axes[d] + "." + body);
   names.emplace_back("contact_heat_rate");
-  for (const auto& [a, b] : sim.contact_pairs())
+  for (const auto& [a, b] : pairs)
     names.push_back("contact_heat_rate." + mats[static_cast<std::size_t>(a)].name + "." +
                     mats[static_cast<std::size_t>(b)].name);
+}
+
+template <int Dim>
+void append_contact_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim) {
+  if (!sim.contact_enabled()) return;
+  std::vector<std::string> bodies;
+  for (const auto& body : sim.bodies()) bodies.push_back(body.name);
+  append_contact_series_names(names, bodies, sim.materials(), sim.contact_pairs(), Dim);
   // Penalty contact (docs/penalty_contact.md): the springs' energy, and per pair (master.slave) the
   // normal force, active contacts, deepest gap and the summed length of the penetrated master segments.
   if (!sim.penalty_contact()) return;
-  append_penalty_series_names(names, sim.penalty_pairs(), mats);
+  append_penalty_series_names(names, sim.penalty_pairs(), sim.materials());
 }
 
 void append_penalty_series_names(std::vector<std::string>& names, const std::vector<mechanics::PenaltyPairInfo>& pairs,
@@ -57,54 +66,44 @@ void append_penalty_series_names(std::vector<std::string>& names, const std::vec
   }
 }
 
+void append_body_series_names(std::vector<std::string>& names, const std::vector<std::string>& bodies, int dim) {
+  const char* axes[3] = {"x", "y", "z"};
+  for (const auto& body : bodies) {
+    names.push_back("mean_temperature." + body);
+    for (int d = 0; d < dim; ++d) names.push_back(std::string("mean_displacement_") + axes[d] + "." + body);
+  }
+}
+
 template <int Dim>
 void append_body_series_names(std::vector<std::string>& names, const mechanics::Simulation<Dim>& sim) {
-  const char* axes[3] = {"x", "y", "z"};
-  for (const auto& body : sim.bodies()) {
-    names.push_back("mean_temperature." + body.name);
-    for (int d = 0; d < Dim; ++d) names.push_back(std::string("mean_displacement_") + axes[d] + "." + body.name);
-  }
+  std::vector<std::string> bodies;
+  for (const auto& body : sim.bodies()) bodies.push_back(body.name);
+  append_body_series_names(names, bodies, Dim);
 }
 
 namespace {
 
-// Mass-weighted means over each body's particles: temperature (K) and displacement x - X (m).
+// Mass-weighted sums over each body's particles (particle_output.hpp).
 template <int Dim>
-void append_body_means(std::vector<double>& row, const mechanics::Simulation<Dim>& sim) {
+BodySums<Dim> body_sums(const mechanics::Simulation<Dim>& sim) {
   const auto& p = sim.particles();
-  const std::size_t bodies = sim.bodies().size();
-  std::vector<double> m(bodies, 0.0), mT(bodies, 0.0);
-  std::vector<mechanics::Vec<Dim>> mu(bodies, mechanics::Vec<Dim>::Zero());
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const std::size_t b = static_cast<std::size_t>(p.body[k]);
-    m[b] += p.mass[k];
-    mT[b] += p.mass[k] * p.temperature[k];
-    mu[b] += p.mass[k] * (p.position[k] - p.initial_position[k]);
-  }
-  const double nan = std::numeric_limits<double>::quiet_NaN();  // a body without mass has no mean
-  for (std::size_t b = 0; b < bodies; ++b) {
-    row.push_back(m[b] > 0.0 ? mT[b] / m[b] : nan);
-    for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mu[b][d] / m[b] : nan);
-  }
-}
-
-// contact_heat_rate: the increase of the cumulative frictional work (of the order handed to the
-// thermal solver) since the previous series row over the time between them, W. The rates times the
-// row intervals add up to the frictional work exactly (a telescoping sum); 0 in the first row.
-template <int Dim>
-void append_heat_rates(std::vector<double>& row, const mechanics::Simulation<Dim>& sim, SeriesMemory& memory,
-                       mechanics::HeatingOrder order) {
-  std::vector<double> work{sim.cumulative_frictional_work(order)};
-  for (const auto& [a, b] : sim.contact_pairs()) work.push_back(sim.cumulative_frictional_work(order, a, b));
-  const double dt = sim.time() - memory.time;
-  for (std::size_t j = 0; j < work.size(); ++j)
-    row.push_back(memory.has_previous && dt > 0.0 ? (work[j] - memory.work[j]) / dt : 0.0);
-  memory.time = sim.time();
-  memory.has_previous = true;
-  memory.work = std::move(work);
+  BodySums<Dim> sums(sim.bodies().size());
+  for (std::size_t k = 0; k < p.size(); ++k)
+    sums.add(static_cast<std::size_t>(p.body[k]), p.mass[k], p.temperature[k], p.position[k], p.initial_position[k],
+             p.velocity[k]);
+  return sums;
 }
 
 }  // namespace
+
+void append_heat_rates(std::vector<double>& row, std::vector<double> work, double time, SeriesMemory& memory) {
+  const double dt = time - memory.time;
+  for (std::size_t j = 0; j < work.size(); ++j)
+    row.push_back(memory.has_previous && dt > 0.0 ? (work[j] - memory.work[j]) / dt : 0.0);
+  memory.time = time;
+  memory.has_previous = true;
+  memory.work = std::move(work);
+}
 
 template <int Dim>
 std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemory& memory,
@@ -116,7 +115,8 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   const mechanics::EnergyBalance e = sim.energy_balance(order);
   row.insert(row.end(), {e.rigid_work, e.damping_work, e.plastic_work, e.lost(), e.numerical_dissipation()});
-  append_body_means(row, sim);
+  const BodySums<Dim> bodies = body_sums(sim);
+  bodies.append_means(row);
   if (!sim.contact_enabled()) return row;
   for (auto each : {mechanics::HeatingOrder::first, mechanics::HeatingOrder::second}) {
     row.push_back(sim.cumulative_frictional_work(each));
@@ -124,18 +124,10 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
   }
   row.push_back(static_cast<double>(sim.contact_stats().contact_nodes));
   row.push_back(static_cast<double>(sim.contact_stats().sliding_nodes));
-  // Mass-weighted mean velocity of each body (what the sliding-block charts plot).
-  const auto& p = sim.particles();
-  std::vector<mechanics::Vec<Dim>> mv(sim.bodies().size(), mechanics::Vec<Dim>::Zero());
-  std::vector<double> m(sim.bodies().size(), 0.0);
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const std::size_t b = static_cast<std::size_t>(p.body[k]);
-    mv[b] += p.mass[k] * p.velocity[k];
-    m[b] += p.mass[k];
-  }
-  for (std::size_t b = 0; b < mv.size(); ++b)
-    for (int d = 0; d < Dim; ++d) row.push_back(m[b] > 0.0 ? mv[b][d] / m[b] : 0.0);
-  append_heat_rates(row, sim, memory, order);
+  bodies.append_velocities(row);
+  std::vector<double> work{sim.cumulative_frictional_work(order)};
+  for (const auto& [a, b] : sim.contact_pairs()) work.push_back(sim.cumulative_frictional_work(order, a, b));
+  append_heat_rates(row, std::move(work), sim.time(), memory);
   if (const mechanics::PenaltyContact<Dim>* pc = sim.penalty_contact()) append_penalty_row(row, *pc, sim.boundary_points());
   return row;
 }
@@ -165,64 +157,23 @@ void append_penalty_row(std::vector<double>& row, const mechanics::PenaltyContac
   }
 }
 
-// Snapshot fields in the shapes VTK (ParaView's XDMF reader, Warp By Vector, Calculator) expects:
-// vectors are (n, 3) and the stress is the full 3x3 tensor (n, 9, row-major) in 2D as in 3D. In 2D the
-// z components of vectors are 0 and the stress's zz entry is the out-of-plane stress (stress_zz, 0 in
-// plane stress), its xz, yz, zx, zy entries 0. position keeps (n, Dim): it is the XDMF geometry (XY in
-// 2D), which VTK pads itself. docs/output.md describes every array.
+// Snapshot fields (particle_output.hpp: the shapes VTK expects).
 template <int Dim>
 void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields) {
   const auto& p = sim.particles();
-  const std::size_t n = p.size();
-  std::vector<double> buf;
-  auto vectors = [&](const std::string& name, auto&& get) {
-    buf.assign(n * 3, 0.0);
-    for (std::size_t k = 0; k < n; ++k) {
-      const mechanics::Vec<Dim> v = get(k);
-      for (int d = 0; d < Dim; ++d) buf[k * 3 + static_cast<std::size_t>(d)] = v[d];
-    }
-    out.snapshot_field(name, buf.data(), n, 3);
-  };
-  auto scalars = [&](const std::string& name, const std::vector<double>& v) { out.snapshot_field(name, v.data(), n, 1); };
-  for (const std::string& f : fields) {
-    if (f == "position") {
-      buf.resize(n * Dim);
-      for (std::size_t k = 0; k < n; ++k)
-        for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = p.position[k][d];
-      out.snapshot_field(f, buf.data(), n, Dim);
-    } else if (f == "velocity") {
-      vectors(f, [&](std::size_t k) { return p.velocity[k]; });
-    } else if (f == "displacement") {
-      vectors(f, [&](std::size_t k) { return mechanics::Vec<Dim>(p.position[k] - p.initial_position[k]); });
-      // With it the reference positions X (dim columns), the geometry of RUN_reference.xdmf: Warp By
-      // Vector on `displacement` there draws x = X + u (docs/output.md "In ParaView").
-      buf.resize(n * Dim);
-      for (std::size_t k = 0; k < n; ++k)
-        for (int d = 0; d < Dim; ++d) buf[k * Dim + static_cast<std::size_t>(d)] = p.initial_position[k][d];
-      out.snapshot_field("initial_position", buf.data(), n, Dim);
-    } else if (f == "stress") {
-      buf.assign(n * 9, 0.0);
-      for (std::size_t k = 0; k < n; ++k) {
-        double* s = &buf[k * 9];
-        for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j) s[3 * i + j] = p.stress[k](i, j);
-        if (Dim == 2 && k < p.stress_zz.size()) s[8] = p.stress_zz[k];
-      }
-      out.snapshot_field(f, buf.data(), n, 9);
-    } else if (f == "stress_zz") {
-      scalars(f, p.stress_zz);
-    } else if (f == "mass") {
-      scalars(f, p.mass);
-    } else if (f == "volume") {
-      scalars(f, p.volume);
-    } else if (f == "temperature") {
-      scalars(f, p.temperature);
-    } else if (f == "material") {
-      out.snapshot_field(f, p.material.data(), n);
-    } else if (f == "body") {
-      out.snapshot_field(f, p.body.data(), n);
-    }
-  }
+  ParticleArrays<Dim> a;
+  a.n = p.size();
+  a.position = p.position.data();
+  a.velocity = p.velocity.data();
+  a.initial_position = p.initial_position.data();
+  a.stress = p.stress.data();
+  a.stress_zz = &p.stress_zz;
+  a.mass = &p.mass;
+  a.volume = &p.volume;
+  a.temperature = &p.temperature;
+  a.material = p.material.data();
+  a.body = p.body.data();
+  write_particle_fields(out, a, fields);
 }
 
 template <int Dim>

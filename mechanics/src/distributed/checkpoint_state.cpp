@@ -73,6 +73,8 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.empty_node_mass = s.empty_node_mass;
   c.work_first = s.work_first;
   c.work_second = s.work_second;
+  c.pair_first = s.pair_first;
+  c.pair_second = s.pair_second;
   c.stats = {s.stats.contact_nodes, s.stats.multi_nodes, s.stats.sliding_nodes, s.stats.guarded};
   return c;
 }
@@ -93,8 +95,10 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
                                 " materials for " + std::to_string(n) + " ids");
   // The last step's work per owned node (empty before the first step with contact).
   const auto owned = static_cast<std::size_t>(s.owned_count());
+  const std::size_t pairs = s.materials.size() * s.materials.size();
   if (c.stats.size() != 4 || (!c.work_first.empty() && c.work_first.size() != owned && !migrate) ||
-      c.work_second.size() != c.work_first.size())
+      c.work_second.size() != c.work_first.size() || (!c.pair_first.empty() && c.pair_first.size() != pairs) ||
+      c.pair_second.size() != c.pair_first.size())
     throw std::invalid_argument("decomposed mechanics: checkpoint state of another decomposition (owned nodes or "
                                 "contact counters differ)");
   const auto fields = real_fields<Dim>(s.scalars);
@@ -147,6 +151,8 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.empty_node_mass = c.empty_node_mass;
   s.work_first = c.work_first;
   s.work_second = c.work_second;
+  s.pair_first = c.pair_first;
+  s.pair_second = c.pair_second;
   s.stats = DecomposedContactStats{c.stats[0], c.stats[1], c.stats[2], c.stats[3]};
   s.current_valid = false;
   if (migrate) {

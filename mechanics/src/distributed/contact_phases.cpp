@@ -206,12 +206,13 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
           }
           if (rigid_side) rigid_work += dp.dot(rigid_side->rigid_velocity);
         },
-        [&](int, int, double w1, double w2) {
+        [&](int ma, int mb, double w1, double w2) {
           if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // never inject NaN heat (as the serial step)
           work_first[uq] += w1;
           work_second[uq] += w2;
           cumulative_first += w1;
           cumulative_second += w2;
+          add_pair_work(ma, mb, w1, w2);
         },
         stats.sliding_nodes);
     } catch (const std::exception& e) {  // kept, not thrown: the other ranks would wait in the next collective
@@ -242,6 +243,15 @@ double DecomposedMpm<Dim>::cumulative_frictional_work(HeatingOrder order) const 
 }
 
 template <int Dim>
+std::vector<double> DecomposedMpm<Dim>::cumulative_pair_work(HeatingOrder order) const {
+  const std::size_t n = impl_->materials.size();
+  std::vector<double> w = order == HeatingOrder::first ? impl_->pair_first : impl_->pair_second;
+  w.resize(n * n, 0.0);
+  MPI_Allreduce(MPI_IN_PLACE, w.data(), static_cast<int>(w.size()), MPI_DOUBLE, MPI_SUM, impl_->comm);
+  return w;
+}
+
+template <int Dim>
 const std::string& DecomposedMpm<Dim>::contact_failure() const {
   return impl_->contact_failure;
 }
@@ -265,6 +275,7 @@ DecomposedContactStats DecomposedMpm<Dim>::contact_stats() const {
                                                      std::vector<int>&, std::vector<std::size_t>&) const;     \
   template const std::vector<double>& DecomposedMpm<D>::frictional_work(HeatingOrder) const; \
   template double DecomposedMpm<D>::cumulative_frictional_work(HeatingOrder) const;     \
+  template std::vector<double> DecomposedMpm<D>::cumulative_pair_work(HeatingOrder) const; \
   template DecomposedContactStats DecomposedMpm<D>::contact_stats() const;               \
   template const std::string& DecomposedMpm<D>::contact_failure() const;
 FRICTHERM_INSTANTIATE_CONTACT(2)

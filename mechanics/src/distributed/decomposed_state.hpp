@@ -287,6 +287,15 @@ struct DecomposedMpm<Dim>::Impl {
   MPI_Datatype extent_list_unit = MPI_DATATYPE_NULL, extent_max_unit = MPI_DATATYPE_NULL;
   std::vector<double> work_first, work_second;
   double cumulative_first = 0.0, cumulative_second = 0.0;
+  // This rank's part of the cumulative frictional work per material pair (pair_book_index, materials²;
+  // empty until the first contact work), as the serial Simulation's pair books.
+  std::vector<double> pair_first, pair_second;
+  void add_pair_work(int a, int b, double w1, double w2) {
+    const std::size_t n = materials.size();
+    if (pair_first.size() != n * n) pair_first.assign(n * n, 0.0), pair_second.assign(n * n, 0.0);
+    pair_first[pair_book_index(a, b, n)] += w1;
+    pair_second[pair_book_index(a, b, n)] += w2;
+  }
   DecomposedContactStats stats;
   // The first friction law that threw in this step's contact phases on this rank ("" if none): the
   // step goes on at every rank (that node's contact as far as it got) and the run loop agrees on the

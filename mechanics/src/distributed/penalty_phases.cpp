@@ -131,6 +131,13 @@ void DecomposedMpm<Dim>::Impl::penalty_forces(double /*dt*/) {
       work_first[q] += w1, work_second[q] += w2;
       cumulative_first += w1, cumulative_second += w2;
     }
+    // The pairs' heat of the step (the same on every rank: every rank runs the kernels on all the
+    // points) into rank 0's pair books, so their sum over ranks counts it once (the serial
+    // apply_penalty_forces's books).
+    if (rank == 0)
+      for (std::size_t k = 0; k < penalty->pair_count(); ++k)
+        add_pair_work(opt.penalty_materials[k][0], opt.penalty_materials[k][1], penalty->books(k).heat_step,
+                      penalty->books(k).heat_step);
   }
 }
 

@@ -78,6 +78,9 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data(bool kinematics
     out.position.assign(f.x, f.x + Dim * n);
     out.velocity.assign(f.velocity, f.velocity + Dim * n);
     out.half_size.assign(f.half_size, f.half_size + Dim * n);
+    out.initial_position.assign(f.x0, f.x0 + Dim * n);
+    out.stress.assign(f.stress, f.stress + Dim * Dim * n);
+    out.stress_zz.assign(f.stress_zz, f.stress_zz + n);
   }
   return out;
 }

@@ -45,9 +45,19 @@ struct DecomposedSnapshot {
   std::vector<double> velocity;     // n × dim, m/s
   std::vector<double> temperature;  // n, K (empty: not written)
   std::vector<int> material;        // n
-  /// More per-particle scalars by name (n each; the same names on every rank), e.g. the interface
-  /// temperature: datasets beside `temperature` and XDMF attributes.
-  std::vector<std::pair<std::string, std::vector<double>>> fields;
+  /// More per-particle fields by name (n × components each; the same names on every rank), e.g. the
+  /// interface temperature or the serial snapshot's displacement and stress: datasets beside
+  /// `temperature` and XDMF attributes.
+  struct Field {
+    Field(std::string field_name, std::vector<double> field_values, int field_components = 1)
+        : name(std::move(field_name)), values(std::move(field_values)), components(field_components) {}
+    std::string name;
+    std::vector<double> values;
+    int components = 1;
+  };
+  std::vector<Field> fields;
+  /// Integer per-particle fields (n each), e.g. the body index.
+  std::vector<std::pair<std::string, std::vector<int>>> integer_fields;
 };
 
 /// Particle snapshots of a decomposed run (issue 16 item 3): one HDF5 file per rank,
@@ -75,6 +85,12 @@ class DecomposedOutput {
   const std::vector<std::string>& xdmf_grids() const { return grids_; }
   /// Rank 0: the XDMF document joining every snapshot so far (what BASE.xdmf holds).
   std::string xdmf_text() const;
+  /// Rank 0: the same grids drawn at the particles' reference positions (geometry initial_position,
+  /// the serial RUN_reference.xdmf) for the snapshots that hold initial_position; "" without any.
+  /// Checkpoints store reference_grids(); a resumed run gives them back (restore_reference_grids).
+  const std::vector<std::string>& reference_grids() const { return reference_grids_; }
+  void restore_reference_grids(std::vector<std::string> grids) { reference_grids_ = std::move(grids); }
+  std::string reference_xdmf_text() const;
   long snapshots() const { return snapshots_; }
   ~DecomposedOutput();
   DecomposedOutput(const DecomposedOutput&) = delete;
@@ -96,6 +112,7 @@ class DecomposedOutput {
   std::string base_, xdmf_path_;
   long long file_ = -1;              // hid_t of this rank's file
   std::vector<std::string> grids_;  // rank 0: the XDMF text of every snapshot so far
+  std::vector<std::string> reference_grids_;  // rank 0: the same at the reference positions
   bool write_xdmf_ = true;          // rank 0 rewrites BASE.xdmf after every snapshot
   long snapshots_ = 0;
 };

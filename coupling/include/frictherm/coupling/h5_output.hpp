@@ -143,7 +143,8 @@ class H5Output {
   /// With via_temporary and write_xdmf false: `text` is the XDMF document published with the result
   /// in close() under xdmf_path_for(path()) (publish_with_xdmf), e.g. a decomposed run's OUT.xdmf that
   /// joins its rank files (issue 34: written with the result, never before it).
-  void publish_xdmf_with_result(std::string text);
+  /// `reference` (may be ""): RUN_reference.xdmf published with it (xdmf_reference_path_for).
+  void publish_xdmf_with_result(std::string text, std::string reference = "");
   /// Flushes, rewrites the XDMF file and closes the file. Further calls throw std::logic_error.
   void close();
 

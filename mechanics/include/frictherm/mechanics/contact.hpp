@@ -21,6 +21,7 @@
 #include <frictherm/mechanics/friction.hpp>
 #include <frictherm/mechanics/types.hpp>
 
+#include <cstddef>
 #include <string>
 
 namespace frictherm::mechanics {
@@ -48,6 +49,12 @@ TangentialLaw tangential_law_from_string(const std::string& name);        // "re
 const char* to_string(NormalMethod m);
 const char* to_string(SeparationMethod m);
 const char* to_string(HeatingOrder o);
+
+/// The frictional work books per material pair (Simulation and DecomposedMpm): materials² entries,
+/// the unordered pair {a, b} at min(a, b)·materials + max(a, b).
+inline std::size_t pair_book_index(int a, int b, std::size_t materials) {
+  return static_cast<std::size_t>(a < b ? a : b) * materials + static_cast<std::size_t>(a < b ? b : a);
+}
 const char* to_string(ContactMethod m);
 const char* to_string(TangentialLaw law);
 

@@ -129,6 +129,9 @@ struct DecomposedLocalParticles {
   std::vector<double> position, velocity, half_size;
   /// Plastic work done on each particle since the start (J; 0 for non-plastic materials).
   std::vector<double> plastic_work;
+  /// With kinematics also the initial positions X_p (Dim per particle), the stress σ_p (Dim² per
+  /// particle, Eigen's column-major Mat<Dim>) and the 2D out-of-plane σ_zz (0 in 3D).
+  std::vector<double> initial_position, stress, stress_zz;
 };
 
 /// Contact counters of the last step, summed over ranks (as the serial ContactStats).
@@ -282,6 +285,9 @@ class DecomposedMpm {
   const std::vector<double>& frictional_work(HeatingOrder order) const;
   /// Collective: frictional work since the start, summed over owned nodes and ranks (J).
   double cumulative_frictional_work(HeatingOrder order) const;
+  /// Collective: the same per material pair, materials² entries at pair_book_index(a, b, materials)
+  /// (as Simulation::cumulative_frictional_work(order, a, b)), summed over ranks (J).
+  std::vector<double> cumulative_pair_work(HeatingOrder order) const;
   /// Collective: the last step's contact counters summed over ranks.
   DecomposedContactStats contact_stats() const;
   /// Not collective: the first friction law that threw during the last step's contact on this rank
@@ -357,6 +363,7 @@ class DecomposedMpm {
     double external_work = 0.0, damping_work = 0.0, rigid_work = 0.0;  // this rank's part of the books
     double initial_energy = std::numeric_limits<double>::quiet_NaN();  // the books' start (every rank's)
     std::vector<double> work_first, work_second;
+    std::vector<double> pair_first, pair_second;  // this rank's part of the pair books (materials² or empty)
     std::vector<long> stats;  // contact_nodes, multi_nodes, sliding_nodes, guarded (this rank)
   };
   CheckpointState checkpoint_state() const;

@@ -1,0 +1,204 @@
+// Every scene of examples/ under mpirun (issue 32, "every example decomposes"): each shortened with
+// run.max_steps to 150 steps (pbx_3d, 85,184 particles: 10), a series row every step and every
+// snapshot field (output.fields=null: the EBS scenes write four of them), run by
+// `frictherm run` and by `mpirun -n 2` and `-n 4`. The decomposed result must hold every series column
+// and every field of the last snapshot that the serial one holds, and agree with it:
+//   * a series column within 1e-9 of its own scale, the largest |value| of the serial column (the bound
+//     of test_cli_mpirun.cpp: the same arithmetic, sums over particles, nodes and ranks in another
+//     order). Where a column is a difference of larger totals its round-off is theirs, so its scale is
+//     theirs: energy_lost and numerical_dissipation take the largest of the total energy and the
+//     external, rigid and damping work; the momenta take √(2 M max KE) (M the total particle mass, from
+//     the snapshot); temperatures their rise over the run (at least 1 mK); thermal_energy_change,
+//     Σ C_i T_i at the end less at the start, is bounded by ten times the serial run's own
+//     |thermal_energy_change − heat_delivered| (the round-off of Σ C T, which the serial books show);
+//   * counts (contact_nodes, sliding_nodes, hotspot_count) differ by at most one node or spot: a node
+//     counted as sliding when its slide impulse exceeds 1e-12 of the stick one, or a spot at the
+//     threshold, flips on round-off;
+//   * every field of the last snapshot, particle by particle (by id, every particle held by exactly one
+//     rank), within 1e-9 of the field's largest |value| (temperature: of the rise, at least 1 mK).
+// Skipped when mpirun is not installed. Labels verification;mpi; one ctest per example.
+#include <gtest/gtest.h>
+
+#include "cli_test_support.hpp"
+#include "h5_test_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace frictherm::test {
+namespace {
+
+struct ExampleCase {
+  const char* name;
+  int steps;
+};
+
+std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
+
+bool is_count(const std::string& c) { return c == "contact_nodes" || c == "sliding_nodes" || c == "hotspot_count"; }
+bool is_temperature(const std::string& c) { return c.find("temperature") != std::string::npos; }
+
+double largest(const std::vector<double>& a) {
+  double s = 0.0;
+  for (double x : a)
+    if (std::isfinite(x)) s = std::max(s, std::fabs(x));
+  return s;
+}
+
+// The rise of a temperature column or field over its finite values, at least 1 mK.
+double rise(const std::vector<double>& a) {
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (double x : a)
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  return std::max(hi > lo ? hi - lo : 0.0, 1e-3);
+}
+
+class MpirunExamples : public MpirunScratchTest, public ::testing::WithParamInterface<ExampleCase> {
+ protected:
+  MpirunExamples() : MpirunScratchTest("frictherm_mpirun_examples_") {}
+
+  std::string run_command(const std::string& out) const {
+    return exe() + " run '" + FRICTHERM_SOURCE_DIR + "/examples/" + GetParam().name + ".json' --set run.max_steps=" +
+           std::to_string(GetParam().steps) + " --set output.series_interval=0 --set output.fields=null -q --threads 1 --force -o '" + path(out) + "'";
+  }
+
+  std::vector<double> series(const std::string& file, const std::string& c) const {
+    return read_doubles(path(file), "/series/" + c);
+  }
+
+  // The total particle mass of the serial run's last snapshot.
+  double total_mass() const {
+    const std::vector<std::string> snaps = names_in(path("serial.h5"), "/snapshots");
+    if (snaps.empty()) return 0.0;
+    double m = 0.0;
+    for (double x : read_doubles(path("serial.h5"), "/snapshots/" + snaps.back() + "/mass")) m += x;
+    return m;
+  }
+
+  void compare_series(const std::string& split) {
+    const std::vector<std::string> have = names_in(path(split), "/series");
+    const double kinetic = largest(series("serial.h5", "kinetic_energy"));
+    const double momentum_scale = std::sqrt(2.0 * total_mass() * kinetic);
+    double energy_scale = 0.0;
+    for (const char* c : {"total_energy", "external_work", "rigid_work", "damping_work"})
+      energy_scale = std::max(energy_scale, largest(series("serial.h5", c)));
+    double worst = 0.0;
+    std::string worst_column;
+    int compared = 0;
+    for (const std::string& c : names_in(path("serial.h5"), "/series")) {
+      if (std::find(have.begin(), have.end(), c) == have.end()) {
+        ADD_FAILURE() << split << " lacks the serial series column " << c;
+        continue;
+      }
+      const std::vector<double> a = series("serial.h5", c), b = series(split, c);
+      ASSERT_EQ(a.size(), b.size()) << c;
+      double diff = 0.0;
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        if (std::isnan(a[k]) || std::isnan(b[k])) {
+          EXPECT_EQ(std::isnan(a[k]), std::isnan(b[k])) << c << " row " << k;
+          continue;
+        }
+        diff = std::max(diff, std::fabs(a[k] - b[k]));
+      }
+      if (is_count(c)) {
+        EXPECT_LE(diff, 1.0) << c;
+        continue;
+      }
+      double scale = largest(a), tolerance = 1e-9;
+      if (c == "energy_lost" || c == "numerical_dissipation") scale = std::max(scale, energy_scale);
+      if (c.rfind("momentum_", 0) == 0) scale = std::max(scale, momentum_scale);
+      if (is_temperature(c)) scale = rise(a);
+      double bound = tolerance * scale;
+      if (c == "thermal_energy_change") {
+        const std::vector<double> q = series("serial.h5", "heat_delivered");
+        double book = 0.0;
+        for (std::size_t k = 0; k < std::min(a.size(), q.size()); ++k) book = std::max(book, std::fabs(a[k] - q[k]));
+        bound = std::max(bound, 10.0 * book);
+      }
+      EXPECT_LE(diff, bound) << c << " (scale " << scale << ")";
+      const double rel = scale > 0.0 ? diff / scale : diff;
+      if (rel > worst) worst = rel, worst_column = c;
+      ++compared;
+    }
+    std::printf("  %s: %d series columns, largest difference %.3g of its scale (%s)\n", split.c_str(), compared, worst,
+                worst_column.c_str());
+  }
+
+  // The last snapshot's fields by particle id over the rank files of `split` (K ranks).
+  void compare_snapshot(const std::string& split, int ranks) {
+    const std::vector<std::string> snaps = names_in(path("serial.h5"), "/snapshots");
+    ASSERT_FALSE(snaps.empty());
+    const std::string snap = "/snapshots/" + snaps.back() + "/";
+    const std::string stem = split.substr(0, split.size() - 3);
+    std::vector<std::vector<double>> ids(static_cast<std::size_t>(ranks));
+    for (int r = 0; r < ranks; ++r)
+      ids[static_cast<std::size_t>(r)] = read_doubles(path(stem + ".rank" + std::to_string(r) + ".h5"), snap + "id");
+    const std::size_t n = read_doubles(path("serial.h5"), snap + "mass").size();
+    ASSERT_GT(n, 0u);
+    std::vector<int> seen(n, 0);
+    for (const auto& v : ids)
+      for (double id : v) {
+        ASSERT_LT(static_cast<std::size_t>(id), n);
+        ++seen[static_cast<std::size_t>(id)];
+      }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(n)) << "every particle on one rank";
+    double worst = 0.0;
+    std::string worst_field;
+    int fields = 0;
+    for (const std::string& f : names_in(path("serial.h5"), snap)) {
+      const std::vector<double> a = read_doubles(path("serial.h5"), snap + f);
+      if (a.empty() || a.size() % n != 0) continue;  // per-particle fields only
+      const std::size_t width = a.size() / n;
+      const double scale = is_temperature(f) ? rise(a) : std::max(largest(a), 1e-300);
+      double diff = 0.0;
+      for (int r = 0; r < ranks; ++r) {
+        const std::string file = stem + ".rank" + std::to_string(r) + ".h5";
+        const std::vector<double> b = read_doubles(path(file), snap + f);
+        const auto& id = ids[static_cast<std::size_t>(r)];
+        if (b.size() != id.size() * width) {
+          ADD_FAILURE() << file << snap << f << ": " << b.size() << " values for " << id.size() << " particles";
+          break;
+        }
+        for (std::size_t k = 0; k < id.size(); ++k)
+          for (std::size_t j = 0; j < width; ++j)
+            diff = std::max(diff, std::fabs(b[k * width + j] - a[static_cast<std::size_t>(id[k]) * width + j]));
+      }
+      EXPECT_LE(diff, 1e-9 * scale) << f;
+      if (diff / scale > worst) worst = diff / scale, worst_field = f;
+      ++fields;
+    }
+    std::printf("  %s: %d snapshot fields of %zu particles, largest difference %.3g of its scale (%s)\n", split.c_str(),
+                fields, n, worst, worst_field.c_str());
+  }
+};
+
+TEST_P(MpirunExamples, SplitRunsMatchTheSerialRun) {
+  const Result s = shell(run_command("serial.h5"));
+  ASSERT_EQ(s.code, 0) << s.output;
+  for (int ranks : {2, 4}) {
+    const std::string split = "split" + std::to_string(ranks) + ".h5";
+    const Result d = shell(mpirun_command(ranks) + " " + run_command(split));
+    ASSERT_EQ(d.code, 0) << d.output;
+    compare_series(split);
+    compare_snapshot(split, ranks);
+  }
+}
+
+const ExampleCase kExamples[] = {
+    {"bar_vibration", 150},      {"bars_impact", 150},         {"granular_waves", 150},
+    {"half_disk_plane", 150},    {"hertz_disks", 150},         {"image_body", 150},
+    {"neo_hookean_rings", 150},  {"oscillating_block", 150},   {"pbx_3d", 10},
+    {"pbx_compaction", 150},     {"pbx_microstructure_small", 150}, {"pressed_block", 150},
+    {"rigid_push", 150},         {"sliding_block", 150},       {"sliding_block_expression", 150},
+    {"sliding_block_heating", 150}, {"sphere_3d", 150},
+};
+
+INSTANTIATE_TEST_SUITE_P(Examples, MpirunExamples, ::testing::ValuesIn(kExamples),
+                         [](const ::testing::TestParamInfo<ExampleCase>& p) { return std::string(p.param.name); });
+
+}  // namespace
+}  // namespace frictherm::test
