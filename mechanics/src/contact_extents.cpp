@@ -22,49 +22,49 @@ template <int Dim>
 template <class Stencils>
 void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   compute_contact_normals();
-  const std::size_t entries = contact_entries_.size();
+  const std::size_t entries = contact_nodes_.entries.size();
   constexpr double none = -std::numeric_limits<double>::infinity();
-  entry_extent_own_.assign(entries, none);
-  entry_extent_other_.assign(entries, none);
+  contact_nodes_.entry_extent_own.assign(entries, none);
+  contact_nodes_.entry_extent_other.assign(entries, none);
   if (entries == 0) return;
-  if (static_cast<int>(extent_thread_.size()) < threads_ - 1) extent_thread_.resize(static_cast<std::size_t>(threads_ - 1));
-#pragma omp parallel num_threads(threads_)
+  if (static_cast<int>(contact_nodes_.extent_thread.size()) < threads_.count - 1) contact_nodes_.extent_thread.resize(static_cast<std::size_t>(threads_.count - 1));
+#pragma omp parallel num_threads(threads_.count)
   {
     const int tid = omp_get_thread_num();
-    double* own = entry_extent_own_.data();
-    double* other = entry_extent_other_.data();
+    double* own = contact_nodes_.entry_extent_own.data();
+    double* other = contact_nodes_.entry_extent_other.data();
     if (tid > 0) {
-      std::vector<double>& buf = extent_thread_[static_cast<std::size_t>(tid - 1)];
+      std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(tid - 1)];
       buf.assign(2 * entries, none);
       own = buf.data();
       other = buf.data() + entries;
     }
     for (std::size_t m = 0; m < materials_.size(); ++m) {
-      const int f = field_of_material_[m];
+      const int f = layout_.field_of_material[m];
       if (f < 0) continue;
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
-      for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+      for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
         const Vec<Dim>& x = p_.position[k];
         const Vec<Dim>& l = p_.half_size[k];
         st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
           if (!(S > 0.0)) return;
-          const std::size_t node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(slot)]);
-          const int c = node_field_count_[node];
+          const std::size_t node = static_cast<std::size_t>(layout_.slot_node[static_cast<std::size_t>(slot)]);
+          const int c = contact_nodes_.node_field_count[node];
           if (c < 2) return;
-          const int begin = node_entry_cursor_[node] - c;  // the node's run (find_contact_nodes)
-          const ContactEntry* run = contact_entries_.data() + begin;
+          const int begin = contact_nodes_.node_entry_cursor[node] - c;  // the node's run (find_contact_nodes)
+          const ContactEntry* run = contact_nodes_.entries.data() + begin;
           contact_detail::add_particle_extent<Dim>(x, l, f, c, [run](int j) { return run[j].field; },
-                                                   entry_normal_.data() + begin, own + begin, other + begin);
+                                                   contact_nodes_.entry_normal.data() + begin, own + begin, other + begin);
         });
       }
     }
   }
-  for (int t = 0; t + 1 < threads_; ++t) {
-    const std::vector<double>& buf = extent_thread_[static_cast<std::size_t>(t)];
+  for (int t = 0; t + 1 < threads_.count; ++t) {
+    const std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(t)];
     for (std::size_t q = 0; q < entries; ++q) {
-      entry_extent_own_[q] = std::max(entry_extent_own_[q], buf[q]);
-      entry_extent_other_[q] = std::max(entry_extent_other_[q], buf[entries + q]);
+      contact_nodes_.entry_extent_own[q] = std::max(contact_nodes_.entry_extent_own[q], buf[q]);
+      contact_nodes_.entry_extent_other[q] = std::max(contact_nodes_.entry_extent_other[q], buf[entries + q]);
     }
   }
 }

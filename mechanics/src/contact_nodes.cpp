@@ -22,61 +22,61 @@ namespace frictherm::mechanics {
 // Counting sort, O(slots) with no comparison sort.
 template <int Dim>
 void Simulation<Dim>::find_contact_nodes() {
-  if (!any_multimaterial_) {  // every present pair uses penalty contact
-    contact_entries_.clear();
-    contact_groups_.assign(1, 0);
+  if (!contact_setup_.any_multimaterial) {  // every present pair uses penalty contact
+    contact_nodes_.entries.clear();
+    contact_nodes_.groups.assign(1, 0);
     return;
   }
   const std::size_t nf = fields_.size();
   int span_lo = INT_MAX, span_hi = INT_MIN;  // the grid nodes some field covers: [span_lo, span_hi)
   for (const VelocityField<Dim>& F : fields_)
     if (F.count > 0) {
-      span_lo = std::min(span_lo, slot_node_[F.first]);
-      span_hi = std::max(span_hi, slot_node_[F.first + F.count - 1] + 1);
+      span_lo = std::min(span_lo, layout_.slot_node[F.first]);
+      span_hi = std::max(span_hi, layout_.slot_node[F.first + F.count - 1] + 1);
     }
   if (span_lo >= span_hi) {
-    contact_entries_.clear();
-    contact_groups_.assign(1, 0);
+    contact_nodes_.entries.clear();
+    contact_nodes_.groups.assign(1, 0);
     return;
   }
   // Below a few thousand slots the fork and the barriers cost more than the work they share.
-  const int threads = nodes_.mass.size() >= 8192 ? threads_ : 1;
-  if (contact_node_listing_.size() < static_cast<std::size_t>(threads))
-    contact_node_listing_.resize(static_cast<std::size_t>(threads));
+  const int threads = nodes_.mass.size() >= 8192 ? threads_.count : 1;
+  if (contact_nodes_.listing.size() < static_cast<std::size_t>(threads))
+    contact_nodes_.listing.resize(static_cast<std::size_t>(threads));
   const double mmin = empty_node_mass_;
   const bool reset_whole_range = nodes_.mass.size() >= static_cast<std::size_t>(span_hi - span_lo);
 
 #pragma omp parallel num_threads(threads)
   {
     const int t = omp_get_thread_num(), T = omp_get_num_threads();
-    ContactNodeListing& w = contact_node_listing_[static_cast<std::size_t>(t)];
+    ContactNodeListing& w = contact_nodes_.listing[static_cast<std::size_t>(t)];
     const EvenShare share(span_lo, span_hi, t, T);
     const int node_lo = static_cast<int>(share.lo), node_hi = static_cast<int>(share.hi);
     w.slot_begin.resize(nf), w.slot_end.resize(nf), w.field_end.resize(nf);
     w.entries.assign(nf, 0), w.groups.assign(nf, 0), w.entry_base.resize(nf), w.group_base.resize(nf);
     for (std::size_t f = 0; f < nf; ++f) {
-      const int* b = slot_node_.data() + fields_[f].first;
+      const int* b = layout_.slot_node.data() + fields_[f].first;
       const int* e = b + fields_[f].count;
-      w.slot_begin[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_lo) - slot_node_.data());
-      w.slot_end[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_hi) - slot_node_.data());
+      w.slot_begin[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_lo) - layout_.slot_node.data());
+      w.slot_end[f] = static_cast<std::size_t>(std::lower_bound(b, e, node_hi) - layout_.slot_node.data());
     }
     // 1. Reset this range's counts and cursors (over the range or slot by slot, whichever is shorter).
     if (reset_whole_range) {
-      std::fill(node_field_count_.begin() + node_lo, node_field_count_.begin() + node_hi, 0);
-      std::fill(node_entry_cursor_.begin() + node_lo, node_entry_cursor_.begin() + node_hi, -1);
+      std::fill(contact_nodes_.node_field_count.begin() + node_lo, contact_nodes_.node_field_count.begin() + node_hi, 0);
+      std::fill(contact_nodes_.node_entry_cursor.begin() + node_lo, contact_nodes_.node_entry_cursor.begin() + node_hi, -1);
     } else {
       for (std::size_t f = 0; f < nf; ++f)
         for (std::size_t s = w.slot_begin[f]; s < w.slot_end[f]; ++s) {
-          const auto node = static_cast<std::size_t>(slot_node_[s]);
-          node_field_count_[node] = 0;
-          node_entry_cursor_[node] = -1;
+          const auto node = static_cast<std::size_t>(layout_.slot_node[s]);
+          contact_nodes_.node_field_count[node] = 0;
+          contact_nodes_.node_entry_cursor[node] = -1;
         }
     }
     w.occupied.clear();
     for (std::size_t f = 0; f < nf; ++f) {
       for (std::size_t s = w.slot_begin[f]; s < w.slot_end[f]; ++s)
         if (nodes_.mass[s] > mmin) {
-          ++node_field_count_[static_cast<std::size_t>(slot_node_[s])];
+          ++contact_nodes_.node_field_count[static_cast<std::size_t>(layout_.slot_node[s])];
           w.occupied.push_back(static_cast<int>(s));
         }
       w.field_end[f] = w.occupied.size();
@@ -85,10 +85,10 @@ void Simulation<Dim>::find_contact_nodes() {
     //    block's offset is known).
     for (std::size_t f = 0, o = 0; f < nf; ++f)
       for (; o < w.field_end[f]; ++o) {
-        const auto node = static_cast<std::size_t>(slot_node_[static_cast<std::size_t>(w.occupied[o])]);
-        if (node_field_count_[node] >= 2 && node_entry_cursor_[node] == -1) {
-          node_entry_cursor_[node] = -2 - static_cast<int>(w.entries[f]);
-          w.entries[f] += node_field_count_[node];
+        const auto node = static_cast<std::size_t>(layout_.slot_node[static_cast<std::size_t>(w.occupied[o])]);
+        if (contact_nodes_.node_field_count[node] >= 2 && contact_nodes_.node_entry_cursor[node] == -1) {
+          contact_nodes_.node_entry_cursor[node] = -2 - static_cast<int>(w.entries[f]);
+          w.entries[f] += contact_nodes_.node_field_count[node];
           ++w.groups[f];
         }
       }
@@ -98,27 +98,27 @@ void Simulation<Dim>::find_contact_nodes() {
       std::size_t entries = 0, groups = 0;
       for (std::size_t f = 0; f < nf; ++f)
         for (int u = 0; u < T; ++u) {
-          ContactNodeListing& x = contact_node_listing_[static_cast<std::size_t>(u)];
+          ContactNodeListing& x = contact_nodes_.listing[static_cast<std::size_t>(u)];
           x.entry_base[f] = entries, x.group_base[f] = groups;
           entries += x.entries[f], groups += x.groups[f];
         }
-      contact_entries_.resize(entries);
-      contact_groups_.resize(groups + 1);
-      contact_groups_[groups] = entries;  // the end of the last node's run
+      contact_nodes_.entries.resize(entries);
+      contact_nodes_.groups.resize(groups + 1);
+      contact_nodes_.groups[groups] = entries;  // the end of the last node's run
     }  // (implicit barrier)
     // 3. The runs, in field order within each node; a node's group starts where its run does.
     for (std::size_t f = 0, o = 0; f < nf; ++f) {
       std::size_t group = w.group_base[f];
       for (; o < w.field_end[f]; ++o) {
         const int s = w.occupied[o];
-        const int node = slot_node_[static_cast<std::size_t>(s)];
-        if (node_field_count_[static_cast<std::size_t>(node)] < 2) continue;
-        int& cursor = node_entry_cursor_[static_cast<std::size_t>(node)];
+        const int node = layout_.slot_node[static_cast<std::size_t>(s)];
+        if (contact_nodes_.node_field_count[static_cast<std::size_t>(node)] < 2) continue;
+        int& cursor = contact_nodes_.node_entry_cursor[static_cast<std::size_t>(node)];
         if (cursor <= -2) {
           cursor = static_cast<int>(w.entry_base[f]) + (-2 - cursor);
-          contact_groups_[group++] = static_cast<std::size_t>(cursor);
+          contact_nodes_.groups[group++] = static_cast<std::size_t>(cursor);
         }
-        contact_entries_[static_cast<std::size_t>(cursor++)] = {node, s, static_cast<int>(f)};
+        contact_nodes_.entries[static_cast<std::size_t>(cursor++)] = {node, s, static_cast<int>(f)};
       }
     }
   }

@@ -39,22 +39,22 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const std::size_t nm = materials_.size();
   Vec<Dim> h = grid_.cell_size();
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
-  if (heat) contact_stats_ = ContactStats{};
-  const bool regularized = contact_opt_.regularized();
-  if (regularized && lagged_normal_traction_.size() != grid_.node_count()) {
-    lagged_normal_traction_.assign(grid_.node_count(), std::numeric_limits<double>::quiet_NaN());
-    lagged_normal_step_.assign(grid_.node_count(), -2.0);
+  if (heat) contact_books_.stats = ContactStats{};
+  const bool regularized = contact_setup_.options.regularized();
+  if (regularized && contact_nodes_.lagged_normal_traction.size() != grid_.node_count()) {
+    contact_nodes_.lagged_normal_traction.assign(grid_.node_count(), std::numeric_limits<double>::quiet_NaN());
+    contact_nodes_.lagged_normal_step.assign(grid_.node_count(), -2.0);
   }
 
-  // The node groups of contact_entries_ (find_contact_nodes): each group reads and writes only its own
+  // The node groups of contact_nodes_.entries (find_contact_nodes): each group reads and writes only its own
   // node's slots and work entries, so groups run in parallel. Stats are counts; the pair books'
   // entries are listed per thread and added in group order afterwards, so every number is the same
   // however many threads share the groups. (Handing the groups out in chunks as threads came free, schedule
   // dynamic, made the PBX's contact phase slower: 22.1 % of the wall time against 20.0 %.)
-  const long groups = static_cast<long>(contact_groups_.size()) - 1;
-  const int threads = groups >= 256 ? threads_ : 1;
-  contact_thread_work_.resize(static_cast<std::size_t>(threads));
-  for (auto& t : contact_thread_work_) {
+  const long groups = static_cast<long>(contact_nodes_.groups.size()) - 1;
+  const int threads = groups >= 256 ? threads_.count : 1;
+  contact_nodes_.thread_work.resize(static_cast<std::size_t>(threads));
+  for (auto& t : contact_nodes_.thread_work) {
     t.stats = ContactStats{};
     t.entries.clear();
     t.rigid_work.clear();
@@ -70,12 +70,12 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   ContactFailure failure;
 #pragma omp parallel num_threads(threads)
   {
-    ContactThreadWork& acc = contact_thread_work_[static_cast<std::size_t>(omp_get_thread_num())];
-    PairContext ctx{nullptr, contact_opt_.separation, contact_opt_.position_correction, contact_opt_.extent_tolerance,
-                    cell_volume, contact_opt_.area, dt, heat};
-    ctx.step = static_cast<double>(step_);
-    ctx.slip_length = contact_opt_.regularization_slip_length;
-    ctx.relaxation_time = contact_opt_.regularization_time;
+    ContactThreadWork& acc = contact_nodes_.thread_work[static_cast<std::size_t>(omp_get_thread_num())];
+    PairContext ctx{nullptr, contact_setup_.options.separation, contact_setup_.options.position_correction, contact_setup_.options.extent_tolerance,
+                    cell_volume, contact_setup_.options.area, dt, heat};
+    ctx.step = static_cast<double>(clock_.step);
+    ctx.slip_length = contact_setup_.options.regularization_slip_length;
+    ctx.relaxation_time = contact_setup_.options.regularization_time;
     // Per-node scratch, reused from call to call (no allocation per step once grown).
     thread_local std::vector<ContactSide<Dim>> sides;
     thread_local std::vector<int> slots, mats, entries;
@@ -86,8 +86,8 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     };
     auto add_work = [&](int node, int ma, int mb, double w1, double w2) {
       if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
-      work_first_[static_cast<std::size_t>(node)] += w1;
-      work_second_[static_cast<std::size_t>(node)] += w2;
+      contact_books_.work_first[static_cast<std::size_t>(node)] += w1;
+      contact_books_.work_second[static_cast<std::size_t>(node)] += w2;
       const std::size_t k = pair_book_index(ma, mb, nm);
       acc.entries.push_back({k, w1, w2});
     };
@@ -96,7 +96,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
 
 #pragma omp for schedule(static)
     for (long g = 0; g < groups; ++g) {
-      const int node = contact_entries_[contact_groups_[static_cast<std::size_t>(g)]].node;
+      const int node = contact_nodes_.entries[contact_nodes_.groups[static_cast<std::size_t>(g)]].node;
       try {
       const int guarded = gather_contact_sides(static_cast<std::size_t>(g), dt, sides, slots, mats, entries);
       if (heat) stats.guarded += guarded;
@@ -105,8 +105,8 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
         ++stats.contact_nodes;
         if (count > 2) ++stats.multi_nodes;
       }
-      double* lagged_normal = regularized ? &lagged_normal_traction_[static_cast<std::size_t>(node)] : nullptr;
-      double* lagged_step = regularized ? &lagged_normal_step_[static_cast<std::size_t>(node)] : nullptr;
+      double* lagged_normal = regularized ? &contact_nodes_.lagged_normal_traction[static_cast<std::size_t>(node)] : nullptr;
+      double* lagged_step = regularized ? &contact_nodes_.lagged_normal_step[static_cast<std::size_t>(node)] : nullptr;
       // The energy books' rigid work, in the momentum-update pass (the changes the particles receive).
       const ContactSide<Dim>* rigid = forces ? rigid_work_side(sides) : nullptr;
       double rigid_work = 0.0;
@@ -128,7 +128,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   if (failure.group >= 0) {  // "step S, t = T s: contact.pairs[0].law (materials 'a' and 'b') at node ..."
     std::ostringstream msg;
     msg.precision(6);
-    msg << "step " << step_ << ", t = " << time_ << " s: ";
+    msg << "step " << clock_.step << ", t = " << clock_.time << " s: ";
     if (failure.material_a >= 0) {
       const std::string& origin = contact_pair(failure.material_a, failure.material_b).origin;
       msg << (origin.empty() ? std::string("contact") : origin) << " (materials '"
@@ -141,25 +141,25 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     msg << " at node " << failure.node << " (";
     for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << x[d];
     msg << ") m: " << failure.what;
-    throw SimulationError(msg.str(), step_, time_, -1);
+    throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
   }
   if (!heat) return;
-  for (const auto& t : contact_thread_work_) {
-    contact_stats_.contact_nodes += t.stats.contact_nodes;
-    contact_stats_.multi_nodes += t.stats.multi_nodes;
-    contact_stats_.sliding_nodes += t.stats.sliding_nodes;
-    contact_stats_.guarded += t.stats.guarded;
+  for (const auto& t : contact_nodes_.thread_work) {
+    contact_books_.stats.contact_nodes += t.stats.contact_nodes;
+    contact_books_.stats.multi_nodes += t.stats.multi_nodes;
+    contact_books_.stats.sliding_nodes += t.stats.sliding_nodes;
+    contact_books_.stats.guarded += t.stats.guarded;
   }
   // The pair books: every thread's entries, in thread order, summed into the first thread's books,
   // then into the run's. The static schedule gives thread t the t-th contiguous run of groups, so
   // this is group order, as on one thread (a dynamic schedule would need the lists merged by group).
-  ContactThreadWork& books = contact_thread_work_.front();
-  for (const auto& t : contact_thread_work_) {
+  ContactThreadWork& books = contact_nodes_.thread_work.front();
+  for (const auto& t : contact_nodes_.thread_work) {
     for (const auto& e : t.entries) books.add(e.k, e.w1, e.w2);
-    for (const double w : t.rigid_work) rigid_work_ += w;  // group order too: the same sum on any thread count
+    for (const double w : t.rigid_work) work_books_.rigid += w;  // group order too: the same sum on any thread count
   }
   for (const std::size_t k : books.touched) {  // (the others add zero)
-    pair_work_first_[k] += books.pair_first[k], pair_work_second_[k] += books.pair_second[k];
+    contact_books_.pair_work_first[k] += books.pair_first[k], contact_books_.pair_work_second[k] += books.pair_second[k];
     books.pair_first[k] = books.pair_second[k] = 0.0, books.marked[k] = 0;
   }
   books.touched.clear();
@@ -170,20 +170,20 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
 template <int Dim>
 int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides,
                                           std::vector<int>& slots, std::vector<int>& mats, std::vector<int>& entries) const {
-  const std::size_t e = contact_groups_[group], end = contact_groups_[group + 1];
+  const std::size_t e = contact_nodes_.groups[group], end = contact_nodes_.groups[group + 1];
   sides.clear(), slots.clear(), mats.clear(), entries.clear();
-  const bool extents = contact_opt_.separation == SeparationMethod::extent && entry_extent_own_.size() == contact_entries_.size();
+  const bool extents = contact_setup_.options.separation == SeparationMethod::extent && contact_nodes_.entry_extent_own.size() == contact_nodes_.entries.size();
   double node_mass = 0.0;
-  for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_entries_[q].slot)];
+  for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_nodes_.entries[q].slot)];
   int guarded = 0;
   for (std::size_t q = e; q < end; ++q) {
-    const int slot = contact_entries_[q].slot;
+    const int slot = contact_nodes_.entries[q].slot;
     const std::size_t su = static_cast<std::size_t>(slot);
-    if (nodes_.mass[su] < contact_opt_.min_mass_fraction * node_mass) {
+    if (nodes_.mass[su] < contact_setup_.options.min_mass_fraction * node_mass) {
       ++guarded;
       continue;
     }
-    const std::size_t f = static_cast<std::size_t>(contact_entries_[q].field);
+    const std::size_t f = static_cast<std::size_t>(contact_nodes_.entries[q].field);
     ContactSide<Dim> sd;
     sd.mass = nodes_.mass[su];
     sd.momentum = nodes_.momentum[su];
@@ -192,14 +192,14 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
     sd.domain = nodes_.domain[su];
     sd.domain_gradient = nodes_.domain_gradient[su];
     sd.rigid = fields_[f].rigid;
-    sd.sliver = nodes_.mass[su] < contact_opt_.sliver_fraction * node_mass;
+    sd.sliver = nodes_.mass[su] < contact_setup_.options.sliver_fraction * node_mass;
     if (sd.rigid) {
       const Material& mat = materials_[static_cast<std::size_t>(fields_[f].material)];
-      sd.rigid_velocity = field_velocity_[f];
-      sd.rigid_acceleration = (mat.rigid_velocity_at(time_ + dt).template head<Dim>() - field_velocity_[f]) / dt;
+      sd.rigid_velocity = layout_.field_velocity[f];
+      sd.rigid_acceleration = (mat.rigid_velocity_at(clock_.time + dt).template head<Dim>() - layout_.field_velocity[f]) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
-      sd.extent_gap = contact_detail::extent_gap(entry_extent_own_[q], entry_extent_other_[q]);
+      sd.extent_gap = contact_detail::extent_gap(contact_nodes_.entry_extent_own[q], contact_nodes_.entry_extent_other[q]);
     sides.push_back(sd);
     slots.push_back(slot);
     mats.push_back(fields_[f].material);
@@ -212,10 +212,10 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
 // resolve_contact will compute it (two materials: the pair's normal; more: against the lump).
 template <int Dim>
 void Simulation<Dim>::compute_contact_normals() {
-  entry_normal_.assign(contact_entries_.size(), Vec<Dim>::Zero());
-  entry_extent_own_.clear();  // no gap while the normals are gathered
-  const long groups = static_cast<long>(contact_groups_.size()) - 1;
-  const int threads = groups >= 256 ? threads_ : 1;
+  contact_nodes_.entry_normal.assign(contact_nodes_.entries.size(), Vec<Dim>::Zero());
+  contact_nodes_.entry_extent_own.clear();  // no gap while the normals are gathered
+  const long groups = static_cast<long>(contact_nodes_.groups.size()) - 1;
+  const int threads = groups >= 256 ? threads_.count : 1;
 #pragma omp parallel num_threads(threads)
   {
     thread_local std::vector<ContactSide<Dim>> sides;
@@ -225,7 +225,7 @@ void Simulation<Dim>::compute_contact_normals() {
     for (long g = 0; g < groups; ++g) {
       gather_contact_sides(static_cast<std::size_t>(g), 1.0, sides, slots, mats, entries);
       contact_detail::side_normals(sides, mats, pair_of, [&](std::size_t a, const Vec<Dim>& n) {
-        entry_normal_[static_cast<std::size_t>(entries[a])] = n;
+        contact_nodes_.entry_normal[static_cast<std::size_t>(entries[a])] = n;
       });
     }
   }
@@ -233,7 +233,7 @@ void Simulation<Dim>::compute_contact_normals() {
 
 template <int Dim>
 double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order) const {
-  const auto& w = order == HeatingOrder::first ? pair_work_first_ : pair_work_second_;
+  const auto& w = order == HeatingOrder::first ? contact_books_.pair_work_first : contact_books_.pair_work_second;
   double sum = 0.0;
   for (double x : w) sum += x;
   return sum;
@@ -241,7 +241,7 @@ double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order) const {
 
 template <int Dim>
 double Simulation<Dim>::cumulative_frictional_work(HeatingOrder order, int a, int b) const {
-  const auto& w = order == HeatingOrder::first ? pair_work_first_ : pair_work_second_;
+  const auto& w = order == HeatingOrder::first ? contact_books_.pair_work_first : contact_books_.pair_work_second;
   const std::size_t nm = materials_.size();
   if (w.size() != nm * nm || a < 0 || b < 0 || static_cast<std::size_t>(a) >= nm || static_cast<std::size_t>(b) >= nm) return 0.0;
   return w[pair_book_index(a, b, nm)];

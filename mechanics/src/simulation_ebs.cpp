@@ -20,55 +20,55 @@ void Simulation<Dim>::prepare_extended_stencils() {
   EbsOptions eo;
   eo.occupation = opt_.ebs_occupation;
   eo.out_of_plane = Dim == 2 ? opt_.thickness : 1.0;  // Ω_c in the units of Particles::volume
-  if (ebs_.size() != fields_.size()) ebs_.resize(fields_.size());
+  if (ebs_.bases.size() != fields_.size()) ebs_.bases.resize(fields_.size());
   // Nodes with a velocity condition (fixed faces, rigid boundary materials) keep their own
   // B-spline: a degenerate node has no weight, so a condition on it would not reach the body.
-  ebs_kept_.resize(grid_.node_count());
-  for (std::size_t i = 0; i < ebs_kept_.size(); ++i) ebs_kept_[i] = fixed_mask_[i] | rigid_mask_[i];
+  ebs_.kept.resize(grid_.node_count());
+  for (std::size_t i = 0; i < ebs_.kept.size(); ++i) ebs_.kept[i] = conditions_.fixed_mask[i] | conditions_.rigid_mask[i];
   for (std::size_t f = 0; f < fields_.size(); ++f) {
-    ebs_ranges_.clear();
+    ebs_.ranges.clear();
     for (std::size_t m = 0; m < materials_.size(); ++m)
-      if (field_of_material_[m] == static_cast<int>(f) && material_end_[m] > material_begin_[m])
-        ebs_ranges_.emplace_back(material_begin_[m], material_end_[m]);
-    ebs_[f].set_options(eo);
-    ebs_[f].set_kept_nodes(&ebs_kept_);
+      if (layout_.field_of_material[m] == static_cast<int>(f) && layout_.material_end[m] > layout_.material_begin[m])
+        ebs_.ranges.emplace_back(layout_.material_begin[m], layout_.material_end[m]);
+    ebs_.bases[f].set_options(eo);
+    ebs_.bases[f].set_kept_nodes(&ebs_.kept);
     try {
-      ebs_[f].rebuild(grid_, p_.position, p_.volume, ebs_ranges_);
+      ebs_.bases[f].rebuild(grid_, p_.position, p_.volume, ebs_.ranges);
     } catch (const std::exception& e) {
       std::ostringstream msg;
-      msg << "step " << step_ << ", t = " << time_ << " s: extended B-spline of velocity field " << f;
+      msg << "step " << clock_.step << ", t = " << clock_.time << " s: extended B-spline of velocity field " << f;
       if (fields_[f].material >= 0) msg << " (material '" << materials_[static_cast<std::size_t>(fields_[f].material)].name << "')";
       msg << ": " << e.what();
-      throw SimulationError(msg.str(), step_, time_, -1);
+      throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
     }
   }
 
   // 2. Contact: a material's field covers the nodes its plain B-spline stencils reach. The extension
   //    only moves weight from degenerate nodes to stable ones, whose supports hold an interior cell
   //    of the body and so lie in that box: the box is the same as with the plain quadratic B-spline.
-  if (contact_) {
+  if (contact_setup_.enabled) {
     for (std::size_t f = 0; f < fields_.size(); ++f) {
       const auto m = static_cast<std::size_t>(fields_[f].material);
-      ebs_[f].node_box(box_lo_[m], box_hi_[m]);
+      ebs_.bases[f].node_box(layout_.box_lo[m], layout_.box_hi[m]);
     }
-    layout_fields(box_lo_, box_hi_);
+    layout_fields(layout_.box_lo, layout_.box_hi);
   }
 
   // 3. Flatten: entries per particle, prefix sum, then slots, N^e and ∇N^e. Particles without a
-  //    field (rigid materials acting through rigid_mask_) get no entries.
-  PrecomputedStencils<Dim>& st = st_extended_;
+  //    field (rigid materials acting through conditions_.rigid_mask) get no entries.
+  PrecomputedStencils<Dim>& st = stencil_store_.extended;
   const std::size_t n = p_.size();
   st.begin.resize(n + 1);
   st.begin[0] = 0;
   for (std::size_t m = 0; m < materials_.size(); ++m) {
-    const int f = field_of_material_[m];
-    const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
+    const int f = layout_.field_of_material[m];
+    const long b = static_cast<long>(layout_.material_begin[m]), e = static_cast<long>(layout_.material_end[m]);
     if (f < 0) {
       for (long k = b; k < e; ++k) st.begin[static_cast<std::size_t>(k) + 1] = 0;
       continue;
     }
-    const EbsBasis<Dim>& basis = ebs_[static_cast<std::size_t>(f)];
-#pragma omp parallel for num_threads(threads_) schedule(static)
+    const EbsBasis<Dim>& basis = ebs_.bases[static_cast<std::size_t>(f)];
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
     for (long kk = b; kk < e; ++kk) {
       const auto k = static_cast<std::size_t>(kk);
       EbsStencil<Dim> s;
@@ -83,13 +83,13 @@ void Simulation<Dim>::prepare_extended_stencils() {
   st.G.resize(total);
 
   for (std::size_t m = 0; m < materials_.size(); ++m) {
-    const int f = field_of_material_[m];
+    const int f = layout_.field_of_material[m];
     if (f < 0) continue;
-    const EbsBasis<Dim>& basis = ebs_[static_cast<std::size_t>(f)];
+    const EbsBasis<Dim>& basis = ebs_.bases[static_cast<std::size_t>(f)];
     const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-    const bool whole_grid = !contact_;  // the shared field: slot = grid node index
-    const long b = static_cast<long>(material_begin_[m]), e = static_cast<long>(material_end_[m]);
-#pragma omp parallel for num_threads(threads_) schedule(static)
+    const bool whole_grid = !contact_setup_.enabled;  // the shared field: slot = grid node index
+    const long b = static_cast<long>(layout_.material_begin[m]), e = static_cast<long>(layout_.material_end[m]);
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
     for (long kk = b; kk < e; ++kk) {
       const auto k = static_cast<std::size_t>(kk);
       EbsStencil<Dim> s;

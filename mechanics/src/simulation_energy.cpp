@@ -31,13 +31,13 @@ template <int Dim>
 EnergyBalance Simulation<Dim>::energy_balance(HeatingOrder order) const {
   EnergyBalance b;
   b.kinetic = kinetic_energy();
-  b.stored = strain_energy() + (penalty_ ? penalty_->stored_energy() : 0.0);
-  b.initial = std::isnan(initial_energy_) ? b.kinetic + b.stored : initial_energy_;
-  b.external_work = external_work_;
-  b.rigid_work = rigid_work_;
-  b.damping_work = damping_work_;
+  b.stored = strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
+  b.initial = std::isnan(work_books_.initial_energy) ? b.kinetic + b.stored : work_books_.initial_energy;
+  b.external_work = work_books_.external;
+  b.rigid_work = work_books_.rigid;
+  b.damping_work = work_books_.damping;
   b.plastic_work = plastic_work();
-  b.friction_work = contact_ ? cumulative_frictional_work(order) : 0.0;
+  b.friction_work = contact_setup_.enabled ? cumulative_frictional_work(order) : 0.0;
   return b;
 }
 

@@ -45,17 +45,17 @@ void Simulation<Dim>::enable_contact(const ContactOptions& options) {
   if (!(options.boundary_spacing >= 0.0) || !std::isfinite(options.boundary_spacing))
     throw std::invalid_argument("contact boundary_spacing must be finite and >= 0 (0: half the cell size)");
   check_penalty_settings(options.default_pair, -1, -1);
-  contact_ = true;
-  contact_opt_ = options;
-  pair_settings_.assign(1, options.default_pair);
+  contact_setup_.enabled = true;
+  contact_setup_.options = options;
+  contact_setup_.pair_settings.assign(1, options.default_pair);
 }
 
 template <int Dim>
 void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& settings) {
-  if (!contact_) throw std::logic_error("enable_contact() must come before set_contact_pair()");
+  if (!contact_setup_.enabled) throw std::logic_error("enable_contact() must come before set_contact_pair()");
   const int n = static_cast<int>(materials_.size());
   if (a < 0 || b < 0 || a >= n || b >= n || a == b) throw std::invalid_argument("contact pair needs two different materials");
-  if (pair_index_.size() != static_cast<std::size_t>(n * n)) pair_index_.assign(static_cast<std::size_t>(n * n), 0);
+  if (contact_setup_.pair_index.size() != static_cast<std::size_t>(n * n)) contact_setup_.pair_index.assign(static_cast<std::size_t>(n * n), 0);
   ContactPairSettings s = settings;
   check_penalty_settings(s, a, b);
   if (s.method == ContactMethod::multimaterial && s.normal == NormalMethod::specified) {
@@ -63,64 +63,64 @@ void Simulation<Dim>::set_contact_pair(int a, int b, const ContactPairSettings& 
     if (!(len > 0.0)) throw std::invalid_argument("a specified contact normal must be non-zero");
     s.normal_vector /= len;
   }
-  pair_settings_.push_back(s);
+  contact_setup_.pair_settings.push_back(s);
   ContactPairSettings flipped = s;  // the same pair seen from b: the normal points from b to a
   flipped.normal_vector = -s.normal_vector;
-  pair_settings_.push_back(flipped);
-  const int k = static_cast<int>(pair_settings_.size());
-  pair_index_[static_cast<std::size_t>(a * n + b)] = k - 2;
-  pair_index_[static_cast<std::size_t>(b * n + a)] = k - 1;
-  explicit_pairs_.emplace_back(a, b);
+  contact_setup_.pair_settings.push_back(flipped);
+  const int k = static_cast<int>(contact_setup_.pair_settings.size());
+  contact_setup_.pair_index[static_cast<std::size_t>(a * n + b)] = k - 2;
+  contact_setup_.pair_index[static_cast<std::size_t>(b * n + a)] = k - 1;
+  contact_setup_.explicit_pairs.emplace_back(a, b);
 }
 
 template <int Dim>
 const ContactPairSettings& Simulation<Dim>::contact_pair(int a, int b) const {
   const std::size_t n = materials_.size();
-  if (pair_index_.size() != n * n) return pair_settings_.at(0);
-  return pair_settings_.at(static_cast<std::size_t>(pair_index_[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)]));
+  if (contact_setup_.pair_index.size() != n * n) return contact_setup_.pair_settings.at(0);
+  return contact_setup_.pair_settings.at(static_cast<std::size_t>(contact_setup_.pair_index[static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b)]));
 }
 
 // Without contact: one field over the whole grid shared by every deformable material (slot = node),
-// rigid materials act through rigid_mask_. With contact: one field per material, laid out each step.
+// rigid materials act through conditions_.rigid_mask. With contact: one field per material, laid out each step.
 template <int Dim>
 void Simulation<Dim>::init_fields() {
   const std::size_t nm = materials_.size();
   fields_.clear();
-  field_of_material_.assign(nm, -1);
-  if (!contact_) {
+  layout_.field_of_material.assign(nm, -1);
+  if (!contact_setup_.enabled) {
     VelocityField<Dim> f;
     f.extent = grid_.nodes_per_dim();
     f.count = grid_.node_count();
     f.index = NodeIndexer<Dim>{grid_.strides(), 0};
     fields_.push_back(f);
     for (std::size_t m = 0; m < nm; ++m)
-      if (!materials_[m].is_rigid()) field_of_material_[m] = 0;
-    slot_node_.resize(grid_.node_count());
-    for (std::size_t i = 0; i < slot_node_.size(); ++i) slot_node_[i] = static_cast<int>(i);
-    slot_node_valid_ = false;  // (the per-material layout is not this one)
+      if (!materials_[m].is_rigid()) layout_.field_of_material[m] = 0;
+    layout_.slot_node.resize(grid_.node_count());
+    for (std::size_t i = 0; i < layout_.slot_node.size(); ++i) layout_.slot_node[i] = static_cast<int>(i);
+    layout_.slot_node_valid = false;  // (the per-material layout is not this one)
     nodes_.resize(grid_.node_count(), false);
   } else {
     for (std::size_t m = 0; m < nm; ++m) {
-      if (materials_[m].is_rigid() && materials_[m].rigid_boundary) continue;  // acts through rigid_mask_
+      if (materials_[m].is_rigid() && materials_[m].rigid_boundary) continue;  // acts through conditions_.rigid_mask
       VelocityField<Dim> f;
       f.material = static_cast<int>(m);
       f.rigid = materials_[m].is_rigid();
-      field_of_material_[m] = static_cast<int>(fields_.size());
+      layout_.field_of_material[m] = static_cast<int>(fields_.size());
       fields_.push_back(f);
     }
-    if (pair_index_.size() != nm * nm) pair_index_.assign(nm * nm, 0);
-    slot_node_valid_ = false;
-    box_lo_.assign(nm, IVec<Dim>{});
-    box_hi_.assign(nm, IVec<Dim>{});
-    node_field_count_.assign(grid_.node_count(), 0);
-    node_entry_cursor_.assign(grid_.node_count(), -1);
-    pair_work_first_.assign(nm * nm, 0.0);
-    pair_work_second_.assign(nm * nm, 0.0);
+    if (contact_setup_.pair_index.size() != nm * nm) contact_setup_.pair_index.assign(nm * nm, 0);
+    layout_.slot_node_valid = false;
+    layout_.box_lo.assign(nm, IVec<Dim>{});
+    layout_.box_hi.assign(nm, IVec<Dim>{});
+    contact_nodes_.node_field_count.assign(grid_.node_count(), 0);
+    contact_nodes_.node_entry_cursor.assign(grid_.node_count(), -1);
+    contact_books_.pair_work_first.assign(nm * nm, 0.0);
+    contact_books_.pair_work_second.assign(nm * nm, 0.0);
   }
-  work_first_.assign(grid_.node_count(), 0.0);
-  work_second_.assign(grid_.node_count(), 0.0);
-  field_velocity_.assign(fields_.size(), Vec<Dim>::Zero());
-  if (contact_) setup_penalty();
+  contact_books_.work_first.assign(grid_.node_count(), 0.0);
+  contact_books_.work_second.assign(grid_.node_count(), 0.0);
+  layout_.field_velocity.assign(fields_.size(), Vec<Dim>::Zero());
+  if (contact_setup_.enabled) setup_penalty();
 }
 
 // Each material's field covers the box [lo, hi] of nodes its particles reach, stored contiguously:
@@ -136,7 +136,7 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
     const std::size_t m = static_cast<std::size_t>(F.material);
     changed = changed || F.first != total;
     F.first = total;
-    if (material_end_[m] == material_begin_[m]) {
+    if (layout_.material_end[m] == layout_.material_begin[m]) {
       changed = changed || F.count != 0;
       F.count = 0;
       F.extent = IVec<Dim>{};
@@ -152,11 +152,11 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
   }
   if (nodes_.mass.size() != total) {
     nodes_.resize_slots(total, true);
-    for (auto& t : thread_nodes_) t.resize_slots(total, true);
+    for (auto& t : threads_.nodes) t.resize_slots(total, true);
   }
-  if (!changed && slot_node_.size() == total && slot_node_valid_) return;
-  slot_node_valid_ = true;
-  slot_node_.resize(total);
+  if (!changed && layout_.slot_node.size() == total && layout_.slot_node_valid) return;
+  layout_.slot_node_valid = true;
+  layout_.slot_node.resize(total);
   const IVec<Dim>& gs = grid_.strides();
   for (const VelocityField<Dim>& F : fields_) {
     for (std::size_t s = 0; s < F.count; ++s) {
@@ -167,16 +167,16 @@ void Simulation<Dim>::layout_fields(const std::vector<IVec<Dim>>& lo, const std:
         r /= static_cast<std::size_t>(F.extent[d]);
         node += (F.lo[d] + local) * gs[d];
       }
-      slot_node_[F.first + s] = node;
+      layout_.slot_node[F.first + s] = node;
     }
   }
 }
 
 template <int Dim>
 void Simulation<Dim>::update_partition() {
-  if (!partition_.matches(threads_, fields_.size(), p_.size()))
-    partition_.build(threads_, material_begin_, material_end_, field_of_material_, fields_.size(), p_.size());
-  if (!pass_split_.matches(threads_, p_.size())) pass_split_.reset(partition_);
+  if (!threads_.partition.matches(threads_.count, fields_.size(), p_.size()))
+    threads_.partition.build(threads_.count, layout_.material_begin, layout_.material_end, layout_.field_of_material, fields_.size(), p_.size());
+  if (!threads_.pass_split.matches(threads_.count, p_.size())) threads_.pass_split.reset(threads_.partition);
 }
 
 // Each thread clears the slots it scatters into: in the nodes, the fields whose first thread it is;
@@ -197,11 +197,11 @@ void Simulation<Dim>::clear_scatter_targets(int tid, Accumulated which) {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.count == 0) continue;
-    const int first = partition_.first_thread[f], last = partition_.last_thread[f];
+    const int first = threads_.partition.first_thread[f], last = threads_.partition.last_thread[f];
     if (tid == first)
       clear(nodes_, F.first, F.first + F.count);
     else if (tid > first && tid <= last)
-      clear(thread_nodes_[static_cast<std::size_t>(tid - 1)], F.first, F.first + F.count);
+      clear(threads_.nodes[static_cast<std::size_t>(tid - 1)], F.first, F.first + F.count);
   }
 }
 
@@ -209,16 +209,16 @@ void Simulation<Dim>::clear_scatter_targets(int tid, Accumulated which) {
 // worksharing loop per shared field (a scatter phase calls it after its barrier).
 template <int Dim>
 void Simulation<Dim>::sum_shared_fields(Accumulated which) {
-  for (const int f : partition_.shared_fields) {
+  for (const int f : threads_.partition.shared_fields) {
     const VelocityField<Dim>& F = fields_[static_cast<std::size_t>(f)];
-    const std::size_t t0 = static_cast<std::size_t>(partition_.first_thread[static_cast<std::size_t>(f)]);
-    const std::size_t t1 = static_cast<std::size_t>(partition_.last_thread[static_cast<std::size_t>(f)]);
+    const std::size_t t0 = static_cast<std::size_t>(threads_.partition.first_thread[static_cast<std::size_t>(f)]);
+    const std::size_t t1 = static_cast<std::size_t>(threads_.partition.last_thread[static_cast<std::size_t>(f)]);
     const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
 #pragma omp for schedule(static) nowait
     for (long ii = b; ii < e; ++ii) {
       const std::size_t i = static_cast<std::size_t>(ii);
       for (std::size_t t = t0 + 1; t <= t1; ++t) {
-        const NodalFields<Dim>& buf = thread_nodes_[t - 1];
+        const NodalFields<Dim>& buf = threads_.nodes[t - 1];
         if (which.mass) nodes_.mass[i] += buf.mass[i];
         if (which.momentum) nodes_.momentum[i] += buf.momentum[i];
         if (which.force) nodes_.force[i] += buf.force[i];
@@ -244,7 +244,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (!F.rigid) continue;
-    const Vec<Dim> v = field_velocity_[f];
+    const Vec<Dim> v = layout_.field_velocity[f];
     for (std::size_t s = F.first; s < F.first + F.count; ++s) {
       momentum[s] = nodes_.mass[s] * v;
       if (force) {
@@ -255,7 +255,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   }
   // One parallel region over the deformable fields (one per grain in a PBX: a region each would
   // cost more than their few hundred slots).
-#pragma omp parallel num_threads(threads_) reduction(+ : work)
+#pragma omp parallel num_threads(threads_.count) reduction(+ : work)
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -263,19 +263,19 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
 #pragma omp for schedule(static) nowait
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
-      const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
-      if (const std::uint8_t driven = rigid_mask_[i]) {
+      const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
+      if (const std::uint8_t driven = conditions_.rigid_mask[i]) {
         // Driven components end the step at the rigid velocity. In the momentum update the change is
         // made a force, (m v_rigid − p)/dt, so that the particles' FLIP update receives it too.
         for (int d = 0; d < Dim; ++d)
           if (driven & (1u << d)) {
             if (force)  // the kernel shared with the decomposed step (energy/energy_books.hpp)
-              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], rigid_velocity_[i][d], dt);
+              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], conditions_.rigid_velocity[i][d], dt);
             else
-              momentum[s][d] = nodes_.mass[s] * rigid_velocity_[i][d];
+              momentum[s][d] = nodes_.mass[s] * conditions_.rigid_velocity[i][d];
           }
       }
-      if (const std::uint8_t mask = fixed_mask_[i]) {
+      if (const std::uint8_t mask = conditions_.fixed_mask[i]) {
         for (int d = 0; d < Dim; ++d)
           if (mask & (1u << d)) {
             momentum[s][d] = 0.0;
@@ -292,7 +292,7 @@ template <int Dim>
 void Simulation<Dim>::velocity_from_momentum() {
   apply_velocity_bc(nodes_.momentum, nullptr, 0.0);
   const double mmin = empty_node_mass_;
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
     nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
 }
@@ -308,14 +308,14 @@ void Simulation<Dim>::save_start_velocity() {
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
   transfer_.start.resize(n);
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t i = 0; i < n; ++i)
     transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
 }
 
 template <int Dim>
 void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
-  rigid_work_ += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
+  work_books_.rigid += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
 }
 
 // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
@@ -326,10 +326,10 @@ void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
 // with the decomposed step.
 template <int Dim>
 void Simulation<Dim>::apply_damping(double dt) {
-  if (!damping_active(opt_.damping_rate, opt_.damping_until, time_)) return;
+  if (!damping_active(opt_.damping_rate, opt_.damping_until, clock_.time)) return;
   const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
   double removed = 0.0;
-#pragma omp parallel num_threads(threads_) reduction(+ : removed)
+#pragma omp parallel num_threads(threads_.count) reduction(+ : removed)
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -337,17 +337,17 @@ void Simulation<Dim>::apply_damping(double dt) {
 #pragma omp for schedule(static) nowait
     for (long ss = b; ss < e; ++ss) {
       const std::size_t s = static_cast<std::size_t>(ss);
-      const std::uint8_t driven = rigid_mask_[static_cast<std::size_t>(slot_node_[s])];
+      const std::uint8_t driven = conditions_.rigid_mask[static_cast<std::size_t>(layout_.slot_node[s])];
       damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
     }
   }
-  damping_work_ += removed;
+  work_books_.damping += removed;
 }
 
 template <int Dim>
 void Simulation<Dim>::advance_grid_momentum(double dt) {
   const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
 }
 
@@ -357,16 +357,16 @@ void Simulation<Dim>::nodal_velocities() {
   const std::size_t n = nodes_.mass.size();
   // Nodes driven by a rigid boundary material keep its prescribed velocity components (the force was
   // zeroed consistently, so only the velocity needs resetting when the prescribed velocity changes).
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
   for (std::size_t s = 0; s < n; ++s) {
     const double m = nodes_.mass[s];
     if (m > mmin) {
       nodes_.velocity[s] = nodes_.momentum[s] / m;
       nodes_.acceleration[s] = nodes_.force[s] / m;
-      const std::size_t i = static_cast<std::size_t>(slot_node_[s]);
-      if (const std::uint8_t driven = rigid_mask_[i])
+      const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
+      if (const std::uint8_t driven = conditions_.rigid_mask[i])
         for (int d = 0; d < Dim; ++d)
-          if (driven & (1u << d)) nodes_.velocity[s][d] = rigid_velocity_[i][d];
+          if (driven & (1u << d)) nodes_.velocity[s][d] = conditions_.rigid_velocity[i][d];
     } else {
       nodes_.velocity[s].setZero();
       nodes_.acceleration[s].setZero();
@@ -374,7 +374,7 @@ void Simulation<Dim>::nodal_velocities() {
   }
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
-      for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) nodes_.velocity[s] = field_velocity_[f];
+      for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) nodes_.velocity[s] = layout_.field_velocity[f];
 }
 
 template <int Dim>
@@ -389,7 +389,7 @@ void Simulation<Dim>::move_rigid_particles(double dt, double t) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid()) continue;
     const RigidMotion r = rigid_motion(m, t, dt);
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) r.move(p_.velocity[k], p_.position[k]);
+    for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) r.move(p_.velocity[k], p_.position[k]);
   }
 }
 
@@ -400,7 +400,7 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   // materials' ranges are visited, and the first one found is the lowest index as before.
   for (std::size_t m = 0; k < 0 && m < materials_.size(); ++m) {
     if (!materials_[m].is_rigid()) continue;
-    for (std::size_t j = material_begin_[m]; j < material_end_[m]; ++j)
+    for (std::size_t j = layout_.material_begin[m]; j < layout_.material_end[m]; ++j)
       if (!grid_.contains(p_.position[j]) && (k < 0 || static_cast<long>(j) < k)) {
         k = static_cast<long>(j);
         break;
@@ -411,8 +411,8 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   std::ostringstream msg;
   msg.precision(6);
   const bool finite = p_.velocity[u].allFinite() && p_.position[u].allFinite();
-  msg << "step " << step_ << ", t = " << time_ << " s: particle " << k << " of body '"
-      << bodies_[static_cast<std::size_t>(p_.body[u])].name << "' ";
+  msg << "step " << clock_.step << ", t = " << clock_.time << " s: particle " << k << " of body '"
+      << bodies_.info[static_cast<std::size_t>(p_.body[u])].name << "' ";
   if (!finite) {
     msg << "has a non-finite velocity or position (the step blew up; try a smaller CFL factor)";
   } else {
@@ -424,7 +424,7 @@ void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
     for (int d = 0; d < Dim; ++d) msg << (d ? ", " : "") << grid_.hi()[d];
     msg << ") m";
   }
-  throw SimulationError(msg.str(), step_, time_, k);
+  throw SimulationError(msg.str(), clock_.step, clock_.time, k);
 }
 
 // A particle compressed past the limit of its Hugoniot in the stress update (simulation_step.cpp).
@@ -433,11 +433,11 @@ void Simulation<Dim>::throw_beyond_hugoniot(long beyond) const {
   if (beyond >= 0) {
     const std::size_t k = static_cast<std::size_t>(beyond);
     std::ostringstream msg;
-    msg << "step " << step_ << ", t = " << time_ << " s: particle " << beyond << " of material '"
+    msg << "step " << clock_.step << ", t = " << clock_.time << " s: particle " << beyond << " of material '"
         << materials_[static_cast<std::size_t>(p_.material[k])].name
         << "' is compressed past the limit of its Hugoniot (J = " << p_.volume[k] / p_.initial_volume[k]
         << "; try a smaller CFL factor)";
-    throw SimulationError(msg.str(), step_, time_, beyond);
+    throw SimulationError(msg.str(), clock_.step, clock_.time, beyond);
   }
 }
 

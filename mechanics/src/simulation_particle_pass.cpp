@@ -55,8 +55,8 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   const ParticleUpdate update = opt_.particle_update;
   const bool flip = update == ParticleUpdate::flip;
   const Analysis an = opt_.analysis;
-  if (Stress && wave_speed_.size() != p_.size())
-    wave_speed_.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
+  if (Stress && wave_speeds_.speed.size() != p_.size())
+    wave_speeds_.speed.assign(p_.size(), -std::numeric_limits<double>::infinity());  // rigid: never a CFL speed
   // Plain pointers (see map_to_grid): the particle stores below would otherwise reload them.
   const Vec<Dim>* const acceleration = nodes_.acceleration.data();
   const Vec<Dim>* const velocity = nodes_.velocity.data();
@@ -74,17 +74,17 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   double* const ep_p = p_.plastic_strain.data();
   double* const e_p = p_.internal_energy.data();
   double* const wp_p = p_.plastic_work.data();
-  double* const cp = wave_speed_.data();
+  double* const cp = wave_speeds_.speed.data();
   decltype(auto) stk = step_detail::indexable(st);
   // The next step's stencils (refresh): Stencil arrays only; EBS builds its weights per step.
   constexpr bool refreshable = Kinematics && !std::is_same_v<Stencils, PrecomputedStencils<Dim>>;
   refresh = refresh && refreshable;
   const std::size_t nm = materials_.size();
   if (refresh) {
-    rigid_motion_.resize(nm);
-    step_detail::StencilBoxes<Dim>::clear(box_lo_, box_hi_);
+    layout_.rigid_motion.resize(nm);
+    step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
     for (std::size_t m = 0; m < nm; ++m)
-      if (materials_[m].is_rigid()) rigid_motion_[m] = rigid_motion(m, time_, dt);
+      if (materials_[m].is_rigid()) layout_.rigid_motion[m] = rigid_motion(m, clock_.time, dt);
   }
   const Grid<Dim> grid = grid_;  // a local copy (see evaluate_stencils)
   [[maybe_unused]] const auto next_stencils = [&] {
@@ -93,22 +93,22 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   }();
   // On two or more threads each particle's external work goes to its block of the split, summed in
   // block order after the pass: the same sum wherever the split's boundaries are (thread_partition.hpp).
-  const bool blocked = pass_split_.threads > 1;
-  if (blocked) work_blocks_.assign(pass_split_.blocks(), 0.0);
+  const bool blocked = threads_.pass_split.threads > 1;
+  if (blocked) threads_.work_blocks.assign(threads_.pass_split.blocks(), 0.0);
   // The loads' work below, force · the displacement this pass gives: the loaded particles' positions
   // before it (reused from step to step: no allocation once grown).
   thread_local std::vector<Vec<Dim>> load_start_position;
   if constexpr (Kinematics) {
-    load_start_position.resize(resolved_loads_.size());
-    for (std::size_t j = 0; j < resolved_loads_.size(); ++j) load_start_position[j] = p_.position[resolved_loads_[j].particle];
+    load_start_position.resize(conditions_.resolved_loads.size());
+    for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) load_start_position[j] = p_.position[conditions_.resolved_loads[j].particle];
   }
-  double* const work_block = work_blocks_.data();
+  double* const work_block = threads_.work_blocks.data();
 
-#pragma omp parallel num_threads(threads_) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
+#pragma omp parallel num_threads(threads_.count) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
   {
   thread_local step_detail::StencilBoxes<Dim> boxes;
   if (refresh) boxes.reset(nm);
-  for_each_part(pass_split_, [&](int t) {
+  for_each_part(threads_.pass_split, [&](int t) {
     const double started = omp_get_wtime();
     std::size_t m = 0;  // the material of the particles run() is given
     auto add_work = [&](std::size_t k, double w) {
@@ -172,21 +172,21 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     };
     for (m = 0; m < nm; ++m) {
       const Material& mat = materials_[m];
-      const int f = field_of_material_[m];
+      const int f = layout_.field_of_material[m];
       if (f < 0 || mat.is_rigid()) {
         // Not updated by this pass: with refresh, this part's even share of them moved (rigid) and their
         // stencils evaluated.
         if (!refresh) continue;
-        const std::size_t b = material_begin_[m], n = material_end_[m] - b, T = static_cast<std::size_t>(pass_split_.threads);
+        const std::size_t b = layout_.material_begin[m], n = layout_.material_end[m] - b, T = static_cast<std::size_t>(threads_.pass_split.threads);
         const std::size_t tt = static_cast<std::size_t>(t);
         for (std::size_t k = b + n * tt / T; k < b + n * (tt + 1) / T; ++k) {
-          if (mat.is_rigid()) rigid_motion_[m].move(vp[k], xp[k]);
+          if (mat.is_rigid()) layout_.rigid_motion[m].move(vp[k], xp[k]);
           refresh_stencil(k, boxes.lo[m], boxes.hi[m]);
         }
         continue;
       }
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
-      const std::size_t kb = pass_split_.lo(t, material_begin_[m]), ke = pass_split_.hi(t, material_end_[m]);
+      const std::size_t kb = threads_.pass_split.lo(t, layout_.material_begin[m]), ke = threads_.pass_split.hi(t, layout_.material_end[m]);
       if (kb >= ke) continue;
       if constexpr (!Stress) {
         run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [](std::size_t, const Mat<Dim>&) { return true; });
@@ -218,25 +218,25 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
       run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()),
           [&](std::size_t k, const Mat<Dim>& L) { return update_stress<Dim>(mat, law, an, L, dt, state(k)); });
     }
-    pass_split_.seconds[static_cast<std::size_t>(t)] = omp_get_wtime() - started;
+    threads_.pass_split.seconds[static_cast<std::size_t>(t)] = omp_get_wtime() - started;
   });
   if (refresh) {
 #pragma omp critical(frictherm_stencil_boxes)
-    boxes.merge_into(box_lo_, box_hi_);
+    boxes.merge_into(layout_.box_lo, layout_.box_hi);
   }
   }  // omp parallel
   if (blocked) {
-    for (const double w : work_blocks_) work += w;
-    pass_split_.rebalance(material_begin_, material_end_, field_of_material_);
+    for (const double w : threads_.work_blocks) work += w;
+    threads_.pass_split.rebalance(layout_.material_begin, layout_.material_end, layout_.field_of_material);
   }
   if constexpr (Kinematics) {
-    for (std::size_t j = 0; j < resolved_loads_.size(); ++j) {
-      const ResolvedLoad& L = resolved_loads_[j];
-      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, time_), p_.position[L.particle] - load_start_position[j]);
+    for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) {
+      const ResolvedLoad& L = conditions_.resolved_loads[j];
+      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, clock_.time), p_.position[L.particle] - load_start_position[j]);
     }
-    external_work_ += work;
+    work_books_.external += work;
   }
-  if constexpr (Stress) wave_speed_ready_ = true;
+  if constexpr (Stress) wave_speeds_.ready = true;
   return {bad == std::numeric_limits<long>::max() ? -1 : bad, beyond};
 }
 

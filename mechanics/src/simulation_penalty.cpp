@@ -96,25 +96,25 @@ void Simulation<Dim>::check_penalty_settings(const ContactPairSettings& s, int a
 template <int Dim>
 void Simulation<Dim>::set_body_boundary(int body, const std::vector<std::vector<Vec<2>>>& loops) {
   if (finalized_) throw std::logic_error("body boundaries must be set before the simulation is finalized");
-  if (body < 0 || body >= static_cast<int>(bodies_.size())) throw std::invalid_argument("set_body_boundary: no such body");
+  if (body < 0 || body >= static_cast<int>(bodies_.info.size())) throw std::invalid_argument("set_body_boundary: no such body");
   for (const auto& l : loops)
-    if (l.size() < 3) throw std::invalid_argument("body '" + bodies_[static_cast<std::size_t>(body)].name + "': a boundary loop needs at least 3 points");
-  body_loops_[static_cast<std::size_t>(body)] = loops;
-  body_loop_spacing_[static_cast<std::size_t>(body)] = -1.0;  // given, not sampled
+    if (l.size() < 3) throw std::invalid_argument("body '" + bodies_.info[static_cast<std::size_t>(body)].name + "': a boundary loop needs at least 3 points");
+  body_loops_.loops[static_cast<std::size_t>(body)] = loops;
+  body_loops_.spacing[static_cast<std::size_t>(body)] = -1.0;  // given, not sampled
 }
 
 // Pairs of present materials that use penalty contact, their master/slave choice and penalties, and
 // the boundary points of every body in such a pair.
 template <int Dim>
 void Simulation<Dim>::setup_penalty() {
-  penalty_.reset();
-  penalty_pairs_.clear();
-  boundary_ = BoundaryPoints<Dim>{};
+  penalty_state_.contact.reset();
+  penalty_state_.pairs.clear();
+  penalty_state_.boundary = BoundaryPoints<Dim>{};
   const std::size_t nm = materials_.size();
   std::vector<double> mass(nm, 0.0);
   for (std::size_t k = 0; k < p_.size(); ++k) mass[static_cast<std::size_t>(p_.material[k])] += p_.mass[k];
-  const auto present = [&](std::size_t m) { return field_of_material_[m] >= 0 && material_end_[m] > material_begin_[m]; };
-  any_multimaterial_ = false;
+  const auto present = [&](std::size_t m) { return layout_.field_of_material[m] >= 0 && layout_.material_end[m] > layout_.material_begin[m]; };
+  contact_setup_.any_multimaterial = false;
   std::vector<std::uint8_t> in_penalty(nm, 0);
   std::vector<PenaltyPairSettings> settings;
   const double h = grid_.min_cell_size();
@@ -123,7 +123,7 @@ void Simulation<Dim>::setup_penalty() {
       if (!present(a) || !present(b) || (materials_[a].is_rigid() && materials_[b].is_rigid())) continue;
       const ContactPairSettings& s = contact_pair(static_cast<int>(a), static_cast<int>(b));
       if (s.method != ContactMethod::penalty) {
-        any_multimaterial_ = true;
+        contact_setup_.any_multimaterial = true;
         continue;
       }
       check_penalty_settings(s, static_cast<int>(a), static_cast<int>(b));
@@ -137,8 +137,8 @@ void Simulation<Dim>::setup_penalty() {
       }
       const int slave = master == static_cast<int>(a) ? static_cast<int>(b) : static_cast<int>(a);
       PenaltyPairSettings ps;
-      ps.master = field_of_material_[static_cast<std::size_t>(master)];
-      ps.slave = field_of_material_[static_cast<std::size_t>(slave)];
+      ps.master = layout_.field_of_material[static_cast<std::size_t>(master)];
+      ps.slave = layout_.field_of_material[static_cast<std::size_t>(slave)];
       ps.mu = s.law.kind() == FrictionKind::coulomb ? s.law.mu() : 0.0;
       ps.normal_penalty = s.penalty.normal_penalty;
       if (ps.normal_penalty == 0.0) {
@@ -154,23 +154,23 @@ void Simulation<Dim>::setup_penalty() {
       ps.search_radius = s.penalty.search_radius;
       ps.paper_correction_terms = s.penalty.paper_correction_terms;
       settings.push_back(ps);
-      penalty_pairs_.push_back(PenaltyPairInfo{master, slave});
+      penalty_state_.pairs.push_back(PenaltyPairInfo{master, slave});
       in_penalty[a] = in_penalty[b] = 1;
     }
   if (settings.empty()) return;
-  penalty_reference_mass_.assign(fields_.size(), 0.0);
+  penalty_state_.reference_mass.assign(fields_.size(), 0.0);
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const auto m = static_cast<std::size_t>(fields_[f].material);
-    const std::size_t n = material_end_[m] - material_begin_[m];
-    if (n > 0) penalty_reference_mass_[f] = mass[m] / static_cast<double>(n);
+    const std::size_t n = layout_.material_end[m] - layout_.material_begin[m];
+    if (n > 0) penalty_state_.reference_mass[f] = mass[m] / static_cast<double>(n);
   }
-  penalty_.emplace(grid_, PenaltyOptions{Dim == 2 ? opt_.thickness : 1.0});
-  for (const PenaltyPairSettings& ps : settings) penalty_->add_pair(ps);
+  penalty_state_.contact.emplace(grid_, PenaltyOptions{Dim == 2 ? opt_.thickness : 1.0});
+  for (const PenaltyPairSettings& ps : settings) penalty_state_.contact->add_pair(ps);
 
-  const double spacing = contact_opt_.boundary_point_spacing(h);
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    const int m = body_material_[i];
-    const std::string& name = bodies_[i].name;
+  const double spacing = contact_setup_.options.boundary_point_spacing(h);
+  for (std::size_t i = 0; i < bodies_.info.size(); ++i) {
+    const int m = body_loops_.material[i];
+    const std::string& name = bodies_.info[i].name;
     if (m < 0) {
       bool any = false;  // a body of several materials: does one of them use penalty contact?
       for (std::size_t k = 0; k < p_.size() && !any; ++k)
@@ -180,14 +180,14 @@ void Simulation<Dim>::setup_penalty() {
       continue;
     }
     if (!in_penalty[static_cast<std::size_t>(m)]) continue;
-    if (body_loops_[i].empty())
+    if (body_loops_.loops[i].empty())
       throw std::invalid_argument("body '" + name + "': penalty contact needs its boundary, and its shape gives none "
                                   "(images; set one with set_body_boundary)");
-    if (body_loop_spacing_[i] >= 0.0 && std::fabs(body_loop_spacing_[i] - spacing) > 1e-12 * spacing)
+    if (body_loops_.spacing[i] >= 0.0 && std::fabs(body_loops_.spacing[i] - spacing) > 1e-12 * spacing)
       throw std::logic_error("body '" + name + "': the contact boundary spacing changed after the body was added "
                              "(enable_contact must come before add_body)");
     try {
-      boundary_.add_loops(field_of_material_[static_cast<std::size_t>(m)], body_loops_[i], body_half_size_[i], body_velocity_[i]);
+      penalty_state_.boundary.add_loops(layout_.field_of_material[static_cast<std::size_t>(m)], body_loops_.loops[i], body_loops_.half_size[i], body_loops_.velocity[i]);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("body '" + name + "': " + e.what());
     }
@@ -196,15 +196,15 @@ void Simulation<Dim>::setup_penalty() {
 
 template <int Dim>
 void Simulation<Dim>::apply_penalty_forces() {
-  if (!penalty_) return;
-  LentStepWeights<Dim> lent(penalty_fields_, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
-                            penalty_reference_mass_, penalty_sliver_, ebs_);
-  apply_penalty(*penalty_, boundary_, lent.w, nodes_.mass, empty_node_mass_, nodes_.force, work_first_, work_second_);
-  const PenaltyContact<Dim>& pc = *penalty_;
-  for (std::size_t k = 0; k < penalty_pairs_.size(); ++k) {
-    const std::size_t i = pair_book_index(penalty_pairs_[k].master_material, penalty_pairs_[k].slave_material, materials_.size());
-    pair_work_first_[i] += pc.books(k).heat_step;
-    pair_work_second_[i] += pc.books(k).heat_step;
+  if (!penalty_state_.contact) return;
+  LentStepWeights<Dim> lent(penalty_state_.fields, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
+                            penalty_state_.reference_mass, penalty_state_.sliver, ebs_.bases);
+  apply_penalty(*penalty_state_.contact, penalty_state_.boundary, lent.w, nodes_.mass, empty_node_mass_, nodes_.force, contact_books_.work_first, contact_books_.work_second);
+  const PenaltyContact<Dim>& pc = *penalty_state_.contact;
+  for (std::size_t k = 0; k < penalty_state_.pairs.size(); ++k) {
+    const std::size_t i = pair_book_index(penalty_state_.pairs[k].master_material, penalty_state_.pairs[k].slave_material, materials_.size());
+    contact_books_.pair_work_first[i] += pc.books(k).heat_step;
+    contact_books_.pair_work_second[i] += pc.books(k).heat_step;
   }
 }
 
@@ -222,10 +222,10 @@ void Simulation<Dim>::apply_penalty_forces() {
 // v̂ all six hold the contact stress to 0.2 % (tests/verification/test_penalty_stability.cpp).
 template <int Dim>
 void Simulation<Dim>::move_boundary_points(double dt, double t) {
-  if (!penalty_) return;
-  LentStepWeights<Dim> lent(penalty_fields_, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
-                            penalty_reference_mass_, penalty_sliver_, ebs_);  // USF: before apply_penalty_forces
-  BoundaryPoints<Dim>& bp = boundary_;
+  if (!penalty_state_.contact) return;
+  LentStepWeights<Dim> lent(penalty_state_.fields, grid_, opt_.shape, fields_, nodes_.mass, empty_node_mass_,
+                            penalty_state_.reference_mass, penalty_state_.sliver, ebs_.bases);  // USF: before apply_penalty_forces
+  BoundaryPoints<Dim>& bp = penalty_state_.boundary;
   const long bad = move_points(bp, lent.w, grid_, dt, [&](int field, Vec<Dim>& v) {
     const auto f = static_cast<std::size_t>(field);
     if (!fields_[f].rigid) return false;
@@ -237,16 +237,16 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
     const auto i = static_cast<std::size_t>(bad);
     const int m = fields_[static_cast<std::size_t>(bp.field[i])].material;
     std::ostringstream msg;
-    msg << "step " << step_ << ", t = " << time_ << " s: boundary point " << i << " of material '"
+    msg << "step " << clock_.step << ", t = " << clock_.time << " s: boundary point " << i << " of material '"
         << materials_[static_cast<std::size_t>(m)].name << "' "
         << (bp.position[i].allFinite() ? "left the grid" : "has a non-finite position")
         << " (penalty contact; the step blew up: try a smaller CFL factor or penalty)";
-    throw SimulationError(msg.str(), step_, time_, -1);
+    throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
   }
-  contact_stats_.penalty_contacts = contact_stats_.penalty_sliding = 0;
-  for (std::size_t k = 0; k < penalty_->pair_count(); ++k) {
-    contact_stats_.penalty_contacts += penalty_->books(k).active;
-    contact_stats_.penalty_sliding += penalty_->books(k).sliding;
+  contact_books_.stats.penalty_contacts = contact_books_.stats.penalty_sliding = 0;
+  for (std::size_t k = 0; k < penalty_state_.contact->pair_count(); ++k) {
+    contact_books_.stats.penalty_contacts += penalty_state_.contact->books(k).active;
+    contact_books_.stats.penalty_sliding += penalty_state_.contact->books(k).sliding;
   }
 }
 
@@ -255,8 +255,8 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
 // the frequency by √(ε/(E/Δh)), and the time step shrinks by the same factor.
 template <int Dim>
 double Simulation<Dim>::penalty_wave_factor() const {
-  if (!penalty_) return 1.0;
-  return penalty_kernels::penalty_wave_factor(*penalty_, penalty_pairs_, materials_, grid_.min_cell_size());
+  if (!penalty_state_.contact) return 1.0;
+  return penalty_kernels::penalty_wave_factor(*penalty_state_.contact, penalty_state_.pairs, materials_, grid_.min_cell_size());
 }
 
 // Time-step guard (docs/penalty_contact.md, "Stability"): forward Euler on the bodies plus the
@@ -268,8 +268,8 @@ double Simulation<Dim>::penalty_wave_factor() const {
 // sliver test keeps) that the CFL condition does not see. Infinite without contacts.
 template <int Dim>
 double Simulation<Dim>::penalty_time_step_limit(double wave_speed) const {
-  if (!penalty_) return std::numeric_limits<double>::infinity();
-  return penalty_kernels::penalty_time_step_limit(penalty_->frequency_bound_squared(), wave_speed, grid_.min_cell_size());
+  if (!penalty_state_.contact) return std::numeric_limits<double>::infinity();
+  return penalty_kernels::penalty_time_step_limit(penalty_state_.contact->frequency_bound_squared(), wave_speed, grid_.min_cell_size());
 }
 
 #define FRICTHERM_INSTANTIATE_PENALTY(D)                                                              \

@@ -37,9 +37,9 @@ Simulation<Dim>::Simulation(const Grid<Dim>& grid, const SimulationOptions& opti
   if (!(opt_.ebs_occupation >= 0.0) || !std::isfinite(opt_.ebs_occupation))
     throw std::invalid_argument("extended B-spline occupation parameter C_c must be finite and >= 0");
   nodes_.resize(grid_.node_count());
-  fixed_mask_.assign(grid_.node_count(), 0);
-  rigid_mask_.assign(grid_.node_count(), 0);
-  rigid_velocity_.assign(grid_.node_count(), Vec<Dim>::Zero());
+  conditions_.fixed_mask.assign(grid_.node_count(), 0);
+  conditions_.rigid_mask.assign(grid_.node_count(), 0);
+  conditions_.rigid_velocity.assign(grid_.node_count(), Vec<Dim>::Zero());
 }
 
 template <int Dim>
@@ -71,7 +71,7 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
                               double temperature) {
   if (finalized_) throw std::logic_error("bodies must be added before the simulation is finalized");
   if (ppc < 1) throw std::invalid_argument("body '" + name + "': particles per cell must be >= 1");
-  if (taken_ppc_ != 0 && taken_ppc_ != ppc)
+  if (bodies_.taken_ppc != 0 && bodies_.taken_ppc != ppc)
     throw std::invalid_argument("body '" + name + "': every body must use the same particles per cell");
   const Vec<Dim> blo = region.box_lo(), bhi = region.box_hi();
   const Vec<Dim>& h = grid_.cell_size();
@@ -81,9 +81,9 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
     n_fine[d] = grid_.cells()[d] * ppc;
     total *= static_cast<std::size_t>(n_fine[d]);
   }
-  if (taken_.empty()) taken_.assign(total, 0);
-  taken_ppc_ = ppc;
-  const int body_id = static_cast<int>(bodies_.size());
+  if (bodies_.taken.empty()) bodies_.taken.assign(total, 0);
+  bodies_.taken_ppc = ppc;
+  const int body_id = static_cast<int>(bodies_.info.size());
   Vec<Dim> lp;
   double V = grid_.cell_volume() / std::pow(static_cast<double>(ppc), Dim);
   if (Dim == 2) V *= opt_.thickness;
@@ -109,11 +109,11 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
       stride *= static_cast<std::size_t>(n_fine[d]);
     }
     const int mat = region.material_at(x);
-    if (mat >= 0 && !taken_[flat]) {
+    if (mat >= 0 && !bodies_.taken[flat]) {
       if (mat >= static_cast<int>(materials_.size()))
         throw std::invalid_argument("body '" + name + "' refers to material id " + std::to_string(mat) +
                                     " that does not exist");
-      taken_[flat] = 1;
+      bodies_.taken[flat] = 1;
       p_.add(x, lp, materials_[static_cast<std::size_t>(mat)].density * V, V, mat, body_id, temperature);
       p_.velocity.back() = velocity;
     }
@@ -129,25 +129,25 @@ int Simulation<Dim>::add_body(const std::string& name, const Region<Dim>& region
     msg << "body '" << name << "' has no particles: its region lies outside the grid or in space already filled";
     throw std::invalid_argument(msg.str());
   }
-  bodies_.push_back(BodyInfo{name, count});
+  bodies_.info.push_back(BodyInfo{name, count});
   // Penalty contact: the region's boundary, sampled now (the region is not kept), and the body's
   // single material (−1 for several, e.g. an image).
   int body_mat = p_.material[before];
   for (std::size_t k = before; k < p_.size(); ++k)
     if (p_.material[k] != body_mat) body_mat = -1;
-  const double spacing = contact_opt_.boundary_point_spacing(grid_.min_cell_size());
-  body_loops_.push_back(Dim == 2 ? region.boundary_loops(spacing) : std::vector<std::vector<Vec<2>>>{});
-  body_loop_spacing_.push_back(spacing);
-  body_material_.push_back(body_mat);
-  body_half_size_.push_back(lp);
-  body_velocity_.push_back(velocity);
+  const double spacing = contact_setup_.options.boundary_point_spacing(grid_.min_cell_size());
+  body_loops_.loops.push_back(Dim == 2 ? region.boundary_loops(spacing) : std::vector<std::vector<Vec<2>>>{});
+  body_loops_.spacing.push_back(spacing);
+  body_loops_.material.push_back(body_mat);
+  body_loops_.half_size.push_back(lp);
+  body_loops_.velocity.push_back(velocity);
   return body_id;
 }
 
 template <int Dim>
 void Simulation<Dim>::fix_face(const FixedFace& face) {
   if (face.axis < 0 || face.axis >= Dim) throw std::invalid_argument("fixed face axis out of range");
-  faces_.push_back(face);
+  conditions_.faces.push_back(face);
   const IVec<Dim>& nn = grid_.nodes_per_dim();
   for (std::size_t k = 0; k < grid_.node_count(); ++k) {
     const IVec<Dim> i = grid_.node_lattice(static_cast<int>(k));
@@ -155,20 +155,20 @@ void Simulation<Dim>::fix_face(const FixedFace& face) {
     const bool on = face.upper ? i[face.axis] >= last : i[face.axis] <= 0;
     if (!on) continue;
     for (int d = 0; d < Dim; ++d)
-      if (face.components[static_cast<std::size_t>(d)]) fixed_mask_[k] |= static_cast<std::uint8_t>(1u << d);
+      if (face.components[static_cast<std::size_t>(d)]) conditions_.fixed_mask[k] |= static_cast<std::uint8_t>(1u << d);
   }
 }
 
 template <int Dim>
 void Simulation<Dim>::add_point_load(const PointLoad<Dim>& load) {
-  point_loads_.push_back(load);
+  conditions_.point_loads.push_back(load);
   if (finalized_) resolve_loads();
 }
 
 template <int Dim>
 void Simulation<Dim>::add_edge_traction(const EdgeTraction<Dim>& load) {
   if (load.axis < 0 || load.axis >= Dim) throw std::invalid_argument("traction axis out of range");
-  tractions_.push_back(load);
+  conditions_.tractions.push_back(load);
   if (finalized_) resolve_loads();
 }
 
@@ -182,15 +182,15 @@ void Simulation<Dim>::finalize() {
   std::stable_sort(order.begin(), order.end(),
                    [this](std::size_t a, std::size_t b) { return p_.material[a] < p_.material[b]; });
   p_.permute(order);
-  material_begin_.assign(materials_.size(), 0);
-  material_end_.assign(materials_.size(), 0);
+  layout_.material_begin.assign(materials_.size(), 0);
+  layout_.material_end.assign(materials_.size(), 0);
   for (std::size_t m = 0, k = 0; m < materials_.size(); ++m) {
-    material_begin_[m] = k;
+    layout_.material_begin[m] = k;
     while (k < p_.size() && p_.material[k] == static_cast<int>(m)) ++k;
-    material_end_[m] = k;
+    layout_.material_end[m] = k;
   }
-  taken_.clear();
-  taken_.shrink_to_fit();
+  bodies_.taken.clear();
+  bodies_.taken.shrink_to_fit();
   empty_node_mass_ = 1e-12 * *std::max_element(p_.mass.begin(), p_.mass.end());
   finalized_ = true;
   init_fields();
@@ -199,9 +199,9 @@ void Simulation<Dim>::finalize() {
 
 template <int Dim>
 void Simulation<Dim>::resolve_loads() {
-  resolved_loads_.clear();
+  conditions_.resolved_loads.clear();
   const auto n = p_.size();
-  for (const auto& L : point_loads_) {
+  for (const auto& L : conditions_.point_loads) {
     std::vector<std::size_t> chosen;
     if (L.use_box) {
       for (std::size_t k = 0; k < n; ++k) {
@@ -222,9 +222,9 @@ void Simulation<Dim>::resolve_loads() {
     }
     if (chosen.empty()) throw std::invalid_argument("a point load selects no particle");
     for (std::size_t k : chosen)
-      resolved_loads_.push_back({k, L.force / static_cast<double>(chosen.size()), &L.scale});
+      conditions_.resolved_loads.push_back({k, L.force / static_cast<double>(chosen.size()), &L.scale});
   }
-  for (const auto& T : tractions_) {
+  for (const auto& T : conditions_.tractions) {
     // Outer particle layer of the body on the chosen side: within half a particle of its extreme.
     double extreme = T.upper ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < n; ++k)
@@ -238,7 +238,7 @@ void Simulation<Dim>::resolve_loads() {
       for (int d = 0; d < Dim; ++d)
         if (d != T.axis) area *= 2.0 * p_.half_size[k][d];
       if (Dim == 2) area *= opt_.thickness;
-      resolved_loads_.push_back({k, T.traction * area, &T.scale});
+      conditions_.resolved_loads.push_back({k, T.traction * area, &T.scale});
       any = true;
     }
     if (!any) throw std::invalid_argument("an edge traction selects no particle");
@@ -248,13 +248,13 @@ void Simulation<Dim>::resolve_loads() {
 template <int Dim>
 std::vector<ParticleLoad<Dim>> Simulation<Dim>::particle_loads() const {
   std::vector<ParticleLoad<Dim>> loads;
-  loads.reserve(resolved_loads_.size());
-  for (const ResolvedLoad& L : resolved_loads_) {
+  loads.reserve(conditions_.resolved_loads.size());
+  for (const ResolvedLoad& L : conditions_.resolved_loads) {
     int source = 0;
-    for (std::size_t i = 0; i < point_loads_.size(); ++i)
-      if (L.scale == &point_loads_[i].scale) source = static_cast<int>(i);
-    for (std::size_t j = 0; j < tractions_.size(); ++j)
-      if (L.scale == &tractions_[j].scale) source = static_cast<int>(point_loads_.size() + j);
+    for (std::size_t i = 0; i < conditions_.point_loads.size(); ++i)
+      if (L.scale == &conditions_.point_loads[i].scale) source = static_cast<int>(i);
+    for (std::size_t j = 0; j < conditions_.tractions.size(); ++j)
+      if (L.scale == &conditions_.tractions[j].scale) source = static_cast<int>(conditions_.point_loads.size() + j);
     loads.push_back({static_cast<std::int64_t>(L.particle), source, L.force, *L.scale});
   }
   return loads;
@@ -264,16 +264,16 @@ template <int Dim>
 double Simulation<Dim>::stable_time_step() const {
   double cmax = 0.0;
   const std::size_t n = p_.size();
-  if (finalized_ && wave_speed_ready_ && wave_speed_.size() == n) {
+  if (finalized_ && wave_speeds_.ready && wave_speeds_.speed.size() == n) {
     // The wave speeds of the last stress update (rigid particles: −∞; the rigid loop below counts them).
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(max : cmax)
-    for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speed_[k] + p_.velocity[k].norm());
+#pragma omp parallel for num_threads(threads_.count) schedule(static) reduction(max : cmax)
+    for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speeds_.speed[k] + p_.velocity[k].norm());
   } else {
     // One parallel region for all materials (grains are small: see evaluate_stencils).
-#pragma omp parallel num_threads(threads_) reduction(max : cmax)
+#pragma omp parallel num_threads(threads_.count) reduction(max : cmax)
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const Material& mat = materials_[m];
-      const std::size_t b = finalized_ ? material_begin_[m] : 0, e = finalized_ ? material_end_[m] : n;
+      const std::size_t b = finalized_ ? layout_.material_begin[m] : 0, e = finalized_ ? layout_.material_end[m] : n;
       if (mat.is_rigid()) continue;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = b; k < e; ++k) {
@@ -283,10 +283,10 @@ double Simulation<Dim>::stable_time_step() const {
       }
     }
   }
-  cmax = with_rigid_speeds(cmax, materials_, time_);
+  cmax = with_rigid_speeds(cmax, materials_, clock_.time);
   const double dt_penalty = penalty_time_step_limit(cmax);  // light nodes under contacts (simulation_penalty.cpp)
   cmax *= penalty_wave_factor();
-  const double dt_damping = damping_active(opt_.damping_rate, opt_.damping_until, time_)
+  const double dt_damping = damping_active(opt_.damping_rate, opt_.damping_until, clock_.time)
                                 ? damping_time_step_limit(opt_.damping_rate)
                                 : std::numeric_limits<double>::infinity();
   const double dt = cfl_time_step(opt_.cfl, grid_.min_cell_size(), cmax, opt_.max_time_step);

@@ -3,7 +3,7 @@
 // phase; the phases read no clock. The particle loops are templated on the shape-function kernel
 // (static dispatch) and threaded with OpenMP; scatters go to per-thread nodal buffers that are summed
 // afterwards. Every particle scatters into the slots of its material's velocity field
-// (field_of_material_), so the same loops serve the shared single field and the per-material fields
+// (layout_.field_of_material), so the same loops serve the shared single field and the per-material fields
 // of multimaterial contact. With the extended B-spline the weights are precomputed per step
 // (simulation_ebs.cpp) and the same loops read them.
 #include <frictherm/mechanics/errors.hpp>
@@ -38,24 +38,24 @@ void for_each_part(const ThreadPartition& partition, Fn&& fn) {
 template <int Dim>
 template <class Kernel>
 auto& Simulation<Dim>::stencils() {
-  if constexpr (std::is_same_v<Kernel, LinearKernel>) return st_linear_;
-  else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return st_ugimp_;
-  else if constexpr (is_extended<Kernel>) return st_extended_;
-  else return st_quadratic_;
+  if constexpr (std::is_same_v<Kernel, LinearKernel>) return stencil_store_.linear;
+  else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return stencil_store_.ugimp;
+  else if constexpr (is_extended<Kernel>) return stencil_store_.extended;
+  else return stencil_store_.quadratic;
 }
 
 template <int Dim>
 double Simulation<Dim>::step(double dt_limit) {
   finalize();
   // The energy books' start (EnergyBalance::initial): once, before the first step moves anything.
-  if (std::isnan(initial_energy_))
-    initial_energy_ = kinetic_energy() + strain_energy() + (penalty_ ? penalty_->stored_energy() : 0.0);
-  if (phases_.empty() || phases_key_ != phase_key()) build_phases();
+  if (std::isnan(work_books_.initial_energy))
+    work_books_.initial_energy = kinetic_energy() + strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
+  if (schedule_.phases.empty() || schedule_.key != phase_key()) build_phases();
   StepContext ctx;
   ctx.dt_limit = dt_limit;
-  ctx.t = time_;
-  phases_.run(ctx, phase_times_);
-  last_dt_ = ctx.dt;
+  ctx.t = clock_.time;
+  schedule_.phases.run(ctx, schedule_.times);
+  clock_.last_dt = ctx.dt;
   return ctx.dt;
 }
 
@@ -66,29 +66,29 @@ long Simulation<Dim>::phase_key() const {
   key = key * 4 + static_cast<long>(opt_.scheme);
   key = key * 8 + static_cast<long>(opt_.particle_update);
   key = key * 2 + (opt_.damping_rate > 0.0);
-  key = key * 2 + contact_;
-  key = key * 2 + (contact_ && contact_opt_.separation == SeparationMethod::extent);
-  key = key * 2 + penalty_.has_value();
-  key = key * 2 + !resolved_loads_.empty();
+  key = key * 2 + contact_setup_.enabled;
+  key = key * 2 + (contact_setup_.enabled && contact_setup_.options.separation == SeparationMethod::extent);
+  key = key * 2 + penalty_state_.contact.has_value();
+  key = key * 2 + !conditions_.resolved_loads.empty();
   return key;
 }
 
 template <int Dim>
 void Simulation<Dim>::build_phases() {
-  phases_.clear();
+  schedule_.phases.clear();
   if (opt_.shape == ShapeKind::extended_bspline)
     build_phases<ExtendedBSplineKernel>();
   else
     dispatch_shape(opt_.shape, [&](auto kernel) { build_phases<decltype(kernel)>(); });
-  phases_key_ = phase_key();
+  schedule_.key = phase_key();
 }
 
 template <int Dim>
 std::vector<const char*> Simulation<Dim>::step_phase_names() {
   finalize();
-  if (phases_.empty() || phases_key_ != phase_key()) build_phases();
+  if (schedule_.phases.empty() || schedule_.key != phase_key()) build_phases();
   std::vector<const char*> names;
-  for (const StepPhase& p : phases_.phases()) names.push_back(p.name);
+  for (const StepPhase& p : schedule_.phases.phases()) names.push_back(p.name);
   return names;
 }
 
@@ -102,26 +102,26 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
   using T = StepPhaseTimes;
-  PhaseList& P = phases_;
+  PhaseList& P = schedule_.phases;
   const UpdateScheme scheme = opt_.scheme;
   const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
-  const bool penalty = penalty_.has_value();
+  const bool penalty = penalty_state_.contact.has_value();
   const bool flip = opt_.particle_update == ParticleUpdate::flip;
   // USL with contact: the particle pass also evaluates the next step's stencils and boxes and moves
   // the rigid particles (nothing after it in the step needs this step's stencils).
-  const bool refresh = usl && contact_ && !is_extended<Kernel>;
+  const bool refresh = usl && contact_setup_.enabled && !is_extended<Kernel>;
 
   P.add("time_step", &T::time_step, [this](StepContext& c) {
     c.dt = std::min(stable_time_step(), c.dt_limit);
     if (!(c.dt > 0.0) || !std::isfinite(c.dt)) {
       std::ostringstream msg;
-      msg << "step " << step_ << ", t = " << time_ << " s: time step " << c.dt << " s is not positive and finite";
-      throw SimulationError(msg.str(), step_, time_, -1);
+      msg << "step " << clock_.step << ", t = " << clock_.time << " s: time step " << c.dt << " s is not positive and finite";
+      throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
     }
   });
   P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
   P.add("particle_to_grid", &T::particle_to_grid, [this, usf](StepContext& c) { map_to_grid<Kernel>(c.dt, !usf); });
-  if (contact_)
+  if (contact_setup_.enabled)
     P.add("contact_extrapolated", &T::contact, [this](StepContext& c) { contact_at_extrapolated<Kernel>(c.dt); });
   if (usf) {
     P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
@@ -130,7 +130,7 @@ void Simulation<Dim>::build_phases() {
     if (penalty)  // the points move with the velocity the stress update used
       P.add("move_boundary_points", &T::contact, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
   }
-  if (!resolved_loads_.empty())
+  if (!conditions_.resolved_loads.empty())
     P.add("external_loads", &T::particle_to_grid, [this](StepContext& c) { map_external_loads<Kernel>(c.t); });
   if (penalty)  // point forces into the nodal forces (Kakouris 2024 eq. 36), before the velocity conditions
     P.add("penalty_forces", &T::contact, [this](StepContext&) { apply_penalty_forces(); });
@@ -139,7 +139,7 @@ void Simulation<Dim>::build_phases() {
   P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
   if (opt_.damping_rate > 0.0) P.add("damping", &T::grid_update, [this](StepContext& c) { apply_damping(c.dt); });
   P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
-  if (contact_)
+  if (contact_setup_.enabled)
     P.add("contact_updated", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::updated, c.dt); });
   P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
   if (!flip)  // XPIC/FMPM
@@ -161,7 +161,7 @@ void Simulation<Dim>::build_phases() {
   P.add("end_particle_update", &T::grid_to_particle, [this, refresh](StepContext& c) { end_particle_update(c, refresh); });
   if (musl) {
     P.add("remap_momentum", &T::particle_to_grid, [this](StepContext&) { remap_momentum<Kernel>(); });
-    if (contact_)
+    if (contact_setup_.enabled)
       P.add("contact_remapped", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::remapped, c.dt); });
     P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
     if (penalty)  // with the remapped velocity, as the stress update
@@ -179,15 +179,15 @@ void Simulation<Dim>::prepare_step(double t) {
   // Below ~2000 particles per thread the fork/join and the scatter-buffer reduction cost more than
   // the particle work they share.
   const int max_threads = omp_get_max_threads();
-  threads_ = threads_for_particles(p_.size(), max_threads);
-  if (static_cast<int>(thread_nodes_.size()) != threads_ - 1) {
-    thread_nodes_.resize(static_cast<std::size_t>(std::max(0, threads_ - 1)));
-    for (auto& tn : thread_nodes_) tn.resize(nodes_.mass.size(), contact_);
+  threads_.count = threads_for_particles(p_.size(), max_threads);
+  if (static_cast<int>(threads_.nodes.size()) != threads_.count - 1) {
+    threads_.nodes.resize(static_cast<std::size_t>(std::max(0, threads_.count - 1)));
+    for (auto& tn : threads_.nodes) tn.resize(nodes_.mass.size(), contact_setup_.enabled);
   }
   update_partition();
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
-      field_velocity_[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
+      layout_.field_velocity[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
   // Nodes driven by rigid boundary materials (EBS keeps them); with contact from the stencils the step
   // evaluates anyway.
   if constexpr (is_extended<Kernel>) {
@@ -195,19 +195,19 @@ void Simulation<Dim>::prepare_step(double t) {
     prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
   } else {
     auto& st = stencils<Kernel>();
-    if (st.size() != p_.size()) st.resize(p_.size()), stencils_current_ = false;
-    if (contact_) {
+    if (st.size() != p_.size()) st.resize(p_.size()), stencil_store_.current = false;
+    if (contact_setup_.enabled) {
       // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
-      if (!stencils_current_) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
-      layout_fields(box_lo_, box_hi_);
+      if (!stencil_store_.current) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
+      layout_fields(layout_.box_lo, layout_.box_hi);
       map_rigid_particles<Kernel>(t, st.data());
     } else {
       map_rigid_particles<Kernel>(t, nullptr);
     }
   }
-  if (contact_) {
-    std::fill(work_first_.begin(), work_first_.end(), 0.0);
-    std::fill(work_second_.begin(), work_second_.end(), 0.0);
+  if (contact_setup_.enabled) {
+    std::fill(contact_books_.work_first.begin(), contact_books_.work_first.end(), 0.0);
+    std::fill(contact_books_.work_second.begin(), contact_books_.work_second.end(), 0.0);
   }
 }
 
@@ -224,10 +224,10 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
   // a scatter by every particle would give it (the same bits); other slots hold partial sums or 0.
   thread_local std::vector<std::uint8_t> at_contact;  // per slot: 1 at a contact node (no allocation once grown)
   at_contact.assign(nodes_.mass.size(), 0);
-  for (const ContactEntry& c : contact_entries_) at_contact[static_cast<std::size_t>(c.slot)] = 1;
+  for (const ContactEntry& c : contact_nodes_.entries) at_contact[static_cast<std::size_t>(c.slot)] = 1;
   const std::uint8_t* const flag = at_contact.data();
   auto& st = stencils<Kernel>();
-  const bool displacement = contact_opt_.separation == SeparationMethod::displacement;
+  const bool displacement = contact_setup_.options.separation == SeparationMethod::displacement;
   scatter_phase(Accumulated{false, false, false, true}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
     double* const domain = acc.domain.data();
@@ -248,7 +248,7 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
       });
     }
   });
-  if (contact_opt_.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
+  if (contact_setup_.options.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
   resolve_contact(ContactPass::extrapolated, dt);
 }
 
@@ -264,11 +264,11 @@ void Simulation<Dim>::stress_pass(double dt) {
 // The stencils are current again only if the particle pass evaluated them (refreshed).
 template <int Dim>
 void Simulation<Dim>::end_particle_update(StepContext& ctx, bool refreshed) {
-  stencils_current_ = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
-  time_ += ctx.dt;
-  ++step_;
+  stencil_store_.current = false;  // the particles moved; the rest of the step keeps the start-of-step stencils
+  clock_.time += ctx.dt;
+  ++clock_.step;
   check_particle(ctx.bad, ctx.dt);
-  stencils_current_ = refreshed;  // every particle inside the grid: the pass evaluated every stencil
+  stencil_store_.current = refreshed;  // every particle inside the grid: the pass evaluated every stencil
   throw_beyond_hugoniot(ctx.beyond);
 }
 
@@ -284,23 +284,23 @@ void Simulation<Dim>::evaluate_stencils() {
   Stencil<Dim, Kernel>* const stk = st.data();
   const Vec<Dim>* const position = p_.position.data();
   const Vec<Dim>* const half_size = p_.half_size.data();
-  if (!contact_) {
-#pragma omp parallel for num_threads(threads_) schedule(static)
+  if (!contact_setup_.enabled) {
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
     for (std::size_t k = 0; k < p_.size(); ++k) stk[k].evaluate(grid, position[k], half_size[k]);
     return;
   }
   const std::size_t nm = materials_.size();
   update_partition();
-  step_detail::StencilBoxes<Dim>::clear(box_lo_, box_hi_);
+  step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
   // One parallel region for all materials (a grain is a few hundred particles: a region per
   // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_.count)
   {
     thread_local step_detail::StencilBoxes<Dim> boxes;
     boxes.reset(nm);
-    for_each_part(partition_, [&](int t) {
+    for_each_part(threads_.partition, [&](int t) {
       for (std::size_t m = 0; m < nm; ++m) {
-        const std::size_t kb = partition_.even_lo(t, material_begin_[m]), ke = partition_.even_hi(t, material_end_[m]);
+        const std::size_t kb = threads_.partition.even_lo(t, layout_.material_begin[m]), ke = threads_.partition.even_hi(t, layout_.material_end[m]);
         for (std::size_t k = kb; k < ke; ++k) {
           stk[k].evaluate(grid, position[k], half_size[k]);
           boxes.extend(stk[k], boxes.lo[m], boxes.hi[m]);
@@ -308,7 +308,7 @@ void Simulation<Dim>::evaluate_stencils() {
       }
     });
 #pragma omp critical(frictherm_stencil_boxes)
-    boxes.merge_into(box_lo_, box_hi_);
+    boxes.merge_into(layout_.box_lo, layout_.box_hi);
   }
 }
 
@@ -318,11 +318,11 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
   return dispatch_shape(opt_.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
     auto& st = stencils<Kernel>();
-    if (!stencils_current_ || st.size() != p_.size()) {
+    if (!stencil_store_.current || st.size() != p_.size()) {
       PhaseLap lap;  // outside the step: timed with the step's shape_functions phase
       evaluate_stencils<Kernel>();
-      stencils_current_ = true;
-      lap.to(phase_times_.shape_functions);
+      stencil_store_.current = true;
+      lap.to(schedule_.times.shape_functions);
     }
     return StencilView<Dim>{opt_.shape, static_cast<const void*>(st.data()), st.size()};
   });
@@ -334,19 +334,19 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
 template <int Dim>
 template <class Scatter>
 void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter) {
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_.count)
   {
-    for_each_part(partition_, [&](int t) {
+    for_each_part(threads_.partition, [&](int t) {
       clear_scatter_targets(t, which);
       for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const int f = field_of_material_[m];
+        const int f = layout_.field_of_material[m];
         if (f < 0 || (!include_rigid && materials_[m].is_rigid())) continue;
-        const std::size_t kb = partition_.lo(t, material_begin_[m]), ke = partition_.hi(t, material_end_[m]);
+        const std::size_t kb = threads_.partition.lo(t, layout_.material_begin[m]), ke = threads_.partition.hi(t, layout_.material_end[m]);
         if (kb >= ke) continue;
         scatter(scatter_target(t, f), fields_[static_cast<std::size_t>(f)].index, m, kb, ke);
       }
     });
-    if (!partition_.shared_fields.empty()) {
+    if (!threads_.partition.shared_fields.empty()) {
 #pragma omp barrier
       sum_shared_fields(which);
     }
@@ -362,10 +362,10 @@ template <class Kernel>
 void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   auto& st = stencils<Kernel>();
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
-  const bool prepared = stencils_current_;  // by current_stencils() since the last step
+  const bool prepared = stencil_store_.current;  // by current_stencils() since the last step
   scatter_phase(Accumulated{true, true, true, false}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t m, std::size_t kb, std::size_t ke) {
-    if (!contact_) {
+    if (!contact_setup_.enabled) {
       for (std::size_t k = kb; k < ke; ++k) {
         if constexpr (!is_extended<Kernel>)
           if (!prepared) st[k].evaluate(grid_, p_.position[k], p_.half_size[k]);
@@ -437,22 +437,22 @@ void Simulation<Dim>::add_internal_forces() {
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated) {
-  std::fill(rigid_mask_.begin(), rigid_mask_.end(), std::uint8_t{0});
+  std::fill(conditions_.rigid_mask.begin(), conditions_.rigid_mask.end(), std::uint8_t{0});
   for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (!materials_[m].is_rigid() || field_of_material_[m] >= 0) continue;
+    if (!materials_[m].is_rigid() || layout_.field_of_material[m] >= 0) continue;
     const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
     std::uint8_t bits = 0;
     for (int d = 0; d < Dim; ++d)
       if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
     Stencil<Dim, Kernel> own;
-    for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+    for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
       if (!evaluated) own.evaluate(grid_, p_.position[k], p_.half_size[k]);
       const Stencil<Dim, Kernel>& s = evaluated ? evaluated[k] : own;
       s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
         if (S > 0.0) {
-          rigid_mask_[static_cast<std::size_t>(i)] |= bits;
+          conditions_.rigid_mask[static_cast<std::size_t>(i)] |= bits;
           for (int d = 0; d < Dim; ++d)
-            if (bits & (1u << d)) rigid_velocity_[static_cast<std::size_t>(i)][d] = v[d];
+            if (bits & (1u << d)) conditions_.rigid_velocity[static_cast<std::size_t>(i)][d] = v[d];
         }
       });
     }
@@ -465,9 +465,9 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_external_loads(double t) {
   auto& st = stencils<Kernel>();
-  for (const auto& L : resolved_loads_) {
+  for (const auto& L : conditions_.resolved_loads) {
     const Vec<Dim> f = load_force<Dim>(L.force, *L.scale, t);
-    const int fi = field_of_material_[static_cast<std::size_t>(p_.material[L.particle])];
+    const int fi = layout_.field_of_material[static_cast<std::size_t>(p_.material[L.particle])];
     if (fi < 0) continue;
     add_load_to_grid<Dim>(st[L.particle], fields_[static_cast<std::size_t>(fi)].index, f,
                           [&](int i) -> Vec<Dim>& { return nodes_.force[i]; });

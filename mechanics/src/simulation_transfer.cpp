@@ -17,22 +17,22 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
   if (opt_.transfer_order <= 1) return;
   X.term.assign(w0.begin(), w0.end());
   X.round_trip.resize(n);
-  if (X.thread_acc.size() != static_cast<std::size_t>(threads_ - 1)) X.thread_acc.resize(static_cast<std::size_t>(threads_ - 1));
+  if (X.thread_acc.size() != static_cast<std::size_t>(threads_.count - 1)) X.thread_acc.resize(static_cast<std::size_t>(threads_.count - 1));
   for (auto& b : X.thread_acc) b.resize(n);
   const double mmin = empty_node_mass_;
   for (int j = 1; j < opt_.transfer_order; ++j) {
     // round_trip_i = (S⁺ S term)_i = Σ_p S_ip m_p (Σ_k S_kp term_k) / m_i
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_.count)
     {
       const int tid = omp_get_thread_num();
       std::vector<Vec<Dim>>& acc = tid == 0 ? X.round_trip : X.thread_acc[static_cast<std::size_t>(tid - 1)];
       std::fill(acc.begin(), acc.end(), Vec<Dim>::Zero());
       for (std::size_t m = 0; m < materials_.size(); ++m) {
-        const int f = field_of_material_[m];
+        const int f = layout_.field_of_material[m];
         if (f < 0 || materials_[m].is_rigid()) continue;
         const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
-        for (std::size_t k = material_begin_[m]; k < material_end_[m]; ++k) {
+        for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
           Vec<Dim> u = Vec<Dim>::Zero();
           st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { u += S * X.term[static_cast<std::size_t>(i)]; });
           const Vec<Dim> mu = p_.mass[k] * u;
@@ -41,14 +41,14 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
       }
     }
     // term ← term − S⁺S term; zero at velocity conditions (v* keeps w0 there); filtered += term.
-#pragma omp parallel for num_threads(threads_) schedule(static)
+#pragma omp parallel for num_threads(threads_.count) schedule(static)
     for (std::size_t s = 0; s < n; ++s) {
       Vec<Dim> rt = X.round_trip[s];
       for (const auto& b : X.thread_acc) rt += b[s];
       const double ms = nodes_.mass[s];
       Vec<Dim> next = ms > mmin ? Vec<Dim>(X.term[s] - rt / ms) : Vec<Dim>(Vec<Dim>::Zero());
-      const std::size_t node = static_cast<std::size_t>(slot_node_[s]);
-      if (const std::uint8_t bc = static_cast<std::uint8_t>(fixed_mask_[node] | rigid_mask_[node]))
+      const std::size_t node = static_cast<std::size_t>(layout_.slot_node[s]);
+      if (const std::uint8_t bc = static_cast<std::uint8_t>(conditions_.fixed_mask[node] | conditions_.rigid_mask[node]))
         for (int d = 0; d < Dim; ++d)
           if (bc & (1u << d)) next[d] = 0.0;
       X.term[s] = next;

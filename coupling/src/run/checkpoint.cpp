@@ -173,9 +173,10 @@ void require_finite(const std::string& file, const std::string& shown, const dou
 }
 
 bool allowed_sentinel(const std::string& shown, double value) {
-  // EnergyBooks::min_window: +inf until a window closes; Simulation::wave_speed_: -inf for rigid
-  // particles (never a CFL speed); lagged_normal_traction_: NaN where a node had no contact yet;
-  // Simulation::initial_energy_: NaN before the first step (check_arrays requires it finite after).
+  // EnergyBooks::min_window: +inf until a window closes; Simulation's WaveSpeeds::speed: -inf for
+  // rigid particles (never a CFL speed); ContactNodeState::lagged_normal_traction: NaN where a node
+  // had no contact yet; WorkBooks::initial_energy: NaN before the first step (check_arrays requires
+  // it finite after).
   // A decomposed run's global file: the result's series rows as written (NaN where a column is
   // undefined, e.g. the first row's rates).
   if (shown == "/output/series_rows") return true;

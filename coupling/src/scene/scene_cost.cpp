@@ -36,9 +36,10 @@ constexpr double kMinBoundarySpacingPerCell = 0.01;
 double bytes_per_particle(int dim) { return dim == 2 ? 420.0 : 520.0; }
 double bytes_per_node(int dim) { return dim == 2 ? 115.0 : 165.0; }
 double thermal_bytes_per_node(int dim) { return dim == 2 ? 300.0 : 700.0; }
-// Contact keeps dense materials x materials tables (Simulation: pair_index_ 4 B, pair_work_first_ and
-// pair_work_second_ 8 B each; each contact thread's pair books 8 + 8 + 1 B): 50,000 materials asked
-// for 50 GB and ended validate with std::bad_alloc (issue 34; 20,000 took 7.9 GB and 18 s).
+// Contact keeps dense materials x materials tables (Simulation: ContactSetup::pair_index 4 B,
+// ContactBooks::pair_work_first and pair_work_second 8 B each; each contact thread's pair books
+// 8 + 8 + 1 B): 50,000 materials asked for 50 GB and ended validate with std::bad_alloc (issue 34;
+// 20,000 took 7.9 GB and 18 s).
 constexpr double kPairBytes = 20.0, kPairBytesPerThread = 17.0;
 double pair_table_bytes(const Scene& s, int threads) {
   if (!s.contact.enabled) return 0.0;

@@ -29,6 +29,22 @@
 #include <frictherm/mechanics/particles.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/state/body_list.hpp>
+#include <frictherm/mechanics/state/body_loops.hpp>
+#include <frictherm/mechanics/state/contact_books.hpp>
+#include <frictherm/mechanics/state/contact_node_state.hpp>
+#include <frictherm/mechanics/state/contact_setup.hpp>
+#include <frictherm/mechanics/state/ebs_state.hpp>
+#include <frictherm/mechanics/state/field_layout.hpp>
+#include <frictherm/mechanics/state/loads_and_conditions.hpp>
+#include <frictherm/mechanics/state/nodal_fields.hpp>
+#include <frictherm/mechanics/state/penalty_contact_state.hpp>
+#include <frictherm/mechanics/state/stencil_store.hpp>
+#include <frictherm/mechanics/state/step_clock.hpp>
+#include <frictherm/mechanics/state/step_schedule.hpp>
+#include <frictherm/mechanics/state/step_threads.hpp>
+#include <frictherm/mechanics/state/wave_speeds.hpp>
+#include <frictherm/mechanics/state/work_books.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
@@ -71,56 +87,6 @@ struct SimulationOptions {
   Vec<3> gravity = Vec<3>::Zero();             // body force per unit mass (m/s^2)
 };
 
-/// Nodal fields, one entry per slot: a grid node of one velocity field (without contact the single
-/// field covers the whole grid and slot = node index).
-template <int Dim>
-struct NodalFields {
-  std::vector<double> mass;
-  std::vector<Vec<Dim>> momentum;
-  std::vector<Vec<Dim>> force;
-  std::vector<Vec<Dim>> velocity;      // v_i^{n+1} after the momentum update
-  std::vector<Vec<Dim>> acceleration;  // (p^{n+1} - p^n) / (m dt), boundary conditions applied
-  // Contact only (empty otherwise): Σ S m x (or Σ S m (x − x0)), Ω = Σ S V, g = Σ G V (eqs. 4–6, 9).
-  std::vector<Vec<Dim>> mass_position;
-  std::vector<double> domain;
-  std::vector<Vec<Dim>> domain_gradient;
-  void resize(std::size_t n, bool with_contact = false);
-  /// To n slots without clearing the ones kept (a layout change of the step: the step's scatter
-  /// clears every slot of a field before adding to it and nodal_velocities sets every velocity and
-  /// acceleration, so no slot is read before it is written).
-  void resize_slots(std::size_t n, bool with_contact);
-};
-
-/// One velocity field: the nodes of a box of the grid, stored in slots first .. first + count − 1.
-template <int Dim>
-struct VelocityField {
-  int material = -1;          // -1: the shared field of all deformable materials (no contact)
-  bool rigid = false;
-  IVec<Dim> lo{};             // first node of the box (lattice counted from the first ghost node)
-  IVec<Dim> extent{};         // nodes per direction
-  std::size_t first = 0, count = 0;
-  NodeIndexer<Dim> index;     // lattice -> slot
-};
-
-/// Counters of the last step's contact resolution.
-struct ContactStats {
-  long contact_nodes = 0;     // nodes with two or more materials
-  long multi_nodes = 0;       // of which with three or more (lumped virtual material, eqs. 39–40)
-  long sliding_nodes = 0;     // node-pairs sliding in the momentum-update pass
-  long guarded = 0;           // materials left out because their mass fraction was below min_mass_fraction
-  long penalty_contacts = 0;  // penalty contact: active slave point – master segment contacts
-  long penalty_sliding = 0;   // of which sliding
-};
-
-/// A material pair in penalty contact: master and slave materials, index into penalty_contact()'s pairs.
-struct PenaltyPairInfo {
-  int master_material = -1, slave_material = -1;
-};
-
-struct BodyInfo {
-  std::string name;
-  std::size_t particle_count = 0;
-};
 
 template <int Dim>
 struct ContactSide;  // contact internals (mechanics/src/contact_side.hpp)
@@ -171,39 +137,39 @@ class Simulation {
   const NodalFields<Dim>& nodes() const { return nodes_; }
   const std::vector<VelocityField<Dim>>& fields() const { return fields_; }
   /// Grid node of each slot of nodes().
-  const std::vector<int>& slot_nodes() const { return slot_node_; }
-  bool contact_enabled() const { return contact_; }
-  const ContactOptions& contact_options() const { return contact_opt_; }
+  const std::vector<int>& slot_nodes() const { return layout_.slot_node; }
+  bool contact_enabled() const { return contact_setup_.enabled; }
+  const ContactOptions& contact_options() const { return contact_setup_.options; }
   const ContactPairSettings& contact_pair(int material_a, int material_b) const;
-  const ContactStats& contact_stats() const { return contact_stats_; }
+  const ContactStats& contact_stats() const { return contact_books_.stats; }
   /// The pairs given settings with set_contact_pair, in call order.
-  const std::vector<std::pair<int, int>>& contact_pairs() const { return explicit_pairs_; }
+  const std::vector<std::pair<int, int>>& contact_pairs() const { return contact_setup_.explicit_pairs; }
   /// Penalty contact (after finalize()): nullptr without penalty pairs; pair k of it is
   /// penalty_pairs()[k]. Its books hold the last step's forces and the heat per pair.
-  const PenaltyContact<Dim>* penalty_contact() const { return penalty_ ? &*penalty_ : nullptr; }
-  const std::vector<PenaltyPairInfo>& penalty_pairs() const { return penalty_pairs_; }
+  const PenaltyContact<Dim>* penalty_contact() const { return penalty_state_.contact ? &*penalty_state_.contact : nullptr; }
+  const std::vector<PenaltyPairInfo>& penalty_pairs() const { return penalty_state_.pairs; }
   /// Boundary material points of the bodies in penalty pairs (field = velocity field index). The
   /// mutable access is for set-up (e.g. shifting a body with its particles before the first step).
-  const BoundaryPoints<Dim>& boundary_points() const { return boundary_; }
-  BoundaryPoints<Dim>& boundary_points() { return boundary_; }
+  const BoundaryPoints<Dim>& boundary_points() const { return penalty_state_.boundary; }
+  BoundaryPoints<Dim>& boundary_points() { return penalty_state_.boundary; }
   /// Frictional work of the last step per grid node (J), added once per contact node (eqs. 27, 34,
   /// 36, 40): what the coupling hands to the thermal solver. All zeros without contact.
   const std::vector<double>& frictional_work(HeatingOrder order) const {
-    return order == HeatingOrder::first ? work_first_ : work_second_;
+    return order == HeatingOrder::first ? contact_books_.work_first : contact_books_.work_second;
   }
   /// Frictional work since the start (J): all pairs, or the unordered pair (a, b).
   double cumulative_frictional_work(HeatingOrder order) const;
   double cumulative_frictional_work(HeatingOrder order, int material_a, int material_b) const;
   const std::vector<Material>& materials() const { return materials_; }
-  const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  const std::vector<BodyInfo>& bodies() const { return bodies_.info; }
   /// extended_bspline: the extended basis of each velocity field (fields()[f]) as rebuilt at the
   /// start of the last step (classification, counts); empty for the other shape functions.
-  const std::vector<EbsBasis<Dim>>& extended_bases() const { return ebs_; }
-  double time() const { return time_; }
-  long step_count() const { return step_; }
-  double last_time_step() const { return last_dt_; }
+  const std::vector<EbsBasis<Dim>>& extended_bases() const { return ebs_.bases; }
+  double time() const { return clock_.time; }
+  long step_count() const { return clock_.step; }
+  double last_time_step() const { return clock_.last_dt; }
   /// Wall time spent in each phase of step() since the start.
-  const StepPhaseTimes& phase_times() const { return phase_times_; }
+  const StepPhaseTimes& phase_times() const { return schedule_.times; }
   /// The names of the step's phases in order, for this scene's scheme and options (finalizes).
   std::vector<const char*> step_phase_names();
   /// The shape functions of every particle at the current positions, read-only, for code outside the
@@ -216,7 +182,7 @@ class Simulation {
   /// inside the step) and before finalize().
   StencilView<Dim> current_stencils();
   /// Drops the stencils current_stencils() evaluated (the next step evaluates its own).
-  void forget_stencils() { stencils_current_ = false; }
+  void forget_stencils() { stencil_store_.current = false; }
 
   double kinetic_energy() const;  // of deformable particles (J)
   /// Energy stored in the deformable materials (J): elastic strain energy (linear elastic, neo-Hookean)
@@ -225,13 +191,13 @@ class Simulation {
   double strain_energy() const;
   Vec<Dim> linear_momentum() const;  // of deformable particles (kg m/s)
   /// Work done by external loads and body force so far (J), accumulated each step.
-  double external_work() const { return external_work_; }
+  double external_work() const { return work_books_.external; }
   /// Work done by rigid materials (walls, pistons) on the deformable bodies so far (J): per step the
   /// momentum the rigid fields and rigid velocity conditions give the deformable material in the
   /// momentum update (what the particles receive) times the rigid velocity.
-  double rigid_work() const { return rigid_work_; }
+  double rigid_work() const { return work_books_.rigid; }
   /// Energy removed by the mass-proportional damping so far (J, ≥ 0): c |p_i|²/m_i dt per node and step.
-  double damping_work() const { return damping_work_; }
+  double damping_work() const { return work_books_.damping; }
   /// Plastic work of the particles so far, Σ_p σ:Δε_p V (J).
   double plastic_work() const;
   /// The energy books now (frictional work of `order`). Before the first step initial = kinetic + stored.
@@ -246,7 +212,7 @@ class Simulation {
   /// bases, contact nodes and nodal fields are rebuilt each step from these.
   template <class Visitor> void visit_state(Visitor&& v) {
     if (!finalized_) finalize();
-    if constexpr (std::decay_t<Visitor>::reading) stencils_current_ = false;  // positions may change
+    if constexpr (std::decay_t<Visitor>::reading) stencil_store_.current = false;  // positions may change
     v("particles/position", p_.position);
     v("particles/initial_position", p_.initial_position);
     v("particles/velocity", p_.velocity);
@@ -263,39 +229,42 @@ class Simulation {
     v("particles/plastic_work", p_.plastic_work);
     v("particles/material", p_.material);
     v("particles/body", p_.body);
-    v("time", time_);
-    v("step", step_);
-    v("last_dt", last_dt_);
-    v("external_work", external_work_);
-    v("rigid_work", rigid_work_);
-    v("damping_work", damping_work_);
-    v("initial_energy", initial_energy_);
-    v("work_first", work_first_);
-    v("work_second", work_second_);
-    v("pair_work_first", pair_work_first_);
-    v("pair_work_second", pair_work_second_);
-    v("wave_speed", wave_speed_);
-    v("wave_speed_ready", wave_speed_ready_);
-    if (contact_opt_.regularized()) {
-      v("contact/lagged_normal_traction", lagged_normal_traction_);
-      v("contact/lagged_normal_step", lagged_normal_step_);
+    v("time", clock_.time);
+    v("step", clock_.step);
+    v("last_dt", clock_.last_dt);
+    v("external_work", work_books_.external);
+    v("rigid_work", work_books_.rigid);
+    v("damping_work", work_books_.damping);
+    v("initial_energy", work_books_.initial_energy);
+    v("work_first", contact_books_.work_first);
+    v("work_second", contact_books_.work_second);
+    v("pair_work_first", contact_books_.pair_work_first);
+    v("pair_work_second", contact_books_.pair_work_second);
+    v("wave_speed", wave_speeds_.speed);
+    v("wave_speed_ready", wave_speeds_.ready);
+    if (contact_setup_.options.regularized()) {
+      v("contact/lagged_normal_traction", contact_nodes_.lagged_normal_traction);
+      v("contact/lagged_normal_step", contact_nodes_.lagged_normal_step);
     }
     // The last step's contact counters: only reported (series rows of a thermal continuation).
-    for (auto [name, x] : {std::pair<const char*, long*>{"contact_stats/contact_nodes", &contact_stats_.contact_nodes},
-                           {"contact_stats/multi_nodes", &contact_stats_.multi_nodes},
-                           {"contact_stats/sliding_nodes", &contact_stats_.sliding_nodes},
-                           {"contact_stats/guarded", &contact_stats_.guarded},
-                           {"contact_stats/penalty_contacts", &contact_stats_.penalty_contacts},
-                           {"contact_stats/penalty_sliding", &contact_stats_.penalty_sliding}})
+    for (auto [name, x] : {std::pair<const char*, long*>{"contact_stats/contact_nodes", &contact_books_.stats.contact_nodes},
+                           {"contact_stats/multi_nodes", &contact_books_.stats.multi_nodes},
+                           {"contact_stats/sliding_nodes", &contact_books_.stats.sliding_nodes},
+                           {"contact_stats/guarded", &contact_books_.stats.guarded},
+                           {"contact_stats/penalty_contacts", &contact_books_.stats.penalty_contacts},
+                           {"contact_stats/penalty_sliding", &contact_books_.stats.penalty_sliding}})
       v(name, *x);
-    if (penalty_) {  // penalty contact: the boundary points move with the bodies; slip histories
-      v("boundary/position", boundary_.position);
-      v("boundary/velocity", boundary_.velocity);
-      penalty_->visit_state(v);
+    if (penalty_state_.contact) {  // penalty contact: the boundary points move with the bodies; slip histories
+      v("boundary/position", penalty_state_.boundary.position);
+      v("boundary/velocity", penalty_state_.boundary.velocity);
+      penalty_state_.contact->visit_state(v);
     }
   }
 
  private:
+  using ContactEntry = typename ContactNodeState<Dim>::Entry;
+  using ContactNodeListing = typename ContactNodeState<Dim>::Listing;
+  using ContactThreadWork = typename ContactNodeState<Dim>::ThreadWork;
   // The step as phase lists (step/phase_list.hpp; simulation_step.cpp): built by the first step and
   // again when a setting they depend on changes (phase_key()).
   template <class Kernel> void build_phases();
@@ -318,26 +287,26 @@ class Simulation {
     long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
   };
   /// `refresh` (grid-to-particle with Stencil arrays): also the next step's stencils at the moved
-  /// positions, the rigid materials moved (move_rigid_particles) and box_lo_/box_hi_, in the same pass.
+  /// positions, the rigid materials moved (move_rigid_particles) and layout_.box_lo/layout_.box_hi, in the same pass.
   template <bool Kinematics, bool Stress, class Stencils>
   ParticlePassResult particle_pass(double dt, Stencils& st, bool refresh = false);
   void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
   template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
-  template <class Kernel> void evaluate_stencils();  // all particles; with contact also box_lo_/box_hi_
+  template <class Kernel> void evaluate_stencils();  // all particles; with contact also layout_.box_lo/layout_.box_hi
   void prepare_extended_stencils();  // EBS: rebuild per field, lay out the fields, flatten the weights
   template <class Kernel> void map_rigid_fields();
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
-  // Scatters under the thread partition (partition_, thread_partition.hpp; simulation_fields.cpp):
+  // Scatters under the thread partition (threads_.partition, thread_partition.hpp; simulation_fields.cpp):
   // which arrays a scatter accumulates.
   struct Accumulated {
     bool mass = false, momentum = false, force = false, contact_terms = false;
   };
-  void update_partition();  // partition_ for threads_ and the current fields
+  void update_partition();  // threads_.partition for threads_.count and the current fields
   /// Where thread tid scatters field f's values: the nodes themselves, or its buffer when it shares f.
   NodalFields<Dim>& scatter_target(int tid, int field) {
-    return tid == partition_.first_thread[static_cast<std::size_t>(field)] ? nodes_
-                                                                            : thread_nodes_[static_cast<std::size_t>(tid - 1)];
+    return tid == threads_.partition.first_thread[static_cast<std::size_t>(field)] ? nodes_
+                                                                            : threads_.nodes[static_cast<std::size_t>(tid - 1)];
   }
   void clear_scatter_targets(int tid, Accumulated which);  // inside a parallel region, before the scatter
   void sum_shared_fields(Accumulated which);  // inside a parallel region, after a barrier
@@ -365,16 +334,11 @@ class Simulation {
   /// their slots, materials and contact entries; returns how many slivers were left out.
   int gather_contact_sides(std::size_t group, double dt, std::vector<ContactSide<Dim>>& sides, std::vector<int>& slots,
                            std::vector<int>& mats, std::vector<int>& entries) const;
-  void compute_contact_normals();                                // extent separation: entry_normal_
+  void compute_contact_normals();                                // extent separation: contact_nodes_.entry_normal
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
   void move_rigid_particles(double dt, double t);
-  struct RigidMotion {
-    Vec<Dim> velocity, displacement;  // at t, and over [t, t + dt] (trapezoid)
-    void move(Vec<Dim>& particle_velocity, Vec<Dim>& particle_position) const {
-      particle_velocity = velocity;
-      particle_position += displacement;
-    }
-  };
+  using RigidMotion = RigidBodyMotion<Dim>;
+  using ResolvedLoad = typename LoadsAndConditions<Dim>::ResolvedLoad;
   RigidMotion rigid_motion(std::size_t material, double t, double dt) const;
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
   void setup_penalty();                          // finalize(): penalty pairs and boundary points
@@ -389,89 +353,16 @@ class Simulation {
   SimulationOptions opt_;
   Particles<Dim> p_;
   std::vector<Material> materials_;
-  std::vector<BodyInfo> bodies_;
-  std::vector<std::size_t> material_begin_, material_end_;  // particle ranges after finalize()
+  BodyList bodies_;                         // the bodies and the fill lattice they took
   NodalFields<Dim> nodes_;
   std::vector<VelocityField<Dim>> fields_;
-  std::vector<int> field_of_material_;  // -1: rigid material acting through rigid_mask_ (no contact, or a boundary)
-  std::vector<int> slot_node_;
-  bool slot_node_valid_ = false;  // slot_node_ matches the per-material layout of fields_ (layout_fields)
-  // One thread's share of find_contact_nodes (a range of grid nodes), per field: its slots
-  // [slot_begin, slot_end), the end of those with mass in `occupied`, the entries and nodes of the
-  // contact nodes that first have mass in that field, and where they go in contact_entries_/_groups_.
-  struct ContactNodeListing {
-    std::vector<int> occupied;
-    std::vector<std::size_t> slot_begin, slot_end, field_end, entries, groups, entry_base, group_base;
-  };
-  std::vector<ContactNodeListing> contact_node_listing_;
-  std::vector<Vec<Dim>> field_velocity_;  // rigid fields: prescribed velocity at the step's start
-  std::vector<RigidMotion> rigid_motion_;  // per material, for particle_pass(refresh)
-  std::vector<IVec<Dim>> box_lo_, box_hi_;  // per material: nodes reached by its particles (contact)
-  bool contact_ = false;
-  ContactOptions contact_opt_;
-  std::vector<ContactPairSettings> pair_settings_;  // [0] = default
-  std::vector<int> pair_index_;                     // materials² -> pair_settings_ index
-  std::vector<std::pair<int, int>> explicit_pairs_;
-  struct ContactEntry {  // one field with mass at a multi-material node
-    int node, slot, field;
-  };
-  std::vector<ContactEntry> contact_entries_;  // grouped by node; within a node in material order
-  std::vector<std::size_t> contact_groups_;     // start of each node's entries, then the end
-  struct ContactThreadWork {                    // per-thread contact stats and pair books of one pass
-    ContactStats stats;
-    // Material pair k = min·nm + max: the pass's work, zero outside `touched` (the pairs it added
-    // to, marked in `marked`), so a pass clears and sums only those, not all nm² pairs of a PBX.
-    // Only the first thread's are summed into: the threads list their node groups' entries, and the
-    // pass adds the lists in thread order, which is group order (resolve_contact).
-    std::vector<double> pair_first, pair_second;
-    std::vector<std::uint8_t> marked;
-    std::vector<std::size_t> touched;
-    struct PairEntry {
-      std::size_t k;
-      double w1, w2;
-    };
-    std::vector<PairEntry> entries;
-    std::vector<double> rigid_work;  // Δp·v_rigid of each change a rigid partner made, in group order
-    void add(std::size_t k, double w1, double w2) {
-      if (!marked[k]) marked[k] = 1, touched.push_back(k);
-      pair_first[k] += w1;
-      pair_second[k] += w2;
-    }
-  };
-  std::vector<ContactThreadWork> contact_thread_work_;
-  // Normal-stress regularisation (ContactOptions::regularized): per grid node the lagged normal
-  // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
-  // in contact on the previous step starts again from σ).
-  std::vector<double> lagged_normal_traction_, lagged_normal_step_;
-  std::vector<std::uint16_t> node_field_count_;  // per grid node: fields with mass (find_contact_nodes)
-  std::vector<int> node_entry_cursor_;           // per grid node: next entry of its run, −1: none
-  // Extent separation, per contact entry: the normal from its material to its partners, and the
-  // largest extents of its own particle domains along it and of its partners' along its reverse.
-  std::vector<Vec<Dim>> entry_normal_;
-  std::vector<double> entry_extent_own_, entry_extent_other_;
-  std::vector<std::vector<double>> extent_thread_;  // per-thread maxima (threads 1..n-1), own then other
-  std::vector<double> work_first_, work_second_;    // per grid node, last step
-  std::vector<double> pair_work_first_, pair_work_second_;  // materials², cumulative
-  ContactStats contact_stats_;
-  bool any_multimaterial_ = true;               // some present material pair uses multimaterial contact
-  // Penalty contact: per body its boundary loops (from its region, or set_body_boundary), the spacing
-  // they were sampled with (−1: given by the user), its material (−1: several) and particle half-size.
-  std::vector<std::vector<std::vector<Vec<2>>>> body_loops_;
-  std::vector<double> body_loop_spacing_;
-  std::vector<int> body_material_;
-  std::vector<Vec<Dim>> body_half_size_, body_velocity_;
-  BoundaryPoints<Dim> boundary_;
-  std::optional<PenaltyContact<Dim>> penalty_;
-  std::vector<PenaltyPairInfo> penalty_pairs_;
-  std::vector<FieldNodes<Dim>> penalty_fields_;  // the fields' node boxes, refreshed each step
-  std::vector<double> penalty_reference_mass_;   // per field: its mean particle mass (sliver test)
-  // A boundary point leaves out a node of its field holding less than 0.25 S m_p (a sliver of the
-  // body beside its edge, see simulation_penalty.cpp).
-  static constexpr double penalty_sliver_ = 0.25;
-  std::vector<NodalFields<Dim>> thread_nodes_;  // per-thread scatter buffers (threads 1..n-1), shared fields only
-  ThreadPartition partition_;  // each thread's particles, the fields threads share
-  PassSplit pass_split_;       // each thread's particles in the particle passes (timed, rebalanced)
-  std::vector<double> work_blocks_;  // the particle pass's external work per PassSplit block (threads > 1)
+  FieldLayout<Dim> layout_;                 // materials -> particle ranges, fields, node boxes; slot -> node
+  ContactSetup contact_setup_;              // contact on/off, options, per-pair settings
+  ContactNodeState<Dim> contact_nodes_;     // the step's contact nodes, extents, lagged normal traction
+  ContactBooks contact_books_;              // frictional work per node and per pair, contact counters
+  PenaltyContactState<Dim> penalty_state_;  // boundary points, penalty pairs and their histories
+  BodyLoops<Dim> body_loops_;               // per body: boundary loops the boundary points come from
+  StepThreads<Dim> threads_;                // thread count, partition, pass split, scatter buffers
   struct TransferScratch {  // XPIC/FMPM, per slot
     std::vector<Vec<Dim>> start;     // XPIC: lumped v^n at the momentum update
     std::vector<Vec<Dim>> filtered;  // v* (the series' sum)
@@ -479,47 +370,15 @@ class Simulation {
     std::vector<Vec<Dim>> round_trip;  // S⁺S term
     std::vector<std::vector<Vec<Dim>>> thread_acc;  // per-thread scatter buffers (threads 1..n-1)
   } transfer_;
-  std::vector<std::uint8_t> fixed_mask_;        // bit d set: velocity component d fixed to 0
-  std::vector<std::uint8_t> rigid_mask_;        // bit d set: velocity component d driven by a rigid material
-  std::vector<Vec<Dim>> rigid_velocity_;
-  std::vector<FixedFace> faces_;
-  std::vector<PointLoad<Dim>> point_loads_;
-  std::vector<EdgeTraction<Dim>> tractions_;
-  // Resolved loads: particle index, force at scale 1, and which TimeFunction scales it.
-  struct ResolvedLoad {
-    std::size_t particle;
-    Vec<Dim> force;
-    const TimeFunction* scale;
-  };
-  std::vector<ResolvedLoad> resolved_loads_;
-  std::vector<std::uint8_t> taken_;  // fine lattice points already filled by a body
-  int taken_ppc_ = 0;
-  std::vector<Stencil<Dim, LinearKernel>> st_linear_;
-  std::vector<Stencil<Dim, UGIMPKernel>> st_ugimp_;
-  std::vector<Stencil<Dim, QuadraticBSplineKernel>> st_quadratic_;
-  PrecomputedStencils<Dim> st_extended_;   // EBS: N^e, ∇N^e of every particle, this step
-  std::vector<EbsBasis<Dim>> ebs_;         // EBS: one per velocity field
-  std::vector<std::pair<std::size_t, std::size_t>> ebs_ranges_;  // rebuild scratch: a field's particle ranges
-  std::vector<std::uint8_t> ebs_kept_;     // EBS: nodes never made degenerate (velocity conditions)
-  bool finalized_ = false;
-  double time_ = 0.0;
-  long step_ = 0;
-  double last_dt_ = 0.0;
-  double external_work_ = 0.0;
-  double rigid_work_ = 0.0, damping_work_ = 0.0;  // energy books (rigid_work(), damping_work())
-  double initial_energy_ = std::numeric_limits<double>::quiet_NaN();  // kinetic + stored before the first step
+  LoadsAndConditions<Dim> conditions_;      // fixed/rigid node masks, faces, loads, resolved loads
+  StencilStore<Dim> stencil_store_;         // S_ip, G_ip of every particle for the scene's kernel
+  EbsState<Dim> ebs_;                       // extended B-spline basis per field
+  bool finalized_ = false;                  // finalize() has run
+  StepClock clock_;                         // time, step count, last dt
+  WorkBooks work_books_;                    // external, rigid and damping work; initial energy
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
-  // Per particle: the dilatational wave speed of its state (J, e change only in the stress update,
-  // which refreshes it); −∞ for rigid particles. stable_time_step adds |v_p| to it.
-  std::vector<double> wave_speed_;
-  bool wave_speed_ready_ = false;  // set by the first stress update
-  StepPhaseTimes phase_times_;
-  PhaseList phases_;     // the step (build_phases)
-  long phases_key_ = -1;  // phase_key() the list was built for
-  // The stencils of st_linear_/st_ugimp_/st_quadratic_ were evaluated at the current positions (and,
-  // with contact, box_lo_/box_hi_ from them) by current_stencils(): the next step starts from them.
-  bool stencils_current_ = false;
-  int threads_ = 1;  // OpenMP threads of this step: 1 for small problems, where threading costs more than it saves
+  WaveSpeeds wave_speeds_;                  // per-particle wave speed for the CFL step
+  StepSchedule schedule_;                   // the step's phase list and phase timers
 };
 
 extern template class Simulation<2>;

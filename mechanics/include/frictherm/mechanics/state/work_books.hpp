@@ -1,0 +1,16 @@
+#pragma once
+// The energy books of a Simulation<Dim> that accumulate step by step (simulation_energy.cpp):
+// the work done on the deformable bodies from outside and the energy they started with.
+#include <limits>
+
+namespace frictherm::mechanics {
+
+/// Work (J) since the start: external_work(), rigid_work(), damping_work(); and the initial energy.
+struct WorkBooks {
+  double external = 0.0;  // external loads and body force
+  double rigid = 0.0;     // rigid materials on the deformable bodies
+  double damping = 0.0;   // removed by the mass-proportional damping (≥ 0)
+  double initial_energy = std::numeric_limits<double>::quiet_NaN();  // kinetic + stored before the first step
+};
+
+}  // namespace frictherm::mechanics
