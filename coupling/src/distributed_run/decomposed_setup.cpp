@@ -50,7 +50,7 @@ namespace {
 // Penalty contact: the serial build's boundary points and pairs (Simulation::setup_penalty: the bodies'
 // boundary loops, master/slave choice, penalties), with its velocity fields renamed as the decomposed
 // ones (a field per material), and each material's mean particle mass, the serial
-// penalty_reference_mass_ (Σ m_p over the material's particles in the serial order, over their count).
+// penalty_state_.reference_mass (Σ m_p over the material's particles in the serial order, over their count).
 // Every rank builds the scene (the penalty scenes are small: the EBS benchmarks).
 template <int Dim>
 void add_penalty(const Scene& scene, typename mechanics::DecomposedMpm<Dim>::Options& o) {

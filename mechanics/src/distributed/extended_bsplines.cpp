@@ -33,7 +33,7 @@ void DecomposedMpm<Dim>::Impl::prepare_extended(SwarmFields& f) {
     return static_cast<std::size_t>(g);
   };
 
-  // 1. Kept nodes, the serial fixed_mask_ | rigid_mask_: this rank's owned fixed nodes and the nodes
+  // 1. Kept nodes, the serial conditions_.fixed_mask | conditions_.rigid_mask: this rank's owned fixed nodes and the nodes
   //    its rigid walls' particles drive (particle_to_grid marked them), OR-reduced over the ranks.
   ebs_keeps = !opt.fixed_faces.empty() || has_rigid;
   if (ebs_keeps) {

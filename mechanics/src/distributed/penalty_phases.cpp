@@ -31,7 +31,7 @@ using detail::petsc_check;
 
 namespace {
 
-// The serial Simulation::penalty_sliver_: a node keeps a point's weight S only with m_I ≥ 0.25 S m_p
+// The serial PenaltyContactState::sliver: a node keeps a point's weight S only with m_I ≥ 0.25 S m_p
 // (simulation_penalty.cpp, "sliver test").
 constexpr double kSliver = 0.25;
 
