@@ -19,7 +19,9 @@
 //     decides (0.5 % of the PBX's sliding nodes);
 //   * the stress field: its largest |value|, at least 1e-6 ρc² (ρc² the largest P-wave modulus the
 //     validator reports): a body moving rigidly has stresses of ε ρc² only;
-//   * every other field and column: its largest |value|.
+//   * every other field and column: its largest |value|;
+//   * the heat books (/meta): heat delivered as the serial run's to 1e-9; Σ M ΔT and Σ m C ΔT_p close
+//     on it within ten times the serial run's own book error (the round-off of Σ C T near 300 K).
 // Every particle is held by exactly one rank. // Skipped when mpirun is not installed. Labels verification;mpi; one ctest per example.
 #include <gtest/gtest.h>
 
@@ -180,6 +182,27 @@ class MpirunExamples : public MpirunScratchTest, public ::testing::WithParamInte
                 worst_column.c_str());
   }
 
+  // The heat books (/meta): the heat delivered equals the serial run's to 1e-9 (the mechanics' work,
+  // sums in another order); the nodal and particle energy changes, Σ M ΔT and Σ m C ΔT_p, close on it
+  // as well as the serial run's own books do: within ten times its own error (the round-off of Σ C T,
+  // the temperatures being near 300 K), at least 1e-9 of the heat.
+  void compare_books(const std::string& split) {
+    const auto meta = [&](const std::string& file, const char* key) {
+      const std::vector<double> v = read_doubles(path(file), std::string("/meta/") + key);
+      return v.empty() ? std::nan("") : v[0];
+    };
+    const double q_serial = meta("serial.h5", "heat_delivered"), q = meta(split, "heat_delivered");
+    if (!(q_serial > 0.0)) return;  // no heat: no books
+    EXPECT_NEAR(q, q_serial, 1e-9 * q_serial) << "heat_delivered";
+    for (const char* change : {"nodal_energy_change", "particle_energy_change"}) {
+      const double own = std::fabs(meta("serial.h5", change) - q_serial);
+      const double book = std::fabs(meta(split, change) - q);
+      EXPECT_LE(book, std::max(1e-9 * q_serial, 10.0 * own)) << change;
+      std::printf("  %s: %s closes on the heat to %.3g of it (serial run: %.3g)\n", split.c_str(), change, book / q,
+                  own / q_serial);
+    }
+  }
+
   // The last snapshot's fields by particle id over the rank files of `split` (K ranks).
   void compare_snapshot(const std::string& split, int ranks) {
     const std::vector<std::string> snaps = names_in(path("serial.h5"), "/snapshots");
@@ -240,6 +263,7 @@ TEST_P(MpirunExamples, SplitRunsMatchTheSerialRun) {
     ASSERT_EQ(d.code, 0) << d.output;
     compare_series(split);
     compare_snapshot(split, ranks);
+    compare_books(split);
   }
 }
 
