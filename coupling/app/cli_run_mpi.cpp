@@ -11,7 +11,9 @@
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -80,8 +82,28 @@ int run_decomposed(const ParsedArgs& a, const std::string& path, const coupling:
   return run_and_report(scene, path, opt, rank, ranks);
 }
 
-int run_and_report(const coupling::Scene& scene, const std::string& path, const coupling::RunOptions& opt, int rank,
+// The decomposed runs' default wall-clock checkpoint interval (RunOptions::
+// decomposed_default_checkpoint_wall_interval, 600 s) from FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY
+// (seconds ≥ 0; 0 turns it off); empty when valid or unset, else the complaint.
+std::string default_checkpoint_from_environment(coupling::RunOptions& opt) {
+  const char* v = std::getenv("FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY");
+  if (v == nullptr) return "";
+  char* end = nullptr;
+  const double seconds = std::strtod(v, &end);
+  if (end == v || *end != '\0' || !(seconds >= 0.0) || !std::isfinite(seconds))
+    return std::string("FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY: expected wall-clock seconds >= 0 (0: no default "
+                       "checkpoints), got '") + v + "'";
+  opt.decomposed_default_checkpoint_wall_interval = seconds;
+  return "";
+}
+
+int run_and_report(const coupling::Scene& scene, const std::string& path, const coupling::RunOptions& options, int rank,
                    int ranks) {
+  coupling::RunOptions opt = options;
+  if (const std::string why = default_checkpoint_from_environment(opt); !why.empty()) {  // the same on every rank
+    if (rank == 0) std::cerr << "frictherm: " << why << '\n';
+    return kUsage;
+  }
   coupling::RunResult r;
   try {
     r = coupling::run_scene_decomposed(MPI_COMM_WORLD, scene, opt);

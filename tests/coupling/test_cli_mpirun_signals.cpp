@@ -80,8 +80,10 @@ bool wait_until_no_process_names(const std::string& path, double seconds) {
   }
 }
 
-// The uninterrupted run, then each way of signalling in `hows` followed by `resume`.
-void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows);
+// The uninterrupted run, then each way of signalling in `hows` followed by `resume`; `sets` and the
+// environment `env` ("NAME=VALUE ..." or empty) for every run.
+void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows,
+                                 const std::string& sets = kSets, const std::string& env = "");
 
 TEST_F(CliMpirunSignals, TwoSigtermsLeaveACheckpointThatResumesToTheUninterruptedRun) {
   check_signalled_runs_resume(*this, {"mpirun"});
@@ -93,19 +95,44 @@ TEST_F(CliMpirunSignals, TimeoutLeavesACheckpointThatResumesToTheUninterruptedRu
 
 TEST_F(CliMpirunSignals, TwoSigusr1sEndAsOneSigterm) { check_signalled_runs_resume(*this, {"usr1"}); }
 
-void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows) {
+// Without run.checkpoint_interval or --checkpoint-every a decomposed run checkpoints every
+// RunOptions::decomposed_default_checkpoint_wall_interval wall seconds (600; here 1 s through
+// FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY): two SIGTERMs to mpirun still leave something to resume.
+TEST_F(CliMpirunSignals, WithoutACheckpointSettingTwoSigtermsLeaveTheDefaultCheckpoint) {
+  check_signalled_runs_resume(*this, {"mpirun"}, " --set run.end_time=1.5e-2", "FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY=1");
+}
+
+TEST_F(CliMpirunSignals, DefaultCheckpointIntervalIsCheckedAndCanBeTurnedOff) {
+  const std::string run = frictherm::test::mpirun_command(2) + " " + exe() + " run " +
+                          scene("decomposed_sliding_block.json") + " --set run.end_time=1e-3 -q -o '";
+  const Result bad = shell("env FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY=soon " + run + file("bad.h5") + "'");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_THAT(bad.output, ::testing::HasSubstr("FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY: expected wall-clock seconds >= 0"));
+  EXPECT_FALSE(fs::exists(file("bad.h5")));
+  // A short run (under the interval) and one with the default off write no checkpoint.
+  for (const char* env : {"", "env FRICTHERM_DECOMPOSED_CHECKPOINT_EVERY=0 "}) {
+    const std::string out = file(std::string(*env ? "off" : "short") + ".h5");
+    const Result r = shell(std::string(env) + run + out + "'");
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(out + ".checkpoint")) << env;
+  }
+}
+
+void check_signalled_runs_resume(const CliMpirunSignals& t, const std::vector<std::string>& hows,
+                                 const std::string& sets, const std::string& env) {
   const auto path = [&t](const std::string& name) { return t.file(name); };
   const auto text = [&t](const std::string& name) { return t.log(name); };
-  const std::string mpirun = frictherm::test::mpirun_command(2) + " " + exe();
+  const std::string mpirun = (env.empty() ? "" : "env " + env + " ") + frictherm::test::mpirun_command(2) + " " + exe();
   const std::string whole = path("whole.h5");
-  const Result w = shell("timeout -s TERM 240 " + mpirun + " run " + scene("decomposed_sliding_block.json") + kSets +
+  const Result w = shell("timeout -s TERM 240 " + mpirun + " run " + scene("decomposed_sliding_block.json") + sets +
                          " -q -o '" + whole + "'");
   ASSERT_EQ(w.code, 0) << w.output;
   const std::vector<double> whole_time = read_doubles(whole, "/series/time");
 
   for (const std::string& how : hows) {
     const std::string out = path(how + ".h5"), log = how + ".log";
-    const std::string run = mpirun + " run " + scene("decomposed_sliding_block.json") + kSets + " -q -o '" + out +
+    const std::string run = mpirun + " run " + scene("decomposed_sliding_block.json") + sets + " -q -o '" + out +
                             "' > '" + path(log) + "' 2>&1";
     // Until the first checkpoint is committed (renamed into place), then the two signals.
     const std::string started = "for i in $(seq 1 1200); do [ -e '" + out + ".checkpoint' ] && break; sleep 0.1; done; ";

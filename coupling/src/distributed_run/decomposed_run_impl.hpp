@@ -181,6 +181,7 @@ class DecomposedRun {
   // Checkpoints: whether this run writes them, where, the generation of the last one, the clock of
   // --checkpoint-every; rank 0: every series row so far (flat) and OUT.xdmf's grids (from a resume).
   bool checkpoints_ = false, resuming_ = false;
+  double wall_interval_ = 0.0;  // wall seconds between checkpoints (--checkpoint-every, or the decomposed default)
   std::string checkpoint_file_;
   long generation_ = 0, checkpoints_written_ = 0;
   double checkpoint_seconds_ = 0.0;

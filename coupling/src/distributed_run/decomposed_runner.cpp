@@ -43,6 +43,11 @@ RunResult DecomposedRun<Dim>::execute() {
     throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
                      "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
                      "it");
+  // Without a checkpoint setting: every decomposed_default_checkpoint_wall_interval wall seconds where
+  // a decomposed checkpoint is supported (issue 34: two SIGTERMs to mpirun kill the ranks at once).
+  wall_interval_ = o_.checkpoint_wall_interval;
+  if (!checkpoints_ && !detail::interface_temperature(s_) && !heat_continuation())
+    wall_interval_ = std::max(0.0, o_.decomposed_default_checkpoint_wall_interval);
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
   // An interrupted run writes one too (below), so the generation is known whether or not it checkpoints.
@@ -182,7 +187,7 @@ void DecomposedRun<Dim>::stable_time_step(double& dt, int& signal, bool& checkpo
   const mechanics::DecomposedLocalParticles p = mpm_->local_particle_data(true);
   constexpr double none = -std::numeric_limits<double>::infinity();
   // max of −id: lowest id; the last: whether --checkpoint-every's wall interval has passed on some rank
-  const bool wall = o_.checkpoint_wall_interval > 0.0 && seconds_since(last_checkpoint_) >= o_.checkpoint_wall_interval;
+  const bool wall = wall_interval_ > 0.0 && seconds_since(last_checkpoint_) >= wall_interval_;
   // v[4]: the highest rank whose friction law threw in the step (-1: none).
   double v[5] = {static_cast<double>(detail::interrupt_signal()), none, none, wall ? 1.0 : 0.0,
                  mpm_->contact_failure().empty() ? -1.0 : static_cast<double>(rank_)};
@@ -273,7 +278,8 @@ void DecomposedRun<Dim>::loop(detail::ProgressLine& progress) {
     }
     if (schedule.series_due(t)) series();
     if (schedule.snapshot_due(t)) snapshot();
-    if (checkpoints_ && t < T - eps && (t >= next_checkpoint - eps || wall_due)) {  // the end: after the loop
+    if ((checkpoints_ || wall_due) && t < T - eps && (t >= next_checkpoint - eps || wall_due)) {  // the end: after the loop
+      checkpoints_ = true;  // a default wall-clock checkpoint makes the run one that checkpoints (also at its end)
       checkpoint();
       if (ci > 0.0) next_checkpoint = (std::floor(t / ci + 1e-9) + 1.0) * ci;
     }

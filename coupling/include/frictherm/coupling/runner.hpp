@@ -101,6 +101,13 @@ struct RunOptions {
   /// run.checkpoint_interval. With either, a checkpoint is also written at the end and on SIGINT/SIGTERM.
   /// A scene with a thermal continuation always gets one at the end of loading (frictherm continue).
   double checkpoint_wall_interval = 0.0;
+  /// A decomposed run (mpirun) given neither run.checkpoint_interval nor checkpoint_wall_interval
+  /// checkpoints every this many wall seconds where its checkpoints are supported (not with
+  /// coupling.interface_temperature or coupling.continuation): a second SIGTERM to mpirun within 5 s
+  /// ends every rank at once (docs/robustness.md, "Signals"), so this bounds what that loses. Once
+  /// one is written the run checkpoints as with --checkpoint-every (also at its end); a shorter run
+  /// writes none. 0: off. The serial run does not need it (it absorbs a repeated signal).
+  double decomposed_default_checkpoint_wall_interval = 600.0;
   /// A checkpoint (checkpoint.hpp) to start from instead of t = 0: the simulation (and the thermal
   /// coupler) is built from the scene, the checkpoint's state restored, and the run continues to
   /// end_time (and through the thermal continuation) landing on the same snapshot, series and
