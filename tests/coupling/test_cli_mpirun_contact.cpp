@@ -9,7 +9,9 @@
 //     tens of per cent), so a decomposed run measuring no extents or the wrong ones could not match;
 //   * rigid contact partners (examples/oscillating_block.json: the pushers, "boundary" false, bonded
 //     to the block by an adhesion law), with a heat solve added to close the energy books: 1100
-//     steps, 330 of them with the pushers moving, on 2 and 4 ranks.
+//     steps, 330 of them with the pushers moving, on 2 and 4 ranks;
+//   * the normal-stress regularisation (examples/sliding_block.json with Coulomb μ = 0.5 and
+//     contact.regularization), the whole run on 2 and 4 ranks.
 // Every series column within 1e-9 of the serial column's scale; the decomposed heat books (the
 // frictional work received, the heat delivered, the nodal and the particle energy change) closed to
 // 1e-9 of the work. Skipped when mpirun is not installed. Labels verification;mpi.
@@ -84,6 +86,47 @@ TEST_F(MpirunContact, RigidContactPartnersMatchSerialAndCloseTheBooks) {
       std::printf("  %-22s %.12g J (work %.12g J): %.2g of it\n", c, v, work, std::fabs(v - work) / work);
     }
   }
+}
+
+// The normal-stress regularisation (contact.regularization, docs/contact.md): the sliding block with
+// Coulomb μ = 0.5 at 5 mm cells (the friction that floats it without the lag), the whole 13.4 ms
+// (about 2700 steps, 1500 of them sliding) on 2 and 4 ranks. Each owned node keeps its lagged traction
+// (the serial ContactNodeState's, per grid node), so the decomposed run is the serial arithmetic.
+TEST_F(MpirunContact, RegularizedFrictionMatchesSerial) {
+  const std::string law = " --set 'contact.pairs[0].law={\"type\":\"coulomb\",\"mu\":0.5}' --set output.series_interval=0";
+  const std::string lag = " --set 'contact.regularization={\"slip_length\":0.0025,\"time\":5e-5}'";
+  // Without the lag the same run is another motion: the regularisation acts in these steps.
+  const Result plain = shell(exe() + " run " + source("examples/sliding_block.json") + law +
+                             " -q --threads 1 --force -o '" + path("plain.h5") + "'");
+  ASSERT_EQ(plain.code, 0) << plain.output;
+  for (const int ranks : {2, 4}) {
+    run_both("examples/sliding_block.json", law + lag, ranks);
+    std::printf("  %d ranks:\n", ranks);
+    for (const char* c : {"time", "dt", "kinetic_energy", "external_work", "momentum_x", "friction_work_first",
+                          "friction_work_second", "contact_nodes", "sliding_nodes", "mean_displacement_y.block"})
+      expect_same_column(c, kSame);
+    // momentum_y is round-off of the momentum (its own largest value is 1e-3 of momentum_x's): held to
+    // 1e-9 of the momentum's scale.
+    const std::vector<double> px = column("serial.h5", "momentum_x"), a = column("serial.h5", "momentum_y"),
+                              b = column("split.h5", "momentum_y");
+    ASSERT_EQ(a.size(), b.size());
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) scale = std::max(scale, std::fabs(px[k])), diff = std::max(diff, std::fabs(a[k] - b[k]));
+    EXPECT_LE(diff, kSame * scale) << "momentum_y";
+  }
+  const std::vector<double> lagged = column("serial.h5", "mean_displacement_y.block"),
+                            instant = column("plain.h5", "mean_displacement_y.block");
+  const double lift_lagged = *std::max_element(lagged.begin(), lagged.end()),
+               lift_instant = *std::max_element(instant.begin(), instant.end());
+  std::printf("  largest mean lift of the block: %.3g um lagged, %.3g um instantaneous\n", lift_lagged * 1e6,
+              lift_instant * 1e6);
+  EXPECT_GT(lift_instant, 2.0 * std::max(lift_lagged, 1e-7)) << "the regularisation should keep the block down";
+  // Its checkpoints are refused (they do not hold the lagged tractions), naming the key.
+  const Result refused = shell(frictherm::test::mpirun_command(2) + " " + exe() + " run " +
+                               source("examples/sliding_block.json") + law + lag +
+                               " --set run.checkpoint_interval=1e-3 -q -o '" + path("refused.h5") + "'");
+  EXPECT_EQ(refused.code, 2) << refused.output;
+  EXPECT_THAT(refused.output, HasSubstr("run.checkpoint_interval: 0.001 with contact.regularization"));
 }
 
 // `validate` says both examples decompose.

@@ -293,10 +293,7 @@ TEST(DecomposedContact, RefusesWhatItDoesNotSupport) {
   fm::DecomposedOptions penalty = o;
   penalty.contact_options.default_pair.method = fm::ContactMethod::penalty;
   refused(penalty, "penalty");
-  fm::DecomposedOptions lagged = o;
-  lagged.contact_options.regularization_slip_length = 1e-3;
-  lagged.contact_options.regularization_time = 1e-6;
-  refused(lagged, "regularization");
+  // (The normal-stress regularisation runs: CliMpirun.ContactRegularization.)
   fm::DecomposedOptions same = o;
   same.contact_pairs = {fm::DecomposedContactPair{1, 1, {}}};
   refused(same, "two different materials");

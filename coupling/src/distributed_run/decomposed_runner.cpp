@@ -39,6 +39,10 @@ RunResult DecomposedRun<Dim>::execute() {
     throw SceneError("--checkpoint-every: checkpoints with coupling.interface_temperature are not supported in a "
                      "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
                      "supports it");
+  if (checkpoints_ && detail::contact_regularized(s_))  // run.checkpoint_interval: decomposed_run_refusal
+    throw SceneError("--checkpoint-every: checkpoints with contact.regularization are not supported in a "
+                     "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
+                     "supports it");
   if (checkpoints_ && heat_continuation())  // run.checkpoint_interval: decomposed_run_refusal
     throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
                      "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
@@ -46,7 +50,7 @@ RunResult DecomposedRun<Dim>::execute() {
   // Without a checkpoint setting: every decomposed_default_checkpoint_wall_interval wall seconds where
   // a decomposed checkpoint is supported (issue 34: two SIGTERMs to mpirun kill the ranks at once).
   wall_interval_ = o_.checkpoint_wall_interval;
-  if (!checkpoints_ && !detail::interface_temperature(s_) && !heat_continuation())
+  if (!checkpoints_ && !detail::interface_temperature(s_) && !detail::contact_regularized(s_) && !heat_continuation())
     wall_interval_ = std::max(0.0, o_.decomposed_default_checkpoint_wall_interval);
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
@@ -87,8 +91,11 @@ RunResult DecomposedRun<Dim>::execute() {
     // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      // Nor with the interface temperature, whose flux histories a decomposed checkpoint does not hold.
-      if (checkpoints_ || (interrupted && !heat_continuation() && !detail::interface_temperature(s_))) checkpoint();
+      // Nor with the interface temperature or the contact regularisation, whose flux histories and lagged
+      // tractions a decomposed checkpoint does not hold.
+      if (checkpoints_ || (interrupted && !heat_continuation() && !detail::interface_temperature(s_) &&
+                           !detail::contact_regularized(s_)))
+        checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {

@@ -14,6 +14,7 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -34,9 +35,6 @@ void DecomposedMpm<Dim>::Impl::setup_contact() {
   }
   const ContactOptions& co = opt.contact_options;
   const std::string where = "decomposed mechanics: contact ";
-  if (co.regularized())
-    throw std::invalid_argument(where + "normal-stress regularisation is not supported (expected "
-                                        "regularization_slip_length = 0 or regularization_time = 0)");
   if (!(co.position_correction >= 0.0 && co.position_correction < 2.0))
     throw std::invalid_argument(where + "position_correction must be in [0, 2) cell sizes");
   if (!(co.min_mass_fraction >= 0.0 && co.min_mass_fraction < 0.5))
@@ -178,6 +176,14 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   const double cell_volume = grid.cell_volume() * (Dim == 2 ? opt.thickness : 1.0);  // as the serial step
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
                                   co.area, dt, updated};
+  const bool regularized = co.regularized();  // as the serial resolve_contact (simulation_contact.cpp)
+  if (regularized && lagged_normal_traction.size() != static_cast<std::size_t>(owned_count())) {  // fresh: NaN
+    lagged_normal_traction.assign(static_cast<std::size_t>(owned_count()), std::numeric_limits<double>::quiet_NaN());
+    lagged_normal_step.assign(static_cast<std::size_t>(owned_count()), -2.0);
+  }
+  ctx.step = steps_taken;
+  ctx.slip_length = co.regularization_slip_length;
+  ctx.relaxation_time = co.regularization_time;
   auto pair_of = [this](int x, int y) -> const ContactPairSettings& { return this->pair_of(x, y); };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
   thread_local std::vector<ContactSide<Dim>> sides;
@@ -197,7 +203,8 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
     const ContactSide<Dim>* rigid_side = updated ? rigid_work_side(sides) : nullptr;
     try {
     contact_detail::resolve_contact_node(
-        sides, mats, h, ctx, nullptr, nullptr, pair_of, dps,
+        sides, mats, h, ctx, regularized ? &lagged_normal_traction[uq] : nullptr,
+        regularized ? &lagged_normal_step[uq] : nullptr, pair_of, dps,
         [&](std::size_t j, const Vec<Dim>& dp) {
           double* v = mt_at(entries[j]);
           for (int d = 0; d < Dim; ++d) {

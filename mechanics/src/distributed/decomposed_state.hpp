@@ -286,6 +286,11 @@ struct DecomposedMpm<Dim>::Impl {
   int extent_unit_items = 0;                        // items per unit of the datatypes below
   MPI_Datatype extent_list_unit = MPI_DATATYPE_NULL, extent_max_unit = MPI_DATATYPE_NULL;
   std::vector<double> work_first, work_second;
+  // Normal-stress regularisation (ContactOptions::regularized): per owned node the lagged normal
+  // traction σ̃ and the step it was last updated (the serial ContactNodeState's; contact_pair.hpp),
+  // and the steps taken so far (the serial clock's step count).
+  std::vector<double> lagged_normal_traction, lagged_normal_step;
+  double steps_taken = 0.0;
   double cumulative_first = 0.0, cumulative_second = 0.0;
   // This rank's part of the cumulative frictional work per material pair (pair_book_index, materials²;
   // empty until the first contact work), as the serial Simulation's pair books.

@@ -517,6 +517,7 @@ void DecomposedMpm<Dim>::step(double dt) {
   else
     dispatch_shape(s.opt.shape, run);
   s.time += dt;
+  s.steps_taken += 1.0;
   ++s.traffic.steps;
 }
 
