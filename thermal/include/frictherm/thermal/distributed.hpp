@@ -171,12 +171,18 @@ struct EnergyBooks {
   double imbalance() const { return stored - initial_stored - source_heat; }
 };
 
+namespace detail {
+class Scheme;
+class DistributedThermalOde;
+}  // namespace detail
+
+// The serial module's integrators (one implementation, thermal/src/scheme.hpp) on the
+// DistributedProblem's owned rows.
 class DistributedIntegrator {
  public:
-  DistributedIntegrator() = default;
   DistributedIntegrator(const DistributedIntegrator&) = delete;
   DistributedIntegrator& operator=(const DistributedIntegrator&) = delete;
-  virtual ~DistributedIntegrator() = default;
+  ~DistributedIntegrator();
 
   // Collective. Integrates from t0 to t1 (t1 ≥ t0), T holding the owned temperatures (written
   // with the Dirichlet values first). Throws std::invalid_argument for bad input, SolverError /
@@ -187,19 +193,22 @@ class DistributedIntegrator {
   // fresh material (λ = 0) every window.
   void advance(const DistributedProblem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress, double t0,
                double t1);
-  virtual std::string name() const = 0;
+  std::string name() const;
 
   const IntegratorStats& stats() const { return stats_; }  // global counts (same on all ranks)
   const EnergyBooks& books() const { return books_; }
   // This rank's traffic during advance() calls so far.
   const CommunicationStats& communication() const { return comm_; }
 
- protected:
-  virtual void advance_impl(const DistributedProblem& problem, Eigen::VectorXd& T, double t0, double t1) = 0;
-  IntegratorStats stats_;
-  Eigen::VectorXd* progress_ = nullptr;  // the progress of the advance() in course (nullptr: λ = 0)
-
  private:
+  friend std::unique_ptr<DistributedIntegrator> make_distributed_integrator(const std::string&,
+                                                                           const DistributedOptions&);
+  DistributedIntegrator(std::unique_ptr<detail::Scheme> scheme, const std::string& preconditioner);
+  void window(const DistributedProblem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0, double t1);
+
+  std::unique_ptr<detail::DistributedThermalOde> ode_;  // the SUNDIALS callbacks' user data:
+  std::unique_ptr<detail::Scheme> scheme_;              // freed first
+  IntegratorStats stats_;
   EnergyBooks books_;
   bool books_started_ = false;
   CommunicationStats comm_;
