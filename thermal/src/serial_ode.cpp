@@ -19,7 +19,7 @@ std::string SerialOde::state_error(const Eigen::VectorXd& temperature, const Eig
 double SerialOde::dt_limit(const std::string& estimate) const { return forward_euler_dt_limit(*problem_, estimate); }
 
 NVectorPtr SerialOde::make_vector(SUNContext ctx) const {
-  return detail::make_vector(static_cast<long>(sys_.state_size()), ctx);
+  return detail::make_vector(static_cast<long>(form_.state_size()), ctx);
 }
 
 OdeCallbacks SerialOde::callbacks() {
@@ -27,9 +27,9 @@ OdeCallbacks SerialOde::callbacks() {
   c.rhs = &OdeSystem::rhs;
   c.jac = &OdeSystem::jac;
   c.jtimes = &OdeSystem::jtimes;
-  c.psetup = sys_.has_reaction() ? &OdeSystem::psetup : nullptr;  // Jacobi needs no set-up
+  c.psetup = form_.has_reaction() ? &OdeSystem::psetup : nullptr;  // Jacobi needs no set-up
   c.psolve = &OdeSystem::psolve;
-  c.user_data = &sys_;
+  c.user_data = &form_;
   return c;
 }
 

@@ -67,4 +67,37 @@ class ThermalOde {
   virtual long jacobian_evaluations() const = 0;
 };
 
+// The members every implementation forwards alike: to its problem (Problem or DistributedProblem)
+// and to its ODE form (OdeSystem or DistributedOde).
+template <class ProblemT, class Form>
+class FormOde : public ThermalOde {
+ public:
+  void attach(const ProblemT& problem) { problem_ = &problem; }  // the problem of the next window
+
+  std::uint64_t revision() const override { return problem_->revision(); }
+  const Eigen::VectorXd& mass() const override { return problem_->mass(); }
+  void apply_dirichlet(Eigen::VectorXd& temperature) const override { problem_->apply_dirichlet(temperature); }
+  const Reaction* reaction() const override { return problem_->has_reaction() ? &problem_->reaction() : nullptr; }
+  bool reaction_consumes() const override { return problem_->reaction_consumes(); }
+
+  void bind() override { form_.bind(*problem_); }
+  Index nodes() const override { return form_.nodes(); }
+  Index state_size() const override { return form_.state_size(); }
+  bool has_reaction() const override { return form_.has_reaction(); }
+  bool nonsymmetric() const override { return form_.nonsymmetric(); }
+  void to_y(const Eigen::VectorXd& temperature, const Eigen::VectorXd* progress, N_Vector y) override {
+    form_.to_y(temperature, progress, y);
+  }
+  void to_T(N_Vector y, Eigen::VectorXd& temperature, Eigen::VectorXd* progress) const override {
+    form_.to_T(y, temperature, progress);
+  }
+  void fill_abstol(double atol, double progress_atol, N_Vector out) const override {
+    form_.fill_abstol(atol, progress_atol, out);
+  }
+
+ protected:
+  const ProblemT* problem_ = nullptr;
+  Form form_;
+};
+
 }  // namespace frictherm::thermal::detail

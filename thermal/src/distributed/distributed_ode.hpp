@@ -43,7 +43,7 @@ class DistributedOde {
   ReactionBlocksView reaction_blocks_view() const { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
   Index state_size() const { return nodes() + (consume_ ? reacting() : 0); }
   // The problem has a reaction (the same on every rank); it consumes: J is not symmetric (GMRES).
-  bool reacts() const { return reacts_; }
+  bool has_reaction() const { return reacts_; }
   bool nonsymmetric() const { return reacts_ && consume_; }
 
   // progress: λ per owned node (nullptr: 0); to_T writes it back on the reacting nodes (consuming),

@@ -49,10 +49,10 @@ double DistributedThermalOde::max_all(double mine) const {
 }
 
 NVectorPtr DistributedThermalOde::make_vector(SUNContext ctx) const {
-  long local = static_cast<long>(sys_.state_size()), global = 0;  // [s ⊙ T; λ of the reacting nodes]
+  long local = static_cast<long>(form_.state_size()), global = 0;  // [s ⊙ T; λ of the reacting nodes]
   MPI_Allreduce(&local, &global, 1, MPI_LONG, MPI_SUM, problem_->comm());
   DistributedProblem::count_reductions(1);
-  return make_parallel_vector(problem_->comm(), sys_.state_size(), static_cast<Index>(global), ctx);
+  return make_parallel_vector(problem_->comm(), form_.state_size(), static_cast<Index>(global), ctx);
 }
 
 MatrixPtr DistributedThermalOde::make_jacobian_matrix(SUNContext) const {
@@ -65,7 +65,7 @@ OdeCallbacks DistributedThermalOde::callbacks() {
   c.jtimes = &DistributedOde::jtimes;
   c.psetup = &DistributedOde::psetup;  // the PETSc PC on P = I − γJ, or the reaction's blocks
   c.psolve = &DistributedOde::psolve;
-  c.user_data = &sys_;
+  c.user_data = &form_;
   return c;
 }
 
