@@ -30,14 +30,14 @@ LinearSolverKind parse_linear_solver(const std::string& integrator, const std::s
     if (value.empty()) return adams ? LinearSolverKind::FixedPoint : direct ? LinearSolverKind::Klu : LinearSolverKind::Pcg;
     if (value == "klu" && direct) return LinearSolverKind::Klu;
     if (value == "pcg") return LinearSolverKind::Pcg;
-    if (value == "gmres") return LinearSolverKind::Gmres;
+    if (value == "gmres" && !direct) return LinearSolverKind::Gmres;  // serial: "pcg" turns GMRES when needed
     if (adams && value == "fixed_point") return LinearSolverKind::FixedPoint;
     if (value == "klu") {
       throw std::invalid_argument(integrator + ": linear_solver \"klu\" (sparse direct) has no distributed "
                                   "counterpart (valid: pcg, gmres" + (adams ? ", fixed_point)" : ")"));
     }
     throw std::invalid_argument(integrator + ": unknown linear_solver \"" + value + "\" (valid: " +
-                                (direct ? "klu, " : "") + "pcg, gmres" + (adams ? ", fixed_point)" : ")"));
+                                (direct ? "klu, pcg" : "pcg, gmres") + (adams ? ", fixed_point)" : ")"));
   }
   if (!value.empty()) {
     throw std::invalid_argument(integrator + ": linear_solver \"" + value +

@@ -3,15 +3,17 @@
 // communicator. Each rank owns a contiguous range [first_row, first_row + local_size) of global
 // node ids, their lumped capacities M_i, their rows of K (columns are global ids) and their
 // sources. K·T needs the values of T at the columns another rank owns ("ghosts"): they are fetched
-// by one PETSc VecScatter built once per layout. Integrators keep the serial module's names and
-// work on SUNDIALS N_Vector_Parallel vectors; the Krylov path is preconditioned by a PETSc PC
-// (jacobi, bjacobi, hypre BoomerAMG) on P = I − γJ assembled as a parallel PETSc matrix.
+// by one PETSc VecScatter built once per layout. The integrators are the serial module's own
+// (one implementation over an ODE interface, issue 32) on SUNDIALS N_Vector_Parallel vectors; the
+// Krylov path is preconditioned by a PETSc PC (jacobi, bjacobi, hypre BoomerAMG) on P = I − γJ
+// assembled as a parallel PETSc matrix.
 //
 // Built only when MPI, PETSc and SUNDIALS' nvecparallel are found (target frictherm::thermal_mpi,
 // compile definition FRICTHERM_THERMAL_MPI). The Arrhenius reaction (reaction.hpp) of the owned
-// nodes is carried by the SUNDIALS integrators with the serial state [s ⊙ T; λ of the free reacting
-// nodes] (ode_system.hpp), GMRES and the serial 2×2 block-Jacobi preconditioner when it consumes
-// its reactant; not by forward_euler. Not distributed yet: convection and flux boundaries.
+// nodes is carried as in the serial module: the state [s ⊙ T; λ of the free reacting nodes]
+// (ode_system.hpp), GMRES and the 2×2 block-Jacobi preconditioner when it consumes its reactant;
+// forward_euler's reaction sub-step limit is agreed over the ranks. Not distributed yet:
+// convection and flux boundaries, fe_limit_estimate "power".
 #pragma once
 
 #include "frictherm/thermal/integrator.hpp"
