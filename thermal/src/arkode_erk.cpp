@@ -4,21 +4,20 @@
 
 namespace frictherm::thermal::detail {
 
-ArkodeErk::ArkodeErk(const IntegratorOptions& options)
-    : SundialsIntegrator("arkode_erk", options, parse_linear_solver("arkode_erk", options.linear_solver)) {}
+ArkodeErk::ArkodeErk(const IntegratorOptions& options) : SundialsIntegrator("arkode_erk", options, LinearSolverKind::None) {}
 
 void ArkodeErk::create(double t0) {
-  mem_ = MemPtr(ERKStepCreate(&OdeSystem::rhs, t0, y_.get(), ctx_.get()), MemDeleter{&ERKStepFree});
-  check_ptr(mem_.get(), "ERKStepCreate", name_);
+  mem_ = MemPtr(ERKStepCreate(sys_->callbacks().rhs, t0, y_.get(), ctx_.get()), MemDeleter{&ERKStepFree});
+  check_ptr(mem_.get(), "ERKStepCreate", who_);
   void* mem = mem_.get();
   check(ERKStepSetErrHandlerFn(mem, &ErrorSink::handler, &sink_), "ERKStepSetErrHandlerFn");
   check(ERKStepSVtolerances(mem, opt_.rtol, abstol_.get()), "ERKStepSVtolerances");
-  check(ERKStepSetUserData(mem, &sys_), "ERKStepSetUserData");
+  check(ERKStepSetUserData(mem, sys_->callbacks().user_data), "ERKStepSetUserData");
   check(ERKStepSetMaxNumSteps(mem, opt_.max_steps), "ERKStepSetMaxNumSteps");
 }
 
 void ArkodeErk::reinit(double t0) {
-  check(ERKStepReInit(mem_.get(), &OdeSystem::rhs, t0, y_.get()), "ERKStepReInit");
+  check(ERKStepReInit(mem_.get(), sys_->callbacks().rhs, t0, y_.get()), "ERKStepReInit");
   check(ERKStepSVtolerances(mem_.get(), opt_.rtol, abstol_.get()), "ERKStepSVtolerances");  // abstol_ may be new
 }
 
@@ -35,6 +34,7 @@ IntegratorStats ArkodeErk::counters() const {
   ERKStepGetNumSteps(mem, &s.steps);
   ERKStepGetNumRhsEvals(mem, &s.rhs_evals);
   ERKStepGetNumErrTestFails(mem, &s.error_test_failures);
+  if (sys_ != nullptr && sys_->jacobian_evaluations() >= 0) s.jac_evals = sys_->jacobian_evaluations();
   return s;
 }
 

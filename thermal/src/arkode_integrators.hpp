@@ -29,7 +29,7 @@ class ArkodeErk final : public SundialsIntegrator {
 // implicit RHS declared linear and time-independent in its Jacobian (ARKStepSetLinear).
 class ArkodeDirk final : public SundialsIntegrator {
  public:
-  explicit ArkodeDirk(const IntegratorOptions& options);
+  ArkodeDirk(const IntegratorOptions& options, LinearSolverKind lin);
   ~ArkodeDirk() override { release(); }
 
  protected:

@@ -7,8 +7,8 @@
 
 namespace frictherm::thermal::detail {
 
-CvodeIntegrator::CvodeIntegrator(std::string name, int lmm, const IntegratorOptions& options)
-    : SundialsIntegrator(name, options, parse_linear_solver(name, options.linear_solver)), lmm_(lmm) {}
+CvodeIntegrator::CvodeIntegrator(std::string name, int lmm, const IntegratorOptions& options, LinearSolverKind lin)
+    : SundialsIntegrator(std::move(name), options, lin), lmm_(lmm) {}
 
 void CvodeIntegrator::release() {
   mem_.reset();  // CVodeFree before the solvers it references
@@ -20,34 +20,34 @@ void CvodeIntegrator::release() {
 void CvodeIntegrator::create(double t0) {
   SUNContext ctx = ctx_.get();
   mem_ = MemPtr(CVodeCreate(lmm_, ctx), MemDeleter{&CVodeFree});
-  check_ptr(mem_.get(), "CVodeCreate", name_);
+  check_ptr(mem_.get(), "CVodeCreate", who_);
   void* mem = mem_.get();
   check(CVodeSetErrHandlerFn(mem, &ErrorSink::handler, &sink_), "CVodeSetErrHandlerFn");
-  check(CVodeInit(mem, &OdeSystem::rhs, t0, y_.get()), "CVodeInit");
+  check(CVodeInit(mem, sys_->callbacks().rhs, t0, y_.get()), "CVodeInit");
   check(CVodeSVtolerances(mem, opt_.rtol, abstol_.get()), "CVodeSVtolerances");
-  check(CVodeSetUserData(mem, &sys_), "CVodeSetUserData");
+  check(CVodeSetUserData(mem, sys_->callbacks().user_data), "CVodeSetUserData");
   check(CVodeSetMaxNumSteps(mem, opt_.max_steps), "CVodeSetMaxNumSteps");
   switch (lin_) {
     case LinearSolverKind::Klu:  // sparse direct, exact constant Jacobian J = −M⁻¹K_eff
-      a_ = sys_.make_jacobian_matrix(ctx);
+      a_ = sys_->make_jacobian_matrix(ctx);
       ls_ = LinSolPtr(SUNLinSol_KLU(y_.get(), a_.get(), ctx));
-      check_ptr(ls_.get(), "SUNLinSol_KLU", name_);
+      check_ptr(ls_.get(), "SUNLinSol_KLU", who_);
       // J has a symmetric pattern: AMD ordering (0) fills in less than the COLAMD default.
       check(SUNLinSol_KLUSetOrdering(ls_.get(), 0), "SUNLinSol_KLUSetOrdering");
       check(CVodeSetLinearSolver(mem, ls_.get(), a_.get()), "CVodeSetLinearSolver");
-      check(CVodeSetJacFn(mem, &OdeSystem::jac), "CVodeSetJacFn");
+      check(CVodeSetJacFn(mem, sys_->callbacks().jac), "CVodeSetJacFn");
       break;
-    case LinearSolverKind::Pcg:  // CG on the SPD form, exact J·v, Jacobi preconditioner
-      // (GMRES when a consuming reaction makes the Newton matrix non-symmetric; ode_system.hpp)
-      ls_ = make_krylov_solver(sys_, y_.get(), opt_.krylov_maxl, ctx, name_);
+    case LinearSolverKind::Pcg:  // CG on the SPD form, exact J·v, the ODE's preconditioner
+    case LinearSolverKind::Gmres:  // (GMRES when a consuming reaction makes the Newton matrix non-symmetric)
+      ls_ = make_krylov_solver(*sys_, lin_, y_.get(), opt_.krylov_maxl, ctx, who_);
       check(CVodeSetLinearSolver(mem, ls_.get(), nullptr), "CVodeSetLinearSolver");
-      check(CVodeSetJacTimes(mem, nullptr, &OdeSystem::jtimes), "CVodeSetJacTimes");
-      check(CVodeSetPreconditioner(mem, sys_.has_reaction() ? &OdeSystem::psetup : nullptr, &OdeSystem::psolve),
+      check(CVodeSetJacTimes(mem, nullptr, sys_->callbacks().jtimes), "CVodeSetJacTimes");
+      check(CVodeSetPreconditioner(mem, sys_->callbacks().psetup, sys_->callbacks().psolve),
             "CVodeSetPreconditioner");
       break;
     case LinearSolverKind::FixedPoint:  // functional iteration (non-stiff Adams)
       nls_ = NonlinSolPtr(SUNNonlinSol_FixedPoint(y_.get(), 0, ctx));
-      check_ptr(nls_.get(), "SUNNonlinSol_FixedPoint", name_);
+      check_ptr(nls_.get(), "SUNNonlinSol_FixedPoint", who_);
       check(CVodeSetNonlinearSolver(mem, nls_.get()), "CVodeSetNonlinearSolver");
       break;
     case LinearSolverKind::None:
@@ -78,12 +78,13 @@ IntegratorStats CvodeIntegrator::counters() const {
   CVodeGetNonlinSolvStats(mem, &nni, &ncfn);
   s.nonlinear_iters = nni;
   s.convergence_failures = ncfn;
-  if (lin_ == LinearSolverKind::Klu || lin_ == LinearSolverKind::Pcg) {
+  if (lin_ == LinearSolverKind::Klu || krylov()) {
     CVodeGetNumJacEvals(mem, &s.jac_evals);
     CVodeGetNumLinIters(mem, &s.linear_iters);
     CVodeGetNumLinRhsEvals(mem, &nfe_ls);
     s.rhs_evals += nfe_ls;
   }
+  if (sys_ != nullptr && sys_->jacobian_evaluations() >= 0) s.jac_evals = sys_->jacobian_evaluations();
   return s;
 }
 

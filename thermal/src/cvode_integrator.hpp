@@ -8,7 +8,7 @@ namespace frictherm::thermal::detail {
 class CvodeIntegrator final : public SundialsIntegrator {
  public:
   // lmm: CV_BDF or CV_ADAMS.
-  CvodeIntegrator(std::string name, int lmm, const IntegratorOptions& options);
+  CvodeIntegrator(std::string name, int lmm, const IntegratorOptions& options, LinearSolverKind lin);
   ~CvodeIntegrator() override { release(); }
 
  protected:

@@ -1,7 +1,5 @@
 #include "forward_euler.hpp"
 
-#include "frictherm/thermal/stability.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,29 +10,20 @@
 
 namespace frictherm::thermal::detail {
 
-ForwardEuler::ForwardEuler(const IntegratorOptions& options) : opt_(options) {}
+ForwardEuler::ForwardEuler(const IntegratorOptions& options) : Scheme("forward_euler"), opt_(options) {}
 
-void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0,
-                                double t1) {
+void ForwardEuler::advance(ThermalOde& ode, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0, double t1) {
   const auto start = std::chrono::steady_clock::now();
-  problem.check_state(T);
-  if (!(std::isfinite(t0) && std::isfinite(t1) && t1 >= t0)) {
-    std::ostringstream os;
-    os << "forward_euler: need finite t1 >= t0, got [" << t0 << ", " << t1 << "]";
-    throw std::invalid_argument(os.str());
-  }
-  problem.apply_dirichlet(T);
   const double window = t1 - t0;
-  if (window == 0.0) return;
-
-  if (problem.revision() != cached_revision_) {
-    cached_dt_limit_ = forward_euler_dt_limit(problem, opt_.fe_limit_estimate);
-    cached_revision_ = problem.revision();
+  const std::string who = ode.who(name_);
+  if (ode.revision() != cached_revision_) {  // the global limit: equal sub-steps on every process
+    cached_dt_limit_ = ode.dt_limit(opt_.fe_limit_estimate);
+    cached_revision_ = ode.revision();
   }
   const double dt_limit = cached_dt_limit_;
   const double h_stable = opt_.fe_safety * dt_limit;
-  if (problem.has_reaction()) {
-    advance_reacting(problem, T, progress, t0, t1, dt_limit);
+  if (ode.reaction() != nullptr) {
+    advance_reacting(ode, T, progress, t0, t1, dt_limit);
     stats_.wall_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return;
   }
@@ -46,7 +35,7 @@ void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eige
   if (opt_.fe_stability_policy == "substep" && window / steps > h_stable) steps = std::ceil(window / h_stable);
   if (!(steps <= static_cast<double>(opt_.max_steps))) {
     std::ostringstream os;
-    os << "forward_euler: the window [" << t0 << ", " << t1 << "] s needs " << steps
+    os << who << ": the window [" << t0 << ", " << t1 << "] s needs " << steps
        << " sub-steps (stability limit " << h_stable << " s with fe_safety " << opt_.fe_safety
        << (opt_.fe_max_dt > 0.0 ? ", or fe_max_dt" : "") << "), more than max_steps = " << opt_.max_steps
        << ". Use an implicit integrator such as cvode_bdf (or \"auto\"), shorter windows, or a larger max_steps";
@@ -57,7 +46,7 @@ void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eige
     const double h = window / static_cast<double>(n);
     if (h > h_stable) {
       std::ostringstream os;
-      os << "forward_euler: step " << h << " s exceeds the stability limit fe_safety*dt_limit = "
+      os << who << ": step " << h << " s exceeds the stability limit fe_safety*dt_limit = "
          << opt_.fe_safety << "*" << dt_limit << " s = " << h_stable
          << " s (dt_limit = 2/lambda_max, " << opt_.fe_limit_estimate
          << " estimate); refusing (fe_stability_policy \"refuse\"). Use \"substep\", a smaller "
@@ -74,16 +63,16 @@ void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eige
   Eigen::VectorXd dTdt(T.size());
   for (long k = 0; k < n; ++k) {
     const double tm = t0 + (static_cast<double>(k) + 0.5) * h;
-    problem.rhs(tm, work, dTdt);
+    ode.rhs(tm, work, dTdt);
     work.noalias() += h * dTdt;
   }
   stats_.steps += n;
   stats_.rhs_evals += n;
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats_.wall_seconds += elapsed;
-  if (!work.allFinite()) {
+  if (!ode.all_ranks(work.allFinite())) {
     std::ostringstream os;
-    os << "forward_euler: temperatures became non-finite with step " << h
+    os << who << ": temperatures became non-finite with step " << h
        << " s against the stability limit " << dt_limit << " s (policy \"" << opt_.fe_stability_policy
        << "\")";
     throw StabilityError(os.str(), h, dt_limit);
@@ -91,8 +80,8 @@ void ForwardEuler::advance_impl(const Problem& problem, Eigen::VectorXd& T, Eige
   T = std::move(work);
 }
 
-void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress,
-                                    double t0, double t1, double dt_limit) {
+void ForwardEuler::advance_reacting(ThermalOde& ode, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0,
+                                    double t1, double dt_limit) {
   // Explicit Euler for conduction and sources; the reaction is advanced over each sub-step
   // at the sub-step's start temperature with its exact solution for frozen T,
   //   λ⁺ = 1 − (1 − λ) e^{−h k(T)},   released heat Q (λ⁺ − λ)
@@ -100,13 +89,14 @@ void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, 
   // transport heat. The remaining explicit constraint is the self-heating rate
   // a_i = Q_i (1 − λ_i) k'(T_i)/M_i, which with conduction gives sub-steps
   // h ≤ fe_safety·2/(λ_cond + max_i a_i) (the growing mode resolved to a factor e² per step).
-  const Reaction& rx = problem.reaction();
-  const bool consume = problem.reaction_consumes();
-  const Index n = problem.size();
-  const Eigen::VectorXd& m = problem.mass();
+  const Reaction& rx = *ode.reaction();
+  const bool consume = ode.reaction_consumes();
+  const Index n = ode.size();
+  const Eigen::VectorXd& m = ode.mass();
+  const std::string who = ode.who(name_);
   std::vector<Index> nodes;
   for (Index i = 0; i < n; ++i) {
-    if (rx.heat[i] > 0.0 && !problem.is_dirichlet(i)) nodes.push_back(i);
+    if (rx.heat[i] > 0.0 && !ode.is_dirichlet(i)) nodes.push_back(i);
   }
   const double lam_cond = std::isfinite(dt_limit) ? 2.0 / dt_limit : 0.0;
   Eigen::VectorXd work = T;
@@ -124,7 +114,7 @@ void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, 
       const double a = rx.heat[i] * (1.0 - lam[i]) * rx.rate_constant_derivative(work[i]) / m[i];
       smax = std::max(smax, a);
     }
-    const double bound = lam_cond + smax;
+    const double bound = lam_cond + ode.max_all(smax);  // the same sub-step on every process
     h_lim = bound > 0.0 ? opt_.fe_safety * 2.0 / bound : std::numeric_limits<double>::infinity();
     h = t1 - t;
     if (opt_.fe_max_dt > 0.0) h = std::min(h, opt_.fe_max_dt);
@@ -132,14 +122,14 @@ void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, 
       h = std::min(h, h_lim);
     } else if (opt_.fe_stability_policy == "refuse" && h > h_lim) {
       std::ostringstream os;
-      os << "forward_euler: step " << h << " s exceeds the conduction + reaction stability limit "
+      os << who << ": step " << h << " s exceeds the conduction + reaction stability limit "
          << h_lim << " s at t = " << t << " s; refusing (fe_stability_policy \"refuse\"). Use "
          << "\"substep\" or an implicit integrator such as cvode_bdf";
       throw StabilityError(os.str(), h, h_lim / opt_.fe_safety);
     }
     last = h >= t1 - t;
     if (last) h = t1 - t;
-    problem.transport_heat_rate(t + 0.5 * h, work, w);  // source at the sub-step midpoint
+    ode.transport_heat_rate(t + 0.5 * h, work, w);  // source at the sub-step midpoint
     w *= h;                                                // transport heat [J]
     for (std::size_t r = 0; r < nodes.size(); ++r) {
       const Index i = nodes[r];
@@ -155,7 +145,7 @@ void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, 
       stats_.steps += steps;
       stats_.rhs_evals += steps;
       std::ostringstream os;
-      os << "forward_euler: max_steps = " << opt_.max_steps << " sub-steps reached at t = " << t
+      os << who << ": max_steps = " << opt_.max_steps << " sub-steps reached at t = " << t
          << " s in the window [" << t0 << ", " << t1 << "] s: the reaction limits the step to " << h_lim
          << " s. Raise IntegratorOptions::max_steps or use an implicit integrator such as cvode_bdf";
       throw StabilityError(os.str(), h, h_lim / opt_.fe_safety);
@@ -163,9 +153,9 @@ void ForwardEuler::advance_reacting(const Problem& problem, Eigen::VectorXd& T, 
   }
   stats_.steps += steps;
   stats_.rhs_evals += steps;
-  if (!work.allFinite() || !lam.allFinite()) {
+  if (!ode.all_ranks(work.allFinite() && lam.allFinite())) {
     std::ostringstream os;
-    os << "forward_euler: temperatures became non-finite (last step " << h << " s, limit " << h_lim
+    os << who << ": temperatures became non-finite (last step " << h << " s, limit " << h_lim
        << " s, policy \"" << opt_.fe_stability_policy << "\")";
     throw StabilityError(os.str(), h, h_lim);
   }

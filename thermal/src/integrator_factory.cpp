@@ -1,10 +1,7 @@
 #include "frictherm/thermal/integrator.hpp"
 
-#include "arkode_integrators.hpp"
-#include "cvode_integrator.hpp"
-#include "forward_euler.hpp"
-
-#include <cvode/cvode.h>
+#include "scheme.hpp"
+#include "serial_ode.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -48,7 +45,6 @@ void Integrator::advance(const Problem& problem, Eigen::VectorXd& T, double t0, 
 
 void Integrator::advance(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress, double t0,
                          double t1) {
-  problem.check_progress(progress);
   advance_impl(problem, T, &progress, t0, t1);
 }
 
@@ -59,6 +55,31 @@ const std::vector<std::string>& integrator_names() {
 }
 
 namespace {
+
+// Integrator over the serial Problem: a Scheme (scheme.hpp) on the problem's SerialOde.
+class SerialIntegrator final : public Integrator {
+ public:
+  explicit SerialIntegrator(std::unique_ptr<detail::Scheme> scheme) : scheme_(std::move(scheme)) {}
+  std::string name() const override { return scheme_->name(); }
+
+ protected:
+  void advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0,
+                    double t1) override {
+    struct Sync {  // the counters also after a failed window
+      IntegratorStats& to;
+      const detail::Scheme& from;
+      ~Sync() { to = from.stats(); }
+    } sync{stats_, *scheme_};
+    ode_.attach(problem);
+    detail::open_window(ode_, name(), T, progress, t0, t1);
+    if (t1 > t0) scheme_->advance(ode_, T, progress, t0, t1);
+  }
+  void on_reset_stats() override { scheme_->reset_stats(); }
+
+ private:
+  detail::SerialOde ode_;                   // the SUNDIALS callbacks' user data:
+  std::unique_ptr<detail::Scheme> scheme_;  // freed first
+};
 
 void check_options(const std::string& name, const IntegratorOptions& o) {
   auto bad = [&](const std::string& what) {
@@ -83,7 +104,7 @@ void check_options(const std::string& name, const IntegratorOptions& o) {
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_integrator(const std::string& name, const IntegratorOptions& options) {
+void detail::check_integrator_options(const std::string& name, const IntegratorOptions& options) {
   bool known = false;
   for (const auto& n : integrator_names()) known = known || n == name;
   if (!known) {
@@ -94,14 +115,12 @@ std::unique_ptr<Integrator> make_integrator(const std::string& name, const Integ
     throw std::invalid_argument(os.str());
   }
   check_options(name, options);
-  if (name == "forward_euler") {
-    detail::parse_linear_solver(name, options.linear_solver);  // rejects a linear_solver
-    return std::make_unique<detail::ForwardEuler>(options);
-  }
-  if (name == "cvode_bdf") return std::make_unique<detail::CvodeIntegrator>(name, CV_BDF, options);
-  if (name == "cvode_adams") return std::make_unique<detail::CvodeIntegrator>(name, CV_ADAMS, options);
-  if (name == "arkode_erk") return std::make_unique<detail::ArkodeErk>(options);
-  return std::make_unique<detail::ArkodeDirk>(options);
+}
+
+std::unique_ptr<Integrator> make_integrator(const std::string& name, const IntegratorOptions& options) {
+  detail::check_integrator_options(name, options);
+  const auto lin = detail::parse_linear_solver(name, options.linear_solver, true);
+  return std::make_unique<SerialIntegrator>(detail::make_scheme(name, options, lin));
 }
 
 }  // namespace frictherm::thermal

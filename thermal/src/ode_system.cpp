@@ -24,11 +24,8 @@ Index find_entry(const SparseMatrix& a, Index row, Index col) {
 
 void OdeSystem::build(const Problem& problem, bool symmetric) {
   problem_ = &problem;
-  symmetric_ = symmetric;
   const Index n = problem.size();
-  const Eigen::VectorXd& m = problem.mass();
-  s_ = symmetric ? Eigen::VectorXd(m.cwiseSqrt()) : Eigen::VectorXd::Ones(n);
-  fscale_ = s_.cwiseQuotient(m);  // 1/M (plain) or M^{-1/2} (symmetric)
+  scale(problem.mass(), symmetric);
   for (Index d : problem.dirichlet_nodes()) fscale_[d] = 0.0;
 
   rx_node_.clear();
@@ -129,37 +126,6 @@ void OdeSystem::finish_build(Index n, Index nr) {
   w_work_.resize(n);
 }
 
-void OdeSystem::to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y) {
-  auto yv = view(y);
-  const Index n = nodes();
-  yv.head(n) = s_.cwiseProduct(T);
-  for (Index r = 0; r < reacting(); ++r) {
-    const double lam = progress != nullptr ? (*progress)[rx_node_[static_cast<std::size_t>(r)]] : 0.0;
-    if (consume_) {
-      yv[n + r] = lam;
-    } else {
-      frozen_[r] = lam;
-    }
-  }
-  cache_valid_ = false;
-}
-
-void OdeSystem::to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const {
-  const auto yv = view(y);
-  const Index n = nodes();
-  T = yv.head(n).cwiseQuotient(s_);
-  if (progress == nullptr || !consume_) return;
-  for (Index r = 0; r < reacting(); ++r) {
-    (*progress)[rx_node_[static_cast<std::size_t>(r)]] = std::clamp(yv[n + r], 0.0, 1.0);
-  }
-}
-
-void OdeSystem::fill_abstol(double atol, double progress_atol, N_Vector out) const {
-  auto v = view(out);
-  v.head(nodes()) = atol * s_;
-  v.tail(state_size() - nodes()).setConstant(progress_atol);
-}
-
 MatrixPtr OdeSystem::make_jacobian_matrix(SUNContext ctx) const {
   SUNMatrix a = SUNSparseMatrix(static_cast<sunindextype>(state_size()), static_cast<sunindextype>(state_size()),
                                 static_cast<sunindextype>(jac_.nonZeros()), CSR_MAT, ctx);
@@ -170,14 +136,8 @@ MatrixPtr OdeSystem::make_jacobian_matrix(SUNContext ctx) const {
 int OdeSystem::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* self = static_cast<OdeSystem*>(user_data);
   try {
-    const Index n = self->nodes();
-    const auto yv = view(y);
-    auto out = view(ydot);
-    self->t_work_ = yv.head(n).cwiseQuotient(self->s_);
-    self->problem_->transport_heat_rate(t, self->t_work_, self->w_work_);
-    add_reaction_rates(self->problem_->reaction(), self->reaction_nodes(), self->t_work_.data(), yv.data() + n,
-                       self->w_work_.data(), out.data() + n);
-    out.head(n) = self->fscale_.cwiseProduct(self->w_work_);
+    self->problem_->transport_heat_rate(t, self->temperatures(N_VGetArrayPointer(y)), self->w_work_);
+    self->finish_rhs(self->problem_->reaction(), N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
     return 0;
   } catch (...) {
     return -1;  // unrecoverable: SUNDIALS reports *_RHSFUNC_FAIL

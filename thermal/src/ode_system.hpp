@@ -19,7 +19,7 @@
 #pragma once
 
 #include "frictherm/thermal/problem.hpp"
-#include "reaction_blocks.hpp"
+#include "ode_form.hpp"
 #include "sundials_support.hpp"
 
 #include <sundials/sundials_types.h>
@@ -28,25 +28,21 @@
 
 namespace frictherm::thermal::detail {
 
-class OdeSystem {
+class OdeSystem : public OdeForm {
  public:
   void build(const Problem& problem, bool symmetric);
   // Rebinds to the caller's Problem object for this window (same revision as built).
   void bind(const Problem& problem) { problem_ = &problem; }
-  Index nodes() const { return s_.size(); }
-  Index state_size() const { return s_.size() + (consume_ ? reacting() : 0); }
-  Index reacting() const { return static_cast<Index>(rx_node_.size()); }
   bool symmetric() const { return symmetric_; }
   bool has_reaction() const { return !rx_node_.empty(); }
   // The Newton matrix is non-symmetric (consuming reaction): Krylov must be GMRES.
   bool nonsymmetric() const { return consume_ && has_reaction(); }
 
-  // Window state. progress may be null (λ = 0). For a zero-order reaction λ is copied as the
-  // window's fixed parameter; for a consuming one it enters y.
-  void to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y);
-  // T from y; progress (if given and consuming) updated on reacting nodes, clamped to [0, 1].
-  void to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const;
-  void fill_abstol(double atol, double progress_atol, N_Vector out) const;
+  // OdeForm::to_y, and the reaction blocks' cache cleared.
+  void to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y) {
+    OdeForm::to_y(T, progress, y);
+    cache_valid_ = false;
+  }
   const SparseMatrix& jacobian() const { return jac_; }  // constant part (reaction entries 0)
   MatrixPtr make_jacobian_matrix(SUNContext ctx) const;  // CSR SUNSparseMatrix with J's pattern
 
@@ -65,27 +61,15 @@ class OdeSystem {
  private:
   // Reaction Jacobian entries at y into d_tt_ … d_ll_ (cached on the reacting entries of y).
   void reaction_blocks(N_Vector y);
-  ReactionNodes reaction_nodes() const { return {rx_node_, rx_q_, frozen_, consume_}; }
   ReactionBlocks reaction_blocks() { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
-  ReactionBlocksView reaction_blocks_view() const { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
   bool copy_conductance_pattern(const SparseMatrix& k, const Eigen::VectorXd& ha);  // build's fast path
   void finish_build(Index n, Index nr);  // after jac_: its diagonal and the reaction entries' positions
 
   const Problem* problem_ = nullptr;
-  bool symmetric_ = false;
-  bool consume_ = false;
-  Eigen::VectorXd s_;       // y = s ⊙ T
-  Eigen::VectorXd fscale_;  // f = fscale ⊙ w (w the nodal heat rate), 0 on Dirichlet rows
-  Eigen::VectorXd jdiag_;   // diag of the constant part of J
   SparseMatrix jac_;        // constant part of J, with explicit zeros on the reaction entries
-  std::vector<Index> rx_node_;  // node of reacting unknown r
-  Eigen::VectorXd rx_q_;        // Q of reacting node r
-  Eigen::VectorXd frozen_;      // zero-order: λ_r for this window
   std::vector<Index> pos_tt_, pos_tl_, pos_lt_, pos_ll_;  // CSR positions of the reaction entries
-  Eigen::VectorXd d_tt_, d_tl_, d_lt_, d_ll_;
   Eigen::VectorXd cache_key_;  // reacting entries of y the blocks were computed at
   bool cache_valid_ = false;
-  mutable Eigen::VectorXd t_work_, w_work_;
 };
 
 }  // namespace frictherm::thermal::detail

@@ -1,13 +1,15 @@
-// Shared window logic of the SUNDIALS-backed integrators (thermal-notes §1). Internal header.
+// Window logic of the SUNDIALS-backed integrators (thermal-notes §1), serial and distributed
+// alike (thermal_ode.hpp). Internal header.
 //
 // Each advance(problem, T, [progress,] t0, t1) is one window. The solver is
 //  * rebuilt when the problem's M, K or boundaries changed and KLU holds their pattern, or the
-//    state size (reacting nodes) or the reaction's presence changed,
+//    state size (reacting nodes), the reaction's presence or the conservative Krylov wrapper
+//    (its vector M^{1/2}·1) is concerned,
 //  * re-initialised in its kept memory with the new M, K when only their values changed (PCG,
 //    fixed point, explicit: what a coupler's per-window re-assembly does; no CVodeCreate, no
 //    new solvers or vectors),
 //  * re-initialised (history cleared) when T (or the reaction progress) was changed outside,
-//    t0 is not the previous t1,
+//    t0 is not the previous t1 (on any process),
 //    or options.reinit_every_window is set,
 //  * otherwise continued with its history (source changes between windows are then handled
 //    by error control, which the notes found cheaper unless the jumps are large).
@@ -15,7 +17,7 @@
 // Counters are accumulated before any re-init, since ReInit zeroes them.
 #pragma once
 
-#include "ode_system.hpp"
+#include "scheme.hpp"
 #include "sundials_support.hpp"
 
 #include <cstdint>
@@ -24,22 +26,18 @@
 
 namespace frictherm::thermal::detail {
 
-enum class LinearSolverKind { Klu, Pcg, FixedPoint, None };
+// The Krylov solver: PCG ("pcg" on a symmetric Newton matrix) or SPGMR, made exact in Σ M T when
+// the ODE conserves it (conservative_krylov.hpp).
+LinSolPtr make_krylov_solver(const ThermalOde& ode, LinearSolverKind lin, N_Vector y, int maxl, SUNContext ctx,
+                             const std::string& who);
 
-// The Krylov solver for linear_solver "pcg": PCG, or SPGMR when sys.nonsymmetric().
-LinSolPtr make_krylov_solver(const OdeSystem& sys, N_Vector y, int maxl, SUNContext ctx, const std::string& who);
-
-// Parses options.linear_solver for the named integrator (see IntegratorOptions).
-LinearSolverKind parse_linear_solver(const std::string& integrator, const std::string& value);
-
-class SundialsIntegrator : public Integrator {
+class SundialsIntegrator : public Scheme {
  public:
   SundialsIntegrator(std::string name, const IntegratorOptions& options, LinearSolverKind lin);
-  std::string name() const override { return name_; }
+  void advance(ThermalOde& ode, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0, double t1) final;
 
  protected:
-  void advance_impl(const Problem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0,
-                    double t1) final;
+  bool krylov() const { return lin_ == LinearSolverKind::Pcg || lin_ == LinearSolverKind::Gmres; }
   virtual void release() = 0;                  // free solver memory and solvers
   virtual void create(double t0) = 0;          // y_ holds the initial state
   virtual void reinit(double t0) = 0;          // y_ holds the new state
@@ -49,23 +47,23 @@ class SundialsIntegrator : public Integrator {
   virtual const char* evolve_call() const = 0;  // "CVode", "ARKStepEvolve" …
 
   void check(int flag, const char* call) const {
-    check_flag(flag, call, name_, flag_name_fn(), sink_);
+    check_flag(flag, call, who_, flag_name_fn(), sink_);
   }
   void on_reset_stats() override;
 
-  std::string name_;
   IntegratorOptions opt_;
   LinearSolverKind lin_;
   ContextPtr ctx_;
   NVectorPtr y_, abstol_;
-  OdeSystem sys_;
+  ThermalOde* sys_ = nullptr;  // the ODE of the window in course
+  std::string who_;
   ErrorSink sink_;
 
  private:
   void absorb_counters();  // base_ += counters() − offset_
   void refresh_stats();
 
-  bool built_ = false;
+  bool built_ = false, conservative_ = false;
   std::uint64_t revision_ = 0;
   double t_last_ = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd t_state_last_, progress_last_;

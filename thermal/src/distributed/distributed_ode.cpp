@@ -10,10 +10,6 @@
 namespace frictherm::thermal::detail {
 namespace {
 
-Eigen::Map<Eigen::VectorXd> view(N_Vector v) {
-  return {N_VGetArrayPointer(v), static_cast<Index>(N_VGetLocalLength_Parallel(v))};
-}
-
 // Each N_Vector_Parallel reduction is one MPI_Allreduce: count it, then do it.
 void count() { DistributedProblem::count_reductions(1); }
 sunrealtype c_dot(N_Vector x, N_Vector y) { count(); return N_VDotProd_Parallel(x, y); }
@@ -71,11 +67,8 @@ void DistributedOde::destroy_petsc() {
 
 void DistributedOde::build(const DistributedProblem& problem, bool symmetric, const std::string& preconditioner) {
   problem_ = &problem;
-  symmetric_ = symmetric;
   const Index n = problem.local_size();
-  const Eigen::VectorXd& m = problem.mass();
-  s_ = symmetric ? Eigen::VectorXd(m.cwiseSqrt()) : Eigen::VectorXd::Ones(n);
-  fscale_ = s_.cwiseQuotient(m);  // 1/M (plain) or M^{-1/2} (symmetric)
+  scale(problem.mass(), symmetric);
   Eigen::VectorXd free(n);
   for (Index i = 0; i < n; ++i) free[i] = problem.is_dirichlet_local(i) ? 0.0 : 1.0;
   for (Index i = 0; i < n; ++i) fscale_[i] *= free[i];
@@ -192,44 +185,11 @@ void DistributedOde::assemble(double gamma) {
   ++setups_;
 }
 
-void DistributedOde::to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y) {
-  const Index n = nodes();
-  auto v = view(y);
-  v.head(n) = s_.cwiseProduct(T);
-  frozen_.setZero(reacting());
-  for (Index r = 0; r < reacting(); ++r) {
-    const double lam = progress != nullptr ? (*progress)[rx_node_[static_cast<std::size_t>(r)]] : 0.0;
-    if (consume_) v[n + r] = lam;
-    else frozen_[r] = lam;  // zero-order: λ a fixed parameter of the window
-  }
-}
-
-void DistributedOde::to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const {
-  const Index n = nodes();
-  const auto v = view(y);
-  T = v.head(n).cwiseQuotient(s_);
-  if (progress == nullptr || !consume_) return;
-  for (Index r = 0; r < reacting(); ++r) (*progress)[rx_node_[static_cast<std::size_t>(r)]] = std::clamp(v[n + r], 0.0, 1.0);
-}
-
-void DistributedOde::fill_abstol(double atol, double progress_atol, N_Vector out) const {
-  auto v = view(out);
-  v.head(nodes()) = atol * s_;
-  v.tail(state_size() - nodes()).setConstant(progress_atol);
-}
-
 int DistributedOde::rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* self = static_cast<DistributedOde*>(user_data);
   try {
-    const Index n = self->nodes();
-    const auto yv = view(y);
-    auto out = view(ydot);
-    self->t_work_ = yv.head(n).cwiseQuotient(self->s_);
-    self->problem_->heat_rate(t, self->t_work_.data(), self->w_work_.data());
-    if (self->reacts_)  // as OdeSystem::rhs
-      add_reaction_rates(self->problem_->reaction(), self->reaction_nodes(), self->t_work_.data(), yv.data() + n,
-                         self->w_work_.data(), out.data() + n);
-    out.head(n) = self->fscale_.cwiseProduct(self->w_work_);
+    self->problem_->heat_rate(t, self->temperatures(N_VGetArrayPointer(y)).data(), self->w_work_.data());
+    self->finish_rhs(self->problem_->reaction(), N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
     return 0;
   } catch (...) {
     return -1;  // unrecoverable

@@ -11,7 +11,7 @@
 // exactly), no PETSc PC. Internal header; callbacks take this object as user_data.
 #pragma once
 
-#include "../reaction_blocks.hpp"
+#include "../ode_form.hpp"
 #include "../sundials_support.hpp"
 #include "frictherm/thermal/distributed.hpp"
 
@@ -26,7 +26,7 @@ namespace frictherm::thermal::detail {
 // DistributedProblem::count_reductions; clones inherit the counting operations.
 NVectorPtr make_parallel_vector(MPI_Comm comm, Index local, Index global, SUNContext ctx);
 
-class DistributedOde {
+class DistributedOde : public OdeForm {
  public:
   DistributedOde() = default;
   DistributedOde(const DistributedOde&) = delete;
@@ -37,20 +37,10 @@ class DistributedOde {
   // preconditioner: "jacobi", "bjacobi", "hypre", or empty for none (no PETSc objects).
   void build(const DistributedProblem& problem, bool symmetric, const std::string& preconditioner);
   void bind(const DistributedProblem& problem) { problem_ = &problem; }
-  Index nodes() const { return s_.size(); }
-  Index reacting() const { return static_cast<Index>(rx_node_.size()); }
-  ReactionNodes reaction_nodes() const { return {rx_node_, rx_q_, frozen_, consume_}; }
-  ReactionBlocksView reaction_blocks_view() const { return {d_tt_, d_tl_, d_lt_, d_ll_}; }
-  Index state_size() const { return nodes() + (consume_ ? reacting() : 0); }
   // The problem has a reaction (the same on every rank); it consumes: J is not symmetric (GMRES).
-  bool reacts() const { return reacts_; }
+  bool has_reaction() const { return reacts_; }
   bool nonsymmetric() const { return reacts_ && consume_; }
 
-  // progress: λ per owned node (nullptr: 0); to_T writes it back on the reacting nodes (consuming),
-  // clamped to [0, 1], as OdeSystem::to_T.
-  void to_y(const Eigen::VectorXd& T, const Eigen::VectorXd* progress, N_Vector y);
-  void to_T(N_Vector y, Eigen::VectorXd& T, Eigen::VectorXd* progress) const;
-  void fill_abstol(double atol, double progress_atol, N_Vector out) const;  // s_i·atol, progress_atol on λ
 
   static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data);
   static int jtimes(N_Vector v, N_Vector jv, sunrealtype t, N_Vector y, N_Vector fy, void* user_data, N_Vector tmp);
@@ -73,15 +63,10 @@ class DistributedOde {
   void reaction_blocks(const double* y);  // the 2×2 blocks at y (OdeSystem::reaction_blocks)
   int block_jacobi(const double* r, double* z, double gamma) const;
 
-  bool reacts_ = false, consume_ = false;
-  std::vector<Index> rx_node_;  // this rank's free reacting nodes (local), r = 0..R−1
-  Eigen::VectorXd rx_q_, frozen_, d_tt_, d_tl_, d_lt_, d_ll_, jdiag_;
+  bool reacts_ = false;  // rx_node_: this rank's free reacting nodes (local), r = 0..R−1
 
   const DistributedProblem* problem_ = nullptr;
-  bool symmetric_ = false;
   bool conserves_ = false;
-  Eigen::VectorXd s_;       // y = s ⊙ T
-  Eigen::VectorXd fscale_;  // f = fscale ⊙ w, 0 on Dirichlet rows
   std::vector<double> jval_;  // J in the problem's local CSR (row_start, local_col); 0 on dropped entries
   // Preconditioner matrix rows: global columns (K's, plus the diagonal when K lacks it) and the
   // position of the diagonal among them.
@@ -92,7 +77,6 @@ class DistributedOde {
   Vec r_vec_ = nullptr, z_vec_ = nullptr;
   double gamma_ = -1.0;
   long setups_ = 0;
-  mutable Eigen::VectorXd t_work_, w_work_;
 };
 
 }  // namespace frictherm::thermal::detail

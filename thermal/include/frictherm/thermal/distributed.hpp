@@ -3,15 +3,17 @@
 // communicator. Each rank owns a contiguous range [first_row, first_row + local_size) of global
 // node ids, their lumped capacities M_i, their rows of K (columns are global ids) and their
 // sources. K·T needs the values of T at the columns another rank owns ("ghosts"): they are fetched
-// by one PETSc VecScatter built once per layout. Integrators keep the serial module's names and
-// work on SUNDIALS N_Vector_Parallel vectors; the Krylov path is preconditioned by a PETSc PC
-// (jacobi, bjacobi, hypre BoomerAMG) on P = I − γJ assembled as a parallel PETSc matrix.
+// by one PETSc VecScatter built once per layout. The integrators are the serial module's own
+// (one implementation over an ODE interface, issue 32) on SUNDIALS N_Vector_Parallel vectors; the
+// Krylov path is preconditioned by a PETSc PC (jacobi, bjacobi, hypre BoomerAMG) on P = I − γJ
+// assembled as a parallel PETSc matrix.
 //
 // Built only when MPI, PETSc and SUNDIALS' nvecparallel are found (target frictherm::thermal_mpi,
 // compile definition FRICTHERM_THERMAL_MPI). The Arrhenius reaction (reaction.hpp) of the owned
-// nodes is carried by the SUNDIALS integrators with the serial state [s ⊙ T; λ of the free reacting
-// nodes] (ode_system.hpp), GMRES and the serial 2×2 block-Jacobi preconditioner when it consumes
-// its reactant; not by forward_euler. Not distributed yet: convection and flux boundaries.
+// nodes is carried as in the serial module: the state [s ⊙ T; λ of the free reacting nodes]
+// (ode_system.hpp), GMRES and the 2×2 block-Jacobi preconditioner when it consumes its reactant;
+// forward_euler's reaction sub-step limit is agreed over the ranks. Not distributed yet:
+// convection and flux boundaries, fe_limit_estimate "power".
 #pragma once
 
 #include "frictherm/thermal/integrator.hpp"
@@ -171,12 +173,18 @@ struct EnergyBooks {
   double imbalance() const { return stored - initial_stored - source_heat; }
 };
 
+namespace detail {
+class Scheme;
+class DistributedThermalOde;
+}  // namespace detail
+
+// The serial module's integrators (one implementation, thermal/src/scheme.hpp) on the
+// DistributedProblem's owned rows.
 class DistributedIntegrator {
  public:
-  DistributedIntegrator() = default;
   DistributedIntegrator(const DistributedIntegrator&) = delete;
   DistributedIntegrator& operator=(const DistributedIntegrator&) = delete;
-  virtual ~DistributedIntegrator() = default;
+  ~DistributedIntegrator();
 
   // Collective. Integrates from t0 to t1 (t1 ≥ t0), T holding the owned temperatures (written
   // with the Dirichlet values first). Throws std::invalid_argument for bad input, SolverError /
@@ -187,19 +195,22 @@ class DistributedIntegrator {
   // fresh material (λ = 0) every window.
   void advance(const DistributedProblem& problem, Eigen::VectorXd& T, Eigen::VectorXd& progress, double t0,
                double t1);
-  virtual std::string name() const = 0;
+  std::string name() const;
 
   const IntegratorStats& stats() const { return stats_; }  // global counts (same on all ranks)
   const EnergyBooks& books() const { return books_; }
   // This rank's traffic during advance() calls so far.
   const CommunicationStats& communication() const { return comm_; }
 
- protected:
-  virtual void advance_impl(const DistributedProblem& problem, Eigen::VectorXd& T, double t0, double t1) = 0;
-  IntegratorStats stats_;
-  Eigen::VectorXd* progress_ = nullptr;  // the progress of the advance() in course (nullptr: λ = 0)
-
  private:
+  friend std::unique_ptr<DistributedIntegrator> make_distributed_integrator(const std::string&,
+                                                                           const DistributedOptions&);
+  DistributedIntegrator(std::unique_ptr<detail::Scheme> scheme, const std::string& preconditioner);
+  void window(const DistributedProblem& problem, Eigen::VectorXd& T, Eigen::VectorXd* progress, double t0, double t1);
+
+  std::unique_ptr<detail::DistributedThermalOde> ode_;  // the SUNDIALS callbacks' user data:
+  std::unique_ptr<detail::Scheme> scheme_;              // freed first
+  IntegratorStats stats_;
   EnergyBooks books_;
   bool books_started_ = false;
   CommunicationStats comm_;

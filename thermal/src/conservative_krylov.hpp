@@ -1,4 +1,4 @@
-// A Krylov solver that keeps the energy invariant exactly (distributed thermal solve). Internal header.
+// A Krylov solver that keeps the energy invariant exactly (thermal-notes §4 invariant). Internal header.
 //
 // On the symmetric form y = M^{1/2}T of an insulated problem (no Dirichlet node, K with zero row
 // sums), c = M^{1/2}·1 satisfies J c = 0, so c is an eigenvector of the Newton matrix
@@ -12,7 +12,7 @@
 // MPI_Allreduce (both dot products fused) per linear solve.
 #pragma once
 
-#include "../sundials_support.hpp"
+#include "sundials_support.hpp"
 
 namespace frictherm::thermal::detail {
 
