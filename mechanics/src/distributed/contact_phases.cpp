@@ -178,6 +178,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   const double cell_volume = grid.cell_volume() * (Dim == 2 ? opt.thickness : 1.0);  // as the serial step
   contact_detail::PairContext ctx{nullptr, co.separation, co.position_correction, co.extent_tolerance, cell_volume,
                                   co.area, dt, updated};
+  ctx.light_touch_fraction = co.light_touch_fraction;
   auto pair_of = [this](int x, int y) -> const ContactPairSettings& { return this->pair_of(x, y); };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
   thread_local std::vector<ContactSide<Dim>> sides;
