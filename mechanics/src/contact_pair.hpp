@@ -55,6 +55,7 @@ struct PairContext {
   ContactAreaMethod area_method;  // of the node's cell (2D: times thickness), m^3
   double dt;
   bool heat;           // the momentum-update pass: compute frictional work
+  double light_touch_fraction = 0.0;  // ContactOptions::light_touch_fraction
   // Normal-stress regularisation (ContactOptions::regularized): this node's lagged normal traction
   // σ̃ and the step that last set it, or null; updated in the heating pass only.
   double* lagged_normal = nullptr;
@@ -145,7 +146,20 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n);
   else if (c.separation == SeparationMethod::extent)  // particle domains, contact_extents.cpp
     separation = std::isnan(a.extent_gap) ? -1.0 : a.extent_gap - c.extent_tolerance * h_perp;
-  const bool touching = separation < 0.0;
+  // A material holding under light_touch_fraction of the pair's mass at the node reaches it with the
+  // tails of its particles' shape functions only: its mass centroid there sits about a cell from its
+  // surface, so eqs. 8–10 call it separated however far it has pressed into its partner's cell. Left
+  // free, its field takes its own stress's force alone, f_j = −Σ V σ G, pushing its surface into the
+  // partner unopposed; under MUSL the particles take that push while the stress is updated from the
+  // stopped velocities where the pair is in contact, and an impact gains energy (docs/contact.md,
+  // "Where the frictionless impact creates energy"). With the option such a material is touching
+  // whenever the pair approaches, and gets normal contact only there (as a sliver: no friction, no
+  // heat at a node the position test calls open).
+  const bool light = c.light_touch_fraction > 0.0 && !b.rigid &&
+                     (c.separation == SeparationMethod::position || c.separation == SeparationMethod::displacement) &&
+                     std::min(a.mass, b.mass) < c.light_touch_fraction * (a.mass + b.mass);
+  const bool light_only = light && !(separation < 0.0);  // touching by the light rule alone
+  const bool touching = separation < 0.0 || light;
 
   // Stick momentum change and reduced mass (eqs. 12–14); a rigid b has v_c = v_b, m_red = m_a.
   Vec<Dim> dp_stick;
@@ -185,7 +199,7 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   // sign of the approach velocity; at a node a rigid body barely reaches (the oscillating block's
   // pushers, moved by a fraction of a cell) that pinned the heavy block field there on some steps and
   // not on others, and the block's particles gained kinetic energy without bound at small time steps.
-  if (a.sliver || b.sliver) {
+  if (a.sliver || b.sliver || light_only) {
     if (in_contact) {
       out.changed = true;
       out.dp = d_n * n;

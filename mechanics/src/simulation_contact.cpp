@@ -74,6 +74,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     PairContext ctx{nullptr, contact_setup_.options.separation, contact_setup_.options.position_correction, contact_setup_.options.extent_tolerance,
                     cell_volume, contact_setup_.options.area, dt, heat};
     ctx.step = static_cast<double>(clock_.step);
+    ctx.light_touch_fraction = contact_setup_.options.light_touch_fraction;
     ctx.slip_length = contact_setup_.options.regularization_slip_length;
     ctx.relaxation_time = contact_setup_.options.regularization_time;
     // Per-node scratch, reused from call to call (no allocation per step once grown).

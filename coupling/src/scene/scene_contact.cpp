@@ -171,6 +171,7 @@ static void parse_detection(const JsonReader& c, ContactSpec& spec) {
   o.extent_tolerance = c.number("extent_tolerance", o.extent_tolerance, Range{0.0, 1.0, false, false});
   o.min_mass_fraction = c.number("min_mass_fraction", o.min_mass_fraction, Range{0.0, 0.5, false, true});
   o.sliver_fraction = c.number("sliver_fraction", o.sliver_fraction, Range{0.0, 0.5, false, true});
+  o.light_touch_fraction = c.number("light_touch_fraction", 0.0, Range{0.0, 0.5, false, true});
   o.area = c.choice("area", {"domain", "surface"}, "surface") == "surface" ? mechanics::ContactAreaMethod::surface
                                                                          : mechanics::ContactAreaMethod::domain;
   // Normal-stress regularisation of friction (docs/contact.md, "Normal-stress regularisation").

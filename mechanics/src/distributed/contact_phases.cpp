@@ -184,6 +184,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
   ctx.step = steps_taken;
   ctx.slip_length = co.regularization_slip_length;
   ctx.relaxation_time = co.regularization_time;
+  ctx.light_touch_fraction = co.light_touch_fraction;
   auto pair_of = [this](int x, int y) -> const ContactPairSettings& { return this->pair_of(x, y); };
   // Per-node scratch, reused from call to call (no allocation per step once grown).
   thread_local std::vector<ContactSide<Dim>> sides;
