@@ -11,7 +11,8 @@
 //     to the block by an adhesion law), with a heat solve added to close the energy books: 1100
 //     steps, 330 of them with the pushers moving, on 2 and 4 ranks;
 //   * the normal-stress regularisation (examples/sliding_block.json with Coulomb μ = 0.5 and
-//     contact.regularization), the whole run on 2 and 4 ranks.
+//     contact.regularization), the whole run on 2 and 4 ranks;
+//   * contact.light_touch_fraction (the oscillating block under MUSL, position separation) on 2 ranks.
 // Every series column within 1e-9 of the serial column's scale; the decomposed heat books (the
 // frictional work received, the heat delivered, the nodal and the particle energy change) closed to
 // 1e-9 of the work. Skipped when mpirun is not installed. Labels verification;mpi.
@@ -127,6 +128,27 @@ TEST_F(MpirunContact, RegularizedFrictionMatchesSerial) {
                                " --set run.checkpoint_interval=1e-3 -q -o '" + path("refused.h5") + "'");
   EXPECT_EQ(refused.code, 2) << refused.output;
   EXPECT_THAT(refused.output, HasSubstr("run.checkpoint_interval: 0.001 with contact.regularization"));
+}
+
+// contact.light_touch_fraction (docs/contact.md, "The source: light materials the position test calls
+// separated"): the oscillating block under MUSL with position separation, 1100 steps on 2 ranks. The
+// option moves this run's kinetic energy by 90 % of its scale, so a decomposed run that ignored it could
+// not match.
+TEST_F(MpirunContact, LightTouchMatchesSerial) {
+  const std::string sets = " --set 'solver.scheme=\"musl\"' --set 'contact.separation=\"position\"'"
+                           " --set run.max_steps=1100 --set output.series_interval=0";
+  run_both("examples/oscillating_block.json", sets + " --set contact.light_touch_fraction=0.03", 2);
+  for (const char* c : {"time", "dt", "kinetic_energy", "external_work", "momentum_x", "friction_work_first",
+                        "friction_work_second", "contact_nodes", "sliding_nodes"})
+    expect_same_column(c, kSame);
+  const Result off = shell(exe() + " run " + source("examples/oscillating_block.json") + sets +
+                           " -q --threads 1 --force -o '" + path("off.h5") + "'");
+  ASSERT_EQ(off.code, 0) << off.output;
+  const std::vector<double> on = column("serial.h5", "kinetic_energy"), without = column("off.h5", "kinetic_energy");
+  ASSERT_EQ(on.size(), without.size());
+  double scale = 0.0, diff = 0.0;
+  for (std::size_t k = 0; k < on.size(); ++k) scale = std::max(scale, on[k]), diff = std::max(diff, std::fabs(on[k] - without[k]));
+  EXPECT_GT(diff, 0.1 * scale) << "the light-touch option should change this run";
 }
 
 // `validate` says both examples decompose.
