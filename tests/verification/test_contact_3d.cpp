@@ -20,20 +20,33 @@
 
 using namespace frictherm::mechanics;
 
-TEST(Contact3D, ObliqueCollisionConservesMomentumWithFiniteHeat) {
+namespace {
+
+// The two blocks on a 40 × 28 × 20 mm grid of cell h (MUSL, C = 0.4): block a moves right and up,
+// block b left; they meet on the plane x = 0.02 with a shear velocity.
+Simulation<3> oblique_blocks(double h) {
   SimulationOptions o;
   o.cfl = 0.4;
-  const double h = 0.002;
-  Simulation<3> sim(Grid<3>(Vec<3>(0, 0, 0), Vec<3>(h, h, h), IVec<3>{20, 14, 10}), o);
+  const IVec<3> cells{static_cast<int>(std::lround(0.04 / h)), static_cast<int>(std::lround(0.028 / h)),
+                      static_cast<int>(std::lround(0.02 / h))};
+  Simulation<3> sim(Grid<3>(Vec<3>(0, 0, 0), Vec<3>(h, h, h), cells), o);
   Material m;
   m.density = 1000, m.youngs_modulus = 1e8, m.poisson_ratio = 0.3;
   m.name = "a";
   const int a = sim.add_material(m);
   m.name = "b";
   const int b = sim.add_material(m);
-  // Block a moves right and up, block b left: they meet on the plane x = 0.02 with a shear velocity.
   sim.add_body("a", *make_box<3>(Vec<3>(0.006, 0.008, 0.006), Vec<3>(0.020, 0.018, 0.014), a), 2, Vec<3>(20, 8, 0));
   sim.add_body("b", *make_box<3>(Vec<3>(0.020, 0.010, 0.006), Vec<3>(0.034, 0.020, 0.014), b), 2, Vec<3>(-20, -4, 0));
+  return sim;
+}
+
+}  // namespace
+
+TEST(Contact3D, ObliqueCollisionConservesMomentumWithFiniteHeat) {
+  const double h = 0.002;
+  Simulation<3> sim = oblique_blocks(h);
+  const int a = 0;  // the first material (block b is material 1)
   ContactOptions co;
   co.default_pair.law = FrictionLaw::coulomb(0.3);
   sim.enable_contact(co);
@@ -116,19 +129,7 @@ struct ImpactEnergy {
 // The set-up above at cell size h (MUSL, position separation, C = 0.4): the energy lost is the initial
 // kinetic energy less the mean of kinetic + strain energy over the free flight (260–340 µs).
 ImpactEnergy oblique_impact(double h, const FrictionLaw& law, double light_touch_fraction, double sliver_fraction = 0.0) {
-  SimulationOptions o;
-  o.cfl = 0.4;
-  const IVec<3> cells{static_cast<int>(std::lround(0.04 / h)), static_cast<int>(std::lround(0.028 / h)),
-                      static_cast<int>(std::lround(0.02 / h))};
-  Simulation<3> sim(Grid<3>(Vec<3>(0, 0, 0), Vec<3>(h, h, h), cells), o);
-  Material m;
-  m.density = 1000, m.youngs_modulus = 1e8, m.poisson_ratio = 0.3;
-  m.name = "a";
-  const int a = sim.add_material(m);
-  m.name = "b";
-  const int b = sim.add_material(m);
-  sim.add_body("a", *make_box<3>(Vec<3>(0.006, 0.008, 0.006), Vec<3>(0.020, 0.018, 0.014), a), 2, Vec<3>(20, 8, 0));
-  sim.add_body("b", *make_box<3>(Vec<3>(0.020, 0.010, 0.006), Vec<3>(0.034, 0.020, 0.014), b), 2, Vec<3>(-20, -4, 0));
+  Simulation<3> sim = oblique_blocks(h);
   ContactOptions co;
   co.default_pair.law = law;
   co.light_touch_fraction = light_touch_fraction;
