@@ -132,6 +132,17 @@ TEST_F(MpirunReaction, PbxReactionInTheContinuationEqualsTheSerialRun) {
   compare(true);
 }
 
+// Forward Euler with the reaction (its reacting sub-steps: the serial Scheme on the distributed ODE,
+// the self-heating step bound agreed over the ranks), during loading and in the continuation.
+TEST_F(MpirunReaction, PbxReactionWithForwardEulerEqualsTheSerialRun) {
+  run_both(kScene,
+           std::string(kSets) + " --set thermal.integrator=forward_euler --set thermal.linear_solver=null --set thermal.reaction.during_loading=true"
+                                " --set coupling.interface_temperature=null",
+           2);
+  if (HasFatalFailure()) return;
+  compare(false);
+}
+
 TEST_F(MpirunReaction, PbxReactionDuringLoadingEqualsTheSerialRun) {
   run_both(kScene,
            std::string(kSets) + " --set thermal.reaction.during_loading=true --set coupling.interface_temperature=null",
@@ -141,15 +152,15 @@ TEST_F(MpirunReaction, PbxReactionDuringLoadingEqualsTheSerialRun) {
 }
 
 // What a decomposed run does not take with a reaction, said by `frictherm validate` (the same check,
-// decomposed_run_refusal, refuses `mpirun -n K frictherm run`: CliMpirun.Refusals): forward Euler
-// (its reacting sub-steps are not distributed) and the interface temperature with the reaction during
-// loading (the interface reaction starts with the continuation).
+// decomposed_run_refusal, refuses `mpirun -n K frictherm run`: CliMpirun.Refusals): the interface
+// temperature with the reaction during loading (the interface reaction starts with the continuation).
+// Forward Euler with the reaction decomposes.
 TEST_F(MpirunReaction, ValidateNamesWhatIsNotDecomposed) {
   const std::string scene = source("tests/coupling/scenes/decomposed_sliding_block.json");
   const std::string reaction =
       " --set 'thermal.reaction={\"kinetics\":\"hmx_rogers1975\",\"materials\":[\"block\"]}'";
   const std::pair<std::string, std::string> cases[] = {
-      {reaction, "serial only (thermal.integrator: \"forward_euler\" with thermal.reaction is not supported"},
+      {reaction, "mpirun -n K frictherm run decomposes it"},  // forward Euler (the scene's) with the reaction
       {reaction + " --set thermal.integrator=cvode_bdf --set coupling.interface_temperature=true",
        "serial only (thermal.reaction.during_loading: true with coupling.interface_temperature is not supported"},
       {reaction + " --set thermal.integrator=cvode_bdf", "mpirun -n K frictherm run decomposes it"},

@@ -83,10 +83,8 @@ std::string thermal_refusal(const Scene& s) {
     return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
   // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed
-  // integrators carry λ), not with forward Euler; its interface reaction from the continuation on.
-  if (c.reaction.enabled && c.integrator == "forward_euler")
-    return refuse("thermal.integrator", quoted("forward_euler") + " with thermal.reaction",
-                  "\"cvode_bdf\", \"auto\" or another implicit integrator");
+  // integrators carry λ: forward Euler's reacting sub-steps too, the serial Scheme on the distributed
+  // ODE); its interface reaction from the continuation on.
   if (c.reaction.enabled && c.reaction.during_loading && c.interface_temperature.enabled)
     return refuse("thermal.reaction.during_loading", "true with coupling.interface_temperature",
                   "false (the interface reaction from the continuation on)");
