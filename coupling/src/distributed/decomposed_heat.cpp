@@ -442,6 +442,8 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   if (matrix_free) {
     last_lambda_ = lambda;
     if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (opt_.fe_safety * 2.0 / lambda) - 1e-12)));
+    const double max_dt = opt_.integrator_options.fe_max_dt;  // and the cap on the sub-step, as the serial window
+    if (max_dt > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / max_dt - 1e-12)));
     matrix_free = n <= opt_.matrix_free_max_substeps;
   }
 

@@ -79,8 +79,7 @@ std::string thermal_refusal(const Scene& s) {
     return refuse("thermal.forward_euler.stability", quoted(io.fe_stability_policy), "\"substep\"");
   if (forward_euler && io.fe_limit_estimate != "gershgorin")
     return refuse("thermal.forward_euler.limit_estimate", quoted(io.fe_limit_estimate), "\"gershgorin\"");
-  if (forward_euler && io.fe_max_dt > 0.0)
-    return refuse("thermal.forward_euler.max_dt", number(io.fe_max_dt), "0 or no key");
+  // thermal.forward_euler.max_dt caps the sub-steps of both paths (as the serial Coupler's window).
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
   // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed
   // integrators carry λ: forward Euler's reacting sub-steps too, the serial Scheme on the distributed
