@@ -5,6 +5,7 @@
 // mechanics' transfers (DMLocalToGlobal ADD, DMGlobalToLocal). One template on Dim for the 2D and 3D
 // mechanics; G'_ip flat, Dim values per kept entry.
 #include <frictherm/coupling/decomposed_heat.hpp>
+#include <frictherm/thermal/stability.hpp>
 #include <frictherm/coupling/fixed_temperature.hpp>
 
 #include "distributed/decomposed_assembled.hpp"
@@ -441,9 +442,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   long n = 1;
   if (matrix_free) {
     last_lambda_ = lambda;
-    if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (opt_.fe_safety * 2.0 / lambda) - 1e-12)));
-    const double max_dt = opt_.integrator_options.fe_max_dt;  // and the cap on the sub-step, as the serial window
-    if (max_dt > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / max_dt - 1e-12)));
+    n = thermal::forward_euler_substeps(dt, lambda, opt_.fe_safety, opt_.integrator_options.fe_max_dt);  // as the serial window
     matrix_free = n <= opt_.matrix_free_max_substeps;
   }
 

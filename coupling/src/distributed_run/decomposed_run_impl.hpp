@@ -71,6 +71,7 @@ class DecomposedRun {
  private:
   bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
   bool heat_continuation() const { return s_.thermal.enabled && s_.thermal.continuation_duration > 0.0; }
+  bool checkpoints_supported() const;  // decomposed_runner.cpp
 
   bool show_progress() const {
     if (o_.quiet || o_.progress == RunOptions::Progress::never) return false;

@@ -27,6 +27,13 @@ DecomposedRun<Dim>::~DecomposedRun() {
   if (failure_comm_ != MPI_COMM_NULL) MPI_Comm_free(&failure_comm_);
 }
 
+// Whether a decomposed checkpoint can hold this run: not the interface temperature's flux histories,
+// the contact regularisation's lagged tractions or a continuation's last window.
+template <int Dim>
+bool DecomposedRun<Dim>::checkpoints_supported() const {
+  return !detail::interface_temperature(s_) && !detail::contact_regularized(s_) && !heat_continuation();
+}
+
 template <int Dim>
 RunResult DecomposedRun<Dim>::execute() {
   const Clock::time_point t0 = Clock::now();
@@ -50,7 +57,7 @@ RunResult DecomposedRun<Dim>::execute() {
   // Without a checkpoint setting: every decomposed_default_checkpoint_wall_interval wall seconds where
   // a decomposed checkpoint is supported (issue 34: two SIGTERMs to mpirun kill the ranks at once).
   wall_interval_ = o_.checkpoint_wall_interval;
-  if (!checkpoints_ && !detail::interface_temperature(s_) && !detail::contact_regularized(s_) && !heat_continuation())
+  if (!checkpoints_ && checkpoints_supported())
     wall_interval_ = std::max(0.0, o_.decomposed_default_checkpoint_wall_interval);
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
@@ -93,9 +100,7 @@ RunResult DecomposedRun<Dim>::execute() {
     try {
       // Nor with the interface temperature or the contact regularisation, whose flux histories and lagged
       // tractions a decomposed checkpoint does not hold.
-      if (checkpoints_ || (interrupted && !heat_continuation() && !detail::interface_temperature(s_) &&
-                           !detail::contact_regularized(s_)))
-        checkpoint();
+      if (checkpoints_ || (interrupted && checkpoints_supported())) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {

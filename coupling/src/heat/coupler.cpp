@@ -1,5 +1,6 @@
 // The coupling window: accumulate work, assemble (eq. 38), deliver, integrate, map back, track.
 #include <frictherm/coupling/coupler.hpp>
+#include <frictherm/thermal/stability.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -182,12 +183,7 @@ bool Coupler<Dim>::matrix_free_window(mechanics::Particles<Dim>& p, double dt) {
   // exact bound too; otherwise the exact bound decides. (On the PBX scene the quick bound exceeds the
   // one-step limit in 13 of 100 windows: nodes at the edge of the material with little M, where it is
   // ~3× the exact one.)
-  const auto substeps = [&](double lam) {
-    long n = 1;
-    if (lam > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (o.fe_safety * 2.0 / lam) - 1e-12)));
-    if (o.fe_max_dt > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / o.fe_max_dt - 1e-12)));
-    return n;
-  };
+  const auto substeps = [&](double lam) { return thermal::forward_euler_substeps(dt, lam, o.fe_safety, o.fe_max_dt); };
   long n = substeps(last_lambda_bound_);
   if (lambda_bound_is_quick_ && n > 1) {  // the window's stencils are still those of the gather
     last_lambda_bound_ = explicit_.lambda_bound(system_, fixed_nodes_);

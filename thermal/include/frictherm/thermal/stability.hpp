@@ -5,6 +5,8 @@
 
 #include "frictherm/thermal/problem.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace frictherm::thermal {
@@ -23,5 +25,14 @@ double lambda_max_power(const Problem& problem, int iterations = 200);
 // λ = min(1.05·λ_power, λ_gershgorin): a 5 % margin for the iteration's underestimate.
 // Returns +inf when λ = 0 (no conduction or everything fixed).
 double forward_euler_dt_limit(const Problem& problem, const std::string& estimate = "gershgorin");
+
+// Forward Euler sub-steps for a window dt: stable under the bound lambda (h ≤ safety · 2/λ; λ ≤ 0: no
+// limit) and no longer than max_dt when max_dt > 0 (IntegratorOptions::fe_max_dt).
+inline long forward_euler_substeps(double dt, double lambda, double safety, double max_dt) {
+  long n = 1;
+  if (lambda > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / (safety * 2.0 / lambda) - 1e-12)));
+  if (max_dt > 0.0) n = std::max(n, static_cast<long>(std::ceil(dt / max_dt - 1e-12)));
+  return n;
+}
 
 }  // namespace frictherm::thermal
