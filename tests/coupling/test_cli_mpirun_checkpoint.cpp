@@ -323,4 +323,65 @@ TEST_F(CliMpirunCheckpoint, RegularizedContactResumesToTheUninterruptedRun) {
   EXPECT_GT(read_doubles(path("full.h5"), "/series/sliding_nodes").back(), 0.0) << "the block slides to the end";
 }
 
+// A run with a thermal-only continuation (coupling.continuation: 2 ms of conduction alone in 1500
+// intervals after the 10 ms of loading, checkpoints every 2 ms, hot spots above a 0.3 K rise: two at the
+// end of the loading), stopped by SIGUSR1 in its continuation
+// and resumed on 2 ranks: every series column and the /hotspot_fates table equal the uninterrupted run's.
+//   * The scene's matrix-free forward-Euler windows: the continuation gathers and assembles afresh from
+//     the particles, so the end-of-loading checkpoint (marks/end_of_loading = 1, written just before the
+//     continuation starts: the signal follows it) lets the resume rerun the continuation bit for bit.
+//   * cvode_bdf windows: the continuation goes on from the last window's assembled problem and end
+//     temperatures, which a decomposed checkpoint does not hold, so no end-of-loading checkpoint is
+//     written (resumed from one, the hottest temperature had moved by 2 % of the rise and a hot spot's
+//     decision time by 0.75 ms); the last checkpoint of the loading (8 ms) stays and the resume reruns
+//     the loading's last windows and the continuation bit for bit.
+TEST_F(CliMpirunCheckpoint, ContinuationInterruptedResumesToTheUninterruptedRun) {
+  const std::string continuation =
+      " --set 'coupling.continuation={\"duration\":2e-3,\"intervals\":1500}'"
+      " --set 'coupling.hotspots={\"mode\":\"rise\",\"threshold\":0.3}'";
+  const std::string cvode = " --set thermal.integrator='\"cvode_bdf\"' --set thermal.linear_solver='\"pcg\"'"
+                            " --set thermal.rtol=1e-6 --set thermal.atol=1e-6 --set coupling.window='\"adaptive\"'";
+  for (const bool assembled : {false, true}) {
+    const std::string extra = continuation + (assembled ? cvode : "");
+    for (const auto& e : fs::directory_iterator(path("")))
+      if (e.is_regular_file()) fs::remove(e.path());
+    run_full("2e-3", "1e-2", extra);
+    if (HasFatalFailure()) return;
+    // The loading's checkpoints are generations 1-4 (2, 4, 6, 8 ms); the end-of-loading one is 5.
+    const std::string wait_for = path(assembled ? "part.h5.checkpoint.4.rank0" : "part.h5.checkpoint.5.rank0");
+    const std::string out = path("part.h5");
+    shell(mpirun(2) + " " + exe() + " run" + scene_args("2e-3", "1e-2", extra) + " -o '" + out + "' > '" +
+          path("log") + "' 2>&1 & pid=$!; for i in $(seq 1 6000); do [ -e '" + wait_for + "' ] && break; sleep 0.01; done; " +
+          (assembled ? "sleep 1; " : "") + "kill -USR1 $pid; wait $pid; exit 0");
+    ASSERT_THAT(text("log"), HasSubstr("interrupted by SIGUSR1")) << "the run must be stopped before its end";
+    const std::vector<double> rows = read_doubles(out, "/series/time"), full = read_doubles(path("full.h5"), "/series/time");
+    const std::vector<double> mark = read_doubles(path("part.h5.checkpoint"), "/marks/time"),
+                              end_of_loading = read_doubles(path("part.h5.checkpoint"), "/marks/end_of_loading");
+    ASSERT_EQ(mark.size(), 1u);
+    ASSERT_EQ(end_of_loading.size(), 1u);
+    std::printf("  %s windows: stopped at series row %zu of %zu (t = %.6g s); checkpoint at t = %.6g s, end of loading %g\n",
+                assembled ? "cvode_bdf" : "forward-Euler", rows.size(), full.size(), rows.empty() ? 0.0 : rows.back(),
+                mark[0], end_of_loading[0]);
+    EXPECT_EQ(end_of_loading[0], assembled ? 0.0 : 1.0);
+    if (!assembled) EXPECT_GT(rows.back(), 1e-2) << "the signal follows the end-of-loading checkpoint: in the continuation";
+    const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + out + "'");
+    ASSERT_EQ(resumed.code, 0) << resumed.output;
+    std::size_t columns = 0;
+    for (const std::string& c : frictherm::test::names_in(path("full.h5"), "/series")) {
+      const std::vector<double> a = read_doubles(path("full.h5"), "/series/" + c), b = read_doubles(out, "/series/" + c);
+      ASSERT_EQ(a.size(), b.size()) << c;
+      for (std::size_t k = 0; k < a.size(); ++k)
+        ASSERT_TRUE(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k]))) << c << " row " << k;
+      ++columns;
+    }
+    for (const char* c : {"id", "decision_time", "final_peak_temperature", "max_peak_temperature"}) {
+      const std::vector<double> a = read_doubles(path("full.h5"), std::string("/hotspot_fates/") + c);
+      EXPECT_FALSE(a.empty()) << c << ": the block makes a hot spot";
+      EXPECT_EQ(a, read_doubles(out, std::string("/hotspot_fates/") + c)) << c;
+    }
+    std::printf("  resumed: %zu series columns of %zu rows and the hot-spot fates equal the uninterrupted run's\n",
+                columns, full.size());
+  }
+}
+
 }  // namespace

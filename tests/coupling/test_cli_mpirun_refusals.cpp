@@ -1,7 +1,7 @@
 // Refusals of `mpirun -n 2 frictherm run` and `validate` (issue 16, issue 34; coupling/app/cli_run_mpi.cpp,
 // coupling/src/scene/scene_decomposed.cpp, coupling/src/distributed_run/decomposed_runner.cpp):
-//   * a scene the decomposed engine does not support (checkpoints of a run with a continuation, the KLU
-//     solver) is refused with exit code 2 naming the scene key, before any
+//   * a scene the decomposed engine does not support (the KLU solver, the interface temperature's patch
+//     or checkpoints) is refused with exit code 2 naming the scene key, before any
 //     file is written, and `validate` says so;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
 //     untouched, and replaced with it;
@@ -27,8 +27,6 @@ using CliMpirun = CliMpirunTest;
 
 TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
   const std::pair<const char*, const char*> cases[] = {
-      {"--set 'coupling.continuation={\"duration\":1e-4}' --set run.checkpoint_interval=1e-4",
-       "run.checkpoint_interval: 0.0001 with coupling.continuation is not supported in a decomposed run"},
       {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
        "thermal.linear_solver: \"klu\" is not supported in a decomposed run"},
       // The interface temperature runs decomposed, but not its patch nor checkpoints (no histories in them).

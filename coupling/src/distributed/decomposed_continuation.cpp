@@ -12,6 +12,11 @@
 
 namespace frictherm::coupling {
 
+// As the serial reaction_starts: with a reaction the continuation assembles afresh (its Q_i, λ_i).
+bool DecomposedHeat::continuation_regathers() const {
+  return !last_assembled_ || !assembled_->assembled() || opt_.reaction.enabled;
+}
+
 void DecomposedHeat::continue_thermal(double time) {
   if (mpm3_) continue_on(*mpm3_, time);
   else continue_on(*mpm2_, time);
@@ -31,10 +36,10 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
   const MPI_Comm comm = mpm.communicator();
   bool gathered = false;  // this interval starts from the particles' temperatures (as the serial Coupler)
   if (!continuing_) {
+    const bool regather = continuation_regathers();
     assembled_->restart_integrator();  // the continuation depends only on the end-of-loading state
     continuing_ = true;  // a reaction held back during loading is active from here (reaction_active)
-    // As the serial reaction_starts: with a reaction the continuation assembles afresh (its Q_i, λ_i).
-    if (!last_assembled_ || !assembled_->assembled() || opt_.reaction.enabled) {
+    if (regather) {
       gathered = true;
       gather_window(mpm);
       number_unknowns(mpm);

@@ -7,9 +7,10 @@
 namespace frictherm::coupling::decomposed {
 
 template <int Dim>
-void DecomposedRun<Dim>::checkpoint() {
+void DecomposedRun<Dim>::checkpoint(bool end_of_loading) {
   const Clock::time_point c0 = Clock::now();
   CheckpointMarks m;
+  m.end_of_loading = end_of_loading;
   m.step = step_;
   m.time = time_;
   m.series_rows = series_columns_ > 0 ? static_cast<long>(series_rows_.size()) / series_columns_ : 0;
@@ -190,7 +191,7 @@ void DecomposedRun<Dim>::redistribute(int old) {
 }
 
 #define FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(D) \
-  template void DecomposedRun<D>::checkpoint(); \
+  template void DecomposedRun<D>::checkpoint(bool); \
   template void DecomposedRun<D>::restore(); \
   template void DecomposedRun<D>::redistribute(int old);
 FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(2)

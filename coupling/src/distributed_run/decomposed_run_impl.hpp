@@ -70,8 +70,8 @@ class DecomposedRun {
 
  private:
   bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
-  bool heat_continuation() const { return s_.thermal.enabled && s_.thermal.continuation_duration > 0.0; }
   bool checkpoints_supported() const;  // decomposed_runner.cpp
+  bool end_of_loading_checkpoint_exact() const;  // decomposed_runner.cpp
 
   bool show_progress() const {
     if (o_.quiet || o_.progress == RunOptions::Progress::never) return false;
@@ -182,6 +182,8 @@ class DecomposedRun {
   // Checkpoints: whether this run writes them, where, the generation of the last one, the clock of
   // --checkpoint-every; rank 0: every series row so far (flat) and OUT.xdmf's grids (from a resume).
   bool checkpoints_ = false, resuming_ = false;
+  bool continuation_started_ = false;  // the thermal continuation after the loading has begun
+  bool loading_complete_ = false;      // the loop reached the end time
   double wall_interval_ = 0.0;  // wall seconds between checkpoints (--checkpoint-every, or the decomposed default)
   std::string checkpoint_file_;
   long generation_ = 0, checkpoints_written_ = 0;
@@ -194,8 +196,9 @@ class DecomposedRun {
   typename Mpm::CheckpointState restored_;
   int redistributed_from_ = 0;  // ranks of a checkpoint resumed on another number of ranks
 
-  // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's.
-  void checkpoint();
+  // Collective: one checkpoint (decomposed_checkpoint.hpp), marks as the serial run's; `end_of_loading`
+  // for the one before a continuation (CheckpointMarks::end_of_loading).
+  void checkpoint(bool end_of_loading = false);
   // Collective: what a rank file must fit (decomposed_run_checkpoint.cpp).
   ckpt::RankSizes rank_sizes(bool ghosted) const;
 

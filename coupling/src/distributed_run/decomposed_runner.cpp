@@ -28,10 +28,21 @@ DecomposedRun<Dim>::~DecomposedRun() {
 }
 
 // Whether a decomposed checkpoint can hold this run: not the interface temperature's flux histories
-// or a continuation's last window (the contact regularisation's lagged tractions it holds).
+// (the contact regularisation's lagged tractions it holds; with a continuation it is taken during the
+// loading and at its end, as the serial run's).
 template <int Dim>
 bool DecomposedRun<Dim>::checkpoints_supported() const {
-  return !detail::interface_temperature(s_) && !heat_continuation();
+  return !detail::interface_temperature(s_);
+}
+
+// Whether a checkpoint at the end of the loading lets a resume repeat the run bit for bit: no
+// continuation follows, or one whose first interval gathers afresh from the particles. After
+// assembled windows (cvode_bdf, ...) the continuation goes on from the last window's problem, which a
+// decomposed checkpoint does not hold: a resume from the last checkpoint during the loading reruns
+// that window instead (docs/checkpoints.md).
+template <int Dim>
+bool DecomposedRun<Dim>::end_of_loading_checkpoint_exact() const {
+  return !(heat_ && s_.thermal.continuation_duration > 0.0) || heat_->continuation_regathers();
 }
 
 template <int Dim>
@@ -46,10 +57,6 @@ RunResult DecomposedRun<Dim>::execute() {
     throw SceneError("--checkpoint-every: checkpoints with coupling.interface_temperature are not supported in a "
                      "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
                      "supports it");
-  if (checkpoints_ && heat_continuation())  // run.checkpoint_interval: decomposed_run_refusal
-    throw SceneError("--checkpoint-every: checkpoints with coupling.continuation are not supported in a decomposed "
-                     "run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) supports "
-                     "it");
   // Without a checkpoint setting: every decomposed_default_checkpoint_wall_interval wall seconds where
   // a decomposed checkpoint is supported (issue 34: two SIGTERMs to mpirun kill the ranks at once).
   wall_interval_ = o_.checkpoint_wall_interval;
@@ -58,7 +65,7 @@ RunResult DecomposedRun<Dim>::execute() {
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
   // An interrupted run writes one too (below), so the generation is known whether or not it checkpoints.
-  if (!resuming_ && !heat_continuation()) generation_ = detail::committed_generation(comm_, checkpoint_file_);
+  if (!resuming_) generation_ = detail::committed_generation(comm_, checkpoint_file_);
   build();
   if (resuming_) restore();
   if (rank_ == 0)  // the result's identity (/meta/run_id, every checkpoint's marks): a resume keeps its checkpoint's
@@ -76,6 +83,10 @@ RunResult DecomposedRun<Dim>::execute() {
     }
     loop(progress);
     if (heat_ && r_.status == RunResult::Status::completed && s_.thermal.continuation_duration > 0.0) {
+      // The end-of-loading checkpoint, always where supported (as the serial run): a run interrupted in
+      // its continuation resumes from it and reruns the whole continuation (docs/checkpoints.md).
+      if (checkpoints_supported() && end_of_loading_checkpoint_exact()) checkpoint(true);
+      continuation_started_ = true;
       const Clock::time_point c0 = Clock::now();
       continuation();
       continuation_seconds_ = seconds_since(c0);
@@ -90,12 +101,14 @@ RunResult DecomposedRun<Dim>::execute() {
     // At the end, a stop at run.max_steps or an interruption: before the off-schedule row and
     // snapshot below, which an uninterrupted run does not have (a resume drops them).
     // Interrupted (SIGINT/SIGTERM): a checkpoint also without run.checkpoint_interval, so that `mpirun
-    // -n K frictherm resume` goes on (issue 34, as the serial run); not with a continuation, which a
-    // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
+    // -n K frictherm resume` goes on (issue 34, as the serial run); not with the interface temperature,
+    // whose flux histories a decomposed checkpoint does not hold. Once a continuation began, the
+    // end-of-loading checkpoint stays: a resume reruns the continuation from it.
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      // Nor with the interface temperature, whose flux histories a decomposed checkpoint does not hold.
-      if (checkpoints_ || (interrupted && checkpoints_supported())) checkpoint();
+      if ((checkpoints_ || (interrupted && checkpoints_supported())) && !continuation_started_ &&
+          (!loading_complete_ || end_of_loading_checkpoint_exact()))
+        checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();
     } catch (const std::exception& e) {
@@ -292,6 +305,7 @@ void DecomposedRun<Dim>::loop(detail::ProgressLine& progress) {
     }
     progress.update(step_, t);
   }
+  loading_complete_ = !(time_ < T - eps);
   if (signal != 0) {  // caught during the last step: the run is complete, but say so as the serial run
     r_.status = RunResult::Status::interrupted;
     r_.signal = signal;

@@ -100,12 +100,8 @@ std::string thermal_refusal(const Scene& s) {
     return refuse("coupling.reuse_distance", number(c.reuse_distance),
                   "0 or no key: the gather every window, or an integrator other than forward_euler and auto");
   // Plastic heating and the sub-grid relaxation run (DecomposedHeat, decomposed_sources.cpp).
-  // The continuation runs (DecomposedHeat::continue_thermal, the fates reduced over ranks), but is not
-  // checkpointed: its first interval goes on from the last window's problem and nodal temperatures,
-  // which a decomposed checkpoint does not hold (a resume would regather them: not the same run).
-  if (t.continuation_duration > 0.0 && s.checkpoint_interval > 0.0)
-    return refuse("run.checkpoint_interval", number(s.checkpoint_interval) + " with coupling.continuation",
-                  "no checkpoints with a continuation");
+  // The continuation runs (DecomposedHeat::continue_thermal, the fates reduced over ranks), with
+  // checkpoints during the loading and at its end (a resume from the end reruns the continuation).
   return "";
 }
 

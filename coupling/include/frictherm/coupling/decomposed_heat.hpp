@@ -150,6 +150,11 @@ class DecomposedHeat {
   /// end of the last window or interval to `time` (s) without a source, the mechanics frozen; ΔT_i back
   /// to the particles. Close the window first (no pending heat; else std::logic_error).
   void continue_thermal(double time);
+  /// Whether the continuation's first interval would gather and assemble afresh from the particles
+  /// (the last window matrix-free, or none, or a reaction), so that a checkpoint taken before it lets
+  /// a resume repeat it bit for bit; false when it goes on from the last assembled window's problem and
+  /// end temperatures, which a checkpoint does not hold.
+  bool continuation_regathers() const;
   /// Σ of the pending work over ranks (J).
   double pending_heat() const;
   /// The distributed integrator's global counts (zero before the first assembled window).
