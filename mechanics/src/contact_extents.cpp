@@ -8,6 +8,7 @@
 // from the grid lines, so a material that reaches a node only as a sliver of its edge row is still
 // seen in contact there, where the centre-of-mass test puts it ≈ 1.25 h away.
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include "contact_extent.hpp"
 
@@ -28,8 +29,7 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   contact_nodes_.entry_extent_other.assign(entries, none);
   if (entries == 0) return;
   if (static_cast<int>(contact_nodes_.extent_thread.size()) < threads_.count - 1) contact_nodes_.extent_thread.resize(static_cast<std::size_t>(threads_.count - 1));
-#pragma omp parallel num_threads(threads_.count)
-  {
+  parallel_region(threads_.count, [&] {
     const int tid = omp_get_thread_num();
     double* own = contact_nodes_.entry_extent_own.data();
     double* other = contact_nodes_.entry_extent_other.data();
@@ -59,7 +59,7 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
         });
       }
     }
-  }
+  });
   for (int t = 0; t + 1 < threads_.count; ++t) {
     const std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(t)];
     for (std::size_t q = 0; q < entries; ++q) {
