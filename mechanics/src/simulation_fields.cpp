@@ -288,7 +288,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
     }
   }
   };
-  if (threads_.count <= 1) {
+  if (without_team(threads_.count)) {
     fields_pass(field_work);
   } else {
 #pragma omp parallel num_threads(threads_.count) reduction(+ : field_work)
@@ -352,7 +352,7 @@ void Simulation<Dim>::apply_damping(double dt) {
     }
   }
   };
-  if (threads_.count <= 1) {  // without a team (parallel_region.hpp)
+  if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
     damp_pass(damped);
   } else {
 #pragma omp parallel num_threads(threads_.count) reduction(+ : damped)

@@ -231,7 +231,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   beyond_out = std::max(beyond_out, beyond);
   work_out += work;
   };
-  if (threads_.count <= 1) {  // without a team (parallel_region.hpp)
+  if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
     pass(first_bad, last_beyond, external_work);
   } else {
 #pragma omp parallel num_threads(threads_.count) reduction(min : first_bad) reduction(max : last_beyond) reduction(+ : external_work)
