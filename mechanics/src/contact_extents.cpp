@@ -8,12 +8,14 @@
 // from the grid lines, so a material that reaches a node only as a sliver of its edge row is still
 // seen in contact there, where the centre-of-mass test puts it ≈ 1.25 h away.
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include "contact_extent.hpp"
 
 #include <omp.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace frictherm::mechanics {
@@ -28,8 +30,15 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   contact_nodes_.entry_extent_other.assign(entries, none);
   if (entries == 0) return;
   if (static_cast<int>(contact_nodes_.extent_thread.size()) < threads_.count - 1) contact_nodes_.extent_thread.resize(static_cast<std::size_t>(threads_.count - 1));
-#pragma omp parallel num_threads(threads_.count)
-  {
+  // Per slot: 1 if its node has two or more fields with mass (the nodes add_particle_extent is
+  // called for). A particle whose stencil reaches no such slot with S > 0 adds nothing and is passed
+  // over after reading one byte per node (the same calls, in the same order, for the others).
+  thread_local std::vector<std::uint8_t> at_contact;  // no allocation once grown
+  at_contact.resize(nodes_.mass.size());
+  for (std::size_t q = 0; q < at_contact.size(); ++q)
+    at_contact[q] = contact_nodes_.node_field_count[static_cast<std::size_t>(layout_.slot_node[q])] >= 2;
+  const std::uint8_t* const flag = at_contact.data();
+  parallel_region(threads_.count, [&] {
     const int tid = omp_get_thread_num();
     double* own = contact_nodes_.entry_extent_own.data();
     double* other = contact_nodes_.entry_extent_other.data();
@@ -45,6 +54,9 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
+        int reaches = 0;
+        st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) { reaches |= flag[slot] & (S > 0.0); });
+        if (!reaches) continue;
         const Vec<Dim>& x = p_.position[k];
         const Vec<Dim>& l = p_.half_size[k];
         st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
@@ -59,7 +71,7 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
         });
       }
     }
-  }
+  });
   for (int t = 0; t + 1 < threads_.count; ++t) {
     const std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(t)];
     for (std::size_t q = 0; q < entries; ++q) {

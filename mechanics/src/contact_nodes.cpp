@@ -3,6 +3,7 @@
 // ranges of grid nodes. The list is the same for every thread count.
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include <omp.h>
 
@@ -46,8 +47,7 @@ void Simulation<Dim>::find_contact_nodes() {
   const double mmin = empty_node_mass_;
   const bool reset_whole_range = nodes_.mass.size() >= static_cast<std::size_t>(span_hi - span_lo);
 
-#pragma omp parallel num_threads(threads)
-  {
+  parallel_region(threads, [&] {
     const int t = omp_get_thread_num(), T = omp_get_num_threads();
     ContactNodeListing& w = contact_nodes_.listing[static_cast<std::size_t>(t)];
     const EvenShare share(span_lo, span_hi, t, T);
@@ -121,7 +121,7 @@ void Simulation<Dim>::find_contact_nodes() {
         contact_nodes_.entries[static_cast<std::size_t>(cursor++)] = {node, s, static_cast<int>(f)};
       }
     }
-  }
+  });
 }
 
 template void Simulation<2>::find_contact_nodes();

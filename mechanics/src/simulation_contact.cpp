@@ -3,6 +3,7 @@
 // frictional work. Sign convention in contact.hpp: n̂ points from material a to material b.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include "contact_extent.hpp"
 
@@ -68,8 +69,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   // the parallel region (that would end the program): the failure at the first such group is kept
   // and thrown after it as a SimulationError, the run's ordinary breakdown.
   ContactFailure failure;
-#pragma omp parallel num_threads(threads)
-  {
+  parallel_region(threads, [&] {
     ContactThreadWork& acc = contact_nodes_.thread_work[static_cast<std::size_t>(omp_get_thread_num())];
     PairContext ctx{nullptr, contact_setup_.options.separation, contact_setup_.options.position_correction, contact_setup_.options.extent_tolerance,
                     cell_volume, contact_setup_.options.area, dt, heat};
@@ -125,7 +125,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
         failure.keep(g, node, -1, -1, e.what());
       }
     }
-  }
+  });
   if (failure.group >= 0) {  // "step S, t = T s: contact.pairs[0].law (materials 'a' and 'b') at node ..."
     std::ostringstream msg;
     msg.precision(6);
@@ -217,8 +217,7 @@ void Simulation<Dim>::compute_contact_normals() {
   contact_nodes_.entry_extent_own.clear();  // no gap while the normals are gathered
   const long groups = static_cast<long>(contact_nodes_.groups.size()) - 1;
   const int threads = groups >= 256 ? threads_.count : 1;
-#pragma omp parallel num_threads(threads)
-  {
+  parallel_region(threads, [&] {
     thread_local std::vector<ContactSide<Dim>> sides;
     thread_local std::vector<int> slots, mats, entries;
     auto pair_of = [this](int ma, int mb) -> const ContactPairSettings& { return contact_pair(ma, mb); };
@@ -229,7 +228,7 @@ void Simulation<Dim>::compute_contact_normals() {
         contact_nodes_.entry_normal[static_cast<std::size_t>(entries[a])] = n;
       });
     }
-  }
+  });
 }
 
 template <int Dim>

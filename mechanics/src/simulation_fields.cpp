@@ -2,6 +2,7 @@
 // buffer reduction, velocity boundary conditions, p ← p + f dt, and rigid-body motion.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include <cmath>
@@ -240,7 +241,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   // returned: the impulse a rigid velocity condition adds, m v_rigid − (p + f dt), and the reaction of
   // a force on a rigid field (penalty contact: the slave's force on a rigid master), each dotted
   // with the rigid velocity.
-  double work = 0.0;
+  double rigid_work = 0.0;
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (!F.rigid) continue;
@@ -248,14 +249,16 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
     for (std::size_t s = F.first; s < F.first + F.count; ++s) {
       momentum[s] = nodes_.mass[s] * v;
       if (force) {
-        work += rigid_reaction_work<Dim>((*force)[s], v, dt);  // energy/energy_books.hpp
+        rigid_work += rigid_reaction_work<Dim>((*force)[s], v, dt);  // energy/energy_books.hpp
         (*force)[s].setZero();
       }
     }
   }
   // One parallel region over the deformable fields (one per grain in a PBX: a region each would
-  // cost more than their few hundred slots).
-#pragma omp parallel num_threads(threads_.count) reduction(+ : work)
+  // cost more than their few hundred slots); one thread runs it without a team (parallel_region.hpp),
+  // its sum added to `work` as the reduction clause adds it.
+  double field_work = 0.0;
+  const auto fields_pass = [&](double& work) {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -284,7 +287,14 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
       }
     }
   }
-  return work;
+  };
+  if (without_team(threads_.count)) {
+    fields_pass(field_work);
+  } else {
+#pragma omp parallel num_threads(threads_.count) reduction(+ : field_work)
+    fields_pass(field_work);
+  }
+  return rigid_work + field_work;
 }
 
 // v_i = p_i / m_i after the velocity boundary conditions on p_i; empty nodes get no velocity.
@@ -292,9 +302,9 @@ template <int Dim>
 void Simulation<Dim>::velocity_from_momentum() {
   apply_velocity_bc(nodes_.momentum, nullptr, 0.0);
   const double mmin = empty_node_mass_;
-#pragma omp parallel for num_threads(threads_.count) schedule(static)
-  for (std::size_t i = 0; i < nodes_.mass.size(); ++i)
+  parallel_for(threads_.count, nodes_.mass.size(), [&](std::size_t i) {
     nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+  });
 }
 
 // The grid update p_i^{n+1} = p_i^n + f_i dt after the velocity conditions on both, in phases (the
@@ -308,9 +318,9 @@ void Simulation<Dim>::save_start_velocity() {
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
   transfer_.start.resize(n);
-#pragma omp parallel for num_threads(threads_.count) schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
+  parallel_for(threads_.count, n, [&](std::size_t i) {
     transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
+  });
 }
 
 template <int Dim>
@@ -328,8 +338,8 @@ template <int Dim>
 void Simulation<Dim>::apply_damping(double dt) {
   if (!damping_active(opt_.damping_rate, opt_.damping_until, clock_.time)) return;
   const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
-  double removed = 0.0;
-#pragma omp parallel num_threads(threads_.count) reduction(+ : removed)
+  double damped = 0.0;
+  const auto damp_pass = [&](double& removed) {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -341,14 +351,20 @@ void Simulation<Dim>::apply_damping(double dt) {
       damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
     }
   }
-  work_books_.damping += removed;
+  };
+  if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
+    damp_pass(damped);
+  } else {
+#pragma omp parallel num_threads(threads_.count) reduction(+ : damped)
+    damp_pass(damped);
+  }
+  work_books_.damping += damped;
 }
 
 template <int Dim>
 void Simulation<Dim>::advance_grid_momentum(double dt) {
   const std::size_t n = nodes_.mass.size();
-#pragma omp parallel for num_threads(threads_.count) schedule(static)
-  for (std::size_t i = 0; i < n; ++i) nodes_.momentum[i] += nodes_.force[i] * dt;
+  parallel_for(threads_.count, n, [&](std::size_t i) { nodes_.momentum[i] += nodes_.force[i] * dt; });
 }
 
 template <int Dim>
@@ -357,8 +373,7 @@ void Simulation<Dim>::nodal_velocities() {
   const std::size_t n = nodes_.mass.size();
   // Nodes driven by a rigid boundary material keep its prescribed velocity components (the force was
   // zeroed consistently, so only the velocity needs resetting when the prescribed velocity changes).
-#pragma omp parallel for num_threads(threads_.count) schedule(static)
-  for (std::size_t s = 0; s < n; ++s) {
+  parallel_for(threads_.count, n, [&](std::size_t s) {
     const double m = nodes_.mass[s];
     if (m > mmin) {
       nodes_.velocity[s] = nodes_.momentum[s] / m;
@@ -371,7 +386,7 @@ void Simulation<Dim>::nodal_velocities() {
       nodes_.velocity[s].setZero();
       nodes_.acceleration[s].setZero();
     }
-  }
+  });
   for (std::size_t f = 0; f < fields_.size(); ++f)
     if (fields_[f].rigid)
       for (std::size_t s = fields_[f].first; s < fields_[f].first + fields_[f].count; ++s) nodes_.velocity[s] = layout_.field_velocity[f];

@@ -8,6 +8,7 @@
 // the start of the next step and the heat hand-off after it need not pass over the particles again.
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/transfer/pic_blend.hpp>
 
@@ -47,9 +48,9 @@ FRICTHERM_ALWAYS_INLINE void add_gradient(Mat<Dim>& L, const Vec<Dim>& v, const 
 template <int Dim>
 template <bool Kinematics, bool Stress, class Stencils>
 typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(double dt, Stencils& st, bool refresh) {
-  long bad = std::numeric_limits<long>::max();  // min-reduction identity
-  long beyond = -1;                              // max-reduction identity
-  double work = 0.0;
+  long first_bad = std::numeric_limits<long>::max();  // min-reduction identity
+  long last_beyond = -1;                              // max-reduction identity
+  double external_work = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const double pic = pic_blend_fraction(dt, opt_.pic_relaxation_time);
   const ParticleUpdate update = opt_.particle_update;
@@ -104,8 +105,10 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   }
   double* const work_block = threads_.work_blocks.data();
 
-#pragma omp parallel num_threads(threads_.count) reduction(min : bad) reduction(max : beyond) reduction(+ : work)
-  {
+  // The region's body: its own minimum, maximum and sum (in registers) into the reduction's.
+  const auto pass = [&](long& bad_out, long& beyond_out, double& work_out) {
+  long bad = std::numeric_limits<long>::max(), beyond = -1;
+  double work = 0.0;
   thread_local step_detail::StencilBoxes<Dim> boxes;
   if (refresh) boxes.reset(nm);
   for_each_part(threads_.pass_split, [&](int t) {
@@ -224,7 +227,17 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
 #pragma omp critical(frictherm_stencil_boxes)
     boxes.merge_into(layout_.box_lo, layout_.box_hi);
   }
-  }  // omp parallel
+  bad_out = std::min(bad_out, bad);
+  beyond_out = std::max(beyond_out, beyond);
+  work_out += work;
+  };
+  if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
+    pass(first_bad, last_beyond, external_work);
+  } else {
+#pragma omp parallel num_threads(threads_.count) reduction(min : first_bad) reduction(max : last_beyond) reduction(+ : external_work)
+    pass(first_bad, last_beyond, external_work);
+  }
+  double work = external_work;
   if (blocked) {
     for (const double w : threads_.work_blocks) work += w;
     threads_.pass_split.rebalance(layout_.material_begin, layout_.material_end, layout_.field_of_material);
@@ -237,7 +250,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     work_books_.external += work;
   }
   if constexpr (Stress) wave_speeds_.ready = true;
-  return {bad == std::numeric_limits<long>::max() ? -1 : bad, beyond};
+  return {first_bad == std::numeric_limits<long>::max() ? -1 : first_bad, last_beyond};
 }
 
 #define FRICTHERM_INSTANTIATE_PASS_FOR(D, ...)                                                          \

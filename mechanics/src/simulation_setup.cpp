@@ -1,5 +1,6 @@
 // Simulation set-up: materials, bodies filled with particles, boundary conditions and loads.
 #include <frictherm/mechanics/loads/grid_loads.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/time_step/cfl_time_step.hpp>
 
@@ -266,8 +267,13 @@ double Simulation<Dim>::stable_time_step() const {
   const std::size_t n = p_.size();
   if (finalized_ && wave_speeds_.ready && wave_speeds_.speed.size() == n) {
     // The wave speeds of the last stress update (rigid particles: −∞; the rigid loop below counts them).
+    // One thread: no team (parallel_region.hpp); a maximum is exact in any order.
+    if (without_team(threads_.count)) {
+      for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speeds_.speed[k] + p_.velocity[k].norm());
+    } else {
 #pragma omp parallel for num_threads(threads_.count) schedule(static) reduction(max : cmax)
-    for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speeds_.speed[k] + p_.velocity[k].norm());
+      for (std::size_t k = 0; k < n; ++k) cmax = std::max(cmax, wave_speeds_.speed[k] + p_.velocity[k].norm());
+    }
   } else {
     // One parallel region for all materials (grains are small: see evaluate_stencils).
 #pragma omp parallel num_threads(threads_.count) reduction(max : cmax)

@@ -8,6 +8,7 @@
 // (simulation_ebs.cpp) and the same loops read them.
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
 #include "stencil_access.hpp"
@@ -285,8 +286,7 @@ void Simulation<Dim>::evaluate_stencils() {
   const Vec<Dim>* const position = p_.position.data();
   const Vec<Dim>* const half_size = p_.half_size.data();
   if (!contact_setup_.enabled) {
-#pragma omp parallel for num_threads(threads_.count) schedule(static)
-    for (std::size_t k = 0; k < p_.size(); ++k) stk[k].evaluate(grid, position[k], half_size[k]);
+    parallel_for(threads_.count, p_.size(), [&](std::size_t k) { stk[k].evaluate(grid, position[k], half_size[k]); });
     return;
   }
   const std::size_t nm = materials_.size();
@@ -294,8 +294,7 @@ void Simulation<Dim>::evaluate_stencils() {
   step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
   // One parallel region for all materials (a grain is a few hundred particles: a region per
   // material would cost more in fork/join than its particles); per-thread boxes merged at the end.
-#pragma omp parallel num_threads(threads_.count)
-  {
+  parallel_region(threads_.count, [&] {
     thread_local step_detail::StencilBoxes<Dim> boxes;
     boxes.reset(nm);
     for_each_part(threads_.partition, [&](int t) {
@@ -309,7 +308,7 @@ void Simulation<Dim>::evaluate_stencils() {
     });
 #pragma omp critical(frictherm_stencil_boxes)
     boxes.merge_into(layout_.box_lo, layout_.box_hi);
-  }
+  });
 }
 
 template <int Dim>
@@ -330,12 +329,11 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
 
 // Each part of the thread partition clears the slots it scatters into (its own fields in the nodes,
 // its buffer for a field it shares) and scatters; after a barrier the shared fields' buffers are
-// summed into the nodes. One parallel region per phase.
+// summed into the nodes. One parallel region per phase (none on one thread: parallel_region.hpp).
 template <int Dim>
 template <class Scatter>
 void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter) {
-#pragma omp parallel num_threads(threads_.count)
-  {
+  parallel_region(threads_.count, [&] {
     for_each_part(threads_.partition, [&](int t) {
       clear_scatter_targets(t, which);
       for (std::size_t m = 0; m < materials_.size(); ++m) {
@@ -350,7 +348,7 @@ void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatt
 #pragma omp barrier
       sum_shared_fields(which);
     }
-  }
+  });
 }
 
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:

@@ -2,6 +2,7 @@
 // v* = Σ_{j=0}^{order−1} (I − S⁺S)^j w0 on each deformable velocity field, one grid → particle → grid
 // round trip per term. Hammerquist & Nairn 2017 (XPIC), Nairn & Hammerquist 2021 (FMPM).
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include <omp.h>
 
@@ -22,8 +23,7 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
   const double mmin = empty_node_mass_;
   for (int j = 1; j < opt_.transfer_order; ++j) {
     // round_trip_i = (S⁺ S term)_i = Σ_p S_ip m_p (Σ_k S_kp term_k) / m_i
-#pragma omp parallel num_threads(threads_.count)
-    {
+    parallel_region(threads_.count, [&] {
       const int tid = omp_get_thread_num();
       std::vector<Vec<Dim>>& acc = tid == 0 ? X.round_trip : X.thread_acc[static_cast<std::size_t>(tid - 1)];
       std::fill(acc.begin(), acc.end(), Vec<Dim>::Zero());
@@ -39,10 +39,9 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
           st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc[static_cast<std::size_t>(i)] += S * mu; });
         }
       }
-    }
+    });
     // term ← term − S⁺S term; zero at velocity conditions (v* keeps w0 there); filtered += term.
-#pragma omp parallel for num_threads(threads_.count) schedule(static)
-    for (std::size_t s = 0; s < n; ++s) {
+    parallel_for(threads_.count, n, [&](std::size_t s) {
       Vec<Dim> rt = X.round_trip[s];
       for (const auto& b : X.thread_acc) rt += b[s];
       const double ms = nodes_.mass[s];
@@ -53,7 +52,7 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
           if (bc & (1u << d)) next[d] = 0.0;
       X.term[s] = next;
       X.filtered[s] += next;
-    }
+    });
   }
   // Rigid fields keep their prescribed velocity.
   for (const VelocityField<Dim>& F : fields_)

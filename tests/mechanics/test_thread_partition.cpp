@@ -1,7 +1,8 @@
 // The thread partition of the particle loops (thread_partition.hpp): its ranges, the fields it
 // shares, and that a multimaterial contact run gives the same particles on 1, 2 and 3 threads (to
 // round-off: only a shared field's sums are split among threads) and bit for bit the same whether
-// its parts run on their own threads or on fewer (a nested region). The particle passes' timed
+// its parts run on their own threads or on fewer (a nested region), and one-thread steps inside the
+// caller's own team of threads give the bits of a serial run. The particle passes' timed
 // split (PassSplit) moves to equal measured cost, and the numbers do not depend on where it is.
 #include <frictherm/mechanics/geometry.hpp>
 #include <frictherm/mechanics/simulation.hpp>
@@ -230,6 +231,37 @@ TEST(ThreadPartition, FewerThreadsThanPartsGiveTheSameParticles) {
     }
     EXPECT_NEAR(r.w2, three.w2, 1e-12 * three.w2);
     EXPECT_EQ(r.external_work, three.external_work);
+  }
+}
+
+// Steps asked for one thread inside the caller's own team of two (each of its threads runs a
+// simulation of its own): a step's regions run without an OpenMP team only outside any team of two or
+// more (parallel_region.hpp). Called directly there, their thread numbers and orphaned `omp for`
+// would bind to the caller's team and leave parts of the particles to the other thread; opened as
+// regions of one thread, each run gives the bits of a run outside any region.
+TEST(ThreadPartition, OneThreadStepsInsideACallersTeamGiveTheSerialBits) {
+  constexpr int steps = 40;
+  constexpr double gravity = 9.81;
+  omp_set_num_threads(1);
+  const RunResult serial = run_colliding_blocks(steps, gravity);
+  std::vector<RunResult> inside(2);
+  int team = 0;
+#pragma omp parallel num_threads(2)
+  {
+    omp_set_num_threads(1);  // this thread's steps: one thread
+#pragma omp single
+    team = omp_get_num_threads();
+    inside[static_cast<std::size_t>(omp_get_thread_num())] = run_colliding_blocks(steps, gravity);
+  }
+  if (team < 2) GTEST_SKIP() << "the runtime gave the enclosing region one thread";
+  for (const RunResult& r : inside) {
+    ASSERT_EQ(r.particles, serial.particles);
+    for (std::size_t k = 0; k < r.particles; ++k) {
+      ASSERT_EQ(r.velocity[k], serial.velocity[k]) << k;
+      ASSERT_EQ(r.position[k], serial.position[k]) << k;
+    }
+    EXPECT_EQ(r.w2, serial.w2);
+    EXPECT_EQ(r.external_work, serial.external_work);
   }
 }
 

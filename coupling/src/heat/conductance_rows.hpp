@@ -4,6 +4,7 @@
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/thermal/problem.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include <omp.h>
 
@@ -103,8 +104,7 @@ void conductance_from_rows(const std::vector<double>& rows, const std::vector<in
   int rebuild = same_unknowns ? 0 : 1;
   const double* sums = rows.data();
   pattern.row_size.resize(static_cast<std::size_t>(n));  // (sized here: only read and written by row below)
-#pragma omp parallel num_threads(threads)
-  {
+  mechanics::parallel_region(threads, [&] {
     const NodeRange mine = NodeRange::of_thread(0, n);
     auto row_sums = [&](int u) { return sums + static_cast<std::size_t>(u) * slots; };
     if (same_unknowns) {
@@ -158,7 +158,7 @@ void conductance_from_rows(const std::vector<double>& rows, const std::vector<in
         value[e] = sl == centre ? -off_sum : r[sl];
       }
     }
-  }
+  });
 }
 
 }  // namespace frictherm::coupling::assembly_detail

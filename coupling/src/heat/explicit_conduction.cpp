@@ -3,6 +3,7 @@
 // gradients, each forward-Euler sub-step is one pass computing (∇T)_p and scattering f_i, and the
 // change goes back to the particles with the stencils of the gather.
 #include <frictherm/coupling/explicit_conduction.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include "explicit_conduction_detail.hpp"  // the passes' helpers, expand, any_changed
 
@@ -66,12 +67,11 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;
   }
   if (stencils_kept_) {
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!holds_heat_[k]) continue;
+    mechanics::parallel_for(threads, p.size(), [&](std::size_t k) {
+      if (!holds_heat_[k]) return;
       if (step_stencils) kept_stencils[k] = step_stencils[k];
       else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
-    }
+    });
   }
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   if (threads <= 1) {  // the same sums without the range checks
@@ -173,8 +173,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
   whole_.assign(p.size(), 0);
-#pragma omp parallel num_threads(threads)
-  {
+  mechanics::parallel_region(threads, [&] {
   Expanded e{};
 #pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -186,7 +185,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     quiet_[k] = quiet_temperatures(e, sys.temperature);
     particle_scratch_[k] = (e.count < e.total ? 1.0 : 0.0) + (quiet_[k] ? 0.0 : 2.0);
   }
-  }
+  });
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (particle_scratch_[k] != 0.0) listed_.push_back(k);

@@ -3,6 +3,7 @@
 // explicit_conduction_passes.cpp: the sub-steps and the map back): the stencil walks, the scatter by
 // node ranges, and the member templates both call (expand, count_changed, any_changed).
 #include <frictherm/coupling/explicit_conduction.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include "conductance_rows.hpp"  // NodeRange, assembly_threads
 
@@ -134,12 +135,11 @@ void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_
     for (std::size_t k : list) body(k, all, scratch);
     return;
   }
-#pragma omp parallel num_threads(threads)
-  {
+  mechanics::parallel_region(threads, [&] {
     const NodeRange mine = NodeRange::of_thread(0, nodes);
     Scratch scratch{};
     for (std::size_t k : list) body(k, mine, scratch);
-  }
+  });
 }
 
 // Relative spread of a particle's nodal temperatures below which they are taken as equal in the

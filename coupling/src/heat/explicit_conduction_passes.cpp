@@ -92,8 +92,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
     // Each particle's look (threads by particles), then the fluxes of those that carry flux,
     // scattered by node ranges in particle order.
     particle_scratch_.assign(holds_heat_.size(), 0.0);  // 1: carries flux
-#pragma omp parallel num_threads(threads)
-    {
+    mechanics::parallel_region(threads, [&] {
     Expanded e{};
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < holds_heat_.size(); ++k) {
@@ -113,7 +112,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       quiet_[k] = quiet_temperatures(e, T);
       if (!quiet_[k]) particle_scratch_[k] = 1.0;
     }
-    }
+    });
     listed_.clear();
     for (std::size_t k = 0; k < holds_heat_.size(); ++k)
       if (particle_scratch_[k] != 0.0) listed_.push_back(k);
@@ -241,8 +240,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   std::vector<unsigned char>& changed = quiet_changed_;
   changed.assign(p.size(), 0);
   double face_heat = 0.0;
-#pragma omp parallel num_threads(threads)
-  {
+  mechanics::parallel_region(threads, [&] {
   Expanded c{};
 #pragma omp for schedule(static) reduction(+ : face_heat)
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -256,7 +254,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     particle_scratch_[k] = heat_capacity_[k] * (T - before);
     changed[k] = 1;
   }
-  }
+  });
   face_heat_ = face_heat;
   if (!keep_sums) return;
   listed_.clear();

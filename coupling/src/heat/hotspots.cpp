@@ -67,15 +67,31 @@ std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<
     throw std::invalid_argument("HotSpotTracker: one id and one reference temperature per particle");
   const std::vector<double>& T0_p = reference ? *reference : reference_;
   std::vector<HotCandidate> hot;
-  max_temperature = -std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const auto id = static_cast<std::size_t>(p.material[k]);
-    if (id >= materials.size() || !materials[id].conducts) continue;
-    const double T = criterion ? (*criterion)[k] : p.temperature[k];
-    max_temperature = std::max(max_temperature, T);
-    const double T0 = k < T0_p.size() ? T0_p[k] : 0.0;
-    const double level = opt_.mode == HotSpotOptions::Mode::absolute ? T : T - T0;
-    if (!(level > opt_.threshold)) continue;
+  // Plain pointers and local copies (this runs every window over every particle): the candidate
+  // stores below may alias anything, so through the vectors and members every particle would reload
+  // them. The maximum in a loop of its own: across the candidate loop's push_back (a call, after
+  // which no SSE register survives) it would live on the stack, a store and a load per particle in
+  // its dependency chain.
+  const int* const material = p.material.data();
+  const double* const level_T = criterion ? criterion->data() : p.temperature.data();
+  const double* const T0_data = T0_p.data();
+  const std::size_t n = p.size(), n_T0 = T0_p.size(), n_materials = materials.size();
+  const ThermalProperties* const props = materials.data();
+  const bool absolute = opt_.mode == HotSpotOptions::Mode::absolute;
+  const double threshold = opt_.threshold;
+  double T_max = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto id = static_cast<std::size_t>(material[k]);
+    if (id < n_materials && props[id].conducts) T_max = std::max(T_max, level_T[k]);
+  }
+  max_temperature = T_max;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto id = static_cast<std::size_t>(material[k]);
+    if (id >= n_materials || !props[id].conducts) continue;
+    const double T = level_T[k];
+    const double T0 = k < n_T0 ? T0_data[k] : 0.0;
+    const double level = absolute ? T : T - T0;
+    if (!(level > threshold)) continue;
     HotCandidate c{};
     c.index = ids ? static_cast<std::size_t>((*ids)[k]) : k;
     for (int d = 0; d < Dim; ++d) c.x[static_cast<std::size_t>(d)] = p.position[k][d];

@@ -1,6 +1,7 @@
 // Nodal thermal mass, temperature and conductance from particles (Nairn et al. 2018 eq. 38), and
 // the incremental particle update T_p += Σ_i S_ip ΔT_i (design §4).
 #include <frictherm/coupling/thermal_assembly.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 
 #include "conductance_rows.hpp"
 
@@ -129,8 +130,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
 
   // Pass 1: M_i and M_i T_i (eq. 38). The node lists filled in parallel; then each thread sums into
   // its own range of nodes, in particle order (the sums of one thread are those of a serial pass).
-#pragma omp parallel num_threads(threads)
-  {
+  mechanics::parallel_region(threads, [&] {
     const NodeRange r = NodeRange::of_thread(0, static_cast<int>(n_nodes));  // cleared by this thread
     std::fill(sys.grid_mass.begin() + r.lo, sys.grid_mass.begin() + r.hi, 0.0);
     std::fill(mct.begin() + r.lo, mct.begin() + r.hi, 0.0);
@@ -159,7 +159,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
         mct[static_cast<std::size_t>(i)] += mc * p.temperature[k] * nl.S[a];
       }
     }
-  }
+  });
 
   // Unknowns: nodes carrying more than a tiny fraction of the largest nodal heat capacity.
   sys.select_unknowns(mct, opt.active_mass_fraction);
@@ -192,8 +192,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
   }
   // Each thread adds into its own range of rows, in particle order, so every (row, slot) entry gets
   // the same terms in the same order as in a serial pass: K is the same for every thread count.
-#pragma omp parallel num_threads(threads)
-  {
+  mechanics::parallel_region(threads, [&] {
   const NodeRange mine = NodeRange::of_thread(0, static_cast<int>(n));  // rows
   std::fill(rows.begin() + static_cast<std::ptrdiff_t>(mine.lo) * slots, rows.begin() + static_cast<std::ptrdiff_t>(mine.hi) * slots, 0.0);
   // The grid nodes of these rows: a particle reaching none of them is skipped before its lumping.
@@ -250,7 +249,7 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
       }
     }
   }
-  }  // omp parallel
+  });  // omp parallel
 
   // K in CSR, the diagonal minus the off-diagonal row sum (conductance_rows.hpp).
   conductance_from_rows<Dim, Kernel>(rows, sys.grid_node, sys.unknown, stride, threads,
