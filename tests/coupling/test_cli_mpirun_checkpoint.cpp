@@ -384,4 +384,49 @@ TEST_F(CliMpirunCheckpoint, ContinuationInterruptedResumesToTheUninterruptedRun)
   }
 }
 
+// The sub-cell interface temperature (coupling.interface_temperature) resumed: each rank's checkpoint
+// holds the flux histories of its owned heated nodes (the serial InterfaceTemperature::visit_state), so
+// the heated sliding block stopped by SIGUSR1 right after its first checkpoint (0.2 ms, while it slides
+// and heats) resumes on 2 ranks to the uninterrupted run bit for bit, max_interface_temperature
+// included (a history restarted empty gives another interface temperature from the next window on).
+// On 3 ranks it is refused with exit code 2 naming the rank count (the histories are per rank).
+TEST_F(CliMpirunCheckpoint, InterfaceTemperatureResumesToTheUninterruptedRun) {
+  const std::string extra = " --set coupling.interface_temperature=true";
+  run_full("2e-4", "3e-3", extra);
+  if (HasFatalFailure()) return;
+  const std::string out = path("part.h5");
+  shell(mpirun(2) + " " + exe() + " run" + scene_args("2e-4", "3e-3", extra) + " -o '" + out + "' > '" + path("log") +
+        "' 2>&1 & pid=$!; for i in $(seq 1 6000); do [ -e '" + out + ".checkpoint' ] && break; sleep 0.01; done; " +
+        "kill -USR1 $pid; wait $pid; exit 0");
+  ASSERT_THAT(text("log"), HasSubstr("interrupted by SIGUSR1")) << "the run must be stopped before its end";
+  const std::vector<double> rows = read_doubles(out, "/series/time");
+  ASSERT_FALSE(rows.empty());
+  std::printf("  interrupted at t = %.6g s\n", rows.back());
+  fs::create_directory(path("three"));
+  for (const auto& e : fs::directory_iterator(path("")))
+    if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
+      fs::copy_file(e.path(), path("three/" + e.path().filename().string()));
+  const Result three = shell(mpirun(3) + " " + exe() + " resume '" + path("three/part.h5") + "'");
+  EXPECT_EQ(three.code, 2) << three.output;
+  EXPECT_THAT(three.output, HasSubstr("resume on the same number of ranks only (expected mpirun -n 2, not 3)"));
+  const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + out + "'");
+  ASSERT_EQ(resumed.code, 0) << resumed.output;
+  const std::vector<double> Tint = read_doubles(path("full.h5"), "/series/max_interface_temperature");
+  ASSERT_GT(Tint.size(), 100u);
+  double peak = 0.0;  // NaN before the first heat
+  for (const double t : Tint)
+    if (!std::isnan(t)) peak = std::max(peak, t);
+  std::printf("  hottest interface node %.4g K, heat recorded in the histories %.4g J\n", peak,
+              read_doubles(path("full.h5"), "/meta/interface_heat_recorded").at(0));
+  EXPECT_GT(peak, 300.3) << "the interface heats (the block starts at 300 K)";
+  for (const std::string& c : frictherm::test::names_in(path("full.h5"), "/series")) {
+    const std::vector<double> a = read_doubles(path("full.h5"), "/series/" + c), b = read_doubles(out, "/series/" + c);
+    ASSERT_EQ(a.size(), b.size()) << c;
+    for (std::size_t k = 0; k < a.size(); ++k)
+      ASSERT_TRUE(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k]))) << c << " row " << k;
+  }
+  for (const char* k : {"interface_heat_recorded", "work_received", "heat_delivered"})
+    EXPECT_EQ(read_doubles(path("full.h5"), std::string("/meta/") + k), read_doubles(out, std::string("/meta/") + k)) << k;
+}
+
 }  // namespace

@@ -1,7 +1,7 @@
 // Refusals of `mpirun -n 2 frictherm run` and `validate` (issue 16, issue 34; coupling/app/cli_run_mpi.cpp,
 // coupling/src/scene/scene_decomposed.cpp, coupling/src/distributed_run/decomposed_runner.cpp):
-//   * a scene the decomposed engine does not support (the KLU solver, the interface temperature's patch
-//     or checkpoints) is refused with exit code 2 naming the scene key, before any
+//   * a scene the decomposed engine does not support (the KLU solver, the interface temperature's patch)
+//     is refused with exit code 2 naming the scene key, before any
 //     file is written, and `validate` says so;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
 //     untouched, and replaced with it;
@@ -29,11 +29,9 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
   const std::pair<const char*, const char*> cases[] = {
       {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
        "thermal.linear_solver: \"klu\" is not supported in a decomposed run"},
-      // The interface temperature runs decomposed, but not its patch nor checkpoints (no histories in them).
+      // The interface temperature runs decomposed, but not its patch.
       {"--set 'coupling.interface_temperature={\"patch_length\":1e-3}'",
-       "coupling.interface_temperature.patch_length: 0.001 is not supported in a decomposed run"},
-      {"--set coupling.interface_temperature=true --set run.checkpoint_interval=1e-4",
-       "run.checkpoint_interval: 0.0001 with coupling.interface_temperature is not supported in a decomposed run"}};
+       "coupling.interface_temperature.patch_length: 0.001 is not supported in a decomposed run"}};
   for (const auto& [set, message] : cases) {
     const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
                            " -o '" + path("refused.h5") + "'");

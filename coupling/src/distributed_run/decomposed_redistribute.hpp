@@ -151,8 +151,7 @@ class Redistribution {
       else if (n == "gather/T") v = T;
       else if (n == "gather/local_M") v = local_M;
     }
-    void operator()(const char*, double&) const {}
-    void operator()(const char*, long&) const {}
+    template <class T> void operator()(const char*, T&) const {}  // the rest: read from file 0 already
   };
 
   Mpm& mpm_;

@@ -70,7 +70,6 @@ class DecomposedRun {
 
  private:
   bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
-  bool checkpoints_supported() const;  // decomposed_runner.cpp
   bool end_of_loading_checkpoint_exact() const;  // decomposed_runner.cpp
 
   bool show_progress() const {

@@ -27,14 +27,6 @@ DecomposedRun<Dim>::~DecomposedRun() {
   if (failure_comm_ != MPI_COMM_NULL) MPI_Comm_free(&failure_comm_);
 }
 
-// Whether a decomposed checkpoint can hold this run: not the interface temperature's flux histories
-// (the contact regularisation's lagged tractions it holds; with a continuation it is taken during the
-// loading and at its end, as the serial run's).
-template <int Dim>
-bool DecomposedRun<Dim>::checkpoints_supported() const {
-  return !detail::interface_temperature(s_);
-}
-
 // Whether a checkpoint at the end of the loading lets a resume repeat the run bit for bit: no
 // continuation follows, or one whose first interval gathers afresh from the particles. After
 // assembled windows (cvode_bdf, ...) the continuation goes on from the last window's problem, which a
@@ -53,14 +45,10 @@ RunResult DecomposedRun<Dim>::execute() {
   r_.output = o_.output.empty() ? s_.output.file : o_.output;
   resuming_ = !o_.resume_checkpoint.empty();
   checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
-  if (checkpoints_ && detail::interface_temperature(s_))  // run.checkpoint_interval: decomposed_run_refusal
-    throw SceneError("--checkpoint-every: checkpoints with coupling.interface_temperature are not supported in a "
-                     "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
-                     "supports it");
   // Without a checkpoint setting: every decomposed_default_checkpoint_wall_interval wall seconds where
   // a decomposed checkpoint is supported (issue 34: two SIGTERMs to mpirun kill the ranks at once).
   wall_interval_ = o_.checkpoint_wall_interval;
-  if (!checkpoints_ && checkpoints_supported())
+  if (!checkpoints_)
     wall_interval_ = std::max(0.0, o_.decomposed_default_checkpoint_wall_interval);
   checkpoint_file_ = o_.checkpoint_file.empty() ? checkpoint_path(r_.output) : o_.checkpoint_file;
   if (!resuming_) check_output_files();  // before anything is built: refusals cost nothing
@@ -85,7 +73,7 @@ RunResult DecomposedRun<Dim>::execute() {
     if (heat_ && r_.status == RunResult::Status::completed && s_.thermal.continuation_duration > 0.0) {
       // The end-of-loading checkpoint, always where supported (as the serial run): a run interrupted in
       // its continuation resumes from it and reruns the whole continuation (docs/checkpoints.md).
-      if (checkpoints_supported() && end_of_loading_checkpoint_exact()) checkpoint(true);
+      if (end_of_loading_checkpoint_exact()) checkpoint(true);
       continuation_started_ = true;
       const Clock::time_point c0 = Clock::now();
       continuation();
@@ -101,12 +89,11 @@ RunResult DecomposedRun<Dim>::execute() {
     // At the end, a stop at run.max_steps or an interruption: before the off-schedule row and
     // snapshot below, which an uninterrupted run does not have (a resume drops them).
     // Interrupted (SIGINT/SIGTERM): a checkpoint also without run.checkpoint_interval, so that `mpirun
-    // -n K frictherm resume` goes on (issue 34, as the serial run); not with the interface temperature,
-    // whose flux histories a decomposed checkpoint does not hold. Once a continuation began, the
+    // -n K frictherm resume` goes on (issue 34, as the serial run). Once a continuation began, the
     // end-of-loading checkpoint stays: a resume reruns the continuation from it.
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      if ((checkpoints_ || (interrupted && checkpoints_supported())) && !continuation_started_ &&
+      if ((checkpoints_ || interrupted) && !continuation_started_ &&
           (!loading_complete_ || end_of_loading_checkpoint_exact()))
         checkpoint();
       if (last_series_step_ != step_) series();

@@ -181,7 +181,9 @@ bool allowed_sentinel(const std::string& shown, double value) {
   // undefined, e.g. the first row's rates).
   if (shown == "/output/series_rows") return true;
   if (value == std::numeric_limits<double>::infinity()) return shown == "/books/min_window";
-  if (value == -std::numeric_limits<double>::infinity()) return shown == "/mechanics/wave_speed";
+  // A decomposed rank file's /interface/max_temperature: −∞ before any heat (DecomposedHeat).
+  if (value == -std::numeric_limits<double>::infinity())
+    return shown == "/mechanics/wave_speed" || shown == "/interface/max_temperature";
   return std::isnan(value) &&
          (shown == "/mechanics/initial_energy" || shown == "/mechanics/contact/lagged_normal_traction");
 }

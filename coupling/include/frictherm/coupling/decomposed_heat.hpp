@@ -190,8 +190,8 @@ class DecomposedHeat {
   /// windows read, as Coupler::visit_state: the books (sums over ranks, the same on every rank), the
   /// pending work per owned node, the window's times, steps and adaptive estimate, and the last
   /// gather (M_i, T_i, M_i on the ghosted box, threshold, smallest unknown M_i) the adaptive estimate
-  /// reads. The assembled path's integrator starts afresh every window: only its counters (metadata)
-  /// are not restored.
+  /// reads, and the interface temperature's flux histories. The assembled path's integrator starts
+  /// afresh every window: only its counters (metadata) are not restored.
   template <class V> void visit_state(V&& v) {
     DecomposedHeatBooks& b = books_;
     for (auto [name, x] : {std::pair<const char*, double*>{"books/work_received", &b.work_received},
@@ -218,6 +218,14 @@ class DecomposedHeat {
     v("gather/M", M_);
     v("gather/T", T0_);
     v("gather/local_M", local_M_);
+    // The sub-cell interface temperature: the flux histories of this rank's owned heated nodes (the
+    // serial InterfaceTemperature::visit_state) and the last maximum and recorded heat over ranks.
+    if (interface2_) interface2_->visit_state(v);
+    if (interface3_) interface3_->visit_state(v);
+    if (interface2_ || interface3_) {
+      v("interface/max_temperature", interface_max_);
+      v("interface/heat", interface_heat_);
+    }
   }
 
  private:
