@@ -30,10 +30,10 @@ std::string mechanics_refusal(const Scene& s) {
   const mechanics::SimulationOptions& o = s.options;
   // Every shape function runs decomposed, the extended B-spline too (the serial EbsBasis on the
   // particles gathered from all ranks, a ghost layer of its reach: mechanics/src/distributed/extended_bsplines.cpp).
-  // USL, and MUSL with or without contact (DecomposedMpm: the USL phases with the remap, its
-  // exchange and, with multimaterial contact, the contact pass on the remapped momenta).
-  if (o.scheme == mechanics::UpdateScheme::usf)
-    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");
+  // USL, MUSL and USF with or without contact (DecomposedMpm: the USL phases with, under MUSL, the
+  // remap, its exchange and, with multimaterial contact, the contact pass on the remapped momenta;
+  // under USF the stress update from the extrapolated velocities after their ghost update, then the
+  // forces and their exchange: mechanics/src/distributed/phase_lists.cpp).
   if (o.particle_update != mechanics::ParticleUpdate::flip)
     return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
   // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).
