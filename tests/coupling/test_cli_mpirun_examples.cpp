@@ -291,7 +291,12 @@ INSTANTIATE_TEST_SUITE_P(Examples, MpirunExamples, ::testing::ValuesIn(kExamples
 // and their exchange after it: mechanics/src/distributed/phase_lists.cpp) with multimaterial contact,
 // frictional heating and tractions (sliding_block_heating), rigid contact partners and damping
 // (oscillating_block), rigid walls and a fixed face (rigid_push), penalty contact with extended
-// B-splines (hertz_disks), 3D (sphere_3d) and the PBX grains (pbx_microstructure_small).
+// B-splines (hertz_disks), 3D (sphere_3d) and the PBX grains (pbx_microstructure_small). XPIC(3) and
+// FMPM(3) (two round trips of the filters' series, each with its exchanges:
+// mechanics/src/distributed/velocity_filter.cpp) on the same kinds of scene: per-material entries at
+// multi-material nodes (the contact scenes, the PBX grains), velocity conditions in the series (fixed
+// faces, rigid drives, rigid partners keeping w0), penalty contact, 3D, one shared field (bars_impact,
+// MUSL), and XPIC under USF.
 const ExampleCase kSchemes[] = {
     {"sliding_block_heating", 150, "--set solver.scheme=usf", "usf_sliding_block_heating", {{2, 3}}},
     {"oscillating_block", 150, "--set solver.scheme=usf", "usf_oscillating_block", {{2, 3}}},
@@ -299,6 +304,19 @@ const ExampleCase kSchemes[] = {
     {"hertz_disks", 150, "--set solver.scheme=usf", "usf_hertz_disks", {{2, 3}}},
     {"sphere_3d", 150, "--set solver.scheme=usf", "usf_sphere_3d", {{2, 3}}},
     {"pbx_microstructure_small", 150, "--set solver.scheme=usf", "usf_pbx_microstructure_small", {{2, 3}}},
+    {"sliding_block_heating", 150, R"(--set 'solver.particle_update={"type":"xpic","order":3}')",
+     "xpic_sliding_block_heating", {{2, 3}}},
+    {"oscillating_block", 150, R"(--set 'solver.particle_update={"type":"xpic","order":3}')", "xpic_oscillating_block",
+     {{2, 3}}},
+    {"sphere_3d", 150, R"(--set 'solver.particle_update={"type":"xpic","order":3}')", "xpic_sphere_3d", {{2, 3}}},
+    {"sliding_block", 150, R"(--set solver.scheme=usf --set 'solver.particle_update={"type":"xpic","order":3}')",
+     "xpic_usf_sliding_block", {{2, 3}}},
+    {"rigid_push", 150, R"(--set 'solver.particle_update={"type":"fmpm","order":3}')", "fmpm_rigid_push", {{2, 3}}},
+    {"hertz_disks", 150, R"(--set 'solver.particle_update={"type":"fmpm","order":3}')", "fmpm_hertz_disks", {{2, 3}}},
+    {"bars_impact", 150, R"(--set 'solver.particle_update={"type":"fmpm","order":3}')", "fmpm_bars_impact", {{2, 3}}},
+    {"pbx_microstructure_small", 150,
+     R"(--set solver.pic_relaxation_time=null --set 'solver.particle_update={"type":"fmpm","order":3}')",
+     "fmpm_pbx_microstructure_small", {{2, 3}}},
 };
 
 INSTANTIATE_TEST_SUITE_P(Schemes, MpirunExamples, ::testing::ValuesIn(kSchemes),

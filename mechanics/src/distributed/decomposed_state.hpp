@@ -370,6 +370,28 @@ struct DecomposedMpm<Dim>::Impl {
   // USF (scheme_phases.cpp): the post-condition momenta of the owned fields in for_each_owned_field's
   // order, kept by velocity_from_momentum for forces_to_owners.
   std::vector<double> kept_momentum;
+  // XPIC/FMPM (velocity_filter.cpp): a DMDA of Dim values per node (DMDACreateCompatibleDMDA, made at
+  // the first filtered step) with its vectors; per owned node (q) and per group entry (e) XPIC's start
+  // velocity, the series' term and its sum v*; per slot the term or v* a particle reads at a
+  // multi-material node and the round trip's sums; the Dim-vector unit and buffers over entry_sf.
+  DM filter_da = nullptr;
+  ::Vec filter_local = nullptr, filter_global = nullptr;
+  std::vector<Vec<Dim>> start_owned, start_mt, term_owned, term_mt, filtered_owned, filtered_mt, sums_owned, sums_mt;
+  std::vector<Vec<Dim>> slot_vector, slot_sums;
+  std::vector<double> vector_send, vector_recv;
+  MPI_Datatype vector_unit = MPI_DATATYPE_NULL;
+  bool filtered() const { return opt.particle_update != ParticleUpdate::flip; }
+  void start_velocity(double dt);
+  template <class Kernel>
+  void velocity_filter(double dt);
+  void vectors_to_ghosts(const std::vector<Vec<Dim>>& owned, const std::vector<Vec<Dim>>& entries);
+  void vectors_to_owners(std::vector<Vec<Dim>>& owned, std::vector<Vec<Dim>>& entries);
+  /// The value a particle reads at its field's slot: slot_vector at a multi-material node, else the
+  /// Dim-vector DMDA's ghosted value `local_vectors` (filter_local's array).
+  Vec<Dim> slot_vector_at(const PetscScalar* local_vectors, std::size_t slot) const {
+    const PetscInt l = slot_node[slot];
+    return multi[static_cast<std::size_t>(l)] ? slot_vector[slot] : Vec<Dim>(Eigen::Map<const Vec<Dim>>(local_vectors + Dim * l));
+  }
   template <class Kernel>
   void internal_forces(double dt);
   void forces_to_owners(double dt);

@@ -46,11 +46,13 @@ void DecomposedMpm<Dim>::step(double dt) {
                                     {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
                                     {&Impl::contact_extrapolated, 5},
                                     {&Impl::penalty_forces, 16},  // penalty contact (penalty_phases.cpp)
+                                    {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
                                     {&Impl::momentum_update, 6},
                                     {&Impl::contact_updated, 7},
                                     {&Impl::nodal_velocities, 8},
                                     {&Impl::ghost_velocities, 9},
                                     {&Impl::fields_to_ghosts, 10},
+                                    {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
                                     {&Impl::template grid_to_particle<Kernel>, 11},
                                     {&Impl::move_boundary_points, 17},  // with v^{n+1}, as the serial USL
                                     {&Impl::template stress_update<Kernel>, 12},
@@ -71,12 +73,14 @@ void DecomposedMpm<Dim>::step(double dt) {
                                      {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
                                      {&Impl::contact_extrapolated, 5},
                                      {&Impl::penalty_forces, 16},
-                                     {&Impl::momentum_update, 6},
+                                     {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
+                                    {&Impl::momentum_update, 6},
                                      {&Impl::contact_updated, 7},
                                      {&Impl::nodal_velocities, 8},
                                      {&Impl::ghost_velocities, 9},
                                      {&Impl::fields_to_ghosts, 10},
-                                     {&Impl::template grid_to_particle<Kernel>, 11},
+                                     {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
+                                    {&Impl::template grid_to_particle<Kernel>, 11},
                                      {&Impl::template remap_momentum<Kernel>, 14},
                                      {&Impl::sum_to_owners, 1},
                                      {&Impl::fields_to_owners, 3},
@@ -108,11 +112,13 @@ void DecomposedMpm<Dim>::step(double dt) {
                                     {&Impl::template internal_forces<Kernel>, 0},
                                     {&Impl::forces_to_owners, 1},
                                     {&Impl::penalty_forces, 16},
+                                    {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
                                     {&Impl::momentum_update, 6},
                                     {&Impl::contact_updated, 7},
                                     {&Impl::nodal_velocities, 8},
                                     {&Impl::ghost_velocities, 9},
                                     {&Impl::fields_to_ghosts, 10},
+                                    {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
                                     {&Impl::template grid_to_particle<Kernel>, 11},
                                     {&Impl::migrate, 13}};
     const Phase* phases = s.opt.usf ? usf : s.opt.musl ? musl : usl;

@@ -11,7 +11,7 @@
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
 #include <frictherm/mechanics/energy/energy_books.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
-#include <frictherm/mechanics/transfer/pic_blend.hpp>
+#include <frictherm/mechanics/transfer/grid_to_particle.hpp>
 
 #include <mpi.h>
 
@@ -320,8 +320,9 @@ void DecomposedMpm<Dim>::Impl::ghost_velocities(double /*dt*/) {
   petsc_check(DMGlobalToLocalEnd(da, global, INSERT_VALUES, local), "DMGlobalToLocalEnd");
 }
 
-// Phase 12, local (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
-// field, start-of-step stencils; with a PIC relaxation time the serial FLIP/PIC blend.
+// Phase 12, local: FLIP v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
+// field, start-of-step stencils, with a PIC relaxation time the serial FLIP/PIC blend; XPIC and FMPM
+// from v* of velocity_filter (the serial kernel, transfer/grid_to_particle.hpp).
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
@@ -330,6 +331,9 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const auto& st = stencils<Kernel>();
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+  const bool filter = filtered();
+  const PetscScalar* vstar = nullptr;  // v* of XPIC/FMPM over the ghosted box
+  if (filter) petsc_check(VecGetArrayRead(filter_local, &vstar), "VecGetArrayRead");
   const double pic = pic_blend_fraction(dt, opt.pic_relaxation_time);  // the serial FLIP/PIC blend
   load_start_position.resize(local_loads.size());
   for (std::size_t n = 0; n < local_loads.size(); ++n)
@@ -343,19 +347,20 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
       Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dx;
       continue;
     }
-    Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
+    Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
     st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
       const double* node = node_values(a, static_cast<std::size_t>(slot));
       acc += S * Eigen::Map<const Vec<Dim>>(node + acceleration);
       v += S * Eigen::Map<const Vec<Dim>>(node + velocity);
+      if (filter) vf += S * slot_vector_at(vstar, static_cast<std::size_t>(slot));
     });
-    Eigen::Map<Vec<Dim>> vp(f.velocity + Dim * k);
-    external_work += f.mass[k] * opt.gravity.dot(vp + 0.5 * dt * acc) * dt;  // gravity's work, as the serial pass
-    vp += dt * acc;
-    pic_blend(vp, v, pic);
+    // The velocity, gravity's work and the position, as the serial pass.
+    external_work += update_particle_velocity<Dim>(opt.particle_update, pic, dt, f.mass[k], opt.gravity, acc, v, vf,
+                                                   Eigen::Map<Vec<Dim>>(f.velocity + Dim * k));
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
+  if (filter) petsc_check(VecRestoreArrayRead(filter_local, &vstar), "VecRestoreArrayRead");
   for (std::size_t n = 0; n < local_loads.size(); ++n) {  // the loads' work, F · Δx_p (the serial pass)
     const auto& [k, j] = local_loads[n];
     external_work += load_work<Dim>(load_force<Dim>(loads[j].force, loads[j].scale, time),

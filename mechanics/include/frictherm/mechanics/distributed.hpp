@@ -57,6 +57,13 @@
 //                          kept momenta back
 // and USL's list from momentum_update on (the serial USF list, simulation_step.cpp).
 //
+// XPIC and FMPM (Options::particle_update) add, in every list,
+//   start_velocity         owned nodes (XPIC): v^n = p/m before the momentum update
+//   velocity_filter        before grid_to_particle: v* = Σ_{j<order} (I − S⁺S)^j w0 per field, each
+//                          term's round trip over the local particles, its sums to the owners and the
+//                          next term back to the ghosts (a Dim-vector DMDA and the per-field entries)
+// and grid_to_particle reads v* (velocity_filter.cpp).
+//
 // Velocity fields: without contact every deformable material shares one field (as the serial
 // Simulation); with contact each material has its own. Each rank stores each field over the box of
 // local nodes its local particles' stencils reach (the serial layout_fields), so memory and work
@@ -87,6 +94,7 @@
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/transfer.hpp>
 #include <frictherm/mechanics/types.hpp>
 
 #include <mpi.h>
@@ -212,6 +220,11 @@ class DecomposedMpm {
     /// FLIP/PIC blend time τ (s), as SimulationOptions::pic_relaxation_time: after the FLIP update
     /// v_p ← (1 − α) v_p + α Σ S_ip v_i, α = 1 − e^(−dt/τ); infinity: pure FLIP.
     double pic_relaxation_time = std::numeric_limits<double>::infinity();
+    /// Grid-to-particle transfer (transfer.hpp), as SimulationOptions::particle_update and
+    /// transfer_order: FLIP, XPIC(m) or FMPM(k), the filters' Neumann series over the ranks with a
+    /// Dim-vector exchange per term (velocity_filter.cpp).
+    ParticleUpdate particle_update = ParticleUpdate::flip;
+    int transfer_order = 1;
     std::vector<FixedFace> fixed_faces;   // grid faces with velocity components fixed to 0 (Simulation::fix_face)
     /// Multimaterial contact (one velocity field per material), as Simulation::enable_contact and
     /// set_contact_pair. Supported: multimaterial pairs with any friction law, separation position,
