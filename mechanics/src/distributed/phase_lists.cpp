@@ -74,13 +74,13 @@ void DecomposedMpm<Dim>::step(double dt) {
                                      {&Impl::contact_extrapolated, 5},
                                      {&Impl::penalty_forces, 16},
                                      {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
-                                    {&Impl::momentum_update, 6},
+                                     {&Impl::momentum_update, 6},
                                      {&Impl::contact_updated, 7},
                                      {&Impl::nodal_velocities, 8},
                                      {&Impl::ghost_velocities, 9},
                                      {&Impl::fields_to_ghosts, 10},
                                      {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
-                                    {&Impl::template grid_to_particle<Kernel>, 11},
+                                     {&Impl::template grid_to_particle<Kernel>, 11},
                                      {&Impl::template remap_momentum<Kernel>, 14},
                                      {&Impl::sum_to_owners, 1},
                                      {&Impl::fields_to_owners, 3},

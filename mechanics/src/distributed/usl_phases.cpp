@@ -1,7 +1,7 @@
-// The decomposed USL step (frictherm/mechanics/distributed.hpp) as a list of named phases; the
-// exchanges (sum_to_owners, exchange_field_ranges, fields_to_owners, ghost_velocities,
-// fields_to_ghosts, migrate) are phases of their own, the contact phases are in contact_phases.cpp
-// and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
+// The phases of the decomposed USL step (frictherm/mechanics/distributed.hpp; its lists, with MUSL's
+// and USF's, in phase_lists.cpp); the exchanges (sum_to_owners, exchange_field_ranges,
+// fields_to_owners, ghost_velocities, fields_to_ghosts, migrate) are phases of their own, the contact
+// phases are in contact_phases.cpp and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
 // Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted box, and its
 // constitutive updates (material.hpp, mie_gruneisen.hpp, plane_strain_update.hpp), so they compute what the serial Simulation<Dim>'s USL
 // step computes (mechanics/src/simulation_step.cpp, simulation_fields.cpp) on this rank's particles,
