@@ -7,7 +7,7 @@
 
 #include <mpi.h>
 
-#include <iterator>
+#include <vector>
 
 namespace frictherm::mechanics {
 
@@ -36,97 +36,63 @@ void DecomposedMpm<Dim>::step(double dt) {
       void (Impl::*run)(double);
       int name;
     };
-    // USL, in order. Without contact (one velocity field) the per-field exchanges and the contact
-    // phases have nothing to do.
-    static constexpr Phase usl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
-                                    {&Impl::sum_to_owners, 1},
-                                    {&Impl::exchange_field_ranges, 2},
-                                    {&Impl::fields_to_owners, 3},
-                                    {&Impl::find_contact_nodes, 4},
-                                    {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
-                                    {&Impl::contact_extrapolated, 5},
-                                    {&Impl::penalty_forces, 16},  // penalty contact (penalty_phases.cpp)
-                                    {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
-                                    {&Impl::momentum_update, 6},
-                                    {&Impl::contact_updated, 7},
-                                    {&Impl::nodal_velocities, 8},
-                                    {&Impl::ghost_velocities, 9},
-                                    {&Impl::fields_to_ghosts, 10},
-                                    {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
-                                    {&Impl::template grid_to_particle<Kernel>, 11},
-                                    {&Impl::move_boundary_points, 17},  // with v^{n+1}, as the serial USL
-                                    {&Impl::template stress_update<Kernel>, 12},
-                                    {&Impl::migrate, 13}};
-    // MUSL: USL's phases up to the grid-to-particle update (with several velocity fields the slots of
-    // particle_to_grid kept), then the momenta remapped from the updated particles with their exchange
-    // (sum to the owners, the per-field entries to the owners, multimaterial contact on the remapped
-    // momenta there, the velocity conditions and v_i = p_i/m_i, the ghost update), the penalty
-    // contact's points moved with those velocities and the stress update from them (the serial MUSL
-    // list, simulation_step.cpp: contact_extrapolated, contact_updated, contact_remapped). The
-    // remapped pass is timed with the extrapolated one (both momentum changes only).
-    static constexpr Phase musl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
-                                     {&Impl::keep_grid_values, 0},
-                                     {&Impl::sum_to_owners, 1},
-                                     {&Impl::exchange_field_ranges, 2},
-                                     {&Impl::fields_to_owners, 3},
-                                     {&Impl::find_contact_nodes, 4},
-                                     {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
-                                     {&Impl::contact_extrapolated, 5},
-                                     {&Impl::penalty_forces, 16},
-                                     {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
-                                     {&Impl::momentum_update, 6},
-                                     {&Impl::contact_updated, 7},
-                                     {&Impl::nodal_velocities, 8},
-                                     {&Impl::ghost_velocities, 9},
-                                     {&Impl::fields_to_ghosts, 10},
-                                     {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
-                                     {&Impl::template grid_to_particle<Kernel>, 11},
-                                     {&Impl::template remap_momentum<Kernel>, 14},
-                                     {&Impl::sum_to_owners, 1},
-                                     {&Impl::fields_to_owners, 3},
-                                     {&Impl::contact_remapped, 5},
-                                     {&Impl::velocity_from_momentum, 15},
-                                     {&Impl::move_boundary_points, 17},
-                                     {&Impl::ghost_velocities, 9},
-                                     {&Impl::fields_to_ghosts, 10},
-                                     {&Impl::template stress_update<Kernel>, 12},
-                                     {&Impl::migrate, 13}};
-    // USF: the momenta's exchange and the extrapolated contact pass as USL's, then the velocities from
-    // those momenta (the post-condition momenta kept), the penalty contact's points moved with them,
-    // their ghost update and the stress update from them; then the forces from the new stress and the
-    // loads with their exchange to the owners (the kept momenta back), and USL's list from the
-    // momentum update on (the serial USF list, simulation_step.cpp). The force pass is timed with
-    // particle_to_grid and its exchange with sum_to_owners (as the serial internal_forces).
-    static constexpr Phase usf[] = {{&Impl::template particle_to_grid<Kernel>, 0},
-                                    {&Impl::sum_to_owners, 1},
-                                    {&Impl::exchange_field_ranges, 2},
-                                    {&Impl::fields_to_owners, 3},
-                                    {&Impl::find_contact_nodes, 4},
-                                    {&Impl::template measure_contact_extents<Kernel>, 4},
-                                    {&Impl::contact_extrapolated, 5},
-                                    {&Impl::velocity_from_momentum, 15},
-                                    {&Impl::move_boundary_points, 17},
-                                    {&Impl::ghost_velocities, 9},
-                                    {&Impl::fields_to_ghosts, 10},
-                                    {&Impl::template stress_update<Kernel>, 12},
-                                    {&Impl::template internal_forces<Kernel>, 0},
-                                    {&Impl::forces_to_owners, 1},
-                                    {&Impl::penalty_forces, 16},
-                                    {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
-                                    {&Impl::momentum_update, 6},
-                                    {&Impl::contact_updated, 7},
-                                    {&Impl::nodal_velocities, 8},
-                                    {&Impl::ghost_velocities, 9},
-                                    {&Impl::fields_to_ghosts, 10},
-                                    {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
-                                    {&Impl::template grid_to_particle<Kernel>, 11},
-                                    {&Impl::migrate, 13}};
-    const Phase* phases = s.opt.usf ? usf : s.opt.musl ? musl : usl;
-    const std::size_t count = s.opt.usf ? std::size(usf) : s.opt.musl ? std::size(musl) : std::size(usl);
-    for (std::size_t p = 0; p < count; ++p) {
+    // The serial lists (simulation_step.cpp, build_phases) with the exchanges inserted. Without
+    // contact (one velocity field) the per-field exchanges and the contact phases have nothing to do,
+    // without penalty contact its phases, under FLIP the velocity filter's.
+    const bool usf = s.opt.usf, usl = !s.opt.usf && !s.opt.musl, musl = s.opt.musl;
+    thread_local std::vector<Phase> P;  // reused from step to step
+    P.clear();
+    P.push_back({&Impl::template particle_to_grid<Kernel>, 0});  // USF: m and p only
+    // MUSL with several fields: the slots as particle_to_grid left them, for the remap.
+    if (musl) P.push_back({&Impl::keep_grid_values, 0});
+    P.insert(P.end(), {{&Impl::sum_to_owners, 1},
+                       {&Impl::exchange_field_ranges, 2},
+                       {&Impl::fields_to_owners, 3},
+                       {&Impl::find_contact_nodes, 4},
+                       {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
+                       {&Impl::contact_extrapolated, 5}});
+    // USF: the stress from the extrapolated velocities (their ghost update first; the post-condition
+    // momenta kept), the penalty contact's points moved with them, then the forces from the new stress
+    // and the loads, summed to the owners (scheme_phases.cpp). Timed with particle_to_grid and
+    // sum_to_owners (as the serial internal_forces).
+    if (usf)
+      P.insert(P.end(), {{&Impl::velocity_from_momentum, 15},
+                         {&Impl::move_boundary_points, 17},
+                         {&Impl::ghost_velocities, 9},
+                         {&Impl::fields_to_ghosts, 10},
+                         {&Impl::template stress_update<Kernel>, 12},
+                         {&Impl::template internal_forces<Kernel>, 0},
+                         {&Impl::forces_to_owners, 1}});
+    P.insert(P.end(), {{&Impl::penalty_forces, 16},  // penalty contact (penalty_phases.cpp)
+                       {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
+                       {&Impl::momentum_update, 6},
+                       {&Impl::contact_updated, 7},
+                       {&Impl::nodal_velocities, 8},
+                       {&Impl::ghost_velocities, 9},
+                       {&Impl::fields_to_ghosts, 10},
+                       {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
+                       {&Impl::template grid_to_particle<Kernel>, 11}});
+    if (usl)  // the points with v^{n+1}, then the stress from it
+      P.insert(P.end(), {{&Impl::move_boundary_points, 17}, {&Impl::template stress_update<Kernel>, 12}});
+    // MUSL: the momenta remapped from the updated particles with their exchange (sum to the owners,
+    // the per-field entries, multimaterial contact on the remapped momenta), the velocity conditions
+    // and v_i = p_i/m_i, the points moved with them, the ghost update and the stress from them. The
+    // remapped contact pass is timed with the extrapolated one (both change momenta only).
+    if (musl)
+      P.insert(P.end(), {{&Impl::template remap_momentum<Kernel>, 14},
+                         {&Impl::sum_to_owners, 1},
+                         {&Impl::fields_to_owners, 3},
+                         {&Impl::contact_remapped, 5},
+                         {&Impl::velocity_from_momentum, 15},
+                         {&Impl::move_boundary_points, 17},
+                         {&Impl::ghost_velocities, 9},
+                         {&Impl::fields_to_ghosts, 10},
+                         {&Impl::template stress_update<Kernel>, 12}});
+    P.push_back({&Impl::migrate, 13});
+    for (const Phase& phase : P) {
       const double t0 = MPI_Wtime();
-      (s.*phases[p].run)(dt);
-      s.traffic.phase_seconds[static_cast<std::size_t>(phases[p].name)] += MPI_Wtime() - t0;
+      (s.*phase.run)(dt);
+      s.traffic.phase_seconds[static_cast<std::size_t>(phase.name)] += MPI_Wtime() - t0;
     }
   };
   if (s.opt.shape == ShapeKind::extended_bspline)
