@@ -122,12 +122,7 @@ TEST_F(MpirunContact, RegularizedFrictionMatchesSerial) {
   std::printf("  largest mean lift of the block: %.3g um lagged, %.3g um instantaneous\n", lift_lagged * 1e6,
               lift_instant * 1e6);
   EXPECT_GT(lift_instant, 2.0 * std::max(lift_lagged, 1e-7)) << "the regularisation should keep the block down";
-  // Its checkpoints are refused (they do not hold the lagged tractions), naming the key.
-  const Result refused = shell(frictherm::test::mpirun_command(2) + " " + exe() + " run " +
-                               source("examples/sliding_block.json") + law + lag +
-                               " --set run.checkpoint_interval=1e-3 -q -o '" + path("refused.h5") + "'");
-  EXPECT_EQ(refused.code, 2) << refused.output;
-  EXPECT_THAT(refused.output, HasSubstr("run.checkpoint_interval: 0.001 with contact.regularization"));
+  // Its checkpoints: CliMpirunCheckpoint.RegularizedContactResumesToTheUninterruptedRun.
 }
 
 // contact.light_touch_fraction (docs/contact.md, "The source: light materials the position test calls

@@ -5,7 +5,7 @@
 // mechanics' cumulative work books of file j go with its particles (their sum over ranks is kept);
 // the heat's per-node state (pending work, M_i and T_i of the last gather) is copied node by node from
 // the file whose rank owned the node (DMDA indices are the same for every K), M_i on the ghosted box
-// from the new owners. The particles' order on a rank and the ranks' sums then differ from an
+// from the new owners; so is the contact regularisation's lagged normal traction per node. The particles' order on a rank and the ranks' sums then differ from an
 // uninterrupted K'-rank run: results agree to the round-off of reordered sums, not bit-for-bit.
 #include "run/checkpoint_io.hpp"
 
@@ -13,6 +13,7 @@
 #include <frictherm/mechanics/distributed.hpp>
 
 #include <array>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,6 +40,10 @@ class Redistribution {
     pending_.assign(n, 0.0);
     M_.assign(n, 0.0);
     T_.assign(n, 0.0);
+    acc_.lagged_normal_traction.clear();
+    acc_.lagged_normal_step.clear();
+    lagged_.assign(n, std::numeric_limits<double>::quiet_NaN());  // fresh, as resolve_contact starts them
+    lagged_step_.assign(n, -2.0);
   }
 
   /// Rank file j of the checkpoint: its particles and books when `particles`, its nodes' heat.
@@ -49,6 +54,16 @@ class Redistribution {
     r("mechanics/time", acc_.time);
     r("mechanics/empty_node_mass", acc_.empty_node_mass);
     r("mechanics/initial_energy", acc_.initial_energy);  // the books' start: the same in every file
+    r("mechanics/steps_taken", acc_.steps_taken);        // the regularisation's clock: the same too
+    // The regularisation's lagged tractions of file j's owned nodes (empty: off, or no contact there yet).
+    std::vector<double> lagged, lagged_step;
+    r("mechanics/contact/lagged_normal_traction", lagged);
+    r("mechanics/contact/lagged_normal_step", lagged_step);
+    if (!lagged.empty()) {
+      copy_nodes(box, lagged, lagged_);
+      copy_nodes(box, lagged_step, lagged_step_);
+      regularized_ = true;
+    }
     if (particles) {
       for (auto& [name, values] : acc_.reals) {
         std::vector<double> v;
@@ -94,6 +109,7 @@ class Redistribution {
 
   /// Collective: the particles into the swarm (migrated) and the per-node heat into `heat`.
   void finish(DecomposedHeat* heat) {
+    if (regularized_) acc_.lagged_normal_traction = lagged_, acc_.lagged_normal_step = lagged_step_;
     mpm_.restore_checkpoint_state(acc_, true);
     if (!heat) return;
     std::vector<double> local_M;
@@ -113,7 +129,7 @@ class Redistribution {
       lo[d] = std::max(blo[d], mlo[d]), hi[d] = std::min(box[2 * d + 1], static_cast<long>(mine_[2 * d + 1]));
       count *= static_cast<std::size_t>(bn[d]);
     }
-    if (from.size() != count) throw std::runtime_error("checkpoint: per-node heat of the wrong size");
+    if (from.size() != count) throw std::runtime_error("checkpoint: per-node state of the wrong size");
     for (long k = lo[2]; k < hi[2]; ++k)
       for (long j = lo[1]; j < hi[1]; ++j)
         for (long i = lo[0]; i < hi[0]; ++i)
@@ -144,6 +160,8 @@ class Redistribution {
   std::array<int, 2 * Dim> mine_;
   typename Mpm::CheckpointState acc_;
   std::vector<double> pending_, M_, T_;
+  std::vector<double> lagged_, lagged_step_;  // the regularisation's, on this rank's owned nodes
+  bool regularized_ = false;
 };
 
 }  // namespace frictherm::coupling::detail

@@ -110,6 +110,11 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   v("mechanics/pair_work_first", st.pair_first);  // this rank's part of the per-pair books
   v("mechanics/pair_work_second", st.pair_second);
   v("mechanics/contact_stats", st.stats);
+  // The normal-stress regularisation's lagged tractions per owned node (the serial checkpoint's names;
+  // empty when it is off) and its clock.
+  v("mechanics/contact/lagged_normal_traction", st.lagged_normal_traction);
+  v("mechanics/contact/lagged_normal_step", st.lagged_normal_step);
+  v("mechanics/steps_taken", st.steps_taken);
   std::vector<long> owned;  // this rank's owned nodes (DMDA indices, [begin, end) per axis): redistribution
   if constexpr (!V::reading) for (int b : mpm_->owned_nodes()) owned.push_back(b);
   v("mechanics/owned_nodes", owned);

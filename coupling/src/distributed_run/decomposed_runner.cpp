@@ -27,11 +27,11 @@ DecomposedRun<Dim>::~DecomposedRun() {
   if (failure_comm_ != MPI_COMM_NULL) MPI_Comm_free(&failure_comm_);
 }
 
-// Whether a decomposed checkpoint can hold this run: not the interface temperature's flux histories,
-// the contact regularisation's lagged tractions or a continuation's last window.
+// Whether a decomposed checkpoint can hold this run: not the interface temperature's flux histories
+// or a continuation's last window (the contact regularisation's lagged tractions it holds).
 template <int Dim>
 bool DecomposedRun<Dim>::checkpoints_supported() const {
-  return !detail::interface_temperature(s_) && !detail::contact_regularized(s_) && !heat_continuation();
+  return !detail::interface_temperature(s_) && !heat_continuation();
 }
 
 template <int Dim>
@@ -44,10 +44,6 @@ RunResult DecomposedRun<Dim>::execute() {
   checkpoints_ = s_.checkpoint_interval > 0.0 || o_.checkpoint_wall_interval > 0.0;
   if (checkpoints_ && detail::interface_temperature(s_))  // run.checkpoint_interval: decomposed_run_refusal
     throw SceneError("--checkpoint-every: checkpoints with coupling.interface_temperature are not supported in a "
-                     "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
-                     "supports it");
-  if (checkpoints_ && detail::contact_regularized(s_))  // run.checkpoint_interval: decomposed_run_refusal
-    throw SceneError("--checkpoint-every: checkpoints with contact.regularization are not supported in a "
                      "decomposed run (expected no --checkpoint-every); the serial run (without mpirun, or with -n 1) "
                      "supports it");
   if (checkpoints_ && heat_continuation())  // run.checkpoint_interval: decomposed_run_refusal
@@ -98,8 +94,7 @@ RunResult DecomposedRun<Dim>::execute() {
     // decomposed checkpoint does not hold (docs/distributed_run.md, "Not done").
     const bool interrupted = r_.status == RunResult::Status::interrupted;
     try {
-      // Nor with the interface temperature or the contact regularisation, whose flux histories and lagged
-      // tractions a decomposed checkpoint does not hold.
+      // Nor with the interface temperature, whose flux histories a decomposed checkpoint does not hold.
       if (checkpoints_ || (interrupted && checkpoints_supported())) checkpoint();
       if (last_series_step_ != step_) series();
       if (last_snapshot_step_ != step_) snapshot();

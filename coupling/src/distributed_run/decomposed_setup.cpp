@@ -38,8 +38,6 @@ bool interface_temperature(const Scene& scene) {
   return scene.thermal.enabled && scene.thermal.coupler.interface_temperature.enabled;
 }
 
-bool contact_regularized(const Scene& scene) { return scene.contact.enabled && scene.contact.options.regularized(); }
-
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene) {
   mechanics::IVec<Dim> cells{};

@@ -23,9 +23,6 @@ mechanics::Grid<Dim> scene_grid(const Scene& scene);
 bool plastic_heating(const Scene& scene);
 /// Whether the scene has the sub-cell interface temperature (thermal on, coupling.interface_temperature).
 bool interface_temperature(const Scene& scene);
-/// Whether the scene's contact uses the normal-stress regularisation (contact.regularization), whose
-/// per-node lagged tractions a decomposed checkpoint does not hold.
-bool contact_regularized(const Scene& scene);
 
 /// The decomposed engine's options for a supported scene; the particles carry two scalars,
 /// "temperature" and "reference_temperature" (T_p and its initial value T0_p, K), and with plastic

@@ -290,6 +290,12 @@ void check_rank_file(hid_t f, const std::string& path, const RankSizes& z) {
     if (owned > 0) require(f, path, a, owned, true, "the nodes of /mechanics/owned_nodes");
   require(f, path, "mechanics/contact_stats", 4, false, "contact, multi-material, sliding and guarded nodes");
   counts(f, path, {"mechanics/contact_stats"});
+  // The regularisation's lagged tractions per owned node (empty when it is off; NaN: no contact yet).
+  for (const char* a : {"mechanics/contact/lagged_normal_traction", "mechanics/contact/lagged_normal_step"})
+    if (owned > 0) require(f, path, a, owned, true, "the nodes of /mechanics/owned_nodes");
+  require_finite(f, path, "mechanics/contact/lagged_normal_step");
+  require(f, path, "mechanics/steps_taken", 1, false, "the steps taken");
+  require_finite(f, path, "mechanics/steps_taken");
   // This rank's part of the frictional work per material pair (empty before any contact work).
   for (const char* a : {"mechanics/pair_work_first", "mechanics/pair_work_second"}) {
     require(f, path, a, z.materials * z.materials, true, "one per pair of the scene's materials");

@@ -55,11 +55,8 @@ std::string contact_refusal(const Scene& s) {
                         quoted(mechanics::to_string(c.default_pair.method)),
                     "every pair with the same method");
 
-  // The regularisation runs (the serial kernel with each owned node's lagged traction), without
-  // checkpoints: they do not hold the lagged tractions.
-  if (c.regularized() && s.checkpoint_interval > 0.0)
-    return refuse("run.checkpoint_interval", number(s.checkpoint_interval) + " with contact.regularization",
-                  "no checkpoints with the normal-stress regularisation");
+  // The regularisation runs (the serial kernel with each owned node's lagged traction, which its
+  // checkpoints hold: DecomposedMpm::CheckpointState).
   return "";
 }
 

@@ -1,6 +1,6 @@
 // Checkpoint state of the decomposed MPM (DecomposedMpm::checkpoint_state, restore_checkpoint_state;
 // frictherm/mechanics/distributed.hpp): every registered swarm field of this rank's particles in
-// swarm order, so a restored rank holds the same particles in the same order and every particle
+// swarm order (and the owned nodes' contact state), so a restored rank holds the same particles in the same order and every particle
 // loop of the next step (and every sum over particles) runs as in the uninterrupted run.
 #include "distributed/decomposed_state.hpp"
 
@@ -76,6 +76,9 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.pair_first = s.pair_first;
   c.pair_second = s.pair_second;
   c.stats = {s.stats.contact_nodes, s.stats.multi_nodes, s.stats.sliding_nodes, s.stats.guarded};
+  c.lagged_normal_traction = s.lagged_normal_traction;
+  c.lagged_normal_step = s.lagged_normal_step;
+  c.steps_taken = s.steps_taken;
   return c;
 }
 
@@ -98,9 +101,11 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   const std::size_t pairs = s.materials.size() * s.materials.size();
   if (c.stats.size() != 4 || (!c.work_first.empty() && c.work_first.size() != owned && !migrate) ||
       c.work_second.size() != c.work_first.size() || (!c.pair_first.empty() && c.pair_first.size() != pairs) ||
-      c.pair_second.size() != c.pair_first.size())
-    throw std::invalid_argument("decomposed mechanics: checkpoint state of another decomposition (owned nodes or "
-                                "contact counters differ)");
+      c.pair_second.size() != c.pair_first.size() ||
+      (!c.lagged_normal_traction.empty() && c.lagged_normal_traction.size() != owned) ||
+      c.lagged_normal_step.size() != c.lagged_normal_traction.size())
+    throw std::invalid_argument("decomposed mechanics: checkpoint state of another decomposition (owned nodes, "
+                                "contact counters or lagged tractions differ)");
   const auto fields = real_fields<Dim>(s.scalars);
   for (const auto& [name, components] : fields) {
     const std::string key = short_name(name);
@@ -154,6 +159,9 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.pair_first = c.pair_first;
   s.pair_second = c.pair_second;
   s.stats = DecomposedContactStats{c.stats[0], c.stats[1], c.stats[2], c.stats[3]};
+  s.lagged_normal_traction = c.lagged_normal_traction;  // empty: resolve_contact starts them fresh (NaN)
+  s.lagged_normal_step = c.lagged_normal_step;
+  s.steps_taken = c.steps_taken;
   s.current_valid = false;
   if (migrate) {
     const long sent = s.traffic.particles_sent, received = s.traffic.particles_received;

@@ -383,7 +383,7 @@ class DecomposedMpm {
   /// field of every local particle in swarm order (PETSc's DMSwarmPIC_coor as "coor", the particle
   /// scalars as "scalars"; integer fields as int64), the step's start time, the frictional work books
   /// (this rank's part), the last step's work per owned node and contact counters, and the empty-node
-  /// mass threshold. Restored on the same rank of a decomposition built from the same scene and rank
+  /// mass threshold, the regularisation's lagged normal tractions. Restored on the same rank of a decomposition built from the same scene and rank
   /// count, the run steps on bit-for-bit (same particles in the same swarm order).
   struct CheckpointState {
     std::vector<std::pair<std::string, std::vector<double>>> reals;          // name, n × components
@@ -394,6 +394,10 @@ class DecomposedMpm {
     std::vector<double> work_first, work_second;
     std::vector<double> pair_first, pair_second;  // this rank's part of the pair books (materials² or empty)
     std::vector<long> stats;  // contact_nodes, multi_nodes, sliding_nodes, guarded (this rank)
+    // The normal-stress regularisation's state per owned node (empty when off or before the first
+    // contact: NaN where a node had no contact yet) and the steps taken, its clock.
+    std::vector<double> lagged_normal_traction, lagged_normal_step;
+    double steps_taken = 0.0;
   };
   CheckpointState checkpoint_state() const;
   /// This rank alone: replaces its particles and books by `state` (no migration: the particles stay
