@@ -10,7 +10,7 @@
 #include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
-#include <frictherm/mechanics/transfer/pic_blend.hpp>
+#include <frictherm/mechanics/transfer/grid_to_particle.hpp>
 
 #include "stencil_access.hpp"
 
@@ -151,18 +151,8 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           });
         }
         if constexpr (Kinematics) {
-          const Vec<Dim> v_old = vp[k];
-          if (flip) {
-            add_work(k, mp[k] * g.dot(v_old + 0.5 * dt * a) * dt);
-            vp[k] += dt * a;
-            pic_blend(vp[k], v, pic);
-          } else if (update == ParticleUpdate::xpic) {
-            vp[k] = vf + dt * a;  // S (v* + Δt a): Hammerquist & Nairn 2017
-          } else {
-            vp[k] = vf;  // S v*, v* ≈ M_C⁻¹ p^{n+1}: Nairn & Hammerquist 2021
-            v = vf;
-          }
-          if (!flip) add_work(k, mp[k] * g.dot(0.5 * (v_old + vp[k])) * dt);
+          // FLIP (PIC blend), XPIC or FMPM: the kernel shared with the decomposed step.
+          add_work(k, update_particle_velocity<Dim>(update, pic, dt, mp[k], g, a, v, vf, vp[k]));
           xp[k] += dt * v;
           const bool ok = vp[k].allFinite() && grid.contains(xp[k]);
           if (!ok) bad = std::min(bad, static_cast<long>(k));

@@ -3,6 +3,7 @@
 // round trip per term. Hammerquist & Nairn 2017 (XPIC), Nairn & Hammerquist 2021 (FMPM).
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
+#include <frictherm/mechanics/transfer/grid_to_particle.hpp>
 
 #include <omp.h>
 
@@ -33,10 +34,8 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
         const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
         for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
-          Vec<Dim> u = Vec<Dim>::Zero();
-          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { u += S * X.term[static_cast<std::size_t>(i)]; });
-          const Vec<Dim> mu = p_.mass[k] * u;
-          st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc[static_cast<std::size_t>(i)] += S * mu; });
+          filter_round_trip<Dim>(st[k], ix, p_.mass[k], [&](int i) -> const Vec<Dim>& { return X.term[static_cast<std::size_t>(i)]; },
+                                 [&](int i, const Vec<Dim>& share) { acc[static_cast<std::size_t>(i)] += share; });
         }
       }
     });
@@ -44,12 +43,9 @@ void Simulation<Dim>::filter_grid_velocity(const Stencils& st) {
     parallel_for(threads_.count, n, [&](std::size_t s) {
       Vec<Dim> rt = X.round_trip[s];
       for (const auto& b : X.thread_acc) rt += b[s];
-      const double ms = nodes_.mass[s];
-      Vec<Dim> next = ms > mmin ? Vec<Dim>(X.term[s] - rt / ms) : Vec<Dim>(Vec<Dim>::Zero());
       const std::size_t node = static_cast<std::size_t>(layout_.slot_node[s]);
-      if (const std::uint8_t bc = static_cast<std::uint8_t>(conditions_.fixed_mask[node] | conditions_.rigid_mask[node]))
-        for (int d = 0; d < Dim; ++d)
-          if (bc & (1u << d)) next[d] = 0.0;
+      const std::uint8_t bc = static_cast<std::uint8_t>(conditions_.fixed_mask[node] | conditions_.rigid_mask[node]);
+      const Vec<Dim> next = filter_next_term<Dim>(X.term[s], rt, nodes_.mass[s], mmin, bc);
       X.term[s] = next;
       X.filtered[s] += next;
     });

@@ -29,6 +29,7 @@
 #include "h5_test_support.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -42,6 +43,9 @@ namespace {
 struct ExampleCase {
   const char* name;
   int steps;
+  const char* sets = "";            // further --set options (the scheme cases below)
+  const char* label = nullptr;      // the test's name (default: the example's)
+  std::array<int, 2> ranks{{2, 4}};  // the split runs' rank counts
 };
 
 std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
@@ -76,7 +80,8 @@ class MpirunExamples : public MpirunScratchTest, public ::testing::WithParamInte
 
   std::string run_command(const std::string& out) const {
     return exe() + " run '" + FRICTHERM_SOURCE_DIR + "/examples/" + GetParam().name + ".json' --set run.max_steps=" +
-           std::to_string(GetParam().steps) + " --set output.series_interval=0 --set output.fields=null -q --threads 1 --force -o '" + path(out) + "'";
+           std::to_string(GetParam().steps) + " " + GetParam().sets +
+           " --set output.series_interval=0 --set output.fields=null -q --threads 1 --force -o '" + path(out) + "'";
   }
 
   std::vector<double> series(const std::string& file, const std::string& c) const {
@@ -95,7 +100,8 @@ class MpirunExamples : public MpirunScratchTest, public ::testing::WithParamInte
 
   // The largest P-wave modulus ρc² of the scene's materials, as `frictherm validate` reports them.
   double wave_modulus() const {
-    const Result v = shell(exe() + " validate '" + FRICTHERM_SOURCE_DIR + "/examples/" + GetParam().name + ".json'");
+    const Result v = shell(exe() + " validate '" + FRICTHERM_SOURCE_DIR + "/examples/" + GetParam().name + ".json' " +
+                           GetParam().sets);
     double m = 0.0;
     std::size_t at = 0;
     while ((at = v.output.find("density ", at)) != std::string::npos) {
@@ -257,7 +263,7 @@ class MpirunExamples : public MpirunScratchTest, public ::testing::WithParamInte
 TEST_P(MpirunExamples, SplitRunsMatchTheSerialRun) {
   const Result s = shell(run_command("serial.h5"));
   ASSERT_EQ(s.code, 0) << s.output;
-  for (int ranks : {2, 4}) {
+  for (int ranks : GetParam().ranks) {
     const std::string split = "split" + std::to_string(ranks) + ".h5";
     const Result d = shell(mpirun_command(ranks) + " " + run_command(split));
     ASSERT_EQ(d.code, 0) << d.output;
@@ -278,6 +284,43 @@ const ExampleCase kExamples[] = {
 
 INSTANTIATE_TEST_SUITE_P(Examples, MpirunExamples, ::testing::ValuesIn(kExamples),
                          [](const ::testing::TestParamInfo<ExampleCase>& p) { return std::string(p.param.name); });
+
+// The update schemes and grid-to-particle transfers no example uses, on examples that exercise what
+// they meet (issue 32): the same comparison on 2 and 3 ranks (3: a split along one axis into unequal
+// parts). USF (the stress update from the extrapolated velocities after their ghost update, the forces
+// and their exchange after it: mechanics/src/distributed/phase_lists.cpp) with multimaterial contact,
+// frictional heating and tractions (sliding_block_heating), rigid contact partners and damping
+// (oscillating_block), rigid walls and a fixed face (rigid_push), penalty contact with extended
+// B-splines (hertz_disks), 3D (sphere_3d) and the PBX grains (pbx_microstructure_small). XPIC(3) and
+// FMPM(3) (two round trips of the filters' series, each with its exchanges:
+// mechanics/src/distributed/velocity_filter.cpp) on the same kinds of scene: per-material entries at
+// multi-material nodes (the contact scenes, the PBX grains), velocity conditions in the series (fixed
+// faces, rigid drives, rigid partners keeping w0), penalty contact, 3D, one shared field (bars_impact,
+// MUSL), and XPIC under USF.
+const ExampleCase kSchemes[] = {
+    {"sliding_block_heating", 150, "--set solver.scheme=usf", "usf_sliding_block_heating", {{2, 3}}},
+    {"oscillating_block", 150, "--set solver.scheme=usf", "usf_oscillating_block", {{2, 3}}},
+    {"rigid_push", 150, "--set solver.scheme=usf", "usf_rigid_push", {{2, 3}}},
+    {"hertz_disks", 150, "--set solver.scheme=usf", "usf_hertz_disks", {{2, 3}}},
+    {"sphere_3d", 150, "--set solver.scheme=usf", "usf_sphere_3d", {{2, 3}}},
+    {"pbx_microstructure_small", 150, "--set solver.scheme=usf", "usf_pbx_microstructure_small", {{2, 3}}},
+    {"sliding_block_heating", 150, R"(--set 'solver.particle_update={"type":"xpic","order":3}')",
+     "xpic_sliding_block_heating", {{2, 3}}},
+    {"oscillating_block", 150, R"(--set 'solver.particle_update={"type":"xpic","order":3}')", "xpic_oscillating_block",
+     {{2, 3}}},
+    {"sphere_3d", 150, R"(--set 'solver.particle_update={"type":"xpic","order":3}')", "xpic_sphere_3d", {{2, 3}}},
+    {"sliding_block", 150, R"(--set solver.scheme=usf --set 'solver.particle_update={"type":"xpic","order":3}')",
+     "xpic_usf_sliding_block", {{2, 3}}},
+    {"rigid_push", 150, R"(--set 'solver.particle_update={"type":"fmpm","order":3}')", "fmpm_rigid_push", {{2, 3}}},
+    {"hertz_disks", 150, R"(--set 'solver.particle_update={"type":"fmpm","order":3}')", "fmpm_hertz_disks", {{2, 3}}},
+    {"bars_impact", 150, R"(--set 'solver.particle_update={"type":"fmpm","order":3}')", "fmpm_bars_impact", {{2, 3}}},
+    {"pbx_microstructure_small", 150,
+     R"(--set solver.pic_relaxation_time=null --set 'solver.particle_update={"type":"fmpm","order":3}')",
+     "fmpm_pbx_microstructure_small", {{2, 3}}},
+};
+
+INSTANTIATE_TEST_SUITE_P(Schemes, MpirunExamples, ::testing::ValuesIn(kSchemes),
+                         [](const ::testing::TestParamInfo<ExampleCase>& p) { return std::string(p.param.label); });
 
 }  // namespace
 }  // namespace frictherm::test

@@ -92,7 +92,10 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   o.ebs_occupation = scene.options.ebs_occupation;  // C_c of the extended B-spline (docs/ebs.md)
   for (int d = 0; d < Dim; ++d) o.gravity[d] = scene.options.gravity[d];
   o.pic_relaxation_time = scene.options.pic_relaxation_time;
-  o.musl = scene.options.scheme == mechanics::UpdateScheme::musl;  // usf is refused (scene_decomposed.cpp)
+  o.particle_update = scene.options.particle_update;
+  o.transfer_order = scene.options.transfer_order;
+  o.musl = scene.options.scheme == mechanics::UpdateScheme::musl;
+  o.usf = scene.options.scheme == mechanics::UpdateScheme::usf;
   o.damping_rate = scene.options.damping_rate;
   o.damping_until = scene.options.damping_until;
   o.fixed_faces = scene.fixed_faces;

@@ -26,16 +26,16 @@ std::string refuse(const std::string& key, const std::string& value, const std::
          "); the serial run (without mpirun, or with -n 1) supports it";
 }
 
-std::string mechanics_refusal(const Scene& s) {
-  const mechanics::SimulationOptions& o = s.options;
+// The mechanics refuse nothing now; the check stays with the others for what comes next.
+std::string mechanics_refusal(const Scene&) {
   // Every shape function runs decomposed, the extended B-spline too (the serial EbsBasis on the
   // particles gathered from all ranks, a ghost layer of its reach: mechanics/src/distributed/extended_bsplines.cpp).
-  // USL, and MUSL with or without contact (DecomposedMpm: the USL phases with the remap, its
-  // exchange and, with multimaterial contact, the contact pass on the remapped momenta).
-  if (o.scheme == mechanics::UpdateScheme::usf)
-    return refuse("solver.scheme", quoted(mechanics::to_string(o.scheme)), "\"usl\" or \"musl\"");
-  if (o.particle_update != mechanics::ParticleUpdate::flip)
-    return refuse("solver.particle_update", quoted(mechanics::to_string(o.particle_update)), "\"flip\"");
+  // USL, MUSL and USF with or without contact (DecomposedMpm: the USL phases with, under MUSL, the
+  // remap, its exchange and, with multimaterial contact, the contact pass on the remapped momenta;
+  // under USF the stress update from the extrapolated velocities after their ghost update, then the
+  // forces and their exchange: mechanics/src/distributed/phase_lists.cpp).
+  // Every grid-to-particle transfer: FLIP with the PIC blend, XPIC and FMPM (the filters' series at
+  // the owners with a Dim-vector exchange per term: mechanics/src/distributed/velocity_filter.cpp).
   // Damping, point loads and tractions run decomposed (the serial kernels, loads/grid_loads.hpp).
   // Every material kind runs decomposed (DecomposedMpm: linear elastic, neo-Hookean, Mie-Grüneisen/J2,
   // rigid walls and rigid contact partners; docs/distributed_pbx.md).

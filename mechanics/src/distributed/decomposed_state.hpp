@@ -203,6 +203,14 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<double> mt_values;
   std::vector<std::array<std::size_t, 2>> mt_own;  // (own slot, entry): written back after the step's grid phases
   std::vector<std::size_t> mt_recv_entry;          // per received entry: its group entry
+  // The groups' sum in fields_to_mt's order (node, material, rank): entry, own slot or received
+  // entry. Later sums over the same entries (USF's forces, the velocity filters' round trips) add in
+  // this order too.
+  struct MtItem {
+    std::size_t entry, where;
+    bool own;
+  };
+  std::vector<MtItem> mt_order;
   double* mt_at(std::size_t e) { return mt_values.data() + e * static_cast<std::size_t>(per_field); }
   // The entry exchange: leaves are this rank's (ghost node, field) entries at multi-material nodes
   // (send_slot: their slots), roots the owners' received entries; a unit is per_field values, the
@@ -354,9 +362,41 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<double> p2g_values;            // MUSL with several fields: the slots after particle_to_grid
   void setup_penalty();
   void penalty_forces(double dt);
+  bool penalty_mass_current = false;  // penalty_mass gathered in this step (step() clears it)
+  void gather_penalty_mass();
   void move_boundary_points(double dt);
   double penalty_time_step(double& cmax) const;  // the springs' limit; cmax times the penalty's wave factor
   void keep_grid_values(double dt);              // MUSL with several fields: p2g_values = field_values
+  // USF (scheme_phases.cpp): the post-condition momenta of the owned fields in for_each_owned_field's
+  // order, kept by velocity_from_momentum for forces_to_owners.
+  std::vector<double> kept_momentum;
+  // XPIC/FMPM (velocity_filter.cpp): a DMDA of Dim values per node (DMDACreateCompatibleDMDA, made at
+  // the first filtered step) with its vectors; per owned node (q) and per group entry (e) XPIC's start
+  // velocity, the series' term and its sum v*; per slot the term or v* a particle reads at a
+  // multi-material node and the round trip's sums; the Dim-vector unit and buffers over entry_sf.
+  DM filter_da = nullptr;
+  ::Vec filter_local = nullptr, filter_global = nullptr;
+  std::vector<Vec<Dim>> start_owned, start_mt, term_owned, term_mt, filtered_owned, filtered_mt, sums_owned, sums_mt;
+  std::vector<Vec<Dim>> slot_vector, slot_sums;
+  std::vector<double> vector_send, vector_recv;
+  MPI_Datatype vector_unit = MPI_DATATYPE_NULL;
+  bool filtered() const { return opt.particle_update != ParticleUpdate::flip; }
+  void start_velocity(double dt);
+  template <class Kernel>
+  void velocity_filter(double dt);
+  void vectors_to_ghosts(const std::vector<Vec<Dim>>& owned, const std::vector<Vec<Dim>>& entries);
+  void vectors_to_owners(std::vector<Vec<Dim>>& owned, std::vector<Vec<Dim>>& entries);
+  /// The value a particle reads at its field's slot: slot_vector at a multi-material node, else the
+  /// Dim-vector DMDA's ghosted value `local_vectors` (filter_local's array).
+  Vec<Dim> slot_vector_at(const PetscScalar* local_vectors, std::size_t slot) const {
+    const PetscInt l = slot_node[slot];
+    return multi[static_cast<std::size_t>(l)] ? slot_vector[slot] : Vec<Dim>(Eigen::Map<const Vec<Dim>>(local_vectors + Dim * l));
+  }
+  template <class Kernel>
+  void internal_forces(double dt);
+  void forces_to_owners(double dt);
+  template <class Kernel>
+  void add_loads(SwarmFields& f);  // the loads of this rank's particles into their slots' forces
   template <class Visit>
   void gather_owned_fields(int components, std::vector<double>& dense, Visit&& value);
 

@@ -78,6 +78,10 @@ DecomposedMpm<Dim>::Impl::~Impl() {
   free_extent_units();
   VecDestroy(&local);
   VecDestroy(&global);
+  VecDestroy(&filter_local);
+  VecDestroy(&filter_global);
+  DMDestroy(&filter_da);
+  if (vector_unit != MPI_DATATYPE_NULL) MPI_Type_free(&vector_unit);
   DMDestroy(&swarm);
   DMDestroy(&da);
 }

@@ -11,8 +11,9 @@
 //                         the sum is the owner's value exactly); then detection, the forces and heat
 //                         through the points' weights into whole-grid arrays, and each rank adds them
 //                         to the nodes it owns only (each node once, as the serial nodal force);
-//   move_boundary_points  (where the serial step moves them: after velocity_from_momentum under MUSL,
-//                         after the grid-to-particle update under USL) each field's nodal velocity over
+//   move_boundary_points  (where the serial step moves them: after velocity_from_momentum under MUSL
+//                         and USF (then before penalty_forces: the masses gathered first), after the
+//                         grid-to-particle update under USL) each field's nodal velocity over
 //                         the grid the same way, then the serial motion of every point.
 // Cost per step: two reductions of fields × grid nodes × (1 + Dim) doubles; fine for the EBS benchmark
 // scenes (about 10^4 nodes), a limit for large grids (then: the values at the points' stencil nodes only).
@@ -103,13 +104,21 @@ void DecomposedMpm<Dim>::Impl::gather_owned_fields(int components, std::vector<d
   MPI_Allreduce(MPI_IN_PLACE, dense.data(), static_cast<int>(dense.size()), MPI_DOUBLE, MPI_SUM, comm);
 }
 
+// Each field's complete nodal mass over the grid (the weights' sliver test), once per step.
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::gather_penalty_mass() {
+  if (penalty_mass_current) return;
+  gather_owned_fields(1, penalty_mass, [](const double* node, int) { return node[Dof::mass]; });
+  penalty_mass_current = true;
+}
+
 // Detection and penalty forces at the points' step-start positions (K·27–34), the forces into the
 // owned nodes' force (K·36) before the momentum update, the heat into the step's frictional work.
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::penalty_forces(double /*dt*/) {
   if (!penalty) return;
   if constexpr (Dim == 2) {
-    gather_owned_fields(1, penalty_mass, [](const double* node, int) { return node[Dof::mass]; });
+    gather_penalty_mass();
     const std::size_t N = grid.node_count();
     penalty_force.assign(static_cast<std::size_t>(fields) * N, Vec<Dim>::Zero());
     penalty_heat_first.assign(N, 0.0);
@@ -148,6 +157,7 @@ template <int Dim>
 void DecomposedMpm<Dim>::Impl::move_boundary_points(double dt) {
   if (!penalty) return;
   if constexpr (Dim == 2) {
+    gather_penalty_mass();  // USF moves the points before the forces
     gather_owned_fields(Dim, penalty_gather, [](const double* node, int d) { return node[Dof::velocity + d]; });
     penalty_kernels::StepWeights<Dim> w = lend_penalty_weights<Dim>(*this);
     const long bad = penalty_kernels::move_points(boundary, w, grid, dt, [&](int field, Vec<Dim>& v) {
@@ -205,6 +215,7 @@ BoundaryPoints<Dim>& DecomposedMpm<Dim>::boundary_points() {
 #define FRICTHERM_INSTANTIATE_PENALTY_PHASES(D)                                   \
   template void DecomposedMpm<D>::Impl::setup_penalty();                          \
   template void DecomposedMpm<D>::Impl::penalty_forces(double);                   \
+  template void DecomposedMpm<D>::Impl::gather_penalty_mass();                    \
   template void DecomposedMpm<D>::Impl::move_boundary_points(double);             \
   template double DecomposedMpm<D>::Impl::penalty_time_step(double&) const;       \
   template const PenaltyContact<D>* DecomposedMpm<D>::penalty_contact() const;    \

@@ -223,7 +223,7 @@ void DecomposedMpm<Dim>::Impl::fields_to_mt() {
   std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
     return a.node != b.node ? a.node < b.node : a.field != b.field ? a.field < b.field : a.from < b.from;
   });
-  mt_q.clear(), mt_l.clear(), mt_first.clear(), mt_field.clear(), mt_values.clear(), mt_own.clear();
+  mt_q.clear(), mt_l.clear(), mt_first.clear(), mt_field.clear(), mt_values.clear(), mt_own.clear(), mt_order.clear();
   mt_recv_entry.assign(received, 0);
   const PetscInt bx = box_size[0], by = box_size[1];
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -247,6 +247,7 @@ void DecomposedMpm<Dim>::Impl::fields_to_mt() {
     const double* v = it.own ? slot_values(it.where) : recv_buf.data() + it.where * unit;
     double* m = mt_at(e);
     for (int c = 0; c < per_field; ++c) m[c] += v[c];
+    mt_order.push_back({e, it.where, it.own});
     if (it.own)
       mt_own.push_back({it.where, e});
     else

@@ -1,7 +1,7 @@
-// The decomposed USL step (frictherm/mechanics/distributed.hpp) as a list of named phases; the
-// exchanges (sum_to_owners, exchange_field_ranges, fields_to_owners, ghost_velocities,
-// fields_to_ghosts, migrate) are phases of their own, the contact phases are in contact_phases.cpp
-// and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
+// The phases of the decomposed USL step (frictherm/mechanics/distributed.hpp; its lists, with MUSL's
+// and USF's, in phase_lists.cpp); the exchanges (sum_to_owners, exchange_field_ranges,
+// fields_to_owners, ghost_velocities, fields_to_ghosts, migrate) are phases of their own, the contact
+// phases are in contact_phases.cpp and the per-material exchanges in sparse_exchange.cpp. The particle loops reuse the serial module's
 // Stencil (shape_functions.hpp) through a NodeIndexer onto the ghosted box, and its
 // constitutive updates (material.hpp, mie_gruneisen.hpp, plane_strain_update.hpp), so they compute what the serial Simulation<Dim>'s USL
 // step computes (mechanics/src/simulation_step.cpp, simulation_fields.cpp) on this rank's particles,
@@ -11,7 +11,7 @@
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
 #include <frictherm/mechanics/energy/energy_books.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
-#include <frictherm/mechanics/transfer/pic_blend.hpp>
+#include <frictherm/mechanics/transfer/grid_to_particle.hpp>
 
 #include <mpi.h>
 
@@ -151,7 +151,7 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
     if (ranges ? rigid_wall(f.material[k]) : !evaluate(k)) continue;
     const auto& s = st[static_cast<std::size_t>(k)];
     const int field = field_of(f.material[k]);
-    const bool forces = !rigid(f.material[k]);
+    const bool forces = !rigid(f.material[k]) && !opt.usf;  // USF: internal_forces, after the stress update
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field)].index;
     const double mp = f.mass[k], Vp = f.volume[k];
     const Vec<Dim> mv = mp * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
@@ -181,13 +181,22 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
     });
   }
   if (loads.empty()) return;
-  // The point loads and tractions of this rank's particles, f_i += S_ip F(t) into their fields' slots
-  // (the serial kernel): a particle is on one rank, so sum_to_owners gives the owners each load once.
+  // This rank's loaded particles (for the loads' work in grid_to_particle) and, but under USF, their loads.
   local_loads.clear();
   for (PetscInt k = 0; k < f.n; ++k) {
     const auto [lo, hi] = std::equal_range(load_ids.begin(), load_ids.end(), static_cast<std::int64_t>(f.id[k]));
     for (auto j = lo; j != hi; ++j) local_loads.emplace_back(k, static_cast<std::size_t>(j - load_ids.begin()));
   }
+  if (!opt.usf) add_loads<Kernel>(f);
+}
+
+// The point loads and tractions of this rank's particles, f_i += S_ip F(t) into their fields' slots
+// (the serial kernel): a particle is on one rank, so sum_to_owners gives the owners each load once.
+template <int Dim>
+template <class Kernel>
+void DecomposedMpm<Dim>::Impl::add_loads(SwarmFields& f) {
+  constexpr int force = Dof::force;
+  const auto& st = stencils<Kernel>();
   for (const auto& [k, j] : local_loads) {
     if (rigid(f.material[k])) continue;  // as the serial step: a rigid particle's velocity is prescribed
     const Vec<Dim> F = load_force<Dim>(loads[j].force, loads[j].scale, time);
@@ -311,8 +320,9 @@ void DecomposedMpm<Dim>::Impl::ghost_velocities(double /*dt*/) {
   petsc_check(DMGlobalToLocalEnd(da, global, INSERT_VALUES, local), "DMGlobalToLocalEnd");
 }
 
-// Phase 12, local (FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
-// field, start-of-step stencils; with a PIC relaxation time the serial FLIP/PIC blend.
+// Phase 12, local: FLIP v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1} from the particle's own
+// field, start-of-step stencils, with a PIC relaxation time the serial FLIP/PIC blend; XPIC and FMPM
+// from v* of velocity_filter (the serial kernel, transfer/grid_to_particle.hpp).
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
@@ -321,6 +331,9 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   const auto& st = stencils<Kernel>();
   const PetscScalar* a = nullptr;
   petsc_check(VecGetArrayRead(local, &a), "VecGetArrayRead");
+  const bool filter = filtered();
+  const PetscScalar* vstar = nullptr;  // v* of XPIC/FMPM over the ghosted box
+  if (filter) petsc_check(VecGetArrayRead(filter_local, &vstar), "VecGetArrayRead");
   const double pic = pic_blend_fraction(dt, opt.pic_relaxation_time);  // the serial FLIP/PIC blend
   load_start_position.resize(local_loads.size());
   for (std::size_t n = 0; n < local_loads.size(); ++n)
@@ -334,19 +347,20 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
       Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dx;
       continue;
     }
-    Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero();
+    Vec<Dim> acc = Vec<Dim>::Zero(), v = Vec<Dim>::Zero(), vf = Vec<Dim>::Zero();
     const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
     st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
       const double* node = node_values(a, static_cast<std::size_t>(slot));
       acc += S * Eigen::Map<const Vec<Dim>>(node + acceleration);
       v += S * Eigen::Map<const Vec<Dim>>(node + velocity);
+      if (filter) vf += S * slot_vector_at(vstar, static_cast<std::size_t>(slot));
     });
-    Eigen::Map<Vec<Dim>> vp(f.velocity + Dim * k);
-    external_work += f.mass[k] * opt.gravity.dot(vp + 0.5 * dt * acc) * dt;  // gravity's work, as the serial pass
-    vp += dt * acc;
-    pic_blend(vp, v, pic);
+    // The velocity, gravity's work and the position, as the serial pass.
+    external_work += update_particle_velocity<Dim>(opt.particle_update, pic, dt, f.mass[k], opt.gravity, acc, v, vf,
+                                                   Eigen::Map<Vec<Dim>>(f.velocity + Dim * k));
     Eigen::Map<Vec<Dim>>(f.x + Dim * k) += dt * v;
   }
+  if (filter) petsc_check(VecRestoreArrayRead(filter_local, &vstar), "VecRestoreArrayRead");
   for (std::size_t n = 0; n < local_loads.size(); ++n) {  // the loads' work, F · Δx_p (the serial pass)
     const auto& [k, j] = local_loads[n];
     external_work += load_work<Dim>(load_force<Dim>(loads[j].force, loads[j].scale, time),
@@ -428,163 +442,17 @@ double DecomposedMpm<Dim>::damping_work() const {
   return w;
 }
 
-template <int Dim>
-const std::array<const char*, 18>& DecomposedMpm<Dim>::phase_names() {
-  static const std::array<const char*, 18> names{
-      {"particle_to_grid", "sum_to_owners", "exchange_field_ranges", "fields_to_owners", "find_contact_nodes",
-       "contact_extrapolated", "momentum_update", "contact_updated", "nodal_velocities", "ghost_velocities",
-       "fields_to_ghosts", "grid_to_particle", "stress_update", "migrate", "remap_momentum",
-       "velocity_from_momentum", "penalty_forces", "move_boundary_points"}};
-  return names;
-}
-
-template <int Dim>
-void DecomposedMpm<Dim>::step(double dt) {
-  Impl& s = *impl_;
-  s.take_initial_energy();  // the energy books' start, once (energy_books.cpp)
-  s.current_valid = false;  // the particles move: current_stencils() evaluates them again
-  // The kernel's phases: dispatch_shape names the quadratic B-spline for extended_bspline (the kernel
-  // outside the step), so the extended one is chosen here (as the serial build_phases).
-  const auto run = [&](auto kernel) {
-    using Kernel = decltype(kernel);
-    // A phase and the phase_names() entry that times it.
-    struct Phase {
-      void (Impl::*run)(double);
-      int name;
-    };
-    // USL, in order. Without contact (one velocity field) the per-field exchanges and the contact
-    // phases have nothing to do.
-    static constexpr Phase usl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
-                                    {&Impl::sum_to_owners, 1},
-                                    {&Impl::exchange_field_ranges, 2},
-                                    {&Impl::fields_to_owners, 3},
-                                    {&Impl::find_contact_nodes, 4},
-                                    {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
-                                    {&Impl::contact_extrapolated, 5},
-                                    {&Impl::penalty_forces, 16},  // penalty contact (penalty_phases.cpp)
-                                    {&Impl::momentum_update, 6},
-                                    {&Impl::contact_updated, 7},
-                                    {&Impl::nodal_velocities, 8},
-                                    {&Impl::ghost_velocities, 9},
-                                    {&Impl::fields_to_ghosts, 10},
-                                    {&Impl::template grid_to_particle<Kernel>, 11},
-                                    {&Impl::move_boundary_points, 17},  // with v^{n+1}, as the serial USL
-                                    {&Impl::template stress_update<Kernel>, 12},
-                                    {&Impl::migrate, 13}};
-    // MUSL: USL's phases up to the grid-to-particle update (with several velocity fields the slots of
-    // particle_to_grid kept), then the momenta remapped from the updated particles with their exchange
-    // (sum to the owners, the per-field entries to the owners, multimaterial contact on the remapped
-    // momenta there, the velocity conditions and v_i = p_i/m_i, the ghost update), the penalty
-    // contact's points moved with those velocities and the stress update from them (the serial MUSL
-    // list, simulation_step.cpp: contact_extrapolated, contact_updated, contact_remapped). The
-    // remapped pass is timed with the extrapolated one (both momentum changes only).
-    static constexpr Phase musl[] = {{&Impl::template particle_to_grid<Kernel>, 0},
-                                     {&Impl::keep_grid_values, 0},
-                                     {&Impl::sum_to_owners, 1},
-                                     {&Impl::exchange_field_ranges, 2},
-                                     {&Impl::fields_to_owners, 3},
-                                     {&Impl::find_contact_nodes, 4},
-                                     {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
-                                     {&Impl::contact_extrapolated, 5},
-                                     {&Impl::penalty_forces, 16},
-                                     {&Impl::momentum_update, 6},
-                                     {&Impl::contact_updated, 7},
-                                     {&Impl::nodal_velocities, 8},
-                                     {&Impl::ghost_velocities, 9},
-                                     {&Impl::fields_to_ghosts, 10},
-                                     {&Impl::template grid_to_particle<Kernel>, 11},
-                                     {&Impl::template remap_momentum<Kernel>, 14},
-                                     {&Impl::sum_to_owners, 1},
-                                     {&Impl::fields_to_owners, 3},
-                                     {&Impl::contact_remapped, 5},
-                                     {&Impl::velocity_from_momentum, 15},
-                                     {&Impl::move_boundary_points, 17},
-                                     {&Impl::ghost_velocities, 9},
-                                     {&Impl::fields_to_ghosts, 10},
-                                     {&Impl::template stress_update<Kernel>, 12},
-                                     {&Impl::migrate, 13}};
-    const bool is_musl = s.opt.musl;
-    const Phase* phases = is_musl ? musl : usl;
-    const std::size_t count = is_musl ? std::size(musl) : std::size(usl);
-    for (std::size_t p = 0; p < count; ++p) {
-      const double t0 = MPI_Wtime();
-      (s.*phases[p].run)(dt);
-      s.traffic.phase_seconds[static_cast<std::size_t>(phases[p].name)] += MPI_Wtime() - t0;
-    }
-  };
-  if (s.opt.shape == ShapeKind::extended_bspline)
-    run(ExtendedBSplineKernel{});
-  else
-    dispatch_shape(s.opt.shape, run);
-  s.time += dt;
-  s.steps_taken += 1.0;
-  ++s.traffic.steps;
-}
-
-// MUSL phase, local: the slots' momenta rebuilt from the updated particle velocities,
-// p_i = Σ S_ip m_p v_p^{n+1} over the start-of-step stencils of the deformable particles (the masses
-// and forces of particle_to_grid stay in the slots), as the serial remap_momentum.
-template <int Dim>
-template <class Kernel>
-void DecomposedMpm<Dim>::Impl::remap_momentum(double /*dt*/) {
-  constexpr int momentum = Dof::momentum;
-  // Several fields: fields_to_ghosts wrote the groups' complete values into the slots at multi-material
-  // nodes; this rank's own sums of particle_to_grid come back, so that the exchange sums them again.
-  if (fields > 1) field_values = p2g_values;
-  const std::size_t slots = slot_node.size();
-  for (std::size_t sl = 0; sl < slots; ++sl)
-    for (int d = 0; d < Dim; ++d) slot_values(sl)[momentum + d] = 0.0;
-  SwarmFields f(swarm);
-  const auto& st = stencils<Kernel>();
-  for (PetscInt k = 0; k < f.n; ++k) {
-    if (rigid(f.material[k])) continue;
-    const NodeIndexer<Dim> ix = boxes[static_cast<std::size_t>(field_of(f.material[k]))].index;
-    const Vec<Dim> mv = f.mass[k] * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k);
-    st[static_cast<std::size_t>(k)].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {
-      double* node = slot_values(static_cast<std::size_t>(slot));
-      for (int d = 0; d < Dim; ++d) node[momentum + d] += S * mv[d];
-    });
-  }
-}
-
-// MUSL phase, local: with several velocity fields this rank's slots as particle_to_grid left them,
-// for remap_momentum (fields_to_ghosts overwrites those at multi-material nodes).
-template <int Dim>
-void DecomposedMpm<Dim>::Impl::keep_grid_values(double /*dt*/) {
-  if (fields > 1) p2g_values = field_values;
-}
-
-// MUSL phase, owned nodes: the velocity conditions on the remapped momenta (driven components
-// m v_rigid, fixed ones 0), then v_i = p_i/m_i (empty nodes 0), as the serial velocity_from_momentum.
-template <int Dim>
-void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
-  constexpr int mass = Dof::mass, momentum = Dof::momentum, velocity = Dof::velocity;
-  PetscScalar* a = nullptr;
-  petsc_check(VecGetArray(global, &a), "VecGetArray");
-  for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
-    const std::uint8_t fixed = fixed_mask[static_cast<std::size_t>(q)];
-    const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
-    const double m = node[mass];
-    if (partner(field)) {  // a rigid partner's field: m v_rigid (the serial apply_velocity_bc)
-      const Vec<Dim> v = partner_velocity(field);
-      for (int d = 0; d < Dim; ++d) node[momentum + d] = m * v[d];
-    } else {
-      for (int d = 0; d < Dim; ++d) {
-        if (driven & (1u << d)) node[momentum + d] = m * drive_velocity[static_cast<std::size_t>(q)][d];
-        if (fixed & (1u << d)) node[momentum + d] = 0.0;
-      }
-    }
-    for (int d = 0; d < Dim; ++d) node[velocity + d] = m > empty_node_mass ? node[momentum + d] / m : 0.0;
-  });
-  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
-}
-
-// The members defined here, for both dimensions (the phase templates are instantiated by step).
+// The members defined here, for both dimensions and every kernel (the phase lists are in phase_lists.cpp).
+#define FRICTHERM_INSTANTIATE_USL_KERNEL(D, K)                                  \
+  template void DecomposedMpm<D>::Impl::particle_to_grid<K>(double);            \
+  template void DecomposedMpm<D>::Impl::grid_to_particle<K>(double);            \
+  template void DecomposedMpm<D>::Impl::stress_update<K>(double);              \
+  template void DecomposedMpm<D>::Impl::add_loads<K>(SwarmFields&);
 #define FRICTHERM_INSTANTIATE_USL(D)                                   \
-  template void DecomposedMpm<D>::step(double);                        \
-  template const std::array<const char*, 18>& DecomposedMpm<D>::phase_names(); \
-  template void DecomposedMpm<D>::Impl::keep_grid_values(double); \
-  template void DecomposedMpm<D>::Impl::velocity_from_momentum(double); \
+  FRICTHERM_INSTANTIATE_USL_KERNEL(D, LinearKernel)                    \
+  FRICTHERM_INSTANTIATE_USL_KERNEL(D, UGIMPKernel)                     \
+  FRICTHERM_INSTANTIATE_USL_KERNEL(D, QuadraticBSplineKernel)          \
+  FRICTHERM_INSTANTIATE_USL_KERNEL(D, ExtendedBSplineKernel)           \
   template double DecomposedMpm<D>::external_work() const;             \
   template double DecomposedMpm<D>::damping_work() const;              \
   template void DecomposedMpm<D>::Impl::sum_to_owners(double);         \
@@ -594,5 +462,6 @@ void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
 FRICTHERM_INSTANTIATE_USL(2)
 FRICTHERM_INSTANTIATE_USL(3)
 #undef FRICTHERM_INSTANTIATE_USL
+#undef FRICTHERM_INSTANTIATE_USL_KERNEL
 
 }  // namespace frictherm::mechanics

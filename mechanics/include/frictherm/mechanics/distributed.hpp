@@ -48,6 +48,22 @@
 //   ghost_velocities       exchange, as above
 // and stress_update, migrate (the serial MUSL list, simulation_step.cpp).
 //
+// USF (Options::usf) runs particle_to_grid (m, p only) and the exchanges and contact pass that
+// follow it, then
+//   velocity_from_momentum owned nodes: as above, the post-condition momenta kept for the momentum update
+//   ghost_velocities, fields_to_ghosts, stress_update (from these velocities)
+//   internal_forces        local: f_i = Σ (S_ip m_p g − V_p σ_p G_ip) and the loads into the slots
+//   forces_to_owners       exchange: the forces summed to the owners (DMDA, per-field entries), the
+//                          kept momenta back
+// and USL's list from momentum_update on (the serial USF list, simulation_step.cpp).
+//
+// XPIC and FMPM (Options::particle_update) add, in every list,
+//   start_velocity         owned nodes (XPIC): v^n = p/m before the momentum update
+//   velocity_filter        before grid_to_particle: v* = Σ_{j<order} (I − S⁺S)^j w0 per field, each
+//                          term's round trip over the local particles, its sums to the owners and the
+//                          next term back to the ghosts (a Dim-vector DMDA and the per-field entries)
+// and grid_to_particle reads v* (velocity_filter.cpp).
+//
 // Velocity fields: without contact every deformable material shares one field (as the serial
 // Simulation); with contact each material has its own. Each rank stores each field over the box of
 // local nodes its local particles' stencils reach (the serial layout_fields), so memory and work
@@ -78,6 +94,7 @@
 #include <frictherm/mechanics/material.hpp>
 #include <frictherm/mechanics/penalty_contact.hpp>
 #include <frictherm/mechanics/shape_functions.hpp>
+#include <frictherm/mechanics/transfer.hpp>
 #include <frictherm/mechanics/types.hpp>
 
 #include <mpi.h>
@@ -193,9 +210,21 @@ class DecomposedMpm {
     /// remapped from the particles, p_i = Σ S_ip m_p v_p, and the stress is updated from v_i = p_i/m_i,
     /// as the serial UpdateScheme::musl); MUSL without contact only.
     bool musl = false;
+    /// USF (true; not with musl): the stress updated from the extrapolated grid velocities before the
+    /// forces, as the serial UpdateScheme::usf. particle_to_grid scatters m and p only; after the
+    /// extrapolated contact pass velocity_from_momentum (the momenta kept), ghost_velocities,
+    /// fields_to_ghosts and stress_update, then internal_forces (f_i from the new stress and the
+    /// loads into the slots) and forces_to_owners (their exchange, DMDA and per-field entries), and
+    /// the USL list from the momentum update on (scheme_phases.cpp).
+    bool usf = false;
     /// FLIP/PIC blend time τ (s), as SimulationOptions::pic_relaxation_time: after the FLIP update
     /// v_p ← (1 − α) v_p + α Σ S_ip v_i, α = 1 − e^(−dt/τ); infinity: pure FLIP.
     double pic_relaxation_time = std::numeric_limits<double>::infinity();
+    /// Grid-to-particle transfer (transfer.hpp), as SimulationOptions::particle_update and
+    /// transfer_order: FLIP, XPIC(m) or FMPM(k), the filters' Neumann series over the ranks with a
+    /// Dim-vector exchange per term (velocity_filter.cpp).
+    ParticleUpdate particle_update = ParticleUpdate::flip;
+    int transfer_order = 1;
     std::vector<FixedFace> fixed_faces;   // grid faces with velocity components fixed to 0 (Simulation::fix_face)
     /// Multimaterial contact (one velocity field per material), as Simulation::enable_contact and
     /// set_contact_pair. Supported: multimaterial pairs with any friction law, separation position,
@@ -251,7 +280,7 @@ class DecomposedMpm {
   /// migrated to their owners. Every particle must lie inside the grid's physical region.
   void add_particles(const std::vector<Particle>& particles);
 
-  /// One USL or MUSL step of size dt (collective): the phases listed above, in that order. Throws
+  /// One USL, MUSL or USF step of size dt (collective): the phases listed above, in that order. Throws
   /// std::runtime_error on every rank when a particle is compressed past its Hugoniot's limit.
   void step(double dt);
   static const std::array<const char*, 18>& phase_names();
