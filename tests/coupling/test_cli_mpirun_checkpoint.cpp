@@ -63,6 +63,14 @@ class CliMpirunCheckpoint : public frictherm::test::MpirunScratchTest {
     return s.str();
   }
 
+  // Every file of the interrupted run (part.*) into the sub-folder `dir`.
+  void copy_part_files(const std::string& dir) const {
+    fs::create_directory(path(dir));
+    for (const auto& e : fs::directory_iterator(path("")))
+      if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
+        fs::copy_file(e.path(), path(dir + "/" + e.path().filename().string()));
+  }
+
   // The uninterrupted run into full.h5.
   void run_full(const std::string& interval, const std::string& end_time, const std::string& extra = "") {
     const Result r =
@@ -209,10 +217,7 @@ TEST_F(CliMpirunCheckpoint, PenaltyContactResumesToTheUninterruptedRun) {
   const std::vector<double> t = read_doubles(path("part.h5"), "/series/time");
   ASSERT_FALSE(t.empty());
   std::printf("  interrupted at t = %.6g s after %zu series rows\n", t.back(), t.size());
-  fs::create_directory(path("three"));
-  for (const auto& e : fs::directory_iterator(path("")))
-    if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
-      fs::copy_file(e.path(), path("three/" + e.path().filename().string()));
+  copy_part_files("three");  // the interrupted run's files, to resume on 3 ranks too
   const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + path("part.h5") + "'");
   ASSERT_EQ(resumed.code, 0) << resumed.output;
   const Result three = shell(mpirun(3) + " " + exe() + " resume '" + path("three/part.h5") + "'");
@@ -292,10 +297,7 @@ TEST_F(CliMpirunCheckpoint, RegularizedContactResumesToTheUninterruptedRun) {
   const std::vector<double> t = read_doubles(out, "/series/time"), sliding = read_doubles(out, "/series/sliding_nodes");
   ASSERT_FALSE(t.empty());
   std::printf("  interrupted at t = %.6g s with %g sliding nodes\n", t.back(), sliding.back());
-  fs::create_directory(path("three"));
-  for (const auto& e : fs::directory_iterator(path("")))
-    if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
-      fs::copy_file(e.path(), path("three/" + e.path().filename().string()));
+  copy_part_files("three");  // the interrupted run's files, to resume on 3 ranks too
   const Result resumed = shell(mpirun(2) + " " + exe() + " resume '" + out + "'");
   ASSERT_EQ(resumed.code, 0) << resumed.output;
   const Result three = shell(mpirun(3) + " " + exe() + " resume '" + path("three/part.h5") + "'");
@@ -402,10 +404,7 @@ TEST_F(CliMpirunCheckpoint, InterfaceTemperatureResumesToTheUninterruptedRun) {
   const std::vector<double> rows = read_doubles(out, "/series/time");
   ASSERT_FALSE(rows.empty());
   std::printf("  interrupted at t = %.6g s\n", rows.back());
-  fs::create_directory(path("three"));
-  for (const auto& e : fs::directory_iterator(path("")))
-    if (e.is_regular_file() && e.path().filename().string().rfind("part.", 0) == 0)
-      fs::copy_file(e.path(), path("three/" + e.path().filename().string()));
+  copy_part_files("three");  // the interrupted run's files, to resume on 3 ranks too
   const Result three = shell(mpirun(3) + " " + exe() + " resume '" + path("three/part.h5") + "'");
   EXPECT_EQ(three.code, 2) << three.output;
   EXPECT_THAT(three.output, HasSubstr("resume on the same number of ranks only (expected mpirun -n 2, not 3)"));
