@@ -2,6 +2,13 @@
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(SUNDIALS 6.4 REQUIRED COMPONENTS cvode arkode nvecserial
              sunlinsolklu sunlinsolpcg sunlinsolspgmr sunmatrixsparse)
+# SUNDIALS unpacked outside the system's folders (scripts/install_deps.sh program, .deps/sundials): its
+# libraries find each other (libsundials_sunlinsolklu needs libsundials_sunmatrixsparse) through the
+# executable's search path only when it is a DT_RPATH, which, unlike the linker's default DT_RUNPATH,
+# also serves the dependencies of the libraries loaded.
+if(NOT SUNDIALS_DIR MATCHES "^/usr/")
+  add_link_options(-Wl,--disable-new-dtags)
+endif()
 find_package(HDF5 REQUIRED COMPONENTS C)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(Boost 1.74 REQUIRED)  # header-only: Boost.Math root finders (mechanics friction laws)

@@ -19,15 +19,22 @@ if command -v ccache >/dev/null 2>&1; then
   export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(dirname "$(pwd)")}
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 fi
+# SUNDIALS: the system's (libsundials-dev) when installed, else the Debian packages that
+# scripts/install_deps.sh program unpacked into .deps/sundials (it says why). Named on every configure,
+# so a build folder configured against the unpacked copy moves to the system's once command 2 installs it.
+sundials_config=$(compgen -G "/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" ||
+                  compgen -G "$(pwd)/.deps/sundials/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" || true)
+sundials=()
+if [ -n "$sundials_config" ]; then sundials=(-DSUNDIALS_DIR="$(dirname "$(echo "$sundials_config" | head -1)")"); fi
 if [ "$mode" = --program ]; then
   options=()
   if [ ! -f "$build/CMakeCache.txt" ]; then
     options=(-DFRICTHERM_BUILD_TESTS=OFF -DFRICTHERM_BUILD_BENCH=OFF -DFRICTHERM_WITH_MPI=OFF)
   fi
-  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${options[@]}"
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${options[@]}"
   cmake --build "$build" -j "$jobs" --target frictherm
 else
-  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" \
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" \
         -DFRICTHERM_BUILD_TESTS=ON -DFRICTHERM_BUILD_BENCH=ON -DFRICTHERM_WITH_MPI=ON
   cmake --build "$build" -j "$jobs"
 fi
