@@ -198,6 +198,48 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   };
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
+  if (threads <= 1 && !pull && !relax) {
+    // The usual window (no held face, no sub-grid blend): T_p + Σ S_ip ΔT_i, as blend() gives it
+    // then. A whole particle's S_ip and unknowns are kept from the first walk for the second (the
+    // same products, so the same sums), and the loop has no per-node tests.
+    constexpr int nodes = mechanics::Stencil<Dim, Kernel>::node_count;
+    Expanded c{};
+    const int* un = sys.unknown.data();
+    double* const temperature = p.temperature.data();
+    double* const sums = next_mct_.data();
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+      const double before = temperature[k];
+      if (whole_[k]) {
+        double w[nodes];
+        int at[nodes];
+        int a = 0;
+        double dT = 0.0;
+        for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double s, double, double, double) {
+          dT += s * dl[u];
+          w[a] = s;
+          at[a] = u;
+          ++a;
+        });
+        const double T = before + dT;
+        if (T == before) continue;
+        temperature[k] = T;
+        if (!keep_sums) continue;
+        const double change = heat_capacity_[k] * (T - before);
+        for (int b = 0; b < nodes; ++b) sums[at[b]] += change * w[b];
+        continue;
+      }
+      expand<Kernel, false>(stencils[k], sys.unknown, c);
+      if (c.count == 0) continue;  // reaches no unknown
+      const double T = new_temperature(before, c, k, face_heat_);
+      if (T == before) continue;
+      temperature[k] = T;
+      if (!keep_sums) continue;
+      const double change = heat_capacity_[k] * (T - before);
+      for (int a = 0; a < c.count; ++a) sums[c.unknown[a]] += change * c.S[a];
+    }
+    return;
+  }
   if (threads <= 1) {  // one pass: the same numbers in the same order, no lists
     Expanded c{};
     const int* un = sys.unknown.data();

@@ -80,11 +80,19 @@ std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<
   const bool absolute = opt_.mode == HotSpotOptions::Mode::absolute;
   const double threshold = opt_.threshold;
   double T_max = -std::numeric_limits<double>::infinity();
+  // The highest level (T or T − T0) as well: when none is above the threshold the candidate loop
+  // finds nothing (the usual window), so it is not run. std::max leaves a NaN level out, as the
+  // candidate test does.
+  double level_max = -std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < n; ++k) {
     const auto id = static_cast<std::size_t>(material[k]);
-    if (id < n_materials && props[id].conducts) T_max = std::max(T_max, level_T[k]);
+    if (!(id < n_materials && props[id].conducts)) continue;
+    const double T = level_T[k];
+    T_max = std::max(T_max, T);
+    level_max = std::max(level_max, absolute ? T : T - (k < n_T0 ? T0_data[k] : 0.0));
   }
   max_temperature = T_max;
+  if (!(level_max > threshold)) return hot;
   for (std::size_t k = 0; k < n; ++k) {
     const auto id = static_cast<std::size_t>(material[k]);
     if (id >= n_materials || !props[id].conducts) continue;
