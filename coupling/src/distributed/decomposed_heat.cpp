@@ -138,7 +138,9 @@ void DecomposedHeat::check_materials(mechanics::DecomposedMpm<Dim>& mpm) {
                                 " has no thermal properties (expected " + std::to_string(opt_.materials.size()) +
                                 " entries in materials to cover it)");
   pending_.assign(mpm.owned_local_nodes().size(), 0.0);
-  if (w.kind == WindowPolicy::Kind::adaptive) gather_mass(mpm);  // the first estimate's M (Coupler::start)
+  // M_i and T_i of the start (eq. 38), as Coupler::start: the adaptive policy's first estimate and the
+  // first snapshot's thermal nodes (thermal_nodes).
+  gather_mass(mpm);
 }
 
 MPI_Comm DecomposedHeat::communicator() const { return mpm3_ ? mpm3_->communicator() : mpm2_->communicator(); }

@@ -191,7 +191,7 @@ class DecomposedRun {
   std::vector<double> series_rows_;
   long series_columns_ = 0;
   detail::SeriesMemory series_memory_;  // the previous series row, for the contact_heat_rate columns
-  std::string xdmf_grids_, xdmf_reference_grids_;
+  std::string xdmf_grids_, xdmf_reference_grids_, xdmf_node_grids_;
   typename Mpm::CheckpointState restored_;
   int redistributed_from_ = 0;  // ranks of a checkpoint resumed on another number of ranks
 

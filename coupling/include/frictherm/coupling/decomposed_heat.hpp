@@ -127,6 +127,14 @@ struct DecomposedHeatBooks {
   long exchanges = 0;                   // grid exchanges (sum_to_owned, owned_to_local): 4 + 2 n per window (+1 relocating, +1 per step with plastic heating)
 };
 
+/// One rank's thermal unknowns at a snapshot (DecomposedHeat::thermal_nodes): the serial grid node
+/// numbers, T_i (K) and M_i (J/K, eq. 38), in the serial Coupler's system()->grid_node,
+/// nodal_temperature() and system()->mass sense.
+struct DecomposedThermalNodes {
+  std::vector<int> grid_node;
+  std::vector<double> temperature, heat_capacity;
+};
+
 class DecomposedHeat {
  public:
   /// The mechanics must carry the particle scalar options.temperature and hold its particles (the
@@ -179,6 +187,10 @@ class DecomposedHeat {
   /// Σ_p m_p C_v,p T_p over all ranks (J).
   double heat_content() const;
 
+  /// The owned nodes that are unknowns of the last gather (the start's, a window's or an interval's),
+  /// with the last window's or interval's end T_i (the gathered T_i before any window) and M_i: each
+  /// thermal unknown on its owner only (the serial /nodes of a snapshot).
+  DecomposedThermalNodes thermal_nodes() const;
   /// This rank's particles for DecomposedOutput::write (ids, x_p, v_p, T_p, materials; swarm order).
   DecomposedSnapshot snapshot() const;
   /// Collective: one update of `tracker` (built with dim()) over the particles of all ranks
@@ -255,6 +267,8 @@ class DecomposedHeat {
                     double time) const;
   // decomposed_interface.cpp: InterfaceTemperature on the owned nodes (start, each step's heat, the
   // update after each window or interval, which writes T_int,p into the particle scalar).
+  // Owned node u (x fastest over owned_nodes()) -> its serial grid node number.
+  template <int Dim> static std::vector<int> owned_grid_nodes(const mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> InterfaceTemperature<Dim>* interface_model();
   template <int Dim> void interface_start(mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> void interface_step(const std::vector<double>& work);
