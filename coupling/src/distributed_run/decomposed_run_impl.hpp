@@ -175,6 +175,7 @@ class DecomposedRun {
   long step_ = 0, snapshots_ = 0;
   long last_series_step_ = -1, last_snapshot_step_ = -1;
   double heating_seconds_ = 0.0, output_seconds_ = 0.0, continuation_seconds_ = 0.0;
+  double loading_solve_seconds_ = 0.0;  // of heating_seconds_, inside the integrator (rank's wall time)
   double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
   double particle_reaction_heat_ = 0.0;  // q Σ m_p λ_p over ranks at the end (J)
   Clock::time_point last_flush_ = Clock::now();
