@@ -68,6 +68,32 @@ void write_attribute(hid_t group, const std::string& file, const char* name, hid
   h5::check(H5Awrite(a.get(), type, value), file, std::string("cannot write attribute ") + name);
 }
 
+// A snapshot's group `path` (particles or thermal nodes) in a rank file: the serial group's step and
+// time attributes and the polyvertex connectivity 0..n−1 its XDMF grid draws.
+h5::Handle drawn_group(hid_t f, const std::string& file, const std::string& path, long step, double time,
+                       std::size_t n, int dim) {
+  h5::Handle g{h5::check_id(H5Gcreate2(f, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
+                            "cannot create " + path),
+               H5Gclose};
+  const std::int64_t step64 = step;
+  write_attribute(g.get(), file, "step", H5T_NATIVE_INT64, &step64);
+  write_attribute(g.get(), file, "time", H5T_NATIVE_DOUBLE, &time);
+  std::vector<int> connectivity(n);
+  for (std::size_t k = 0; k < n; ++k) connectivity[k] = static_cast<int>(k);
+  write_dataset(g.get(), file, "connectivity", H5T_NATIVE_INT, connectivity.data(), n, 1, dim);
+  return g;
+}
+
+// Every rank's row count on rank 0 (collective).
+std::vector<unsigned long long> counts_on_root(MPI_Comm comm, std::size_t n) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  const unsigned long long mine = n;
+  std::vector<unsigned long long> counts(static_cast<std::size_t>(size));
+  MPI_Gather(&mine, 1, MPI_UNSIGNED_LONG_LONG, counts.data(), 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  return counts;
+}
+
 // n × dim values padded to n × 3 (ParaView's vectors).
 std::vector<double> padded(const std::vector<double>& v, std::size_t n, int dim) {
   std::vector<double> out(3 * n, 0.0);
@@ -248,16 +274,7 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
   if (error.empty()) {
     try {
       const h5::Quiet quiet;
-      const std::string path = "/snapshots/" + index;
-      const h5::Handle g{h5::check_id(H5Gcreate2(file_, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
-                                      "cannot create " + path),
-                         H5Gclose};
-      const std::int64_t step64 = step;
-      write_attribute(g.get(), file, "step", H5T_NATIVE_INT64, &step64);
-      write_attribute(g.get(), file, "time", H5T_NATIVE_DOUBLE, &time);
-      std::vector<int> connectivity(n);
-      for (std::size_t k = 0; k < n; ++k) connectivity[k] = static_cast<int>(k);
-      write_dataset(g.get(), file, "connectivity", H5T_NATIVE_INT, connectivity.data(), n, 1);
+      const h5::Handle g = drawn_group(file_, file, "/snapshots/" + index, step, time, n, 3);
       write_dataset(g.get(), file, "id", H5T_NATIVE_INT64, s.id.data(), n, 1);
       write_dataset(g.get(), file, "position", H5T_NATIVE_DOUBLE, s.position.data(), n, dim);
       const std::vector<double> v = padded(s.velocity, n, dim_);
@@ -277,9 +294,7 @@ void DecomposedOutput::write(long step, double time, const DecomposedSnapshot& s
   agree(comm_, error);
 
   // Rank 0 joins the ranks' grids (ranks without particles have none) and rewrites the XDMF file.
-  const unsigned long long mine = n;
-  std::vector<unsigned long long> counts(static_cast<std::size_t>(size_));
-  MPI_Gather(&mine, 1, MPI_UNSIGNED_LONG_LONG, counts.data(), 1, MPI_UNSIGNED_LONG_LONG, 0, comm_);
+  const std::vector<unsigned long long> counts = counts_on_root(comm_, n);
   error.clear();
   if (rank_ == 0) {
     try {
@@ -330,15 +345,7 @@ void DecomposedOutput::write_nodes(long step, double time, const std::string& in
         h5::Handle{h5::check_id(H5Gcreate2(file_, "nodes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
                                 "cannot create /nodes"),
                    H5Gclose};
-      const h5::Handle g{h5::check_id(H5Gcreate2(file_, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file,
-                                      "cannot create " + path),
-                         H5Gclose};
-      const std::int64_t step64 = step;
-      write_attribute(g.get(), file, "step", H5T_NATIVE_INT64, &step64);
-      write_attribute(g.get(), file, "time", H5T_NATIVE_DOUBLE, &time);
-      std::vector<int> connectivity(n);
-      for (std::size_t k = 0; k < n; ++k) connectivity[k] = static_cast<int>(k);
-      write_dataset(g.get(), file, "connectivity", H5T_NATIVE_INT, connectivity.data(), n, 1, dim_);
+      const h5::Handle g = drawn_group(file_, file, path, step, time, n, dim_);
       for (const DecomposedSnapshot::NodeField& f : s.node_fields)
         write_dataset(g.get(), file, f.name, f.integer ? H5T_NATIVE_INT32 : H5T_NATIVE_DOUBLE,
                       f.integer ? static_cast<const void*>(f.integers.data()) : f.values.data(), n,
@@ -349,9 +356,7 @@ void DecomposedOutput::write_nodes(long step, double time, const std::string& in
     }
   }
   agree(comm_, error);
-  const unsigned long long count = n;
-  std::vector<unsigned long long> counts(static_cast<std::size_t>(size_));
-  MPI_Gather(&count, 1, MPI_UNSIGNED_LONG_LONG, counts.data(), 1, MPI_UNSIGNED_LONG_LONG, 0, comm_);
+  const std::vector<unsigned long long> counts = counts_on_root(comm_, n);
   if (rank_ == 0) {
     try {
       std::vector<XdmfField> fields;
