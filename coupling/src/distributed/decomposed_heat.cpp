@@ -544,6 +544,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
       assembled_->advance(comm, *ids_, entries_of, M, q, face_temperature_, Tn, t0, t0 + dt);
     }
     ++books_.assembled_windows;
+    books_.max_row_sum_residual = std::max(books_.max_row_sum_residual, assembled_->row_sum_residual());
     books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
   }
 

@@ -198,8 +198,8 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
                                     double particle_reaction_heat, long hotspots_seen) {
   const DecomposedHeatBooks& b = heat.books();
   // The serial EnergyBooks from the books summed over ranks. Every matrix-free window gathers its
-  // particles afresh (no reuse, no partial refresh); the assembly residual is the heat capacity's
-  // partition of unity (|Σ_i M_i − Σ_p m_p C_v,p| / Σ_p m_p C_v,p), K·1 = 0 not measured.
+  // particles afresh (no reuse, no partial refresh); the assembly residual is the worst of the heat
+  // capacity's partition of unity and K·1 = 0 (assembled windows), as the serial Coupler's.
   EnergyBooks e;
   e.work_received = b.work_received;
   e.plastic_work_received = b.plastic_work_received;
@@ -214,7 +214,7 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   e.steps = b.steps;
   e.min_window = b.min_window;
   e.max_window = b.max_window;
-  e.max_assembly_residual = b.max_capacity_residual;
+  e.max_assembly_residual = std::max(b.max_capacity_residual, b.max_row_sum_residual);
   e.matrix_free_windows = b.windows - b.assembled_windows;
   e.matrix_free_substeps = b.substeps;
   e.matrix_free_gathers = e.matrix_free_windows;

@@ -113,6 +113,7 @@ struct DecomposedHeatBooks {
   double nodal_energy_change = 0.0;     // Σ over windows of Σ_i M_i ΔT_i
   double particle_energy_change = 0.0;  // Σ over windows of Σ_p m_p C_v,p ΔT_p
   double max_capacity_residual = 0.0;   // worst |Σ_i M_i − Σ_p m_p C_v,p| / Σ_p m_p C_v,p
+  double max_row_sum_residual = 0.0;    // worst max_i |(K·1)_i| / max_i K_ii of assembled windows (over ranks)
   double plastic_work_received = 0.0;   // Σ over steps of Δw_p of the particles with β > 0
   double plastic_heat_received = 0.0;   // Σ over steps of Σ_i β Δw_p S_ip (part of the pending heat)
   double plastic_heat_delivered = 0.0;  // of it, handed to closed windows
@@ -211,6 +212,7 @@ class DecomposedHeat {
                            {"books/nodal_energy_change", &b.nodal_energy_change},
                            {"books/particle_energy_change", &b.particle_energy_change},
                            {"books/max_capacity_residual", &b.max_capacity_residual},
+                           {"books/max_row_sum_residual", &b.max_row_sum_residual},
                            {"books/min_window", &b.min_window}, {"books/max_window", &b.max_window},
                            {"books/plastic_work_received", &b.plastic_work_received},
                            {"books/plastic_heat_received", &b.plastic_heat_received},
