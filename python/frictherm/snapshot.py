@@ -116,25 +116,40 @@ class Snapshot:
         df.attrs.update(units=units, time=self.time, step=self.step)
         return df
 
+    def _node_group(self):
+        """/nodes/<label> of the file, or of a decomposed run's rank files joined (each rank holds the
+        nodes it owns, each node once: frictherm/ranks.py); None when there is none."""
+        if self.index is None:
+            return None
+        if self._run.ranks > 1:
+            from .ranks import joined_groups
+            return joined_groups(self._run._decomposed_files(), "nodes").get(self.label)
+        f = self._group.file
+        return f["nodes"][self.label] if "nodes" in f and self.label in f["nodes"] else None
+
     @property
     def has_nodes(self):
-        """True when the file holds the thermal grid's nodes at this snapshot (/nodes, runs with heat)."""
-        f = self._group.file
-        return self.index is not None and "nodes" in f and self.label in f["nodes"]
+        """True when the result holds the thermal grid's nodes at this snapshot (/nodes, runs with heat)."""
+        return self._node_group() is not None
 
     def nodes(self):
         """The thermal grid's nodes at this snapshot as a pandas DataFrame, one row per node that is
         a thermal unknown: position_x, position_y (position_z), temperature (K, the nodal T_i at the
-        snapshot time), heat_capacity (J/K, M_i) and lattice_x, ... (grid node coordinates);
-        ``df.attrs`` as for to_dataframe. KeyError when the file has none (runs without heat,
-        decomposed runs, the failure state)."""
+        snapshot time), heat_capacity (J/K, M_i) and lattice_x, ... (grid node coordinates), in grid
+        node order (x fastest; a decomposed run's ranks joined); ``df.attrs`` as for to_dataframe.
+        KeyError when the result has none (runs without heat, the failure state)."""
         import pandas as pd
-        if not self.has_nodes:
+        g = self._node_group()
+        if g is None:
             raise KeyError(f"snapshot {self.label} has no thermal grid nodes (/nodes/{self.label})")
-        g = self._group.file["nodes"][self.label]
+        names = [n for n in g if n != "connectivity"]
+        order = slice(None)
+        if self._run.ranks > 1 and "lattice" in names:  # the serial order: grid node number, x fastest
+            lattice = np.asarray(g["lattice"][()])
+            order = np.lexsort(tuple(lattice[:, i] for i in range(lattice.shape[1])))
         cols, units = {}, {}
-        for name in g:
-            data = np.asarray(g[name][()])
+        for name in names:
+            data = np.asarray(g[name][()])[order]
             unit = text(g[name].attrs["units"]) if "units" in g[name].attrs else ""
             if data.ndim == 1:
                 cols[name], units[name] = data, unit

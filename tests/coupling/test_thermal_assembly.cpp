@@ -78,6 +78,27 @@ TEST(ThermalAssembly, PartitionOfUnityAndZeroRowSums2D) {
   }
 }
 
+// The zero-row-sum check on row blocks (row_sum_extremes: a decomposed run's owned rows with global
+// columns, the largest |Σ_j K_ij| and |K_ii| reduced over ranks): on a system whose K·1 is not zero
+// (its diagonal scaled) the maxima over two blocks give the whole system's residual exactly (maxima
+// of the same numbers), which is the one NodalThermalSystem::row_sum_residual reports.
+TEST(ThermalAssembly, RowSumResidualOfRowBlocksIsTheSystems) {
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
+  fc::NodalThermalSystem s = fc::assemble_thermal(grid, block_2d(), fm::ShapeKind::ugimp, two_materials());
+  const Eigen::Index n = s.conductance.rows();
+  ASSERT_GT(n, 4);
+  for (Eigen::Index i = 0; i < n; ++i) s.conductance.coeffRef(i, i) *= 1.0 + 1e-3 * static_cast<double>(i % 7);
+  const Eigen::VectorXd r = s.conductance * Eigen::VectorXd::Ones(n);
+  const double expected = r.cwiseAbs().maxCoeff() / s.conductance.diagonal().cwiseAbs().maxCoeff();
+  EXPECT_GT(expected, 1e-6);  // not round-off: the check sees the scaled diagonal
+  EXPECT_EQ(s.row_sum_residual(), expected);
+  const Eigen::Index k = n / 3;
+  const frictherm::thermal::SparseMatrix top = s.conductance.topRows(k), bottom = s.conductance.bottomRows(n - k);
+  const fc::RowSumExtremes a = fc::row_sum_extremes(top, 0), b = fc::row_sum_extremes(bottom, k);
+  EXPECT_EQ((fc::RowSumExtremes{std::max(a.sum, b.sum), std::max(a.diagonal, b.diagonal)}.residual()), expected);
+  EXPECT_EQ(fc::row_sum_extremes(frictherm::thermal::SparseMatrix(0, n), 0).residual(), 0.0);
+}
+
 TEST(ThermalAssembly, PartitionOfUnityAndZeroRowSums3D) {
   const auto grid = make_grid<3>({0.0, 0.0, 0.0}, 1e-3, {6, 5, 5});
   fm::Particles<3> p;

@@ -200,6 +200,17 @@ def test_decomposed_run_snapshots_join_the_rank_files(decomposed_pair):
             assert np.abs(b["position"] - a["position"]).max() <= 1e-12 * 0.026
             assert np.abs(b["velocity"] - a["velocity"]).max() <= 1e-12 * 10.0
             assert np.abs(b["temperature"] - a["temperature"]).max() <= 1e-12 * 300.0
+            # The thermal grid's nodes: each rank's owned unknowns joined in the serial (grid node)
+            # order, the serial positions and lattice exactly, T_i and M_i to round-off (issue 32).
+            assert a.has_nodes and b.has_nodes
+            na, nb = a.nodes(), b.nodes()
+            assert list(nb.columns) == list(na.columns) and len(nb) == len(na) > 0
+            for c in na.columns:
+                if c.startswith(("position", "lattice")):
+                    np.testing.assert_array_equal(nb[c].values, na[c].values)
+            assert np.abs(nb["temperature"].values - na["temperature"].values).max() <= 1e-12 * 300.0
+            assert np.abs(nb["heat_capacity"].values - na["heat_capacity"].values).max() <= 1e-12 * na["heat_capacity"].max()
+            assert nb.attrs["units"] == na.attrs["units"]
         assert decomposed.failure is None
     # Without its rank files a decomposed run says which file is missing.
     os.rename(decomposed_file.replace(".h5", ".rank1.h5"), decomposed_file.replace(".h5", ".rank1.moved"))

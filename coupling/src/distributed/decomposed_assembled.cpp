@@ -2,6 +2,8 @@
 // particles summed at their owners through a PETSc matrix, then the distributed integrator.
 #include "distributed/decomposed_assembled.hpp"
 
+#include <frictherm/coupling/thermal_assembly.hpp>
+
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <petscmat.h>
@@ -157,6 +159,10 @@ void DecomposedAssembledSolve::assemble(MPI_Comm comm, const UnknownNumbering& i
   entries_ = static_cast<long>(entries.size());
   thermal::SparseMatrix rows_k(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(N));
   rows_k.setFromTriplets(entries.begin(), entries.end());
+  const RowSumExtremes extremes = row_sum_extremes(rows_k, static_cast<Eigen::Index>(ids.first));
+  double sums[2] = {extremes.sum, extremes.diagonal};  // the largest over ranks, as one serial system's
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_MAX, comm);
+  row_sum_residual_ = RowSumExtremes{sums[0], sums[1]}.residual();
 
   // M on the owned unknowns (compact, in global-id order): the window's problem, kept.
   Eigen::VectorXd mass(n);

@@ -87,6 +87,9 @@ class DecomposedAssembledSolve {
   std::string name() const { return integrator_->name(); }
   /// Stored entries of K's owned rows in the last window (this rank).
   long last_entries() const { return entries_; }
+  /// The last assembly's max_i |(K·1)_i| / max_i K_ii over all ranks (row_sum_extremes, the serial
+  /// NodalThermalSystem::row_sum_residual).
+  double row_sum_residual() const { return row_sum_residual_; }
 
  private:
   std::string name_, preconditioner_;
@@ -95,6 +98,7 @@ class DecomposedAssembledSolve {
   thermal::IntegratorStats stats_offset_;  // of the integrators replaced by restart_integrator
   std::unique_ptr<thermal::DistributedProblem> problem_;  // the last window's
   long entries_ = 0;
+  double row_sum_residual_ = 0.0;
 };
 
 }  // namespace frictherm::coupling

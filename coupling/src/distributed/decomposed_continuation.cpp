@@ -47,6 +47,7 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
       KeptEntries entries_of{Dim, {1, 1, 1}, &kept_first_, &kept_node_, &kept_G_, &conductance_};
       for (int d = 0; d < Dim; ++d) entries_of.box[static_cast<std::size_t>(d)] = box[2 * d + 1] - box[2 * d];
       assembled_->assemble(comm, *ids_, entries_of, M_, face_temperature_);
+      books_.max_row_sum_residual = std::max(books_.max_row_sum_residual, assembled_->row_sum_residual());
       last_T_ = T0_;
       books_.exchanges += 4;  // M and Σ m C T, M back, the bounds, the ids
       if (reaction_active()) {

@@ -138,7 +138,9 @@ void DecomposedHeat::check_materials(mechanics::DecomposedMpm<Dim>& mpm) {
                                 " has no thermal properties (expected " + std::to_string(opt_.materials.size()) +
                                 " entries in materials to cover it)");
   pending_.assign(mpm.owned_local_nodes().size(), 0.0);
-  if (w.kind == WindowPolicy::Kind::adaptive) gather_mass(mpm);  // the first estimate's M (Coupler::start)
+  // M_i and T_i of the start (eq. 38), as Coupler::start: the adaptive policy's first estimate and the
+  // first snapshot's thermal nodes (thermal_nodes).
+  gather_mass(mpm);
 }
 
 MPI_Comm DecomposedHeat::communicator() const { return mpm3_ ? mpm3_->communicator() : mpm2_->communicator(); }
@@ -542,6 +544,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
       assembled_->advance(comm, *ids_, entries_of, M, q, face_temperature_, Tn, t0, t0 + dt);
     }
     ++books_.assembled_windows;
+    books_.max_row_sum_residual = std::max(books_.max_row_sum_residual, assembled_->row_sum_residual());
     books_.exchanges += 5;  // M and Σ m C T, M back, the bounds, the ids, ΔT
   }
 

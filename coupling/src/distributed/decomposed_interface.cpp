@@ -16,6 +16,8 @@
 //
 // T_int,p lives in a particle scalar (it migrates with the particle: the serial run keeps it by
 // particle until the next update). The hottest node is reduced over ranks (MPI_MAX).
+// Also the owned nodes' serial grid numbers (owned_grid_nodes) and the owned thermal unknowns of a
+// snapshot (thermal_nodes, the serial /nodes).
 #include <frictherm/coupling/decomposed_heat.hpp>
 
 #include <algorithm>
@@ -59,13 +61,20 @@ void DecomposedHeat::interface_start(mechanics::DecomposedMpm<Dim>& mpm) {
   model->start_sides(mpm.grid(), opt_.thickness, mass, volume, opt_.materials, o, time_);
   if constexpr (Dim == 2) interface2_ = std::move(model);
   else interface3_ = std::move(model);
-  // Owned node u (x fastest over owned_nodes()) ↔ the serial grid node (lattice = DMDA index − ghost).
+  owned_grid_node_ = owned_grid_nodes(mpm);
+  owned_of_grid_.assign(mpm.grid().node_count(), -1);
+  for (std::size_t u = 0; u < owned_grid_node_.size(); ++u)
+    owned_of_grid_[static_cast<std::size_t>(owned_grid_node_[u])] = static_cast<int>(u);
+  interface_max_ = -std::numeric_limits<double>::infinity();
+}
+
+// Owned node u (x fastest over owned_nodes()) -> the serial grid node (lattice = DMDA index − ghost).
+template <int Dim>
+std::vector<int> DecomposedHeat::owned_grid_nodes(const mechanics::DecomposedMpm<Dim>& mpm) {
   const std::array<int, 2 * Dim> own = mpm.owned_nodes();
   const mechanics::Grid<Dim>& grid = mpm.grid();
-  const std::size_t no = mpm.owned_local_nodes().size();
-  owned_grid_node_.assign(no, -1);
-  owned_of_grid_.assign(grid.node_count(), -1);
-  for (std::size_t u = 0; u < no; ++u) {
+  std::vector<int> nodes(mpm.owned_local_nodes().size(), -1);
+  for (std::size_t u = 0; u < nodes.size(); ++u) {
     mechanics::IVec<Dim> lattice{};
     std::size_t r = u;
     for (int d = 0; d < Dim; ++d) {
@@ -73,11 +82,24 @@ void DecomposedHeat::interface_start(mechanics::DecomposedMpm<Dim>& mpm) {
       lattice[d] = own[2 * d] + static_cast<int>(r % extent) - mechanics::Grid<Dim>::ghost;
       r /= extent;
     }
-    const int node = grid.node_index(lattice);
-    owned_grid_node_[u] = node;
-    owned_of_grid_[static_cast<std::size_t>(node)] = static_cast<int>(u);
+    nodes[u] = grid.node_index(lattice);
   }
-  interface_max_ = -std::numeric_limits<double>::infinity();
+  return nodes;
+}
+
+// The owned unknowns of the last gather with the temperature the serial Coupler::nodal_temperature
+// holds: the last window's (or interval's) end T_i, the gathered T_i (eq. 38) before any window.
+DecomposedThermalNodes DecomposedHeat::thermal_nodes() const {
+  DecomposedThermalNodes out;
+  const std::vector<int> grid_node = mpm3_ ? owned_grid_nodes(*mpm3_) : owned_grid_nodes(*mpm2_);
+  const std::vector<double>& T = last_T_.size() == M_.size() ? last_T_ : T0_;
+  for (std::size_t u = 0; u < M_.size() && u < T.size() && u < grid_node.size(); ++u) {
+    if (!is_unknown(M_[u])) continue;
+    out.grid_node.push_back(grid_node[u]);
+    out.temperature.push_back(T[u]);
+    out.heat_capacity.push_back(M_[u]);
+  }
+  return out;
 }
 
 // InterfaceTemperature::add_step on the owned nodes: the step's frictional work per owned node, then
@@ -168,6 +190,7 @@ void DecomposedHeat::interface_update(mechanics::DecomposedMpm<Dim>& mpm) {
 }
 
 #define FRICTHERM_DECOMPOSED_INTERFACE(D)                                                      \
+  template std::vector<int> DecomposedHeat::owned_grid_nodes<D>(const mechanics::DecomposedMpm<D>&); \
   template InterfaceTemperature<D>* DecomposedHeat::interface_model<D>();                      \
   template void DecomposedHeat::interface_start<D>(mechanics::DecomposedMpm<D>&);              \
   template void DecomposedHeat::interface_step<D>(const std::vector<double>&);                 \

@@ -19,6 +19,7 @@ void DecomposedRun<Dim>::checkpoint(bool end_of_loading) {
   if (hot_) m.table_rows.emplace_back("hotspots", hot_->table_rows());
   xdmf_grids_ = detail::join_grids(snapshots_out_->xdmf_grids());
   xdmf_reference_grids_ = detail::join_grids(snapshots_out_->reference_grids());
+  xdmf_node_grids_ = detail::join_grids(snapshots_out_->node_grids());
   try {
     detail::write_decomposed_checkpoint(
         comm_, checkpoint_file_, s_, Dim, ++generation_, m, [&](const ckpt::Writer& w) { visit_rank_state(w); },
@@ -161,6 +162,7 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
   v("run/series_memory/work", series_memory_.work);
   v("output/xdmf_grids", xdmf_grids_);
   v("output/xdmf_reference_grids", xdmf_reference_grids_);
+  v("output/xdmf_node_grids", xdmf_node_grids_);
   if (hot_) hot_->visit_state(v);
   // Penalty contact: the boundary points and PenaltyContact::visit_state (slip histories, books, the
   // frequency bound of the next step), the same on every rank, so once, in the global file that every

@@ -175,6 +175,7 @@ class DecomposedRun {
   long step_ = 0, snapshots_ = 0;
   long last_series_step_ = -1, last_snapshot_step_ = -1;
   double heating_seconds_ = 0.0, output_seconds_ = 0.0, continuation_seconds_ = 0.0;
+  double loading_solve_seconds_ = 0.0;  // of heating_seconds_, inside the integrator (rank's wall time)
   double pending_heat_ = 0.0;  // work of a window left open (a stop at run.max_steps, an interruption), J
   double particle_reaction_heat_ = 0.0;  // q Σ m_p λ_p over ranks at the end (J)
   Clock::time_point last_flush_ = Clock::now();
@@ -191,7 +192,7 @@ class DecomposedRun {
   std::vector<double> series_rows_;
   long series_columns_ = 0;
   detail::SeriesMemory series_memory_;  // the previous series row, for the contact_heat_rate columns
-  std::string xdmf_grids_, xdmf_reference_grids_;
+  std::string xdmf_grids_, xdmf_reference_grids_, xdmf_node_grids_;
   typename Mpm::CheckpointState restored_;
   int redistributed_from_ = 0;  // ranks of a checkpoint resumed on another number of ranks
 

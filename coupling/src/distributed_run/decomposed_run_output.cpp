@@ -1,8 +1,9 @@
 // The decomposed run's output (decomposed_run_impl.hpp): series and metadata on rank 0 (OUT.h5, the
-// serial writer), particle snapshots per rank (OUT.rank<r>.h5), and at the end OUT.h5 published with
-// OUT.xdmf joining the rank files (issue 34: the XDMF goes with its result, never before it).
+// serial writer), particle snapshots and the thermal grid's owned nodes per rank (OUT.rank<r>.h5), and
+// at the end OUT.h5 published with OUT.xdmf (and OUT_nodes.xdmf) joining the rank files (issue 34: the XDMF goes with its result, never before it).
 #include "distributed_run/decomposed_run_impl.hpp"
 
+#include "run/node_output.hpp"
 #include "run/particle_output.hpp"
 
 namespace frictherm::coupling::decomposed {
@@ -34,6 +35,7 @@ void DecomposedRun<Dim>::open_output() {
                                : std::make_unique<DecomposedOutput>(comm_, output_base(r_.output), Dim, overwrite(),
                                                                     false);
     if (resuming_) snapshots_out_->restore_reference_grids(detail::split_grids(xdmf_reference_grids_));
+    if (resuming_) snapshots_out_->restore_node_grids(detail::split_grids(xdmf_node_grids_));
   } catch (const std::exception& e) {
     throw OutputError(e.what());
   }
@@ -41,20 +43,18 @@ void DecomposedRun<Dim>::open_output() {
 
 template <int Dim>
 void DecomposedRun<Dim>::write_start_metadata() {
-  out_->write_metadata("scene", s_.text);
-  out_->write_metadata("scene_json", s_.json);
-  out_->write_metadata("scene_file", s_.source);
-  out_->write_metadata("version", FRICTHERM_VERSION);
-  out_->write_metadata("command_line", o_.command_line);
-  out_->write_metadata("status", "running");
+  // The serial run's start metadata, by its code (runner_output.cpp), of the run's grid, the scene's
+  // materials, bodies and options and the global particle count; threads: OpenMP threads per rank.
+  detail::write_microstructure_images(*out_, s_, r_.output);
+  detail::write_start_metadata<Dim>(*out_, s_, detail::RunLayout<Dim>{mpm_->grid(), s_.materials, body_names(),
+                                                                        s_.options, r_.particles},
+                                    o_);
   out_->write_metadata("run_id", run_id_);
-  out_->write_metadata("dimension", Dim);
   out_->write_metadata("engine", "decomposed");
   out_->write_metadata("ranks", size_);
   std::string grid;
   for (int p : mpm_->processes()) grid += (grid.empty() ? "" : " x ") + std::to_string(p);
   out_->write_metadata("process_grid", grid);
-  out_->write_metadata("particle_count", r_.particles);
   out_->write_metadata("snapshots", xdmf_path_for(r_.output));
 }
 
@@ -265,6 +265,11 @@ void DecomposedRun<Dim>::snapshot(double time) {
     snap.fields.emplace_back("reaction_progress", mpm_->particle_scalar(mpm_->particle_scalar_index("reaction_progress")));
   if (heat_ && heat_->interface_reaction().started())  // from the continuation on (no migration since)
     snap.fields.emplace_back("interface_reaction_progress", heat_->interface_reaction().progress());
+  if (heat_) {  // the thermal grid's owned unknowns, by the serial writer (node_output.hpp)
+    const DecomposedThermalNodes nodes = heat_->thermal_nodes();
+    detail::write_node_fields<Dim>(snap, mpm_->grid(), nodes.grid_node, nodes.temperature.data(),
+                                   nodes.heat_capacity.data());
+  }
   snapshots_out_->write(step_, std::isnan(time) ? time_ : time, snap);
   ++snapshots_;
   last_snapshot_step_ = step_;
@@ -297,7 +302,8 @@ std::string DecomposedRun<Dim>::publish() {
     if (!write_error_.empty()) throw std::runtime_error(write_error_);
     write_end_metadata();
     // OUT.xdmf (and OUT_reference.xdmf) with OUT.h5, as the serial run's
-    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text(), snapshots_out_->reference_xdmf_text());
+    out_->publish_xdmf_with_result(snapshots_out_->xdmf_text(), snapshots_out_->reference_xdmf_text(),
+                                   snapshots_out_->nodes_xdmf_text());
     out_->sync();  // before the name: the published result is on disk
   } catch (const std::exception& e) {
     const std::string live = out_->live_path();
@@ -318,8 +324,8 @@ void DecomposedRun<Dim>::write_end_metadata() {
   if (r_.status == RunResult::Status::interrupted) out_->write_metadata("interruption", r_.message);
   for (const auto& [name, seconds] : r_.phase_seconds) out_->write_metadata("time_" + name, seconds);
   if (heat_)
-    detail::write_decomposed_heat_metadata(*out_, s_, *heat_, pending_heat_, hot_->tracker().ids_issued());
-  if (heat_ && heat_->reaction_enabled()) out_->write_metadata("particle_reaction_heat", particle_reaction_heat_);
+    detail::write_decomposed_heat_metadata(*out_, s_, *heat_, pending_heat_, particle_reaction_heat_,
+                                           hot_->tracker().ids_issued());
   const char* status = r_.status == RunResult::Status::failed                 ? "failed"
                        : r_.status == RunResult::Status::stopped_at_max_steps ? "stopped_at_max_steps"
                        : r_.status == RunResult::Status::interrupted          ? "interrupted"

@@ -2,6 +2,8 @@
 // the traffic record (decomposed_setup.hpp).
 #include "distributed_run/decomposed_setup.hpp"
 
+#include "run/runner_thermal.hpp"
+
 #include "scene/scene_detail.hpp"
 
 #include <algorithm>
@@ -193,49 +195,40 @@ FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
 #undef FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP
 
 void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const DecomposedHeat& heat, double pending,
-                                    long hotspots_seen) {
+                                    double particle_reaction_heat, long hotspots_seen) {
   const DecomposedHeatBooks& b = heat.books();
-  const CouplerOptions& c = scene.thermal.coupler;
-  out.write_metadata("thermal_integrator", c.integrator);
-  out.write_metadata("thermal_rtol", c.integrator_options.rtol);
-  out.write_metadata("thermal_atol", c.integrator_options.atol);
+  // The serial EnergyBooks from the books summed over ranks. Every matrix-free window gathers its
+  // particles afresh (no reuse, no partial refresh); the assembly residual is the worst of the heat
+  // capacity's partition of unity and K·1 = 0 (assembled windows), as the serial Coupler's.
+  EnergyBooks e;
+  e.work_received = b.work_received;
+  e.plastic_work_received = b.plastic_work_received;
+  e.plastic_heat_received = b.plastic_heat_received;
+  e.heat_delivered = b.heat_delivered;
+  e.plastic_heat_delivered = b.plastic_heat_delivered;
+  e.reaction_heat_released = b.reaction_heat_released;
+  e.heat_relocated = b.heat_relocated;
+  e.nodal_energy_change = b.nodal_energy_change;
+  e.windows = b.windows;
+  e.continuation_intervals = b.continuation_intervals;
+  e.steps = b.steps;
+  e.min_window = b.min_window;
+  e.max_window = b.max_window;
+  e.max_assembly_residual = std::max(b.max_capacity_residual, b.max_row_sum_residual);
+  e.matrix_free_windows = b.windows - b.assembled_windows;
+  e.matrix_free_substeps = b.substeps;
+  e.matrix_free_gathers = e.matrix_free_windows;
+  e.matrix_free_refreshes = 0;
+  write_thermal_metadata(out, ThermalMetadata{scene.thermal.coupler, scene.thermal.heating_order, e,
+                                              heat.integrator_stats(),  // global counts
+                                              particle_reaction_heat, pending, b.particle_energy_change,
+                                              static_cast<std::int64_t>(hotspots_seen)});
+  // The decomposed heat's own entries: the Krylov path's preconditioner, its windows, the residual
+  // under its own name, the interface temperature's flux histories summed over ranks (= work received).
   out.write_metadata("thermal_preconditioner", scene.thermal.preconditioner);
-  out.write_metadata("thermal_window_policy", to_string(c.window.kind));
-  out.write_metadata("heating_order", mechanics::to_string(scene.thermal.heating_order));
-  out.write_metadata("thermal_windows", b.windows);
-  out.write_metadata("thermal_continuation_intervals", b.continuation_intervals);
-  out.write_metadata("thermal_matrix_free_windows", b.windows - b.assembled_windows);
-  out.write_metadata("thermal_matrix_free_substeps", b.substeps);
   out.write_metadata("thermal_assembled_windows", b.assembled_windows);
-  out.write_metadata("thermal_min_window", b.min_window);
-  out.write_metadata("thermal_max_window", b.max_window);
-  const thermal::IntegratorStats st = heat.integrator_stats();  // global counts
-  out.write_metadata("thermal_steps", st.steps);
-  out.write_metadata("thermal_rhs_evals", st.rhs_evals);
-  out.write_metadata("thermal_linear_iters", st.linear_iters);
-  out.write_metadata("thermal_error_test_failures", st.error_test_failures);
-  out.write_metadata("thermal_reinits", st.reinits);
-  out.write_metadata("thermal_wall_time", st.wall_seconds);
-  out.write_metadata("work_received", b.work_received);
-  out.write_metadata("plastic_heating", c.plastic.enabled ? "on" : "off");
-  out.write_metadata("plastic_work_received", b.plastic_work_received);
-  out.write_metadata("plastic_heat_received", b.plastic_heat_received);
-  out.write_metadata("plastic_heat_delivered", b.plastic_heat_delivered);
-  out.write_metadata("heat_delivered", b.heat_delivered);
-  out.write_metadata("heat_pending", pending);
-  out.write_metadata("nodal_energy_change", b.nodal_energy_change);
-  out.write_metadata("particle_energy_change", b.particle_energy_change);
   out.write_metadata("max_capacity_residual", b.max_capacity_residual);
-  out.write_metadata("hotspots_seen", hotspots_seen);
-  // The interface temperature's flux histories, summed over ranks at the last update (= work received).
   if (heat.interface_enabled()) out.write_metadata("interface_heat_recorded", heat.interface_heat_recorded());
-  if (c.reaction.enabled) {  // as the serial ThermalRun::write_metadata (particle_reaction_heat: the caller)
-    out.write_metadata("reaction_heat_released", b.reaction_heat_released);
-    out.write_metadata("reaction_kinetics", c.reaction.kinetics_name);
-    out.write_metadata("reaction_prefactor", c.reaction.kinetics.prefactor);
-    out.write_metadata("reaction_activation_temperature", c.reaction.kinetics.activation_temperature);
-    out.write_metadata("reaction_heat_of_reaction", c.reaction.kinetics.specific_heat_of_reaction);
-  }
 }
 
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& b, int ranks) {

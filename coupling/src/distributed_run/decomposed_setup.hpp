@@ -51,9 +51,11 @@ bool penalty_contact_scene(const Scene& scene);
 void print_decomposed_books(std::ostream& log, const DecomposedHeatBooks& books, int ranks);
 
 /// Rank 0: the heat's settings, window and integrator counts (global) and energy books (over ranks)
-/// as metadata of OUT.h5; `pending` the work of a window left open (J), `hotspots_seen` the tracker's ids.
+/// as metadata of OUT.h5, by the serial run's writer (write_thermal_metadata, runner_thermal.hpp), then
+/// the decomposed heat's own entries; `pending` the work of a window left open (J),
+/// `particle_reaction_heat` q Σ_p m_p λ_p over ranks (J), `hotspots_seen` the tracker's ids.
 void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const DecomposedHeat& heat, double pending,
-                                    long hotspots_seen);
+                                    double particle_reaction_heat, long hotspots_seen);
 
 /// Collective: the engine's traffic counters per rank, their mean and largest over the ranks, as
 /// metadata of OUT.h5 (`out`, rank 0: traffic_*_mean, traffic_*_max) and one line on rank 0's `log`

@@ -309,11 +309,15 @@ double NodalThermalSystem::mass_residual() const {
   return particle_heat_capacity > 0.0 ? std::fabs(total - particle_heat_capacity) / particle_heat_capacity : 0.0;
 }
 
-double NodalThermalSystem::row_sum_residual() const {
-  if (size() == 0) return 0.0;
-  const Eigen::VectorXd r = conductance * Eigen::VectorXd::Ones(static_cast<Eigen::Index>(size()));
-  const double kmax = conductance.diagonal().cwiseAbs().maxCoeff();
-  return kmax > 0.0 ? r.cwiseAbs().maxCoeff() / kmax : 0.0;
+double NodalThermalSystem::row_sum_residual() const { return row_sum_extremes(conductance, 0).residual(); }
+
+RowSumExtremes row_sum_extremes(const thermal::SparseMatrix& rows, Eigen::Index first) {
+  RowSumExtremes e;
+  if (rows.rows() == 0) return e;
+  const Eigen::VectorXd r = rows * Eigen::VectorXd::Ones(rows.cols());
+  e.sum = r.cwiseAbs().maxCoeff();
+  for (Eigen::Index i = 0; i < rows.rows(); ++i) e.diagonal = std::max(e.diagonal, std::fabs(rows.coeff(i, first + i)));
+  return e;
 }
 
 double NodalThermalSystem::energy(const Eigen::VectorXd& nodal_temperature) const {

@@ -201,9 +201,10 @@ void H5Output::close() {
   if (m.io.file != m.final_path) m.publish();
 }
 
-void H5Output::publish_xdmf_with_result(std::string text, std::string reference) {
+void H5Output::publish_xdmf_with_result(std::string text, std::string reference, std::string nodes) {
   live().given_xdmf = std::move(text);
   live().given_reference_xdmf = std::move(reference);
+  live().given_nodes_xdmf = std::move(nodes);
 }
 
 std::size_t H5Output::snapshot_count() const { return impl_ ? impl_->count : 0; }

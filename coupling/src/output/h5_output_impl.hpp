@@ -125,6 +125,7 @@ struct H5Output::Impl {
   }
   std::string given_xdmf;  // publish_xdmf_with_result: published with the result (write_xdmf off)
   std::string given_reference_xdmf;  // and its reference document ("" if none)
+  std::string given_nodes_xdmf;      // and its thermal nodes' document ("" if none)
   void write_xdmf();
   // The result renamed onto its name with its XDMF files (publish_with_xdmf, output_files.hpp).
   void publish();

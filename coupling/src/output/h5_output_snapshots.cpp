@@ -39,7 +39,8 @@ void H5Output::Impl::write_xdmf() {
 
 void H5Output::Impl::publish() {
   if (!options.write_xdmf && !given_xdmf.empty())
-    return publish_with_xdmf(io.file, final_path, options.replace_existing, given_xdmf, given_reference_xdmf);
+    return publish_with_xdmf(io.file, final_path, options.replace_existing, given_xdmf, given_reference_xdmf,
+                             given_nodes_xdmf);
   if (!options.write_xdmf) return publish_file(io.file, final_path, options.replace_existing);
   publish_with_xdmf(io.file, final_path, options.replace_existing, document(grid_xml, failure_xml, "particles"),
                     has_reference() ? document(reference_xml, reference_failure_xml, "particles_reference") : "",

@@ -106,7 +106,7 @@ class Run {
     // result published with status "failed" (issue 34).
     // Generated bodies (ellipse_packing): the image beside the output (an appended output: the result
     // has it). A refused image path is a bad output (exit code 2), not a failed run.
-    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) write_microstructure_images(out);
+    if (!(o_.resume_appends && !o_.resume_checkpoint.empty())) detail::write_microstructure_images(out, s_, r_.output);
     try {
       detail::write_start_metadata<Dim>(out, s_, *sim_, o_);
       out.write_metadata("run_id", run_id_);
@@ -249,17 +249,6 @@ class Run {
     for (const auto& [name, seconds] : ph) out.write_metadata("time_" + name, seconds);
   }
 
-  void write_microstructure_images(H5Output& out) const {
-    std::vector<std::string> written;
-    try {
-      written = write_generated_images(s_, r_.output);
-    } catch (const std::exception& e) {
-      throw OutputError(e.what());
-    }
-    std::string list;
-    for (const auto& w : written) list += (list.empty() ? "" : "; ") + w;
-    if (!list.empty()) out.write_metadata("microstructure_images", list);
-  }
 
   bool overwrite() const { return o_.overwrite || s_.output.overwrite; }
 

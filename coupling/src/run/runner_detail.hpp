@@ -66,10 +66,29 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
 template <int Dim>
 void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields);
 
-/// Metadata known before the first step (scene text, version, command line, date, grid, ...).
+/// What the start metadata says of the mechanics: the grid, the materials and bodies (by id), the
+/// solver options (shape function, scheme, CFL factor) and the particle count; the serial Simulation's
+/// or a decomposed run's (its grid, the scene's materials, bodies and options, the global count).
+template <int Dim>
+struct RunLayout {
+  const mechanics::Grid<Dim>& grid;
+  const std::vector<mechanics::Material>& materials;
+  std::vector<std::string> body_names;
+  const mechanics::SimulationOptions& options;
+  std::size_t particles;
+};
+
+/// Metadata known before the first step (scene text, version, command line, date, grid, ...): the
+/// serial run's and a decomposed run's (threads: OpenMP threads per process).
+template <int Dim>
+void write_start_metadata(H5Output& out, const Scene& scene, const RunLayout<Dim>& layout, const RunOptions& options);
 template <int Dim>
 void write_start_metadata(H5Output& out, const Scene& scene, const mechanics::Simulation<Dim>& sim,
                           const RunOptions& options);
+
+/// Generated bodies (ellipse_packing): their images beside `output` (write_generated_images) and
+/// /meta/microstructure_images listing them; a refused image path throws OutputError.
+void write_microstructure_images(H5Output& out, const Scene& scene, const std::string& output);
 
 /// "step N  t = ... s  (xx.x %)  NNNN steps/s  ETA mm:ss" on a terminal, redrawn about 4 times a second.
 class ProgressLine {

@@ -3,6 +3,8 @@
 
 #include "run/particle_output.hpp"
 
+#include <frictherm/coupling/microstructure.hpp>
+
 #include <omp.h>
 
 #include <algorithm>
@@ -179,6 +181,15 @@ void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const st
 template <int Dim>
 void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simulation<Dim>& sim,
                           const RunOptions& options) {
+  std::vector<std::string> body_names;  // by id
+  for (const auto& body : sim.bodies()) body_names.push_back(body.name);
+  write_start_metadata<Dim>(out, s, RunLayout<Dim>{sim.grid(), sim.materials(), body_names, sim.options(),
+                                                   sim.particles().size()},
+                            options);
+}
+
+template <int Dim>
+void write_start_metadata(H5Output& out, const Scene& s, const RunLayout<Dim>& run, const RunOptions& options) {
   out.write_metadata("scene", s.text);
   out.write_metadata("scene_json", s.json);
   out.write_metadata("scene_file", s.source);
@@ -198,9 +209,9 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
     out.write_metadata("analysis", s.options.analysis == mechanics::Analysis::plane_stress ? "plane_stress" : "plane_strain");
     out.write_metadata("thickness", s.options.thickness);
   }
-  out.write_metadata("particle_count", sim.particles().size());
+  out.write_metadata("particle_count", run.particles);
   out.write_metadata("threads", omp_get_max_threads());
-  const auto& g = sim.grid();
+  const auto& g = run.grid;
   std::ostringstream grid, materials, bodies;
   grid.precision(10);
   grid << "lo";
@@ -225,27 +236,38 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
   out.write_metadata("grid_hi", hi);
   out.write_metadata("grid_cells", cells);
   out.write_metadata("grid_cell_size", h);
-  std::vector<std::string> material_names, material_kinds, body_names;  // by id
-  for (const auto& mat : sim.materials()) {
+  std::vector<std::string> material_names, material_kinds;  // by id
+  for (const auto& mat : run.materials) {
     material_names.push_back(mat.name);
     material_kinds.push_back(mechanics::to_string(mat.kind));
   }
-  for (const auto& body : sim.bodies()) body_names.push_back(body.name);
   out.write_metadata("material_names", material_names);
   out.write_metadata("material_kinds", material_kinds);
-  out.write_metadata("body_names", body_names);
+  out.write_metadata("body_names", run.body_names);
   out.write_metadata("cell_size", g.min_cell_size());
-  for (std::size_t m = 0; m < sim.materials().size(); ++m)
-    materials << (m ? "; " : "") << m << ' ' << sim.materials()[m].name << ' '
-              << mechanics::to_string(sim.materials()[m].kind);
+  for (std::size_t m = 0; m < run.materials.size(); ++m)
+    materials << (m ? "; " : "") << m << ' ' << run.materials[m].name << ' '
+              << mechanics::to_string(run.materials[m].kind);
   out.write_metadata("materials", materials.str());
-  for (std::size_t b = 0; b < sim.bodies().size(); ++b) bodies << (b ? "; " : "") << b << ' ' << sim.bodies()[b].name;
+  for (std::size_t b = 0; b < run.body_names.size(); ++b) bodies << (b ? "; " : "") << b << ' ' << run.body_names[b];
   out.write_metadata("bodies", bodies.str());
-  const auto& o = sim.options();
+  const auto& o = run.options;
   out.write_metadata("shape_function", mechanics::to_string(o.shape));
   out.write_metadata("scheme", mechanics::to_string(o.scheme));
   out.write_metadata("cfl", o.cfl);
   out.write_metadata("end_time", s.end_time);
+}
+
+void write_microstructure_images(H5Output& out, const Scene& s, const std::string& output) {
+  std::vector<std::string> written;
+  try {
+    written = write_generated_images(s, output);
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+  std::string list;
+  for (const auto& w : written) list += (list.empty() ? "" : "; ") + w;
+  if (!list.empty()) out.write_metadata("microstructure_images", list);
 }
 
 #define FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(D)                                                                \
@@ -255,7 +277,8 @@ void write_start_metadata(H5Output& out, const Scene& s, const mechanics::Simula
   template void append_penalty_row<D>(std::vector<double>&, const mechanics::PenaltyContact<D>&,            \
                                       const mechanics::BoundaryPoints<D>&);                                   \
   template void write_fields<D>(H5Output&, const mechanics::Simulation<D>&, const std::vector<std::string>&); \
-  template void write_start_metadata<D>(H5Output&, const Scene&, const mechanics::Simulation<D>&, const RunOptions&);
+  template void write_start_metadata<D>(H5Output&, const Scene&, const mechanics::Simulation<D>&, const RunOptions&); \
+  template void write_start_metadata<D>(H5Output&, const Scene&, const RunLayout<D>&, const RunOptions&);
 FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(2)
 FRICTHERM_INSTANTIATE_RUNNER_OUTPUT(3)
 #undef FRICTHERM_INSTANTIATE_RUNNER_OUTPUT

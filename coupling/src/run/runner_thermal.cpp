@@ -1,6 +1,7 @@
 // The thermal side of a run: coupler calls, series columns, /hotspots, metadata, continuation.
 #include "run/runner_thermal.hpp"
 
+#include "run/node_output.hpp"
 #include "run/run_signals.hpp"
 
 #include <frictherm/mechanics/errors.hpp>
@@ -170,31 +171,28 @@ void ThermalRun<Dim>::write_nodes(H5Output& out) const {
   const NodalThermalSystem* system = coupler_.system();
   const Eigen::VectorXd& t = coupler_.nodal_temperature();
   if (system == nullptr || system->size() == 0 || static_cast<std::size_t>(t.size()) != system->size()) return;
-  const std::size_t n = system->size();
-  const mechanics::Grid<Dim>& grid = coupler_.grid();
-  std::vector<double> x(n * Dim);
-  std::vector<std::int32_t> lattice(n * Dim);
-  for (std::size_t k = 0; k < n; ++k) {
-    const mechanics::Vec<Dim> p = grid.node_position(system->grid_node[k]);
-    const mechanics::IVec<Dim> i = grid.node_lattice(system->grid_node[k]);
-    for (int d = 0; d < Dim; ++d) x[k * Dim + d] = p[d], lattice[k * Dim + d] = static_cast<std::int32_t>(i[d]);
-  }
-  out.node_field("position", x.data(), n, Dim);
-  out.node_field("temperature", t.data(), n, 1);
-  out.node_field("heat_capacity", system->mass.data(), n, 1);
-  out.node_field("lattice", lattice.data(), n, Dim);
+  write_node_fields<Dim>(out, coupler_.grid(), system->grid_node, t.data(), system->mass.data());
 }
 
 template <int Dim>
 void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<Dim>& sim) const {
-  const CouplerOptions& o = coupler_.options();
-  const EnergyBooks& b = coupler_.books();
-  const thermal::IntegratorStats st = coupler_.integrator_stats();
+  write_thermal_metadata(out, ThermalMetadata{coupler_.options(), spec_.heating_order, coupler_.books(),
+                                              coupler_.integrator_stats(),
+                                              coupler_.particle_reaction_heat(sim.particles()),
+                                              coupler_.pending_heat(),
+                                              coupler_.particle_energy_change(sim.particles()),
+                                              static_cast<std::int64_t>(coupler_.hotspots().ids_issued())});
+}
+
+void write_thermal_metadata(H5Output& out, const ThermalMetadata& m) {
+  const CouplerOptions& o = m.options;
+  const EnergyBooks& b = m.books;
+  const thermal::IntegratorStats& st = m.stats;
   out.write_metadata("thermal_integrator", o.integrator);
   out.write_metadata("thermal_rtol", o.integrator_options.rtol);
   out.write_metadata("thermal_atol", o.integrator_options.atol);
   out.write_metadata("thermal_window_policy", to_string(o.window.kind));
-  out.write_metadata("heating_order", to_string(spec_.heating_order));
+  out.write_metadata("heating_order", to_string(m.heating_order));
   const std::pair<const char*, std::int64_t> counts[] = {
       {"thermal_steps", static_cast<std::int64_t>(st.steps)},
       {"thermal_rhs_evals", static_cast<std::int64_t>(st.rhs_evals)},
@@ -210,7 +208,7 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"thermal_matrix_free_gathers", static_cast<std::int64_t>(b.matrix_free_gathers)},
       {"thermal_matrix_free_refreshes", static_cast<std::int64_t>(b.matrix_free_refreshes)},
       {"thermal_continuation_intervals", static_cast<std::int64_t>(b.continuation_intervals)},
-      {"hotspots_seen", static_cast<std::int64_t>(coupler_.hotspots().ids_issued())},
+      {"hotspots_seen", m.hotspots_seen},
   };
   for (const auto& [key, value] : counts) out.write_metadata(key, value);
   const std::pair<const char*, double> values[] = {
@@ -223,11 +221,11 @@ void ThermalRun<Dim>::write_metadata(H5Output& out, const mechanics::Simulation<
       {"plastic_heat_received", b.plastic_heat_received},
       {"plastic_heat_delivered", b.plastic_heat_delivered},
       {"reaction_heat_released", b.reaction_heat_released},
-      {"particle_reaction_heat", coupler_.particle_reaction_heat(sim.particles())},
+      {"particle_reaction_heat", m.particle_reaction_heat},
       {"heat_relocated", b.heat_relocated},
-      {"heat_pending", coupler_.pending_heat()},
+      {"heat_pending", m.pending_heat},
       {"nodal_energy_change", b.nodal_energy_change},
-      {"particle_energy_change", coupler_.particle_energy_change(sim.particles())},
+      {"particle_energy_change", m.particle_energy_change},
       {"max_assembly_residual", b.max_assembly_residual},
   };
   for (const auto& [key, value] : values) out.write_metadata(key, value);

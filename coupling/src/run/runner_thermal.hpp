@@ -6,10 +6,28 @@
 
 #include <frictherm/coupling/coupler.hpp>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 namespace frictherm::coupling::detail {
+
+/// What the thermal /meta entries report: the coupler's settings, heating order, energy books and
+/// integrator counts, the particles' reaction heat and energy change (J), the heat of a window left
+/// open (J) and the hot-spot ids issued; a serial run's Coupler or a decomposed run's (sums over ranks).
+struct ThermalMetadata {
+  const CouplerOptions& options;
+  HeatingOrder heating_order;
+  EnergyBooks books;
+  thermal::IntegratorStats stats;
+  double particle_reaction_heat = 0.0;
+  double pending_heat = 0.0;
+  double particle_energy_change = 0.0;
+  std::int64_t hotspots_seen = 0;
+};
+/// Integrator statistics, energy books and the heat's settings into /meta (thermal_*, heat_*, ...):
+/// the serial run's and the decomposed run's entries, by this one writer.
+void write_thermal_metadata(H5Output& out, const ThermalMetadata& metadata);
 
 template <int Dim>
 class ThermalRun {

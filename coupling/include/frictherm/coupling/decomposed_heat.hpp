@@ -113,6 +113,7 @@ struct DecomposedHeatBooks {
   double nodal_energy_change = 0.0;     // Σ over windows of Σ_i M_i ΔT_i
   double particle_energy_change = 0.0;  // Σ over windows of Σ_p m_p C_v,p ΔT_p
   double max_capacity_residual = 0.0;   // worst |Σ_i M_i − Σ_p m_p C_v,p| / Σ_p m_p C_v,p
+  double max_row_sum_residual = 0.0;    // worst max_i |(K·1)_i| / max_i K_ii of assembled windows (over ranks)
   double plastic_work_received = 0.0;   // Σ over steps of Δw_p of the particles with β > 0
   double plastic_heat_received = 0.0;   // Σ over steps of Σ_i β Δw_p S_ip (part of the pending heat)
   double plastic_heat_delivered = 0.0;  // of it, handed to closed windows
@@ -125,6 +126,14 @@ struct DecomposedHeatBooks {
   double min_window = 0.0, max_window = 0.0;  // s (0 before the first window)
   long dropped_nodes = 0;               // last window: nodes with mass that are not unknowns
   long exchanges = 0;                   // grid exchanges (sum_to_owned, owned_to_local): 4 + 2 n per window (+1 relocating, +1 per step with plastic heating)
+};
+
+/// One rank's thermal unknowns at a snapshot (DecomposedHeat::thermal_nodes): the serial grid node
+/// numbers, T_i (K) and M_i (J/K, eq. 38), in the serial Coupler's system()->grid_node,
+/// nodal_temperature() and system()->mass sense.
+struct DecomposedThermalNodes {
+  std::vector<int> grid_node;
+  std::vector<double> temperature, heat_capacity;
 };
 
 class DecomposedHeat {
@@ -179,6 +188,10 @@ class DecomposedHeat {
   /// Σ_p m_p C_v,p T_p over all ranks (J).
   double heat_content() const;
 
+  /// The owned nodes that are unknowns of the last gather (the start's, a window's or an interval's),
+  /// with the last window's or interval's end T_i (the gathered T_i before any window) and M_i: each
+  /// thermal unknown on its owner only (the serial /nodes of a snapshot).
+  DecomposedThermalNodes thermal_nodes() const;
   /// This rank's particles for DecomposedOutput::write (ids, x_p, v_p, T_p, materials; swarm order).
   DecomposedSnapshot snapshot() const;
   /// Collective: one update of `tracker` (built with dim()) over the particles of all ranks
@@ -199,6 +212,7 @@ class DecomposedHeat {
                            {"books/nodal_energy_change", &b.nodal_energy_change},
                            {"books/particle_energy_change", &b.particle_energy_change},
                            {"books/max_capacity_residual", &b.max_capacity_residual},
+                           {"books/max_row_sum_residual", &b.max_row_sum_residual},
                            {"books/min_window", &b.min_window}, {"books/max_window", &b.max_window},
                            {"books/plastic_work_received", &b.plastic_work_received},
                            {"books/plastic_heat_received", &b.plastic_heat_received},
@@ -255,6 +269,8 @@ class DecomposedHeat {
                     double time) const;
   // decomposed_interface.cpp: InterfaceTemperature on the owned nodes (start, each step's heat, the
   // update after each window or interval, which writes T_int,p into the particle scalar).
+  // Owned node u (x fastest over owned_nodes()) -> its serial grid node number.
+  template <int Dim> static std::vector<int> owned_grid_nodes(const mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> InterfaceTemperature<Dim>* interface_model();
   template <int Dim> void interface_start(mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> void interface_step(const std::vector<double>& work);

@@ -58,6 +58,28 @@ struct DecomposedSnapshot {
   std::vector<Field> fields;
   /// Integer per-particle fields (n each), e.g. the body index.
   std::vector<std::pair<std::string, std::vector<int>>> integer_fields;
+  /// The thermal grid's nodes this rank owns (the serial /nodes/<number>: position, temperature,
+  /// heat_capacity, lattice; node_field as H5Output's): written to /nodes/<number> of the rank file
+  /// and drawn by BASE_nodes.xdmf. Empty on every rank: no nodes (a run without heat).
+  struct NodeField {
+    std::string name;
+    std::vector<double> values;          // n × components (integer false)
+    std::vector<std::int32_t> integers;  // n × components (integer true)
+    int components = 1;
+    bool integer = false;
+  };
+  std::vector<NodeField> node_fields;
+  std::size_t nodes = 0;
+  void node_field(const std::string& name, const double* data, std::size_t n, int components) {
+    node_fields.push_back({name, std::vector<double>(data, data + n * static_cast<std::size_t>(components)), {},
+                           components, false});
+    nodes = n;
+  }
+  void node_field(const std::string& name, const std::int32_t* data, std::size_t n, int components) {
+    node_fields.push_back({name, {}, std::vector<std::int32_t>(data, data + n * static_cast<std::size_t>(components)),
+                           components, true});
+    nodes = n;
+  }
 };
 
 /// Particle snapshots of a decomposed run (issue 16 item 3): one HDF5 file per rank,
@@ -91,6 +113,12 @@ class DecomposedOutput {
   const std::vector<std::string>& reference_grids() const { return reference_grids_; }
   void restore_reference_grids(std::vector<std::string> grids) { reference_grids_ = std::move(grids); }
   std::string reference_xdmf_text() const;
+  /// Rank 0: the thermal grid's nodes of every snapshot that has them (the serial RUN_nodes.xdmf,
+  /// collection "thermal_nodes": a spatial collection of the ranks' /nodes/<number> per snapshot);
+  /// "" without any. Checkpoints store node_grids(); a resumed run gives them back.
+  const std::vector<std::string>& node_grids() const { return node_grids_; }
+  void restore_node_grids(std::vector<std::string> grids) { node_grids_ = std::move(grids); }
+  std::string nodes_xdmf_text() const;
   long snapshots() const { return snapshots_; }
   ~DecomposedOutput();
   DecomposedOutput(const DecomposedOutput&) = delete;
@@ -107,12 +135,15 @@ class DecomposedOutput {
  private:
   /// The constructors' end: every rank learns whether any failed; on failure the files are closed.
   void agree_or_close(const std::string& error);
+  /// write's thermal nodes (collective): /nodes/<index> of each rank file and their XDMF grids.
+  void write_nodes(long step, double time, const std::string& index, const DecomposedSnapshot& snapshot);
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1, dim_ = 2;
   std::string base_, xdmf_path_;
   long long file_ = -1;              // hid_t of this rank's file
   std::vector<std::string> grids_;  // rank 0: the XDMF text of every snapshot so far
   std::vector<std::string> reference_grids_;  // rank 0: the same at the reference positions
+  std::vector<std::string> node_grids_;       // rank 0: the thermal nodes' grids
   bool write_xdmf_ = true;          // rank 0 rewrites BASE.xdmf after every snapshot
   long snapshots_ = 0;
 };

@@ -143,8 +143,9 @@ class H5Output {
   /// With via_temporary and write_xdmf false: `text` is the XDMF document published with the result
   /// in close() under xdmf_path_for(path()) (publish_with_xdmf), e.g. a decomposed run's OUT.xdmf that
   /// joins its rank files (issue 34: written with the result, never before it).
-  /// `reference` (may be ""): RUN_reference.xdmf published with it (xdmf_reference_path_for).
-  void publish_xdmf_with_result(std::string text, std::string reference = "");
+  /// `reference` (may be ""): RUN_reference.xdmf published with it (xdmf_reference_path_for);
+  /// `nodes` (may be ""): RUN_nodes.xdmf (xdmf_nodes_path_for), the thermal grid's nodes.
+  void publish_xdmf_with_result(std::string text, std::string reference = "", std::string nodes = "");
   /// Flushes, rewrites the XDMF file and closes the file. Further calls throw std::logic_error.
   void close();
 

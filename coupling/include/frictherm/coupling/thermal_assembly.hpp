@@ -67,10 +67,19 @@ struct NodalThermalSystem {
   /// |Σ_i M_i(all nodes) − Σ_p m_p C_v,p| / Σ_p m_p C_v,p: partition of unity, round-off only.
   double mass_residual() const;
   /// max_i |(K·1)_i| / max_i K_ii: zero row sums, round-off only (0 without conduction).
-  double row_sum_residual() const;
+  double row_sum_residual() const;  // row_sum_extremes(conductance, 0).residual()
   /// Σ_i M_i T_i over the unknowns (J).
   double energy(const Eigen::VectorXd& nodal_temperature) const;
 };
+
+/// The zero-row-sum check of K (K·1 = 0) on owned rows `rows` (global columns; row i's diagonal in
+/// column first + i): the largest |Σ_j K_ij| and the largest |K_ii| over the rows. A decomposed run
+/// reduces both over ranks (MPI_MAX) before residual(); a serial system is all rows, first 0.
+struct RowSumExtremes {
+  double sum = 0.0, diagonal = 0.0;
+  double residual() const { return diagonal > 0.0 ? sum / diagonal : 0.0; }
+};
+RowSumExtremes row_sum_extremes(const thermal::SparseMatrix& rows, Eigen::Index first);
 
 /// The thermal properties of material `id`; throws std::invalid_argument when it has none.
 const ThermalProperties& thermal_properties_of(const std::vector<ThermalProperties>& materials, int id);
