@@ -284,18 +284,23 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   double face_heat = 0.0;
   mechanics::parallel_region(threads, [&] {
   Expanded c{};
-#pragma omp for schedule(static) reduction(+ : face_heat)
+  // Each thread's own sum, added below (a reduction clause on this orphaned loop would name a variable
+  // the lambda captures, which clang refuses); on one thread 0 + the same sum, as the clause gave.
+  double my_face_heat = 0.0;
+#pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
     expand<Kernel, false>(stencils[k], sys.unknown, c);
     if (c.count == 0) continue;  // reaches no unknown
     const double before = p.temperature[k];
-    const double T = new_temperature(before, c, k, face_heat);
+    const double T = new_temperature(before, c, k, my_face_heat);
     if (T == before) continue;  // unchanged (no heat reached its nodes): its eq. 38 terms stand
     p.temperature[k] = T;
     particle_scratch_[k] = heat_capacity_[k] * (T - before);
     changed[k] = 1;
   }
+#pragma omp atomic
+  face_heat += my_face_heat;
   });
   face_heat_ = face_heat;
   if (!keep_sums) return;

@@ -134,7 +134,10 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
     const NodeRange r = NodeRange::of_thread(0, static_cast<int>(n_nodes));  // cleared by this thread
     std::fill(sys.grid_mass.begin() + r.lo, sys.grid_mass.begin() + r.hi, 0.0);
     std::fill(mct.begin() + r.lo, mct.begin() + r.hi, 0.0);
-#pragma omp for schedule(static) reduction(min : span_lo) reduction(max : span_hi)
+    // The span as each thread's own min/max, combined below (a reduction clause on this orphaned loop
+    // would name a variable the lambda captures, which clang refuses: "reduction variable must be shared").
+    int my_lo = static_cast<int>(n_nodes), my_hi = -1;
+#pragma omp for schedule(static)
     for (std::size_t k = 0; k < np; ++k) {
       std::array<int, 2>& reach = reach_of[k];
       reach = {static_cast<int>(n_nodes), -1};
@@ -144,9 +147,12 @@ NodalThermalSystem assemble_with(const mechanics::Grid<Dim>& grid, const mechani
       }
       const Nodes& nl = cache.fill(grid, p, k, step_stencils);
       for (int a = 0; a < nl.count; ++a) reach[0] = std::min(reach[0], nl.node[a]), reach[1] = std::max(reach[1], nl.node[a]);
-      span_lo = std::min(span_lo, reach[0]), span_hi = std::max(span_hi, reach[1]);
+      my_lo = std::min(my_lo, reach[0]), my_hi = std::max(my_hi, reach[1]);
     }
-    // (the loop's end is a barrier: every node is cleared before any thread adds)
+#pragma omp critical(frictherm_assembly_span)
+    span_lo = std::min(span_lo, my_lo), span_hi = std::max(span_hi, my_hi);
+#pragma omp barrier
+    // (every node is cleared and the span complete before any thread adds)
     const NodeRange mine = NodeRange::of_thread(span_lo, span_hi + 1);
     for (std::size_t k = 0; k < np; ++k) {
       if (!mine.meets(reach_of[k])) continue;
