@@ -5,8 +5,13 @@
 // mechanics' cumulative work books of file j go with its particles (their sum over ranks is kept);
 // the heat's per-node state (pending work, M_i and T_i of the last gather) is copied node by node from
 // the file whose rank owned the node (DMDA indices are the same for every K), M_i on the ghosted box
-// from the new owners; so is the contact regularisation's lagged normal traction per node. The particles' order on a rank and the ranks' sums then differ from an
-// uninterrupted K'-rank run: results agree to the round-off of reordered sums, not bit-for-bit.
+// from the new owners; so is the contact regularisation's lagged normal traction per node. The
+// interface temperature's flux histories (InterfaceTemperature::visit_state: one slot per heated
+// node, named by its serial grid node, with the bins' boundaries and levels the same in every file)
+// go slot by slot to the rank that now owns the slot's node; the heat they recorded goes with file
+// j's particles (its sum over ranks is kept). The particles' order on a rank and the ranks' sums then
+// differ from an uninterrupted K'-rank run: results agree to the round-off of reordered sums, not
+// bit-for-bit.
 #include "run/checkpoint_io.hpp"
 
 #include <frictherm/coupling/decomposed_heat.hpp>
@@ -105,6 +110,7 @@ class Redistribution {
     copy_nodes(box, pending, pending_);
     copy_nodes(box, M, M_);
     copy_nodes(box, T, T_);
+    take_interface_histories(r, j, particles);
   }
 
   /// Collective: the particles into the swarm (migrated) and the per-node heat into `heat`.
@@ -114,7 +120,11 @@ class Redistribution {
     if (!heat) return;
     std::vector<double> local_M;
     mpm_.owned_to_local(M_, 1, local_M);
-    Assign a{pending_, M_, T_, local_M};
+    // The taken slots' histories, bin-major as BinnedHeatHistory::Flat holds them.
+    std::vector<double> energy(iface_.levels.size() * iface_.nodes.size());
+    for (std::size_t b = 0; b < iface_.levels.size(); ++b)
+      for (std::size_t k = 0; k < iface_.nodes.size(); ++k) energy[b * iface_.nodes.size() + k] = iface_.columns[k][b];
+    Assign a{pending_, M_, T_, local_M, iface_, energy};
     heat->visit_state(a);
   }
 
@@ -137,19 +147,87 @@ class Redistribution {
               from[static_cast<std::size_t>(((k - blo[2]) * bn[1] + (j - blo[1])) * bn[0] + (i - blo[0]))];
   }
 
-  // A visitor of DecomposedHeat::visit_state that sets only the per-node arrays.
+  // The interface temperature's flux-history slots of the nodes this rank owns, gathered from every
+  // rank file (InterfaceTemperature::visit_state's names).
+  struct InterfaceSlots {
+    bool present = false;
+    std::vector<double> boundaries;           // the bins' time boundaries (the same in every file)
+    std::vector<int> levels;                  // the bins' levels (the same too)
+    std::vector<int> nodes;                   // slot -> serial grid node
+    std::vector<double> open;                 // the open interval's heat per area, per slot
+    std::vector<std::vector<double>> columns;  // per slot: its heat per area in each bin
+    double heat_recorded = 0.0;               // of the files whose particles this rank takes
+  };
+
+  void take_interface_histories(const ckpt::Reader& r, int j, bool particles) {
+    std::vector<double> boundaries, energy, open;
+    std::vector<int> levels, nodes;
+    double recorded = 0.0;
+    r("interface/boundaries", boundaries);
+    if (boundaries.empty()) return;  // the model is off (or started after this checkpoint)
+    r("interface/levels", levels);
+    r("interface/energy", energy);
+    r("interface/open", open);
+    r("interface/nodes", nodes);
+    r("interface/heat_recorded", recorded);
+    const std::string file = "checkpoint rank file " + std::to_string(j) + ": interface/";
+    if (!iface_.present) {
+      iface_.present = true, iface_.boundaries = boundaries, iface_.levels = levels;
+    } else if (boundaries != iface_.boundaries || levels != iface_.levels) {
+      throw std::runtime_error(file + "boundaries and levels differ from rank file 0's (the flux histories' "
+                               "bins must be the same on every rank)");
+    }
+    const std::size_t slots = nodes.size();
+    if (open.size() != slots || energy.size() != levels.size() * slots || boundaries.size() != levels.size() + 1)
+      throw std::runtime_error(file + "energy, open and nodes do not fit " + std::to_string(levels.size()) + " bins of " +
+                               std::to_string(slots) + " slots");
+    const mechanics::Grid<Dim>& grid = mpm_.grid();
+    for (std::size_t k = 0; k < slots; ++k) {
+      if (nodes[k] < 0 || static_cast<std::size_t>(nodes[k]) >= grid.node_count())
+        throw std::runtime_error(file + "nodes names grid node " + std::to_string(nodes[k]) + " outside the grid");
+      const mechanics::IVec<Dim> lattice = grid.node_lattice(nodes[k]);
+      bool mine = true;  // DMDA index = lattice + ghost (DecomposedHeat::owned_grid_nodes)
+      for (int d = 0; d < Dim; ++d) {
+        const int i = lattice[d] + mechanics::Grid<Dim>::ghost;
+        mine = mine && i >= mine_[2 * d] && i < mine_[2 * d + 1];
+      }
+      if (!mine) continue;
+      iface_.nodes.push_back(nodes[k]);
+      iface_.open.push_back(open[k]);
+      std::vector<double> column(levels.size());
+      for (std::size_t b = 0; b < levels.size(); ++b) column[b] = energy[b * slots + k];
+      iface_.columns.push_back(std::move(column));
+    }
+    if (particles) iface_.heat_recorded += recorded;
+  }
+
+  // A visitor of DecomposedHeat::visit_state that sets only the per-node arrays and the interface
+  // histories of this rank's nodes.
   struct Assign {
     static constexpr bool reading = true;
     const std::vector<double>& pending;
     const std::vector<double>& M;
     const std::vector<double>& T;
     const std::vector<double>& local_M;
+    const InterfaceSlots& iface;
+    const std::vector<double>& iface_energy;
     void operator()(const char* name, std::vector<double>& v) const {
       const std::string n(name);
       if (n == "window/pending") v = pending;
       else if (n == "gather/M") v = M;
       else if (n == "gather/T") v = T;
       else if (n == "gather/local_M") v = local_M;
+      else if (iface.present && n == "interface/boundaries") v = iface.boundaries;
+      else if (iface.present && n == "interface/energy") v = iface_energy;
+      else if (iface.present && n == "interface/open") v = iface.open;
+    }
+    void operator()(const char* name, std::vector<int>& v) const {
+      const std::string n(name);
+      if (iface.present && n == "interface/levels") v = iface.levels;
+      else if (iface.present && n == "interface/nodes") v = iface.nodes;
+    }
+    void operator()(const char* name, double& v) const {
+      if (iface.present && std::string(name) == "interface/heat_recorded") v = iface.heat_recorded;
     }
     template <class T> void operator()(const char*, T&) const {}  // the rest: read from file 0 already
   };
@@ -161,6 +239,7 @@ class Redistribution {
   std::vector<double> pending_, M_, T_;
   std::vector<double> lagged_, lagged_step_;  // the regularisation's, on this rank's owned nodes
   bool regularized_ = false;
+  InterfaceSlots iface_;
 };
 
 }  // namespace frictherm::coupling::detail

@@ -72,13 +72,6 @@ ckpt::RankSizes DecomposedRun<Dim>::rank_sizes(bool ghosted) const {
 template <int Dim>
 void DecomposedRun<Dim>::restore() {
   if (const int old = checkpoint_ranks(o_.resume_checkpoint); old > 0 && old != size_) {
-    // The interface temperature's flux histories are kept per rank for its owned nodes, in slots of
-    // that rank's own order: they are not redistributed (docs/checkpoints.md).
-    if (detail::interface_temperature(s_))
-      throw OutputError("checkpoint '" + o_.resume_checkpoint + "' was written by " + std::to_string(old) +
-                        " ranks with coupling.interface_temperature, whose flux histories resume on the same "
-                        "number of ranks only (expected mpirun -n " + std::to_string(old) + ", not " +
-                        std::to_string(size_) + ")");
     redistribute(old);
     return;
   }
