@@ -29,8 +29,30 @@ struct PairChange {
   bool counted = false;  // sliding, and counted in ContactStats::sliding_nodes (kCountedSlideFraction)
   Vec<Dim> dp = Vec<Dim>::Zero();  // Δp'_{i,a}
   double work_first = 0.0, work_second = 0.0;
+  double work_normal = 0.0;  // the energy the normal change removes (normal_stop_work), where it is applied
   double reduced_mass = 0.0;
 };
+
+/// The energy the normal contact impulse removes at a node in contact (J): the normal analogue of the
+/// second-order frictional work (Nairn, Bardenhagen & Smith 2018 eqs. 32–36). Over the step the normal
+/// change d_n n̂ of material a (−d_n n̂ of b, eq. 15) acts as a constant force d_n n̂/dt while the
+/// relative normal velocity v_n = (v_b − v_a)·n̂ goes linearly from its start-of-step value v_n(0),
+/// the momenta before this step's force increment, p_j − f_j dt (as v'(0) of eq. 32, not the
+/// force-updated momenta, whose f dt/m under a large pressure no particle moves with), to its end
+/// value v_n(dt) = −g/dt (the approach left to close an open extent gap g, 0 otherwise). Its work on
+/// the pair is d_n n̂·(v̄_a − v̄_b) dt/dt = −d_n (v_n(0) + v_n(dt))/2; removed: ½ d_n (v_n(0) + v_n(dt)),
+/// ≥ 0 for an approach stopped (d_n < 0, v_n < 0), ½ m_red v_n(0)² for a stop without force, and 0
+/// for a pair resting in contact (v_n(0) = 0) however large the pressure. A rigid b moves at its
+/// velocity throughout. force_dt: how long the sides' forces have acted on their momenta (dt in the
+/// momentum-update pass, 0 in the passes before it or after a remap).
+template <int Dim>
+double normal_stop_work(const ContactSide<Dim>& a, const ContactSide<Dim>& b, const Vec<Dim>& n, double d_n,
+                        double closing, double reduced_mass, double force_dt) {
+  const Vec<Dim> va0 = (a.momentum - a.force * force_dt) / a.mass;
+  const Vec<Dim> vb0 = b.rigid ? b.rigid_velocity : Vec<Dim>((b.momentum - b.force * force_dt) / b.mass);
+  const double v_start = (vb0 - va0).dot(n), v_end = -closing / reduced_mass;
+  return 0.5 * d_n * (v_start + v_end);
+}
 
 /// ContactStats::sliding_nodes counts a sliding node only where its sliding impulse is above this
 /// fraction of the stick tangential impulse d_t. Where a pair touches with a relative normal velocity
@@ -199,6 +221,7 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   // sign of the approach velocity; at a node a rigid body barely reaches (the oscillating block's
   // pushers, moved by a fraction of a cell) that pinned the heavy block field there on some steps and
   // not on others, and the block's particles gained kinetic energy without bound at small time steps.
+  if (in_contact) out.work_normal = normal_stop_work(a, b, n, d_n, closing, out.reduced_mass, c.heat ? c.dt : 0.0);
   if (a.sliver || b.sliver || light_only) {
     if (in_contact) {
       out.changed = true;
@@ -278,13 +301,14 @@ PairChange<Dim> pair_contact_of(const ContactSide<Dim>& a, const ContactSide<Dim
 }
 
 /// W1, W2) for the frictional work of the material pair (a, b), counting sliding pairs in
-/// sliding_nodes. lagged_normal / lagged_step: the node's regularisation state (null when off), used
+/// sliding_nodes, and add_normal(E) for the energy a normal change removes (normal_stop_work; with
+/// three or more materials weighted as eq. 40, weights that sum to 1 for two). lagged_normal / lagged_step: the node's regularisation state (null when off), used
 /// by two-material nodes only. dps: scratch.
-template <int Dim, class PairOf, class Apply, class AddWork>
+template <int Dim, class PairOf, class Apply, class AddWork, class AddNormal>
 void resolve_contact_node(const std::vector<ContactSide<Dim>>& sides, const std::vector<int>& mats,
                           const Vec<Dim>& h, PairContext& ctx, double* lagged_normal, double* lagged_step,
                           const PairOf& pair_of, std::vector<Vec<Dim>>& dps, Apply&& apply, AddWork&& add_work,
-                          long& sliding_nodes) {
+                          AddNormal&& add_normal, long& sliding_nodes) {
   const std::size_t count = sides.size();
   const bool heat = ctx.heat;
   if (count == 2) {
@@ -299,6 +323,7 @@ void resolve_contact_node(const std::vector<ContactSide<Dim>>& sides, const std:
       if (r.changed) {
         apply(ia, r.dp);
         if (!sides[ib].rigid) apply(ib, Vec<Dim>(-r.dp));
+        if (r.work_normal != 0.0) add_normal(r.work_normal);
       }
       if (r.sliding && heat) {
         if (r.counted) ++sliding_nodes;
@@ -322,6 +347,7 @@ void resolve_contact_node(const std::vector<ContactSide<Dim>>& sides, const std:
       ctx.settings = &pair_of(mats[a], mats[dominant]);
       const PairChange<Dim> r = pair_contact_of(sides[a], rest, h, ctx, mats[a], mats[dominant]);
       if (r.changed) dps[a] = r.dp;
+      if (r.changed && r.work_normal != 0.0) add_normal((m_red_node / sides[a].mass) * r.work_normal);  // eq. 40
       if (r.sliding && heat) {
         if (r.counted) ++sliding_nodes;
         const double w = m_red_node / sides[a].mass;  // eq. 40

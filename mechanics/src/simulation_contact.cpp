@@ -42,6 +42,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
   if (heat) contact_books_.stats = ContactStats{};
   const bool regularized = contact_setup_.options.regularized();
+  if (pass == ContactPass::extrapolated) contact_nodes_.extrapolated_change.assign(nodes_.mass.size(), Vec<Dim>::Zero());
   if (regularized && contact_nodes_.lagged_normal_traction.size() != grid_.node_count()) {
     contact_nodes_.lagged_normal_traction.assign(grid_.node_count(), std::numeric_limits<double>::quiet_NaN());
     contact_nodes_.lagged_normal_step.assign(grid_.node_count(), -2.0);
@@ -59,6 +60,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     t.stats = ContactStats{};
     t.entries.clear();
     t.rigid_work.clear();
+    t.normal_work.clear();
     if (heat && t.marked.size() != nm * nm) {
       t.pair_first.assign(nm * nm, 0.0), t.pair_second.assign(nm * nm, 0.0), t.marked.assign(nm * nm, 0);
       t.touched.clear();
@@ -84,6 +86,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
     auto apply = [&](int slot, const Vec<Dim>& dp) {
       nodes_.momentum[static_cast<std::size_t>(slot)] += dp;
       if (forces) nodes_.force[static_cast<std::size_t>(slot)] += dp / dt;  // eq. 19
+      if (pass == ContactPass::extrapolated) contact_nodes_.extrapolated_change[static_cast<std::size_t>(slot)] += dp;
     };
     auto add_work = [&](int node, int ma, int mb, double w1, double w2) {
       if (!(std::isfinite(w1) && std::isfinite(w2))) return;  // guarded upstream; never inject NaN heat
@@ -110,15 +113,18 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
       double* lagged_step = regularized ? &contact_nodes_.lagged_normal_step[static_cast<std::size_t>(node)] : nullptr;
       // The energy books' rigid work, in the momentum-update pass (the changes the particles receive).
       const ContactSide<Dim>* rigid = forces ? rigid_work_side(sides) : nullptr;
-      double rigid_work = 0.0;
+      double rigid_work = 0.0, normal_work = 0.0;
       contact_detail::resolve_contact_node(
           sides, mats, h, ctx, lagged_normal, lagged_step, pair_of, dps,
           [&](std::size_t j, const Vec<Dim>& dp) {
             apply(slots[j], dp);
             if (rigid) rigid_work += dp.dot(rigid->rigid_velocity);
           },
-          [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); }, stats.sliding_nodes);
+          [&](int ma, int mb, double w1, double w2) { add_work(node, ma, mb, w1, w2); },
+          [&](double e) { normal_work += e; }, stats.sliding_nodes);
       if (rigid) acc.rigid_work.push_back(rigid_work);
+      // The energy books' normal stop, in the momentum-update pass (the changes the particles receive).
+      if (forces && normal_work != 0.0) acc.normal_work.push_back(normal_work);
       } catch (const contact_detail::ContactPairError& e) {
         failure.keep(g, node, e.material_a, e.material_b, e.what());
       } catch (const std::exception& e) {
@@ -158,6 +164,7 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   for (const auto& t : contact_nodes_.thread_work) {
     for (const auto& e : t.entries) books.add(e.k, e.w1, e.w2);
     for (const double w : t.rigid_work) work_books_.rigid += w;  // group order too: the same sum on any thread count
+    for (const double w : t.normal_work) work_books_.contact_normal += w;
   }
   for (const std::size_t k : books.touched) {  // (the others add zero)
     contact_books_.pair_work_first[k] += books.pair_first[k], contact_books_.pair_work_second[k] += books.pair_second[k];

@@ -236,11 +236,13 @@ void Simulation<Dim>::sum_shared_fields(Accumulated which) {
 // Fixed components are zeroed; components driven by a rigid boundary material take its velocity; rigid
 // fields (contact) take m v_rigid and no force.
 template <int Dim>
-double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const {
+double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt,
+                                          double* stop) const {
   // With `force` (the momentum update) the work of the rigid bodies on the deformable material is
   // returned: the impulse a rigid velocity condition adds, m v_rigid − (p + f dt), and the reaction of
   // a force on a rigid field (penalty contact: the slave's force on a rigid master), each dotted
-  // with the rigid velocity.
+  // with the rigid velocity; and into *stop the energy the conditions' stops remove from the
+  // deformable fields (condition_stop_work, energy/energy_books.hpp).
   double rigid_work = 0.0;
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
@@ -257,8 +259,13 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   // One parallel region over the deformable fields (one per grain in a PBX: a region each would
   // cost more than their few hundred slots); one thread runs it without a team (parallel_region.hpp),
   // its sum added to `work` as the reduction clause adds it.
-  double field_work = 0.0;
-  const auto fields_pass = [&](double& work) {
+  double field_work = 0.0, field_stop = 0.0;
+  // The start-of-step momentum the stops are measured from: the particles' (p^n of the extrapolation),
+  // without the extrapolated contact pass's change, which the particles never receive.
+  const std::vector<Vec<Dim>>& changed = contact_nodes_.extrapolated_change;
+  const bool contact_changed = changed.size() == momentum.size();
+  const auto start = [&](std::size_t s, int d) { return contact_changed ? momentum[s][d] - changed[s][d] : momentum[s][d]; };
+  const auto fields_pass = [&](double& work, double& stopped) {
   for (std::size_t f = 0; f < fields_.size(); ++f) {
     const VelocityField<Dim>& F = fields_[f];
     if (F.rigid) continue;
@@ -273,7 +280,8 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
         for (int d = 0; d < Dim; ++d)
           if (driven & (1u << d)) {
             if (force)  // the kernel shared with the decomposed step (energy/energy_books.hpp)
-              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], conditions_.rigid_velocity[i][d], dt);
+              work += drive_component(nodes_.mass[s], momentum[s][d], (*force)[s][d], conditions_.rigid_velocity[i][d], dt,
+                                      start(s, d), stopped);
             else
               momentum[s][d] = nodes_.mass[s] * conditions_.rigid_velocity[i][d];
           }
@@ -289,11 +297,12 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   }
   };
   if (without_team(threads_.count)) {
-    fields_pass(field_work);
+    fields_pass(field_work, field_stop);
   } else {
-#pragma omp parallel num_threads(threads_.count) reduction(+ : field_work)
-    fields_pass(field_work);
+#pragma omp parallel num_threads(threads_.count) reduction(+ : field_work, field_stop)
+    fields_pass(field_work, field_stop);
   }
+  if (stop) *stop += field_stop;
   return rigid_work + field_work;
 }
 
@@ -325,7 +334,7 @@ void Simulation<Dim>::save_start_velocity() {
 
 template <int Dim>
 void Simulation<Dim>::apply_grid_velocity_conditions(double dt) {
-  work_books_.rigid += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt);
+  work_books_.rigid += apply_velocity_bc(nodes_.momentum, &nodes_.force, dt, &work_books_.boundary_stop);
 }
 
 // Mass-proportional damping force −c m_i v_i = −c p_i, taken at the step's start momentum
@@ -467,7 +476,7 @@ template struct NodalFields<3>;
   template void Simulation<D>::update_partition();                                                            \
   template void Simulation<D>::clear_scatter_targets(int, Accumulated);                                      \
   template void Simulation<D>::sum_shared_fields(Accumulated);                                               \
-  template double Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double) const;       \
+  template double Simulation<D>::apply_velocity_bc(std::vector<Vec<D>>&, std::vector<Vec<D>>*, double, double*) const;       \
   template void Simulation<D>::velocity_from_momentum();                                                      \
   template void Simulation<D>::save_start_velocity();                                                         \
   template void Simulation<D>::apply_grid_velocity_conditions(double);                                        \

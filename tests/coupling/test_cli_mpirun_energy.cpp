@@ -37,7 +37,7 @@ constexpr double kSame = 1e-9;
 
 const char* const kBooks[] = {"kinetic_energy", "strain_energy",       "total_energy", "external_work",
                               "rigid_work",     "damping_work",        "plastic_dissipation", "energy_lost",
-                              "numerical_dissipation"};
+                              "numerical_dissipation", "contact_normal_work", "boundary_stop_work"};
 
 class MpirunEnergyBooks : public frictherm::test::MpirunCompare {
  protected:
@@ -83,7 +83,8 @@ class MpirunEnergyBooks : public frictherm::test::MpirunCompare {
                 diff / scale, scale, own > 0.0 ? diff / own : 0.0, own);
   }
 
-  // energy_lost − damping_work − plastic_dissipation − W = numerical_dissipation on every row of
+  // energy_lost − damping_work − plastic_dissipation − W − contact_normal_work − boundary_stop_work =
+  // numerical_dissipation on every row of
   // `file`, W the frictional work of the order handed to the heat (second: these runs have none; 0
   // without contact), to 1e-12 of the row's largest term: the columns are written from one set of
   // sums, so only the round-off of the three subtractions (a few ε of that term) may remain.
@@ -91,12 +92,14 @@ class MpirunEnergyBooks : public frictherm::test::MpirunCompare {
     const std::vector<double> lost = column(file, "energy_lost"), damping = column(file, "damping_work");
     const std::vector<double> plastic = column(file, "plastic_dissipation");
     const std::vector<double> numerical = column(file, "numerical_dissipation");
+    const std::vector<double> normal = column(file, "contact_normal_work"), stop = column(file, "boundary_stop_work");
     const std::vector<double> W = contact ? column(file, "friction_work_second") : std::vector<double>(lost.size(), 0.0);
     ASSERT_FALSE(lost.empty()) << file;
     double worst = 0.0;
     for (std::size_t k = 0; k < lost.size(); ++k) {
-      const double scale = std::max({std::fabs(lost[k]), std::fabs(damping[k]), std::fabs(plastic[k]), std::fabs(W[k])});
-      const double diff = std::fabs(lost[k] - damping[k] - plastic[k] - W[k] - numerical[k]);
+      const double scale = std::max({std::fabs(lost[k]), std::fabs(damping[k]), std::fabs(plastic[k]), std::fabs(W[k]),
+                                     std::fabs(normal[k]), std::fabs(stop[k])});
+      const double diff = std::fabs(lost[k] - damping[k] - plastic[k] - W[k] - normal[k] - stop[k] - numerical[k]);
       EXPECT_LE(diff, 1e-12 * scale) << file << " row " << k;
       if (scale > 0.0) worst = std::max(worst, diff / scale);
     }

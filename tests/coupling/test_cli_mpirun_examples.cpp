@@ -6,7 +6,8 @@
 // within 1e-9 of its own scale (the bound of test_cli_mpirun.cpp: the same arithmetic, sums over
 // particles, nodes and ranks in another order), the scale being that of what its round-off comes from:
 //   * the energy columns (kinetic, strain, total, external, rigid, damping, plastic, energy_lost,
-//     numerical_dissipation): terms of one balance, the largest of its terms over the run;
+//     numerical_dissipation, contact_normal_work, boundary_stop_work): terms of one balance, the
+//     largest of its terms over the run;
 //   * the momenta: √(2 M max KE), M the total particle mass (zero by symmetry in most scenes);
 //   * a body's mean displacement or velocity: the largest of that body's components (x, y, z);
 //   * temperatures (columns and the snapshot field): their rise, at least 1 mK; the mean of n values
@@ -53,7 +54,8 @@ std::string exe() { return std::string("'") + FRICTHERM_EXE + "'"; }
 bool is_count(const std::string& c) { return c == "contact_nodes" || c == "sliding_nodes" || c == "hotspot_count"; }
 bool is_energy(const std::string& c) {
   for (const char* e : {"kinetic_energy", "strain_energy", "total_energy", "external_work", "rigid_work", "damping_work",
-                        "plastic_dissipation", "energy_lost", "numerical_dissipation"})
+                        "plastic_dissipation", "energy_lost", "numerical_dissipation", "contact_normal_work",
+                        "boundary_stop_work"})
     if (c == e) return true;
   return false;
 }

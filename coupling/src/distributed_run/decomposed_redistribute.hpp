@@ -35,6 +35,7 @@ class Redistribution {
     for (auto& r : acc_.integers) r.second.clear();
     acc_.cumulative_first = acc_.cumulative_second = 0.0;
     acc_.external_work = acc_.damping_work = acc_.rigid_work = 0.0;
+    acc_.contact_normal_work = acc_.boundary_stop_work = 0.0;
     acc_.work_first.clear();
     acc_.work_second.clear();
     acc_.pair_first.clear();
@@ -91,6 +92,10 @@ class Redistribution {
       acc_.damping_work += w;
       r("mechanics/rigid_work", w);
       acc_.rigid_work += w;
+      r("mechanics/contact_normal_work", w);
+      acc_.contact_normal_work += w;
+      r("mechanics/boundary_stop_work", w);
+      acc_.boundary_stop_work += w;
       for (auto [name, sum] : {std::pair<const char*, std::vector<double>*>{"mechanics/pair_work_first", &acc_.pair_first},
                                {"mechanics/pair_work_second", &acc_.pair_second}}) {
         std::vector<double> pw;

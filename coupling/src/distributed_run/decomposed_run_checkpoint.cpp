@@ -105,6 +105,8 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   v("mechanics/external_work", st.external_work);
   v("mechanics/damping_work", st.damping_work);
   v("mechanics/rigid_work", st.rigid_work);
+  v("mechanics/contact_normal_work", st.contact_normal_work);
+  v("mechanics/boundary_stop_work", st.boundary_stop_work);
   v("mechanics/initial_energy", st.initial_energy);
   v("mechanics/empty_node_mass", st.empty_node_mass);
   v("mechanics/work_first", st.work_first);

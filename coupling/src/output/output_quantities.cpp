@@ -32,6 +32,8 @@ const std::map<std::string, Entry>& catalogue() {
       {"plastic_dissipation", {"J", "plastic work"}},
       {"energy_lost", {"J", "mechanical energy lost"}},
       {"numerical_dissipation", {"J", "numerical dissipation"}},
+      {"contact_normal_work", {"J", "energy removed by the normal contact impulses"}},
+      {"boundary_stop_work", {"J", "energy removed by the velocity conditions' stops"}},
       {"mean_temperature", {"K", "mean temperature"}},
       {"mean_displacement_x", {"m", "mean displacement x"}},
       {"mean_displacement_y", {"m", "mean displacement y"}},

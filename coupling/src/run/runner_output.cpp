@@ -20,7 +20,8 @@ std::vector<std::string> series_names(int dim) {
   const char* axes[3] = {"momentum_x", "momentum_y", "momentum_z"};
   for (int d = 0; d < dim; ++d) n.emplace_back(axes[d]);
   // The energy balance (mechanics::EnergyBalance, docs/output.md "Energy balance").
-  for (const char* c : {"rigid_work", "damping_work", "plastic_dissipation", "energy_lost", "numerical_dissipation"})
+  for (const char* c : {"rigid_work", "damping_work", "plastic_dissipation", "energy_lost", "numerical_dissipation",
+                        "contact_normal_work", "boundary_stop_work"})
     n.emplace_back(c);
   return n;
 }
@@ -116,7 +117,8 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
   const auto P = sim.linear_momentum();
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   const mechanics::EnergyBalance e = sim.energy_balance(order);
-  row.insert(row.end(), {e.rigid_work, e.damping_work, e.plastic_work, e.lost(), e.numerical_dissipation()});
+  row.insert(row.end(), {e.rigid_work, e.damping_work, e.plastic_work, e.lost(), e.numerical_dissipation(),
+                         e.contact_normal_work, e.boundary_stop_work});
   const BodySums<Dim> bodies = body_sums(sim);
   bodies.append_means(row);
   if (!sim.contact_enabled()) return row;

@@ -69,6 +69,8 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.external_work = s.external_work;
   c.damping_work = s.damping_work;
   c.rigid_work = s.rigid_work;
+  c.contact_normal_work = s.contact_normal_work;
+  c.boundary_stop_work = s.boundary_stop_work;
   c.initial_energy = s.initial_energy;
   c.empty_node_mass = s.empty_node_mass;
   c.work_first = s.work_first;
@@ -152,6 +154,8 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.external_work = c.external_work;
   s.damping_work = c.damping_work;
   s.rigid_work = c.rigid_work;
+  s.contact_normal_work = c.contact_normal_work;
+  s.boundary_stop_work = c.boundary_stop_work;
   s.initial_energy = c.initial_energy;
   s.empty_node_mass = c.empty_node_mass;
   s.work_first = c.work_first;

@@ -97,7 +97,10 @@ void DecomposedMpm<Dim>::Impl::find_contact_nodes(double /*dt*/) {
 template <int Dim>
 void DecomposedMpm<Dim>::Impl::contact_extrapolated(double dt) {
   contact_failure.clear();
+  mt_start_change.assign(mt_field.size(), Vec<Dim>::Zero());
+  recording_start_change = true;
   resolve_contact(false, dt);
+  recording_start_change = false;
 }
 
 // Phase 8: contact on p^{n+1}, forces kept consistent (eq. 19), frictional work (eqs. 27, 34, 36, 40).
@@ -212,6 +215,7 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
             v[momentum + d] += dp[d];
             if (updated) v[force + d] += dp[d] / dt;  // eq. 19
           }
+          if (recording_start_change) mt_start_change[entries[j]] += dp;
           if (rigid_side) rigid_work += dp.dot(rigid_side->rigid_velocity);
         },
         [&](int ma, int mb, double w1, double w2) {
@@ -221,6 +225,9 @@ void DecomposedMpm<Dim>::Impl::resolve_contact(bool updated, double dt) {
           cumulative_first += w1;
           cumulative_second += w2;
           add_pair_work(ma, mb, w1, w2);
+        },
+        [&](double e) {
+          if (updated) contact_normal_work += e;  // the changes the particles receive (as the serial books)
         },
         stats.sliding_nodes);
     } catch (const std::exception& e) {  // kept, not thrown: the other ranks would wait in the next collective

@@ -325,6 +325,14 @@ struct DecomposedMpm<Dim>::Impl {
   // drives and the updated contact pass's rigid partners) and the start energy, kinetic + stored
   // before the first step (the same on every rank; NaN until then), energy_books.cpp.
   double rigid_work = 0.0;
+  // This rank's energy removed by the normal contact impulses (the updated pass, owned nodes) and by
+  // the velocity conditions' stops (the momentum update, owned nodes): energy_books.hpp, contact_pair.hpp.
+  double contact_normal_work = 0.0, boundary_stop_work = 0.0;
+  // Per group entry (mt_field), the extrapolated contact pass's momentum change this step: the
+  // velocity conditions' stops are measured from the momentum the particles brought (the serial
+  // ContactNodeState::extrapolated_change). Recorded while recording_start_change.
+  std::vector<Vec<Dim>> mt_start_change;
+  bool recording_start_change = false;
   double initial_energy = std::numeric_limits<double>::quiet_NaN();
   std::array<double, 3> particle_books() const;  // this rank's kinetic, stored energy and plastic work
   void take_initial_energy();           // collective, at the start of the first step

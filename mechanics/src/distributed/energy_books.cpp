@@ -50,14 +50,16 @@ template <int Dim>
 EnergyBalance DecomposedMpm<Dim>::energy_balance(HeatingOrder order) const {
   const Impl& s = *impl_;
   const std::array<double, 3> p = s.particle_books();
-  double v[7] = {p[0],
+  double v[9] = {p[0],
                  p[1],
                  p[2],
                  s.external_work,
                  s.rigid_work,
                  s.damping_work,
-                 order == HeatingOrder::first ? s.cumulative_first : s.cumulative_second};
-  MPI_Allreduce(MPI_IN_PLACE, v, 7, MPI_DOUBLE, MPI_SUM, s.comm);
+                 order == HeatingOrder::first ? s.cumulative_first : s.cumulative_second,
+                 s.contact_normal_work,
+                 s.boundary_stop_work};
+  MPI_Allreduce(MPI_IN_PLACE, v, 9, MPI_DOUBLE, MPI_SUM, s.comm);
   EnergyBalance b;
   b.kinetic = v[0];
   b.stored = v[1] + (s.penalty ? s.penalty->stored_energy() : 0.0);  // + the penalty springs' (every rank's)
@@ -67,6 +69,8 @@ EnergyBalance DecomposedMpm<Dim>::energy_balance(HeatingOrder order) const {
   b.rigid_work = v[4];
   b.damping_work = v[5];
   b.friction_work = v[6];
+  b.contact_normal_work = v[7];
+  b.boundary_stop_work = v[8];
   return b;
 }
 

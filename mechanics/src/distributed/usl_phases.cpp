@@ -252,7 +252,17 @@ template <int Dim>
 void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   constexpr int momentum = Dof::momentum, force = Dof::force;
   const bool damped = damping_active(opt.damping_rate, opt.damping_until, time);
-  double removed = 0.0, driven_work = 0.0;
+  double removed = 0.0, driven_work = 0.0, stopped = 0.0;
+  // The start-of-step momentum of the stops (the serial apply_velocity_bc): without the extrapolated
+  // contact pass's change at a group entry.
+  const double* const mt_begin = mt_values.data();
+  const std::size_t per = static_cast<std::size_t>(per_field);
+  const bool changed = mt_start_change.size() == mt_field.size() && !mt_field.empty();
+  const auto start = [&](const double* node, int d) {
+    if (changed && node >= mt_begin && node < mt_begin + mt_values.size())
+      return node[Dof::momentum + d] - mt_start_change[static_cast<std::size_t>(node - mt_begin) / per][d];
+    return node[Dof::momentum + d];
+  };
   PetscScalar* a = nullptr;
   petsc_check(VecGetArray(global, &a), "VecGetArray");
   for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
@@ -271,7 +281,7 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
       for (int d = 0; d < Dim; ++d)
         if (driven & (1u << d))
           driven_work += drive_component(node[Dof::mass], node[momentum + d], node[force + d],
-                                         drive_velocity[static_cast<std::size_t>(q)][d], dt);
+                                         drive_velocity[static_cast<std::size_t>(q)][d], dt, start(node, d), stopped);
     }
     for (int d = 0; d < Dim; ++d)
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
@@ -284,6 +294,7 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
   damping_work += removed;
   rigid_work += driven_work;
+  boundary_stop_work += stopped;
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields

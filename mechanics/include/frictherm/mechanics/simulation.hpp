@@ -198,6 +198,10 @@ class Simulation {
   double rigid_work() const { return work_books_.rigid; }
   /// Energy removed by the mass-proportional damping so far (J, ≥ 0): c |p_i|²/m_i dt per node and step.
   double damping_work() const { return work_books_.damping; }
+  /// Energy removed by the normal contact impulses (contact_pair.hpp normal_stop_work) and by the
+  /// velocity conditions' stops (energy_books.hpp condition_stop_work) since the start (J).
+  double contact_normal_work() const { return work_books_.contact_normal; }
+  double boundary_stop_work() const { return work_books_.boundary_stop; }
   /// Plastic work of the particles so far, Σ_p σ:Δε_p V (J).
   double plastic_work() const;
   /// The energy books now (frictional work of `order`). Before the first step initial = kinetic + stored.
@@ -235,6 +239,8 @@ class Simulation {
     v("external_work", work_books_.external);
     v("rigid_work", work_books_.rigid);
     v("damping_work", work_books_.damping);
+    v("contact_normal_work", work_books_.contact_normal);
+    v("boundary_stop_work", work_books_.boundary_stop);
     v("initial_energy", work_books_.initial_energy);
     v("work_first", contact_books_.work_first);
     v("work_second", contact_books_.work_second);
@@ -316,7 +322,8 @@ class Simulation {
   template <class Scatter> void scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter);
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead, and the rigid bodies' work is returned (0 without).
-  double apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt) const;
+  double apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt,
+                           double* stop = nullptr) const;
   // The grid update p_i^{n+1} = p_i^n + f_i dt in phases (simulation_fields.cpp).
   void save_start_velocity();                  // XPIC: v^n = p^n/m, before the momentum update
   void apply_grid_velocity_conditions(double dt);  // velocity conditions on p and f, rigid work

@@ -11,8 +11,10 @@ namespace frictherm::mechanics {
 
 /// The mechanical energy books of a run (J; docs/output.md, "Energy balance"). The energy the bodies
 /// lost, lost() = initial + external_work + rigid_work − kinetic − stored, pays for the damping, the
-/// plastic and the frictional work; what is left, numerical_dissipation(), is the scheme's own loss
-/// (or, if negative, its gain): the normal part of the contact impulses, FLIP/grid transfers, fixed faces.
+/// plastic and the frictional work, and the two stops the scheme makes at nodes: the normal contact
+/// (contact_normal_work) and the velocity conditions (boundary_stop_work); what is left,
+/// numerical_dissipation(), is the scheme's own loss (or, if negative, its gain): FLIP/PIC and
+/// grid transfers, the explicit update's O(dt) error.
 struct EnergyBalance {
   double kinetic = 0.0;        // of the deformable particles
   double stored = 0.0;         // strain_energy() (elastic and equation-of-state) + penalty springs
@@ -22,8 +24,12 @@ struct EnergyBalance {
   double damping_work = 0.0;   // removed by the mass-proportional damping (damping_work())
   double plastic_work = 0.0;   // Σ_p σ:Δε_p V of the particles (plastic_work())
   double friction_work = 0.0;  // cumulative frictional work of the order asked for
+  double contact_normal_work = 0.0;  // removed by the normal contact impulses (normal_stop_work)
+  double boundary_stop_work = 0.0;   // removed by the velocity conditions of walls and fixed faces (condition_stop_work)
   double lost() const { return initial + external_work + rigid_work - kinetic - stored; }
-  double numerical_dissipation() const { return lost() - damping_work - plastic_work - friction_work; }
+  double numerical_dissipation() const {
+    return lost() - damping_work - plastic_work - friction_work - contact_normal_work - boundary_stop_work;
+  }
 };
 
 namespace energy_detail {
@@ -65,13 +71,37 @@ inline double particle_stored_energy(const Material& m, Analysis analysis, doubl
   return 0.0;
 }
 
+/// The energy a velocity condition removes from one nodal momentum component in the momentum update
+/// (J), the analogue of the frictional work's second order (Nairn, Bardenhagen & Smith 2018 eqs. 32–36)
+/// for a stop: over the step the condition's impulse J = m v_w − (p + f dt) acts as a constant force
+/// J/dt while the node's velocity relative to the wall goes linearly from its start-of-step value
+/// p0/m − v_w to 0 at the end, so it does the work J (p0/m − v_w)/2 in the wall's frame: removed,
+/// −½ J (p0/m − v_w). p0 is the momentum the particles brought to the node (before this step's force
+/// increment, as v'(0) of eq. 32, and before the extrapolated contact pass's change, which no
+/// particle receives): a node resting on the wall (p0 = m v_w) books 0 however large its force; one
+/// arriving at u = p0/m − v_w with no force books ½ m u², the perfectly inelastic stop. The wall's
+/// own work J v_w is rigid_work (drive_component). A fixed face books nothing: it zeroes the node's
+/// momentum and force, so the particles' FLIP update never receives a stop there (their velocity
+/// keeps p0; only the grid's velocity, and so their motion and strain, is held), and the energy the
+/// stop would remove at the node stays in the particles (measured: a bar run into a fixed face loses
+/// 0.6 % of its energy where ½ p0²/m summed over the steps is 15 % of it; test_energy_stops.cpp).
+FRICTHERM_ALWAYS_INLINE double condition_stop_work(double mass, double momentum, double force, double v, double dt,
+                                                   double start_momentum) {
+  if (!(mass > 0.0)) return 0.0;
+  const double impulse = mass * v - momentum - force * dt;
+  return 0.5 * impulse * (v - start_momentum / mass);
+}
+
 /// One nodal momentum component driven by a rigid material to its velocity v in the momentum update:
 /// the change is made a force, f = (m v − p)/dt, so that the particles' FLIP update receives it too.
 /// Returns the work the rigid material does on the node, (m v − (p + f_old dt)) v: the impulse the
-/// condition adds beyond the node's own force, times the velocity it is given at.
-FRICTHERM_ALWAYS_INLINE double drive_component(double mass, double momentum, double& force, double v, double dt) {
+/// condition adds beyond the node's own force, times the velocity it is given at; adds the energy the
+/// stop removes (condition_stop_work, from start_momentum) to `stop`.
+FRICTHERM_ALWAYS_INLINE double drive_component(double mass, double momentum, double& force, double v, double dt,
+                                               double start_momentum, double& stop) {
   const double target = mass * v;
   const double work = (target - momentum - force * dt) * v;
+  stop += condition_stop_work(mass, momentum, force, v, dt, start_momentum);
   force = (target - momentum) / dt;
   return work;
 }

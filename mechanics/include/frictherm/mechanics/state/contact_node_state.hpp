@@ -39,6 +39,7 @@ struct ContactNodeState {
     };
     std::vector<PairEntry> entries;
     std::vector<double> rigid_work;  // Δp·v_rigid of each change a rigid partner made, in group order
+    std::vector<double> normal_work;  // each node group's normal_stop_work (contact_pair.hpp), in group order
     void add(std::size_t k, double w1, double w2) {
       if (!marked[k]) marked[k] = 1, touched.push_back(k);
       pair_first[k] += w1;
@@ -57,6 +58,9 @@ struct ContactNodeState {
   std::vector<double> entry_extent_own, entry_extent_other;
   std::vector<std::vector<double>> extent_thread;  // per-thread maxima (threads 1..n-1), own then other
   std::vector<ThreadWork> thread_work;             // per thread, of one pass
+  // Per slot, the momentum change of this step's extrapolated contact pass (the energy books' start
+  // of step: contact_pair.hpp normal_stop_work, energy_books.hpp condition_stop_work).
+  std::vector<Vec<Dim>> extrapolated_change;
   // Normal-stress regularisation (ContactOptions::regularized): per grid node the lagged normal
   // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
   // in contact on the previous step starts again from σ).
