@@ -30,6 +30,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   heat_capacity_.assign(p.size(), 0.0);
   conductance_.assign(p.size(), 0.0);
   bounds_ready_ = false;  // rayleigh_ made with the bounds (make_bounds)
+  node_operator_ready_ = false;  // made anew by the first sub-step that takes it
   quiet_.assign(p.size(), 1);  // particles that hold no heat carry no flux
   flux_temperature_.resize(0);  // set with quiet_ at the end
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
@@ -401,7 +402,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
 
   // The moved particles' kept state, bounds and eq. 38 sums for the next reproject(), anew: the
   // exact bounds if they were made since the gather (lambda_bound), else the quick bound's sums.
-  Expanded e{};
+  Expanded e{}, g{};
   StencilVector<Kernel>& kept = stencils_.template of<Kernel>();
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
@@ -412,6 +413,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
     if (bounds_ready_) remove_bounds(k, e);
     add_quick(kept[k], conductance_[k], sys, e, -1.0);
+    if (node_operator_ready_) add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);  // its K terms out
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
@@ -423,6 +425,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       expand<Kernel, false>(kept[k], sys.unknown, e);
     }
     add_quick(kept[k], conductance_[k], sys, e, 1.0);
+    if (node_operator_ready_) add_to_node_operator(kept[k], conductance_[k], sys.unknown, 1.0, g);  // and in now
     quiet_[k] = 0;  // looked at in the next sub-step
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];  // and its new ones in
     gathered_at_[k] = p.position[k];

@@ -41,9 +41,27 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
   const int threads = assembly_detail::assembly_threads(holds_heat_.size());
   const int nodes = static_cast<int>(sys.unknown.size());
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  // With the stencils kept, K at node level (use_node_operator) for every sub-step the gather's f_i
+  // do not serve: made once after a gather, kept up to date by refresh().
+  const bool node_level = node_operator_on_ && stencils_kept_ && (substeps > 1 || !force_ready);
+  if (node_level && !node_operator_ready_) {
+    assemble_node_operator<Kernel>(sys, threads);
+    flux_temperature_.resize(0);  // every f_i made anew with it
+  }
   for (long s = 0; s < substeps; ++s) {
     if (force_ready) {
       force_ready = false;
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
+    if (node_level) {
+      // f_i anew where a node within reach changed since the last sub-step (a refresh marks the rows
+      // it changed); the other rows' f_i stand, as the quiet particles of the pass below.
+      const bool first = flux_temperature_.size() != n;
+      count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
+      flux_temperature_ = T;
+      node_operator_force(sys, T, threads);
       for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
@@ -196,6 +214,19 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const double pulled = pulled_change(q, k, heat, pic);
     return blend(before, dT, pulled, pic, s);
   };
+  // One thread, a particle whose stencil is not whole (lumped onto its unknowns): both one-thread
+  // loops below take it here (the same numbers whether the window pulls or blends or not).
+  const auto map_back_lumped = [&](std::size_t k, Expanded& c) {
+    expand<Kernel, false>(stencils[k], sys.unknown, c);
+    if (c.count == 0) return;  // reaches no unknown
+    const double before = p.temperature[k];
+    const double T = new_temperature(before, c, k, face_heat_);
+    if (T == before) return;
+    p.temperature[k] = T;
+    if (!keep_sums) return;
+    const double change = heat_capacity_[k] * (T - before);
+    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+  };
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
   if (threads <= 1 && !pull && !relax) {
@@ -229,14 +260,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         for (int b = 0; b < nodes; ++b) sums[at[b]] += change * w[b];
         continue;
       }
-      expand<Kernel, false>(stencils[k], sys.unknown, c);
-      if (c.count == 0) continue;  // reaches no unknown
-      const double T = new_temperature(before, c, k, face_heat_);
-      if (T == before) continue;
-      temperature[k] = T;
-      if (!keep_sums) continue;
-      const double change = heat_capacity_[k] * (T - before);
-      for (int a = 0; a < c.count; ++a) sums[c.unknown[a]] += change * c.S[a];
+      map_back_lumped(k, c);
     }
     return;
   }
@@ -266,15 +290,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double w, double, double, double) { next_mct_[u] += change * w; });
         continue;
       }
-      expand<Kernel, false>(stencils[k], sys.unknown, c);
-      if (c.count == 0) continue;  // reaches no unknown
-      const double before = p.temperature[k];
-      const double T = new_temperature(before, c, k, face_heat_);
-      if (T == before) continue;
-      p.temperature[k] = T;
-      if (!keep_sums) continue;
-      const double change = heat_capacity_[k] * (T - before);
-      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+      map_back_lumped(k, c);
     }
     return;
   }

@@ -119,6 +119,22 @@ class ExplicitConduction {
                 double relaxation, const Eigen::VectorXd* end,
                 const std::vector<typename FacePull<Dim>::Held>* held = nullptr);
 
+  /// Sub-steps with the operator at node level (issue 35) while the stencils are kept (reuse_distance
+  /// > 0): K_ij = Σ_p V_p k_p G'_ip·G'_jp, i ≠ j, made once after a gather and changed by refresh()
+  /// for the moved particles only (their old terms out, their new ones in), and a sub-step's
+  ///   f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)      (Σ_j K_ij = 0: Σ_j G'_jp = 0)
+  /// one product over each unknown's ≤ 5^Dim − 1 neighbours instead of a look and a scatter per
+  /// particle. A pair whose temperatures agree to round-off (kQuietSpread, as a quiet particle)
+  /// carries no flux, so a node whose neighbours all agree with it keeps its temperature exactly.
+  /// Differs from the per-particle sums by round-off (the terms regrouped). Off: the per-particle
+  /// sub-steps. Memory 5^Dim doubles and ints a unknown (the coupler turns it on in 2D only).
+  void use_node_operator(bool on) {
+    node_operator_on_ = on;
+    node_operator_ready_ = false;
+  }
+  /// Whether the last advance() took the node-level operator (tests).
+  bool node_operator_ready() const { return node_operator_ready_; }
+
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
   /// A particle's unknowns, S_ip and (when asked) G'_ip, in stencil order, evaluated again from its
@@ -256,6 +272,27 @@ class ExplicitConduction {
   std::vector<std::size_t> listed_;           // scratch: the particles a scatter visits, in order
   std::vector<double> particle_scratch_;      // scratch: a per-particle value of a pass
   std::vector<unsigned char> quiet_changed_;  // scratch: particles whose temperature the map back changed
+  // The node-level operator (use_node_operator): by unknown i, one slot per grid-node offset of j
+  // (−2..2 along each axis: two nodes of one stencil of ≤ 3 nodes an axis), K_ij and j (i itself where
+  // no particle joins them: T_i − T_i = 0).
+  static constexpr int offsets = Dim == 2 ? 25 : 125;
+  bool node_operator_on_ = false;
+  bool node_operator_ready_ = false;       // node_k_ made since the gather (kept by refresh)
+  std::vector<double> node_k_;             // K_ij by unknown i and slot (W/K)
+  std::vector<int> node_col_;              // j by unknown i and slot
+  /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
+  /// rows of its unknowns i at grid nodes in `range` (all without one).
+  template <class Kernel>
+  void add_to_node_operator(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                            const std::vector<int>& unknown, double sign, Expanded& e,
+                            const void* range = nullptr);
+  /// node_k_ anew from every heat-holding particle, in particle order (threads by rows).
+  template <class Kernel>
+  void assemble_node_operator(const NodalThermalSystem& sys, int threads);
+  /// force_ = −K T from node_k_ in the rows with a changed node (changed_before_) within their
+  /// reach; the other rows keep f_i of the last sub-step (threads by rows: each row alone, the same
+  /// bits on any number).
+  void node_operator_force(const NodalThermalSystem& sys, const Eigen::VectorXd& T, int threads);
   /// changed_before_ from whether unknown u changed.
   template <class Changed>
   void count_changed(const std::vector<int>& unknown, Changed&& changed);
