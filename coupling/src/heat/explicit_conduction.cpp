@@ -402,7 +402,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
 
   // The moved particles' kept state, bounds and eq. 38 sums for the next reproject(), anew: the
   // exact bounds if they were made since the gather (lambda_bound), else the quick bound's sums.
-  Expanded e{}, g{};
+  Expanded e{};
   StencilVector<Kernel>& kept = stencils_.template of<Kernel>();
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
@@ -413,7 +413,10 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
     if (bounds_ready_) remove_bounds(k, e);
     add_quick(kept[k], conductance_[k], sys, e, -1.0);
-    if (node_operator_ready_) add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);  // its K terms out
+    if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out; its flux particle by particle
+      add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);
+      in_node_k_[k] = 0;
+    }
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
@@ -425,7 +428,6 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       expand<Kernel, false>(kept[k], sys.unknown, e);
     }
     add_quick(kept[k], conductance_[k], sys, e, 1.0);
-    if (node_operator_ready_) add_to_node_operator(kept[k], conductance_[k], sys.unknown, 1.0, g);  // and in now
     quiet_[k] = 0;  // looked at in the next sub-step
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];  // and its new ones in
     gathered_at_[k] = p.position[k];

@@ -217,7 +217,7 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
   // node, unknown and G_ip; the slot of the pair (a, b) in row a is code_b − code_a + code of (2, 2).
   constexpr int K = Kernel::K;
   constexpr int centre = Dim == 2 ? 2 + 5 * 2 : 2 + 5 * 2 + 25 * 2;
-  int code[capacity], node[capacity], un[capacity];
+  int code[capacity], node[capacity] = {}, un[capacity];  // node: {} against a false -Wmaybe-uninitialized
   double G[Dim][capacity];
   int total = 0, kept = 0;
   double s_kept = 0.0;  // as expand: Σ S_ip over the unknowns in node order

@@ -18,8 +18,13 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
               node_col_.begin() + static_cast<std::ptrdiff_t>((u + 1) * offsets), static_cast<int>(u));
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   listed_.clear();
+  in_node_k_.assign(holds_heat_.size(), 0);
   for (std::size_t k = 0; k < holds_heat_.size(); ++k)
-    if (holds_heat_[k] && conductance_[k] != 0.0) listed_.push_back(k);
+    if (holds_heat_[k] && conductance_[k] != 0.0) {
+      listed_.push_back(k);
+      in_node_k_[k] = 1;
+    }
+  node_force_.setZero(static_cast<Eigen::Index>(n));
   // Each thread adds only into the rows of its grid nodes, over the particles in order: every K_ij
   // gets the same terms in the same order on any number of threads.
   scatter_by_node_ranges<Expanded>(threads, static_cast<int>(sys.unknown.size()), listed_,
@@ -58,7 +63,7 @@ void ExplicitConduction<Dim>::node_operator_force(const NodalThermalSystem& sys,
     }
     return false;
   };
-  double* f = force_.data();
+  double* f = node_force_.data();
   const auto row = [&](std::ptrdiff_t u) {
     if (!reached(grid_node[u])) return;  // f_i of the last sub-step stands: the same K row and T_j
     const double ti = t[u], ai = std::fabs(ti);

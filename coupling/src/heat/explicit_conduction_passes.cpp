@@ -62,6 +62,32 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
       flux_temperature_ = T;
       node_operator_force(sys, T, threads);
+      force_ = node_force_;
+      // The particles out of K (moved since the gather): their fluxes as the per-particle pass below
+      // makes them (quiet ones left out), in particle order.
+      listed_.clear();
+      for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+        if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
+      scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+        const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+        if (!r.meets(node_span(st, indexer_))) return;
+        if (threads <= 1 && whole_[k]) {  // the stencil walked directly, the same sums
+          double lo, hi, s_kept;
+          mechanics::Vec<Dim> grad;
+          look_whole(st, sys.unknown, T.data(), lo, hi, s_kept, grad);
+          if (!(s_kept > 0.0) || quiet_spread(lo, hi)) return;
+          grad *= conductance_[k];
+          scatter_whole(st, sys.unknown, grad, force_.data());
+          return;
+        }
+        expand<Kernel, true>(st, sys.unknown, e);
+        if (!e.reaches() || quiet_temperatures(e, T)) return;
+        mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+        for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+        grad *= conductance_[k];
+        for (int a = 0; a < e.count; ++a)
+          if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+      });
       for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;

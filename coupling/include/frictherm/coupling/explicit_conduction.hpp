@@ -120,12 +120,13 @@ class ExplicitConduction {
                 const std::vector<typename FacePull<Dim>::Held>* held = nullptr);
 
   /// Sub-steps with the operator at node level (issue 35) while the stencils are kept (reuse_distance
-  /// > 0): K_ij = Σ_p V_p k_p G'_ip·G'_jp, i ≠ j, made once after a gather and changed by refresh()
-  /// for the moved particles only (their old terms out, their new ones in), and a sub-step's
+  /// > 0): K_ij = Σ_p V_p k_p G'_ip·G'_jp, i ≠ j, over the particles that have not moved since the
+  /// gather (made once after it; refresh() takes a moved particle's terms out), and a sub-step's
   ///   f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)      (Σ_j K_ij = 0: Σ_j G'_jp = 0)
-  /// one product over each unknown's ≤ 5^Dim − 1 neighbours instead of a look and a scatter per
-  /// particle. A pair whose temperatures agree to round-off (kQuietSpread, as a quiet particle)
-  /// carries no flux, so a node whose neighbours all agree with it keeps its temperature exactly.
+  /// one product over each unknown's ≤ 5^Dim − 1 neighbours, plus the moved particles' fluxes as the
+  /// per-particle pass makes them, instead of a look and a scatter per particle. A pair whose
+  /// temperatures agree to round-off (kQuietSpread, as a quiet particle) carries no flux, so a node
+  /// whose neighbours all agree with it keeps its temperature exactly.
   /// Differs from the per-particle sums by round-off (the terms regrouped). Off: the per-particle
   /// sub-steps. Memory 5^Dim doubles and ints a unknown (the coupler turns it on in 2D only).
   void use_node_operator(bool on) {
@@ -280,6 +281,11 @@ class ExplicitConduction {
   bool node_operator_ready_ = false;       // node_k_ made since the gather (kept by refresh)
   std::vector<double> node_k_;             // K_ij by unknown i and slot (W/K)
   std::vector<int> node_col_;              // j by unknown i and slot
+  Eigen::VectorXd node_force_;             // −(K T)_i of the last sub-step (rows not reached stand)
+  // By particle: its terms are in node_k_. A refresh takes a moved particle's terms out and leaves
+  // it out until the next gather (a particle that moved once moves again: the sliding body); the
+  // sub-steps add the flux of those left out particle by particle, as the per-particle pass.
+  std::vector<unsigned char> in_node_k_;
   /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
   /// rows of its unknowns i at grid nodes in `range` (all without one).
   template <class Kernel>
@@ -289,7 +295,7 @@ class ExplicitConduction {
   /// node_k_ anew from every heat-holding particle, in particle order (threads by rows).
   template <class Kernel>
   void assemble_node_operator(const NodalThermalSystem& sys, int threads);
-  /// force_ = −K T from node_k_ in the rows with a changed node (changed_before_) within their
+  /// node_force_ = −K T from node_k_ in the rows with a changed node (changed_before_) within their
   /// reach; the other rows keep f_i of the last sub-step (threads by rows: each row alone, the same
   /// bits on any number).
   void node_operator_force(const NodalThermalSystem& sys, const Eigen::VectorXd& T, int threads);
