@@ -66,16 +66,14 @@ void ExplicitConduction<Dim>::node_operator_force(const NodalThermalSystem& sys,
   double* f = node_force_.data();
   const auto row = [&](std::ptrdiff_t u) {
     if (!reached(grid_node[u])) return;  // f_i of the last sub-step stands: the same K row and T_j
-    const double ti = t[u], ai = std::fabs(ti);
+    const double ti = t[u], quiet = kQuietSpread * std::fabs(ti);
     const double* k_row = k_all + u * offsets;
     const int* col = col_all + u * offsets;
     double sum = 0.0;
     for (int s = 0; s < offsets; ++s) {
-      const double tj = t[col[s]];
-      const double d = tj - ti;
-      // a pair at temperatures equal to round-off carries no flux (both rows test the same |d|)
-      const bool quiet = std::fabs(d) <= kQuietSpread * std::max(ai, std::fabs(tj));
-      sum += quiet ? 0.0 : k_row[s] * d;
+      const double d = t[col[s]] - ti;
+      // a pair at temperatures equal to round-off (relative to T_i) carries no flux
+      sum += std::fabs(d) <= quiet ? 0.0 : k_row[s] * d;
     }
     f[u] = -sum;  // f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)
   };
