@@ -1,7 +1,8 @@
 #pragma once
 // Matrix-free explicit conduction for one coupling window (issue 13 item 1), as the reference code
 // NairnMPM does: lumped nodal heat capacities, the nodal conduction force from the particles'
-// temperature gradients, forward-Euler sub-steps, no K assembled.
+// temperature gradients, forward-Euler sub-steps, no K assembled (with the gather reused, 2D: K kept
+// at node level for the particles that have not moved, use_node_operator).
 //
 //   M_i = Σ_p m_p C_v,p S_ip,  T_i = Σ_p m_p C_v,p T_p S_ip / M_i       Nairn et al. 2018 eq. 38
 //   (∇T)_p = Σ_j G'_jp T_j                                             eq. 37 (gradient on the particle)
@@ -133,8 +134,6 @@ class ExplicitConduction {
     node_operator_on_ = on;
     node_operator_ready_ = false;
   }
-  /// Whether the last advance() took the node-level operator (tests).
-  bool node_operator_ready() const { return node_operator_ready_; }
 
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
