@@ -79,7 +79,7 @@ struct CouplerOptions {
   double reuse_distance = 0.0;
   /// Matrix-free windows with the gather reused, 2D (issue 35): the sub-steps take f = −K T from K
   /// kept at node level (ExplicitConduction::use_node_operator) instead of a pass over the particles.
-  /// Differs from the per-particle sums by round-off (docs/performance.md, 30 Nov). false: the
+  /// Differs from the per-particle sums by round-off (docs/performance.md, session of 29 Nov, evening). false: the
   /// per-particle sub-steps.
   bool matrix_free_node_operator = true;
   AssemblyOptions assembly;

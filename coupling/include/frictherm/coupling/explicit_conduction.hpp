@@ -126,7 +126,7 @@ class ExplicitConduction {
   ///   f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)      (Σ_j K_ij = 0: Σ_j G'_jp = 0)
   /// one product over each unknown's ≤ 5^Dim − 1 neighbours, plus the moved particles' fluxes as the
   /// per-particle pass makes them, instead of a look and a scatter per particle. A pair whose
-  /// temperatures agree to round-off (kQuietSpread, as a quiet particle) carries no flux, so a node
+  /// temperatures agree to round-off (kQuietSpread of T_i, as a quiet particle) carries no flux, so a node
   /// whose neighbours all agree with it keeps its temperature exactly.
   /// Differs from the per-particle sums by round-off (the terms regrouped). Off: the per-particle
   /// sub-steps. Memory 5^Dim doubles and ints a unknown (the coupler turns it on in 2D only).
