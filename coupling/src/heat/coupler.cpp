@@ -35,6 +35,7 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
   if (!(w.max_duration > 0.0)) throw std::invalid_argument("Coupler: max_duration must be > 0");
   if (opt_.matrix_free_max_substeps < 0)
     throw std::invalid_argument("Coupler: matrix_free_max_substeps must be >= 0");
+  explicit_.use_node_operator(opt_.matrix_free_node_operator && Dim == 2);
   if (!(opt_.subgrid_relaxation_time > 0.0))
     throw std::invalid_argument("Coupler: subgrid_relaxation_time must be > 0");
   for (const FixedTemperatureFace& f : opt_.fixed_faces)

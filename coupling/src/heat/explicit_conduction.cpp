@@ -30,6 +30,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   heat_capacity_.assign(p.size(), 0.0);
   conductance_.assign(p.size(), 0.0);
   bounds_ready_ = false;  // rayleigh_ made with the bounds (make_bounds)
+  node_operator_ready_ = false;  // made anew by the first sub-step that takes it
   quiet_.assign(p.size(), 1);  // particles that hold no heat carry no flux
   flux_temperature_.resize(0);  // set with quiet_ at the end
   // The MPM step's stencils at these positions when it gives them (the same S_ip, G_ip), else our own.
@@ -412,6 +413,10 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
     if (bounds_ready_) remove_bounds(k, e);
     add_quick(kept[k], conductance_[k], sys, e, -1.0);
+    if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out; its flux particle by particle
+      add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);
+      in_node_k_[k] = 0;
+    }
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);

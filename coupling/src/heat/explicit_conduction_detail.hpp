@@ -208,6 +208,86 @@ void ExplicitConduction<Dim>::expand(const mechanics::Stencil<Dim, Kernel>& st, 
 }
 
 template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                                                   const std::vector<int>& unknown, double sign, Expanded& e,
+                                                   const void* range) {
+  if (conductance == 0.0) return;  // no conduction (as the sub-steps' quiet particles)
+  // One walk: each node's offset code Σ_d l_d 5^d (l_d: its place along axis d in the stencil), grid
+  // node, unknown and G_ip; the slot of the pair (a, b) in row a is code_b − code_a + code of (2, 2).
+  constexpr int K = Kernel::K;
+  constexpr int centre = Dim == 2 ? 2 + 5 * 2 : 2 + 5 * 2 + 25 * 2;
+  int code[capacity], node[capacity] = {}, un[capacity];  // node: {} against a false -Wmaybe-uninitialized
+  double G[Dim][capacity];
+  int total = 0, kept = 0;
+  double s_kept = 0.0;  // as expand: Σ S_ip over the unknowns in node order
+  explicit_detail::for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+    const int l0 = total % K, l1 = (total / K) % K, l2 = total / (K * K);
+    code[total] = l0 + 5 * l1 + (Dim == 3 ? 25 * l2 : 0);
+    node[total] = i;
+    un[total] = unknown[static_cast<std::size_t>(i)];
+    G[0][total] = gx;
+    G[1][total] = gy;
+    if constexpr (Dim == 3) G[2][total] = gz;
+    if (un[total] >= 0) {
+      s_kept += w;
+      ++kept;
+    }
+    ++total;
+  });
+  const double* g[Dim];
+  const int* u = un;
+  int count = total;
+  if (kept < total) {  // G' lumps the dropped nodes' G onto the kept ones: expand's numbers
+    expand<Kernel, true>(st, unknown, e);
+    if (!e.reaches()) return;  // no heat capacity of its own reaches an unknown
+    int c = 0;
+    for (int t = 0; t < total; ++t)
+      if (un[t] >= 0) {
+        code[c] = code[t];
+        node[c] = node[t];
+        ++c;
+      }
+    for (int d = 0; d < Dim; ++d) g[d] = e.G[d];
+    u = e.unknown;
+    count = e.count;
+  } else {
+    if (!(s_kept > 0.0)) return;
+    for (int d = 0; d < Dim; ++d) g[d] = G[d];
+  }
+  const auto* r = static_cast<const assembly_detail::NodeRange*>(range);
+  const bool mark = r == nullptr && flux_temperature_.size() == static_cast<Eigen::Index>(node_k_.size() / offsets);
+  bool mine[capacity];
+  for (int a = 0; a < count; ++a) {
+    mine[a] = !r || r->holds(node[a]);
+    // A refresh changes row a: its f_i is made anew in the next sub-step (NaN: "changed").
+    if (mark) flux_temperature_[u[a]] = std::numeric_limits<double>::quiet_NaN();
+  }
+  double* k_all = node_k_.data();
+  int* col_all = node_col_.data();
+  for (int a = 0; a < count; ++a) {
+    const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+    for (int b = a + 1; b < count; ++b) {
+      if (!mine[a] && !mine[b]) continue;
+      // G'_a·G'_b, the same bits for (a, b) and (b, a): K stays symmetric bit for bit
+      double dot = g[0][a] * g[0][b] + g[1][a] * g[1][b];
+      if constexpr (Dim == 3) dot += g[2][a] * g[2][b];
+      const double term = sign * (conductance * dot);
+      const int slot = code[b] - code[a] + centre;  // of b in row a; of a in row b: 2 centre − slot
+      if (mine[a]) {
+        k_all[row_a + static_cast<std::size_t>(slot)] += term;
+        col_all[row_a + static_cast<std::size_t>(slot)] = u[b];
+      }
+      if (mine[b]) {
+        const std::size_t at = static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot);
+        k_all[at] += term;
+        col_all[at] = u[a];
+      }
+    }
+  }
+}
+
+template <int Dim>
 template <class Changed>
 void ExplicitConduction<Dim>::count_changed(const std::vector<int>& unknown, Changed&& changed) {
   const std::size_t nodes = unknown.size();

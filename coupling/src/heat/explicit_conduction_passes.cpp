@@ -41,9 +41,53 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
   const int threads = assembly_detail::assembly_threads(holds_heat_.size());
   const int nodes = static_cast<int>(sys.unknown.size());
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  // With the stencils kept, K at node level (use_node_operator) for every sub-step the gather's f_i
+  // do not serve: made once after a gather, kept up to date by refresh().
+  const bool node_level = node_operator_on_ && stencils_kept_ && (substeps > 1 || !force_ready);
+  if (node_level && !node_operator_ready_) {
+    assemble_node_operator<Kernel>(sys, threads);
+    flux_temperature_.resize(0);  // every f_i made anew with it
+  }
   for (long s = 0; s < substeps; ++s) {
     if (force_ready) {
       force_ready = false;
+      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
+      continue;
+    }
+    if (node_level) {
+      // f_i anew where a node within reach changed since the last sub-step (a refresh marks the rows
+      // it changed); the other rows' f_i stand, as the quiet particles of the pass below.
+      const bool first = flux_temperature_.size() != n;
+      count_changed(sys.unknown, [&](int u) { return first || T[u] != flux_temperature_[u]; });
+      flux_temperature_ = T;
+      node_operator_force(sys, T, threads);
+      force_ = node_force_;
+      // The particles out of K (moved since the gather): their fluxes as the per-particle pass below
+      // makes them (quiet ones left out), in particle order.
+      listed_.clear();
+      for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+        if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
+      scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+        const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+        if (!r.meets(node_span(st, indexer_))) return;
+        if (threads <= 1 && whole_[k]) {  // the stencil walked directly, the same sums
+          double lo, hi, s_kept;
+          mechanics::Vec<Dim> grad;
+          look_whole(st, sys.unknown, T.data(), lo, hi, s_kept, grad);
+          if (!(s_kept > 0.0) || quiet_spread(lo, hi)) return;
+          grad *= conductance_[k];
+          scatter_whole(st, sys.unknown, grad, force_.data());
+          return;
+        }
+        expand<Kernel, true>(st, sys.unknown, e);
+        if (!e.reaches() || quiet_temperatures(e, T)) return;
+        mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+        for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+        grad *= conductance_[k];
+        for (int a = 0; a < e.count; ++a)
+          if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
+      });
       for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
@@ -196,6 +240,19 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const double pulled = pulled_change(q, k, heat, pic);
     return blend(before, dT, pulled, pic, s);
   };
+  // One thread, a particle whose stencil is not whole (lumped onto its unknowns): both one-thread
+  // loops below take it here (the same numbers whether the window pulls or blends or not).
+  const auto map_back_lumped = [&](std::size_t k, Expanded& c) {
+    expand<Kernel, false>(stencils[k], sys.unknown, c);
+    if (c.count == 0) return;  // reaches no unknown
+    const double before = p.temperature[k];
+    const double T = new_temperature(before, c, k, face_heat_);
+    if (T == before) return;
+    p.temperature[k] = T;
+    if (!keep_sums) return;
+    const double change = heat_capacity_[k] * (T - before);
+    for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+  };
   // Each particle's new temperature (threads by particles), then the changes of the eq. 38 sums,
   // scattered by node ranges in particle order.
   if (threads <= 1 && !pull && !relax) {
@@ -229,14 +286,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         for (int b = 0; b < nodes; ++b) sums[at[b]] += change * w[b];
         continue;
       }
-      expand<Kernel, false>(stencils[k], sys.unknown, c);
-      if (c.count == 0) continue;  // reaches no unknown
-      const double T = new_temperature(before, c, k, face_heat_);
-      if (T == before) continue;
-      temperature[k] = T;
-      if (!keep_sums) continue;
-      const double change = heat_capacity_[k] * (T - before);
-      for (int a = 0; a < c.count; ++a) sums[c.unknown[a]] += change * c.S[a];
+      map_back_lumped(k, c);
     }
     return;
   }
@@ -266,15 +316,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double w, double, double, double) { next_mct_[u] += change * w; });
         continue;
       }
-      expand<Kernel, false>(stencils[k], sys.unknown, c);
-      if (c.count == 0) continue;  // reaches no unknown
-      const double before = p.temperature[k];
-      const double T = new_temperature(before, c, k, face_heat_);
-      if (T == before) continue;
-      p.temperature[k] = T;
-      if (!keep_sums) continue;
-      const double change = heat_capacity_[k] * (T - before);
-      for (int a = 0; a < c.count; ++a) next_mct_[c.unknown[a]] += change * c.S[a];
+      map_back_lumped(k, c);
     }
     return;
   }

@@ -77,6 +77,11 @@ struct CouplerOptions {
   /// re-projected from the particles every window; energy stays exact, the weights lag by at most
   /// this shift). 0: gather every window. Error against gathering every window: docs/performance.md.
   double reuse_distance = 0.0;
+  /// Matrix-free windows with the gather reused, 2D (issue 35): the sub-steps take f = −K T from K
+  /// kept at node level (ExplicitConduction::use_node_operator) instead of a pass over the particles.
+  /// Differs from the per-particle sums by round-off (docs/performance.md, session of 29 Nov, evening). false: the
+  /// per-particle sub-steps.
+  bool matrix_free_node_operator = true;
   AssemblyOptions assembly;
   WindowPolicy window;
   HotSpotOptions hotspots;

@@ -1,7 +1,8 @@
 #pragma once
 // Matrix-free explicit conduction for one coupling window (issue 13 item 1), as the reference code
 // NairnMPM does: lumped nodal heat capacities, the nodal conduction force from the particles'
-// temperature gradients, forward-Euler sub-steps, no K assembled.
+// temperature gradients, forward-Euler sub-steps, no K assembled (with the gather reused, 2D: K kept
+// at node level for the particles that have not moved, use_node_operator).
 //
 //   M_i = Σ_p m_p C_v,p S_ip,  T_i = Σ_p m_p C_v,p T_p S_ip / M_i       Nairn et al. 2018 eq. 38
 //   (∇T)_p = Σ_j G'_jp T_j                                             eq. 37 (gradient on the particle)
@@ -118,6 +119,21 @@ class ExplicitConduction {
   double map_back(mechanics::Particles<Dim>& particles, const NodalThermalSystem& sys, const Eigen::VectorXd& delta,
                 double relaxation, const Eigen::VectorXd* end,
                 const std::vector<typename FacePull<Dim>::Held>* held = nullptr);
+
+  /// Sub-steps with the operator at node level (issue 35) while the stencils are kept (reuse_distance
+  /// > 0): K_ij = Σ_p V_p k_p G'_ip·G'_jp, i ≠ j, over the particles that have not moved since the
+  /// gather (made once after it; refresh() takes a moved particle's terms out), and a sub-step's
+  ///   f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)      (Σ_j K_ij = 0: Σ_j G'_jp = 0)
+  /// one product over each unknown's ≤ 5^Dim − 1 neighbours, plus the moved particles' fluxes as the
+  /// per-particle pass makes them, instead of a look and a scatter per particle. A pair whose
+  /// temperatures agree to round-off (kQuietSpread of T_i, as a quiet particle) carries no flux, so a node
+  /// whose neighbours all agree with it keeps its temperature exactly.
+  /// Differs from the per-particle sums by round-off (the terms regrouped). Off: the per-particle
+  /// sub-steps. Memory 5^Dim doubles and ints a unknown (the coupler turns it on in 2D only).
+  void use_node_operator(bool on) {
+    node_operator_on_ = on;
+    node_operator_ready_ = false;
+  }
 
  private:
   static constexpr int capacity = Dim == 2 ? 9 : 27;  // the widest stencil: 3 nodes per axis
@@ -256,6 +272,32 @@ class ExplicitConduction {
   std::vector<std::size_t> listed_;           // scratch: the particles a scatter visits, in order
   std::vector<double> particle_scratch_;      // scratch: a per-particle value of a pass
   std::vector<unsigned char> quiet_changed_;  // scratch: particles whose temperature the map back changed
+  // The node-level operator (use_node_operator): by unknown i, one slot per grid-node offset of j
+  // (−2..2 along each axis: two nodes of one stencil of ≤ 3 nodes an axis), K_ij and j (i itself where
+  // no particle joins them: T_i − T_i = 0).
+  static constexpr int offsets = Dim == 2 ? 25 : 125;
+  bool node_operator_on_ = false;
+  bool node_operator_ready_ = false;       // node_k_ made since the gather (kept by refresh)
+  std::vector<double> node_k_;             // K_ij by unknown i and slot (W/K)
+  std::vector<int> node_col_;              // j by unknown i and slot
+  Eigen::VectorXd node_force_;             // −(K T)_i of the last sub-step (rows not reached stand)
+  // By particle: its terms are in node_k_. A refresh takes a moved particle's terms out and leaves
+  // it out until the next gather (a particle that moved once moves again: the sliding body); the
+  // sub-steps add the flux of those left out particle by particle, as the per-particle pass.
+  std::vector<unsigned char> in_node_k_;
+  /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
+  /// rows of its unknowns i at grid nodes in `range` (all without one).
+  template <class Kernel>
+  void add_to_node_operator(const mechanics::Stencil<Dim, Kernel>& st, double conductance,
+                            const std::vector<int>& unknown, double sign, Expanded& e,
+                            const void* range = nullptr);
+  /// node_k_ anew from every heat-holding particle, in particle order (threads by rows).
+  template <class Kernel>
+  void assemble_node_operator(const NodalThermalSystem& sys, int threads);
+  /// node_force_ = −K T from node_k_ in the rows with a changed node (changed_before_) within their
+  /// reach; the other rows keep f_i of the last sub-step (threads by rows: each row alone, the same
+  /// bits on any number).
+  void node_operator_force(const NodalThermalSystem& sys, const Eigen::VectorXd& T, int threads);
   /// changed_before_ from whether unknown u changed.
   template <class Changed>
   void count_changed(const std::vector<int>& unknown, Changed&& changed);
