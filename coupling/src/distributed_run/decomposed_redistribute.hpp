@@ -29,7 +29,10 @@ template <int Dim>
 class Redistribution {
  public:
   using Mpm = mechanics::DecomposedMpm<Dim>;
-  Redistribution(Mpm& mpm, bool heat) : mpm_(mpm), heat_(heat), mine_(mpm.owned_nodes()) {
+  /// `interface`: the run keeps the interface temperature's flux histories (its checkpoint files
+  /// hold /interface/…).
+  Redistribution(Mpm& mpm, bool heat, bool interface)
+      : mpm_(mpm), heat_(heat), interface_(interface), mine_(mpm.owned_nodes()) {
     acc_ = mpm.checkpoint_state();  // the field names; emptied
     for (auto& r : acc_.reals) r.second.clear();
     for (auto& r : acc_.integers) r.second.clear();
@@ -165,6 +168,7 @@ class Redistribution {
   };
 
   void take_interface_histories(const ckpt::Reader& r, int j, bool particles) {
+    if (!interface_) return;
     std::vector<double> boundaries, energy, open;
     std::vector<int> levels, nodes;
     double recorded = 0.0;
@@ -239,6 +243,7 @@ class Redistribution {
 
   Mpm& mpm_;
   bool heat_;
+  bool interface_;
   std::array<int, 2 * Dim> mine_;
   typename Mpm::CheckpointState acc_;
   std::vector<double> pending_, M_, T_;

@@ -177,7 +177,7 @@ void DecomposedRun<Dim>::visit_global_state(const V& v) {
 
 template <int Dim>
 void DecomposedRun<Dim>::redistribute(int old) {
-  detail::Redistribution<Dim> re(*mpm_, heat_ != nullptr);
+  detail::Redistribution<Dim> re(*mpm_, heat_ != nullptr, heat_ && heat_->interface_enabled());
   const ckpt::RankSizes sizes = rank_sizes(false);
   try {
     generation_ = detail::read_redistributed_checkpoint(
