@@ -221,7 +221,9 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   // sign of the approach velocity; at a node a rigid body barely reaches (the oscillating block's
   // pushers, moved by a fraction of a cell) that pinned the heavy block field there on some steps and
   // not on others, and the block's particles gained kinetic energy without bound at small time steps.
-  if (in_contact) out.work_normal = normal_stop_work(a, b, n, d_n, closing, out.reduced_mass, c.heat ? c.dt : 0.0);
+  // Booked in the momentum-update pass only (the heating pass: the changes the particles receive), so
+  // evaluated there only.
+  if (in_contact && c.heat) out.work_normal = normal_stop_work(a, b, n, d_n, closing, out.reduced_mass, c.dt);
   if (a.sliver || b.sliver || light_only) {
     if (in_contact) {
       out.changed = true;
