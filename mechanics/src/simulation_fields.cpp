@@ -10,6 +10,21 @@
 
 namespace frictherm::mechanics {
 
+namespace {
+// fn(s) for every slot of the deformable velocity fields: an orphaned worksharing loop per field (in a
+// parallel region the slots are shared out, without one it runs them all), no barrier after it.
+template <int Dim, class Fn>
+void for_each_deformable_slot(const std::vector<VelocityField<Dim>>& fields, Fn&& fn) {
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    const VelocityField<Dim>& F = fields[f];
+    if (F.rigid) continue;
+    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
+#pragma omp for schedule(static) nowait
+    for (long ss = b; ss < e; ++ss) fn(static_cast<std::size_t>(ss));
+  }
+}
+}  // namespace
+
 template <int Dim>
 void NodalFields<Dim>::resize(std::size_t n, bool with_contact) {
   mass.assign(n, 0.0);
@@ -266,13 +281,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
   const bool contact_changed = changed.size() == momentum.size();
   const auto start = [&](std::size_t s, int d) { return contact_changed ? momentum[s][d] - changed[s][d] : momentum[s][d]; };
   const auto fields_pass = [&](double& work, double& stopped) {
-  for (std::size_t f = 0; f < fields_.size(); ++f) {
-    const VelocityField<Dim>& F = fields_[f];
-    if (F.rigid) continue;
-    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
-#pragma omp for schedule(static) nowait
-    for (long ss = b; ss < e; ++ss) {
-      const std::size_t s = static_cast<std::size_t>(ss);
+    for_each_deformable_slot(fields_, [&](std::size_t s) {
       const std::size_t i = static_cast<std::size_t>(layout_.slot_node[s]);
       if (const std::uint8_t driven = conditions_.rigid_mask[i]) {
         // Driven components end the step at the rigid velocity. In the momentum update the change is
@@ -293,8 +302,7 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
             if (force) (*force)[s][d] = 0.0;
           }
       }
-    }
-  }
+    });
   };
   if (without_team(threads_.count)) {
     fields_pass(field_work, field_stop);
@@ -349,17 +357,10 @@ void Simulation<Dim>::apply_damping(double dt) {
   const double c = opt_.damping_rate, mmin_damped = empty_node_mass_;
   double damped = 0.0;
   const auto damp_pass = [&](double& removed) {
-  for (std::size_t f = 0; f < fields_.size(); ++f) {
-    const VelocityField<Dim>& F = fields_[f];
-    if (F.rigid) continue;
-    const long b = static_cast<long>(F.first), e = static_cast<long>(F.first + F.count);
-#pragma omp for schedule(static) nowait
-    for (long ss = b; ss < e; ++ss) {
-      const std::size_t s = static_cast<std::size_t>(ss);
+    for_each_deformable_slot(fields_, [&](std::size_t s) {
       const std::uint8_t driven = conditions_.rigid_mask[static_cast<std::size_t>(layout_.slot_node[s])];
       damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
-    }
-  }
+    });
   };
   if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
     damp_pass(damped);
