@@ -52,6 +52,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // here) when a refresh may follow.
   const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
+  holding_ = 0;
   listed_.clear();
   const std::size_t n_materials = materials.size();
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -61,6 +62,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
                                      : thermal_properties_of(materials, id);  // throws here
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
+    ++holding_;
     listed_.push_back(k);
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
@@ -349,14 +351,20 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       stencils_.template of<Kernel>().size() != p.size())
     return Refresh::regather;
   moved_.clear();
-  std::size_t holding = 0;
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!holds_heat_[k]) continue;
-    ++holding;
-    if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) moved_.push_back(k);
+  {
+    // Moved: a coordinate shifted by more than max_shift since its gather (the largest |shift| >
+    // max_shift), as scalars without a branch per particle for the usual unmoved one.
+    const mechanics::Vec<Dim>* at = gathered_at_.data();
+    const mechanics::Vec<Dim>* now_at = p.position.data();
+    const unsigned char* holds = holds_heat_.data();
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      bool within = std::fabs(now_at[k][0] - at[k][0]) <= max_shift;
+      for (int d = 1; d < Dim; ++d) within &= std::fabs(now_at[k][d] - at[k][d]) <= max_shift;
+      if (!within && holds[k]) moved_.push_back(k);
+    }
   }
   if (moved_.empty()) return Refresh::kept;
-  if (4 * moved_.size() > holding) return Refresh::regather;  // a full gather costs less
+  if (4 * moved_.size() > holding_) return Refresh::regather;  // a full gather costs less
 
   // M_i on every node (eq. 38): each moved particle's weights at its last gather out, at its
   // position now in (the step's stencils when given: the same numbers as evaluating them here).
@@ -416,6 +424,10 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out; its flux particle by particle
       add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);
       in_node_k_[k] = 0;
+    }
+    if (node_operator_ready_) {  // the sub-steps' list of particles out of K, in particle order
+      const auto at = std::lower_bound(out_of_k_.begin(), out_of_k_.end(), k);
+      if (at == out_of_k_.end() || *at != k) out_of_k_.insert(at, k);
     }
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);

@@ -263,6 +263,24 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
     // A refresh changes row a: its f_i is made anew in the next sub-step (NaN: "changed").
     if (mark) flux_temperature_[u[a]] = std::numeric_limits<double>::quiet_NaN();
   }
+  if (node_compact_) {  // a refresh: the pairs the assembly joined, in the compacted rows
+    for (int a = 0; a < count; ++a) {
+      const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+      for (int b = a + 1; b < count; ++b) {
+        double dot = g[0][a] * g[0][b] + g[1][a] * g[1][b];  // as below: the same bits
+        if constexpr (Dim == 3) dot += g[2][a] * g[2][b];
+        const double term = sign * (conductance * dot);
+        const int slot = code[b] - code[a] + centre;
+        const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
+        const int ba = node_pos_[static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot)];
+        if (ab < 0 || ba < 0)
+          throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
+        node_kc_[static_cast<std::size_t>(ab)] += term;
+        node_kc_[static_cast<std::size_t>(ba)] += term;
+      }
+    }
+    return;
+  }
   double* k_all = node_k_.data();
   int* col_all = node_col_.data();
   for (int a = 0; a < count; ++a) {

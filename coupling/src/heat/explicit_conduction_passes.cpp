@@ -65,8 +65,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       force_ = node_force_;
       // The particles out of K (moved since the gather): their fluxes as the per-particle pass below
       // makes them (quiet ones left out), in particle order.
+      // (Out of K: taken out by a refresh, or not in it at the assembly, where every heat-holding
+      // particle with V_p k_p != 0 joined it; only a refresh changes V_p k_p, and it lists the particle.)
       listed_.clear();
-      for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+      for (std::size_t k : out_of_k_)
         if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
       scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
         const mechanics::Stencil<Dim, Kernel>& st = stencils[k];

@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -255,6 +256,7 @@ class ExplicitConduction {
   Eigen::VectorXd mass_peak_;              // largest M_a since the gather, by unknown
   double rayleigh_scale_ = 1.0;            // max_a M_peak_a / M_a
   std::vector<std::size_t> moved_;         // refresh scratch: particles to gather again
+  std::size_t holding_ = 0;                // particles that hold heat (gather)
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
   bool first_force_ready_ = false;        // force_ holds f_i at flux_temperature_ (made by the gather)
   // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
@@ -278,13 +280,24 @@ class ExplicitConduction {
   static constexpr int offsets = Dim == 2 ? 25 : 125;
   bool node_operator_on_ = false;
   bool node_operator_ready_ = false;       // node_k_ made since the gather (kept by refresh)
-  std::vector<double> node_k_;             // K_ij by unknown i and slot (W/K)
-  std::vector<int> node_col_;              // j by unknown i and slot
+  std::vector<double> node_k_;             // assembly scratch: K_ij by unknown i and slot (W/K)
+  std::vector<int> node_col_;              // assembly scratch: j by unknown i and slot
+  // The rows compacted to the slots some particle joined at the assembly (a row at a body's edge has
+  // fewer than 5^Dim − 1; the others hold K_ij = 0 and j = i, which add exactly 0 to f_i), in slot
+  // order: row i is [row_start_[i], row_start_[i + 1]) of node_kc_ and node_cc_; node_pos_ by unknown
+  // and slot gives the place a refresh takes a term out of (−1: no particle joined the pair).
+  bool node_compact_ = false;              // node_kc_ made from node_k_ (refresh writes there)
+  std::vector<int> row_start_;
+  std::vector<double> node_kc_;            // K_ij, compacted
+  std::vector<int> node_cc_;               // j, compacted
+  std::vector<int> node_pos_;
   Eigen::VectorXd node_force_;             // −(K T)_i of the last sub-step (rows not reached stand)
+  std::array<std::vector<unsigned char>, 2> reach_;  // scratch: rows with a changed node in reach, by grid node
   // By particle: its terms are in node_k_. A refresh takes a moved particle's terms out and leaves
   // it out until the next gather (a particle that moved once moves again: the sliding body); the
   // sub-steps add the flux of those left out particle by particle, as the per-particle pass.
   std::vector<unsigned char> in_node_k_;
+  std::vector<std::size_t> out_of_k_;      // in order: particles a refresh saw out of K since the assembly
   /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
   /// rows of its unknowns i at grid nodes in `range` (all without one).
   template <class Kernel>
