@@ -141,10 +141,12 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     // particle order as the two passes below, so the same numbers.
     Expanded e{};
     whole_.assign(p.size(), 0);
+    first_node_.assign(p.size(), 0);
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k]) continue;
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
       whole_[k] = whole(st);  // read by the sub-steps and the map back
+      first_node_[k] = node_span(st, indexer_)[0];
       if (conductance_[k] == 0.0) continue;  // quiet
       if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
         double lo, hi, s_kept;
@@ -176,12 +178,14 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
   whole_.assign(p.size(), 0);
+  first_node_.assign(p.size(), 0);
   mechanics::parallel_region(threads, [&] {
   Expanded e{};
 #pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k]) continue;
     whole_[k] = whole(stencils[k]);  // for one-thread windows that may follow (the governor)
+    first_node_[k] = node_span(stencils[k], indexer_)[0];
     if (conductance_[k] == 0.0) continue;  // quiet
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
@@ -431,6 +435,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     }
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);
+    first_node_[k] = node_span(kept[k], indexer_)[0];
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
     if (bounds_ready_) {

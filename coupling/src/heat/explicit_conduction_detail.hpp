@@ -86,6 +86,37 @@ inline void for_each_unknown_whole(const mechanics::Stencil<Dim, Kernel>& st, co
   }
 }
 
+// for_each_unknown_whole with the stencil's first grid node given (ExplicitConduction::first_node_,
+// node_span's first): the same products in the same order.
+template <int Dim, class Kernel, class F>
+inline void for_each_unknown_whole_from(const mechanics::Stencil<Dim, Kernel>& st, int first,
+                                        const mechanics::NodeIndexer<Dim>& ix, const int* un, F&& f) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = ix.stride;
+  if constexpr (Dim == 2) {
+    for (int j = 0; j < K; ++j) {
+      const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+      const int u0 = un[first + j * sd[1]];
+      for (int i = 0; i < K; ++i) {
+        const double wx = st.axis[0].w[i];
+        f(u0 + i, wx * wy, st.axis[0].dw[i] * wy, wx * dwy, 0.0);
+      }
+    }
+  } else {
+    for (int k = 0; k < K; ++k) {
+      const double wz = st.axis[2].w[k], dwz = st.axis[2].dw[k];
+      for (int j = 0; j < K; ++j) {
+        const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+        const int u0 = un[first + k * sd[2] + j * sd[1]];
+        for (int i = 0; i < K; ++i) {
+          const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
+          f(u0 + i, wx * wy * wz, dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
+        }
+      }
+    }
+  }
+}
+
 // V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
 // (quick_bound).
 template <int Dim, class Kernel>
@@ -337,6 +368,24 @@ inline bool counts_in_rows(const mechanics::Stencil<Dim, Kernel>& st, const mech
   } else {
     for (int k = 0; k < K; ++k) {
       int row = ix.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
+      for (int j = 0; j < K; ++j, row += sd[1])
+        if (before[row + span] != before[row]) return true;
+    }
+  }
+  return false;
+}
+
+// counts_in_rows with the stencil's first grid node given (first_node_): its K^(Dim-1) rows of K nodes.
+template <int Dim, int K>
+inline bool counts_in_rows_from(int first, const mechanics::IVec<Dim>& sd, const int* before) {
+  const int span = (K - 1) * sd[0] + 1;
+  if constexpr (Dim == 2) {
+    int row = first;
+    for (int j = 0; j < K; ++j, row += sd[1])
+      if (before[row + span] != before[row]) return true;
+  } else {
+    for (int k = 0; k < K; ++k) {
+      int row = first + k * sd[2];
       for (int j = 0; j < K; ++j, row += sd[1])
         if (before[row + span] != before[row]) return true;
     }

@@ -268,6 +268,7 @@ class ExplicitConduction {
   std::vector<int> changed_before_;           // scratch: changed unknowns at grid nodes < i
   std::vector<int> dropped_before_;           // grid nodes < i that are not unknowns (by the gather)
   std::vector<unsigned char> whole_;          // by heat-holding particle: whole() of its window stencil
+  std::vector<int> first_node_;               // by heat-holding particle: its window stencil's first grid node
   // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
   // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
   // in order, so every sum has the same terms in the same order on any number of threads.
