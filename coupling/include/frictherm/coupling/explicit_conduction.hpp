@@ -130,7 +130,8 @@ class ExplicitConduction {
   /// temperatures agree to round-off (kQuietSpread of T_i, as a quiet particle) carries no flux, so a node
   /// whose neighbours all agree with it keeps its temperature exactly.
   /// Differs from the per-particle sums by round-off (the terms regrouped). Off: the per-particle
-  /// sub-steps. Memory 5^Dim doubles and ints a unknown (the coupler turns it on in 2D only).
+  /// sub-steps. Memory 5^Dim doubles and two ints a unknown (the full rows of the assembly, and
+  /// the slot map node_pos_) plus the compacted rows (the coupler turns it on in 2D only).
   void use_node_operator(bool on) {
     node_operator_on_ = on;
     node_operator_ready_ = false;
