@@ -52,6 +52,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // here) when a refresh may follow.
   const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
+  holding_ = 0;
   listed_.clear();
   const std::size_t n_materials = materials.size();
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -61,6 +62,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
                                      : thermal_properties_of(materials, id);  // throws here
     if (!m.conducts) continue;
     holds_heat_[k] = 1;
+    ++holding_;
     listed_.push_back(k);
     const double mc = p.mass[k] * m.heat_capacity;
     sys.particle_heat_capacity += mc;
@@ -139,10 +141,12 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     // particle order as the two passes below, so the same numbers.
     Expanded e{};
     whole_.assign(p.size(), 0);
+    first_node_.assign(p.size(), 0);
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k]) continue;
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
       whole_[k] = whole(st);  // read by the sub-steps and the map back
+      first_node_[k] = node_span(st, indexer_)[0];
       if (conductance_[k] == 0.0) continue;  // quiet
       if (whole_[k]) {  // no lumping: the stencil walked directly, the same sums
         double lo, hi, s_kept;
@@ -174,12 +178,14 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
   whole_.assign(p.size(), 0);
+  first_node_.assign(p.size(), 0);
   mechanics::parallel_region(threads, [&] {
   Expanded e{};
 #pragma omp for schedule(static)
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (!holds_heat_[k]) continue;
     whole_[k] = whole(stencils[k]);  // for one-thread windows that may follow (the governor)
+    first_node_[k] = node_span(stencils[k], indexer_)[0];
     if (conductance_[k] == 0.0) continue;  // quiet
     expand<Kernel, false>(stencils[k], sys.unknown, e);
     if (!e.reaches()) continue;  // no heat capacity of its own reaches an unknown: no conduction
@@ -349,14 +355,20 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       stencils_.template of<Kernel>().size() != p.size())
     return Refresh::regather;
   moved_.clear();
-  std::size_t holding = 0;
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!holds_heat_[k]) continue;
-    ++holding;
-    if (!((p.position[k] - gathered_at_[k]).cwiseAbs().maxCoeff() <= max_shift)) moved_.push_back(k);
+  {
+    // Moved: a coordinate shifted by more than max_shift since its gather (the largest |shift| >
+    // max_shift), as scalars without a branch per particle for the usual unmoved one.
+    const mechanics::Vec<Dim>* at = gathered_at_.data();
+    const mechanics::Vec<Dim>* now_at = p.position.data();
+    const unsigned char* holds = holds_heat_.data();
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      bool within = std::fabs(now_at[k][0] - at[k][0]) <= max_shift;
+      for (int d = 1; d < Dim; ++d) within &= std::fabs(now_at[k][d] - at[k][d]) <= max_shift;
+      if (!within && holds[k]) moved_.push_back(k);
+    }
   }
   if (moved_.empty()) return Refresh::kept;
-  if (4 * moved_.size() > holding) return Refresh::regather;  // a full gather costs less
+  if (4 * moved_.size() > holding_) return Refresh::regather;  // a full gather costs less
 
   // M_i on every node (eq. 38): each moved particle's weights at its last gather out, at its
   // position now in (the step's stencils when given: the same numbers as evaluating them here).
@@ -417,8 +429,13 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);
       in_node_k_[k] = 0;
     }
+    if (node_operator_ready_) {  // the sub-steps' list of particles out of K, in particle order
+      const auto at = std::lower_bound(out_of_k_.begin(), out_of_k_.end(), k);
+      if (at == out_of_k_.end() || *at != k) out_of_k_.insert(at, k);
+    }
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);
+    first_node_[k] = node_span(kept[k], indexer_)[0];
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
     if (bounds_ready_) {

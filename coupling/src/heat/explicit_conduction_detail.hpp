@@ -86,6 +86,37 @@ inline void for_each_unknown_whole(const mechanics::Stencil<Dim, Kernel>& st, co
   }
 }
 
+// for_each_unknown_whole with the stencil's first grid node given (ExplicitConduction::first_node_,
+// node_span's first): the same products in the same order.
+template <int Dim, class Kernel, class F>
+inline void for_each_unknown_whole_from(const mechanics::Stencil<Dim, Kernel>& st, int first,
+                                        const mechanics::NodeIndexer<Dim>& ix, const int* un, F&& f) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<Dim>& sd = ix.stride;
+  if constexpr (Dim == 2) {
+    for (int j = 0; j < K; ++j) {
+      const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+      const int u0 = un[first + j * sd[1]];
+      for (int i = 0; i < K; ++i) {
+        const double wx = st.axis[0].w[i];
+        f(u0 + i, wx * wy, st.axis[0].dw[i] * wy, wx * dwy, 0.0);
+      }
+    }
+  } else {
+    for (int k = 0; k < K; ++k) {
+      const double wz = st.axis[2].w[k], dwz = st.axis[2].dw[k];
+      for (int j = 0; j < K; ++j) {
+        const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+        const int u0 = un[first + k * sd[2] + j * sd[1]];
+        for (int i = 0; i < K; ++i) {
+          const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
+          f(u0 + i, wx * wy * wz, dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
+        }
+      }
+    }
+  }
+}
+
 // V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
 // (quick_bound).
 template <int Dim, class Kernel>
@@ -263,6 +294,24 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
     // A refresh changes row a: its f_i is made anew in the next sub-step (NaN: "changed").
     if (mark) flux_temperature_[u[a]] = std::numeric_limits<double>::quiet_NaN();
   }
+  if (node_compact_) {  // a refresh: the pairs the assembly joined, in the compacted rows
+    for (int a = 0; a < count; ++a) {
+      const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+      for (int b = a + 1; b < count; ++b) {
+        double dot = g[0][a] * g[0][b] + g[1][a] * g[1][b];  // as below: the same bits
+        if constexpr (Dim == 3) dot += g[2][a] * g[2][b];
+        const double term = sign * (conductance * dot);
+        const int slot = code[b] - code[a] + centre;
+        const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
+        const int ba = node_pos_[static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot)];
+        if (ab < 0 || ba < 0)
+          throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
+        node_kc_[static_cast<std::size_t>(ab)] += term;
+        node_kc_[static_cast<std::size_t>(ba)] += term;
+      }
+    }
+    return;
+  }
   double* k_all = node_k_.data();
   int* col_all = node_col_.data();
   for (int a = 0; a < count; ++a) {
@@ -319,6 +368,24 @@ inline bool counts_in_rows(const mechanics::Stencil<Dim, Kernel>& st, const mech
   } else {
     for (int k = 0; k < K; ++k) {
       int row = ix.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
+      for (int j = 0; j < K; ++j, row += sd[1])
+        if (before[row + span] != before[row]) return true;
+    }
+  }
+  return false;
+}
+
+// counts_in_rows with the stencil's first grid node given (first_node_): its K^(Dim-1) rows of K nodes.
+template <int Dim, int K>
+inline bool counts_in_rows_from(int first, const mechanics::IVec<Dim>& sd, const int* before) {
+  const int span = (K - 1) * sd[0] + 1;
+  if constexpr (Dim == 2) {
+    int row = first;
+    for (int j = 0; j < K; ++j, row += sd[1])
+      if (before[row + span] != before[row]) return true;
+  } else {
+    for (int k = 0; k < K; ++k) {
+      int row = first + k * sd[2];
       for (int j = 0; j < K; ++j, row += sd[1])
         if (before[row + span] != before[row]) return true;
     }

@@ -11,6 +11,8 @@ template <int Dim>
 template <class Kernel>
 void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& sys, int threads) {
   const std::size_t n = sys.size();
+  node_compact_ = false;  // the scatter below fills the full rows
+  out_of_k_.clear();
   node_k_.assign(n * offsets, 0.0);
   node_col_.resize(n * offsets);
   for (std::size_t u = 0; u < n; ++u)
@@ -33,49 +35,79 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
                                      if (!r.meets(node_span(st, indexer_))) return;
                                      add_to_node_operator(st, conductance_[k], sys.unknown, 1.0, e, &r);
                                    });
+  // Compacted to the slots a particle joined (j ≠ i): the others add exactly 0 to f_i (T_i − T_i = 0,
+  // quiet), and the sum of the rest keeps the slot order, so f_i keeps its bits.
+  row_start_.resize(n + 1);
+  node_pos_.assign(n * offsets, -1);
+  node_kc_.clear();
+  node_cc_.clear();
+  row_start_[0] = 0;
+  for (std::size_t u = 0; u < n; ++u) {
+    for (std::size_t s = u * offsets; s < (u + 1) * offsets; ++s)
+      if (node_col_[s] != static_cast<int>(u)) {
+        node_pos_[s] = static_cast<int>(node_kc_.size());
+        node_kc_.push_back(node_k_[s]);
+        node_cc_.push_back(node_col_[s]);
+      }
+    row_start_[u + 1] = static_cast<int>(node_kc_.size());
+  }
+  node_compact_ = true;
   node_operator_ready_ = true;
 }
+
+namespace {
+
+// Σ_j K_ij (T_j − T_i) over the compacted slots [s, end) of row i in slot order, a pair at temperatures
+// equal to round-off (kQuietSpread of T_i, as a quiet particle) carrying no flux. A function of its
+// own (not the row lambda's captures) so the pointers stay in registers.
+inline double row_flux(const double* t, double ti, const double* k_all, const int* col_all, int s, int end) {
+  const double quiet = kQuietSpread * std::fabs(ti);
+  double sum = 0.0;
+  for (; s < end; ++s) {  // the joined slots in order
+    const double d = t[col_all[s]] - ti;
+    // a pair at temperatures equal to round-off (relative to T_i) carries no flux
+    sum += std::fabs(d) <= quiet ? 0.0 : k_all[s] * d;
+  }
+  return sum;
+}
+
+}  // namespace
 
 template <int Dim>
 void ExplicitConduction<Dim>::node_operator_force(const NodalThermalSystem& sys, const Eigen::VectorXd& T, int threads) {
   const auto n = static_cast<std::ptrdiff_t>(T.size());
   const double* t = T.data();
-  const double* k_all = node_k_.data();
-  const int* col_all = node_col_.data();
+  const double* k_all = node_kc_.data();
+  const int* col_all = node_cc_.data();
+  const int* start = row_start_.data();
   const int* before = changed_before_.data();
   const int* grid_node = sys.grid_node.data();
   const int nodes = static_cast<int>(sys.unknown.size());
   const mechanics::IVec<Dim>& sd = indexer_.stride;  // sd[0] = 1: x fastest (for_each_unknown_whole)
-  // Whether a node within ±2 along each axis changed (changed_before_, by runs of 5 along x; a run
-  // clipped at the ends of the numbering, a run across a grid edge taking in more: never fewer).
-  const auto reached = [&](int g) {
-    const auto run = [&](int c) {
-      const int lo = std::max(c - 2, 0), hi = std::min(c + 3, nodes);
-      return lo < hi && before[hi] != before[lo];
-    };
-    if constexpr (Dim == 2) {
-      for (int dy = -2; dy <= 2; ++dy)
-        if (run(g + dy * sd[1])) return true;
-    } else {
-      for (int dz = -2; dz <= 2; ++dz)
-        for (int dy = -2; dy <= 2; ++dy)
-          if (run(g + dz * sd[2] + dy * sd[1])) return true;
-    }
-    return false;
-  };
+  // Whether a node within ±2 along each axis changed, by grid node: first along x from the prefix
+  // counts (changed_before_, a run of 5 clipped at the ends of the numbering; a run across a grid edge
+  // takes in more: never fewer), then dilated by ±2 along each further axis (a centre outside the
+  // numbering counts nothing: a real neighbour's centre is a grid node). A row reached recomputes
+  // f_i from the same K row and T_j as it stands when none of its nodes changed, so a larger set
+  // than needed changes no bit.
+  const int pad = 2 * sd[Dim - 1];
+  for (std::vector<unsigned char>& r : reach_) r.assign(static_cast<std::size_t>(nodes + 2 * pad), 0);
+  unsigned char* x = reach_[0].data() + pad;
+  for (int g = 0; g < nodes; ++g) {
+    const int lo = g < 2 ? 0 : g - 2, hi = g + 3 > nodes ? nodes : g + 3;
+    x[g] = before[hi] != before[lo];
+  }
+  for (int d = 1; d < Dim; ++d) {
+    unsigned char* y = reach_[d % 2].data() + pad;
+    const unsigned char* from = reach_[(d - 1) % 2].data() + pad;
+    const int s1 = sd[d], s2 = 2 * sd[d];
+    for (int g = 0; g < nodes; ++g) y[g] = from[g - s2] | from[g - s1] | from[g] | from[g + s1] | from[g + s2];
+  }
+  const unsigned char* reached = reach_[(Dim - 1) % 2].data() + pad;
   double* f = node_force_.data();
   const auto row = [&](std::ptrdiff_t u) {
-    if (!reached(grid_node[u])) return;  // f_i of the last sub-step stands: the same K row and T_j
-    const double ti = t[u], quiet = kQuietSpread * std::fabs(ti);
-    const double* k_row = k_all + u * offsets;
-    const int* col = col_all + u * offsets;
-    double sum = 0.0;
-    for (int s = 0; s < offsets; ++s) {
-      const double d = t[col[s]] - ti;
-      // a pair at temperatures equal to round-off (relative to T_i) carries no flux
-      sum += std::fabs(d) <= quiet ? 0.0 : k_row[s] * d;
-    }
-    f[u] = -sum;  // f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)
+    if (!reached[grid_node[u]]) return;  // f_i of the last sub-step stands: the same K row and T_j
+    f[u] = -row_flux(t, t[u], k_all, col_all, start[u], start[u + 1]);  // f_i = −(K T)_i = −Σ_{j≠i} K_ij (T_j − T_i)
   };
   if (threads <= 1) {
     for (std::ptrdiff_t u = 0; u < n; ++u) row(u);

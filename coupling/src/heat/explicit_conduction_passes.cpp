@@ -65,8 +65,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       force_ = node_force_;
       // The particles out of K (moved since the gather): their fluxes as the per-particle pass below
       // makes them (quiet ones left out), in particle order.
+      // (Out of K: taken out by a refresh, or not in it at the assembly, where every heat-holding
+      // particle with V_p k_p != 0 joined it; only a refresh changes V_p k_p, and it lists the particle.)
       listed_.clear();
-      for (std::size_t k = 0; k < holds_heat_.size(); ++k)
+      for (std::size_t k : out_of_k_)
         if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
       scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
         const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
@@ -264,15 +266,18 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const int* un = sys.unknown.data();
     double* const temperature = p.temperature.data();
     double* const sums = next_mct_.data();
+    const int* first = first_node_.data();
+    const int* changed = changed_before_.data();
     for (std::size_t k = 0; k < p.size(); ++k) {
-      if (!holds_heat_[k] || !any_changed(stencils[k])) continue;
+      // any_changed, from the stencil's first grid node kept with it
+      if (!holds_heat_[k] || !counts_in_rows_from<Dim, Kernel::K>(first[k], indexer_.stride, changed)) continue;
       const double before = temperature[k];
       if (whole_[k]) {
         double w[nodes];
         int at[nodes];
         int a = 0;
         double dT = 0.0;
-        for_each_unknown_whole(stencils[k], indexer_, un, [&](int u, double s, double, double, double) {
+        for_each_unknown_whole_from(stencils[k], first[k], indexer_, un, [&](int u, double s, double, double, double) {
           dT += s * dl[u];
           w[a] = s;
           at[a] = u;

@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -129,7 +130,8 @@ class ExplicitConduction {
   /// temperatures agree to round-off (kQuietSpread of T_i, as a quiet particle) carries no flux, so a node
   /// whose neighbours all agree with it keeps its temperature exactly.
   /// Differs from the per-particle sums by round-off (the terms regrouped). Off: the per-particle
-  /// sub-steps. Memory 5^Dim doubles and ints a unknown (the coupler turns it on in 2D only).
+  /// sub-steps. Memory 5^Dim doubles and two ints a unknown (the full rows of the assembly, and
+  /// the slot map node_pos_) plus the compacted rows (the coupler turns it on in 2D only).
   void use_node_operator(bool on) {
     node_operator_on_ = on;
     node_operator_ready_ = false;
@@ -255,6 +257,7 @@ class ExplicitConduction {
   Eigen::VectorXd mass_peak_;              // largest M_a since the gather, by unknown
   double rayleigh_scale_ = 1.0;            // max_a M_peak_a / M_a
   std::vector<std::size_t> moved_;         // refresh scratch: particles to gather again
+  std::size_t holding_ = 0;                // particles that hold heat (gather)
   Eigen::VectorXd force_;                 // scratch: f_i on the unknowns (W)
   bool first_force_ready_ = false;        // force_ holds f_i at flux_temperature_ (made by the gather)
   // Passing over particles whose nodes did not change (issue 13: the per-window passes were bound by
@@ -266,6 +269,7 @@ class ExplicitConduction {
   std::vector<int> changed_before_;           // scratch: changed unknowns at grid nodes < i
   std::vector<int> dropped_before_;           // grid nodes < i that are not unknowns (by the gather)
   std::vector<unsigned char> whole_;          // by heat-holding particle: whole() of its window stencil
+  std::vector<int> first_node_;               // by heat-holding particle: its window stencil's first grid node
   // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
   // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
   // in order, so every sum has the same terms in the same order on any number of threads.
@@ -278,13 +282,24 @@ class ExplicitConduction {
   static constexpr int offsets = Dim == 2 ? 25 : 125;
   bool node_operator_on_ = false;
   bool node_operator_ready_ = false;       // node_k_ made since the gather (kept by refresh)
-  std::vector<double> node_k_;             // K_ij by unknown i and slot (W/K)
-  std::vector<int> node_col_;              // j by unknown i and slot
+  std::vector<double> node_k_;             // assembly scratch: K_ij by unknown i and slot (W/K)
+  std::vector<int> node_col_;              // assembly scratch: j by unknown i and slot
+  // The rows compacted to the slots some particle joined at the assembly (a row at a body's edge has
+  // fewer than 5^Dim − 1; the others hold K_ij = 0 and j = i, which add exactly 0 to f_i), in slot
+  // order: row i is [row_start_[i], row_start_[i + 1]) of node_kc_ and node_cc_; node_pos_ by unknown
+  // and slot gives the place a refresh takes a term out of (−1: no particle joined the pair).
+  bool node_compact_ = false;              // node_kc_ made from node_k_ (refresh writes there)
+  std::vector<int> row_start_;
+  std::vector<double> node_kc_;            // K_ij, compacted
+  std::vector<int> node_cc_;               // j, compacted
+  std::vector<int> node_pos_;
   Eigen::VectorXd node_force_;             // −(K T)_i of the last sub-step (rows not reached stand)
+  std::array<std::vector<unsigned char>, 2> reach_;  // scratch: rows with a changed node in reach, by grid node
   // By particle: its terms are in node_k_. A refresh takes a moved particle's terms out and leaves
   // it out until the next gather (a particle that moved once moves again: the sliding body); the
   // sub-steps add the flux of those left out particle by particle, as the per-particle pass.
   std::vector<unsigned char> in_node_k_;
+  std::vector<std::size_t> out_of_k_;      // in order: particles a refresh saw out of K since the assembly
   /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
   /// rows of its unknowns i at grid nodes in `range` (all without one).
   template <class Kernel>
