@@ -135,3 +135,41 @@ function(frictherm_unity_build target)
     set_source_files_properties(${U_ALONE} TARGET_DIRECTORY ${target} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
   endif()
 endfunction()
+
+# frictherm_setup_sources(<target> <source> ...): the target's setup-time sources (paths relative to the
+# current folder: scene parsing, result files, checkpoints, the command line), compiled at -O2 instead
+# of Release's -O3 in an OBJECT library <target>_setup whose objects go into <target> (same include
+# folders, definitions, links and warnings; its own precompiled headers and unity batches). -O3's extra
+# inlining, unrolling and vectorisation pay in the per-step kernels, not in code that runs once per run
+# or per output row, and cost compile time there (issue 33: nlohmann-json and HDF5 code instantiated
+# and optimised again in every batch). Without -ffast-math and FMA the two levels give the same
+# floating-point results (x86-64 baseline, FRICTHERM_NATIVE off: SSE2 has no fused multiply-add to
+# contract into, and neither level reorders sums); checked with h5diff of the examples' outputs.
+# Call after the target's own definitions; FRICTHERM_SETUP_FLAGS names the flags: only where Release
+# means -O3 (scripts/run_checks.sh's sanitizer build sets its own -O1 for everything).
+set(FRICTHERM_SETUP_FLAGS "")
+if(CMAKE_CXX_FLAGS_RELEASE MATCHES "(^| )-O3( |$)" AND CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  set(FRICTHERM_SETUP_FLAGS "$<$<CONFIG:Release>:-O2>")
+endif()
+function(frictherm_setup_sources target)
+  set(setup ${target}_setup)
+  set(sources ${ARGN})
+  list(TRANSFORM sources PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/)
+  get_target_property(all ${target} SOURCES)
+  list(TRANSFORM all PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/ REGEX "^[^/$]")
+  foreach(s ${sources})
+    if(NOT s IN_LIST all)
+      message(FATAL_ERROR "frictherm_setup_sources: ${s} is not a source of ${target}")
+    endif()
+  endforeach()
+  list(REMOVE_ITEM all ${sources})
+  set_property(TARGET ${target} PROPERTY SOURCES ${all})
+  add_library(${setup} OBJECT ${sources})
+  get_target_property(links ${target} LINK_LIBRARIES)
+  target_link_libraries(${setup} PRIVATE ${links})
+  target_include_directories(${setup} PRIVATE $<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>)
+  target_compile_definitions(${setup} PRIVATE $<TARGET_PROPERTY:${target},COMPILE_DEFINITIONS>)
+  target_compile_options(${setup} PRIVATE ${FRICTHERM_SETUP_FLAGS})
+  frictherm_set_warnings(${setup})
+  target_sources(${target} PRIVATE $<TARGET_OBJECTS:${setup}>)
+endfunction()
