@@ -24,11 +24,6 @@ fi
 # so a build folder configured against the unpacked copy moves to the system's once command 2 installs it.
 sundials_config=$(compgen -G "/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" ||
                   compgen -G "$(pwd)/.deps/sundials/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" || true)
-# Ninja when installed (scripts/install_deps.sh installs it), for a new build folder: it compiles any
-# library's sources as soon as their headers exist, where Make finishes each library before starting the
-# next, so both cores stay busy to the end (an existing folder keeps its generator).
-generator=()
-if [ ! -f "$build/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 sundials=()
 if [ -n "$sundials_config" ]; then sundials=(-DSUNDIALS_DIR="$(dirname "$(echo "$sundials_config" | head -1)")"); fi
 if [ "$mode" = --program ]; then
@@ -36,10 +31,10 @@ if [ "$mode" = --program ]; then
   if [ ! -f "$build/CMakeCache.txt" ]; then
     options=(-DFRICTHERM_BUILD_TESTS=OFF -DFRICTHERM_BUILD_BENCH=OFF -DFRICTHERM_WITH_MPI=OFF)
   fi
-  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${options[@]}"
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${options[@]}"
   cmake --build "$build" -j "$jobs" --target frictherm
 else
-  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" \
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" \
         -DFRICTHERM_BUILD_TESTS=ON -DFRICTHERM_BUILD_BENCH=ON -DFRICTHERM_WITH_MPI=ON
   cmake --build "$build" -j "$jobs"
 fi

@@ -21,7 +21,7 @@ set -euo pipefail
 check=no
 if [ "${1:-}" = --check ]; then check=yes; shift; fi
 profile=${1:-all}
-build=(build-essential cmake ninja-build pkg-config libeigen3-dev libsundials-dev libhdf5-dev nlohmann-json3-dev
+build=(build-essential cmake pkg-config libeigen3-dev libsundials-dev libhdf5-dev nlohmann-json3-dev
        libboost-dev libmuparser-dev libpng-dev libtiff-dev)
 plot=(python3 python3-numpy python3-matplotlib python3-h5py)
 rest=(libgtest-dev libgmock-dev libopenmpi-dev openmpi-bin petsc-dev
