@@ -16,6 +16,7 @@
 #endif
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace frictherm::coupling {
 namespace explicit_detail {
@@ -57,33 +58,16 @@ inline void for_each_node(const mechanics::Stencil<Dim, Kernel>& st, const mecha
 // (stride 1 along x), so a whole row's unknowns are un[first] + 0, 1, ..., K − 1: one index load per
 // row instead of one per node (Grid numbers x fastest: stride 1). The same products in the same order. f(u, S, gx, gy, gz).
 template <int Dim, class Kernel, class F>
+inline void for_each_unknown_whole_from(const mechanics::Stencil<Dim, Kernel>& st, int first,
+                                        const mechanics::NodeIndexer<Dim>& ix, const int* un, F&& f);
+
+template <int Dim, class Kernel, class F>
 inline void for_each_unknown_whole(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix,
                                    const int* un, F&& f) {
-  constexpr int K = Kernel::K;
-  const mechanics::IVec<Dim>& sd = ix.stride;
   const mechanics::IVec<Dim> b = st.first_node();
-  if constexpr (Dim == 2) {
-    for (int j = 0; j < K; ++j) {
-      const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
-      const int u0 = un[ix.shift + (b[1] + j) * sd[1] + b[0] * sd[0]];
-      for (int i = 0; i < K; ++i) {
-        const double wx = st.axis[0].w[i];
-        f(u0 + i, wx * wy, st.axis[0].dw[i] * wy, wx * dwy, 0.0);
-      }
-    }
-  } else {
-    for (int k = 0; k < K; ++k) {
-      const double wz = st.axis[2].w[k], dwz = st.axis[2].dw[k];
-      for (int j = 0; j < K; ++j) {
-        const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
-        const int u0 = un[ix.shift + (b[2] + k) * sd[2] + (b[1] + j) * sd[1] + b[0] * sd[0]];
-        for (int i = 0; i < K; ++i) {
-          const double wx = st.axis[0].w[i], dwx = st.axis[0].dw[i];
-          f(u0 + i, wx * wy * wz, dwx * wy * wz, wx * dwy * wz, wx * wy * dwz);
-        }
-      }
-    }
-  }
+  int first = ix.shift;
+  for (int d = Dim - 1; d >= 0; --d) first += b[d] * ix.stride[d];
+  for_each_unknown_whole_from(st, first, ix, un, std::forward<F>(f));
 }
 
 // for_each_unknown_whole with the stencil's first grid node given (ExplicitConduction::first_node_,
