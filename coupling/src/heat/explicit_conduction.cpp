@@ -7,6 +7,9 @@
 
 #include "explicit_conduction_detail.hpp"  // the passes' helpers, expand, any_changed
 
+#include <algorithm>
+#include <iterator>
+
 namespace frictherm::coupling {
 
 using namespace explicit_detail;
@@ -429,10 +432,6 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);
       in_node_k_[k] = 0;
     }
-    if (node_operator_ready_) {  // the sub-steps' list of particles out of K, in particle order
-      const auto at = std::lower_bound(out_of_k_.begin(), out_of_k_.end(), k);
-      if (at == out_of_k_.end() || *at != k) out_of_k_.insert(at, k);
-    }
     kept[k] = now[j];
     whole_[k] = whole(kept[k]);
     first_node_[k] = node_span(kept[k], indexer_)[0];
@@ -448,6 +447,12 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     quiet_[k] = 0;  // looked at in the next sub-step
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];  // and its new ones in
     gathered_at_[k] = p.position[k];
+  }
+  if (node_operator_ready_) {  // the sub-steps' list of particles out of K, in particle order (moved_ is)
+    std::vector<std::size_t>& merged = out_of_k_merge_;
+    merged.clear();
+    std::set_union(out_of_k_.begin(), out_of_k_.end(), moved_.begin(), moved_.end(), std::back_inserter(merged));
+    out_of_k_.swap(merged);
   }
   return Refresh::refreshed;
 }

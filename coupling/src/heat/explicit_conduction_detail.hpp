@@ -338,25 +338,16 @@ namespace explicit_detail {
 
 // Whether a prefix count by grid node (before[i]: counted nodes < i) counts a node of the stencil.
 // The stencil's rows are runs of grid nodes (for_each_node's numbering): first to first + (K-1) s_0.
+template <int Dim, int K>
+inline bool counts_in_rows_from(int first, const mechanics::IVec<Dim>& sd, const int* before);
+
 template <int Dim, class Kernel>
 inline bool counts_in_rows(const mechanics::Stencil<Dim, Kernel>& st, const mechanics::NodeIndexer<Dim>& ix,
                            const int* before) {
-  constexpr int K = Kernel::K;
-  const mechanics::IVec<Dim>& sd = ix.stride;
   const mechanics::IVec<Dim> b = st.first_node();
-  const int span = (K - 1) * sd[0] + 1;
-  if constexpr (Dim == 2) {
-    int row = ix.shift + b[1] * sd[1] + b[0] * sd[0];
-    for (int j = 0; j < K; ++j, row += sd[1])
-      if (before[row + span] != before[row]) return true;
-  } else {
-    for (int k = 0; k < K; ++k) {
-      int row = ix.shift + (b[2] + k) * sd[2] + b[1] * sd[1] + b[0] * sd[0];
-      for (int j = 0; j < K; ++j, row += sd[1])
-        if (before[row + span] != before[row]) return true;
-    }
-  }
-  return false;
+  int first = ix.shift;
+  for (int d = Dim - 1; d >= 0; --d) first += b[d] * ix.stride[d];
+  return counts_in_rows_from<Dim, Kernel::K>(first, ix.stride, before);
 }
 
 // counts_in_rows with the stencil's first grid node given (first_node_): its K^(Dim-1) rows of K nodes.

@@ -300,6 +300,7 @@ class ExplicitConduction {
   // sub-steps add the flux of those left out particle by particle, as the per-particle pass.
   std::vector<unsigned char> in_node_k_;
   std::vector<std::size_t> out_of_k_;      // in order: particles a refresh saw out of K since the assembly
+  std::vector<std::size_t> out_of_k_merge_;  // scratch of refresh's merge into out_of_k_
   /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
   /// rows of its unknowns i at grid nodes in `range` (all without one).
   template <class Kernel>
