@@ -28,7 +28,8 @@ struct ContactSide {
   double extent_gap = std::numeric_limits<double>::quiet_NaN();
   /// Below ContactOptions::sliver_fraction of the node's mass: kept from interpenetrating, never
   /// given friction (a sliver's contact area ~ its overlap but its mass ~ overlap², so any area-based
-  /// law would stick it and its shape-function gradient would strain its particles).
+  /// law would stick it and its shape-function gradient would strain its particles). A deformable
+  /// sliver bonded to a non-sliver rigid partner sticks to it instead (contact_pair.hpp).
   bool sliver = false;
 
   void add(const ContactSide& o) {

@@ -95,7 +95,9 @@ struct ContactOptions {
   double min_mass_fraction = 1e-6;
   /// A material whose mass at a node is below this fraction of the node's mass (but above
   /// min_mass_fraction) is a sliver there: contact stops it interpenetrating (normal change only)
-  /// but applies no friction and makes no heat. 0: none.
+  /// but applies no friction and makes no heat; a deformable sliver whose rigid partner holds the node
+  /// and whose pair's law bonds the surfaces (stick, or adhesion with a tensile strength that holds)
+  /// sticks to the rigid body. 0: none.
   double sliver_fraction = 0.0;
   /// Position and displacement separation: a material holding less than this fraction of a pair's
   /// mass at a node is in contact there whenever the pair approaches, normal contact only (its mass
