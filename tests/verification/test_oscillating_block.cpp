@@ -61,8 +61,8 @@ TEST(OscillatingBlock, SecondOrderHeatingConvergesFaster) {
 // v_max = 0.158 m/s (the block's kinetic energy at that speed is 8e-6 J), so the kinetic energy can
 // only be the ringing the ramp left (FLIP keeps it, friction takes from it) plus what the pushers'
 // slow motion excites: its peak after the ramp must stay near the ringing's peak over the ramp's last
-// 0.1 ms. Bound: twice that peak (measured ratio 0.73 up to 0.65 ms at C = 0.025, 3.95 before the
-// fix; the energy the pushers put in over the whole interval, friction included, is a few mJ, about
+// 0.1 ms. Bound: twice that peak (measured ratio 0.67 up to 0.65 ms at C = 0.025; 0.73 before bonded
+// slivers stuck to the pushers, 3.95 before the sliver fix; the energy the pushers put in over the whole interval, friction included, is a few mJ, about
 // one ringing energy, and most of it leaves as frictional heat).
 // Before the sliver fix (contact_pair.hpp: a sliver held by adhesion while "separated", normal
 // contact only while "in contact") the pushers' sliver at the node column one cell inside the block
