@@ -68,14 +68,24 @@ inline constexpr double kCountedSlideFraction = 1e-12;
 /// impact came from nodes below 3 % (docs/contact.md, "Frictional work in impacts").
 inline constexpr double kHeatMassFloor = 0.03;
 
+/// The tractions that would hold the surfaces together this step: the stick change dp_stick (eqs.
+/// 12–14) over `area` and dt, normal N (eq. 15, > 0 compressive) and tangential S.
+struct StickTractions {
+  double N, S;
+};
+template <int Dim>
+StickTractions stick_tractions(const Vec<Dim>& dp_stick, const Vec<Dim>& n, double d_t, double area, double dt) {
+  return {-dp_stick.dot(n) / (area * dt), d_t / (area * dt)};
+}
+
 /// A deformable sliver against a rigid partner is bonded to it when the pair's law is stick, or an
 /// adhesive law with a tensile strength that holds the sliver's tractions (eq. 25, the normal one
 /// counted only when tensile) on area `area`.
 template <int Dim>
 bool bonded_sliver(const FrictionLaw& law, const Vec<Dim>& dp_stick, const Vec<Dim>& n, double d_t, double area, double dt) {
   if (law.kind() == FrictionKind::stick) return true;
-  const double N = -dp_stick.dot(n) / (area * dt);  // eq. 15's traction, > 0 compressive
-  return law.holds_when_separated(d_t / (area * dt), std::min(N, 0.0));
+  const StickTractions held = stick_tractions(dp_stick, n, d_t, area, dt);
+  return law.holds_when_separated(held.S, std::min(held.N, 0.0));
 }
 
 struct PairContext {
@@ -225,31 +235,31 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     if (surface > 0.0) area = surface;
   }
 
-  // A sliver (ContactSide::sliver) gets normal contact only, whether the pair is found in contact or
-  // separated: no friction, no adhesive hold (eq. 25), no heat. Letting a separated sliver hold by
-  // adhesion made the constraint switch between "stick" and "normal only" from step to step with the
-  // sign of the approach velocity; at a node a rigid body barely reaches (the oscillating block's
-  // pushers, moved by a fraction of a cell) that pinned the heavy block field there on some steps and
-  // not on others, and the block's particles gained kinetic energy without bound at small time steps.
   // Booked in the momentum-update pass only (the heating pass: the changes the particles receive), so
   // evaluated there only.
   if (in_contact && c.heat) out.work_normal = normal_stop_work(a, b, n, d_n, closing, out.reduced_mass, c.dt);
-  // A deformable sliver bonded to a rigid partner moves with it: the rigid body holds most of the
-  // node's mass, and the pair's law bonds the surfaces (stick, or an adhesive law whose tensile
-  // strength holds the sliver's own tractions, eq. 25, on the domain area of eq. 11: the surface form
-  // vanishes at a rigid body's interior nodes). Left free tangentially (normal change only), the
-  // sliver's field moved with its own force over its own mass, f/m ~ 1/overlap, and that velocity
-  // entered its particles' velocity gradient through G ~ overlap: the bonded surface's shear relaxed at
-  // a rate proportional to dt, a Maxwell element whose loss grows as the time step shrinks (the
-  // undamped oscillating block at 1.25 mm, one material, over the load ramp: 1.0 / 10.3 mJ at the
-  // pushers at C = 0.5 / 0.025; docs/contact.md, "Slivers bonded to a rigid partner"). Held in
-  // contact and when separated alike, so the constraint does not switch with the approach's sign.
-  if (a.sliver && b.rigid && !b.sliver && bonded_sliver(s.law, dp_stick, n, d_t, domain_area, c.dt)) {
-    out.changed = true;
-    out.dp = in_contact ? Vec<Dim>(dp_stick + closing * n) : dp_stick;
-    return out;
-  }
+  // Slivers (ContactSide::sliver), one rule: a deformable sliver takes its rigid partner's bonded
+  // outcome, every other sliver (and a light-only touch) the normal change only; no friction, no heat,
+  // and the same outcome whether the pair is found in contact or separated.
+  // - Bonded: the rigid body holds most of the node's mass, and the pair's law bonds the surfaces
+  //   (stick, or an adhesive law whose tensile strength holds the sliver's own tractions, eq. 25, on
+  //   the domain area of eq. 11: the surface form vanishes at a rigid body's interior nodes). Left free
+  //   tangentially, the sliver's field moved with its own force over its own mass, f/m ~ 1/overlap, and
+  //   that velocity entered its particles' velocity gradient through G ~ overlap: the bonded surface's
+  //   shear relaxed at a rate proportional to dt, a Maxwell element whose loss grows as the time step
+  //   shrinks (the undamped oscillating block at 1.25 mm, one material, over the load ramp: 1.0 / 10.3
+  //   mJ at the pushers at C = 0.5 / 0.025; docs/contact.md, "Slivers bonded to a rigid partner").
+  // - Not switching with the approach's sign: letting a separated sliver hold by adhesion only when
+  //   separated made the constraint switch between "stick" and "normal only" from step to step; at a
+  //   node a rigid body barely reaches (the oscillating block's pushers, moved by a fraction of a cell)
+  //   that pinned the heavy block field there on some steps and not on others, and the block's
+  //   particles gained kinetic energy without bound at small time steps.
   if (a.sliver || b.sliver || light_only) {
+    if (a.sliver && b.rigid && !b.sliver && bonded_sliver(s.law, dp_stick, n, d_t, domain_area, c.dt)) {
+      out.changed = true;
+      out.dp = in_contact ? Vec<Dim>(dp_stick + closing * n) : dp_stick;
+      return out;
+    }
     if (in_contact) {
       out.changed = true;
       out.dp = d_n * n;
@@ -257,8 +267,8 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     return out;
   }
   if (!in_contact) {  // separated: only an adhesive interface with tensile strength may hold (eq. 25)
-    const double N = -dp_stick.dot(n) / (area * c.dt), S_stick = d_t / (area * c.dt);
-    if (s.law.holds_when_separated(S_stick, N)) {
+    const StickTractions held = stick_tractions(dp_stick, n, d_t, area, c.dt);
+    if (s.law.holds_when_separated(held.S, held.N)) {
       out.changed = true;
       out.dp = dp_stick;
       return out;
