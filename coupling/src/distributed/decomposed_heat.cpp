@@ -104,14 +104,7 @@ void DecomposedHeat::check_materials(mechanics::DecomposedMpm<Dim>& mpm) {
   if (!(opt_.fe_safety > 0.0 && opt_.fe_safety <= 1.0))
     throw std::invalid_argument("decomposed heat: fe_safety " + std::to_string(opt_.fe_safety) +
                                 " (expected a value in (0, 1])");
-  const WindowPolicy& w = opt_.window;  // the serial Coupler's checks
-  if (w.kind == WindowPolicy::Kind::every_n_steps && w.steps < 1)
-    throw std::invalid_argument("decomposed heat: every_n_steps needs steps >= 1");
-  if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
-    throw std::invalid_argument("decomposed heat: adaptive windows need max_temperature_rise > 0");
-  if (!(w.max_duration > 0.0)) throw std::invalid_argument("decomposed heat: max_duration must be > 0");
-  if (opt_.matrix_free_max_substeps < 0)
-    throw std::invalid_argument("decomposed heat: matrix_free_max_substeps must be >= 0");
+  check_window_options(opt_.window, opt_.matrix_free_max_substeps, "decomposed heat");  // the serial Coupler's checks
   thermal::IntegratorOptions io = opt_.integrator_options;
   io.fe_safety = opt_.fe_safety;
   // The same on every rank (all hold the same options): a bad name throws everywhere.

@@ -20,20 +20,11 @@ using h5detail::check;
 using h5detail::check_id;
 using h5detail::Handle;
 
+// Every integer attribute of a decomposed checkpoint is 64-bit (as before).
 void write_int_attribute(hid_t obj, const std::string& file, const char* name, long value) {
-  const Handle space{check_id(H5Screate(H5S_SCALAR), file, "dataspace"), H5Sclose};
-  const Handle a{check_id(H5Acreate2(obj, name, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), file,
-                          std::string("attribute ") + name),
-                 H5Aclose};
-  check(H5Awrite(a.get(), H5T_NATIVE_LONG, &value), file, std::string("attribute ") + name);
+  ckpt::write_int_attribute(obj, file, name, value);
 }
-
-long read_int_attribute(hid_t obj, const std::string& file, const char* name) {
-  const Handle a{check_id(H5Aopen(obj, name, H5P_DEFAULT), file, std::string("no attribute ") + name), H5Aclose};
-  long value = 0;
-  check(H5Aread(a.get(), H5T_NATIVE_LONG, &value), file, std::string("attribute ") + name);
-  return value;
-}
+using ckpt::read_int_attribute;
 
 void write_text(hid_t f, const std::string& file, const char* name, const std::string& text) {
   ckpt::write_array(f, file, name, H5T_NATIVE_CHAR, text.data(), text.size(), 1);

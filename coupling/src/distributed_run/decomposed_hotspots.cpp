@@ -92,12 +92,7 @@ void DecomposedHotSpots<Dim>::extend_series_row(std::vector<double>& row) const 
 
 template <int Dim>
 void DecomposedHotSpots<Dim>::declare_table(H5Output& out) const {
-  std::vector<std::string> c{"time", "id", "particle_count", "peak_temperature", "mean_temperature", "size",
-                             "equivalent_diameter"};
-  const char* axes[3] = {"centroid_x", "centroid_y", "centroid_z"};
-  for (int d = 0; d < Dim; ++d) c.emplace_back(axes[d]);
-  for (const char* name : {"birth_time", "duration", "excess_energy", "material_mask"}) c.emplace_back(name);
-  out.declare_table("hotspots", c);
+  out.declare_table("hotspots", hotspot_table_columns(Dim));
 }
 
 template <int Dim>
@@ -105,12 +100,7 @@ void DecomposedHotSpots<Dim>::append_table_rows(H5Output& out, double time) {
   if (updates_ == updates_written_) return;
   updates_written_ = updates_;
   for (const HotSpot& h : tracker_.hot_spots()) {
-    std::vector<double> r{time, static_cast<double>(h.id), static_cast<double>(h.particle_count), h.peak_temperature,
-                          h.mean_temperature, h.size, h.equivalent_diameter};
-    for (int d = 0; d < Dim; ++d) r.push_back(h.centroid[static_cast<std::size_t>(d)]);
-    double mask = 0.0;  // bit m set: material id m present
-    for (int m : h.materials) mask += std::ldexp(1.0, m);
-    r.insert(r.end(), {h.birth_time, h.duration, h.excess_energy, mask});
+    const std::vector<double> r = hotspot_table_row(h, time, Dim);
     out.append_table_row("hotspots", r);
     table_rows_.insert(table_rows_.end(), r.begin(), r.end());
   }

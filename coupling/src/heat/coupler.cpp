@@ -17,6 +17,15 @@ constexpr double kAssemblyTolerance = 1e-10;
 
 }  // namespace
 
+void check_window_options(const WindowPolicy& w, long matrix_free_max_substeps, const std::string& who) {
+  if (w.kind == WindowPolicy::Kind::every_n_steps && w.steps < 1)
+    throw std::invalid_argument(who + ": every_n_steps needs steps >= 1");
+  if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
+    throw std::invalid_argument(who + ": adaptive windows need max_temperature_rise > 0");
+  if (!(w.max_duration > 0.0)) throw std::invalid_argument(who + ": max_duration must be > 0");
+  if (matrix_free_max_substeps < 0) throw std::invalid_argument(who + ": matrix_free_max_substeps must be >= 0");
+}
+
 template <int Dim>
 Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind shape, CouplerOptions options)
     : grid_(grid),
@@ -27,14 +36,7 @@ Coupler<Dim>::Coupler(const mechanics::Grid<Dim>& grid, mechanics::ShapeKind sha
       plastic_(opt_.plastic),
       tracker_(Dim, opt_.hotspots, opt_.thickness),
       fates_(opt_.fates) {
-  const WindowPolicy& w = opt_.window;
-  if (w.kind == WindowPolicy::Kind::every_n_steps && w.steps < 1)
-    throw std::invalid_argument("Coupler: every_n_steps needs steps >= 1");
-  if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
-    throw std::invalid_argument("Coupler: adaptive windows need max_temperature_rise > 0");
-  if (!(w.max_duration > 0.0)) throw std::invalid_argument("Coupler: max_duration must be > 0");
-  if (opt_.matrix_free_max_substeps < 0)
-    throw std::invalid_argument("Coupler: matrix_free_max_substeps must be >= 0");
+  check_window_options(opt_.window, opt_.matrix_free_max_substeps, "Coupler");
   explicit_.use_node_operator(opt_.matrix_free_node_operator && Dim == 2);
   if (!(opt_.subgrid_relaxation_time > 0.0))
     throw std::invalid_argument("Coupler: subgrid_relaxation_time must be > 0");

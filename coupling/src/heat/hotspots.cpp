@@ -12,6 +12,25 @@
 
 namespace frictherm::coupling {
 
+std::vector<std::string> hotspot_table_columns(int dim) {
+  std::vector<std::string> c{"time", "id", "particle_count", "peak_temperature", "mean_temperature", "size",
+                             "equivalent_diameter"};
+  const char* axes[3] = {"centroid_x", "centroid_y", "centroid_z"};
+  for (int d = 0; d < dim; ++d) c.emplace_back(axes[d]);
+  for (const char* n : {"birth_time", "duration", "excess_energy", "material_mask"}) c.emplace_back(n);
+  return c;
+}
+
+std::vector<double> hotspot_table_row(const HotSpot& h, double time, int dim) {
+  std::vector<double> r{time, static_cast<double>(h.id), static_cast<double>(h.particle_count), h.peak_temperature,
+                        h.mean_temperature, h.size, h.equivalent_diameter};
+  for (int d = 0; d < dim; ++d) r.push_back(h.centroid[static_cast<std::size_t>(d)]);
+  double mask = 0.0;
+  for (int m : h.materials) mask += std::ldexp(1.0, m);
+  r.insert(r.end(), {h.birth_time, h.duration, h.excess_energy, mask});
+  return r;
+}
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;

@@ -188,6 +188,40 @@ bool allowed_sentinel(const std::string& shown, double value) {
          (shown == "/mechanics/initial_energy" || shown == "/mechanics/contact/lagged_normal_traction");
 }
 
+// Integer attributes of a checkpoint (int as 32-bit, long as 64-bit), serial and decomposed.
+template <class Int>
+void write_integer_attribute(hid_t obj, const std::string& file, const char* name, Int value, hid_t file_type,
+                             hid_t memory_type) {
+  const Handle space{check_id(H5Screate(H5S_SCALAR), file, "dataspace"), H5Sclose};
+  const Handle a{check_id(H5Acreate2(obj, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), file,
+                          std::string("attribute ") + name),
+                 H5Aclose};
+  check(H5Awrite(a.get(), memory_type, &value), file, std::string("attribute ") + name);
+}
+
+void write_int_attribute(hid_t obj, const std::string& file, const char* name, int value) {
+  write_integer_attribute(obj, file, name, value, H5T_STD_I32LE, H5T_NATIVE_INT);
+}
+
+void write_int_attribute(hid_t obj, const std::string& file, const char* name, long value) {
+  write_integer_attribute(obj, file, name, value, H5T_STD_I64LE, H5T_NATIVE_LONG);
+}
+
+long read_int_attribute(hid_t obj, const std::string& file, const char* name) {
+  if (H5Aexists(obj, name) <= 0)
+    throw std::runtime_error("checkpoint '" + file + "': not a checkpoint, or damaged: no attribute '" + name + "'");
+  const Handle a{check_id(H5Aopen(obj, name, H5P_DEFAULT), file, std::string("not a checkpoint: no attribute ") + name),
+                 H5Aclose};
+  const Handle type{check_id(H5Aget_type(a.get()), file, std::string("attribute ") + name), H5Tclose};
+  const Handle space{check_id(H5Aget_space(a.get()), file, std::string("attribute ") + name), H5Sclose};
+  if (H5Tget_class(type.get()) != H5T_INTEGER || H5Sget_simple_extent_npoints(space.get()) != 1)
+    throw std::runtime_error("checkpoint '" + file + "': attribute '" + name +
+                             "' is not one integer; the checkpoint is damaged");
+  long value = 0;
+  check(H5Aread(a.get(), H5T_NATIVE_LONG, &value), file, std::string("attribute ") + name);
+  return value;
+}
+
 }  // namespace ckpt
 
 namespace {
@@ -216,32 +250,9 @@ template <class F> auto refusing(const std::string& path, F&& read) -> decltype(
 }
 
 
-void write_int_attribute(hid_t obj, const std::string& file, const char* name, int value) {
-  const Handle space{check_id(H5Screate(H5S_SCALAR), file, "dataspace"), H5Sclose};
-  const Handle a{check_id(H5Acreate2(obj, name, H5T_STD_I32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), file,
-                          std::string("attribute ") + name),
-                 H5Aclose};
-  check(H5Awrite(a.get(), H5T_NATIVE_INT, &value), file, std::string("attribute ") + name);
-}
-
-int read_int_attribute(hid_t obj, const std::string& file, const char* name) {
-  if (H5Aexists(obj, name) <= 0)
-    throw std::runtime_error("checkpoint '" + file + "': not a checkpoint, or damaged: no attribute '" + name + "'");
-  const Handle a{check_id(H5Aopen(obj, name, H5P_DEFAULT), file, std::string("not a checkpoint: no attribute ") + name),
-                 H5Aclose};
-  const Handle type{check_id(H5Aget_type(a.get()), file, std::string("attribute ") + name), H5Tclose};
-  const Handle space{check_id(H5Aget_space(a.get()), file, std::string("attribute ") + name), H5Sclose};
-  if (H5Tget_class(type.get()) != H5T_INTEGER || H5Sget_simple_extent_npoints(space.get()) != 1)
-    throw std::runtime_error("checkpoint '" + file + "': attribute '" + name +
-                             "' is not one integer; the checkpoint is damaged");
-  int value = 0;
-  check(H5Aread(a.get(), H5T_NATIVE_INT, &value), file, std::string("attribute ") + name);
-  return value;
-}
-
 Handle open_checkpoint(const std::string& path, int dimension) {
   Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
-  const int format = read_int_attribute(f.get(), path, "format");
+  const long format = ckpt::read_int_attribute(f.get(), path, "format");
   if (format == ckpt::kFormat) ckpt::check_objects(f.get(), path);
   if (format == 2)  // before issue 34: no checksums, no /reaction/enabled
     throw std::runtime_error("checkpoint '" + path + "': format 2, written by a frictherm version before checkpoints "
@@ -251,9 +262,9 @@ Handle open_checkpoint(const std::string& path, int dimension) {
   if (format != ckpt::kFormat)
     throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + " (expected " +
                              std::to_string(ckpt::kFormat) + "; written by another frictherm version)");
-  if (dimension > 0 && read_int_attribute(f.get(), path, "dimension") != dimension)
+  if (dimension > 0 && ckpt::read_int_attribute(f.get(), path, "dimension") != dimension)
     throw std::runtime_error("checkpoint '" + path + "': written by a " +
-                             std::to_string(read_int_attribute(f.get(), path, "dimension")) +
+                             std::to_string(ckpt::read_int_attribute(f.get(), path, "dimension")) +
                              "D simulation (its attribute 'dimension'), restored into a " + std::to_string(dimension) +
                              "D one");
   return f;
@@ -292,8 +303,8 @@ void write_file(const std::string& path, mechanics::Simulation<Dim>& sim, const 
   try {
     const h5detail::Quiet quiet;
     const Handle f = ckpt::create_file(tmp);
-    write_int_attribute(f.get(), tmp, "format", ckpt::kFormat);
-    write_int_attribute(f.get(), tmp, "dimension", Dim);
+    ckpt::write_int_attribute(f.get(), tmp, "format", ckpt::kFormat);
+    ckpt::write_int_attribute(f.get(), tmp, "dimension", Dim);
     write_text(f.get(), tmp, "scene", scene_text);
     write_text(f.get(), tmp, "scene_source", source);
     write_text(f.get(), tmp, "scene_overrides", overrides);
@@ -336,11 +347,11 @@ int checkpoint_ranks(const std::string& path) {
     const h5detail::Quiet quiet;
     const Handle f = open_checkpoint(path, 0);
     if (H5Aexists(f.get(), "ranks") <= 0) return 0;
-    const int ranks = read_int_attribute(f.get(), path, "ranks");
+    const long ranks = ckpt::read_int_attribute(f.get(), path, "ranks");
     if (ranks < 1)
       throw std::runtime_error("checkpoint '" + path + "': attribute 'ranks' is " + std::to_string(ranks) +
                                ", expected a number of ranks >= 1; the checkpoint is damaged");
-    return ranks;
+    return static_cast<int>(ranks);
   });
 }
 

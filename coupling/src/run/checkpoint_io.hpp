@@ -167,5 +167,10 @@ namespace ckpt {
 /// The run's marks under /marks of the checkpoint `f` (`w` writes at its root), as checkpoint_marks
 /// reads them: serial and decomposed checkpoints (checkpoint.cpp).
 void write_marks(const Writer& w, hid_t f, const std::string& file, CheckpointMarks m);
+/// Integer attribute `name` of `obj` in checkpoint `file`: int written as 32-bit, long as 64-bit;
+/// read as long, a missing attribute or one that is not one integer throwing (the checkpoint is damaged).
+void write_int_attribute(hid_t obj, const std::string& file, const char* name, int value);
+void write_int_attribute(hid_t obj, const std::string& file, const char* name, long value);
+long read_int_attribute(hid_t obj, const std::string& file, const char* name);
 }  // namespace ckpt
 }  // namespace frictherm::coupling

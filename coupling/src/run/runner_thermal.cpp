@@ -21,14 +21,6 @@ const char* const kSeriesColumns[] = {"heat_delivered",         "thermal_energy_
                                       "hotspot_count",          "hottest_hotspot_temperature", "hottest_hotspot_size",
                                       "hottest_hotspot_diameter", "thermal_windows"};
 
-std::vector<std::string> hotspot_columns(int dim) {
-  std::vector<std::string> c{"time", "id", "particle_count", "peak_temperature", "mean_temperature", "size",
-                             "equivalent_diameter"};
-  const char* axes[3] = {"centroid_x", "centroid_y", "centroid_z"};
-  for (int d = 0; d < dim; ++d) c.emplace_back(axes[d]);
-  for (const char* n : {"birth_time", "duration", "excess_energy", "material_mask"}) c.emplace_back(n);
-  return c;
-}
 
 }  // namespace
 
@@ -54,7 +46,7 @@ void ThermalRun<Dim>::declare_output(H5Output& out, std::vector<std::string>& na
   if (o.interface_temperature.enabled && o.interface_temperature.patch_length > 0.0)
     names.emplace_back("max_node_interface_temperature");
   if (o.interface_temperature.enabled && o.reaction.enabled) names.emplace_back("max_interface_reaction_progress");
-  out.declare_table("hotspots", hotspot_columns(Dim));
+  out.declare_table("hotspots", hotspot_table_columns(Dim));
   if (spec_.continuation_duration > 0.0)
     out.declare_table("hotspot_fates", hotspot_fate_columns());
 }
@@ -90,15 +82,7 @@ void ThermalRun<Dim>::extend_series_row(std::vector<double>& row, H5Output& out,
   if (o.interface_temperature.enabled && o.reaction.enabled) row.push_back(coupler_.interface_reaction().max_progress());
   if (windows == hotspot_windows_written_) return;
   hotspot_windows_written_ = windows;
-  for (const HotSpot& h : hs.hot_spots()) {
-    std::vector<double> r{time, static_cast<double>(h.id), static_cast<double>(h.particle_count), h.peak_temperature,
-                          h.mean_temperature, h.size, h.equivalent_diameter};
-    for (int d = 0; d < Dim; ++d) r.push_back(h.centroid[static_cast<std::size_t>(d)]);
-    double mask = 0.0;  // bit m set: material id m present (exact in a double up to id 52)
-    for (int m : h.materials) mask += std::ldexp(1.0, m);
-    r.insert(r.end(), {h.birth_time, h.duration, h.excess_energy, mask});
-    out.append_table_row("hotspots", r);
-  }
+  for (const HotSpot& h : hs.hot_spots()) out.append_table_row("hotspots", hotspot_table_row(h, time, Dim));
 }
 
 template <int Dim>

@@ -57,6 +57,10 @@ struct WindowPolicy {
   long max_steps = 0;                                              // adaptive: most steps (0: no limit)
 };
 
+/// Throws std::invalid_argument, the message starting with `who`, when the window policy or the
+/// matrix-free sub-step limit is out of range: the serial Coupler and DecomposedHeat check alike.
+void check_window_options(const WindowPolicy& w, long matrix_free_max_substeps, const std::string& who);
+
 struct CouplerOptions {
   std::vector<ThermalProperties> materials;  // by material id
   /// thermal::make_integrator name, or "auto": matrix-free forward Euler (explicit_conduction.hpp)

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -44,6 +45,12 @@ struct HotSpot {
   double duration = 0.0;             // s, time of the last update minus birth_time
   std::vector<std::size_t> particles;  // particle indices, ascending
 };
+
+/// The `/hotspots` table of a run's file, serial and decomposed alike: its columns for a `dim`-
+/// dimensional run, and the row of hot spot `h` at `time` (material_mask: bit m set when material id m
+/// is present, exact in a double up to id 52).
+std::vector<std::string> hotspot_table_columns(int dim);
+std::vector<double> hotspot_table_row(const HotSpot& h, double time, int dim);
 
 /// One hot particle as the clustering sees it. `index` names the particle: its index in the run's
 /// particles, or its global id in a decomposed run (distributed.hpp).
