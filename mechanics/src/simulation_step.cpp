@@ -227,6 +227,12 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
   at_contact.assign(nodes_.mass.size(), 0);
   for (const ContactEntry& c : contact_nodes_.entries) at_contact[static_cast<std::size_t>(c.slot)] = 1;
   const std::uint8_t* const flag = at_contact.data();
+  // The reach test as one load per particle (issue 35, speed-s52): the flags dilated by the stencil's
+  // box, read at the stencil's first slot, say exactly whether any of its K^Dim slots is flagged (the
+  // test above it replaces walked all of them). EBS stencils have no box: they walk.
+  thread_local std::vector<std::uint8_t> reach_flag, reach_tmp;
+  if constexpr (!is_extended<Kernel>) step_detail::dilate_slot_flags<Kernel::K, Dim>(fields_, at_contact, reach_flag, reach_tmp);
+  const std::uint8_t* const reach = reach_flag.data();
   auto& st = stencils<Kernel>();
   const bool displacement = contact_setup_.options.separation == SeparationMethod::displacement;
   scatter_phase(Accumulated{false, false, false, true}, true,
@@ -237,9 +243,13 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
     decltype(auto) stk = indexable(st);
     const NodeIndexer<Dim> index = ix;
     for (std::size_t k = kb; k < ke; ++k) {
-      int reaches = 0;
-      stk[k].for_each(index, [&](int i, double, const Vec<Dim>&) { reaches |= flag[i]; });
-      if (!reaches) continue;
+      if constexpr (is_extended<Kernel>) {
+        int reaches = 0;
+        stk[k].for_each(index, [&](int i, double, const Vec<Dim>&) { reaches |= flag[i]; });
+        if (!reaches) continue;
+      } else {
+        if (!reach[step_detail::first_slot(stk[k], index)]) continue;
+      }
       const double mp = p_.mass[k], Vp = p_.volume[k];
       const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
       stk[k].for_each(index, [&](int i, double S, const Vec<Dim>& G) {
