@@ -1,7 +1,6 @@
 #pragma once
 // Material parameters and the constitutive updates (inline: they run inside particle loops).
 #include <frictherm/mechanics/mie_gruneisen_params.hpp>
-#include <frictherm/mechanics/small_products.hpp>
 #include <frictherm/mechanics/time_function.hpp>
 #include <frictherm/mechanics/types.hpp>
 
@@ -76,20 +75,8 @@ FRICTHERM_ALWAYS_INLINE void linear_elastic_update(const Mat<Dim>& L, double dt,
   // σ += w σ − σ w, spelled out as Eigen evaluates that expression (a temporary w σ, minus σ w, then
   // added): GCC keeps Eigen's combined form out of line; this inlines with the same arithmetic.
   Mat<Dim> rotation;
-#if FRICTHERM_INLINE_SMALL_PRODUCTS
-  if constexpr (Dim == 3) {
-    // 3D: GCC keeps both of Eigen's 3×3 products out of line (3D PBX, 10 steps: 105 M instructions in
-    // the two calls, issue 35); the same entries as Eigen's lazy product (small_products.hpp), each
-    // subtracted as the noalias() -= form subtracts it.
-    product_into<3>(w, sigma, rotation);
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) rotation(i, j) -= small_detail::product_entry<3>(sigma, w, i, j);
-  } else
-#endif
-  {
-    rotation.noalias() = w * sigma;
-    rotation.noalias() -= sigma * w;
-  }
+  rotation.noalias() = w * sigma;
+  rotation.noalias() -= sigma * w;
   sigma += rotation;
   sigma += 2.0 * mu * de;
   sigma.diagonal().array() += lam * tr;
