@@ -237,46 +237,55 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
   const std::uint8_t* const reach = reach_flag.data();
   auto& st = stencils<Kernel>();
   const bool displacement = contact_setup_.options.separation == SeparationMethod::displacement;
-  if constexpr (!is_extended<Kernel>) {  // the share that decides the next step's scatter (map_to_grid)
-    std::size_t reaching = 0, all = 0;
+  // Unless map_to_grid scattered them with mass and momentum this step (every particle's). The
+  // particles whose stencils reach a contact node's slot are counted on the way (reach_share: it
+  // decides the next step's scatter); after a fused scatter, by a pass of one load per particle.
+  const bool scattered = contact_nodes_.terms_scattered;
+  contact_nodes_.terms_scattered = false;
+  std::size_t reaching = 0;
+  if (!scattered) {
+    scatter_phase(Accumulated{false, false, false, true}, true,
+                  [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
+      double* const domain = acc.domain.data();
+      Vec<Dim>* const mass_position = acc.mass_position.data();
+      Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
+      decltype(auto) stk = indexable(st);
+      const NodeIndexer<Dim> index = ix;
+      std::size_t mine = 0;
+      for (std::size_t k = kb; k < ke; ++k) {
+        if constexpr (is_extended<Kernel>) {
+          int reaches = 0;
+          stk[k].for_each(index, [&](int i, double, const Vec<Dim>&) { reaches |= flag[i]; });
+          if (!reaches) continue;
+        } else {
+          if (!reach[step_detail::first_slot(stk[k], index)]) continue;
+        }
+        ++mine;
+        const double mp = p_.mass[k], Vp = p_.volume[k];
+        const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
+        stk[k].for_each(index, [&](int i, double S, const Vec<Dim>& G) {
+          mass_position[i] += S * mx;
+          domain[i] += S * Vp;
+          domain_gradient[i] += Vp * G;
+        });
+      }
+#pragma omp atomic
+      reaching += mine;
+    });
+  }
+  if constexpr (!is_extended<Kernel>) {
+    std::size_t all = 0;
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const int f = layout_.field_of_material[m];
       if (f < 0) continue;
+      all += layout_.material_end[m] - layout_.material_begin[m];
+      if (!scattered) continue;
       const NodeIndexer<Dim> index = fields_[static_cast<std::size_t>(f)].index;
       for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k)
         reaching += reach[step_detail::first_slot(st[k], index)];
-      all += layout_.material_end[m] - layout_.material_begin[m];
     }
     contact_nodes_.reach_share = all ? static_cast<double>(reaching) / static_cast<double>(all) : 0.0;
   }
-  // Unless map_to_grid scattered them with mass and momentum this step (every particle's).
-  const bool scattered = contact_nodes_.terms_scattered;
-  contact_nodes_.terms_scattered = false;
-  if (!scattered)
-  scatter_phase(Accumulated{false, false, false, true}, true,
-                [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
-    double* const domain = acc.domain.data();
-    Vec<Dim>* const mass_position = acc.mass_position.data();
-    Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
-    decltype(auto) stk = indexable(st);
-    const NodeIndexer<Dim> index = ix;
-    for (std::size_t k = kb; k < ke; ++k) {
-      if constexpr (is_extended<Kernel>) {
-        int reaches = 0;
-        stk[k].for_each(index, [&](int i, double, const Vec<Dim>&) { reaches |= flag[i]; });
-        if (!reaches) continue;
-      } else {
-        if (!reach[step_detail::first_slot(stk[k], index)]) continue;
-      }
-      const double mp = p_.mass[k], Vp = p_.volume[k];
-      const Vec<Dim> mx = mp * (displacement ? Vec<Dim>(p_.position[k] - p_.initial_position[k]) : p_.position[k]);
-      stk[k].for_each(index, [&](int i, double S, const Vec<Dim>& G) {
-        mass_position[i] += S * mx;
-        domain[i] += S * Vp;
-        domain_gradient[i] += Vp * G;
-      });
-    }
-  });
   if (contact_setup_.options.separation == SeparationMethod::extent) measure_contact_extents(stencils<Kernel>());
   resolve_contact(ContactPass::extrapolated, dt);
 }
