@@ -11,12 +11,14 @@
 #include <frictherm/mechanics/parallel_region.hpp>
 
 #include "contact_extent.hpp"
+#include "stencil_access.hpp"
 
 #include <omp.h>
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 namespace frictherm::mechanics {
 
@@ -38,6 +40,14 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   for (std::size_t q = 0; q < at_contact.size(); ++q)
     at_contact[q] = contact_nodes_.node_field_count[static_cast<std::size_t>(layout_.slot_node[q])] >= 2;
   const std::uint8_t* const flag = at_contact.data();
+  // The same test as one load per particle (issue 35, speed-s52): the flags dilated by the stencil's
+  // box (stencil_access.hpp), read at its first slot, say whether any of its slots is flagged; the
+  // S > 0 part of the test is left to the loop below, which skips S = 0 and single-field nodes
+  // itself (a particle that passes only through S = 0 slots adds nothing there). EBS walks as before.
+  constexpr bool boxed = !std::is_same_v<Stencils, PrecomputedStencils<Dim>>;
+  thread_local std::vector<std::uint8_t> reach_flag, reach_tmp;
+  if constexpr (boxed) step_detail::dilate_slot_flags_for(st, fields_, at_contact, reach_flag, reach_tmp);
+  const std::uint8_t* const reach = reach_flag.data();
   parallel_region(threads_.count, [&] {
     const int tid = omp_get_thread_num();
     double* own = contact_nodes_.entry_extent_own.data();
@@ -54,9 +64,13 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
       const NodeIndexer<Dim> ix = fields_[static_cast<std::size_t>(f)].index;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
-        int reaches = 0;
-        st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) { reaches |= flag[slot] & (S > 0.0); });
-        if (!reaches) continue;
+        if constexpr (boxed) {
+          if (!reach[step_detail::first_slot(st[k], ix)]) continue;
+        } else {
+          int reaches = 0;
+          st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) { reaches |= flag[slot] & (S > 0.0); });
+          if (!reaches) continue;
+        }
         const Vec<Dim>& x = p_.position[k];
         const Vec<Dim>& l = p_.half_size[k];
         st[k].for_each(ix, [&](int slot, double S, const Vec<Dim>&) {

@@ -65,6 +65,12 @@ struct ContactNodeState {
   // traction σ̃ (Pa) of its two-material pair and the step that last updated it (a node that was not
   // in contact on the previous step starts again from σ).
   std::vector<double> lagged_normal_traction, lagged_normal_step;
+  // The contact terms' scatter (simulation_step.cpp, issue 35): the share of the particles whose
+  // stencil reached a contact node's slot on the last step, and whether map_to_grid scattered the
+  // terms of every particle this step (when that share was over one half), so contact_at_extrapolated
+  // does not scatter them again.
+  double reach_share = 0.0;
+  bool terms_scattered = false;
 };
 
 }  // namespace frictherm::mechanics
