@@ -48,8 +48,9 @@ TEST(SceneBuild, ThreeDimensionalBoxAndSphere) {
 }
 
 // The update scheme a scene gets when it names none: USL with multimaterial (grid) contact, whose
-// frictional heat MUSL makes grow with the time step (docs/transfer.md); MUSL without contact or with
-// penalty contact only; a named scheme always wins.
+// frictional heat MUSL makes grow with the time step (docs/transfer.md), except with linear shape
+// functions (MUSL: USL blows up with them, docs/contact.md); MUSL without contact or with penalty
+// contact only; a named scheme always wins.
 TEST(SceneBuild, DefaultUpdateSchemeFollowsTheContactMethod) {
   using frictherm::mechanics::UpdateScheme;
   Json j = good_scene();
@@ -60,7 +61,12 @@ TEST(SceneBuild, DefaultUpdateSchemeFollowsTheContactMethod) {
   EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::musl);
   j["solver"] = Json::parse(R"({"cfl": 0.4})");
   EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::usl);
+  j["solver"] = Json::parse(R"({"shape_function": "linear"})");  // USL blows up with linear shapes
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::musl);
+  j["solver"] = Json::parse(R"({"shape_function": "linear", "scheme": "usl"})");
+  EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::usl);
   j["contact"] = Json::parse(R"({"method": "penalty", "boundary_spacing": 0.005})");
+  j.erase("solver");
   EXPECT_EQ(parse_scene(j.dump(), "<test>", ".", "s").options.scheme, UpdateScheme::musl);
 }
 

@@ -145,9 +145,11 @@ void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
 
 /// The update scheme of a scene that names none: USL when a pair uses multimaterial (grid) contact,
 /// whose frictional heat MUSL makes grow with the time step (docs/transfer.md, "What they do for
-/// frictional heat"), MUSL otherwise.
-mechanics::UpdateScheme default_update_scheme(const ContactSpec& contact) {
-  if (!contact.enabled) return mechanics::UpdateScheme::musl;
+/// frictional heat"), MUSL otherwise, and MUSL with linear shape functions: with USL (and USF) every
+/// contact scene measured blew up with them, MUSL ran each (docs/contact.md, "Linear shape
+/// functions and multimaterial contact").
+mechanics::UpdateScheme default_update_scheme(const ContactSpec& contact, mechanics::ShapeKind shape) {
+  if (!contact.enabled || shape == mechanics::ShapeKind::linear) return mechanics::UpdateScheme::musl;
   bool grid_contact = contact.options.default_pair.method == mechanics::ContactMethod::multimaterial;
   for (const ContactPairSpec& p : contact.pairs)
     grid_contact = grid_contact || p.settings.method == mechanics::ContactMethod::multimaterial;
@@ -155,11 +157,12 @@ mechanics::UpdateScheme default_update_scheme(const ContactSpec& contact) {
 }
 
 void parse_solver(const JsonReader& root, Scene& s) {  // after the contact section: default_update_scheme
-  s.options.scheme = default_update_scheme(s.contact);
+  s.options.scheme = default_update_scheme(s.contact, s.options.shape);
   const auto solver = root.find("solver");
   if (!solver) return;
   s.options.shape = mechanics::shape_kind_from_string(solver->choice(
       "shape_function", {"linear", "ugimp", "quadratic_bspline", "extended_bspline", "ebs"}, "ugimp"));
+  s.options.scheme = default_update_scheme(s.contact, s.options.shape);
   if (s.options.shape == mechanics::ShapeKind::extended_bspline)  // C_c, Kakouris 2024 eq. 20
     s.options.ebs_occupation = solver->number("ebs_occupation", s.options.ebs_occupation, Range::closed(0.0, 1.0));
   else if (const auto c = solver->find("ebs_occupation"))
