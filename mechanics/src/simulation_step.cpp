@@ -402,8 +402,8 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
   // the separate scatter of contact_at_extrapolated gives a contact node's slot, and full sums in the
   // others), when most particles reached a contact node on the last step: then the separate scatter
   // would walk most stencils a second time. 3D PBX (pbx_3d.json, nearly every particle reaches): 634 M
-  // instructions of the separate scatter in 10 steps became 463 M more in this one, and the 38 steps
-  // took 16-20 % less CPU; the 2D twin (a third reach) keeps the separate scatter (fused: +64 M in
+  // instructions of the separate scatter in 10 steps became 463 M more in this one, and 38 steps
+  // took 7-9 % less CPU (docs/performance.md, speed-s52); the 2D twin (a third reach) keeps the separate scatter (fused: +64 M in
   // 1540 steps). EBS stencils keep the separate scatter (no reach share is measured for them).
   const bool fused = contact_setup_.enabled && !is_extended<Kernel> && contact_nodes_.reach_share > 0.5;
   contact_nodes_.terms_scattered = fused;
