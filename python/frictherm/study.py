@@ -30,28 +30,33 @@ import sys
 
 from . import open as open_run
 from .study_analysis import study_levels
-from .study_runs import Output, cell_sets, find_program, last_line, read_scene, run_program, scene_cfl, validate
+from .study_runs import (Output, cell_sets, find_program, last_line, offset_sets, read_scene, run_program, scene_cfl,
+                         validate)
 
 __all__ = ["run_study", "Study", "Output", "find_program", "main"]
 
 
-def _run_name(cell, cfl):
-    return "h%.6g_C%.6g" % (cell, cfl)
+def _run_name(cell, cfl, offset=0.0):
+    return "h%.6g_C%.6g" % (cell, cfl) + ("_o%.6g" % offset if offset else "")
 
 
 class Study:
     """The runs of a study and their analysis. ``rows``: one dict per (cell, C) with keys cell, cfl,
     status (the run's /meta/status, or "error"), values {label: float}, wall_s (the child's wall
     time), cpu_s (its user + system CPU time), run_wall_s (the run's own /meta/wall_time), steps,
-    particles, file, note. ``outputs``: the Output objects; ``reference``: {label: given value}."""
+    particles, file, note. ``outputs``: the Output objects; ``reference``: {label: given value}.
+    With several grid offsets (``offsets``, fractions of a cell along ``offset_axes``) a row is the
+    ensemble of its (cell, C): values the mean over the offsets, ``spread`` {label: (min, max)},
+    costs summed, ``members`` the rows of the single runs (each with its ``offset``)."""
 
     def __init__(self, scene, rows, outputs, cells, cfls, sets=(), reference=None, assumed_order=None,
-                 tolerance=0.01, program=None):
+                 tolerance=0.01, program=None, offsets=(0.0,), offset_axes="x"):
         self.scene, self.rows, self.outputs = scene, rows, list(outputs)
         self.cells, self.cfls = sorted(cells, reverse=True), sorted(cfls, reverse=True)
         self.sets, self.program = list(sets), program
         self.reference = dict(reference or {})
         self.assumed_order, self.tolerance = assumed_order, tolerance
+        self.offsets, self.offset_axes = [float(o) for o in offsets], offset_axes
         self._analysis = {}
 
     def output(self, label):
@@ -125,14 +130,34 @@ class Study:
         return write_all(self, directory, charts=charts)
 
 
-def _plan(scene_path, cells, cfls, sets, scale_with_cell):
+def _plan(scene_path, cells, cfls, sets, scale_with_cell, offsets=(0.0,), offset_axes="x"):
     scene = read_scene(scene_path)
     plan = []
     for cell in cells:
         csets, _ = cell_sets(scene, cell, scale_with_cell)
         for cfl in cfls:
-            plan.append((cell, cfl, list(sets) + csets + ["solver.cfl=%r" % float(cfl)]))
+            for offset in offsets:
+                plan.append((cell, cfl, offset, list(sets) + csets + offset_sets(scene, cell, offset, offset_axes)
+                             + ["solver.cfl=%r" % float(cfl)]))
     return plan
+
+
+def _ensemble_row(members, outputs):
+    """One (cell, C) over several grid offsets: the mean of each output over the completed members
+    (NaN unless all completed), its (min, max), the costs summed (the ensemble's cost)."""
+    first = members[0]
+    bad = [m for m in members if m["status"] != "completed"]
+    row = dict(first, members=members, values={}, spread={},
+               status=bad[0]["status"] if bad else "completed",
+               note="; ".join("offset %g: %s" % (m["offset"], m["note"] or m["status"]) for m in bad),
+               wall_s=sum(m["wall_s"] for m in members), cpu_s=sum(m["cpu_s"] for m in members),
+               run_wall_s=sum(m["run_wall_s"] for m in members))
+    for o in outputs:
+        vals = [m["values"][o.label] for m in members]
+        ok = not bad and all(math.isfinite(v) for v in vals)
+        row["values"][o.label] = sum(vals) / len(vals) if ok else math.nan
+        row["spread"][o.label] = (min(vals), max(vals)) if ok else (math.nan, math.nan)
+    return row
 
 
 def _command(program, scene_path, out, threads, run_sets):
@@ -152,14 +177,14 @@ def _record(out, record_path, cmd):
     return None
 
 
-def _skipped_row(cell, cfl, outputs, runs_dir, note):
-    return dict(cell=cell, cfl=cfl, status="skipped", values={o.label: math.nan for o in outputs}, wall_s=math.nan,
-                cpu_s=math.nan, run_wall_s=math.nan, steps=0, particles=0,
-                file=os.path.join(runs_dir, _run_name(cell, cfl) + ".h5"), note=note, returncode=None)
+def _skipped_row(cell, cfl, offset, outputs, runs_dir, note):
+    return dict(cell=cell, cfl=cfl, offset=offset, status="skipped", values={o.label: math.nan for o in outputs},
+                wall_s=math.nan, cpu_s=math.nan, run_wall_s=math.nan, steps=0, particles=0,
+                file=os.path.join(runs_dir, _run_name(cell, cfl, offset) + ".h5"), note=note, returncode=None)
 
 
-def _one_run(program, scene_path, cell, cfl, run_sets, threads, runs_dir, outputs, reuse):
-    name = _run_name(cell, cfl)
+def _one_run(program, scene_path, cell, cfl, offset, run_sets, threads, runs_dir, outputs, reuse):
+    name = _run_name(cell, cfl, offset)
     out = os.path.join(runs_dir, name + ".h5")
     record_path = os.path.join(runs_dir, name + ".json")
     cmd = _command(program, scene_path, out, threads, run_sets)
@@ -170,7 +195,8 @@ def _one_run(program, scene_path, cell, cfl, run_sets, threads, runs_dir, output
                       note="" if rc == 0 else last_line(os.path.join(runs_dir, name + ".log")))
         with open(record_path, "w") as f:
             json.dump(record, f, indent=1)
-    row = dict(cell=cell, cfl=cfl, status="error", values={o.label: math.nan for o in outputs}, wall_s=record["wall_s"],
+    row = dict(cell=cell, cfl=cfl, offset=offset, status="error", values={o.label: math.nan for o in outputs},
+               wall_s=record["wall_s"],
                cpu_s=record["cpu_s"], run_wall_s=math.nan, steps=0, particles=0, file=out, note=record["note"],
                returncode=record["returncode"])
     if not os.path.exists(out):
@@ -194,7 +220,7 @@ def _one_run(program, scene_path, cell, cfl, run_sets, threads, runs_dir, output
 def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), reduce="final", sets=(),
               scale_with_cell=(), threads=1, jobs=1, program=None, workdir=None, reuse=True, reference=None,
               assumed_order=None, tolerance=0.01, units=None, max_cpu=None, plan_only=False, write=True, charts=True,
-              log=print):
+              offsets=None, offset_axes="x", log=print):
     """Runs `scene` at every cell size of `cells` (m; default the scene's own) and CFL factor of
     `cfls` (default the scene's own) and returns a Study.
 
@@ -214,8 +240,12 @@ def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), r
     units     {output label: unit} for the charts (else guessed: J for work, K for temperature)
     max_cpu   skip a run whose CPU time, predicted from the finished ones (CPU s per particle-step
               times its particles x steps from `frictherm validate`), exceeds this many seconds
+    offsets   grid offsets in cells, e.g. [0, 0.5]: each (cell, C) runs once per offset with the grid
+              moved under the scene along `offset_axes` ("x", "xy"); its values are the mean over the
+              offsets and their range the alignment spread (docs/study.md, "Grid alignment")
     plan_only check every combination with `frictherm validate` and return
-              {(cell, C): (particles, estimated steps)} without running anything
+              {(cell, C): (particles, estimated steps)} ({(cell, C, offset): ...} with several
+              offsets) without running anything
     log       a function for progress lines (None: quiet)
     """
     program = find_program(program)
@@ -238,61 +268,76 @@ def run_study(scene, cells=None, cfls=None, outputs=("friction_work_second",), r
         cells = [float(own[0] if isinstance(own, list) else own)]
     if len(set(cells)) != len(cells) or len(set(cfls)) != len(cfls):
         raise ValueError("the cell sizes and the C values must each be distinct")
-    plan = _plan(scene, cells, cfls, sets, scale_with_cell)
+    offsets = [float(o) for o in (offsets or [0.0])]
+    if len(set(offsets)) != len(offsets):
+        raise ValueError("the grid offsets must be distinct")
+    plan = _plan(scene, cells, cfls, sets, scale_with_cell, offsets, offset_axes)
     workdir = workdir or os.path.join(os.getcwd(), os.path.splitext(os.path.basename(scene))[0] + "_study")
     runs_dir = os.path.join(workdir, "runs")
     if log:
-        log("study of %s: %d runs (cells %s m, C %s), %d thread(s) each, %d at once, in %s"
+        log("study of %s: %d runs (cells %s m, C %s%s), %d thread(s) each, %d at once, in %s"
             % (scene, len(plan), ", ".join("%g" % h for h in sorted(cells, reverse=True)),
-               ", ".join("%g" % c for c in sorted(cfls, reverse=True)), threads, jobs, runs_dir))
-    plan.sort(key=lambda p: (-p[0], -p[1]))  # cheapest first: a broken set-up shows at once
-    estimates = {(cell, cfl): validate(program, scene, run_sets) for cell, cfl, run_sets in plan}  # scene errors now
+               ", ".join("%g" % c for c in sorted(cfls, reverse=True)),
+               "; grid offsets %s cells along %s" % (", ".join("%g" % o for o in offsets), offset_axes)
+               if len(offsets) > 1 else "", threads, jobs, runs_dir))
+    plan.sort(key=lambda p: (-p[0], -p[1], p[2]))  # cheapest first: a broken set-up shows at once
+    # scene errors now
+    estimates = {(cell, cfl, off): validate(program, scene, run_sets) for cell, cfl, off, run_sets in plan}
     if log:
-        for cell, cfl, _ in plan:
-            n, steps = estimates[(cell, cfl)]
-            log("  plan: h = %-9g C = %-7g %9s particles x %9s steps" % (cell, cfl, n, steps))
-    if plan_only:
-        return estimates
+        for cell, cfl, off, _ in plan:
+            n, steps = estimates[(cell, cfl, off)]
+            log("  plan: h = %-9g C = %-7g %s%9s particles x %9s steps"
+                % (cell, cfl, "offset %-5g " % off if len(offsets) > 1 else "", n, steps))
+    if plan_only:  # keyed (cell, C), or (cell, C, offset) with several offsets
+        return estimates if len(offsets) > 1 else {(h, c): v for (h, c, _), v in estimates.items()}
     os.makedirs(runs_dir, exist_ok=True)
     rows = []
 
     def done(row):
-        row["estimate"] = estimates[(row["cell"], row["cfl"])]
+        row["estimate"] = estimates[(row["cell"], row["cfl"], row["offset"])]
         rows.append(row)
         if log:
             vals = "  ".join("%s = %.6g" % (k, v) for k, v in row["values"].items())
-            log("  h = %-9g C = %-7g %-10s %7.1f s CPU %7.1f s wall  %d steps  %s%s"
-                % (row["cell"], row["cfl"], row["status"], row["cpu_s"], row["wall_s"], row["steps"], vals,
+            log("  h = %-9g C = %-7g %s%-10s %7.1f s CPU %7.1f s wall  %d steps  %s%s"
+                % (row["cell"], row["cfl"], "offset %-5g " % row["offset"] if len(offsets) > 1 else "",
+                   row["status"], row["cpu_s"], row["wall_s"], row["steps"], vals,
                    ("  (" + row["note"] + ")") if row["note"] else ""))
 
-    def predicted_cpu(cell, cfl):
+    def predicted_cpu(cell, cfl, offset):
         """CPU s of a run from the finished ones: CPU s per particle-step times its particles x steps."""
         rates = sorted(r["cpu_s"] / (r["particles"] * r["steps"]) for r in rows
                        if r["status"] == "completed" and r["particles"] and r["steps"])
-        n, steps = estimates[(cell, cfl)]
+        n, steps = estimates[(cell, cfl, offset)]
         if not rates or not n or not steps:
             return None
         return rates[len(rates) // 2] * n * steps
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         pending = set()
-        for cell, cfl, run_sets in plan:
+        for cell, cfl, off, run_sets in plan:
             while len(pending) >= max(1, jobs):
                 finished, pending = concurrent.futures.wait(pending, return_when=concurrent.futures.FIRST_COMPLETED)
                 for fut in finished:
                     done(fut.result())
-            guess = predicted_cpu(cell, cfl) if max_cpu else None
-            out = os.path.join(runs_dir, _run_name(cell, cfl) + ".h5")
+            guess = predicted_cpu(cell, cfl, off) if max_cpu else None
+            out = os.path.join(runs_dir, _run_name(cell, cfl, off) + ".h5")
             cmd = _command(program, scene, out, threads, run_sets)
             if guess is not None and guess > max_cpu and not (reuse and _record(out, out[:-3] + ".json", cmd)):
-                done(_skipped_row(cell, cfl, outs, runs_dir, "predicted %.0f s CPU > max_cpu %g s" % (guess, max_cpu)))
+                done(_skipped_row(cell, cfl, off, outs, runs_dir,
+                                  "predicted %.0f s CPU > max_cpu %g s" % (guess, max_cpu)))
                 continue
-            pending.add(pool.submit(_one_run, program, scene, cell, cfl, run_sets, threads, runs_dir, outs, reuse))
+            pending.add(pool.submit(_one_run, program, scene, cell, cfl, off, run_sets, threads, runs_dir, outs,
+                                    reuse))
         for fut in concurrent.futures.as_completed(pending):
             done(fut.result())
-    rows.sort(key=lambda r: (-r["cell"], -r["cfl"]))
+    rows.sort(key=lambda r: (-r["cell"], -r["cfl"], r["offset"]))
+    if len(offsets) > 1:  # one row per (cell, C): the ensemble over the offsets
+        groups = {}
+        for r in rows:
+            groups.setdefault((r["cell"], r["cfl"]), []).append(r)
+        rows = [_ensemble_row(members, outs) for members in groups.values()]
     study = Study(scene, rows, outs, cells, cfls, sets=sets, reference=reference, assumed_order=assumed_order,
-                  tolerance=tolerance, program=program)
+                  tolerance=tolerance, program=program, offsets=offsets, offset_axes=offset_axes)
     study.created = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     study.threads, study.scale_with_cell = threads, list(scale_with_cell)
     if write:
@@ -334,6 +379,10 @@ def main(argv=None):
     ap.add_argument("-o", "--out", help="directory for runs, table and charts (default SCENE_study)")
     ap.add_argument("--max-cpu", type=float, metavar="S",
                     help="skip runs predicted (from the finished ones) to take more than S CPU seconds")
+    ap.add_argument("--offsets", type=parse_floats, metavar="O1,O2,...",
+                    help="grid offsets in cells, e.g. 0,0.5: every (h, C) runs once per offset, its value the mean "
+                         "and the range the alignment spread")
+    ap.add_argument("--offset-axes", default="x", help="the axes the grid moves along (default x)")
     ap.add_argument("--plan", action="store_true", help="validate every combination, print the plan, run nothing")
     ap.add_argument("--rerun", action="store_true", help="rerun even runs that are already there")
     ap.add_argument("--no-charts", action="store_true")
@@ -362,7 +411,8 @@ def main(argv=None):
                           scale_with_cell=a.scale_with_cell, threads=a.threads, jobs=a.jobs, program=a.frictherm,
                           workdir=a.out, reuse=not a.rerun, reference=reference, assumed_order=a.assumed_order,
                           tolerance=a.tolerance, units=units, max_cpu=a.max_cpu, plan_only=a.plan,
-                          charts=not a.no_charts, log=None if a.quiet and not a.plan else print)
+                          charts=not a.no_charts, offsets=a.offsets, offset_axes=a.offset_axes,
+                          log=None if a.quiet and not a.plan else print)
     except (ValueError, KeyError, FileNotFoundError, RuntimeError) as e:
         print("frictherm.study: %s" % (e.args[0] if e.args else e), file=sys.stderr)
         return 2

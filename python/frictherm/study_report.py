@@ -27,21 +27,34 @@ def _length_scale(cells):
     return 1.0, "m"
 
 
+def _ensembles(study):
+    return len(getattr(study, "offsets", [0.0])) > 1
+
+
+def _spread(row, label):
+    """max - min of an output over a row's grid offsets (NaN without offsets)."""
+    lo, hi = row.get("spread", {}).get(label, (math.nan, math.nan))
+    return hi - lo
+
+
 def write_csv(study, path):
-    """One row per run: cell_m, cfl, status, then per output its value and its relative error to the
-    reference, then wall_s, cpu_s, run_wall_s, steps, particles, file, note."""
+    """One row per run (per (cell, C) ensemble with grid offsets): cell_m, cfl, status, then per output
+    its value, its relative error to the reference (and with offsets its spread, max - min over the
+    offsets), then wall_s, cpu_s, run_wall_s, steps, particles, file, note."""
     labels = [o.label for o in study.outputs]
     errors = {lb: study.analysis(lb)["errors"] for lb in labels}
+    ens = _ensembles(study)
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         head = ["cell_m", "cfl", "status"]
         for lb in labels:
-            head += [lb, lb + " rel_error"]
+            head += [lb, lb + " rel_error"] + ([lb + " offset_spread"] if ens else [])
         w.writerow(head + ["wall_s", "cpu_s", "run_wall_s", "steps", "particles", "file", "note"])
         for r in study.rows:
             line = [repr(r["cell"]), repr(r["cfl"]), r["status"]]
             for lb in labels:
                 line += [_g(r["values"][lb], "%.10g"), _g(errors[lb][(r["cell"], r["cfl"])], "%.4e")]
+                line += [_g(_spread(r, lb), "%.10g")] if ens else []
             w.writerow(line + ["%.3f" % r["wall_s"], "%.3f" % r["cpu_s"], _g(r["run_wall_s"], "%.3f"), r["steps"],
                                r["particles"], os.path.relpath(r["file"], os.path.dirname(os.path.abspath(path))),
                                r["note"]])
@@ -76,6 +89,11 @@ def summary_lines(study):
         ("; every run with " + ", ".join("`--set %s`" % s for s in study.sets)) if study.sets else ""))
     if getattr(study, "scale_with_cell", None):
         out[-1] += " Scaled with the cell: %s." % ", ".join("`%s`" % s for s in study.scale_with_cell)
+    ens = _ensembles(study)
+    if ens:
+        out[-1] += (" Every (h, C) ran with the grid moved by %s cells along %s: its value is the mean over "
+                    "these offsets, ± half their range (the alignment spread)."
+                    % (", ".join("%g" % o for o in study.offsets), study.offset_axes))
     out.append("")
     bad = [r for r in study.rows if r["status"] != "completed"]
     for r in bad:
@@ -98,8 +116,9 @@ def summary_lines(study):
                     cells.append(row["status"])
                 else:
                     err = a["errors"][(h, c)]
-                    cells.append("%.6g (%s %%, %.3g s)"
-                                 % (row["values"][o.label], _g(100 * err, "%+.2g"), row["cpu_s"]))
+                    pm = " ± %.3g" % (0.5 * _spread(row, o.label)) if ens else ""
+                    cells.append("%.6g%s (%s %%, %.3g s)"
+                                 % (row["values"][o.label], pm, _g(100 * err, "%+.2g"), row["cpu_s"]))
             out.append("| %g | " % (h * k) + " | ".join(cells) + " |")
         ref, source = a["reference"]
         out += ["", "Each entry: value (relative error to the reference, CPU seconds of the run). Reference: "
@@ -116,6 +135,8 @@ def summary_lines(study):
                            "triple's GCI does not show" % (len(limits), what, lo, hi, 100 * (hi - lo) / abs(hi)))
         if a["limit_both"] is not None:
             out += ["- " + s for s in _direction_lines(a["limit_both"], "the limits in C, along h")]
+        if ens:
+            out += ["- " + s for s in alignment_lines(study, o.label, k, lu)]
         rec = a["recommendation"]
         tol = 100 * study.tolerance
         if rec is None:
@@ -126,6 +147,27 @@ def summary_lines(study):
                           100 * a["errors"][(rec["cell"], rec["cfl"])], rec["cpu_s"]))
         out.append("")
     return out
+
+
+def alignment_lines(study, label, k=1.0, lu="m"):
+    """Per cell size, the largest spread over the grid offsets (relative to the mean), and whether it
+    shrinks with the cell: a spread that does not shrink is a discretization error of that size at
+    every cell, which no single-grid run shows and no extrapolation removes."""
+    lines = []
+    worst = []
+    for h in study.cells:
+        rel = [abs(_spread(r, label) / r["values"][label]) for r in study.rows
+               if r["cell"] == h and r["status"] == "completed" and r["values"][label]]
+        rel = [x for x in rel if math.isfinite(x)]
+        if rel:
+            worst.append((h, max(rel)))
+    if worst:
+        lines.append("alignment spread (max - min over the offsets, of the mean), largest over C: "
+                     + ", ".join("%.3g %% at h = %g %s" % (100 * x, h * k, lu) for h, x in worst))
+    if len(worst) >= 2:
+        shrinks = all(b[1] < a[1] for a, b in zip(worst, worst[1:]))
+        lines.append("the alignment spread %s as the cell shrinks" % ("shrinks" if shrinks else "does not shrink steadily"))
+    return lines
 
 
 def write_markdown(study, path):
@@ -160,6 +202,18 @@ def _level_ticks(ax, levels):
     ax.xaxis.set_minor_locator(NullLocator())
 
 
+def _offset_bars(ax, study, label, rows, x_key, x_scale, color):
+    """With grid offsets: a bar from the smallest to the largest value over the offsets at each point."""
+    if not _ensembles(study):
+        return
+    pts = [(r[x_key] * x_scale, r["values"][label], r["spread"][label]) for r in rows
+           if r["status"] == "completed" and math.isfinite(r["values"][label])]
+    if pts:
+        ax.errorbar([p[0] for p in pts], [p[1] for p in pts],
+                    yerr=[[p[1] - p[2][0] for p in pts], [p[2][1] - p[1] for p in pts]],
+                    fmt="none", ecolor=color, elinewidth=0.8, capsize=3)
+
+
 def write_charts(study, directory):
     """Per group of outputs with one unit: value against the cell size (one line per C, dashed: the
     extrapolated limit), value against C (one line per cell size), and the work-precision chart:
@@ -186,6 +240,7 @@ def write_charts(study, directory):
                     col = colors[(j * len(study.cfls) + i) % len(colors)]
                     ax.plot([h * k for h in la["levels"]], la["values"], MARKERS[j % len(MARKERS)] + "-", color=col,
                             label="%s, C = %g" % (o.label, c) if len(group) > 1 else "C = %g" % c)
+                    _offset_bars(ax, study, o.label, [r for r in study.rows if r["cfl"] == c], "cell", k, col)
                     b = la["best"]
                     if b is not None and b.extrapolated and b.status in (MONOTONE, CONVERGED, "assumed order"):
                         ax.axhline(b.limit, color=col, ls="--", lw=0.8)
@@ -208,6 +263,7 @@ def write_charts(study, directory):
                     col = colors[(j * len(study.cells) + i) % len(colors)]
                     ax.plot(la["levels"], la["values"], MARKERS[j % len(MARKERS)] + "-", color=col,
                             label=("%s, " % o.label if len(group) > 1 else "") + "h = %g %s" % (h * k, lu))
+                    _offset_bars(ax, study, o.label, [r for r in study.rows if r["cell"] == h], "cfl", 1.0, col)
                     b = la["best"]
                     if b is not None and b.extrapolated:
                         ax.axhline(b.limit, color=col, ls="--", lw=0.8)

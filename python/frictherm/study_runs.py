@@ -146,6 +146,37 @@ def cell_sets(scene, cell, scale_with_cell=()):
     return sets, float(own)
 
 
+AXES = "xyz"
+
+
+def offset_sets(scene, cell, offset, axes="x"):
+    """The --set overrides that move the grid by `offset` cells (a fraction in [0, 1)) along `axes`
+    ("x", "xy", ...) under a scene that stays put: grid.lo and grid.hi each less offset x cell there.
+    Where a body's edge falls on a node line, offset 0.5 puts it in the middle of a cell: the spread of
+    an output over offsets is the part of its discretization error that the grid's alignment makes
+    (docs/study.md, "Grid alignment"). An offset of 0 is the scene's own grid (no override). Only
+    axes whose grid faces carry no boundary condition and whose bodies keep a margin to the grid's
+    faces should move; `frictherm validate` refuses a body that leaves the grid."""
+    offset = float(offset)
+    if not 0.0 <= offset < 1.0:
+        raise ValueError("grid offset %r: an offset is a fraction of a cell in [0, 1)" % offset)
+    if offset == 0.0:
+        return []
+    grid = scene.get("grid", {})
+    lo, hi = grid.get("lo"), grid.get("hi")
+    if not isinstance(lo, list) or not isinstance(hi, list) or len(lo) != len(hi):
+        raise ValueError("grid offsets move grid.lo and grid.hi: the scene must give both as vectors")
+    if not axes or any(a not in AXES[:len(lo)] for a in axes) or len(set(axes)) != len(axes):
+        raise ValueError("grid offset axes %r: letters of %r (the grid has %d dimensions)"
+                         % (axes, AXES[:len(lo)], len(lo)))
+    moved_lo, moved_hi = [float(x) for x in lo], [float(x) for x in hi]
+    for a in axes:
+        i = AXES.index(a)
+        moved_lo[i] -= offset * float(cell)
+        moved_hi[i] -= offset * float(cell)
+    return ["grid.lo=%s" % json.dumps(moved_lo), "grid.hi=%s" % json.dumps(moved_hi)]
+
+
 def scene_cfl(scene):
     return float(scene.get("solver", {}).get("cfl", 0.5))  # docs/scenes.md: solver.cfl defaults to 0.5
 

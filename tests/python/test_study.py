@@ -9,7 +9,7 @@ import pytest
 
 import frictherm
 from frictherm.study import run_study
-from frictherm.study_runs import Output, cell_sets, strip_comments
+from frictherm.study_runs import Output, cell_sets, offset_sets, strip_comments
 
 SOURCE = os.environ.get("FRICTHERM_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 # The smallest sliding block with frictional heat (1 mm cells, 0.5 ms, about 0.2 s of CPU): at 1 and
@@ -100,6 +100,50 @@ def test_a_bad_cell_size_is_refused_before_any_run(workdir):
     with pytest.raises(ValueError, match="grid.cell_size"):
         run_study(SCENE, cells=[0.0007], program=_exe(), workdir=os.path.join(workdir, "bad_study"), log=None)
     assert not os.path.exists(os.path.join(workdir, "bad_study", "runs"))
+
+
+def test_grid_offsets_make_an_ensemble_of_direct_runs(workdir):
+    """Offsets 0 and 0.5 cells along x at 1 mm: each member is `frictherm run` with the grid moved
+    (grid.lo and grid.hi less half a cell in x, the scene in place), bit for bit on one thread; the
+    row is their mean, its spread their range, its cost their sum; offset 0 is the scene's own grid."""
+    d = os.path.join(workdir, "offset_study")
+    st = run_study(SCENE, cells=[0.001], cfls=[0.5], outputs=OUTPUTS[:1], program=_exe(), workdir=d, log=None,
+                   offsets=[0.0, 0.5], offset_axes="x")
+    (row,) = st.rows
+    members = {m["offset"]: m for m in row["members"]}
+    assert sorted(members) == [0.0, 0.5] and row["status"] == "completed"
+    direct = {}
+    for off, extra in ((0.0, []), (0.5, ["--set", "grid.lo=[-0.0005, 0.0]", "--set", "grid.hi=[0.0255, 0.012]"])):
+        out = os.path.join(workdir, "offset_direct_%g.h5" % off)
+        subprocess.run([_exe(), "run", SCENE, "-o", out, "--force", "--quiet", "--threads", "1",
+                        "--set", "grid.cell_size=0.001"] + extra, check=True)
+        with frictherm.open(out) as run:
+            direct[off] = run.series["friction_work_second"][-1]
+        with frictherm.open(members[off]["file"]) as run:
+            assert run.meta["grid_lo"][0] == pytest.approx(-off * 1e-3, abs=1e-15)  # moved by 0 / 0.5 cell
+    for off in (0.0, 0.5):
+        assert members[off]["values"]["friction_work_second"] == direct[off]
+    w = row["values"]["friction_work_second"]
+    assert w == pytest.approx(0.5 * (direct[0.0] + direct[0.5]), rel=1e-15)
+    assert row["spread"]["friction_work_second"] == (min(direct.values()), max(direct.values()))
+    assert row["cpu_s"] == pytest.approx(members[0.0]["cpu_s"] + members[0.5]["cpu_s"], rel=1e-12)
+    with open(os.path.join(d, "study.csv")) as f:
+        (line,) = list(csv.DictReader(f))
+    assert float(line["friction_work_second offset_spread"]) == pytest.approx(abs(direct[0.5] - direct[0.0]), rel=1e-9)
+    with open(os.path.join(d, "study.md")) as f:
+        assert "alignment spread" in f.read()
+
+
+def test_grid_offsets_are_checked():
+    scene = {"grid": {"lo": [0, 0], "hi": [0.2, 0.1], "cell_size": 0.01}}
+    assert offset_sets(scene, 0.01, 0.0) == []
+    assert offset_sets(scene, 0.01, 0.25, "xy") == ["grid.lo=[-0.0025, -0.0025]", "grid.hi=[0.1975, 0.0975]"]
+    with pytest.raises(ValueError, match="fraction of a cell"):
+        offset_sets(scene, 0.01, 1.0)
+    with pytest.raises(ValueError, match="axes 'z'"):
+        offset_sets(scene, 0.01, 0.5, "z")  # a 2D grid
+    with pytest.raises(ValueError, match="grid.lo and grid.hi"):
+        offset_sets({"grid": {"cells": [4, 4]}}, 0.01, 0.5)
 
 
 # ---- scene handling and reductions (no runs) ----
