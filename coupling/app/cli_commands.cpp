@@ -23,13 +23,16 @@ const OptionSpec kForceOption{{"-f", "--force"}, false, "force"};
 namespace {
 
 /// Loads a scene with the --set overrides; a problem becomes "frictherm: SCENE: message" and exit
-/// code 2 (returned as false).
-bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene, std::ostream& err = std::cerr) {
+/// code 2 (returned as false). With `notes`, the scene's notes (Scene::notes) go to `err`.
+bool load(const std::string& path, const ParsedArgs& a, coupling::Scene& scene, std::ostream& err = std::cerr,
+          bool notes = true) {
   try {
     std::vector<coupling::SceneOverride> overrides;
     if (a.lists.count("set"))
       for (const auto& assignment : a.lists.at("set")) overrides.push_back(coupling::parse_override(assignment));
     scene = coupling::load_scene(path, overrides);
+    if (notes)
+      for (const std::string& n : scene.notes) err << "frictherm: " << path << ": note: " << n << '\n';
     return true;
   } catch (const coupling::SceneError& e) {
     err << "frictherm: " << path << ": " << e.what() << '\n';
@@ -85,7 +88,7 @@ int run_command(const std::vector<std::string>& args, const std::string& command
 
 int serial_run_command(const ParsedArgs& a, const std::string& path, const coupling::RunOptions& opt) {
   coupling::Scene scene;
-  if (!load(path, a, scene)) return kUsage;
+  if (!load(path, a, scene, std::cerr, !opt.quiet)) return kUsage;
   coupling::RunResult r;
   try {
     r = coupling::run_scene(scene, opt);

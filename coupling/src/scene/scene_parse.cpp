@@ -169,6 +169,13 @@ void parse_solver(const JsonReader& root, Scene& s) {  // after the contact sect
     c->fail("only with \"shape_function\": \"extended_bspline\"");
   s.options.scheme = mechanics::update_scheme_from_string(
       solver->choice("scheme", {"usf", "usl", "musl"}, mechanics::to_string(s.options.scheme)));
+  if (s.options.shape == mechanics::ShapeKind::linear && s.options.scheme != mechanics::UpdateScheme::musl &&
+      default_update_scheme(s.contact, mechanics::ShapeKind::ugimp) != mechanics::UpdateScheme::musl)
+    s.notes.push_back(std::string("solver.scheme \"") + mechanics::to_string(s.options.scheme) +
+                      "\" with \"shape_function\": \"linear\" and multimaterial contact: every contact scene "
+                      "measured blew up with this combination, MUSL runs them (\"scheme\": \"musl\", the default "
+                      "for linear shape functions with contact; docs/contact.md, \"Linear shape functions and "
+                      "multimaterial contact\")");
   s.options.cfl = solver->number("cfl", 0.5, Range::left_open(0.0, 1.0));
   if (const auto m = solver->find("max_time_step")) s.options.max_time_step = m->as_number(Range::positive());
   if (const auto t = solver->find("pic_relaxation_time")) s.options.pic_relaxation_time = t->as_number(Range::positive());

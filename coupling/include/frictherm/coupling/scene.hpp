@@ -119,6 +119,9 @@ struct Scene {
   OutputSpec output;
   ContactSpec contact;       // `contact` section (scene_contact.hpp); one shared velocity field when absent
   ThermalSceneSpec thermal;  // `thermal` and `coupling` sections (scene_thermal.hpp); disabled when absent
+  // Settings the scene may run with but that are known to fail or mislead, each naming its key and
+  // what to use instead; `frictherm validate` and `frictherm run` (unless --quiet) print them.
+  std::vector<std::string> notes;
 };
 
 /// Reads and validates a scene file. Image files are looked up relative to the scene's folder.
