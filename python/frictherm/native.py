@@ -13,6 +13,7 @@ environment when it finds it (FRICTHERM_BUILD_DIR, python/setup.py, docs/python.
 """
 import json
 import os
+import warnings
 
 try:
     from . import _native
@@ -93,7 +94,9 @@ def _translate(call, *args):
 
 def validate(scene):
     """Parses and validates the scene as the program does; returns {"json", "dimension",
-    "end_time", "name"}. Raises SceneError naming the key."""
+    "end_time", "name", "notes"}: "notes" lists settings the scene runs with but that are known to
+    fail or mislead, each naming its key (what `frictherm validate` prints as notes). Raises
+    SceneError naming the key."""
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
     return _translate(lambda n, *a: n.validate(*a), *scene._args())
 
@@ -106,10 +109,12 @@ def run(scene, output, threads=1, observer=None, overwrite=True, every=1):
     Ctrl-C (SIGINT, or SIGTERM) ends the run after the current step, writes its series and a last
     snapshot (status ``interrupted``) and raises KeyboardInterrupt; a second Ctrl-C ends the process
     at once, as for the program. The handlers are Python's again after the run. Returns {"status", "output", "steps", "time", "wall_time", "snapshots",
-    "series_rows", "particles", "message"}."""
+    "series_rows", "particles", "message", "notes"} (the scene's notes, also warned as UserWarning)."""
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
     result = _translate(lambda n, *a: n.run(*a), *scene._args(), os.fspath(output), int(threads), bool(overwrite),
                         observer, int(every))
+    for note in result.get("notes", []):  # as `frictherm run` prints them (a UserWarning each)
+        warnings.warn(note, stacklevel=2)
     if result["status"] == "interrupted":  # Ctrl-C: the run ended cleanly, the file is complete to here
         raise KeyboardInterrupt(f"{result['message']}; {result['output']} holds the run so far (status interrupted)")
     return result

@@ -126,6 +126,7 @@ PYBIND11_MODULE(_native, m) {
     d["dimension"] = s.dimension;
     d["end_time"] = s.end_time;
     d["name"] = s.name;
+    d["notes"] = s.notes;  // settings known to fail or mislead, naming the key (Scene::notes)
     return d;
   });
 
@@ -167,6 +168,7 @@ PYBIND11_MODULE(_native, m) {
     d["series_rows"] = r.series_rows;
     d["particles"] = r.particles;
     d["message"] = r.message;
+    d["notes"] = scene.notes;
     return d;
   });
 }

@@ -85,6 +85,16 @@ def test_scene_errors_name_the_key():
     assert "grdi" in str(e.value)
 
 
+def test_validate_lists_the_notes_of_a_combination_known_to_fail():
+    """USL with linear shape functions and multimaterial contact blew up in every contact scene
+    measured (docs/contact.md): it validates, with one note naming solver.scheme; the default has none."""
+    scene = frictherm.load_scene(os.path.join(SOURCE, "examples", "sliding_block.json"))
+    assert frictherm.validate(scene)["notes"] == []
+    linear = scene.set("solver.shape_function", "linear").set("solver.scheme", "usl")
+    (note,) = frictherm.validate(linear)["notes"]
+    assert 'solver.scheme "usl"' in note and "musl" in note
+
+
 def test_scene_from_a_dict_and_back():
     scene = frictherm.load_scene(SCENE).set("solver.cfl", 0.3)
     d = scene.to_dict()
