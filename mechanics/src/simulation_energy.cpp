@@ -31,7 +31,7 @@ template <int Dim>
 EnergyBalance Simulation<Dim>::energy_balance(HeatingOrder order) const {
   EnergyBalance b;
   b.kinetic = kinetic_energy();
-  b.stored = strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
+  b.stored = strain_energy() + contact_stored_energy();
   b.initial = std::isnan(work_books_.initial_energy) ? b.kinetic + b.stored : work_books_.initial_energy;
   b.external_work = work_books_.external;
   b.rigid_work = work_books_.rigid;

@@ -136,7 +136,7 @@ void Simulation<Dim>::init_fields() {
   contact_books_.work_first.assign(grid_.node_count(), 0.0);
   contact_books_.work_second.assign(grid_.node_count(), 0.0);
   layout_.field_velocity.assign(fields_.size(), Vec<Dim>::Zero());
-  if (contact_setup_.enabled) setup_penalty();
+  contact_methods_ = contact_methods_for(*this);  // with their set-up (penalty: pairs, boundary points)
 }
 
 // Each material's field covers the box [lo, hi] of nodes its particles reach, stored contiguously:

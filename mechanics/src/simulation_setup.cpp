@@ -290,14 +290,20 @@ double Simulation<Dim>::stable_time_step() const {
     }
   }
   cmax = with_rigid_speeds(cmax, materials_, clock_.time);
-  const double dt_penalty = penalty_time_step_limit(cmax);  // light nodes under contacts (simulation_penalty.cpp)
-  cmax *= penalty_wave_factor();
+  // The contact methods' bounds (penalty: light nodes under its springs) and wave-speed factors (a
+  // penalty stiffer than the bodies), step/contact_method.hpp.
+  double dt_contact = std::numeric_limits<double>::infinity(), contact_factor = 1.0;
+  for (const StepContactMethod<Dim>* m : contact_methods_) {
+    dt_contact = std::min(m->time_step_limit(*this, cmax), dt_contact);
+    contact_factor *= m->wave_speed_factor(*this);
+  }
+  cmax *= contact_factor;
   const double dt_damping = damping_active(opt_.damping_rate, opt_.damping_until, clock_.time)
                                 ? damping_time_step_limit(opt_.damping_rate)
                                 : std::numeric_limits<double>::infinity();
   const double dt = cfl_time_step(opt_.cfl, grid_.min_cell_size(), cmax, opt_.max_time_step);
   if (cmax <= 0.0) return std::min(dt, dt_damping);
-  return std::min({dt, dt_penalty, dt_damping});
+  return std::min({dt, dt_contact, dt_damping});
 }
 
 template <int Dim>

@@ -50,7 +50,7 @@ double Simulation<Dim>::step(double dt_limit) {
   finalize();
   // The energy books' start (EnergyBalance::initial): once, before the first step moves anything.
   if (std::isnan(work_books_.initial_energy))
-    work_books_.initial_energy = kinetic_energy() + strain_energy() + (penalty_state_.contact ? penalty_state_.contact->stored_energy() : 0.0);
+    work_books_.initial_energy = kinetic_energy() + strain_energy() + contact_stored_energy();
   if (schedule_.phases.empty() || schedule_.key != phase_key()) build_phases();
   StepContext ctx;
   ctx.dt_limit = dt_limit;
@@ -60,16 +60,14 @@ double Simulation<Dim>::step(double dt_limit) {
   return ctx.dt;
 }
 
-// What the phase lists depend on; a change rebuilds them.
+// What the phase lists depend on; a change rebuilds them. (The contact methods are not in it:
+// finalize() chooses them, before the first list is built, and nothing changes them after.)
 template <int Dim>
 long Simulation<Dim>::phase_key() const {
   long key = static_cast<long>(opt_.shape);
   key = key * 4 + static_cast<long>(opt_.scheme);
   key = key * 8 + static_cast<long>(opt_.particle_update);
   key = key * 2 + (opt_.damping_rate > 0.0);
-  key = key * 2 + contact_setup_.enabled;
-  key = key * 2 + (contact_setup_.enabled && contact_setup_.options.separation == SeparationMethod::extent);
-  key = key * 2 + penalty_state_.contact.has_value();
   key = key * 2 + !conditions_.resolved_loads.empty();
   return key;
 }
@@ -96,9 +94,10 @@ std::vector<const char*> Simulation<Dim>::step_phase_names() {
 // The step's phase lists. USF: stress from the extrapolated grid velocities, then the forces; USL:
 // forces from the start-of-step stress, the stress update after the grid update (with the
 // grid-to-particle update in one pass); MUSL: as USL, then the momenta remapped from the updated
-// particles and the stress from their velocities. Contact (multimaterial) passes follow each
-// momentum projection; penalty contact adds its forces before the grid update and moves its boundary
-// points with the velocity the stress update uses (simulation_penalty.cpp).
+// particles and the stress from their velocities. The contact methods (step/contact_method.hpp,
+// contact_methods/) add their phases at the hooks `contact(ContactHook::...)` below: multimaterial
+// contact a pass after each momentum projection, penalty contact its forces before the velocity
+// conditions and the boundary points' move where the stress update's velocity is on the grid.
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
@@ -106,11 +105,14 @@ void Simulation<Dim>::build_phases() {
   PhaseList& P = schedule_.phases;
   const UpdateScheme scheme = opt_.scheme;
   const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
-  const bool penalty = penalty_state_.contact.has_value();
   const bool flip = opt_.particle_update == ParticleUpdate::flip;
-  // USL with contact: the particle pass also evaluates the next step's stencils and boxes and moves
-  // the rigid particles (nothing after it in the step needs this step's stencils).
-  const bool refresh = usl && contact_setup_.enabled && !is_extended<Kernel>;
+  const auto contact = [&](ContactHook at) {
+    for (const StepContactMethod<Dim>* m : contact_methods_) m->add_phases(at, scheme, opt_.shape, *this, P);
+  };
+  // USL with contact (the velocity fields per material): the particle pass also evaluates the next
+  // step's stencils and boxes and moves the rigid particles (nothing after it in the step needs this
+  // step's stencils).
+  const bool refresh = usl && !contact_methods_.empty() && !is_extended<Kernel>;
 
   P.add("time_step", &T::time_step, [this](StepContext& c) {
     c.dt = std::min(stable_time_step(), c.dt_limit);
@@ -122,26 +124,22 @@ void Simulation<Dim>::build_phases() {
   });
   P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
   P.add("particle_to_grid", &T::particle_to_grid, [this, usf](StepContext& c) { map_to_grid<Kernel>(c.dt, !usf); });
-  if (contact_setup_.enabled)
-    P.add("contact_extrapolated", &T::contact, [this](StepContext& c) { contact_at_extrapolated<Kernel>(c.dt); });
+  contact(ContactHook::extrapolated);
   if (usf) {
     P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
     P.add("stress_update", &T::stress_update, [this](StepContext& c) { stress_pass<Kernel>(c.dt); });
     P.add("internal_forces", &T::particle_to_grid, [this](StepContext&) { add_internal_forces<Kernel>(); });
-    if (penalty)  // the points move with the velocity the stress update used
-      P.add("move_boundary_points", &T::contact, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
+    contact(ContactHook::stress_velocity);
   }
   if (!conditions_.resolved_loads.empty())
     P.add("external_loads", &T::particle_to_grid, [this](StepContext& c) { map_external_loads<Kernel>(c.t); });
-  if (penalty)  // point forces into the nodal forces (Kakouris 2024 eq. 36), before the velocity conditions
-    P.add("penalty_forces", &T::contact, [this](StepContext&) { apply_penalty_forces(); });
+  contact(ContactHook::forces);
   if (opt_.particle_update == ParticleUpdate::xpic)
     P.add("start_velocity", &T::grid_update, [this](StepContext&) { save_start_velocity(); });
   P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
   if (opt_.damping_rate > 0.0) P.add("damping", &T::grid_update, [this](StepContext& c) { apply_damping(c.dt); });
   P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
-  if (contact_setup_.enabled)
-    P.add("contact_updated", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::updated, c.dt); });
+  contact(ContactHook::updated);
   P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
   if (!flip)  // XPIC/FMPM
     P.add("velocity_filter", usl ? &T::stress_update : &T::grid_to_particle,
@@ -151,7 +149,7 @@ void Simulation<Dim>::build_phases() {
       const ParticlePassResult r = particle_pass<true, true>(c.dt, stencils<Kernel>(), refresh);
       c.bad = r.bad, c.beyond = r.beyond;
     });
-    if (penalty) P.add("move_boundary_points", &T::grid_to_particle, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
+    contact(ContactHook::stress_velocity);
   } else {
     P.add("grid_to_particle", &T::grid_to_particle, [this](StepContext& c) {
       c.bad = particle_pass<true, false>(c.dt, stencils<Kernel>()).bad;
@@ -162,11 +160,9 @@ void Simulation<Dim>::build_phases() {
   P.add("end_particle_update", &T::grid_to_particle, [this, refresh](StepContext& c) { end_particle_update(c, refresh); });
   if (musl) {
     P.add("remap_momentum", &T::particle_to_grid, [this](StepContext&) { remap_momentum<Kernel>(); });
-    if (contact_setup_.enabled)
-      P.add("contact_remapped", &T::contact, [this](StepContext& c) { resolve_contact(ContactPass::remapped, c.dt); });
+    contact(ContactHook::remapped);
     P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
-    if (penalty)  // with the remapped velocity, as the stress update
-      P.add("move_boundary_points", &T::grid_update, [this](StepContext& c) { move_boundary_points(c.dt, c.t); });
+    contact(ContactHook::stress_velocity);
     P.add("stress_update", &T::stress_update, [this](StepContext& c) { stress_pass<Kernel>(c.dt); });
   }
 }
@@ -206,7 +202,7 @@ void Simulation<Dim>::prepare_step(double t) {
       map_rigid_particles<Kernel>(t, nullptr);
     }
   }
-  if (contact_setup_.enabled) {
+  if (!contact_methods_.empty()) {  // the step's frictional work, of every contact method
     std::fill(contact_books_.work_first.begin(), contact_books_.work_first.end(), 0.0);
     std::fill(contact_books_.work_second.begin(), contact_books_.work_second.end(), 0.0);
   }
@@ -557,7 +553,11 @@ void Simulation<Dim>::remap_momentum() {
   template void Simulation<D>::build_phases(); \
   template long Simulation<D>::phase_key() const; \
   template void Simulation<D>::end_particle_update(StepContext&, bool); \
-  template StencilView<D> Simulation<D>::current_stencils();
+  template StencilView<D> Simulation<D>::current_stencils(); \
+  template void Simulation<D>::contact_at_extrapolated<LinearKernel>(double); \
+  template void Simulation<D>::contact_at_extrapolated<UGIMPKernel>(double); \
+  template void Simulation<D>::contact_at_extrapolated<QuadraticBSplineKernel>(double); \
+  template void Simulation<D>::contact_at_extrapolated<ExtendedBSplineKernel>(double);
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)
 #undef FRICTHERM_INSTANTIATE_STEP

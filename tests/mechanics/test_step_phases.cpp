@@ -69,6 +69,50 @@ TEST(StepPhases, ListsPerScheme) {
   EXPECT_EQ(damped[4], "damping");
 }
 
+// The contact methods (step/contact_method.hpp) at their hooks: penalty contact between b and c, and
+// between a and b either multimaterial contact (both methods in one scene) or penalty too.
+Names names_with_penalty(UpdateScheme scheme, bool multimaterial_pair) {
+  SimulationOptions o;
+  o.scheme = scheme;
+  Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
+  const int a = sim.add_material(elastic("a")), b = sim.add_material(elastic("b")), c = sim.add_material(elastic("c"));
+  ContactPairSettings penalty;
+  penalty.method = ContactMethod::penalty;
+  penalty.law = FrictionLaw::frictionless();
+  ContactOptions options;
+  if (!multimaterial_pair) options.default_pair = penalty;
+  sim.enable_contact(options);  // before the bodies: their boundary points
+  sim.add_body("a", *make_box<2>(Vec<2>(0.2, 0.2), Vec<2>(0.35, 0.6), a), 2, Vec<2>(1.0, 0.0));
+  sim.add_body("b", *make_box<2>(Vec<2>(0.45, 0.2), Vec<2>(0.6, 0.6), b), 2, Vec<2>(0.0, 0.0));
+  sim.add_body("c", *make_box<2>(Vec<2>(0.7, 0.2), Vec<2>(0.85, 0.6), c), 2, Vec<2>(-1.0, 0.0));
+  sim.set_contact_pair(b, c, penalty);
+  Names out;
+  for (const char* n : sim.step_phase_names()) out.emplace_back(n);
+  EXPECT_NE(sim.penalty_contact(), nullptr);
+  return out;
+}
+
+TEST(StepPhases, ContactMethodsAtTheirHooks) {
+  // Both methods: the multimaterial passes after the momentum projections, the penalty forces before
+  // the velocity conditions, the boundary points moved with the stress update's velocity.
+  EXPECT_EQ(names_with_penalty(UpdateScheme::usl, true),
+            Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "penalty_forces",
+                   "velocity_conditions", "momentum_update", "contact_updated", "nodal_velocities", "particle_update",
+                   "move_boundary_points", "end_particle_update"}));
+  EXPECT_EQ(names_with_penalty(UpdateScheme::usf, true),
+            Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_from_momentum",
+                   "stress_update", "internal_forces", "move_boundary_points", "penalty_forces", "velocity_conditions",
+                   "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle", "move_rigid_particles",
+                   "end_particle_update"}));
+  const Names musl = {"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "penalty_forces",
+                      "velocity_conditions", "momentum_update", "contact_updated", "nodal_velocities",
+                      "grid_to_particle", "move_rigid_particles", "end_particle_update", "remap_momentum",
+                      "contact_remapped", "velocity_from_momentum", "move_boundary_points", "stress_update"};
+  EXPECT_EQ(names_with_penalty(UpdateScheme::musl, true), musl);
+  // Every pair in penalty contact: the same list (the multimaterial passes find no contact node).
+  EXPECT_EQ(names_with_penalty(UpdateScheme::musl, false), musl);
+}
+
 TEST(StepPhases, TimersAccountForTheSteps) {
   SimulationOptions o;
   Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);

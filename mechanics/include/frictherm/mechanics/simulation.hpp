@@ -45,6 +45,7 @@
 #include <frictherm/mechanics/state/step_threads.hpp>
 #include <frictherm/mechanics/state/wave_speeds.hpp>
 #include <frictherm/mechanics/state/work_books.hpp>
+#include <frictherm/mechanics/step/contact_method.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
@@ -90,6 +91,12 @@ struct SimulationOptions {
 
 template <int Dim>
 struct ContactSide;  // contact internals (mechanics/src/contact_side.hpp)
+// The contact methods (step/contact_method.hpp; mechanics/src/contact_methods/): their phases call
+// the step's contact passes below.
+template <int Dim>
+class MultimaterialContactMethod;
+template <int Dim>
+class PenaltyContactMethod;
 
 template <int Dim>
 class Simulation {
@@ -268,6 +275,8 @@ class Simulation {
   }
 
  private:
+  friend class MultimaterialContactMethod<Dim>;
+  friend class PenaltyContactMethod<Dim>;
   using ContactEntry = typename ContactNodeState<Dim>::Entry;
   using ContactNodeListing = typename ContactNodeState<Dim>::Listing;
   using ContactThreadWork = typename ContactNodeState<Dim>::ThreadWork;
@@ -355,6 +364,12 @@ class Simulation {
   double penalty_time_step_limit(double wave_speed) const;  // time step: the last step's penalty springs
   void check_particle(long bad, double dt) const;
   void resolve_loads();
+  /// Energy stored by the contact methods (penalty springs), for the energy books.
+  double contact_stored_energy() const {
+    double e = 0.0;
+    for (const StepContactMethod<Dim>* m : contact_methods_) e += m->stored_energy(*this);
+    return e;
+  }
 
   Grid<Dim> grid_;
   SimulationOptions opt_;
@@ -386,6 +401,7 @@ class Simulation {
   double empty_node_mass_ = 0.0;  // nodes lighter than this have no velocity (1e-12 of the heaviest particle)
   WaveSpeeds wave_speeds_;                  // per-particle wave speed for the CFL step
   StepSchedule schedule_;                   // the step's phase list and phase timers
+  std::vector<const StepContactMethod<Dim>*> contact_methods_;  // the scene's, chosen by finalize() (contact_methods_for)
 };
 
 extern template class Simulation<2>;
