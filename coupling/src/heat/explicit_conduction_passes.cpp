@@ -259,7 +259,9 @@ const unsigned char* ExplicitConduction<Dim>::changed_in_box(int nodes) {
   const int* before = changed_before_.data();
   for (std::vector<unsigned char>& r : reach_) r.assign(static_cast<std::size_t>(nodes + pad), 0);
   unsigned char* x = reach_[0].data();
-  for (int g = 0; g < nodes; ++g) x[g] = before[g + span > nodes ? nodes : g + span] != before[g];
+  const int full = std::max(0, nodes - span);  // runs that end inside the numbering (a loop without the clip)
+  for (int g = 0; g < full; ++g) x[g] = before[g + span] != before[g];
+  for (int g = full; g < nodes; ++g) x[g] = before[nodes] != before[g];
   for (int d = 1; d < Dim; ++d) {
     unsigned char* y = reach_[d % 2].data();
     const unsigned char* from = reach_[(d - 1) % 2].data();
