@@ -87,7 +87,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
             for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
             continue;
           }
-          const OutOfKStencil& c = out_of_k_stencil(k, stencils[k], sys.unknown);
+          const int slot = k < out_of_k_slot_.size() ? out_of_k_slot_[k] : -1;  // made: read in place
+          const OutOfKStencil& c = slot >= 0 && out_of_k_stencils_[static_cast<std::size_t>(slot)].made
+                                       ? out_of_k_stencils_[static_cast<std::size_t>(slot)]
+                                       : out_of_k_stencil(k, stencils[k], sys.unknown);
           if (!c.reaches) continue;
           double lo = std::numeric_limits<double>::infinity(), hi = -lo;
           double g0 = 0.0, g1 = 0.0, g2 = 0.0;
