@@ -376,20 +376,79 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
   // M_i on every node (eq. 38): each moved particle's weights at its last gather out, at its
   // position now in (the step's stencils when given: the same numbers as evaluating them here).
   const mechanics::Stencil<Dim, Kernel>* step_stencils = view.template as<Kernel>(p.size());
-  const StencilVector<Kernel>& kept_stencils = stencils_.template of<Kernel>();
+  StencilVector<Kernel>& kept_stencils = stencils_.template of<Kernel>();
   StencilVector<Kernel>& now = moved_stencils_.template of<Kernel>();
   now.resize(moved_.size());
+  // Without the exact bounds (which need M after every moved particle's terms), each moved particle's
+  // whole update is made here, in one walk of its old and one of its new stencil when both are whole
+  // (issue 35): M_i, the eq. 38 sums and the quick bound's sums each get the same terms in the same
+  // particle and node order as the two loops below give them (each array alone), so the same bits.
+  // If the unknowns would change, the gather that follows makes all of them anew.
+  const bool fused = !bounds_ready_;
+  Expanded e{};
+  double* const grid_mass = sys.grid_mass.data();
   for (std::size_t j = 0; j < moved_.size(); ++j) {
     const std::size_t k = moved_[j];
     const double mc = heat_capacity_[k];
-    kept_stencils[k].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
-      sys.grid_mass[static_cast<std::size_t>(i)] -= mc * w;
-    });
     if (step_stencils) now[j] = step_stencils[k];
     else now[j].evaluate(grid, p.position[k], p.half_size[k]);
-    now[j].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
-      sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
-    });
+    if (!fused) {
+      kept_stencils[k].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+        sys.grid_mass[static_cast<std::size_t>(i)] -= mc * w;
+      });
+      now[j].for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+        sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+      });
+      continue;
+    }
+    const double mct = mc * p.temperature[k];
+    const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
+    const double conductance_now = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
+    const mechanics::Stencil<Dim, Kernel>& old_st = kept_stencils[k];
+    // One particle's terms out (sign −1, its old stencil and conductance) or in (+1, its new ones).
+    const auto terms = [&](const mechanics::Stencil<Dim, Kernel>& st, bool is_whole, double conductance, double sign) {
+      if (is_whole) {  // S_ip, G_ip and the unknowns of one walk: expand's, add_quick's and M's terms
+        const double quick = conductance == 0.0 ? 0.0 : sign * quick_weight(st, conductance);
+        double* const sums = next_mct_.data();
+        const int* const un = sys.unknown.data();
+        for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+          const auto g = static_cast<std::size_t>(i);
+          if (sign < 0.0) {
+            grid_mass[g] -= mc * w;
+            sums[un[g]] -= mct * w;
+          } else {
+            grid_mass[g] += mc * w;
+            sums[un[g]] += mct * w;
+          }
+          if (conductance != 0.0) quick_sum_[g] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+        });
+        return;
+      }
+      st.for_each(indexer_, [&](int i, double w, const mechanics::Vec<Dim>&) {
+        if (sign < 0.0) sys.grid_mass[static_cast<std::size_t>(i)] -= mc * w;
+        else sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
+      });
+      expand<Kernel, false>(st, sys.unknown, e);
+      if (sign < 0.0)
+        for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];
+      add_quick(st, conductance, sys, e, sign);
+      if (sign > 0.0)
+        for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];
+    };
+    terms(old_st, whole_[k] != 0, conductance_[k], -1.0);
+    if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out; its flux particle by particle
+      add_to_node_operator(old_st, conductance_[k], sys.unknown, -1.0, e);
+      in_node_k_[k] = 0;
+    }
+    kept_stencils[k] = now[j];
+    if (k < out_of_k_slot_.size() && out_of_k_slot_[k] >= 0)  // its kept walk is of the old stencil
+      out_of_k_stencils_[static_cast<std::size_t>(out_of_k_slot_[k])].made = false;
+    whole_[k] = whole(kept_stencils[k]);
+    first_node_[k] = node_span(kept_stencils[k], indexer_)[0];
+    conductance_[k] = conductance_now;
+    terms(kept_stencils[k], whole_[k] != 0, conductance_now, 1.0);
+    quiet_[k] = 0;  // looked at in the next sub-step
+    gathered_at_[k] = p.position[k];
   }
 
   // The unknowns must stay those of the gather (select_unknowns' rule): the kept lists, the lumping
@@ -417,9 +476,8 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
 
   // The moved particles' kept state, bounds and eq. 38 sums for the next reproject(), anew: the
   // exact bounds if they were made since the gather (lambda_bound), else the quick bound's sums.
-  Expanded e{};
   StencilVector<Kernel>& kept = stencils_.template of<Kernel>();
-  for (std::size_t j = 0; j < moved_.size(); ++j) {
+  for (std::size_t j = 0; j < moved_.size() && !fused; ++j) {
     const std::size_t k = moved_[j];
     const double mct = heat_capacity_[k] * p.temperature[k];
     // as its last gather: the unknowns have not changed
@@ -433,6 +491,8 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       in_node_k_[k] = 0;
     }
     kept[k] = now[j];
+    if (k < out_of_k_slot_.size() && out_of_k_slot_[k] >= 0)  // its kept walk is of the old stencil
+      out_of_k_stencils_[static_cast<std::size_t>(out_of_k_slot_[k])].made = false;
     whole_[k] = whole(kept[k]);
     first_node_[k] = node_span(kept[k], indexer_)[0];
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);

@@ -13,6 +13,8 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
   const std::size_t n = sys.size();
   node_compact_ = false;  // the scatter below fills the full rows
   out_of_k_.clear();
+  out_of_k_stencils_.clear();  // the walks kept for particles out of K (out_of_k_stencil)
+  out_of_k_slot_.assign(holds_heat_.size(), -1);
   node_k_.assign(n * offsets, 0.0);
   node_col_.resize(n * offsets);
   for (std::size_t u = 0; u < n; ++u)

@@ -70,6 +70,50 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       listed_.clear();
       for (std::size_t k : out_of_k_)
         if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
+      if (threads <= 1) {
+        // One thread: a whole particle's unknowns and G_ip kept from its first sub-step out of K
+        // (out_of_k_stencil): look_whole and scatter_whole's sums from them, in the same order.
+        Expanded e{};
+        double* const f = force_.data();
+        const double* const t = T.data();
+        constexpr int nodes_of = mechanics::Stencil<Dim, Kernel>::node_count;
+        for (std::size_t k : listed_) {
+          if (!whole_[k]) {
+            expand<Kernel, true>(stencils[k], sys.unknown, e);
+            if (!e.reaches() || quiet_temperatures(e, T)) continue;
+            mechanics::Vec<Dim> grad = mechanics::Vec<Dim>::Zero();
+            for (int a = 0; a < e.count; ++a) grad += e.g(a) * T[e.unknown[a]];
+            grad *= conductance_[k];
+            for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
+            continue;
+          }
+          const int slot = k < out_of_k_slot_.size() ? out_of_k_slot_[k] : -1;  // made: read in place
+          const OutOfKStencil& c = slot >= 0 && out_of_k_stencils_[static_cast<std::size_t>(slot)].made
+                                       ? out_of_k_stencils_[static_cast<std::size_t>(slot)]
+                                       : out_of_k_stencil(k, stencils[k], sys.unknown);
+          if (!c.reaches) continue;
+          double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+          double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+          for (int a = 0; a < nodes_of; ++a) {
+            const double ta = t[c.unknown[a]];
+            lo = std::min(lo, ta);
+            hi = std::max(hi, ta);
+            g0 += c.G[0][a] * ta;
+            g1 += c.G[1][a] * ta;
+            if constexpr (Dim == 3) g2 += c.G[Dim - 1][a] * ta;
+          }
+          if (quiet_spread(lo, hi)) continue;
+          const double kc = conductance_[k];
+          g0 *= kc;
+          g1 *= kc;
+          g2 *= kc;
+          for (int a = 0; a < nodes_of; ++a) {  // G·g as scatter_whole sums it
+            double dot = c.G[0][a] * g0 + c.G[1][a] * g1;
+            if constexpr (Dim == 3) dot += c.G[Dim - 1][a] * g2;
+            f[c.unknown[a]] -= dot;
+          }
+        }
+      } else
       scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
         const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
         if (!r.meets(node_span(st, indexer_))) return;
@@ -179,6 +223,62 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
 }
 
 template <int Dim>
+template <class Kernel>
+const typename ExplicitConduction<Dim>::OutOfKStencil& ExplicitConduction<Dim>::out_of_k_stencil(
+    std::size_t k, const mechanics::Stencil<Dim, Kernel>& st, const std::vector<int>& unknown) {
+  if (out_of_k_slot_.size() != holds_heat_.size()) out_of_k_slot_.assign(holds_heat_.size(), -1);
+  int& slot = out_of_k_slot_[k];
+  if (slot < 0) {
+    slot = static_cast<int>(out_of_k_stencils_.size());
+    out_of_k_stencils_.emplace_back();
+  }
+  OutOfKStencil& c = out_of_k_stencils_[static_cast<std::size_t>(slot)];
+  if (c.made) return c;
+  c.made = true;
+  double s = 0.0;
+  int a = 0;
+  for_each_unknown_whole(st, indexer_, unknown.data(), [&](int u, double w, double gx, double gy, double gz) {
+    s += w;
+    c.unknown[a] = u;
+    c.G[0][a] = gx;
+    c.G[1][a] = gy;
+    if constexpr (Dim == 3) c.G[Dim - 1][a] = gz;
+    ++a;
+  });
+  c.reaches = s > 0.0;
+  return c;
+}
+
+template <int Dim>
+template <int K>
+const unsigned char* ExplicitConduction<Dim>::changed_in_box(int nodes) {
+  // Along x from the prefix counts, as counts_in_rows_from tests a row (the K nodes from g; clipped at
+  // the end of the numbering, where no stencil starts), then OR-ed over K rows along each further
+  // axis (zero padding past the end): reached[g] = 1 exactly when counts_in_rows_from(g) is true.
+  const mechanics::IVec<Dim>& sd = indexer_.stride;
+  int pad = 0;
+  for (int d = 1; d < Dim; ++d) pad += (K - 1) * sd[d];
+  const int span = (K - 1) * sd[0] + 1;
+  const int* before = changed_before_.data();
+  for (std::vector<unsigned char>& r : reach_) r.assign(static_cast<std::size_t>(nodes + pad), 0);
+  unsigned char* x = reach_[0].data();
+  const int full = std::max(0, nodes - span);  // runs that end inside the numbering (a loop without the clip)
+  for (int g = 0; g < full; ++g) x[g] = before[g + span] != before[g];
+  for (int g = full; g < nodes; ++g) x[g] = before[nodes] != before[g];
+  for (int d = 1; d < Dim; ++d) {
+    unsigned char* y = reach_[d % 2].data();
+    const unsigned char* from = reach_[(d - 1) % 2].data();
+    const int s1 = sd[d];
+    for (int g = 0; g < nodes; ++g) {
+      unsigned char v = from[g];
+      for (int j = 1; j < K; ++j) v |= from[g + j * s1];
+      y[g] = v;
+    }
+  }
+  return reach_[(Dim - 1) % 2].data();
+}
+
+template <int Dim>
 double ExplicitConduction<Dim>::map_back(mechanics::Particles<Dim>& p, const NodalThermalSystem& sys,
                                          const Eigen::VectorXd& delta, double beta, const Eigen::VectorXd* end,
                                          const std::vector<typename FacePull<Dim>::Held>* held) {
@@ -267,10 +367,10 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     double* const temperature = p.temperature.data();
     double* const sums = next_mct_.data();
     const int* first = first_node_.data();
-    const int* changed = changed_before_.data();
+    const unsigned char* reached = changed_in_box<Kernel::K>(static_cast<int>(sys.unknown.size()));
     for (std::size_t k = 0; k < p.size(); ++k) {
-      // any_changed, from the stencil's first grid node kept with it
-      if (!holds_heat_[k] || !counts_in_rows_from<Dim, Kernel::K>(first[k], indexer_.stride, changed)) continue;
+      // any_changed, from the stencil's first grid node kept with it: one flag
+      if (!holds_heat_[k] || !reached[first[k]]) continue;
       const double before = temperature[k];
       if (whole_[k]) {
         double w[nodes];

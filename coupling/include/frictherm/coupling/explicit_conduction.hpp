@@ -301,6 +301,21 @@ class ExplicitConduction {
   std::vector<unsigned char> in_node_k_;
   std::vector<std::size_t> out_of_k_;      // in order: particles a refresh saw out of K since the assembly
   std::vector<std::size_t> out_of_k_merge_;  // scratch of refresh's merge into out_of_k_
+  // A whole particle out of K walked once per stencil (issue 35): its unknowns and G_ip (the products
+  // of for_each_unknown_whole) kept from its first sub-step after the refresh that took it out or
+  // gave it a new stencil, so each later sub-step reads them instead of forming them again.
+  struct OutOfKStencil {
+    bool made = false;     // of the particle's stencil now (a refresh that moves it clears it)
+    bool reaches = false;  // Σ S_ip > 0 (look_whole's s)
+    int unknown[capacity];
+    double G[Dim][capacity];
+  };
+  std::vector<OutOfKStencil> out_of_k_stencils_;  // by slot
+  std::vector<int> out_of_k_slot_;                // by particle: its slot, −1 none since the assembly
+  /// The kept walk of whole particle k (made from its window stencil if it has none).
+  template <class Kernel>
+  const OutOfKStencil& out_of_k_stencil(std::size_t k, const mechanics::Stencil<Dim, Kernel>& st,
+                                        const std::vector<int>& unknown);
   /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
   /// rows of its unknowns i at grid nodes in `range` (all without one).
   template <class Kernel>
@@ -314,6 +329,10 @@ class ExplicitConduction {
   /// reach; the other rows keep f_i of the last sub-step (threads by rows: each row alone, the same
   /// bits on any number).
   void node_operator_force(const NodalThermalSystem& sys, const Eigen::VectorXd& T, int threads);
+  /// By grid node g, whether the K^Dim box of nodes from g holds a changed node (changed_before_):
+  /// counts_in_rows_from as one flag per node (reach_ as scratch), for the map back's particle test.
+  template <int K>
+  const unsigned char* changed_in_box(int nodes);
   /// changed_before_ from whether unknown u changed.
   template <class Changed>
   void count_changed(const std::vector<int>& unknown, Changed&& changed);
