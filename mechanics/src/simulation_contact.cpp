@@ -40,7 +40,10 @@ void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const std::size_t nm = materials_.size();
   Vec<Dim> h = grid_.cell_size();
   const double cell_volume = grid_.cell_volume() * (Dim == 2 ? opt_.thickness : 1.0);
-  if (heat) contact_books_.stats = ContactStats{};
+  if (heat) {  // this pass's counters; penalty contact's are its own (under USF set before this pass)
+    ContactStats& st = contact_books_.stats;
+    st.contact_nodes = st.multi_nodes = st.sliding_nodes = st.guarded = 0;
+  }
   const bool regularized = contact_setup_.options.regularized();
   if (pass == ContactPass::extrapolated) contact_nodes_.extrapolated_change.assign(nodes_.mass.size(), Vec<Dim>::Zero());
   if (regularized && contact_nodes_.lagged_normal_traction.size() != grid_.node_count()) {

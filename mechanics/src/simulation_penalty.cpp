@@ -206,6 +206,12 @@ void Simulation<Dim>::apply_penalty_forces() {
     contact_books_.pair_work_first[i] += pc.books(k).heat_step;
     contact_books_.pair_work_second[i] += pc.books(k).heat_step;
   }
+  // The step's counters, from the detection just made (under USF the boundary points move before it).
+  contact_books_.stats.penalty_contacts = contact_books_.stats.penalty_sliding = 0;
+  for (std::size_t k = 0; k < pc.pair_count(); ++k) {
+    contact_books_.stats.penalty_contacts += pc.books(k).active;
+    contact_books_.stats.penalty_sliding += pc.books(k).sliding;
+  }
 }
 
 // With the weights of the step's start (those the forces go out with): a rigid field's points move as
@@ -242,11 +248,6 @@ void Simulation<Dim>::move_boundary_points(double dt, double t) {
         << (bp.position[i].allFinite() ? "left the grid" : "has a non-finite position")
         << " (penalty contact; the step blew up: try a smaller CFL factor or penalty)";
     throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
-  }
-  contact_books_.stats.penalty_contacts = contact_books_.stats.penalty_sliding = 0;
-  for (std::size_t k = 0; k < penalty_state_.contact->pair_count(); ++k) {
-    contact_books_.stats.penalty_contacts += penalty_state_.contact->books(k).active;
-    contact_books_.stats.penalty_sliding += penalty_state_.contact->books(k).sliding;
   }
 }
 
