@@ -350,6 +350,22 @@ void ExplicitConduction<Dim>::gather(const mechanics::Grid<Dim>& grid, const mec
 
 template <int Dim>
 template <class Kernel>
+void ExplicitConduction<Dim>::restencil(std::size_t k, mechanics::Stencil<Dim, Kernel>& kept,
+                                        const mechanics::Stencil<Dim, Kernel>& fresh, const std::vector<int>& unknown,
+                                        Expanded& e) {
+  if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out (its old conductance); its flux particle by particle
+    add_to_node_operator(kept, conductance_[k], unknown, -1.0, e);
+    in_node_k_[k] = 0;
+  }
+  kept = fresh;
+  if (k < out_of_k_slot_.size() && out_of_k_slot_[k] >= 0)  // its kept walk is of the old stencil
+    out_of_k_stencils_[static_cast<std::size_t>(out_of_k_slot_[k])].made = false;
+  whole_[k] = whole(kept);
+  first_node_[k] = node_span(kept, indexer_)[0];
+}
+
+template <int Dim>
+template <class Kernel>
 typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     const mechanics::Grid<Dim>& grid, const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials,
     const AssemblyOptions& opt, NodalThermalSystem& sys, double max_shift, const mechanics::StencilView<Dim>& view) {
@@ -436,15 +452,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
         for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] += mct * e.S[a];
     };
     terms(old_st, whole_[k] != 0, conductance_[k], -1.0);
-    if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out; its flux particle by particle
-      add_to_node_operator(old_st, conductance_[k], sys.unknown, -1.0, e);
-      in_node_k_[k] = 0;
-    }
-    kept_stencils[k] = now[j];
-    if (k < out_of_k_slot_.size() && out_of_k_slot_[k] >= 0)  // its kept walk is of the old stencil
-      out_of_k_stencils_[static_cast<std::size_t>(out_of_k_slot_[k])].made = false;
-    whole_[k] = whole(kept_stencils[k]);
-    first_node_[k] = node_span(kept_stencils[k], indexer_)[0];
+    restencil(k, kept_stencils[k], now[j], sys.unknown, e);
     conductance_[k] = conductance_now;
     terms(kept_stencils[k], whole_[k] != 0, conductance_now, 1.0);
     quiet_[k] = 0;  // looked at in the next sub-step
@@ -486,15 +494,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     for (int a = 0; a < e.count; ++a) next_mct_[e.unknown[a]] -= mct * e.S[a];  // its old terms out
     if (bounds_ready_) remove_bounds(k, e);
     add_quick(kept[k], conductance_[k], sys, e, -1.0);
-    if (node_operator_ready_ && in_node_k_[k]) {  // its K terms out; its flux particle by particle
-      add_to_node_operator(kept[k], conductance_[k], sys.unknown, -1.0, e);
-      in_node_k_[k] = 0;
-    }
-    kept[k] = now[j];
-    if (k < out_of_k_slot_.size() && out_of_k_slot_[k] >= 0)  // its kept walk is of the old stencil
-      out_of_k_stencils_[static_cast<std::size_t>(out_of_k_slot_[k])].made = false;
-    whole_[k] = whole(kept[k]);
-    first_node_[k] = node_span(kept[k], indexer_)[0];
+    restencil(k, kept[k], now[j], sys.unknown, e);
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;  // V_p now
     if (bounds_ready_) {

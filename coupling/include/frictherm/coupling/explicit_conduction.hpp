@@ -316,6 +316,12 @@ class ExplicitConduction {
   template <class Kernel>
   const OutOfKStencil& out_of_k_stencil(std::size_t k, const mechanics::Stencil<Dim, Kernel>& st,
                                         const std::vector<int>& unknown);
+  /// Particle k moves from its kept stencil `kept` to `fresh` (a refresh): out of the node operator
+  /// with `kept` and its conductance so far, `kept` replaced, its kept walk forgotten, whole_ and
+  /// first_node_ anew. Its other terms (M, eq. 38, the bounds) are the caller's.
+  template <class Kernel>
+  void restencil(std::size_t k, mechanics::Stencil<Dim, Kernel>& kept, const mechanics::Stencil<Dim, Kernel>& fresh,
+                 const std::vector<int>& unknown, Expanded& e);
   /// V_p k_p G'_ip·G'_jp of the particle with stencil st added (sign 1) or taken out (−1) into the
   /// rows of its unknowns i at grid nodes in `range` (all without one).
   template <class Kernel>
