@@ -143,17 +143,23 @@ void parse_materials(const JsonReader& root, Scene& s, ParseContext& ctx) {
   mats.finish();
 }
 
+/// Contact is on and some pair (or the default pair) uses multimaterial (grid) contact.
+bool uses_grid_contact(const ContactSpec& contact) {
+  if (!contact.enabled) return false;
+  bool grid_contact = contact.options.default_pair.method == mechanics::ContactMethod::multimaterial;
+  for (const ContactPairSpec& p : contact.pairs)
+    grid_contact = grid_contact || p.settings.method == mechanics::ContactMethod::multimaterial;
+  return grid_contact;
+}
+
 /// The update scheme of a scene that names none: USL when a pair uses multimaterial (grid) contact,
 /// whose frictional heat MUSL makes grow with the time step (docs/transfer.md, "What they do for
 /// frictional heat"), MUSL otherwise, and MUSL with linear shape functions: with USL (and USF) every
 /// contact scene measured blew up with them, MUSL ran each (docs/contact.md, "Linear shape
 /// functions and multimaterial contact").
 mechanics::UpdateScheme default_update_scheme(const ContactSpec& contact, mechanics::ShapeKind shape) {
-  if (!contact.enabled || shape == mechanics::ShapeKind::linear) return mechanics::UpdateScheme::musl;
-  bool grid_contact = contact.options.default_pair.method == mechanics::ContactMethod::multimaterial;
-  for (const ContactPairSpec& p : contact.pairs)
-    grid_contact = grid_contact || p.settings.method == mechanics::ContactMethod::multimaterial;
-  return grid_contact ? mechanics::UpdateScheme::usl : mechanics::UpdateScheme::musl;
+  if (shape == mechanics::ShapeKind::linear) return mechanics::UpdateScheme::musl;
+  return uses_grid_contact(contact) ? mechanics::UpdateScheme::usl : mechanics::UpdateScheme::musl;
 }
 
 void parse_solver(const JsonReader& root, Scene& s) {  // after the contact section: default_update_scheme
@@ -170,7 +176,7 @@ void parse_solver(const JsonReader& root, Scene& s) {  // after the contact sect
   s.options.scheme = mechanics::update_scheme_from_string(
       solver->choice("scheme", {"usf", "usl", "musl"}, mechanics::to_string(s.options.scheme)));
   if (s.options.shape == mechanics::ShapeKind::linear && s.options.scheme != mechanics::UpdateScheme::musl &&
-      default_update_scheme(s.contact, mechanics::ShapeKind::ugimp) != mechanics::UpdateScheme::musl)
+      uses_grid_contact(s.contact))
     s.notes.push_back(std::string("solver.scheme \"") + mechanics::to_string(s.options.scheme) +
                       "\" with \"shape_function\": \"linear\" and multimaterial contact: every contact scene "
                       "measured blew up with this combination, MUSL runs them (\"scheme\": \"musl\", the default "
