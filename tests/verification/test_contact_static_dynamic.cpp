@@ -4,6 +4,7 @@
 //   - the naive law (stick test with μs, slide with μd) starts sliding early: the known failure;
 //   - the smooth law of eq. 42 with v½ = 0.05 m/s follows the rigid static/dynamic block (its β term);
 //   - with v½ = 1000 m/s it is μ = 0.4 Coulomb.
+#include "rigid_block_law.hpp"
 #include "sliding_block.hpp"
 
 #include <gtest/gtest.h>
@@ -23,10 +24,12 @@ struct Result {
   double rigid_onset;     // where the rigid solution reaches 1 % of v_max (s)
 };
 
-Result run(const FrictionLaw& law, const RigidBlock& r, const char* name) {
+template <class Reference>
+Result run(const FrictionLaw& law, const Reference& r, const char* name, double cell = 0.005) {
   using C = SlidingBlockConstants;
   SlidingBlockSetup s;
   s.law = law;
+  s.cell = cell;
   const SlidingHistory h = run_sliding_block(s);
   Result out{0.0, C::t_final(), r.onset()};
   for (std::size_t k = 0; k < h.time.size(); ++k) {
@@ -76,4 +79,19 @@ TEST(StaticDynamicFriction, SmoothLawWithLargeHalfSpeedIsCoulombMuStatic) {
   const Result smooth = run(FrictionLaw::smooth_static_dynamic(0.4, 0.2, 1000.0), rigid_solution(0.4, 0.4, 0.0, 0.0),
                             "smooth v½ = 1000 m/s");
   EXPECT_LT(smooth.velocity_error, 0.03);
+}
+
+// v½ = 1 m/s, between the two limits: the coefficient falls from μs to μd over the block's first
+// metres per second, so neither closed form is the block's motion (the sharp μs → μd step ends 11 %
+// faster). Against its own rigid block (eq. 48 integrated with eq. 42's traction, rigid_block_law.hpp)
+// measured 0.09 % / 0.05 % of v_max at 5 / 2.5 mm; against the sharp step 9.5 %, the law's difference.
+// Bound: the 3 % at both cells.
+TEST(StaticDynamicFriction, SmoothLawWithUnitHalfSpeedMatchesItsRigidBlock) {
+  using C = SlidingBlockConstants;
+  const RigidBlock loads = rigid_solution(0.4, 0.2, 0.0, 0.0);
+  const RigidBlockUnderLaw exact(loads, smooth_law_traction(C::normal_stress(), 0.4, 0.2, 1.0), C::t_final());
+  for (double cell : {0.005, 0.0025}) {
+    const Result smooth = run(FrictionLaw::smooth_static_dynamic(0.4, 0.2, 1.0), exact, "smooth v½ = 1 m/s", cell);
+    EXPECT_LT(smooth.velocity_error, 0.03) << "cell " << cell;
+  }
 }

@@ -1,5 +1,6 @@
 // Sliding block (Nairn, Bardenhagen & Smith 2018, figures 2, 3 and 5): the MPM block's mean velocity
 // and the total frictional work against the rigid-block solution (appendix eqs. 46–54).
+#include "rigid_block_law.hpp"
 #include "sliding_block.hpp"
 
 #include <gtest/gtest.h>
@@ -20,7 +21,9 @@ struct Comparison {
   double work_order_gap = 0.0;  // |W2nd − W1st| / Q at tf
 };
 
-Comparison compare(const SlidingHistory& h, const RigidBlock& r, const char* name) {
+// `Reference`: RigidBlock (the closed forms) or RigidBlockUnderLaw (any law, integrated).
+template <class Reference>
+Comparison compare(const SlidingHistory& h, const Reference& r, const char* name) {
   using C = SlidingBlockConstants;
   Comparison c;
   const double tf = C::t_final(), ti = r.onset();
@@ -72,6 +75,25 @@ TEST(SlidingBlock, RigidSolutionMatchesQuadrature) {
   }
 }
 
+TEST(SlidingBlock, IntegratedRigidBlockMatchesTheClosedForms) {
+  // RigidBlockUnderLaw (eq. 48 integrated with the law's own traction) against eqs. 47, 50 and 53–54
+  // where those apply: Coulomb, a velocity term, adhesion, and all three; 1e-8 of the final speed
+  // and of the work (the integration's tolerance is 1e-12, the table's interpolation 1e-9).
+  using C = SlidingBlockConstants;
+  const double N = C::normal_stress(), tf = C::t_final();
+  for (const auto& [k, S_a] : {std::pair{0.0, 0.0}, std::pair{0.5 / C::v_max, 0.0}, std::pair{0.0, 0.3 * N},
+                               std::pair{0.3 / C::v_max, 0.3 * N}}) {
+    const RigidBlock r = rigid_solution(0.2, 0.2, k, S_a, 1.5);
+    const RigidBlockUnderLaw ode(r, [&](double v) { return (0.2 + k * v) * N + S_a; }, tf);
+    EXPECT_NEAR(ode.onset(), r.onset(), 1e-12 * tf);
+    for (double f : {0.3, 0.6, 0.9, 1.0}) {
+      const double t = r.onset() + f * (tf - r.onset());
+      EXPECT_NEAR(ode.velocity(t), r.velocity(t), 1e-8 * r.velocity(tf)) << "k " << k << " S_a " << S_a;
+      EXPECT_NEAR(ode.friction_work(t), r.friction_work(t), 1e-8 * r.friction_work(tf)) << "k " << k << " S_a " << S_a;
+    }
+  }
+}
+
 TEST(SlidingBlock, CoulombMatchesRigidBlock) {
   SlidingBlockSetup s;
   s.law = FrictionLaw::coulomb(0.2);
@@ -117,8 +139,10 @@ TEST(SlidingBlock, AdhesionMatchesRigidBlock) {
 // The generalized law of eq 21 written as one composite law (FrictionLaw::composite, scene type
 // "composite"): smooth static → dynamic (μs = 0.35, μd = 0.2, v½ = 0.05 m/s), a velocity coefficient
 // (k v_max = 0.3 with the Coulomb case's v_max) and adhesion S_a = 0.3 N, under a tangential load
-// R = 1.5 N, against the rigid block (eqs. 46–54 with a sharp static → dynamic step: v½ is 0.5 % of
-// the block's final speed, so the smooth law differs from it only in the first few steps of sliding).
+// R = 1.5 N, against its own rigid block (RigidBlockUnderLaw: eq. 48 integrated with the law's
+// traction). The closed forms' sharp static → dynamic step is not that block: it ends 0.8 % faster
+// and with 2.4 % more work, because the smooth coefficient stays above μd for the first metres per
+// second of sliding.
 TEST(SlidingBlock, CompositeLawMatchesRigidBlock) {
   using C = SlidingBlockConstants;
   const double N = C::normal_stress(), k = 0.3 / C::v_max, S_a = 0.3 * N;
@@ -126,15 +150,16 @@ TEST(SlidingBlock, CompositeLawMatchesRigidBlock) {
   s.cell = 0.0025;  // adhesion needs 2.5 mm cells (test AdhesionMatchesRigidBlock)
   s.R = 1.5;
   s.law = FrictionLaw::composite(0.35, 0.2, 0.05, k, S_a);
-  const Comparison c = compare(run_sliding_block(s), rigid_solution(0.35, 0.2, k, S_a, 1.5), "composite");
-  // Measured 5.9 % of v_max and 9.9 % of the work (the target is 3 %). The law itself is exact
-  // (tests/mechanics/test_friction.cpp: it reproduces the closed-form laws it contains to 1e-12);
-  // the loss is contact detection: the same law without k is within 1.1 % / 5.0 %, and with
-  // k v and S_a the faster, tilting block lifts off some interface nodes (position separation), which
-  // then carry neither term (docs/contact.md, "Known limitations"). These bounds guard the current
-  // state until the detection holds the interface.
+  const RigidBlockUnderLaw exact(rigid_solution(0.35, 0.2, k, S_a, 1.5),
+                                 smooth_law_traction(N, 0.35, 0.2, 0.05, k, S_a), C::t_final());
+  const Comparison c = compare(run_sliding_block(s), exact, "composite, position separation");
+  // MUSL with position separation, the paper's set-up: measured 5.1 % of v_max and 4.9 % of the work
+  // (the issue's target is 3 %). The law itself is exact (tests/mechanics/test_friction.cpp); the
+  // loss is contact detection: with k v and S_a the faster, tilting block lifts off some interface
+  // nodes, which then carry neither term (docs/contact.md, "Known limitations"). Extent detection,
+  // every scene's default, removes it (next test). These bounds guard the position detection's state.
   EXPECT_LT(c.velocity_error, 0.07);
-  EXPECT_LT(c.work_error, 0.12);
+  EXPECT_LT(c.work_error, 0.07);
 }
 
 // The same composite law with extent detection (docs/contact.md, "Contact detection"): interface nodes
@@ -148,14 +173,17 @@ TEST(SlidingBlock, CompositeLawWithExtentDetectionMatchesRigidBlock) {
   s.R = 1.5;
   s.separation = mechanics::SeparationMethod::extent;
   s.law = FrictionLaw::composite(0.35, 0.2, 0.05, k, S_a);
-  const Comparison c = compare(run_sliding_block(s), rigid_solution(0.35, 0.2, k, S_a, 1.5), "composite, extent");
-  EXPECT_LT(c.velocity_error, 0.03);  // the issue's target for the composite law at 2.5 mm
-  EXPECT_LT(c.work_error, 0.06);
+  const RigidBlockUnderLaw exact(rigid_solution(0.35, 0.2, k, S_a, 1.5),
+                                 smooth_law_traction(N, 0.35, 0.2, 0.05, k, S_a), C::t_final());
+  // Measured 0.61 % of v_max and 0.16 % of the work (against the sharp step's closed form 0.76 % and
+  // 2.2 %: the reference's own difference). Bounds: issue 31's 3 % for velocity and work.
+  const Comparison c = compare(run_sliding_block(s), exact, "composite, extent");
+  EXPECT_LT(c.velocity_error, 0.03);
+  EXPECT_LT(c.work_error, 0.03);
   // USL, what a scene with grid contact gets unless it names a scheme: the same target.
   s.scheme = mechanics::UpdateScheme::usl;
-  const Comparison u =
-      compare(run_sliding_block(s), rigid_solution(0.35, 0.2, k, S_a, 1.5), "composite, extent, USL");
+  const Comparison u = compare(run_sliding_block(s), exact, "composite, extent, USL");
   EXPECT_LT(u.velocity_error, 0.03);
-  EXPECT_LT(u.work_error, 0.06);
+  EXPECT_LT(u.work_error, 0.03);
 }
 

@@ -11,6 +11,7 @@
 // So (1) until the block reaches 10 % of its final speed (through the onset of sliding) the two runs
 // agree to 1e-6 v_max (measured 6.8e-8), and (2) over the whole run within 5e-3 v_max and 5e-3 of
 // the work, the measured roundoff sensitivity with a margin (measured 1.4e-3 and 1.0e-4).
+#include "rigid_block_law.hpp"
 #include "sliding_block.hpp"
 
 #include <frictherm/coupling/json_reader.hpp>
@@ -58,7 +59,9 @@ TEST(SlidingBlock, ExpressionLawRunsAsTheCompositeLaw) {
   const SlidingHistory expr = run_sliding_block(s);
 
   ASSERT_EQ(expr.time.size(), composite.time.size());
-  const RigidBlock rigid = rigid_solution(0.35, 0.2, k, S_a, 1.5);
+  // The law's own rigid block (eq. 48 integrated with its traction, rigid_block_law.hpp).
+  const RigidBlockUnderLaw rigid(rigid_solution(0.35, 0.2, k, S_a, 1.5),
+                                 smooth_law_traction(N, 0.35, 0.2, 0.05, k, S_a), C::t_final());
   const double v_max = rigid.velocity(C::t_final());
   double dv = 0.0, dv_early = 0.0, dv_rigid = 0.0;
   for (std::size_t i = 0; i < expr.time.size(); ++i) {
@@ -78,7 +81,8 @@ TEST(SlidingBlock, ExpressionLawRunsAsTheCompositeLaw) {
   EXPECT_LT(dv, 5e-3);
   EXPECT_LT(dW, 5e-3);
   // And so the composite test's bounds against the rigid block (test_sliding_block.cpp) hold.
-  // Measured with the scene defaults: 0.79 % of v_max and 2.85 % of the work.
-  EXPECT_LT(dv_rigid, 0.02);
-  EXPECT_LT(std::fabs(expr.work_second.back() - Q) / Q, 0.04);
+  // Measured with the scene defaults: 0.56 % of v_max and 0.20 % of the work (against the sharp
+  // step's closed form 0.79 % and 2.85 %: that reference's own difference). Bounds: issue 31's 3 %.
+  EXPECT_LT(dv_rigid, 0.03);
+  EXPECT_LT(std::fabs(expr.work_second.back() - Q) / Q, 0.03);
 }
