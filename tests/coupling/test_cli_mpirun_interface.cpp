@@ -11,7 +11,8 @@
 //     end of loading and at the continuation's end;
 //   * with hot spots judged by the interface temperature (coupling.hotspots.temperature "interface", a
 //     threshold the interface reaches and the grid does not): the hot-spot columns and /hotspots rows;
-//   * the books: the histories received the frictional work (metadata interface_heat_recorded).
+//   * the books: the histories received the frictional work (metadata interface_heat_recorded);
+//   * with patch_length (hot spots of a given size), the patches and the single node's column.
 // Tolerance: T_int = T_i + correction. The correction is the serial arithmetic on the same histories
 // (the steps' work to ~1e-13 of its scale, another summation order of pass 1's sums); T_i comes from
 // CVODE with PCG on both sides, converged to 0.1 of the error weights rtol |T| + atol (test_cli_mpirun.cpp,
@@ -122,6 +123,27 @@ TEST_F(MpirunInterface, PbxInterfaceTemperatureEqualsTheSerialRun) {
   run_both(kScene, kSets, 2);
   if (HasFatalFailure()) return;
   compare();
+}
+
+// Hot spots of a given size (patch_length 16 um, four cells): each node reports the patch of the
+// heated nodes within 8 um, which straddle the ranks' boundary where the interface crosses it (every
+// rank's heated nodes are gathered, decomposed_interface.cpp). The patch columns, the particles'
+// interface temperatures (the patch corrections) and the single node's column
+// max_node_interface_temperature equal the serial run's within the bound of compare().
+TEST_F(MpirunInterface, PbxInterfacePatchesEqualTheSerialRun) {
+  run_both(kScene, std::string(kSets) + " --set 'coupling.interface_temperature={\"patch_length\":16e-6}'", 2);
+  if (HasFatalFailure()) return;
+  compare();
+  const std::vector<double> node = column("serial.h5", "max_node_interface_temperature");
+  const std::vector<double> patch = column("serial.h5", "max_interface_temperature");
+  ASSERT_EQ(node.size(), patch.size());
+  double node_rise = 0.0, patch_rise = 0.0;
+  for (std::size_t k = 0; k < node.size(); ++k)
+    if (!std::isnan(node[k])) node_rise = std::max(node_rise, node[k] - kT0), patch_rise = std::max(patch_rise, patch[k] - kT0);
+  EXPECT_LT(patch_rise, node_rise) << "a patch spreads the hottest node's heat";
+  const double bound = 0.1 * (kRtol * (kT0 + node_rise) + kAtol) + 1e-9 * node_rise;
+  EXPECT_LE(max_difference(node, column("split.h5", "max_node_interface_temperature"), "node column"), bound);
+  std::printf("  hottest patch rise %.4g K, hottest node rise %.4g K\n", patch_rise, node_rise);
 }
 
 // The same with hot spots judged by the interface temperature: a rise of 0.05 K, which the interface

@@ -28,10 +28,7 @@ using CliMpirun = CliMpirunTest;
 TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
   const std::pair<const char*, const char*> cases[] = {
       {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
-       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"},
-      // The interface temperature runs decomposed, but not its patch.
-      {"--set 'coupling.interface_temperature={\"patch_length\":1e-3}'",
-       "coupling.interface_temperature.patch_length: 0.001 is not supported in a decomposed run"}};
+       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"}};
   for (const auto& [set, message] : cases) {
     const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
                            " -o '" + path("refused.h5") + "'");

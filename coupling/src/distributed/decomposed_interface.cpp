@@ -14,6 +14,8 @@
 //           correction among the nodes its shape functions reach (S_ip > 0) as it reads ghosted nodal
 //           temperatures: T_int,p = T_p + max(0, max_i correction_i), the serial pass 2;
 //
+// With patch_length > 0 the owners' slots report patches (interface_patches: every rank's heated
+// nodes gathered), and pass 2 sends the patch corrections.
 // T_int,p lives in a particle scalar (it migrates with the particle: the serial run keeps it by
 // particle until the next update). The hottest node is reduced over ranks (MPI_MAX).
 // Also the owned nodes' serial grid numbers (owned_grid_nodes) and the owned thermal unknowns of a
@@ -43,9 +45,6 @@ template <int Dim>
 void DecomposedHeat::interface_start(mechanics::DecomposedMpm<Dim>& mpm) {
   const InterfaceTemperatureOptions& o = opt_.interface_temperature;
   if (!o.enabled) return;
-  if (o.patch_length > 0.0)  // the patch reads neighbouring nodes' slots (decomposed_run_refusal says so)
-    throw std::invalid_argument("interface temperature: patch_length " + std::to_string(o.patch_length) +
-                                " m is not supported in a decomposed run (expected 0)");
   interface_scalar_ = mpm.particle_scalar_index(opt_.interface_scalar);
   const std::size_t nm = opt_.materials.size();
   const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
@@ -66,6 +65,7 @@ void DecomposedHeat::interface_start(mechanics::DecomposedMpm<Dim>& mpm) {
   for (std::size_t u = 0; u < owned_grid_node_.size(); ++u)
     owned_of_grid_[static_cast<std::size_t>(owned_grid_node_[u])] = static_cast<int>(u);
   interface_max_ = -std::numeric_limits<double>::infinity();
+  interface_node_max_ = interface_max_;
 }
 
 // Owned node u (x fastest over owned_nodes()) -> the serial grid node (lattice = DMDA index − ghost).
@@ -158,8 +158,12 @@ void DecomposedHeat::interface_update(mechanics::DecomposedMpm<Dim>& mpm) {
     if (u < M_.size() && u < last_T_.size() && is_unknown(M_[u])) grid_temperature[s] = last_T_[u];
   }
   model->update_slots(slot_rows, grid_temperature, time_);
+  if (model->patches()) interface_patches(*model, mpm.communicator());
   interface_max_ = model->max_temperature();
-  MPI_Allreduce(MPI_IN_PLACE, &interface_max_, 1, MPI_DOUBLE, MPI_MAX, mpm.communicator());
+  interface_node_max_ = model->max_node_temperature();
+  double maxima[2] = {interface_max_, interface_node_max_};
+  MPI_Allreduce(MPI_IN_PLACE, maxima, 2, MPI_DOUBLE, MPI_MAX, mpm.communicator());
+  interface_max_ = maxima[0], interface_node_max_ = maxima[1];
   interface_heat_ = model->heat_recorded();
   MPI_Allreduce(MPI_IN_PLACE, &interface_heat_, 1, MPI_DOUBLE, MPI_SUM, mpm.communicator());
 
@@ -189,12 +193,37 @@ void DecomposedHeat::interface_update(mechanics::DecomposedMpm<Dim>& mpm) {
   }
 }
 
+// Hot spots of a given size (patch_length > 0): a patch sums the heated nodes within ℓ/2 of its node,
+// which another rank may own. Every rank's heated nodes with their corrections and interface
+// temperatures are gathered to every rank (a few per contact node row: small beside the particles),
+// and each rank's patches are then the serial sums over the same nodes in the same order.
+template <int Dim>
+void DecomposedHeat::interface_patches(InterfaceTemperature<Dim>& model, MPI_Comm comm) {
+  const int count = static_cast<int>(model.nodes().size());
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  const auto total = static_cast<std::size_t>(offsets.back() + counts.back());
+  std::vector<int> nodes(total);
+  std::vector<double> correction(total), temperature(total);
+  MPI_Allgatherv(model.nodes().data(), count, MPI_INT, nodes.data(), counts.data(), offsets.data(), MPI_INT, comm);
+  MPI_Allgatherv(model.node_correction().data(), count, MPI_DOUBLE, correction.data(), counts.data(), offsets.data(),
+                 MPI_DOUBLE, comm);
+  MPI_Allgatherv(model.node_temperature().data(), count, MPI_DOUBLE, temperature.data(), counts.data(),
+                 offsets.data(), MPI_DOUBLE, comm);
+  books_.exchanges += 3;
+  model.update_patches_from(nodes, correction, temperature);
+}
+
 #define FRICTHERM_DECOMPOSED_INTERFACE(D)                                                      \
   template std::vector<int> DecomposedHeat::owned_grid_nodes<D>(const mechanics::DecomposedMpm<D>&); \
   template InterfaceTemperature<D>* DecomposedHeat::interface_model<D>();                      \
   template void DecomposedHeat::interface_start<D>(mechanics::DecomposedMpm<D>&);              \
   template void DecomposedHeat::interface_step<D>(const std::vector<double>&);                 \
-  template void DecomposedHeat::interface_update<D>(mechanics::DecomposedMpm<D>&);
+  template void DecomposedHeat::interface_update<D>(mechanics::DecomposedMpm<D>&);              \
+  template void DecomposedHeat::interface_patches<D>(InterfaceTemperature<D>&, MPI_Comm);
 FRICTHERM_DECOMPOSED_INTERFACE(2)
 FRICTHERM_DECOMPOSED_INTERFACE(3)
 #undef FRICTHERM_DECOMPOSED_INTERFACE

@@ -107,7 +107,8 @@ std::vector<std::string> DecomposedRun<Dim>::series_names() const {
     n.insert(n.end(), {"thermal_windows", "work_received", "nodal_energy_change"});
     if (s_.thermal.coupler.plastic.enabled) n.insert(n.end(), {"plastic_work", "plastic_heat"});
     if (heat_->reaction_enabled()) n.insert(n.end(), {"reaction_heat", "max_reaction_progress"});
-    if (heat_->interface_enabled()) n.emplace_back("max_interface_temperature");  // the serial column
+    if (heat_->interface_enabled()) n.emplace_back("max_interface_temperature");  // the serial columns
+    if (heat_->interface_patches()) n.emplace_back("max_node_interface_temperature");
     if (heat_->interface_enabled() && heat_->reaction_enabled()) n.emplace_back("max_interface_reaction_progress");
   }
   return n;
@@ -172,6 +173,10 @@ void DecomposedRun<Dim>::series(double time) {
     if (heat_->interface_enabled()) {  // NaN until some node has received frictional heat, as the serial run
       const double t_int = heat_->max_interface_temperature();
       row.push_back(std::isfinite(t_int) ? t_int : std::numeric_limits<double>::quiet_NaN());
+      if (heat_->interface_patches()) {
+        const double t_node = heat_->max_node_interface_temperature();
+        row.push_back(std::isfinite(t_node) ? t_node : std::numeric_limits<double>::quiet_NaN());
+      }
     }
     if (heat_->interface_enabled() && heat_->reaction_enabled()) row.push_back(heat_->max_interface_reaction_progress());
   }

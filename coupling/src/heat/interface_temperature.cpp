@@ -233,7 +233,22 @@ void InterfaceTemperature<Dim>::update_slots(const std::vector<double>& rows, co
     max_node_temperature_ = std::max(max_node_temperature_, node_temperature_[s]);
   }
   max_temperature_ = max_node_temperature_;
-  if (patch_area_ > 0.0) update_patches();
+  if (patch_area_ > 0.0)
+    update_patches([this](std::size_t node) { return slot_of_node_[node]; }, node_correction_, node_temperature_);
+}
+
+template <int Dim>
+void InterfaceTemperature<Dim>::update_patches_from(const std::vector<int>& nodes, const std::vector<double>& correction,
+                                                    const std::vector<double>& temperature) {
+  if (!(patch_area_ > 0.0)) return;
+  if (correction.size() != nodes.size() || temperature.size() != nodes.size())
+    throw std::invalid_argument("interface temperature: " + std::to_string(correction.size()) + " corrections and " +
+                                std::to_string(temperature.size()) + " temperatures for " +
+                                std::to_string(nodes.size()) + " heated nodes");
+  patch_index_.resize(grid_->node_count(), -1);
+  for (std::size_t e = 0; e < nodes.size(); ++e) patch_index_[static_cast<std::size_t>(nodes[e])] = static_cast<int>(e);
+  update_patches([this](std::size_t node) { return patch_index_[node]; }, correction, temperature);
+  for (const int node : nodes) patch_index_[static_cast<std::size_t>(node)] = -1;
 }
 
 // A hot spot of size ℓ: the heat of the heated nodes within ℓ/2 of node s, Σ_t A q_t ⊛ R_x, spread
@@ -241,7 +256,9 @@ void InterfaceTemperature<Dim>::update_slots(const std::vector<double>& rows, co
 // is the flash temperature of the patch's mean flux; the total heat in a patch converges with the cell
 // as the frictional work does, where one node's flux keeps growing as the cell resolves sharper slip.
 template <int Dim>
-void InterfaceTemperature<Dim>::update_patches() {
+template <class Index>
+void InterfaceTemperature<Dim>::update_patches(const Index& index, const std::vector<double>& correction,
+                                               const std::vector<double>& temperature) {
   const mechanics::Grid<Dim>& grid = *grid_;
   const std::size_t slots = nodes_.size();
   patch_correction_.assign(slots, 0.0);
@@ -260,11 +277,11 @@ void InterfaceTemperature<Dim>::update_patches() {
         inside = inside && q[d] >= -mechanics::Grid<Dim>::ghost && q[d] <= grid.cells()[d] + mechanics::Grid<Dim>::ghost;
       }
       if (!inside) continue;
-      const int t = slot_of_node_[static_cast<std::size_t>(grid.node_index(q))];
-      if (t < 0 || !std::isfinite(node_temperature_[static_cast<std::size_t>(t)])) continue;
+      const int t = index(static_cast<std::size_t>(grid.node_index(q)));
+      if (t < 0 || !std::isfinite(temperature[static_cast<std::size_t>(t)])) continue;
       const auto u = static_cast<std::size_t>(t);
-      heat_per_area += patch_weights_[j] * node_correction_[u];
-      grid_temperature += patch_weights_[j] * (node_temperature_[u] - node_correction_[u]);
+      heat_per_area += patch_weights_[j] * correction[u];
+      grid_temperature += patch_weights_[j] * (temperature[u] - correction[u]);
       weight += patch_weights_[j];
     }
     patch_correction_[s] = heat_per_area * area_ / patch_area_;

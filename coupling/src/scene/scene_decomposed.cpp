@@ -84,12 +84,9 @@ std::string thermal_refusal(const Scene& s) {
   if (c.reaction.enabled && c.reaction.during_loading && c.interface_temperature.enabled)
     return refuse("thermal.reaction.during_loading", "true with coupling.interface_temperature",
                   "false (the interface reaction from the continuation on)");
-  // The interface temperature runs on the owned nodes (decomposed_interface.cpp), without the patch
-  // (it reads other nodes' histories); its checkpoints hold each rank's histories (resumed on the rank
-  // count that wrote them).
-  if (c.interface_temperature.enabled && c.interface_temperature.patch_length > 0.0)
-    return refuse("coupling.interface_temperature.patch_length", number(c.interface_temperature.patch_length),
-                  "0 or no key");
+  // The interface temperature runs on the owned nodes (decomposed_interface.cpp); its patches
+  // (patch_length > 0) from every rank's heated nodes gathered; its checkpoints hold each rank's
+  // histories (resumed on the rank count that wrote them).
   // Every window policy runs (every_step, every_n_steps, adaptive: DecomposedHeat::after_step). Matrix-free
   // windows gather every window: the serial reuse of the last gather is not decomposed. The default
   // reuse distance is a speed-up of the serial run, so a scene that does not set it runs (gathering

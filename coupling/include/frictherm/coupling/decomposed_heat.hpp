@@ -175,6 +175,11 @@ class DecomposedHeat {
   /// Σ over ranks of the heat its histories recorded by then (J; equals the frictional work received).
   bool interface_enabled() const { return opt_.interface_temperature.enabled; }
   double max_interface_temperature() const { return interface_max_; }
+  /// With patch_length > 0 max_interface_temperature() is the hottest patch's; this is the hottest
+  /// single node's over all ranks (InterfaceTemperature::max_node_temperature; the series column
+  /// max_node_interface_temperature).
+  bool interface_patches() const { return interface_enabled() && opt_.interface_temperature.patch_length > 0.0; }
+  double max_node_interface_temperature() const { return interface_node_max_; }
   double interface_heat_recorded() const { return interface_heat_; }
   /// The reaction (options.reaction): the largest λ_p over ranks (collective; 0 without particles
   /// of reacting materials), q Σ_p m_p λ_p over ranks (collective; Coupler::particle_reaction_heat).
@@ -239,6 +244,7 @@ class DecomposedHeat {
     if (interface2_ || interface3_) {
       v("interface/max_temperature", interface_max_);
       v("interface/heat", interface_heat_);
+      if (interface_patches()) v("interface/node_max_temperature", interface_node_max_);
     }
   }
 
@@ -275,6 +281,7 @@ class DecomposedHeat {
   template <int Dim> void interface_start(mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> void interface_step(const std::vector<double>& work);
   template <int Dim> void interface_update(mechanics::DecomposedMpm<Dim>& mpm);
+  template <int Dim> void interface_patches(InterfaceTemperature<Dim>& model, MPI_Comm comm);
   // decomposed_reaction.cpp: the reacting mass and λ_i gathered from the particles (gather_reaction),
   // and the unreacted ratio scattered back (scatter_progress), as the serial heat_sources.cpp.
   bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }
@@ -322,6 +329,7 @@ class DecomposedHeat {
   int interface_scalar_ = -1;
   std::vector<int> owned_grid_node_, owned_of_grid_;
   double interface_max_ = -std::numeric_limits<double>::infinity(), interface_heat_ = 0.0;
+  double interface_node_max_ = -std::numeric_limits<double>::infinity();
   // The reaction: λ_p's scalar (-1: none), the last gather's reacting mass and λ_i per owned node,
   // λ_i now, and the particles' λ_p at the gather (swarm order; the particles do not move in between).
   int progress_scalar_ = -1;

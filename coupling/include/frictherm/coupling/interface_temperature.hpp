@@ -108,6 +108,15 @@ class InterfaceTemperature {
   double max_node_temperature() const { return max_node_temperature_; }
   /// Patch interface temperatures of the heated nodes (empty unless patch_length > 0).
   const std::vector<double>& patch_temperature() const { return patch_temperature_; }
+  /// Whether the reported values are patches (patch_length > 0).
+  bool patches() const { return patch_area_ > 0.0; }
+  /// The patches of this model's heated nodes from the heated nodes of the whole run (grid indices,
+  /// their node_correction() and node_temperature(); every rank's in a decomposed run, where a patch
+  /// reaches nodes another rank owns): the sums update_slots makes from this model's own nodes, in the
+  /// same order, so a rank's patches equal the serial run's. Sets max_temperature() to this model's
+  /// hottest patch.
+  void update_patches_from(const std::vector<int>& nodes, const std::vector<double>& correction,
+                           const std::vector<double>& temperature);
   /// Σ over nodes of the heat per area times the area handed to the history (J): equals the
   /// frictional heat received (the books check it).
   double heat_recorded() const { return heat_recorded_; }
@@ -125,8 +134,11 @@ class InterfaceTemperature {
   double patch_area_ = 0.0;                    // the patch's interface area (× thickness in 2D), 0: off
   std::vector<mechanics::IVec<Dim>> patch_offsets_;  // lattice offsets within the patch's radius
   std::vector<double> patch_weights_;                 // their weights: the share of the node inside
-  /// Patch values of every slot from node_correction_ and node_temperature_ (patch_length > 0).
-  void update_patches();
+  /// Patch values of every slot from the heated nodes' corrections and interface temperatures,
+  /// `index(grid node)` giving a node's entry in them (−1: not heated) (patch_length > 0).
+  template <class Index>
+  void update_patches(const Index& index, const std::vector<double>& correction, const std::vector<double>& temperature);
+  std::vector<int> patch_index_;  // update_patches_from: grid node → entry of its arguments, −1 elsewhere
   bool enabled_ = false;
   thermal::BinnedHeatHistory history_{8};
   std::vector<int> slot_of_node_;  // grid node → slot, −1 for never heated
