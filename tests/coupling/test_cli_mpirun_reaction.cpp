@@ -11,8 +11,9 @@
 //     both rank files) at the continuation's end;
 //   * metadata reaction_heat_released = particle_reaction_heat (the heat the nodes released is the
 //     particles' q Σ m λ_p), the energy changes the serial run's and = heat delivered + reaction heat;
-//   * the same with the reaction during loading too (thermal.reaction.during_loading, without the
-//     interface temperature, which a decomposed run takes only with the reaction held back).
+//   * the same with the reaction during loading too (thermal.reaction.during_loading), without and
+//     with the interface temperature (its interface reaction then runs during loading as well, λ_int,p
+//     migrating with the particles as a particle scalar).
 // Tolerances: both runs integrate [T; λ] with CVODE, GMRES and the serial 2×2 block-Jacobi
 // preconditioner to rtol = 1e-8, atol = 1e-6 K, progress_atol = 1e-6: converged to 0.1 of the error
 // weights (test_cli_mpirun.cpp): temperatures within 0.1 (rtol T_max + atol) = 3.0e-7 K, λ within
@@ -151,10 +152,25 @@ TEST_F(MpirunReaction, PbxReactionDuringLoadingEqualsTheSerialRun) {
   compare(false);
 }
 
-// What a decomposed run does not take with a reaction, said by `frictherm validate` (the same check,
-// decomposed_run_refusal, refuses `mpirun -n K frictherm run`: CliMpirun.Refusals): the interface
-// temperature with the reaction during loading (the interface reaction starts with the continuation).
-// Forward Euler with the reaction decomposes.
+// The interface reaction during loading: λ_int,p advanced every window at T_int,p while the
+// particles move between the ranks (0.2 us of compaction, ~360 steps), then in the continuation.
+TEST_F(MpirunReaction, PbxInterfaceReactionDuringLoadingEqualsTheSerialRun) {
+  run_both(kScene, std::string(kSets) + " --set thermal.reaction.during_loading=true", 2);
+  if (HasFatalFailure()) return;
+  compare(true);
+  // The interface reaction acted during loading: its progress at the end of loading is not zero.
+  const std::vector<double> lam = column("serial.h5", "max_interface_reaction_progress");
+  const std::vector<double> t = column("serial.h5", "time");
+  double at_end_of_loading = 0.0;
+  for (std::size_t k = 0; k < std::min(lam.size(), t.size()); ++k)
+    if (t[k] <= 2e-7 * (1.0 + 1e-9)) at_end_of_loading = lam[k];
+  EXPECT_GT(at_end_of_loading, 0.0);
+  std::printf("  interface λ_max at the end of loading %.4g\n", at_end_of_loading);
+}
+
+// What a decomposed run takes with a reaction, said by `frictherm validate` (the same check,
+// decomposed_run_refusal, refuses `mpirun -n K frictherm run` what it does not take): with the
+// interface temperature, the reaction during loading or held back; forward Euler with the reaction.
 TEST_F(MpirunReaction, ValidateNamesWhatIsNotDecomposed) {
   const std::string scene = source("tests/coupling/scenes/decomposed_sliding_block.json");
   const std::string reaction =
@@ -162,7 +178,7 @@ TEST_F(MpirunReaction, ValidateNamesWhatIsNotDecomposed) {
   const std::pair<std::string, std::string> cases[] = {
       {reaction, "mpirun -n K frictherm run decomposes it"},  // forward Euler (the scene's) with the reaction
       {reaction + " --set thermal.integrator=cvode_bdf --set coupling.interface_temperature=true",
-       "serial only (thermal.reaction.during_loading: true with coupling.interface_temperature is not supported"},
+       "mpirun -n K frictherm run decomposes it"},
       {reaction + " --set thermal.integrator=cvode_bdf", "mpirun -n K frictherm run decomposes it"},
       {reaction + " --set thermal.integrator=auto --set coupling.interface_temperature=true"
                   " --set thermal.reaction.during_loading=false",

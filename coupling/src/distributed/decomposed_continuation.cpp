@@ -57,7 +57,7 @@ void DecomposedHeat::continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time
     }
     // The interface reaction held back until the continuation (Coupler::continue_thermal).
     if (interface_enabled() && opt_.reaction.enabled && !interface_reaction_.started())
-      interface_reaction_.start(mpm.local_particle_data().mass.size(), window_start_);
+      interface_reaction_start(mpm, window_start_);
   }
   T0_ = last_T_;  // the interval's start: ΔT_i = T_i(t1) − T_i(t0)
   std::vector<double> Tn = last_T_;

@@ -66,6 +66,25 @@ void DecomposedHeat::interface_start(mechanics::DecomposedMpm<Dim>& mpm) {
     owned_of_grid_[static_cast<std::size_t>(owned_grid_node_[u])] = static_cast<int>(u);
   interface_max_ = -std::numeric_limits<double>::infinity();
   interface_node_max_ = interface_max_;
+  if (opt_.reaction.enabled) {  // the interface reaction: from the start (during_loading) or the continuation
+    interface_progress_scalar_ = mpm.particle_scalar_index(opt_.interface_progress_scalar);
+    interface_rate_scalar_ = mpm.particle_scalar_index(opt_.interface_rate_scalar);
+    if (opt_.reaction.during_loading) interface_reaction_start(mpm, time_);  // as the serial Coupler::start
+  }
+}
+
+// The interface reaction starts fresh (λ = 0, no rate yet) on this rank's particles, its state in the
+// particle scalars that migrate with them.
+template <int Dim>
+void DecomposedHeat::interface_reaction_start(mechanics::DecomposedMpm<Dim>& mpm, double time) {
+  interface_reaction_.start(mpm.local_particle_data().mass.size(), time);
+  mpm.set_particle_scalar(interface_progress_scalar_, interface_reaction_.progress());
+  mpm.set_particle_scalar(interface_rate_scalar_, interface_reaction_.rate());
+}
+
+template <int Dim>
+std::vector<double> DecomposedHeat::interface_reaction_progress(const mechanics::DecomposedMpm<Dim>& mpm) const {
+  return interface_reaction_.started() ? mpm.particle_scalar(interface_progress_scalar_) : std::vector<double>{};
 }
 
 // Owned node u (x fastest over owned_nodes()) -> the serial grid node (lattice = DMDA index − ghost).
@@ -185,9 +204,12 @@ void DecomposedHeat::interface_update(mechanics::DecomposedMpm<Dim>& mpm) {
   }
   mpm.set_particle_scalar(interface_scalar_, t_int);
   // The interface reaction at T_int,p (Coupler::update_interface_and_hotspots), this rank's particles.
-  if (interface_reaction_.started()) {
+  if (interface_reaction_.started()) {  // this update's particles' λ_int,p and k from their scalars
     const std::vector<std::int32_t> material(P.material.begin(), P.material.end());
+    interface_reaction_.assign(mpm.particle_scalar(interface_progress_scalar_), mpm.particle_scalar(interface_rate_scalar_));
     interface_reaction_.advance(material, opt_.reaction, t_int, time_);
+    mpm.set_particle_scalar(interface_progress_scalar_, interface_reaction_.progress());
+    mpm.set_particle_scalar(interface_rate_scalar_, interface_reaction_.rate());
     interface_reaction_max_ = interface_reaction_.max_progress();
     MPI_Allreduce(MPI_IN_PLACE, &interface_reaction_max_, 1, MPI_DOUBLE, MPI_MAX, mpm.communicator());
   }
@@ -223,7 +245,9 @@ void DecomposedHeat::interface_patches(InterfaceTemperature<Dim>& model, MPI_Com
   template void DecomposedHeat::interface_start<D>(mechanics::DecomposedMpm<D>&);              \
   template void DecomposedHeat::interface_step<D>(const std::vector<double>&);                 \
   template void DecomposedHeat::interface_update<D>(mechanics::DecomposedMpm<D>&);              \
-  template void DecomposedHeat::interface_patches<D>(InterfaceTemperature<D>&, MPI_Comm);
+  template void DecomposedHeat::interface_patches<D>(InterfaceTemperature<D>&, MPI_Comm);                 \
+  template void DecomposedHeat::interface_reaction_start<D>(mechanics::DecomposedMpm<D>&, double);       \
+  template std::vector<double> DecomposedHeat::interface_reaction_progress<D>(const mechanics::DecomposedMpm<D>&) const;
 FRICTHERM_DECOMPOSED_INTERFACE(2)
 FRICTHERM_DECOMPOSED_INTERFACE(3)
 #undef FRICTHERM_DECOMPOSED_INTERFACE

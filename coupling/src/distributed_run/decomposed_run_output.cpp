@@ -268,8 +268,8 @@ void DecomposedRun<Dim>::snapshot(double time) {
                              mpm_->particle_scalar(mpm_->particle_scalar_index("interface_temperature")));
   if (heat_ && heat_->reaction_enabled())  // λ_p, as the serial snapshot field
     snap.fields.emplace_back("reaction_progress", mpm_->particle_scalar(mpm_->particle_scalar_index("reaction_progress")));
-  if (heat_ && heat_->interface_reaction().started())  // from the continuation on (no migration since)
-    snap.fields.emplace_back("interface_reaction_progress", heat_->interface_reaction().progress());
+  if (heat_ && heat_->interface_reaction().started())  // λ_int,p in the particles' current order
+    snap.fields.emplace_back("interface_reaction_progress", heat_->interface_reaction_progress(*mpm_));
   if (heat_) {  // the thermal grid's owned unknowns, by the serial writer (node_output.hpp)
     const DecomposedThermalNodes nodes = heat_->thermal_nodes();
     detail::write_node_fields<Dim>(snap, mpm_->grid(), nodes.grid_node, nodes.temperature.data(),

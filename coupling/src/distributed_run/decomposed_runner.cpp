@@ -322,7 +322,8 @@ void DecomposedRun<Dim>::continuation() {
       throw thermal_failure("thermal integration unstable: ", e, t);
     }
     hot_->update(*mpm_, t);
-    hot_->update_fates(*mpm_, t, heat_->interface_reaction().started() ? &heat_->interface_reaction().progress() : nullptr);
+    const std::vector<double> interface_progress = heat_->interface_reaction_progress(*mpm_);
+    hot_->update_fates(*mpm_, t, heat_->interface_reaction().started() ? &interface_progress : nullptr);
     series(t);  // the mechanics columns stay at their final values
     const HotSpotFates& f = hot_->fates();
     if (spec.stop_when_decided && !f.records().empty() && f.all_decided()) break;

@@ -40,6 +40,10 @@ bool interface_temperature(const Scene& scene) {
   return scene.thermal.enabled && scene.thermal.coupler.interface_temperature.enabled;
 }
 
+bool interface_reaction(const Scene& scene) {
+  return interface_temperature(scene) && scene.thermal.coupler.reaction.enabled;
+}
+
 template <int Dim>
 mechanics::Grid<Dim> scene_grid(const Scene& scene) {
   mechanics::IVec<Dim> cells{};
@@ -114,6 +118,9 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   if (interface_temperature(scene)) o.particle_scalars.emplace_back("interface_temperature");
   // λ_p of the reaction (DecomposedHeatOptions::progress_scalar).
   if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) o.particle_scalars.emplace_back("reaction_progress");
+  // λ_int,p and k(T_int,p) of the interface reaction (DecomposedHeatOptions::interface_progress_scalar,
+  // interface_rate_scalar): they move with their particles.
+  if (interface_reaction(scene)) o.particle_scalars.insert(o.particle_scalars.end(), {"interface_reaction_progress", "interface_reaction_rate"});
   // The particle's body (the serial Particles::body; exact as a double): the series' per-body means
   // and the snapshots' body field (issue 32).
   o.particle_scalars.emplace_back("body");
@@ -152,6 +159,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
         if (plastic_heating(scene)) q.scalars.push_back(p.plastic_work[k]);  // as PlasticHeatSource::start
         if (interface_temperature(scene)) q.scalars.push_back(p.temperature[k]);  // T_p before any heat
         if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) q.scalars.push_back(0.0);  // fresh
+        if (interface_reaction(scene)) q.scalars.insert(q.scalars.end(), {0.0, -1.0});  // fresh, no reading yet
         q.scalars.push_back(static_cast<double>(p.body[k]));
       }
       for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {

@@ -80,10 +80,8 @@ std::string thermal_refusal(const Scene& s) {
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
   // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed
   // integrators carry λ: forward Euler's reacting sub-steps too, the serial Scheme on the distributed
-  // ODE); its interface reaction from the continuation on.
-  if (c.reaction.enabled && c.reaction.during_loading && c.interface_temperature.enabled)
-    return refuse("thermal.reaction.during_loading", "true with coupling.interface_temperature",
-                  "false (the interface reaction from the continuation on)");
+  // ODE); its interface reaction during loading or from the continuation on, λ_int,p and its rate in
+  // particle scalars that migrate with the particles (decomposed_interface.cpp).
   // The interface temperature runs on the owned nodes (decomposed_interface.cpp); its patches
   // (patch_length > 0) from every rank's heated nodes gathered; its checkpoints hold each rank's
   // histories (resumed on the rank count that wrote them).

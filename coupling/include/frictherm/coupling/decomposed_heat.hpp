@@ -55,6 +55,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -103,6 +104,11 @@ struct DecomposedHeatOptions {
   /// below. Reacting windows are assembled (cvode_bdf for "auto"; not forward_euler).
   ReactionOptions reaction;
   std::string progress_scalar = "reaction_progress";
+  /// With the interface temperature and the reaction: the interface reaction's λ_int,p and its last
+  /// rate k(T_int,p) (InterfaceReaction), particle scalars so that they migrate with the particles
+  /// (the interface reaction runs during loading as well as in the continuation).
+  std::string interface_progress_scalar = "interface_reaction_progress";
+  std::string interface_rate_scalar = "interface_reaction_rate";
 };
 
 /// Energy books summed over ranks (J), as the serial EnergyBooks.
@@ -189,6 +195,9 @@ class DecomposedHeat {
   /// The interface reaction (interface temperature and reaction, from the continuation on: the serial
   /// InterfaceReaction on this rank's particles, swarm order); its largest λ_int,p over ranks.
   const InterfaceReaction& interface_reaction() const { return interface_reaction_; }
+  /// λ_int,p of this rank's particles in their current order (empty before the interface reaction
+  /// starts): the particle scalar interface_progress_scalar.
+  template <int Dim> std::vector<double> interface_reaction_progress(const mechanics::DecomposedMpm<Dim>& mpm) const;
   double max_interface_reaction_progress() const { return interface_reaction_max_; }
   /// Σ_p m_p C_v,p T_p over all ranks (J).
   double heat_content() const;
@@ -245,6 +254,13 @@ class DecomposedHeat {
       v("interface/max_temperature", interface_max_);
       v("interface/heat", interface_heat_);
       if (interface_patches()) v("interface/node_max_temperature", interface_node_max_);
+      if (opt_.reaction.enabled) {  // λ_int,p and k travel in particle scalars; the clock here
+        std::vector<double> state{interface_reaction_.started() ? 1.0 : 0.0, interface_reaction_.time(),
+                                  interface_reaction_max_};
+        v("interface_reaction/state", state);
+        if constexpr (std::decay_t<V>::reading)
+          if (state.size() == 3) interface_reaction_.restore_time(state[0] != 0.0, state[1]), interface_reaction_max_ = state[2];
+      }
     }
   }
 
@@ -282,6 +298,7 @@ class DecomposedHeat {
   template <int Dim> void interface_step(const std::vector<double>& work);
   template <int Dim> void interface_update(mechanics::DecomposedMpm<Dim>& mpm);
   template <int Dim> void interface_patches(InterfaceTemperature<Dim>& model, MPI_Comm comm);
+  template <int Dim> void interface_reaction_start(mechanics::DecomposedMpm<Dim>& mpm, double time);
   // decomposed_reaction.cpp: the reacting mass and λ_i gathered from the particles (gather_reaction),
   // and the unreacted ratio scattered back (scatter_progress), as the serial heat_sources.cpp.
   bool reaction_active() const { return opt_.reaction.enabled && (opt_.reaction.during_loading || continuing_); }
@@ -326,7 +343,7 @@ class DecomposedHeat {
   // particle scalar, owned node -> grid node and back (-1: not owned), the last maximum over ranks.
   std::unique_ptr<InterfaceTemperature<2>> interface2_;
   std::unique_ptr<InterfaceTemperature<3>> interface3_;
-  int interface_scalar_ = -1;
+  int interface_scalar_ = -1, interface_progress_scalar_ = -1, interface_rate_scalar_ = -1;
   std::vector<int> owned_grid_node_, owned_of_grid_;
   double interface_max_ = -std::numeric_limits<double>::infinity(), interface_heat_ = 0.0;
   double interface_node_max_ = -std::numeric_limits<double>::infinity();

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace frictherm::coupling {
@@ -32,6 +33,16 @@ class InterfaceReaction {
 
   bool started() const { return started_; }
   const std::vector<double>& progress() const { return progress_; }
+  /// k(T_int,p) at the last update (1/s; −1: no reading yet), per particle as progress().
+  const std::vector<double>& rate() const { return rate_; }
+  /// For a caller whose particles change between updates (a decomposed run: they migrate between
+  /// ranks with their progress and rate as particle scalars): this update's particles' λ and k.
+  void assign(std::vector<double> progress, std::vector<double> rate) {
+    progress_ = std::move(progress), rate_ = std::move(rate);
+  }
+  /// The time of the last update (started() only).
+  double time() const { return time_; }
+  void restore_time(bool started, double time) { started_ = started, time_ = time; }
   double max_progress() const;
 
   /// Checkpoints (state_visit.hpp).
