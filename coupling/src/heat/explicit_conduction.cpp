@@ -144,7 +144,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     // particle order as the two passes below, so the same numbers.
     Expanded e{};
     whole_.assign(p.size(), 0);
-    first_node_.assign(p.size(), 0);
+    first_node_.assign(p.size(), static_cast<int>(n_nodes));  // past the grid: no flag set there
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k]) continue;
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
@@ -181,7 +181,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
   whole_.assign(p.size(), 0);
-  first_node_.assign(p.size(), 0);
+  first_node_.assign(p.size(), static_cast<int>(n_nodes));  // past the grid: no flag set there
   mechanics::parallel_region(threads, [&] {
   Expanded e{};
 #pragma omp for schedule(static)
@@ -439,6 +439,13 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
         const double quick = conductance == 0.0 ? 0.0 : sign * quick_weight(st, conductance);
         double* const sums = next_mct_.data();
         const int* const un = sys.unknown.data();
+#if defined(FRICTHERM_WHOLE_ROWS_SSE2)
+        if constexpr (Dim == 2) {  // rows packed: the same bits
+          refresh_terms_whole(st, indexer_, un, mc, mct, quick, conductance != 0.0, sign < 0.0, grid_mass, sums,
+                              quick_sum_.data());
+          return;
+        }
+#endif
         for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
           const auto g = static_cast<std::size_t>(i);
           if (sign < 0.0) {

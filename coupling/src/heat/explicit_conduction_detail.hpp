@@ -165,6 +165,47 @@ inline void add_whole_rows(const WholeRows<Dim, K>& r, double c, double* a) {
     if constexpr (K == 3) x[2] += c * r.s2[at];
   }
 }
+
+// A refresh's terms of one particle with a whole 2D stencil (refresh_with: M_i ∓ m C S_ip, the eq. 38
+// sums ∓ m C T S_ip by unknown, quick_sum_ + quick |G_ip|₁ when it conducts), two nodes of a row at a
+// time: each array's element gets the same operation as in for_each_node's loop, so the same bits.
+template <class Kernel>
+inline void refresh_terms_whole(const mechanics::Stencil<2, Kernel>& st, const mechanics::NodeIndexer<2>& ix,
+                                const int* un, double mc, double mct, double quick, bool conducts, bool out,
+                                double* grid_mass, double* sums, double* quick_sum) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<2> b = st.first_node();
+  const __m128d wx = _mm_loadu_pd(st.axis[0].w), dwx = _mm_loadu_pd(st.axis[0].dw);
+  const double wx2 = st.axis[0].w[K - 1], dwx2 = st.axis[0].dw[K - 1];
+  const __m128d mcv = _mm_set1_pd(mc), mctv = _mm_set1_pd(mct), qv = _mm_set1_pd(quick);
+  const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
+  for (int j = 0; j < K; ++j) {
+    const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+    const int row = ix.shift + (b[1] + j) * ix.stride[1] + b[0] * ix.stride[0];  // stride[0] = 1
+    const __m128d S = _mm_mul_pd(wx, _mm_set1_pd(wy));
+    double* const gm = grid_mass + row;
+    double* const sm = sums + un[row];
+    const __m128d m = _mm_mul_pd(mcv, S), t = _mm_mul_pd(mctv, S);
+    _mm_storeu_pd(gm, out ? _mm_sub_pd(_mm_loadu_pd(gm), m) : _mm_add_pd(_mm_loadu_pd(gm), m));
+    _mm_storeu_pd(sm, out ? _mm_sub_pd(_mm_loadu_pd(sm), t) : _mm_add_pd(_mm_loadu_pd(sm), t));
+    const double S2 = wx2 * wy;
+    if constexpr (K == 3) {
+      if (out) {
+        gm[2] -= mc * S2;
+        sm[2] -= mct * S2;
+      } else {
+        gm[2] += mc * S2;
+        sm[2] += mct * S2;
+      }
+    }
+    if (!conducts) continue;
+    const __m128d gx = _mm_mul_pd(dwx, _mm_set1_pd(wy)), gy = _mm_mul_pd(wx, _mm_set1_pd(dwy));
+    const __m128d l1 = _mm_add_pd(_mm_and_pd(gx, abs_mask), _mm_and_pd(gy, abs_mask));
+    double* const qs = quick_sum + row;
+    _mm_storeu_pd(qs, _mm_add_pd(_mm_loadu_pd(qs), _mm_mul_pd(qv, l1)));
+    if constexpr (K == 3) qs[2] += quick * (std::fabs(dwx2 * wy) + std::fabs(wx2 * dwy));
+  }
+}
 #endif
 
 // |G_ip|₁ of for_each_node's components (gz = 0 in 2D): in 2D |gx| + |gy| alone, the same bits

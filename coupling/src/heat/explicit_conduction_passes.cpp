@@ -103,7 +103,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
   for (long s = 0; s < substeps; ++s) {
     if (force_ready) {
       force_ready = false;
-      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
     }
@@ -189,7 +189,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         for (int a = 0; a < e.count; ++a)
           if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
       });
-      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
     }
@@ -230,7 +230,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         grad *= conductance_[k];
         for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
       }
-      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
     }
@@ -272,7 +272,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       for (int a = 0; a < e.count; ++a)  // f_i = −V k G'·∇T
         if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
     });
-    for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+    T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
     for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
   }
 }
@@ -423,8 +423,9 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const int* first = first_node_.data();
     const unsigned char* reached = changed_in_box<Kernel::K>(static_cast<int>(sys.unknown.size()));
     for (std::size_t k = 0; k < p.size(); ++k) {
-      // any_changed, from the stencil's first grid node kept with it: one flag
-      if (!holds_heat_[k] || !reached[first[k]]) continue;
+      // any_changed, from the stencil's first grid node kept with it: one flag (a particle that holds
+      // no heat has its first node past the grid, where no flag is set)
+      if (!reached[first[k]]) continue;
       const double before = temperature[k];
       if (whole_[k]) {
 #if defined(FRICTHERM_WHOLE_ROWS_SSE2)
