@@ -394,6 +394,27 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
     if (mark) flux_temperature_[u[a]] = std::numeric_limits<double>::quiet_NaN();
   }
   if (node_compact_) {  // a refresh: the pairs the assembly joined, in the compacted rows
+    if constexpr (Dim == 2) {
+      if (count == total) {  // a whole stencil: the loop below with its slots known when compiled
+        constexpr int n = mechanics::Stencil<Dim, Kernel>::node_count;
+#pragma GCC unroll 9
+        for (int a = 0; a < n; ++a) {
+          const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+#pragma GCC unroll 9
+          for (int b = a + 1; b < n; ++b) {
+            const double term = sign * (conductance * (g[0][a] * g[0][b] + g[1][a] * g[1][b]));
+            const int slot = (b % K - a % K) + 5 * (b / K - a / K) + centre;  // code_b − code_a + centre
+            const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
+            const int ba = node_pos_[static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot)];
+            if (ab < 0 || ba < 0)
+              throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
+            node_kc_[static_cast<std::size_t>(ab)] += term;
+            node_kc_[static_cast<std::size_t>(ba)] += term;
+          }
+        }
+        return;
+      }
+    }
     for (int a = 0; a < count; ++a) {
       const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
       for (int b = a + 1; b < count; ++b) {

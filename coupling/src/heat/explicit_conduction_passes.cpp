@@ -119,9 +119,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       // makes them (quiet ones left out), in particle order.
       // (Out of K: taken out by a refresh, or not in it at the assembly, where every heat-holding
       // particle with V_p k_p != 0 joined it; only a refresh changes V_p k_p, and it lists the particle.)
-      listed_.clear();
-      for (std::size_t k : out_of_k_)
-        if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
+      const auto out_of_k_flux = [&](std::size_t k) { return holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0; };
       if (threads <= 1) {
         // One thread: a whole particle's unknowns and G_ip kept from its first sub-step out of K
         // (out_of_k_stencil): look_whole and scatter_whole's sums from them, in the same order.
@@ -129,7 +127,8 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         double* const f = force_.data();
         const double* const t = T.data();
         constexpr int nodes_of = mechanics::Stencil<Dim, Kernel>::node_count;
-        for (std::size_t k : listed_) {
+        for (std::size_t k : out_of_k_) {  // in order, as the list the threads take below
+          if (!out_of_k_flux(k)) continue;
           if (!whole_[k]) {
             expand<Kernel, true>(stencils[k], sys.unknown, e);
             if (!e.reaches() || quiet_temperatures(e, T)) continue;
@@ -168,7 +167,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
             f[c.unknown[a]] -= dot;
           }
         }
-      } else
+      } else {
+        listed_.clear();
+        for (std::size_t k : out_of_k_)
+          if (out_of_k_flux(k)) listed_.push_back(k);
       scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
         const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
         if (!r.meets(node_span(st, indexer_))) return;
@@ -189,6 +191,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         for (int a = 0; a < e.count; ++a)
           if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
       });
+      }
       T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
