@@ -95,7 +95,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
         double* a = sums + 3 * static_cast<std::size_t>(i);
         a[0] += mc * w;
         a[1] += mct * w;
-        a[2] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+        a[2] += quick * g_l1<Dim>(gx, gy, gz);
       });
     }
     for (std::size_t i = 0; i < n_nodes; ++i) {
@@ -114,7 +114,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       if (!r.holds(i)) return;
       sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
       mct_[static_cast<std::size_t>(i)] += mct * w;
-      quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+      quick_sum_[static_cast<std::size_t>(i)] += quick * g_l1<Dim>(gx, gy, gz);
     });
   });
   if (!(sys.particle_heat_capacity > 0.0))
@@ -144,7 +144,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     // particle order as the two passes below, so the same numbers.
     Expanded e{};
     whole_.assign(p.size(), 0);
-    first_node_.assign(p.size(), 0);
+    first_node_.assign(p.size(), static_cast<int>(n_nodes));  // past the grid: no flag set there
     for (std::size_t k = 0; k < p.size(); ++k) {
       if (!holds_heat_[k]) continue;
       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
@@ -181,7 +181,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // fluxes of those that carry flux, scattered by node ranges in particle order.
   particle_scratch_.assign(p.size(), 0.0);  // 1: lumped, 2: carries flux (bits)
   whole_.assign(p.size(), 0);
-  first_node_.assign(p.size(), 0);
+  first_node_.assign(p.size(), static_cast<int>(n_nodes));  // past the grid: no flag set there
   mechanics::parallel_region(threads, [&] {
   Expanded e{};
 #pragma omp for schedule(static)
@@ -299,7 +299,7 @@ void ExplicitConduction<Dim>::add_quick(const mechanics::Stencil<Dim, Kernel>& s
   if (conductance == 0.0) return;
   const double quick = sign * quick_weight(st, conductance);
   for_each_node(st, indexer_, [&](int i, double, double gx, double gy, double gz) {
-    quick_sum_[static_cast<std::size_t>(i)] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+    quick_sum_[static_cast<std::size_t>(i)] += quick * g_l1<Dim>(gx, gy, gz);
   });
   if (e.reaches() && e.count < e.total) add_quick_lumping(st, conductance, sys, e, sign);
 }
@@ -380,7 +380,19 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
     const mechanics::Vec<Dim>* at = gathered_at_.data();
     const mechanics::Vec<Dim>* now_at = p.position.data();
     const unsigned char* holds = holds_heat_.data();
-    for (std::size_t k = 0; k < p.size(); ++k) {
+    std::size_t k = 0;
+#if defined(__SSE2__)
+    if constexpr (Dim == 2) {  // both coordinates in one register: the same differences and tests
+      const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
+      const __m128d limit = _mm_set1_pd(max_shift);
+      for (; k < p.size(); ++k) {
+        const __m128d shift = _mm_sub_pd(_mm_loadu_pd(now_at[k].data()), _mm_loadu_pd(at[k].data()));
+        const bool within = _mm_movemask_pd(_mm_cmple_pd(_mm_and_pd(shift, abs_mask), limit)) == 3;
+        if (!within && holds[k]) moved_.push_back(k);
+      }
+    }
+#endif
+    for (; k < p.size(); ++k) {
       bool within = std::fabs(now_at[k][0] - at[k][0]) <= max_shift;
       for (int d = 1; d < Dim; ++d) within &= std::fabs(now_at[k][d] - at[k][d]) <= max_shift;
       if (!within && holds[k]) moved_.push_back(k);
@@ -427,6 +439,13 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
         const double quick = conductance == 0.0 ? 0.0 : sign * quick_weight(st, conductance);
         double* const sums = next_mct_.data();
         const int* const un = sys.unknown.data();
+#if defined(FRICTHERM_WHOLE_ROWS_SSE2)
+        if constexpr (Dim == 2) {  // rows packed: the same bits
+          refresh_terms_whole(st, indexer_, un, mc, mct, quick, conductance != 0.0, sign < 0.0, grid_mass, sums,
+                              quick_sum_.data());
+          return;
+        }
+#endif
         for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
           const auto g = static_cast<std::size_t>(i);
           if (sign < 0.0) {
@@ -436,7 +455,7 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
             grid_mass[g] += mc * w;
             sums[un[g]] += mct * w;
           }
-          if (conductance != 0.0) quick_sum_[g] += quick * (std::fabs(gx) + std::fabs(gy) + std::fabs(gz));
+          if (conductance != 0.0) quick_sum_[g] += quick * g_l1<Dim>(gx, gy, gz);
         });
         return;
       }

@@ -101,6 +101,121 @@ inline void for_each_unknown_whole_from(const mechanics::Stencil<Dim, Kernel>& s
   }
 }
 
+// Packed forms of for_each_unknown_whole_from's loops (issue 35): a whole stencil's row is K
+// consecutive unknowns, so two of its nodes go in one SSE2 register. Each product is the same
+// correctly rounded operation as in the scalar loop (S = wx wy, in 3D (wx wy) wz, then S v), and the
+// sums still take their terms one by one in node order, so the same bits. Not with FMA (a native
+// build may contract the scalar loop's a b + c, the packed one not): there the scalar loops stay.
+#if defined(__SSE2__) && !defined(__FMA__)
+#define FRICTHERM_WHOLE_ROWS_SSE2 1
+// A whole stencil's rows: each row's first unknown and its S_ip (nodes 0, 1 packed; node 2 if K = 3).
+template <int Dim, int K>
+struct WholeRows {
+  static constexpr int rows = Dim == 2 ? K : K * K;
+  int u0[rows];
+  __m128d s01[rows];
+  double s2[rows];
+};
+
+// Σ S_ip v_i over a whole stencil from its first grid node, in node order (as for_each_unknown_whole_from
+// with f = sum += S v[u]); the rows' unknowns and S_ip into r for the scatter (add_whole_rows).
+template <int Dim, class Kernel>
+inline double dot_whole_rows(const mechanics::Stencil<Dim, Kernel>& st, int first, const mechanics::NodeIndexer<Dim>& ix,
+                             const int* un, const double* v, WholeRows<Dim, Kernel::K>& r) {
+  constexpr int K = Kernel::K;
+  static_assert(K == 2 || K == 3, "rows of 2 or 3 nodes");
+  const mechanics::IVec<Dim>& sd = ix.stride;
+  const __m128d wx01 = _mm_loadu_pd(st.axis[0].w);
+  const double wx2 = st.axis[0].w[K - 1];
+  double sum = 0.0;
+  const auto row = [&](int at, int u0, __m128d s01, double s2) {
+    r.u0[at] = u0;
+    r.s01[at] = s01;
+    r.s2[at] = s2;
+    const __m128d p = _mm_mul_pd(s01, _mm_loadu_pd(v + u0));
+    sum += _mm_cvtsd_f64(p);
+    sum += _mm_cvtsd_f64(_mm_unpackhi_pd(p, p));
+    if constexpr (K == 3) sum += s2 * v[u0 + 2];
+  };
+  if constexpr (Dim == 2) {
+    for (int j = 0; j < K; ++j) {
+      const double wy = st.axis[1].w[j];
+      row(j, un[first + j * sd[1]], _mm_mul_pd(wx01, _mm_set1_pd(wy)), wx2 * wy);
+    }
+  } else {
+    for (int k = 0; k < K; ++k) {
+      const double wz = st.axis[2].w[k];
+      for (int j = 0; j < K; ++j) {
+        const double wy = st.axis[1].w[j];
+        row(k * K + j, un[first + k * sd[2] + j * sd[1]],
+            _mm_mul_pd(_mm_mul_pd(wx01, _mm_set1_pd(wy)), _mm_set1_pd(wz)), wx2 * wy * wz);
+      }
+    }
+  }
+  return sum;
+}
+
+// a_i += c S_ip over the rows of dot_whole_rows (each node's own sum: packed, the same bits).
+template <int Dim, int K>
+inline void add_whole_rows(const WholeRows<Dim, K>& r, double c, double* a) {
+  const __m128d cv = _mm_set1_pd(c);
+  for (int at = 0; at < WholeRows<Dim, K>::rows; ++at) {
+    double* x = a + r.u0[at];
+    _mm_storeu_pd(x, _mm_add_pd(_mm_loadu_pd(x), _mm_mul_pd(cv, r.s01[at])));
+    if constexpr (K == 3) x[2] += c * r.s2[at];
+  }
+}
+
+// A refresh's terms of one particle with a whole 2D stencil (refresh_with: M_i ∓ m C S_ip, the eq. 38
+// sums ∓ m C T S_ip by unknown, quick_sum_ + quick |G_ip|₁ when it conducts), two nodes of a row at a
+// time: each array's element gets the same operation as in for_each_node's loop, so the same bits.
+template <class Kernel>
+inline void refresh_terms_whole(const mechanics::Stencil<2, Kernel>& st, const mechanics::NodeIndexer<2>& ix,
+                                const int* un, double mc, double mct, double quick, bool conducts, bool out,
+                                double* grid_mass, double* sums, double* quick_sum) {
+  constexpr int K = Kernel::K;
+  const mechanics::IVec<2> b = st.first_node();
+  const __m128d wx = _mm_loadu_pd(st.axis[0].w), dwx = _mm_loadu_pd(st.axis[0].dw);
+  const double wx2 = st.axis[0].w[K - 1], dwx2 = st.axis[0].dw[K - 1];
+  const __m128d mcv = _mm_set1_pd(mc), mctv = _mm_set1_pd(mct), qv = _mm_set1_pd(quick);
+  const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
+  for (int j = 0; j < K; ++j) {
+    const double wy = st.axis[1].w[j], dwy = st.axis[1].dw[j];
+    const int row = ix.shift + (b[1] + j) * ix.stride[1] + b[0] * ix.stride[0];  // stride[0] = 1
+    const __m128d S = _mm_mul_pd(wx, _mm_set1_pd(wy));
+    double* const gm = grid_mass + row;
+    double* const sm = sums + un[row];
+    const __m128d m = _mm_mul_pd(mcv, S), t = _mm_mul_pd(mctv, S);
+    _mm_storeu_pd(gm, out ? _mm_sub_pd(_mm_loadu_pd(gm), m) : _mm_add_pd(_mm_loadu_pd(gm), m));
+    _mm_storeu_pd(sm, out ? _mm_sub_pd(_mm_loadu_pd(sm), t) : _mm_add_pd(_mm_loadu_pd(sm), t));
+    const double S2 = wx2 * wy;
+    if constexpr (K == 3) {
+      if (out) {
+        gm[2] -= mc * S2;
+        sm[2] -= mct * S2;
+      } else {
+        gm[2] += mc * S2;
+        sm[2] += mct * S2;
+      }
+    }
+    if (!conducts) continue;
+    const __m128d gx = _mm_mul_pd(dwx, _mm_set1_pd(wy)), gy = _mm_mul_pd(wx, _mm_set1_pd(dwy));
+    const __m128d l1 = _mm_add_pd(_mm_and_pd(gx, abs_mask), _mm_and_pd(gy, abs_mask));
+    double* const qs = quick_sum + row;
+    _mm_storeu_pd(qs, _mm_add_pd(_mm_loadu_pd(qs), _mm_mul_pd(qv, l1)));
+    if constexpr (K == 3) qs[2] += quick * (std::fabs(dwx2 * wy) + std::fabs(wx2 * dwy));
+  }
+}
+#endif
+
+// |G_ip|₁ of for_each_node's components (gz = 0 in 2D): in 2D |gx| + |gy| alone, the same bits
+// (the sum of two magnitudes is never −0, so adding |0| = +0 changes nothing).
+template <int Dim>
+inline double g_l1(double gx, double gy, double gz) {
+  if constexpr (Dim == 2) return std::fabs(gx) + std::fabs(gy);
+  else return std::fabs(gx) + std::fabs(gy) + std::fabs(gz);
+}
+
 // V_p k_p A_p, A_p = Σ_d (Σ_j |∂w_d,j|) Π_{e≠d} (Σ_j |w_e,j|) = Σ over the stencil of |G_ip|₁
 // (quick_bound).
 template <int Dim, class Kernel>
@@ -279,6 +394,27 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
     if (mark) flux_temperature_[u[a]] = std::numeric_limits<double>::quiet_NaN();
   }
   if (node_compact_) {  // a refresh: the pairs the assembly joined, in the compacted rows
+    if constexpr (Dim == 2) {
+      if (count == total) {  // a whole stencil: the loop below with its slots known when compiled
+        constexpr int n = mechanics::Stencil<Dim, Kernel>::node_count;
+#pragma GCC unroll 9
+        for (int a = 0; a < n; ++a) {
+          const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+#pragma GCC unroll 9
+          for (int b = a + 1; b < n; ++b) {
+            const double term = sign * (conductance * (g[0][a] * g[0][b] + g[1][a] * g[1][b]));
+            const int slot = (b % K - a % K) + 5 * (b / K - a / K) + centre;  // code_b − code_a + centre
+            const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
+            const int ba = node_pos_[static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot)];
+            if (ab < 0 || ba < 0)
+              throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
+            node_kc_[static_cast<std::size_t>(ab)] += term;
+            node_kc_[static_cast<std::size_t>(ba)] += term;
+          }
+        }
+        return;
+      }
+    }
     for (int a = 0; a < count; ++a) {
       const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
       for (int b = a + 1; b < count; ++b) {
@@ -298,6 +434,28 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
   }
   double* k_all = node_k_.data();
   int* col_all = node_col_.data();
+  if constexpr (Dim == 2) {
+    bool all_mine = count == total;
+    for (int a = 0; a < count; ++a) all_mine = all_mine && mine[a];
+    if (all_mine) {  // a whole stencil on one range: the loop below with its slots known when compiled
+      constexpr int n = mechanics::Stencil<Dim, Kernel>::node_count;
+#pragma GCC unroll 9
+      for (int a = 0; a < n; ++a) {
+        const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+#pragma GCC unroll 9
+        for (int b = a + 1; b < n; ++b) {
+          const double term = sign * (conductance * (g[0][a] * g[0][b] + g[1][a] * g[1][b]));
+          const int slot = (b % K - a % K) + 5 * (b / K - a / K) + centre;  // code_b − code_a + centre
+          k_all[row_a + static_cast<std::size_t>(slot)] += term;
+          col_all[row_a + static_cast<std::size_t>(slot)] = u[b];
+          const std::size_t at = static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot);
+          k_all[at] += term;
+          col_all[at] = u[a];
+        }
+      }
+      return;
+    }
+  }
   for (int a = 0; a < count; ++a) {
     const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
     for (int b = a + 1; b < count; ++b) {

@@ -27,6 +27,58 @@ Eigen::VectorXd ExplicitConduction<Dim>::advance(const NodalThermalSystem& sys, 
   return T;
 }
 
+#if defined(FRICTHERM_WHOLE_ROWS_SSE2)
+template <int Dim>
+template <int K>
+bool ExplicitConduction<Dim>::flux_whole_rows(const OutOfKStencil& c, const double* t, double conductance, double* f) {
+  // The per-particle sub-step of a whole particle out of K (eq. 37, f_i = −V k G'·∇T) with two nodes
+  // of a row in one register: min/max lane by lane (the same extremes: only quiet_spread reads them),
+  // the products G_ip T_i packed and added to g one by one in node order, each f_i's own update packed.
+  static_assert(K == 2 || K == 3, "rows of 2 or 3 nodes");
+  constexpr int rows = Dim == 2 ? K : K * K;
+  __m128d lo2 = _mm_set1_pd(std::numeric_limits<double>::infinity()), hi2 = _mm_set1_pd(-std::numeric_limits<double>::infinity());
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  double g[3] = {0.0, 0.0, 0.0};
+  for (int r = 0; r < rows; ++r) {
+    const int a = r * K;
+    const double* tr = t + c.unknown[a];  // the row's unknowns: c.unknown[a] + 0, 1 (, 2)
+    const __m128d t01 = _mm_loadu_pd(tr);
+    lo2 = _mm_min_pd(t01, lo2);  // t < lo ? t : lo, as std::min(lo, t)
+    hi2 = _mm_max_pd(t01, hi2);
+    double t2 = 0.0;
+    if constexpr (K == 3) {
+      t2 = tr[2];
+      lo = std::min(lo, t2);
+      hi = std::max(hi, t2);
+    }
+    for (int d = 0; d < Dim; ++d) {
+      const __m128d p = _mm_mul_pd(_mm_loadu_pd(&c.G[d][a]), t01);
+      g[d] += _mm_cvtsd_f64(p);
+      g[d] += _mm_cvtsd_f64(_mm_unpackhi_pd(p, p));
+      if constexpr (K == 3) g[d] += c.G[d][a + 2] * t2;
+    }
+  }
+  lo = std::min(lo, std::min(_mm_cvtsd_f64(lo2), _mm_cvtsd_f64(_mm_unpackhi_pd(lo2, lo2))));
+  hi = std::max(hi, std::max(_mm_cvtsd_f64(hi2), _mm_cvtsd_f64(_mm_unpackhi_pd(hi2, hi2))));
+  if (quiet_spread(lo, hi)) return true;
+  for (int d = 0; d < Dim; ++d) g[d] *= conductance;
+  const __m128d g0 = _mm_set1_pd(g[0]), g1 = _mm_set1_pd(g[1]), g2 = _mm_set1_pd(g[2]);
+  for (int r = 0; r < rows; ++r) {  // f_i −= G·g as scatter_whole sums it: (x x' + y y') + z z'
+    const int a = r * K;
+    double* fr = f + c.unknown[a];
+    __m128d dot = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(&c.G[0][a]), g0), _mm_mul_pd(_mm_loadu_pd(&c.G[1][a]), g1));
+    if constexpr (Dim == 3) dot = _mm_add_pd(dot, _mm_mul_pd(_mm_loadu_pd(&c.G[2][a]), g2));
+    _mm_storeu_pd(fr, _mm_sub_pd(_mm_loadu_pd(fr), dot));
+    if constexpr (K == 3) {
+      double dot2 = c.G[0][a + 2] * g[0] + c.G[1][a + 2] * g[1];
+      if constexpr (Dim == 3) dot2 += c.G[2][a + 2] * g[2];
+      fr[2] -= dot2;
+    }
+  }
+  return true;
+}
+#endif
+
 template <int Dim>
 template <class Kernel>
 void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen::VectorXd& T, const Eigen::VectorXd& q,
@@ -51,7 +103,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
   for (long s = 0; s < substeps; ++s) {
     if (force_ready) {
       force_ready = false;
-      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
     }
@@ -67,9 +119,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       // makes them (quiet ones left out), in particle order.
       // (Out of K: taken out by a refresh, or not in it at the assembly, where every heat-holding
       // particle with V_p k_p != 0 joined it; only a refresh changes V_p k_p, and it lists the particle.)
-      listed_.clear();
-      for (std::size_t k : out_of_k_)
-        if (holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0) listed_.push_back(k);
+      const auto out_of_k_flux = [&](std::size_t k) { return holds_heat_[k] && !in_node_k_[k] && conductance_[k] != 0.0; };
       if (threads <= 1) {
         // One thread: a whole particle's unknowns and G_ip kept from its first sub-step out of K
         // (out_of_k_stencil): look_whole and scatter_whole's sums from them, in the same order.
@@ -77,7 +127,8 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         double* const f = force_.data();
         const double* const t = T.data();
         constexpr int nodes_of = mechanics::Stencil<Dim, Kernel>::node_count;
-        for (std::size_t k : listed_) {
+        for (std::size_t k : out_of_k_) {  // in order, as the list the threads take below
+          if (!out_of_k_flux(k)) continue;
           if (!whole_[k]) {
             expand<Kernel, true>(stencils[k], sys.unknown, e);
             if (!e.reaches() || quiet_temperatures(e, T)) continue;
@@ -92,6 +143,9 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
                                        ? out_of_k_stencils_[static_cast<std::size_t>(slot)]
                                        : out_of_k_stencil(k, stencils[k], sys.unknown);
           if (!c.reaches) continue;
+#if defined(FRICTHERM_WHOLE_ROWS_SSE2)
+          if (flux_whole_rows<Kernel::K>(c, t, conductance_[k], f)) continue;
+#endif
           double lo = std::numeric_limits<double>::infinity(), hi = -lo;
           double g0 = 0.0, g1 = 0.0, g2 = 0.0;
           for (int a = 0; a < nodes_of; ++a) {
@@ -113,7 +167,10 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
             f[c.unknown[a]] -= dot;
           }
         }
-      } else
+      } else {
+        listed_.clear();
+        for (std::size_t k : out_of_k_)
+          if (out_of_k_flux(k)) listed_.push_back(k);
       scatter_by_node_ranges<Expanded>(threads, nodes, listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
         const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
         if (!r.meets(node_span(st, indexer_))) return;
@@ -134,7 +191,8 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         for (int a = 0; a < e.count; ++a)
           if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
       });
-      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      }
+      T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
     }
@@ -175,7 +233,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
         grad *= conductance_[k];
         for (int a = 0; a < e.count; ++a) force_[e.unknown[a]] -= e.g(a).dot(grad);
       }
-      for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+      T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
       for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
       continue;
     }
@@ -217,7 +275,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
       for (int a = 0; a < e.count; ++a)  // f_i = −V k G'·∇T
         if (r.holds(sys.grid_node[static_cast<std::size_t>(e.unknown[a])])) force_[e.unknown[a]] -= e.g(a).dot(grad);
     });
-    for (Eigen::Index u = 0; u < n; ++u) T[u] += h * (force_[u] + q[u]) / sys.mass[u];
+    T.array() += h * (force_.array() + q.array()) / sys.mass.array();  // forward Euler, packed by Eigen: the same operations
     for (const FixedNode& f : fixed) T[f.unknown] = f.temperature;
   }
 }
@@ -361,7 +419,6 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     // The usual window (no held face, no sub-grid blend): T_p + Σ S_ip ΔT_i, as blend() gives it
     // then. A whole particle's S_ip and unknowns are kept from the first walk for the second (the
     // same products, so the same sums), and the loop has no per-node tests.
-    constexpr int nodes = mechanics::Stencil<Dim, Kernel>::node_count;
     Expanded c{};
     const int* un = sys.unknown.data();
     double* const temperature = p.temperature.data();
@@ -369,10 +426,22 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     const int* first = first_node_.data();
     const unsigned char* reached = changed_in_box<Kernel::K>(static_cast<int>(sys.unknown.size()));
     for (std::size_t k = 0; k < p.size(); ++k) {
-      // any_changed, from the stencil's first grid node kept with it: one flag
-      if (!holds_heat_[k] || !reached[first[k]]) continue;
+      // any_changed, from the stencil's first grid node kept with it: one flag (a particle that holds
+      // no heat has its first node past the grid, where no flag is set)
+      if (!reached[first[k]]) continue;
       const double before = temperature[k];
       if (whole_[k]) {
+#if defined(FRICTHERM_WHOLE_ROWS_SSE2)
+        // Σ S_ip ΔT_i and the eq. 38 sums' m_p C_v,p ΔT_p S_ip, two nodes of a row at a time
+        // (dot_whole_rows, add_whole_rows: the same products and sums in the same order).
+        WholeRows<Dim, Kernel::K> rows;
+        const double after = before + dot_whole_rows(stencils[k], first[k], indexer_, un, dl, rows);
+        if (after == before) continue;
+        temperature[k] = after;
+        if (keep_sums) add_whole_rows(rows, heat_capacity_[k] * (after - before), sums);
+        continue;
+#else
+        constexpr int nodes = mechanics::Stencil<Dim, Kernel>::node_count;
         double w[nodes];
         int at[nodes];
         int a = 0;
@@ -390,6 +459,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
         const double change = heat_capacity_[k] * (T - before);
         for (int b = 0; b < nodes; ++b) sums[at[b]] += change * w[b];
         continue;
+#endif
       }
       map_back_lumped(k, c);
     }

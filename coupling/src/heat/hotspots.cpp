@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <map>
 #include <limits>
 #include <numeric>
@@ -103,7 +106,50 @@ std::vector<HotCandidate> HotSpotTracker::candidates(const mechanics::Particles<
   // finds nothing (the usual window), so it is not run. std::max leaves a NaN level out, as the
   // candidate test does.
   double level_max = -std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < n; ++k) {
+  std::size_t k0 = 0;
+#if defined(__SSE2__)
+  // Every material conducts (the usual scene) and every particle has its reference: a particle counts
+  // when its id is in range, and two particles go in one register (issue 35: the scalar loop took 17
+  // instructions a particle every window). Out-of-range ones enter as −∞; each lane keeps
+  // (x > max) ? x : max, as std::max(max, x), so a NaN level is left out as above; the lanes' maxima
+  // are the same set's maximum.
+  bool all_conduct = n_T0 >= n;
+  for (std::size_t m = 0; m < n_materials; ++m) all_conduct = all_conduct && props[m].conducts;
+  if (all_conduct) {
+    const __m128d none = _mm_set1_pd(-std::numeric_limits<double>::infinity());
+    const __m128i zero = _mm_setzero_si128(), count = _mm_set1_epi32(static_cast<int>(n_materials));
+    __m128d t_max = none, l_max = none;
+    // Every id in range (four at a time)? Then every particle counts and the maxima need no mask.
+    const __m128i ones = _mm_set1_epi32(-1);
+    __m128i out = zero;
+    std::size_t k = 0;
+    for (; k + 3 < n; k += 4) {  // id < 0, or not id < n_materials
+      const __m128i id = _mm_loadu_si128(reinterpret_cast<const __m128i*>(material + k));
+      out = _mm_or_si128(out, _mm_or_si128(_mm_cmplt_epi32(id, zero), _mm_andnot_si128(_mm_cmplt_epi32(id, count), ones)));
+    }
+    bool all_in = _mm_movemask_epi8(out) == 0;
+    for (; k < n; ++k) all_in = all_in && material[k] >= 0 && static_cast<std::size_t>(material[k]) < n_materials;
+    if (all_in) {
+      for (; k0 + 1 < n; k0 += 2) {
+        const __m128d T = _mm_loadu_pd(level_T + k0);
+        t_max = _mm_max_pd(T, t_max);
+        l_max = _mm_max_pd(absolute ? T : _mm_sub_pd(T, _mm_loadu_pd(T0_data + k0)), l_max);
+      }
+    }
+    for (; k0 + 1 < n; k0 += 2) {  // some id out of range: masked
+      const __m128i id = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(material + k0));
+      const __m128i in32 = _mm_andnot_si128(_mm_cmplt_epi32(id, zero), _mm_cmplt_epi32(id, count));
+      const __m128d in = _mm_castsi128_pd(_mm_unpacklo_epi32(in32, in32));
+      const __m128d T = _mm_loadu_pd(level_T + k0);
+      const __m128d level = absolute ? T : _mm_sub_pd(T, _mm_loadu_pd(T0_data + k0));
+      t_max = _mm_max_pd(_mm_or_pd(_mm_and_pd(in, T), _mm_andnot_pd(in, none)), t_max);
+      l_max = _mm_max_pd(_mm_or_pd(_mm_and_pd(in, level), _mm_andnot_pd(in, none)), l_max);
+    }
+    T_max = std::max(_mm_cvtsd_f64(t_max), _mm_cvtsd_f64(_mm_unpackhi_pd(t_max, t_max)));
+    level_max = std::max(_mm_cvtsd_f64(l_max), _mm_cvtsd_f64(_mm_unpackhi_pd(l_max, l_max)));
+  }
+#endif
+  for (std::size_t k = k0; k < n; ++k) {
     const auto id = static_cast<std::size_t>(material[k]);
     if (!(id < n_materials && props[id].conducts)) continue;
     const double T = level_T[k];

@@ -312,6 +312,11 @@ class ExplicitConduction {
   };
   std::vector<OutOfKStencil> out_of_k_stencils_;  // by slot
   std::vector<int> out_of_k_slot_;                // by particle: its slot, −1 none since the assembly
+  /// A kept walk's flux, packed by stencil rows (its unknowns are K consecutive ones a row): the
+  /// look (lowest and highest T_i, Σ G_ip T_i) and, unless quiet, f_i −= G_ip·(V_p k_p Σ G_jp T_j),
+  /// with the loop's products and sums in its order. Returns true (2D, or 3D with SSE2, no FMA).
+  template <int K>
+  static bool flux_whole_rows(const OutOfKStencil& c, const double* t, double conductance, double* f);
   /// The kept walk of whole particle k (made from its window stencil if it has none).
   template <class Kernel>
   const OutOfKStencil& out_of_k_stencil(std::size_t k, const mechanics::Stencil<Dim, Kernel>& st,
