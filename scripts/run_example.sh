@@ -30,6 +30,6 @@ if ! wait "$plot_install"; then
   cat "$plot_log" >&2
   echo "run_example: installing the figures' packages failed (scripts/install_deps.sh plot)" >&2; exit 1
 fi
-tail -n 1 "$plot_log"
+echo "run_example: the figures' packages are installed ($(head -n 1 "$plot_log"))"
 /usr/bin/python3 examples/plot_run.py "results/$name.h5" --field "$field" -o "results/$name"
 echo "wrote results/$name.h5, results/$name.xdmf, results/${name}_particles.png, results/${name}_series.png"
