@@ -122,15 +122,19 @@ function(frictherm_precompile_headers target)
   endif()
 endfunction()
 
-# frictherm_unity_build(<target> [ALONE <source> ...]): with FRICTHERM_UNITY_BUILD (CMakeLists.txt), the
-# target's sources are compiled in batches of FRICTHERM_UNITY_BATCH as one file each, except the ALONE
-# sources (paths relative to the current folder): the heaviest, whose compile time is code generation
-# that a batch does not share, kept apart so that both cores of a small machine stay busy.
+# frictherm_unity_build(<target> [BATCH <n>] [ALONE <source> ...]): with FRICTHERM_UNITY_BUILD (CMakeLists.txt),
+# the target's sources are compiled in batches of FRICTHERM_UNITY_BATCH (or <n>; 0: all in one) as one file
+# each, except the ALONE sources (paths relative to the current folder): the heaviest, whose compile
+# time is code generation that a batch does not share, kept apart so that both cores of a small
+# machine stay busy.
 set(FRICTHERM_UNITY_BATCH 8 CACHE STRING "Sources per unity batch (FRICTHERM_UNITY_BUILD)")
 function(frictherm_unity_build target)
-  cmake_parse_arguments(U "" "" "ALONE" ${ARGN})
+  cmake_parse_arguments(U "" "BATCH" "ALONE" ${ARGN})
+  if(NOT DEFINED U_BATCH)
+    set(U_BATCH ${FRICTHERM_UNITY_BATCH})
+  endif()
   if(FRICTHERM_UNITY_BUILD)
-    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${FRICTHERM_UNITY_BATCH})
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${U_BATCH})
     list(TRANSFORM U_ALONE PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/)
     set_source_files_properties(${U_ALONE} TARGET_DIRECTORY ${target} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
   endif()

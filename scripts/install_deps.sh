@@ -3,8 +3,8 @@
 #   scripts/install_deps.sh [program|all|build|plot]   (default all)
 #   scripts/install_deps.sh --check PROFILE             exit status 0 when all of PROFILE is present
 # program: what README command 1 needs to build the `frictherm` program and draw a run: `build` and `plot`.
-# build:   what compiling and running the program needs (compiler, CMake, the libraries the program
-#          links). Debian 12's libsundials-dev depends on petsc-dev, hypre and Open MPI (for its parallel
+# build:   what compiling and running the program needs (compiler, CMake, Ninja, the libraries the
+#          program links). Debian 12's libsundials-dev depends on petsc-dev, hypre and Open MPI (for its parallel
 #          vectors, which the program does not link): 361 packages and 315 MB to download for `program`
 #          instead of 224 and 209 MB. So, unless libsundials-dev is installed already, `build` and
 #          `program` install libsuitesparse-dev (KLU, which SUNDIALS' KLU solver links) and unpack
@@ -21,7 +21,7 @@ set -euo pipefail
 check=no
 if [ "${1:-}" = --check ]; then check=yes; shift; fi
 profile=${1:-all}
-build=(build-essential cmake pkg-config libeigen3-dev libsundials-dev libhdf5-dev nlohmann-json3-dev
+build=(build-essential cmake ninja-build pkg-config libeigen3-dev libsundials-dev libhdf5-dev nlohmann-json3-dev
        libboost-dev libmuparser-dev libpng-dev libtiff-dev)
 plot=(python3 python3-numpy python3-matplotlib python3-h5py)
 rest=(libgtest-dev libgmock-dev libopenmpi-dev openmpi-bin petsc-dev

@@ -8,10 +8,6 @@ namespace frictherm::coupling {
 
 using mechanics::TimeFunction;
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}
-
 TimeFunction parse_time_function(const JsonReader& f) {
   if (f.is_number()) return TimeFunction::constant(f.as_number());
   if (!f.is_object())
@@ -30,8 +26,9 @@ TimeFunction parse_time_function(const JsonReader& f) {
     const double amplitude = f.number("amplitude", Range::any());
     const bool has_omega = f.has("omega"), has_period = f.has("period");
     if (has_omega == has_period) f.fail("expected exactly one of omega (rad/s) or period (s)");
+    constexpr double pi = 3.14159265358979323846;  // a local: heat/hotspots.cpp has a kPi in the same unity batch
     const double omega =
-        has_omega ? f.number("omega", Range::any()) : 2.0 * kPi / f.number("period", Range::positive());
+        has_omega ? f.number("omega", Range::any()) : 2.0 * pi / f.number("period", Range::positive());
     const double start = f.number("start", 0.0, Range::non_negative());
     double end = -1.0;
     if (const auto e = f.find("end")) {
