@@ -393,25 +393,34 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
     // A refresh changes row a: its f_i is made anew in the next sub-step (NaN: "changed").
     if (mark) flux_temperature_[u[a]] = std::numeric_limits<double>::quiet_NaN();
   }
+  // The pairs a < b of a whole 2D stencil with their slots known when compiled (code_b − code_a +
+  // centre): f(row_a, a, b, slot, term), the term as the general loops below form it.
+  const auto for_each_whole_pair = [&](auto&& f) {
+    constexpr int n = mechanics::Stencil<Dim, Kernel>::node_count;
+#pragma GCC unroll 9
+    for (int a = 0; a < n; ++a) {
+      const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
+#pragma GCC unroll 9
+      for (int b = a + 1; b < n; ++b) {
+        const double term = sign * (conductance * (g[0][a] * g[0][b] + g[1][a] * g[1][b]));
+        f(row_a, a, b, (b % K - a % K) + 5 * (b / K - a / K) + centre, term);
+      }
+    }
+  };
   if (node_compact_) {  // a refresh: the pairs the assembly joined, in the compacted rows
+    // The pair (a, b) at `slot` of a's row and the mirror slot of b's row gets `term` in both.
+    const auto add_compact_pair = [&](std::size_t row_a, int u_b, int slot, double term) {
+      const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
+      const int ba = node_pos_[static_cast<std::size_t>(u_b) * offsets + static_cast<std::size_t>(2 * centre - slot)];
+      if (ab < 0 || ba < 0) throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
+      node_kc_[static_cast<std::size_t>(ab)] += term;
+      node_kc_[static_cast<std::size_t>(ba)] += term;
+    };
     if constexpr (Dim == 2) {
       if (count == total) {  // a whole stencil: the loop below with its slots known when compiled
-        constexpr int n = mechanics::Stencil<Dim, Kernel>::node_count;
-#pragma GCC unroll 9
-        for (int a = 0; a < n; ++a) {
-          const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
-#pragma GCC unroll 9
-          for (int b = a + 1; b < n; ++b) {
-            const double term = sign * (conductance * (g[0][a] * g[0][b] + g[1][a] * g[1][b]));
-            const int slot = (b % K - a % K) + 5 * (b / K - a / K) + centre;  // code_b − code_a + centre
-            const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
-            const int ba = node_pos_[static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot)];
-            if (ab < 0 || ba < 0)
-              throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
-            node_kc_[static_cast<std::size_t>(ab)] += term;
-            node_kc_[static_cast<std::size_t>(ba)] += term;
-          }
-        }
+        for_each_whole_pair([&](std::size_t row_a, int, int b, int slot, double term) {
+          add_compact_pair(row_a, u[b], slot, term);
+        });
         return;
       }
     }
@@ -420,14 +429,7 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
       for (int b = a + 1; b < count; ++b) {
         double dot = g[0][a] * g[0][b] + g[1][a] * g[1][b];  // as below: the same bits
         if constexpr (Dim == 3) dot += g[2][a] * g[2][b];
-        const double term = sign * (conductance * dot);
-        const int slot = code[b] - code[a] + centre;
-        const int ab = node_pos_[row_a + static_cast<std::size_t>(slot)];
-        const int ba = node_pos_[static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot)];
-        if (ab < 0 || ba < 0)
-          throw std::logic_error("ExplicitConduction: a pair outside the node operator's assembled rows");
-        node_kc_[static_cast<std::size_t>(ab)] += term;
-        node_kc_[static_cast<std::size_t>(ba)] += term;
+        add_compact_pair(row_a, u[b], code[b] - code[a] + centre, sign * (conductance * dot));
       }
     }
     return;
@@ -438,21 +440,13 @@ void ExplicitConduction<Dim>::add_to_node_operator(const mechanics::Stencil<Dim,
     bool all_mine = count == total;
     for (int a = 0; a < count; ++a) all_mine = all_mine && mine[a];
     if (all_mine) {  // a whole stencil on one range: the loop below with its slots known when compiled
-      constexpr int n = mechanics::Stencil<Dim, Kernel>::node_count;
-#pragma GCC unroll 9
-      for (int a = 0; a < n; ++a) {
-        const std::size_t row_a = static_cast<std::size_t>(u[a]) * offsets;
-#pragma GCC unroll 9
-        for (int b = a + 1; b < n; ++b) {
-          const double term = sign * (conductance * (g[0][a] * g[0][b] + g[1][a] * g[1][b]));
-          const int slot = (b % K - a % K) + 5 * (b / K - a / K) + centre;  // code_b − code_a + centre
-          k_all[row_a + static_cast<std::size_t>(slot)] += term;
-          col_all[row_a + static_cast<std::size_t>(slot)] = u[b];
-          const std::size_t at = static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot);
-          k_all[at] += term;
-          col_all[at] = u[a];
-        }
-      }
+      for_each_whole_pair([&](std::size_t row_a, int a, int b, int slot, double term) {
+        k_all[row_a + static_cast<std::size_t>(slot)] += term;
+        col_all[row_a + static_cast<std::size_t>(slot)] = u[b];
+        const std::size_t at = static_cast<std::size_t>(u[b]) * offsets + static_cast<std::size_t>(2 * centre - slot);
+        k_all[at] += term;
+        col_all[at] = u[a];
+      });
       return;
     }
   }
