@@ -38,6 +38,7 @@ struct SlidingBlockSetup {
   double R = 1.0;  // tangential load R N (paper variant)
   double regularization_slip_length = 0.0, regularization_time = 0.0;  // ContactOptions (0: off)
   mechanics::ContactAreaMethod area = mechanics::ContactAreaMethod::surface;  // ContactOptions::area
+  double stiffness_scale = 1.0;  // both bodies' Young's modulus E times this (the rigid limit as it grows)
 };
 
 struct SlidingBlockConstants {
@@ -104,7 +105,7 @@ inline mechanics::Simulation<2> make_sliding_block(const SlidingBlockSetup& s, i
   Material base_m;
   base_m.name = "base";
   base_m.density = C::rho;
-  base_m.youngs_modulus = C::E;
+  base_m.youngs_modulus = C::E * s.stiffness_scale;
   base_m.poisson_ratio = C::nu;
   if (s.rotated) {
     base_m.kind = MaterialKind::rigid;

@@ -187,3 +187,27 @@ TEST(SlidingBlock, CompositeLawWithExtentDetectionMatchesRigidBlock) {
   EXPECT_LT(u.work_error, 0.03);
 }
 
+// The laws that are steep at low sliding speed (the composite law with v½ = 0.05 m/s, R = 1) drift from
+// their rigid block as the cell shrinks on the paper's block (E = 2.5 GPa; scene defaults, work +2.00 /
+// +2.88 / +3.06 % at 5 / 2.5 / 1.25 mm). The drift is the block's compliance, not the friction
+// algorithm: with both bodies ten times stiffer (closer to the rigid block the reference assumes) the
+// same runs give +0.11 / +0.39 / −0.16 % (three times stiffer: +0.38 / +0.59 % at 5 / 2.5 mm), the
+// velocity within 0.3 % of v_max, and the error no longer grows (docs/contact.md, "Friction laws on
+// a compliant block"). Bound 1 %: the stiff block's scatter is under 0.4 %, the compliant one's 2–3 %.
+TEST(SlidingBlock, LowSpeedSteepLawOnAStiffBlockMatchesItsRigidBlock) {
+  using C = SlidingBlockConstants;
+  const double N = C::normal_stress(), k = 0.3 / C::v_max, S_a = 0.3 * N;
+  const RigidBlockUnderLaw exact(rigid_solution(0.35, 0.2, k, S_a), smooth_law_traction(N, 0.35, 0.2, 0.05, k, S_a),
+                                 C::t_final());
+  for (double cell : {0.005, 0.0025}) {
+    SlidingBlockSetup s;
+    s.cell = cell;
+    s.scheme = mechanics::UpdateScheme::usl;
+    s.separation = mechanics::SeparationMethod::extent;
+    s.law = FrictionLaw::composite(0.35, 0.2, 0.05, k, S_a);
+    s.stiffness_scale = 10.0;
+    const Comparison c = compare(run_sliding_block(s), exact, "composite, R = 1, E x 10");
+    EXPECT_LT(c.velocity_error, 0.01);
+    EXPECT_LT(c.work_error, 0.01);
+  }
+}
