@@ -33,6 +33,10 @@ using frictherm::test::mpirun_command;
 
 const std::string kScene = "tests/coupling/scenes/decomposed_sliding_block.json";
 const std::string kSteps = " --set run.max_steps=60 --set output.series_interval=0";
+// The scene's conductivities 1000 times larger (conduction limits the steps of both solvers).
+const std::string kFastConduction =
+    " --set 'thermal.materials={\"base\":{\"heat_capacity\":100,\"conductivity\":50000},"
+    "\"block\":{\"heat_capacity\":150,\"conductivity\":20000}}'";
 
 }  // namespace
 
@@ -50,7 +54,8 @@ class MpirunThermalSolvers : public frictherm::test::MpirunCompare {
     return diff;
   }
   void same_thermal_steps(const std::string& what) {
-    EXPECT_EQ(read_doubles(path("split.h5"), "/meta/thermal_steps"), read_doubles(path("serial.h5"), "/meta/thermal_steps"))
+    EXPECT_EQ(read_doubles(path("split.h5"), "/meta/thermal_steps"),
+              read_doubles(path("serial.h5"), "/meta/thermal_steps"))
         << what;
   }
 };
@@ -72,7 +77,8 @@ TEST_F(MpirunThermalSolvers, BeyondTheLimitEveryRankStopsAsTheSerialRun) {
   // one, where the limit has fallen to 6.09e-8 s: the limit reduced over ranks, the same verdict.
   for (const char* fe : {"{\"stability\":\"refuse\"}", "{\"stability\":\"refuse\",\"max_dt\":1e-7}"}) {
     const std::string sets = kSteps + " --set 'thermal.forward_euler=" + fe + "'";
-    const Result s = shell(exe() + " run " + source(kScene) + sets + " -q --threads 1 --force -o '" + path("serial.h5") + "'");
+    const Result s =
+        shell(exe() + " run " + source(kScene) + sets + " -q --threads 1 --force -o '" + path("serial.h5") + "'");
     const Result d = shell(mpirun_command(2) + " " + exe() + " run " + source(kScene) + sets + " -q --force -o '" +
                            path("split.h5") + "'");
     EXPECT_EQ(s.code, 1) << fe << ": " << s.output;
@@ -103,11 +109,7 @@ TEST_F(MpirunThermalSolvers, PowerEstimateAsSerially) {
   // conductivities 1000 times larger the power limit decides: 354 sub-steps in the 60 windows (about
   // 6 a window), which a limit off by more than round-off would change (the serial Gershgorin limit
   // is some 5000 times smaller there).
-  const std::string sets =
-      " --set 'thermal.materials={\"base\":{\"heat_capacity\":100,\"conductivity\":50000},"
-      "\"block\":{\"heat_capacity\":150,\"conductivity\":20000}}'"
-      " --set 'thermal.forward_euler={\"limit_estimate\":\"power\"}'";
-  run_both(kScene, kSteps + sets, 2);
+  run_both(kScene, kSteps + kFastConduction + " --set 'thermal.forward_euler={\"limit_estimate\":\"power\"}'", 2);
   if (HasFatalFailure()) return;
   same_temperatures(1e-9, 0.02);  // the rise: 0.040 K
   same_thermal_steps("power");
@@ -121,11 +123,7 @@ TEST_F(MpirunThermalSolvers, KluAsSerially) {
   // iteration per Newton iteration). The two accept each step once the Newton iteration has converged
   // to 0.1 of the error weights rtol·|T_i| + atol, so they differ by where those iterations stopped
   // (docs/distributed_run.md: the same bound as PCG on both sides): within 0.1 (rtol T_max + atol).
-  const std::string sets =
-      " --set 'thermal.materials={\"base\":{\"heat_capacity\":100,\"conductivity\":50000},"
-      "\"block\":{\"heat_capacity\":150,\"conductivity\":20000}}'"
-      " --set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu";
-  run_both(kScene, kSteps + sets, 2);
+  run_both(kScene, kSteps + kFastConduction + " --set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu", 2);
   if (HasFatalFailure()) return;
   const std::vector<double> T = column("serial.h5", "max_temperature");
   const double top = *std::max_element(T.begin(), T.end());
