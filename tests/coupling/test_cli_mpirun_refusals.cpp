@@ -1,8 +1,8 @@
 // Refusals of `mpirun -n 2 frictherm run` and `validate` (issue 16, issue 34; coupling/app/cli_run_mpi.cpp,
 // coupling/src/scene/scene_decomposed.cpp, coupling/src/distributed_run/decomposed_runner.cpp):
-//   * a scene the decomposed engine does not support (the KLU solver, the interface temperature's patch)
-//     is refused with exit code 2 naming the scene key, before any
-//     file is written, and `validate` says so;
+//   * a scene the decomposed engine does not support (the reuse of matrix-free gathers,
+//     coupling.reuse_distance > 0 set with forward_euler) is refused with exit code 2 naming the scene
+//     key, before any file is written, and `validate` says so;
 //   * an existing output file (the series file or one rank's file) is refused without --force, left
 //     untouched, and replaced with it;
 //   * `validate` under mpirun: every rank validates, rank 0 alone prints.
@@ -27,8 +27,8 @@ using CliMpirun = CliMpirunTest;
 
 TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
   const std::pair<const char*, const char*> cases[] = {
-      {"--set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu",
-       "thermal.linear_solver: \"klu\" is not supported in a decomposed run"}};
+      {"--set coupling.reuse_distance=0.02",
+       "coupling.reuse_distance: 0.02 is not supported in a decomposed run"}};
   for (const auto& [set, message] : cases) {
     const Result r = shell(mpirun(2) + " " + exe() + " run " + scene("decomposed_sliding_block.json") + " " + set +
                            " -o '" + path("refused.h5") + "'");
@@ -39,9 +39,9 @@ TEST_F(CliMpirun, UnsupportedScenesAreRefusedBeforeWriting) {
   }
   // It is a valid scene: `validate` accepts it and says that it runs serially only, and why.
   const Result v = shell(exe() + " validate " + scene("decomposed_sliding_block.json") +
-                         " --set thermal.integrator=cvode_bdf --set thermal.linear_solver=klu");
+                         " --set coupling.reuse_distance=0.02");
   EXPECT_EQ(v.code, 0) << v.output;
-  EXPECT_THAT(v.output, HasSubstr("serial only (thermal.linear_solver: \"klu\" is not supported in a decomposed run"));
+  EXPECT_THAT(v.output, HasSubstr("serial only (coupling.reuse_distance: 0.02 is not supported in a decomposed run"));
   const Result ok = shell(exe() + " validate " + scene("decomposed_sliding_block.json"));
   EXPECT_THAT(ok.output, HasSubstr("mpirun -n K frictherm run decomposes it"));
 }

@@ -8,6 +8,7 @@
 #include "grids.hpp"
 
 #include "frictherm/thermal/integrator.hpp"
+#include "frictherm/thermal/stability.hpp"
 
 #include "../mpi_ranks.hpp"
 
@@ -96,7 +97,9 @@ TEST(DistributedThermal, ReproducesTheSerialSolution) {
   const std::vector<Case> cases{{"forward_euler", "", "jacobi", 0.0},        {"cvode_bdf", "pcg", "jacobi", 1e-8},
                                 {"cvode_bdf", "gmres", "jacobi", 1e-8},      {"cvode_bdf", "pcg", "hypre", 1e-8},
                                 {"cvode_bdf", "pcg", "bjacobi", 1e-8},       {"cvode_adams", "", "jacobi", 1e-8},
-                                {"arkode_erk", "", "jacobi", 1e-8},          {"arkode_dirk", "pcg", "jacobi", 1e-8}};
+                                {"arkode_erk", "", "jacobi", 1e-8},          {"arkode_dirk", "pcg", "jacobi", 1e-8},
+                                // KLU serially; distributed, PCG preconditioned by MUMPS' LU of P = I − γJ
+                                {"cvode_bdf", "klu", "mumps", 1e-8}};
   for (const Case& c : cases) {
     ft::IntegratorOptions o;
     if (c.rtol > 0.0) o.rtol = o.atol = c.rtol;
@@ -126,6 +129,10 @@ TEST(DistributedThermal, ReproducesTheSerialSolution) {
       EXPECT_LE(diff, 1e-12 * tmax);
       EXPECT_EQ(d_int->stats().steps, s_int->stats().steps);
       EXPECT_EQ(d_int->communication().ghost_exchanges, d_int->stats().steps);  // one K·T per sub-step
+    } else if (c.linear_solver == "klu") {
+      // The preconditioner is the inverse of P (to MUMPS' round-off): one Krylov iteration per
+      // Newton iteration, as the direct solve.
+      EXPECT_LE(d_int->stats().linear_iters, d_int->stats().nonlinear_iters) << c.name;
     } else if (same_algorithm) {
       // The serial algorithm (Jacobi on the symmetric form): the same steps, the runs differing
       // only by the summation order of the global reductions, far below the error control's
@@ -299,12 +306,6 @@ TEST(DistributedThermal, BadLayoutRefusedOnEveryRank) {
                std::invalid_argument);
   EXPECT_THROW(ft::make_distributed_integrator("cvode_bdf", [] {
                  ft::DistributedOptions o;
-                 o.integrator.linear_solver = "klu";
-                 return o;
-               }()),
-               std::invalid_argument);
-  EXPECT_THROW(ft::make_distributed_integrator("cvode_bdf", [] {
-                 ft::DistributedOptions o;
                  o.preconditioner = "ilu";
                  return o;
                }()),
@@ -348,8 +349,26 @@ TEST(DistributedThermal, ForwardEulerRefusesBeyondItsLimitOnEveryRank) {
   EXPECT_THROW(fe->advance(*part.problem, t, 0.0, 2.0 * h * h / 4.0), ft::StabilityError);
   EXPECT_EQ(t, before);  // the last good state kept
   EXPECT_NO_THROW(fe->advance(*part.problem, t, 0.0, 0.8 * h * h / 4.0));  // within fe_safety = 0.9
+}
+
+// ---- the "power" estimate: the serial power iteration over the ranks, to round-off ----
+TEST(DistributedThermal, PowerEstimateEqualsTheSerialOne) {
+  const double h = 1.0 / 15.0;
+  const Grid2D g = make_grid_2d(16, 16, 0.0, 0.0, h, Material{1.0, 1.0});
+  Part part = distribute(g);
+  ft::Problem serial = g.problem();
+  const double lam = ft::lambda_max_power(serial), mine = part.problem->lambda_max_power();
+  EXPECT_GT(lam, 0.5 * 8.0 / (h * h));
+  EXPECT_NEAR(mine, lam, 1e-12 * lam);  // the same start vector and iterations; sums in another order
+  // And through forward Euler's limit (min(1.05 λ_power, λ_Gershgorin)), refused beyond fe_safety = 0.9 of it.
+  const double limit = ft::forward_euler_dt_limit(serial, "power");
+  ft::DistributedOptions o;
+  o.integrator.fe_stability_policy = "refuse";
   o.integrator.fe_limit_estimate = "power";
-  EXPECT_THROW(ft::make_distributed_integrator("forward_euler", o), std::invalid_argument);
+  auto fe = ft::make_distributed_integrator("forward_euler", o);
+  Eigen::VectorXd t = initial_field(g).segment(part.rows.begin, part.rows.size());
+  EXPECT_NO_THROW(fe->advance(*part.problem, t, 0.0, 0.89 * limit));
+  EXPECT_THROW(fe->advance(*part.problem, t, 0.0, 0.91 * limit), ft::StabilityError);
 }
 
 }  // namespace

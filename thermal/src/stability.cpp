@@ -35,35 +35,17 @@ double lambda_max_power(const Problem& problem, int iterations) {
     out = k * u + ha.cwiseProduct(u);
     out = free.cwiseProduct(rsm.cwiseProduct(out));
   };
-  Eigen::VectorXd v(n), w(n);
-  for (Index i = 0; i < n; ++i) {
-    v[i] = ((i % 2) ? -1.0 : 1.0) + 0.1 * std::sin(0.7 * static_cast<double>(i));
-  }
-  v = free.cwiseProduct(v);
-  double vn = v.norm();
-  if (vn == 0.0) return 0.0;
-  v /= vn;
-  double lam = 0.0;
-  for (int it = 0; it < iterations; ++it) {
-    apply(v, w);
-    lam = v.dot(w);  // Rayleigh quotient
-    const double wn = w.norm();
-    if (wn == 0.0) return 0.0;
-    v = w / wn;
-  }
-  return lam;
+  Eigen::VectorXd v(n);
+  for (Index i = 0; i < n; ++i) v[i] = power_iteration_start(i);
+  return power_iteration(
+      Eigen::VectorXd(free.cwiseProduct(v)), iterations, apply,
+      [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return a.dot(b); },
+      [](const Eigen::VectorXd& a) { return a.norm(); });
 }
 
 double forward_euler_dt_limit(const Problem& problem, const std::string& estimate) {
-  double lam = lambda_max_gershgorin(problem);
-  if (estimate == "power") {
-    lam = std::min(1.05 * lambda_max_power(problem), lam);
-  } else if (estimate != "gershgorin") {
-    throw std::invalid_argument("forward_euler_dt_limit: unknown estimate \"" + estimate +
-                                "\" (valid: gershgorin, power)");
-  }
-  if (lam <= 0.0) return std::numeric_limits<double>::infinity();
-  return 2.0 / lam;  // FE amplification |1 − dt·λ| ≤ 1
+  return forward_euler_dt_limit_of(lambda_max_gershgorin(problem), estimate,
+                                   [&] { return lambda_max_power(problem); });
 }
 
 }  // namespace frictherm::thermal

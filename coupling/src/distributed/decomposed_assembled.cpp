@@ -8,6 +8,7 @@
 #include <Eigen/SparseCore>
 #include <petscmat.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -56,6 +57,25 @@ void DecomposedAssembledSolve::advance(MPI_Comm comm, const UnknownNumbering& id
                                        double t1) {
   assemble(comm, ids, kept, M, fixed);
   integrate(ids, &q, T, t0, t1);
+}
+
+void number_serially(MPI_Comm comm, const std::vector<int>& owned_grid_node, UnknownNumbering& ids) {
+  std::vector<int> mine;
+  for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
+    if (ids.owned_id[u] >= 0) mine.push_back(owned_grid_node[u]);
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<int> all(static_cast<std::size_t>(ids.global));
+  MPI_Allgatherv(mine.data(), count, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT, comm);
+  std::sort(all.begin(), all.end());  // the serial unknowns: in grid-node order (thermal_assembly.cpp)
+  ids.serial_id.assign(ids.owned_id.size(), -1);
+  for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
+    if (ids.owned_id[u] >= 0)
+      ids.serial_id[u] = static_cast<long>(std::lower_bound(all.begin(), all.end(), owned_grid_node[u]) - all.begin());
 }
 
 void DecomposedAssembledSolve::assemble(MPI_Comm comm, const UnknownNumbering& ids, const KeptEntries& kept,
@@ -171,6 +191,12 @@ void DecomposedAssembledSolve::assemble(MPI_Comm comm, const UnknownNumbering& i
   problem_ = std::make_unique<thermal::DistributedProblem>(comm, static_cast<thermal::Index>(N),
                                                            static_cast<thermal::Index>(ids.first), std::move(mass),
                                                            std::move(rows_k));
+  if (!ids.serial_id.empty()) {  // the power estimate's start vector by the serial numbering
+    std::vector<thermal::Index> start(static_cast<std::size_t>(n));
+    for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
+      if (ids.owned_id[u] >= 0) start[static_cast<std::size_t>(ids.owned_id[u] - ids.first)] = ids.serial_id[u];
+    problem_->set_power_start_ids(std::move(start));
+  }
   if (!fixed.empty())  // the serial Problem::set_dirichlet of the fixed faces' unknowns
     for (std::size_t u = 0; u < ids.owned_id.size(); ++u)
       if (ids.owned_id[u] >= 0 && !std::isnan(fixed[u]))

@@ -37,11 +37,18 @@ struct KeptEntries {
 /// The unknowns' global numbering: this rank owns [first, first + count) of `global` unknowns, in
 /// owned-node order; `owned_id[u]` is the global id of owned node u (−1: not an unknown), `local_id`
 /// the same on the rank's ghosted box (the owners' ids, as doubles: exact below 2^53).
+/// `serial_id[u]` (filled only for forward Euler's "power" estimate, whose start vector is indexed by
+/// it): the serial Coupler's number of owned unknown u (the unknowns in grid-node order), −1 elsewhere.
 struct UnknownNumbering {
   long global = 0, first = 0, count = 0;
   std::vector<long> owned_id;
   std::vector<double> local_id;
+  std::vector<long> serial_id;
 };
+
+/// Fills ids.serial_id (collective): every rank's unknowns' grid nodes (`owned_grid_node` per owned
+/// node, the serial grid numbers) gathered, an unknown's serial number the count of smaller ones.
+void number_serially(MPI_Comm comm, const std::vector<int>& owned_grid_node, UnknownNumbering& ids);
 
 class DecomposedAssembledSolve {
  public:

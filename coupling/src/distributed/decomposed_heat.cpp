@@ -326,6 +326,10 @@ void DecomposedHeat::number_unknowns(mechanics::DecomposedMpm<Dim>& mpm) {
   for (std::size_t u = 0; u < M_.size(); ++u)
     if (is_unknown(M_[u])) n.owned_id[u] = next, id[u] = static_cast<double>(next), ++next;
   mpm.owned_to_local(id, 1, n.local_id);
+  // Forward Euler's "power" estimate starts from the serial vector, indexed by the serial numbering.
+  n.serial_id.clear();
+  if (opt_.integrator == "forward_euler" && opt_.integrator_options.fe_limit_estimate == "power")
+    number_serially(comm, owned_grid_nodes(mpm), n);
 }
 
 // Pass 1 (gather_mass) and pass 2: each heat-holding particle's kept nodes (unknowns), the lumped
@@ -430,7 +434,11 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   // The serial Coupler's choice (close_window, matrix_free_window): matrix-free forward Euler for
   // "forward_euler" and "auto" when the window needs at most matrix_free_max_substeps stable sub-steps
   // (skipped without looking when the last bound puts it beyond twice that), else the assembled path.
-  const bool fe = opt_.integrator == "forward_euler" || opt_.integrator == "auto";
+  // Only with the "substep" policy and the Gershgorin estimate: "refuse", "unguarded" and "power" run
+  // the serial Scheme on the assembled rows, as the serial Coupler.
+  const thermal::IntegratorOptions& io = opt_.integrator_options;
+  const bool fe = (opt_.integrator == "forward_euler" || opt_.integrator == "auto") &&
+                  io.fe_stability_policy == "substep" && io.fe_limit_estimate == "gershgorin";
   const auto limit = static_cast<double>(opt_.matrix_free_max_substeps);
   bool matrix_free = fe && opt_.matrix_free_max_substeps > 0 && !reaction_active() &&
                      !(last_lambda_ > 0.0 && dt / (opt_.fe_safety * 2.0 / last_lambda_) > 2.0 * limit);

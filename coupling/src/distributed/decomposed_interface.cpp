@@ -176,7 +176,8 @@ void DecomposedHeat::interface_update(mechanics::DecomposedMpm<Dim>& mpm) {
     std::copy_n(owned_rows.begin() + static_cast<long>(u * stride), stride, slot_rows.begin() + static_cast<long>(s * stride));
     if (u < M_.size() && u < last_T_.size() && is_unknown(M_[u])) grid_temperature[s] = last_T_[u];
   }
-  model->update_slots(slot_rows, grid_temperature, time_);
+  // The patches (patch_length > 0) reach nodes another rank owns: formed once, from the gathered nodes.
+  model->update_slots(slot_rows, grid_temperature, time_, /*own_patches=*/false);
   if (model->patches()) interface_patches(*model, mpm.communicator());
   interface_max_ = model->max_temperature();
   interface_node_max_ = model->max_node_temperature();

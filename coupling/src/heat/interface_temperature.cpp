@@ -171,7 +171,7 @@ void InterfaceTemperature<Dim>::update(const mechanics::Particles<Dim>& p, mecha
 
 template <int Dim>
 void InterfaceTemperature<Dim>::update_slots(const std::vector<double>& rows, const std::vector<double>& grid_temperature,
-                                             double time) {
+                                             double time, bool own_patches) {
   const std::size_t slots = nodes_.size(), nm = sides_.size();
   node_correction_.assign(slots, 0.0);
   node_temperature_.assign(slots, 0.0);
@@ -233,7 +233,7 @@ void InterfaceTemperature<Dim>::update_slots(const std::vector<double>& rows, co
     max_node_temperature_ = std::max(max_node_temperature_, node_temperature_[s]);
   }
   max_temperature_ = max_node_temperature_;
-  if (patch_area_ > 0.0)
+  if (patch_area_ > 0.0 && own_patches)
     update_patches([this](std::size_t node) { return slot_of_node_[node]; }, node_correction_, node_temperature_);
 }
 

@@ -65,17 +65,16 @@ std::string thermal_refusal(const Scene& s) {
   if (!t.enabled) return "";
   const CouplerOptions& c = t.coupler;
   // Every integrator name runs (DecomposedHeat: matrix-free forward Euler, or the distributed integrator
-  // of that name on the assembled rows); the Krylov path only, no sparse direct solver.
+  // of that name on the assembled rows); every linear solver: "klu", the serial sparse direct solve, as
+  // MUMPS' sparse direct LU of I − γJ over the ranks preconditioning PCG (make_distributed_integrator).
   const thermal::IntegratorOptions& io = c.integrator_options;
-  if (io.linear_solver == "klu")
-    return refuse("thermal.linear_solver", quoted("klu"), "\"pcg\" (the default of a decomposed run) or no key");
-  // Matrix-free windows: the serial "substep" policy with the Gershgorin estimate, no cap on the step.
-  const bool matrix_free = (c.integrator == "forward_euler" || c.integrator == "auto") && c.matrix_free_max_substeps > 0;
-  const bool forward_euler = c.integrator == "forward_euler" || c.integrator == "auto";
-  if (forward_euler && io.fe_stability_policy != "substep")
-    return refuse("thermal.forward_euler.stability", quoted(io.fe_stability_policy), "\"substep\"");
-  if (forward_euler && io.fe_limit_estimate != "gershgorin")
-    return refuse("thermal.forward_euler.limit_estimate", quoted(io.fe_limit_estimate), "\"gershgorin\"");
+  // Matrix-free windows with the serial "substep" policy and the Gershgorin estimate; every other
+  // policy and estimate runs, as serially, the serial forward Euler Scheme on the assembled rows
+  // ("refuse" stops every rank alike: the limit is reduced over ranks; "power" iterates with reduced
+  // dot products from the serial start vector: DistributedProblem::lambda_max_power).
+  const bool matrix_free = (c.integrator == "forward_euler" || c.integrator == "auto") &&
+                           c.matrix_free_max_substeps > 0 && io.fe_stability_policy == "substep" &&
+                           io.fe_limit_estimate == "gershgorin";
   // thermal.forward_euler.max_dt caps the sub-steps of both paths (as the serial Coupler's window).
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
   // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed

@@ -63,20 +63,23 @@ std::unique_ptr<DistributedIntegrator> make_distributed_integrator(const std::st
   auto bad = [&](const std::string& what) {
     throw std::invalid_argument("make_distributed_integrator(\"" + name + "\"): " + what);
   };
-  const std::string& pc = options.preconditioner;
-  if (pc != "jacobi" && pc != "bjacobi" && pc != "hypre") {
-    bad("unknown preconditioner \"" + pc + "\" (valid: jacobi, bjacobi, hypre)");
+  std::string pc = options.preconditioner;
+  if (pc != "jacobi" && pc != "bjacobi" && pc != "hypre" && pc != "mumps") {
+    bad("unknown preconditioner \"" + pc + "\" (valid: jacobi, bjacobi, hypre, mumps)");
   }
-  if (o.fe_limit_estimate != "gershgorin") {
-    bad("fe_limit_estimate \"" + o.fe_limit_estimate + "\" is not distributed yet (valid: gershgorin)");
-  }
+  // "klu", the serial sparse direct solve: its distributed counterpart is MUMPS' sparse direct LU of
+  // P = I − γJ over the ranks, applied as the preconditioner of the Krylov method (PCG), whose first
+  // iterate is then the direct solution.
+  IntegratorOptions scheme_options = o;
+  if (o.linear_solver == "klu") scheme_options.linear_solver = "pcg", pc = "mumps";
   detail::LinearSolverKind lin = detail::LinearSolverKind::None;
   try {
-    lin = detail::parse_linear_solver(name, o.linear_solver, false);  // no klu: Krylov by default
+    lin = detail::parse_linear_solver(name, scheme_options.linear_solver, false);  // Krylov by default
   } catch (const std::invalid_argument& e) {
     bad(e.what());
   }
-  return std::unique_ptr<DistributedIntegrator>(new DistributedIntegrator(detail::make_scheme(name, o, lin), pc));
+  return std::unique_ptr<DistributedIntegrator>(
+      new DistributedIntegrator(detail::make_scheme(name, scheme_options, lin), pc));
 }
 
 }  // namespace frictherm::thermal

@@ -159,9 +159,12 @@ void DistributedOde::build(const DistributedProblem& problem, bool symmetric, co
   } else if (preconditioner == "hypre") {
     petsc_check(PCSetType(pc, PCHYPRE), "PCSetType(hypre)");
     petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType(boomeramg)");
+  } else if (preconditioner == "mumps") {  // a sparse direct LU of P over the ranks: the first Krylov iterate solves
+    petsc_check(PCSetType(pc, PCLU), "PCSetType(lu)");
+    petsc_check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType(mumps)");
   } else {
     throw std::invalid_argument("thermal (distributed): unknown preconditioner \"" + preconditioner +
-                                "\" (valid: jacobi, bjacobi, hypre)");
+                                "\" (valid: jacobi, bjacobi, hypre, mumps)");
   }
 }
 

@@ -34,7 +34,7 @@ class DistributedOde : public OdeForm {
   ~DistributedOde();
 
   // Collective (two ghost exchanges: s and the Dirichlet mask of the ghost columns).
-  // preconditioner: "jacobi", "bjacobi", "hypre", or empty for none (no PETSc objects).
+  // preconditioner: "jacobi", "bjacobi", "hypre", "mumps" (sparse direct LU), or empty for none (no PETSc objects).
   void build(const DistributedProblem& problem, bool symmetric, const std::string& preconditioner);
   void bind(const DistributedProblem& problem) { problem_ = &problem; }
   // The problem has a reaction (the same on every rank); it consumes: J is not symmetric (GMRES).

@@ -1,6 +1,7 @@
 // Row-partitioned conduction problem (distributed.hpp): layout checks, the ghost VecScatter,
 // the nodal heat rate w = −K T + q(t) (eq. 37 right-hand side) and the energy books.
 #include "frictherm/thermal/distributed.hpp"
+#include "frictherm/thermal/stability.hpp"
 
 #include "petsc_check.hpp"
 
@@ -327,6 +328,46 @@ double DistributedProblem::lambda_max_gershgorin() const {
   MPI_Allreduce(&lam, &global, 1, MPI_DOUBLE, MPI_MAX, comm_);
   count_reductions(1);
   return global;
+}
+
+void DistributedProblem::set_power_start_ids(std::vector<Index> ids) {
+  if (static_cast<Index>(ids.size()) != local_size())
+    fail("set_power_start_ids: " + std::to_string(ids.size()) + " ids for " + std::to_string(local_size()) +
+         " owned nodes");
+  power_start_ids_ = std::move(ids);
+}
+
+double DistributedProblem::lambda_max_power(int iterations) const {
+  // thermal::lambda_max_power on the owned rows: S v = P M^{-1/2} K M^{-1/2} P v (no convection here),
+  // the dot products and norms summed over ranks.
+  const Index n = local_size();
+  const Eigen::VectorXd rsm = mass_.cwiseSqrt().cwiseInverse();
+  Eigen::VectorXd free = Eigen::VectorXd::Ones(n);
+  for (Index d : dirichlet_local_) free[d] = 0.0;
+  const double* kv = k_.valuePtr();
+  auto apply = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+    const Eigen::VectorXd u = rsm.cwiseProduct(free.cwiseProduct(v));
+    const double* g = exchange(u.data());
+    for (Index i = 0; i < n; ++i) {
+      double acc = 0.0;  // (K u)_i in K's column order
+      for (Index e = row_start_[static_cast<std::size_t>(i)]; e < row_start_[static_cast<std::size_t>(i) + 1]; ++e) {
+        const Index c = local_col_[static_cast<std::size_t>(e)];
+        acc += kv[e] * (c < n ? u[c] : g[c - n]);
+      }
+      out[i] = free[i] * (rsm[i] * acc);
+    }
+  };
+  auto dot = [this](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    double local = a.dot(b), global = 0.0;
+    MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    count_reductions(1);
+    return global;
+  };
+  auto norm = [&](const Eigen::VectorXd& a) { return std::sqrt(dot(a, a)); };
+  Eigen::VectorXd v(n);
+  for (Index i = 0; i < n; ++i)
+    v[i] = power_iteration_start(power_start_ids_.empty() ? first_ + i : power_start_ids_[static_cast<std::size_t>(i)]);
+  return power_iteration(Eigen::VectorXd(free.cwiseProduct(v)), iterations, apply, dot, norm);
 }
 
 }  // namespace frictherm::thermal

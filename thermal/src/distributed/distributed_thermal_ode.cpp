@@ -1,5 +1,7 @@
 #include "distributed_thermal_ode.hpp"
 
+#include "frictherm/thermal/stability.hpp"
+
 #include <limits>
 #include <stdexcept>
 
@@ -29,9 +31,9 @@ void DistributedThermalOde::rhs(double t, const Eigen::VectorXd& temperature, Ei
 }
 
 double DistributedThermalOde::dt_limit(const std::string& estimate) const {
-  if (estimate != "gershgorin") throw std::invalid_argument("distributed: fe_limit_estimate must be gershgorin");
-  const double lam = problem_->lambda_max_gershgorin();  // global (MPI_MAX)
-  return lam > 0.0 ? 2.0 / lam : std::numeric_limits<double>::infinity();
+  // The serial rule (stability.hpp) on the global estimates (MPI_MAX, the power iteration's reductions).
+  return forward_euler_dt_limit_of(problem_->lambda_max_gershgorin(), estimate,
+                                   [this] { return problem_->lambda_max_power(); });
 }
 
 bool DistributedThermalOde::all_ranks(bool mine) const {

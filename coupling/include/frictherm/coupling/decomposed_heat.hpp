@@ -42,8 +42,8 @@
 // same nodes, held in both paths). The sub-cell interface temperature on the owned nodes
 // (decomposed_interface.cpp) and the Arrhenius reaction with λ_p as a particle scalar
 // (decomposed_reaction.cpp), as the serial Coupler. Differences from the serial Coupler: that
-// refusal; the reuse of matrix-free gathers, the KLU solver, the interface temperature's patch and
-// forward Euler's reacting sub-steps are absent (docs/distributed_coupling.md, docs/distributed_run.md).
+// refusal; the reuse of matrix-free gathers is absent; the KLU solver's place is taken by MUMPS' sparse
+// direct LU preconditioning PCG (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
 #include <frictherm/coupling/interface_reaction.hpp>
@@ -75,8 +75,10 @@ struct DecomposedHeatOptions {
   /// thermal::make_distributed_integrator name (cvode_bdf, cvode_adams, arkode_erk, arkode_dirk).
   std::string integrator = "forward_euler";
   /// rtol, atol, max_steps, krylov_maxl and linear_solver ("pcg", the default of the implicit
-  /// integrators, or "gmres"; cvode_adams also "fixed_point", its default) of the assembled path;
-  /// fe_safety above replaces theirs.
+  /// integrators, "gmres", or "klu": PCG preconditioned by MUMPS' sparse direct LU; cvode_adams also
+  /// "fixed_point", its default) of the assembled path; fe_safety above replaces theirs; forward
+  /// Euler's stability policy and limit estimate as the serial Coupler (a policy other than "substep"
+  /// or the "power" estimate: every window assembled).
   thermal::IntegratorOptions integrator_options;
   std::string preconditioner = "jacobi";  // of the Krylov path: "jacobi", "bjacobi" or "hypre"
   long matrix_free_max_substeps = 64;     // CouplerOptions::matrix_free_max_substeps (0: never matrix-free)
@@ -93,7 +95,7 @@ struct DecomposedHeatOptions {
   /// rule) are held at the face's temperature: set before the window's sub-steps and after each
   /// (matrix-free), Dirichlet rows of the distributed problem (assembled), out of the λ bounds.
   std::vector<FixedTemperatureFace> fixed_faces;
-  /// CouplerOptions::interface_temperature (patch_length 0 only): the sub-cell interface temperature
+  /// CouplerOptions::interface_temperature: the sub-cell interface temperature
   /// of the nodes this rank owns (decomposed_interface.cpp), each particle's T_int,p in the particle
   /// scalar named below; `thickness` the 2D out-of-plane thickness (CouplerOptions::thickness).
   InterfaceTemperatureOptions interface_temperature;

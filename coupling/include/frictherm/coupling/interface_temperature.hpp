@@ -85,8 +85,11 @@ class InterfaceTemperature {
   }
   /// From pass 1's rows (slots × row_size(), slot order of nodes()) and each slot's grid temperature
   /// T_i at the end of the window (NaN: not a thermal unknown now): the corrections, the nodes'
-  /// interface temperatures and the maxima at `time`.
-  void update_slots(const std::vector<double>& rows, const std::vector<double>& grid_temperature, double time);
+  /// interface temperatures and the maxima at `time`; with patch_length > 0 also the patches of this
+  /// model's own heated nodes, unless `own_patches` is false (a decomposed run, whose patches reach
+  /// nodes another rank owns: update_patches_from forms them once from the gathered nodes).
+  void update_slots(const std::vector<double>& rows, const std::vector<double>& grid_temperature, double time,
+                    bool own_patches = true);
   /// The correction a particle reads per slot after update_slots (the patch's when patch_length > 0).
   const std::vector<double>& slot_correction() const { return patch_area_ > 0.0 ? patch_correction_ : node_correction_; }
   /// After a window or continuation interval ending at the last add_step (or later, `time`):

@@ -13,7 +13,7 @@
 // nodes is carried as in the serial module: the state [s ⊙ T; λ of the free reacting nodes]
 // (ode_system.hpp), GMRES and the 2×2 block-Jacobi preconditioner when it consumes its reactant;
 // forward_euler's reaction sub-step limit is agreed over the ranks. Not distributed yet:
-// convection and flux boundaries, fe_limit_estimate "power".
+// convection and flux boundaries.
 #pragma once
 
 #include "frictherm/thermal/integrator.hpp"
@@ -117,6 +117,14 @@ class DistributedProblem {
   double source_heat(double t0, double t1) const;  // ∫ Σ_free q dt over [t0, t1], exact [J]
   // Global λ_max Gershgorin bound of M⁻¹K over free rows (what forward_euler uses).
   double lambda_max_gershgorin() const;
+  // Global λ_max of M⁻¹K over free rows by the serial power iteration (stability.hpp: the same
+  // start vector, iterations and Rayleigh quotient; one ghost exchange and two reductions per
+  // iteration), the estimate "power" of forward_euler. The start vector is indexed by the rows'
+  // serial ids (set_power_start_ids; default: the global ids).
+  double lambda_max_power(int iterations = 200) const;
+  // The serial module's node id of each owned row (a caller whose ranks number the nodes otherwise
+  // than the serial Problem), for lambda_max_power's start vector.
+  void set_power_start_ids(std::vector<Index> ids);
 
   // Changes when M, K or a Dirichlet node changes (not sources): integrators rebuild then.
   std::uint64_t revision() const { return revision_; }
@@ -143,6 +151,7 @@ class DistributedProblem {
   std::vector<Index> dirichlet_local_;
   Eigen::VectorXd fixed_value_;
   std::vector<Index> ghost_ids_, row_start_, local_col_;
+  std::vector<Index> power_start_ids_;  // empty: the global ids
   Index ghosts_sent_ = 0;
   int neighbours_ = 0;
   // PETSc objects (Vec, VecScatter) kept opaque here: petscvec.h stays out of this header.
@@ -156,10 +165,12 @@ class DistributedProblem {
 struct DistributedOptions {
   IntegratorOptions integrator;  // rtol, atol, max_steps, krylov_maxl, fe_* as in the serial module
   // Implicit integrators: "pcg" (default; CG on the symmetric form y = M^{1/2}T) or "gmres"
-  // (SPGMR, same form). "klu" has no distributed counterpart and is refused.
+  // (SPGMR, same form). "klu" (the serial sparse direct solve) is PCG preconditioned by MUMPS' sparse
+  // direct LU of P = I − γJ over the ranks (the preconditioner below is then "mumps").
   // cvode_adams: "fixed_point" (default) or a Krylov solver as above.
   // PETSc preconditioner of P = I − γJ, one application per Krylov iteration: "jacobi" (default,
-  // the serial module's), "bjacobi" (one ILU(0) block per rank) or "hypre" (BoomerAMG V-cycle).
+  // the serial module's), "bjacobi" (one ILU(0) block per rank), "hypre" (BoomerAMG V-cycle) or
+  // "mumps" (PCLU with MATSOLVERMUMPS: P factored, refactored when γ changes).
   std::string preconditioner = "jacobi";
 };
 

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <string>
 
 namespace frictherm::thermal {
@@ -15,6 +17,47 @@ namespace frictherm::thermal {
 // λmax ≤ max_i (Σ_j |K_ij| + hA_i)/M_i. For zero-row-sum M-matrices this is 2·max_i K_ii/M_i,
 // i.e. dt ≤ min_i M_i/K_ii; it is exact for 3/5/7-point FD with lumped boundary masses.
 double lambda_max_gershgorin(const Problem& problem);
+
+// The power iteration of lambda_max_power, written once for any storage (the serial Problem and the
+// distributed one, whose dot products and norms are reduced over ranks): from v (zero on the fixed
+// nodes, not normalised), `iterations` steps w = S v, λ = v·w, v = w/|w|; returns the last Rayleigh
+// quotient (0 when v or some w vanishes).
+template <class Vector, class Apply, class Dot, class Norm>
+double power_iteration(Vector v, int iterations, Apply&& apply, Dot&& dot, Norm&& norm) {
+  const double vn = norm(v);
+  if (vn == 0.0) return 0.0;
+  v /= vn;
+  Vector w(v.size());
+  double lam = 0.0;
+  for (int it = 0; it < iterations; ++it) {
+    apply(v, w);
+    lam = dot(v, w);  // Rayleigh quotient
+    const double wn = norm(w);
+    if (wn == 0.0) return 0.0;
+    v = w / wn;
+  }
+  return lam;
+}
+
+// The deterministic start vector's entry at node i (checkerboard-like plus a smooth part).
+inline double power_iteration_start(Index i) {
+  return ((i % 2) ? -1.0 : 1.0) + 0.1 * std::sin(0.7 * static_cast<double>(i));
+}
+
+// forward_euler_dt_limit from the Gershgorin bound and, for "power", the power iteration's λ (called
+// only then): 2/λ with λ = min(1.05·λ_power, λ_gershgorin); +inf when λ ≤ 0.
+template <class Power>
+double forward_euler_dt_limit_of(double lambda_gershgorin, const std::string& estimate, Power&& lambda_power) {
+  double lam = lambda_gershgorin;
+  if (estimate == "power") {
+    lam = std::min(1.05 * lambda_power(), lam);
+  } else if (estimate != "gershgorin") {
+    throw std::invalid_argument("forward_euler_dt_limit: unknown estimate \"" + estimate +
+                                "\" (valid: gershgorin, power)");
+  }
+  if (lam <= 0.0) return std::numeric_limits<double>::infinity();
+  return 2.0 / lam;  // FE amplification |1 − dt·λ| ≤ 1
+}
 
 // Power iteration on the symmetric M^{-1/2}K_eff M^{-1/2} restricted to free nodes; returns
 // the Rayleigh quotient after `iterations` steps (a lower bound on λmax that converges from
