@@ -48,7 +48,10 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   thread_local std::vector<std::uint8_t> reach_flag, reach_tmp;
   if constexpr (boxed) step_detail::dilate_slot_flags_for(st, fields_, at_contact, reach_flag, reach_tmp);
   const std::uint8_t* const reach = reach_flag.data();
-  parallel_region(threads_.count, [&] {
+  // The extents are maxima, exact in any order: the same numbers on any number of threads. Boxed
+  // stencils test one flag per particle and work on those reaching (threads_for_reach); EBS walks all.
+  const int threads = boxed ? threads_for_reach(contact_nodes_.reach_share, p_.size(), threads_.count) : threads_.count;
+  parallel_region(threads, [&] {
     const int tid = omp_get_thread_num();
     double* own = contact_nodes_.entry_extent_own.data();
     double* other = contact_nodes_.entry_extent_other.data();
@@ -86,7 +89,7 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
       }
     }
   });
-  for (int t = 0; t + 1 < threads_.count; ++t) {
+  for (int t = 0; t + 1 < threads; ++t) {
     const std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(t)];
     for (std::size_t q = 0; q < entries; ++q) {
       contact_nodes_.entry_extent_own[q] = std::max(contact_nodes_.entry_extent_own[q], buf[q]);

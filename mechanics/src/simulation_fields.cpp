@@ -319,7 +319,7 @@ template <int Dim>
 void Simulation<Dim>::velocity_from_momentum() {
   apply_velocity_bc(nodes_.momentum, nullptr, 0.0);
   const double mmin = empty_node_mass_;
-  parallel_for(threads_.count, nodes_.mass.size(), [&](std::size_t i) {
+  parallel_for(threads_for_slots(nodes_.mass.size(), threads_.count), nodes_.mass.size(), [&](std::size_t i) {
     nodes_.velocity[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
   });
 }
@@ -335,7 +335,7 @@ void Simulation<Dim>::save_start_velocity() {
   const double mmin = empty_node_mass_;
   const std::size_t n = nodes_.mass.size();
   transfer_.start.resize(n);
-  parallel_for(threads_.count, n, [&](std::size_t i) {
+  parallel_for(threads_for_slots(n, threads_.count), n, [&](std::size_t i) {
     transfer_.start[i] = nodes_.mass[i] > mmin ? Vec<Dim>(nodes_.momentum[i] / nodes_.mass[i]) : Vec<Dim>::Zero();
   });
 }
@@ -374,7 +374,7 @@ void Simulation<Dim>::apply_damping(double dt) {
 template <int Dim>
 void Simulation<Dim>::advance_grid_momentum(double dt) {
   const std::size_t n = nodes_.mass.size();
-  parallel_for(threads_.count, n, [&](std::size_t i) { nodes_.momentum[i] += nodes_.force[i] * dt; });
+  parallel_for(threads_for_slots(n, threads_.count), n, [&](std::size_t i) { nodes_.momentum[i] += nodes_.force[i] * dt; });
 }
 
 template <int Dim>
@@ -383,7 +383,7 @@ void Simulation<Dim>::nodal_velocities() {
   const std::size_t n = nodes_.mass.size();
   // Nodes driven by a rigid boundary material keep its prescribed velocity components (the force was
   // zeroed consistently, so only the velocity needs resetting when the prescribed velocity changes).
-  parallel_for(threads_.count, n, [&](std::size_t s) {
+  parallel_for(threads_for_slots(n, threads_.count), n, [&](std::size_t s) {
     const double m = nodes_.mass[s];
     if (m > mmin) {
       nodes_.velocity[s] = nodes_.momentum[s] / m;

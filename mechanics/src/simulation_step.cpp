@@ -240,6 +240,9 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
   contact_nodes_.terms_scattered = false;
   std::size_t reaching = 0;
   if (!scattered) {
+    // On the threads the particles that reached a contact node on the last step pay for
+    // (threads_for_reach): few near one interface would leave a team mate a wake and an idle wait.
+    // EBS walks every stencil (no reach_share): all threads.
     scatter_phase(Accumulated{false, false, false, true}, true,
                   [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t, std::size_t kb, std::size_t ke) {
       double* const domain = acc.domain.data();
@@ -267,7 +270,7 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
       }
 #pragma omp atomic
       reaching += mine;
-    });
+    }, is_extended<Kernel> ? threads_.count : threads_for_reach(contact_nodes_.reach_share, p_.size(), threads_.count));
   }
   if constexpr (!is_extended<Kernel>) {
     std::size_t all = 0;
@@ -363,10 +366,12 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
 // Each part of the thread partition clears the slots it scatters into (its own fields in the nodes,
 // its buffer for a field it shares) and scatters; after a barrier the shared fields' buffers are
 // summed into the nodes. One parallel region per phase (none on one thread: parallel_region.hpp).
+// `threads` may be fewer than the partition's parts: a thread then runs several parts in order
+// (for_each_part), each into the same target as its own thread would, so the same sums.
 template <int Dim>
 template <class Scatter>
-void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter) {
-  parallel_region(threads_.count, [&] {
+void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter, int threads) {
+  parallel_region(threads, [&] {
     for_each_part(threads_.partition, [&](int t) {
       clear_scatter_targets(t, which);
       for (std::size_t m = 0; m < materials_.size(); ++m) {
@@ -471,7 +476,7 @@ void Simulation<Dim>::map_to_grid(double /*dt*/, bool with_forces) {
       if (forces) scatter(std::true_type{}, std::false_type{});
       else scatter(std::false_type{}, std::false_type{});
     }
-  });
+  }, threads_.count);
 }
 
 // USF: internal and body forces from the freshly updated stress.
@@ -487,7 +492,7 @@ void Simulation<Dim>::add_internal_forces() {
       const Vec<Dim> mg = p_.mass[k] * g;
       st[k].for_each(ix, [&](int i, double S, const Vec<Dim>& G) { acc.force[i] += S * mg - Vsig * G; });
     }
-  });
+  }, threads_.count);
 }
 
 // Rigid materials without a velocity field of their own (all of them without contact, boundary ones
@@ -544,7 +549,7 @@ void Simulation<Dim>::remap_momentum() {
       const Vec<Dim> mv = p_.mass[k] * p_.velocity[k];
       st[k].for_each(ix, [&](int i, double S, const Vec<Dim>&) { acc.momentum[i] += S * mv; });
     }
-  });
+  }, threads_.count);
 }
 
 #define FRICTHERM_INSTANTIATE_STEP(D) \

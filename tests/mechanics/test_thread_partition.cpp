@@ -5,6 +5,7 @@
 // caller's own team of threads give the bits of a serial run. The particle passes' timed
 // split (PassSplit) moves to equal measured cost, and the numbers do not depend on where it is.
 #include <frictherm/mechanics/geometry.hpp>
+#include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 
@@ -309,4 +310,18 @@ TEST(ThreadPartition, PairWorkIsTheSameBitsWhicheverThreadResolvesAGroup) {
   const double one = sliding_interface_work(steps);
   std::printf("[pair work] 3 threads %.17g J, one thread per region %.17g J, 1 thread %.17g J\n", three, nested, one);
   EXPECT_EQ(nested, three);
+}
+
+// The thresholds that keep small passes off the team (issue 35, threads-s55): element-wise node loops
+// below 2 x kSlotsPerThread slots, contact passes on the particles that reach a contact node.
+TEST(ThreadPartition, SmallNodeLoopsAndOneSidedContactRunOnOneThread) {
+  EXPECT_EQ(threads_for_slots(2 * kSlotsPerThread - 1, 2), 1);
+  EXPECT_EQ(threads_for_slots(2 * kSlotsPerThread, 2), 2);
+  EXPECT_EQ(threads_for_slots(100 * kSlotsPerThread, 4), 4);
+  EXPECT_EQ(threads_for_slots(3 * kSlotsPerThread, 8), 3);
+  EXPECT_EQ(threads_for_slots(0, 2), 1);
+  // The 1 mm twin: ~10 % of 16,400 particles reach the interface; a PBX with contact everywhere.
+  EXPECT_EQ(threads_for_reach(0.1, 16400, 2), 1);
+  EXPECT_EQ(threads_for_reach(0.6, 16400, 2), 2);
+  EXPECT_EQ(threads_for_reach(0.0, 100000, 2), 1);
 }

@@ -33,6 +33,19 @@ inline int assembly_threads(std::size_t particles) {
   return mechanics::threads_for_particles(particles, omp_get_max_threads());
 }
 
+/// Threads for the explicit conduction hand-off's passes (gather, sub-steps, map back): one unless
+/// at least kHandoffMinThreads are available. Their one-thread loops walk a whole stencil straight
+/// from its first node and keep S_ip from the first walk for the second, where the shared loops
+/// expand every stencil and walk the particle list once per thread's node range: on the 1 mm twin
+/// (16,400 particles, 2 threads) the shared map back cost 5x the CPU of the one-thread one and the
+/// whole hand-off 780 us/step of wall time against 480 on one thread (perf, issue 35). Both give the
+/// same numbers (the same sums in particle order), so the count changes no result.
+inline constexpr int kHandoffMinThreads = 3;
+inline int explicit_handoff_threads(std::size_t particles) {
+  const int threads = assembly_threads(particles);
+  return threads >= kHandoffMinThreads ? threads : 1;
+}
+
 /// K's sparsity pattern of the last assembly (per dimension and kernel, per calling thread): the
 /// unknowns it was built for, its CSR arrays and the row slot of every stored entry (the diagonal at
 /// the centre slot). A new assembly with the same unknowns and the same slots holding non-zero

@@ -53,7 +53,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them, and the sums of
   // quick_bound(); each heat-holding particle's stencil kept (copied from the step's, or evaluated
   // here) when a refresh may follow.
-  const int threads = assembly_detail::assembly_threads(p.size());
+  const int threads = assembly_detail::explicit_handoff_threads(p.size());
   holds_heat_.assign(p.size(), 0);
   holding_ = 0;
   listed_.clear();

@@ -90,7 +90,7 @@ void ExplicitConduction<Dim>::substeps_with(const NodalThermalSystem& sys, Eigen
                      T == flux_temperature_;
   first_force_ready_ = false;
   force_.resize(n);
-  const int threads = assembly_detail::assembly_threads(holds_heat_.size());
+  const int threads = assembly_detail::explicit_handoff_threads(holds_heat_.size());
   const int nodes = static_cast<int>(sys.unknown.size());
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   // With the stencils kept, K at node level (use_node_operator) for every sub-step the gather's f_i
@@ -364,7 +364,7 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
     return relax || delta[u] != 0.0 || (pull && face_pull_.held(static_cast<std::size_t>(u)));
   });
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
-  const int threads = assembly_detail::assembly_threads(p.size());
+  const int threads = assembly_detail::explicit_handoff_threads(p.size());
   // The eq. 38 sums of the next reproject(): only a refresh can lead to one, and without kept
   // stencils the next window gathers anew (and sums them anew), so they are not kept up to date.
   const bool keep_sums = stencils_kept_;

@@ -15,7 +15,31 @@
 
 #include <cstddef>
 
+#include <frictherm/mechanics/thread_partition.hpp>
+
 namespace frictherm::mechanics {
+
+/// Grid slots per thread below which an element-wise loop over the nodes (p += f dt, v = p / m)
+/// costs less on one thread than the wake of a sleeping team mate (OMP_WAIT_POLICY=passive: a futex
+/// wake per region, 10-20 us on this paravirtualised machine, against ~1-3 ns per slot; issue 35).
+/// The 1 mm twin's ~10^4 slots then run on one thread, a 3D PBX grid's ~10^5 on all.
+inline constexpr std::size_t kSlotsPerThread = 16384;
+
+/// Threads for an element-wise loop over `slots` grid slots: at most `available`, at least one.
+/// Each slot is written from its own values only, so the count changes no result.
+inline int threads_for_slots(std::size_t slots, int available) {
+  const std::size_t wanted = slots / kSlotsPerThread;
+  return wanted < 2 ? 1 : (wanted < static_cast<std::size_t>(available) ? static_cast<int>(wanted) : available);
+}
+
+/// Threads for a contact pass whose work is the particles reaching a contact node, `share` of
+/// `particles` (the last step's reach_share): threads_for_particles of those only. On the 1 mm twin
+/// ~10 % of the particles reach the interface, so the contact terms' scatter and the extents run on
+/// one thread instead of leaving the other thread idle at the barrier (contact phase 130 us/step on
+/// one thread, 230 on two; issue 35).
+inline int threads_for_reach(double share, std::size_t particles, int available) {
+  return threads_for_particles(static_cast<std::size_t>(share * static_cast<double>(particles)), available);
+}
 
 /// Whether a region of `threads` threads runs without a team: one thread, and the caller in no team
 /// of two or more.

@@ -328,7 +328,7 @@ class Simulation {
   /// One scatter phase (simulation_step.cpp): a parallel region in which each part of the partition
   /// clears its targets and calls scatter(acc, index, m, k_begin, k_end) for each of its materials that
   /// has a field (rigid ones only with include_rigid), then the shared fields are summed.
-  template <class Scatter> void scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter);
+  template <class Scatter> void scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter, int threads);
   /// Velocity boundary conditions on nodal momenta; with `force` (the momentum update, p + f dt to
   /// come) the forces are made consistent instead, and the rigid bodies' work is returned (0 without).
   double apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::vector<Vec<Dim>>* force, double dt,
