@@ -106,6 +106,11 @@ struct PairContext {
   double slip_length = 0.0, relaxation_time = 0.0;
 };
 
+/// Whether the node's lagged traction carries on from the previous step (it was in contact then).
+inline bool has_lagged_history(const PairContext& c) {
+  return !std::isnan(*c.lagged_normal) && *c.lagged_step >= c.step - 1.0;
+}
+
 /// The normal impulse the friction law sees: −σ̃ A_c dt with σ̃ the lagged normal traction,
 /// dσ̃/dt = −(|v_slip|/L + 1/τ)(σ̃ − σ) (Prakash–Clifton form, Cochard & Rice 2000 eq. 3), integrated
 /// exactly over the step for frozen v_slip and σ = −d_n/(A_c dt) (eq. 15; 0 at a touching node whose
@@ -114,9 +119,8 @@ struct PairContext {
 inline double regularized_normal(double d_n, double d_t, double reduced_mass, double area, const PairContext& c) {
   if (!c.lagged_normal) return d_n;
   const double sigma = std::max(0.0, -d_n) / (area * c.dt);  // N = −d_n/(A_c dt), eq. 15
-  const bool fresh = std::isnan(*c.lagged_normal) || *c.lagged_step < c.step - 1.0;
   double lagged = sigma;
-  if (!fresh) {
+  if (has_lagged_history(c)) {
     const double rate = (d_t / reduced_mass) / c.slip_length + 1.0 / c.relaxation_time;
     lagged = sigma + (*c.lagged_normal - sigma) * std::exp(-rate * c.dt);
   }
@@ -291,7 +295,7 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
     // separation, 2.5 mm: 176 µm). A node with no history (not in contact on the previous step) has no
     // lagged traction to keep.
     if (c.lagged_normal && c.separation == SeparationMethod::extent && touching && d_t > 0.0 &&
-        !std::isnan(*c.lagged_normal) && *c.lagged_step >= c.step - 1.0) {
+        has_lagged_history(c)) {
       const double d_n_law = regularized_normal(0.0, d_t, out.reduced_mass, area, c);
       apply_friction(a, b, s.law.in_contact(ContactImpulse{d_n_law, d_t, out.reduced_mass, area, c.dt}), t_vec, 0.0,
                      n, t_vec, d_t, c, out);
