@@ -60,7 +60,8 @@ double Simulation<Dim>::step(double dt_limit) {
   return ctx.dt;
 }
 
-// What the phase lists depend on; a change rebuilds them. (The contact methods are not in it:
+// What the phase lists depend on; a change rebuilds them: among it what selects the loads
+// (loads/registry.cpp: resolved point loads and tractions, damping). (The contact methods are not in it:
 // finalize() chooses them, before the first list is built, and nothing changes them after.)
 template <int Dim>
 long Simulation<Dim>::phase_key() const {
@@ -97,7 +98,9 @@ std::vector<const char*> Simulation<Dim>::step_phase_names() {
 // particles and the stress from their velocities. The contact methods (step/contact_method.hpp,
 // contact_methods/) add their phases at the hooks `contact(ContactHook::...)` below: multimaterial
 // contact a pass after each momentum projection, penalty contact its forces before the velocity
-// conditions and the boundary points' move where the stress update's velocity is on the grid.
+// conditions and the boundary points' move where the stress update's velocity is on the grid. The
+// loads (step/step_load.hpp, loads/) add theirs at `load(LoadHook::...)`: point loads and tractions
+// into the forces, damping after the velocity conditions.
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
@@ -108,6 +111,10 @@ void Simulation<Dim>::build_phases() {
   const bool flip = opt_.particle_update == ParticleUpdate::flip;
   const auto contact = [&](ContactHook at) {
     for (const StepContactMethod<Dim>* m : contact_methods_) m->add_phases(at, scheme, opt_.shape, *this, P);
+  };
+  const std::vector<const StepLoad<Dim>*> loads = loads_for(*this);  // step/step_load.hpp, loads/
+  const auto load = [&](LoadHook at) {
+    for (const StepLoad<Dim>* l : loads) l->add_phases(at, opt_.shape, *this, P);
   };
   // USL with contact (the velocity fields per material): the particle pass also evaluates the next
   // step's stencils and boxes and moves the rigid particles (nothing after it in the step needs this
@@ -131,13 +138,12 @@ void Simulation<Dim>::build_phases() {
     P.add("internal_forces", &T::particle_to_grid, [this](StepContext&) { add_internal_forces<Kernel>(); });
     contact(ContactHook::stress_velocity);
   }
-  if (!conditions_.resolved_loads.empty())
-    P.add("external_loads", &T::particle_to_grid, [this](StepContext& c) { map_external_loads<Kernel>(c.t); });
+  load(LoadHook::forces);
   contact(ContactHook::forces);
   if (opt_.particle_update == ParticleUpdate::xpic)
     P.add("start_velocity", &T::grid_update, [this](StepContext&) { save_start_velocity(); });
   P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
-  if (opt_.damping_rate > 0.0) P.add("damping", &T::grid_update, [this](StepContext& c) { apply_damping(c.dt); });
+  load(LoadHook::conditioned_forces);
   P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
   contact(ContactHook::updated);
   P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
@@ -562,7 +568,11 @@ void Simulation<Dim>::remap_momentum() {
   template void Simulation<D>::contact_at_extrapolated<LinearKernel>(double); \
   template void Simulation<D>::contact_at_extrapolated<UGIMPKernel>(double); \
   template void Simulation<D>::contact_at_extrapolated<QuadraticBSplineKernel>(double); \
-  template void Simulation<D>::contact_at_extrapolated<ExtendedBSplineKernel>(double);
+  template void Simulation<D>::contact_at_extrapolated<ExtendedBSplineKernel>(double); \
+  template void Simulation<D>::map_external_loads<LinearKernel>(double); \
+  template void Simulation<D>::map_external_loads<UGIMPKernel>(double); \
+  template void Simulation<D>::map_external_loads<QuadraticBSplineKernel>(double); \
+  template void Simulation<D>::map_external_loads<ExtendedBSplineKernel>(double);
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)
 #undef FRICTHERM_INSTANTIATE_STEP

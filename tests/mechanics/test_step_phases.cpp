@@ -132,3 +132,33 @@ TEST(StepPhases, TimersAccountForTheSteps) {
   for (double x : {t.time_step, t.shape_functions, t.particle_to_grid, t.contact, t.grid_update, t.stress_update})
     EXPECT_GT(x, 0.0);
 }
+
+// The loads (step/step_load.hpp) at their hooks and selected by what the scene applies: point loads
+// into the forces (USF: after the internal forces, before the penalty forces), damping after the
+// velocity conditions.
+TEST(StepPhases, LoadsAtTheirHooks) {
+  SimulationOptions o;
+  o.scheme = UpdateScheme::usf;
+  Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
+  const int a = sim.add_material(elastic("a"));
+  sim.add_body("a", *make_box<2>(Vec<2>(0.2, 0.2), Vec<2>(0.45, 0.6), a), 2, Vec<2>(0.0, 0.0));
+  const auto load_names = [&] {
+    Names out;
+    for (const StepLoad<2>* l : loads_for(sim)) out.emplace_back(l->name());
+    return out;
+  };
+  sim.finalize();
+  EXPECT_EQ(load_names(), Names{});
+  PointLoad<2> p;
+  p.point = Vec<2>(0.3, 0.4);
+  p.force = Vec<2>(1.0, 0.0);
+  sim.add_point_load(p);
+  sim.options().damping_rate = 100.0;  // the lists are built again when what they depend on changes
+  sim.options().damping_until = 1.0;
+  Names steps;
+  for (const char* n : sim.step_phase_names()) steps.emplace_back(n);
+  EXPECT_EQ(load_names(), Names({"particle_loads", "mass_damping"}));
+  EXPECT_EQ(steps, Names({"time_step", "shape_functions", "particle_to_grid", "velocity_from_momentum", "stress_update",
+                          "internal_forces", "external_loads", "velocity_conditions", "damping", "momentum_update",
+                          "nodal_velocities", "grid_to_particle", "move_rigid_particles", "end_particle_update"}));
+}

@@ -47,6 +47,7 @@
 #include <frictherm/mechanics/state/work_books.hpp>
 #include <frictherm/mechanics/step/contact_method.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
+#include <frictherm/mechanics/step/step_load.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/mechanics/transfer.hpp>
@@ -97,6 +98,11 @@ template <int Dim>
 class MultimaterialContactMethod;
 template <int Dim>
 class PenaltyContactMethod;
+// The loads (step/step_load.hpp; mechanics/src/loads/): their phases call the step's load passes.
+template <int Dim>
+class ParticleLoads;
+template <int Dim>
+class MassDamping;
 
 template <int Dim>
 class Simulation {
@@ -277,6 +283,8 @@ class Simulation {
  private:
   friend class MultimaterialContactMethod<Dim>;
   friend class PenaltyContactMethod<Dim>;
+  friend class ParticleLoads<Dim>;
+  friend class MassDamping<Dim>;
   using ContactEntry = typename ContactNodeState<Dim>::Entry;
   using ContactNodeListing = typename ContactNodeState<Dim>::Listing;
   using ContactThreadWork = typename ContactNodeState<Dim>::ThreadWork;

@@ -1,0 +1,36 @@
+// Point loads and tractions as a load of the step (step/step_load.hpp): resolved to particles by
+// resolve_loads (simulation_setup.cpp), each scattered into the nodal forces of its material's field
+// over the particle's stencil, f_i += S_ip F(t) (Nairn 2018 eq. 3 with an external force; the kernel
+// add_load_to_grid, loads/grid_loads.hpp, shared with the decomposed step). Their work is booked in
+// the particle pass (F(t)·Δx_p, load_work).
+#include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/step/step_load.hpp>
+
+namespace frictherm::mechanics {
+
+template <int Dim>
+class ParticleLoads final : public StepLoad<Dim> {
+ public:
+  using Sim = Simulation<Dim>;
+  const char* name() const override { return "particle_loads"; }
+
+  void add_phases(LoadHook at, ShapeKind shape, Sim& sim, PhaseList& P) const override {
+    if (at != LoadHook::forces) return;
+    // The scatter reads the step's stencils: the kernel is chosen here, once per list.
+    const auto phase = [&sim](auto kernel) -> std::function<void(StepContext&)> {
+      using Kernel = decltype(kernel);
+      return [&sim](StepContext& c) { sim.template map_external_loads<Kernel>(c.t); };
+    };
+    P.add("external_loads", &StepPhaseTimes::particle_to_grid,
+          shape == ShapeKind::extended_bspline ? phase(ExtendedBSplineKernel{}) : dispatch_shape(shape, phase));
+  }
+
+  static const StepLoad<Dim>* select(const Sim& sim) {
+    static const ParticleLoads load;
+    return sim.conditions_.resolved_loads.empty() ? nullptr : &load;
+  }
+};
+
+FRICTHERM_STEP_LOAD_SELECTION(select_particle_loads, ParticleLoads)
+
+}  // namespace frictherm::mechanics
