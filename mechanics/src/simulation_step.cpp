@@ -100,7 +100,8 @@ std::vector<const char*> Simulation<Dim>::step_phase_names() {
 // contact a pass after each momentum projection, penalty contact its forces before the velocity
 // conditions and the boundary points' move where the stress update's velocity is on the grid. The
 // loads (step/step_load.hpp, loads/) add theirs at `load(LoadHook::...)`: point loads and tractions
-// into the forces, damping after the velocity conditions.
+// into the forces, damping after the velocity conditions; the velocity filters (step/velocity_filter.hpp,
+// filters/) at `filter(FilterHook::...)`: XPIC's start velocity, XPIC/FMPM after nodal_velocities.
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
@@ -108,13 +109,16 @@ void Simulation<Dim>::build_phases() {
   PhaseList& P = schedule_.phases;
   const UpdateScheme scheme = opt_.scheme;
   const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
-  const bool flip = opt_.particle_update == ParticleUpdate::flip;
   const auto contact = [&](ContactHook at) {
     for (const StepContactMethod<Dim>* m : contact_methods_) m->add_phases(at, scheme, opt_.shape, *this, P);
   };
   const std::vector<const StepLoad<Dim>*> loads = loads_for(*this);  // step/step_load.hpp, loads/
   const auto load = [&](LoadHook at) {
     for (const StepLoad<Dim>* l : loads) l->add_phases(at, opt_.shape, *this, P);
+  };
+  const std::vector<const StepVelocityFilter<Dim>*> filters = velocity_filters_for(*this);  // filters/
+  const auto filter = [&](FilterHook at) {
+    for (const StepVelocityFilter<Dim>* f : filters) f->add_phases(at, scheme, opt_.shape, *this, P);
   };
   // USL with contact (the velocity fields per material): the particle pass also evaluates the next
   // step's stencils and boxes and moves the rigid particles (nothing after it in the step needs this
@@ -140,16 +144,13 @@ void Simulation<Dim>::build_phases() {
   }
   load(LoadHook::forces);
   contact(ContactHook::forces);
-  if (opt_.particle_update == ParticleUpdate::xpic)
-    P.add("start_velocity", &T::grid_update, [this](StepContext&) { save_start_velocity(); });
+  filter(FilterHook::start_velocity);
   P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
   load(LoadHook::conditioned_forces);
   P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
   contact(ContactHook::updated);
   P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
-  if (!flip)  // XPIC/FMPM
-    P.add("velocity_filter", usl ? &T::stress_update : &T::grid_to_particle,
-          [this](StepContext&) { filter_grid_velocity(stencils<Kernel>()); });
+  filter(FilterHook::velocities);
   if (usl) {  // grid-to-particle and stress update in one pass over the stencils
     P.add("particle_update", &T::stress_update, [this, refresh](StepContext& c) {
       const ParticlePassResult r = particle_pass<true, true>(c.dt, stencils<Kernel>(), refresh);
@@ -528,6 +529,13 @@ void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* 
   }
 }
 
+// XPIC/FMPM: the grid velocity filtered over the step's stencils (simulation_transfer.cpp).
+template <int Dim>
+template <class Kernel>
+void Simulation<Dim>::filter_velocities() {
+  filter_grid_velocity(stencils<Kernel>());
+}
+
 // Point loads and tractions into the nodal forces (the kernel shared with the decomposed step:
 // loads/grid_loads.hpp).
 template <int Dim>
@@ -572,7 +580,11 @@ void Simulation<Dim>::remap_momentum() {
   template void Simulation<D>::map_external_loads<LinearKernel>(double); \
   template void Simulation<D>::map_external_loads<UGIMPKernel>(double); \
   template void Simulation<D>::map_external_loads<QuadraticBSplineKernel>(double); \
-  template void Simulation<D>::map_external_loads<ExtendedBSplineKernel>(double);
+  template void Simulation<D>::map_external_loads<ExtendedBSplineKernel>(double); \
+  template void Simulation<D>::filter_velocities<LinearKernel>(); \
+  template void Simulation<D>::filter_velocities<UGIMPKernel>(); \
+  template void Simulation<D>::filter_velocities<QuadraticBSplineKernel>(); \
+  template void Simulation<D>::filter_velocities<ExtendedBSplineKernel>();
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)
 #undef FRICTHERM_INSTANTIATE_STEP

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace frictherm::mechanics;
@@ -161,4 +162,32 @@ TEST(StepPhases, LoadsAtTheirHooks) {
   EXPECT_EQ(steps, Names({"time_step", "shape_functions", "particle_to_grid", "velocity_from_momentum", "stress_update",
                           "internal_forces", "external_loads", "velocity_conditions", "damping", "momentum_update",
                           "nodal_velocities", "grid_to_particle", "move_rigid_particles", "end_particle_update"}));
+}
+
+// The grid-velocity filters (step/velocity_filter.hpp): XPIC keeps the start velocity before the
+// velocity conditions and filters after nodal_velocities; FMPM filters only; FLIP has none.
+TEST(StepPhases, VelocityFiltersAtTheirHooks) {
+  const auto run = [](ParticleUpdate update) {
+    SimulationOptions o;
+    o.particle_update = update;
+    o.transfer_order = 2;
+    Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
+    const int a = sim.add_material(elastic("a"));
+    sim.add_body("a", *make_box<2>(Vec<2>(0.2, 0.2), Vec<2>(0.45, 0.6), a), 2, Vec<2>(1.0, 0.0));
+    Names steps, filters;
+    for (const char* n : sim.step_phase_names()) steps.emplace_back(n);
+    for (const StepVelocityFilter<2>* f : velocity_filters_for(sim)) filters.emplace_back(f->name());
+    return std::make_pair(filters, steps);
+  };
+  const auto [xpic, xpic_steps] = run(ParticleUpdate::xpic);
+  EXPECT_EQ(xpic, Names{"xpic"});
+  EXPECT_EQ(xpic_steps, Names({"time_step", "shape_functions", "particle_to_grid", "start_velocity", "velocity_conditions",
+                               "momentum_update", "nodal_velocities", "velocity_filter", "particle_update",
+                               "move_rigid_particles", "end_particle_update"}));
+  const auto [fmpm, fmpm_steps] = run(ParticleUpdate::fmpm);
+  EXPECT_EQ(fmpm, Names{"fmpm"});
+  EXPECT_EQ(fmpm_steps, Names({"time_step", "shape_functions", "particle_to_grid", "velocity_conditions",
+                               "momentum_update", "nodal_velocities", "velocity_filter", "particle_update",
+                               "move_rigid_particles", "end_particle_update"}));
+  EXPECT_EQ(run(ParticleUpdate::flip).first, Names{});
 }

@@ -48,6 +48,7 @@
 #include <frictherm/mechanics/step/contact_method.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
 #include <frictherm/mechanics/step/step_load.hpp>
+#include <frictherm/mechanics/step/velocity_filter.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/mechanics/transfer.hpp>
@@ -103,6 +104,9 @@ template <int Dim>
 class ParticleLoads;
 template <int Dim>
 class MassDamping;
+// The grid-velocity filters (step/velocity_filter.hpp; mechanics/src/filters/).
+template <int Dim>
+struct VelocityFilterPhases;
 
 template <int Dim>
 class Simulation {
@@ -285,6 +289,7 @@ class Simulation {
   friend class PenaltyContactMethod<Dim>;
   friend class ParticleLoads<Dim>;
   friend class MassDamping<Dim>;
+  friend struct VelocityFilterPhases<Dim>;
   using ContactEntry = typename ContactNodeState<Dim>::Entry;
   using ContactNodeListing = typename ContactNodeState<Dim>::Listing;
   using ContactThreadWork = typename ContactNodeState<Dim>::ThreadWork;
@@ -302,6 +307,7 @@ class Simulation {
   /// `evaluated`: this step's stencils of every particle (contact), or null to evaluate them here.
   template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);
   template <class Kernel> void map_external_loads(double t);
+  template <class Kernel> void filter_velocities();  // XPIC/FMPM: filter_grid_velocity on the step's stencils
   template <class Kernel> void remap_momentum();
   /// The particle loops after the grid update (simulation_particle_pass.cpp): grid-to-particle
   /// (Kinematics), stress update from nodes_.velocity (Stress), or both in one pass (USL).
