@@ -8,6 +8,7 @@
 // passes (find_contact_nodes then lists no node), as the step did before the interface.
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/contact_method.hpp>
+#include <frictherm/mechanics/step/component_registry.hpp>
 
 namespace frictherm::mechanics {
 
@@ -52,6 +53,6 @@ class MultimaterialContactMethod final : public StepContactMethod<Dim> {
   }
 };
 
-FRICTHERM_CONTACT_METHOD_SELECTION(select_multimaterial_contact, MultimaterialContactMethod)
+FRICTHERM_STEP_COMPONENT_SELECTION(StepContactMethod, select_multimaterial_contact, MultimaterialContactMethod)
 
 }  // namespace frictherm::mechanics

@@ -7,6 +7,7 @@
 // uses penalty contact (setup_penalty, run by the selection).
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/contact_method.hpp>
+#include <frictherm/mechanics/step/component_registry.hpp>
 
 namespace frictherm::mechanics {
 
@@ -46,6 +47,6 @@ class PenaltyContactMethod final : public StepContactMethod<Dim> {
   }
 };
 
-FRICTHERM_CONTACT_METHOD_SELECTION(select_penalty_contact, PenaltyContactMethod)
+FRICTHERM_STEP_COMPONENT_SELECTION(StepContactMethod, select_penalty_contact, PenaltyContactMethod)
 
 }  // namespace frictherm::mechanics

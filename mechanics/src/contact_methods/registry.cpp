@@ -3,12 +3,10 @@
 // scene does not use it. A new method is one new file plus its line below; the order of the lines is
 // the order of the methods' phases at a hook they share.
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/step/component_registry.hpp>
 #include <frictherm/mechanics/step/contact_method.hpp>
 
 namespace frictherm::mechanics {
-
-template <int Dim>
-using ContactMethodSelection = const StepContactMethod<Dim>* (*)(Simulation<Dim>&);
 
 // Defined in the methods' files.
 template <int Dim> const StepContactMethod<Dim>* select_multimaterial_contact(Simulation<Dim>& sim);
@@ -16,14 +14,11 @@ template <int Dim> const StepContactMethod<Dim>* select_penalty_contact(Simulati
 
 template <int Dim>
 std::vector<const StepContactMethod<Dim>*> contact_methods_for(Simulation<Dim>& sim) {
-  static constexpr ContactMethodSelection<Dim> registry[] = {
+  static constexpr const StepContactMethod<Dim>* (*registry[])(Simulation<Dim>&) = {
       &select_multimaterial_contact<Dim>,  // multimaterial_contact_method.cpp (Nairn 2018)
       &select_penalty_contact<Dim>,        // penalty_contact_method.cpp (Kakouris 2024)
   };
-  std::vector<const StepContactMethod<Dim>*> methods;
-  for (const ContactMethodSelection<Dim> select : registry)
-    if (const StepContactMethod<Dim>* m = select(sim)) methods.push_back(m);
-  return methods;
+  return select_components<StepContactMethod<Dim>>(registry, sim);
 }
 
 template std::vector<const StepContactMethod<2>*> contact_methods_for(Simulation<2>&);

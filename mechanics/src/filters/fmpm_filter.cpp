@@ -2,6 +2,7 @@
 // the updated velocity v^{n+1} filtered by the truncated Neumann series of k terms after
 // nodal_velocities; the particles take the filtered velocity (transfer/grid_to_particle.hpp).
 #include "filters/filter_phases.hpp"
+#include <frictherm/mechanics/step/component_registry.hpp>
 
 namespace frictherm::mechanics {
 
@@ -15,12 +16,12 @@ class FmpmFilter final : public StepVelocityFilter<Dim> {
     if (at == FilterHook::velocities) VelocityFilterPhases<Dim>::add_filter(scheme, shape, sim, P);
   }
 
-  static const StepVelocityFilter<Dim>* select(const Sim& sim) {
+  static const StepVelocityFilter<Dim>* select(Sim& sim) {
     static const FmpmFilter filter;
     return sim.options().particle_update == ParticleUpdate::fmpm ? &filter : nullptr;
   }
 };
 
-FRICTHERM_VELOCITY_FILTER_SELECTION(select_fmpm_filter, FmpmFilter)
+FRICTHERM_STEP_COMPONENT_SELECTION(StepVelocityFilter, select_fmpm_filter, FmpmFilter)
 
 }  // namespace frictherm::mechanics

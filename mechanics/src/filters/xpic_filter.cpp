@@ -3,6 +3,7 @@
 // Neumann series of m terms after nodal_velocities; the particle pass then updates the particles with
 // v^{n+1} and the filtered v^n (transfer/grid_to_particle.hpp, update_particle_velocity).
 #include "filters/filter_phases.hpp"
+#include <frictherm/mechanics/step/component_registry.hpp>
 
 namespace frictherm::mechanics {
 
@@ -17,12 +18,12 @@ class XpicFilter final : public StepVelocityFilter<Dim> {
     if (at == FilterHook::velocities) VelocityFilterPhases<Dim>::add_filter(scheme, shape, sim, P);
   }
 
-  static const StepVelocityFilter<Dim>* select(const Sim& sim) {
+  static const StepVelocityFilter<Dim>* select(Sim& sim) {
     static const XpicFilter filter;
     return sim.options().particle_update == ParticleUpdate::xpic ? &filter : nullptr;
   }
 };
 
-FRICTHERM_VELOCITY_FILTER_SELECTION(select_xpic_filter, XpicFilter)
+FRICTHERM_STEP_COMPONENT_SELECTION(StepVelocityFilter, select_xpic_filter, XpicFilter)
 
 }  // namespace frictherm::mechanics

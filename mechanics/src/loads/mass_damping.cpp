@@ -5,6 +5,7 @@
 // stable_time_step (damping_time_step_limit).
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/step_load.hpp>
+#include <frictherm/mechanics/step/component_registry.hpp>
 
 namespace frictherm::mechanics {
 
@@ -19,12 +20,12 @@ class MassDamping final : public StepLoad<Dim> {
       P.add("damping", &StepPhaseTimes::grid_update, [&sim](StepContext& c) { sim.apply_damping(c.dt); });
   }
 
-  static const StepLoad<Dim>* select(const Sim& sim) {
+  static const StepLoad<Dim>* select(Sim& sim) {
     static const MassDamping load;
     return sim.opt_.damping_rate > 0.0 ? &load : nullptr;
   }
 };
 
-FRICTHERM_STEP_LOAD_SELECTION(select_mass_damping, MassDamping)
+FRICTHERM_STEP_COMPONENT_SELECTION(StepLoad, select_mass_damping, MassDamping)
 
 }  // namespace frictherm::mechanics

@@ -5,6 +5,7 @@
 // the particle pass (F(t)·Δx_p, load_work).
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/step_load.hpp>
+#include <frictherm/mechanics/step/component_registry.hpp>
 
 namespace frictherm::mechanics {
 
@@ -25,12 +26,12 @@ class ParticleLoads final : public StepLoad<Dim> {
           shape == ShapeKind::extended_bspline ? phase(ExtendedBSplineKernel{}) : dispatch_shape(shape, phase));
   }
 
-  static const StepLoad<Dim>* select(const Sim& sim) {
+  static const StepLoad<Dim>* select(Sim& sim) {
     static const ParticleLoads load;
     return sim.conditions_.resolved_loads.empty() ? nullptr : &load;
   }
 };
 
-FRICTHERM_STEP_LOAD_SELECTION(select_particle_loads, ParticleLoads)
+FRICTHERM_STEP_COMPONENT_SELECTION(StepLoad, select_particle_loads, ParticleLoads)
 
 }  // namespace frictherm::mechanics

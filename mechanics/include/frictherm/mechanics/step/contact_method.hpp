@@ -54,12 +54,7 @@ class StepContactMethod {
 template <int Dim>
 std::vector<const StepContactMethod<Dim>*> contact_methods_for(Simulation<Dim>& sim);
 
-/// In a method's file: its selection `select_fn` (the name registry.cpp lists) for 2D and 3D, from
-/// the static `Method<Dim>::select(Simulation<Dim>&)`, which returns the method or null.
-#define FRICTHERM_CONTACT_METHOD_SELECTION(select_fn, Method)                                         \
-  template <int Dim>                                                                                 \
-  const StepContactMethod<Dim>* select_fn(Simulation<Dim>& sim) { return Method<Dim>::select(sim); } \
-  template const StepContactMethod<2>* select_fn(Simulation<2>&);                                   \
-  template const StepContactMethod<3>* select_fn(Simulation<3>&);
+// A method's file defines its selection with FRICTHERM_STEP_COMPONENT_SELECTION
+// (step/component_registry.hpp).
 
 }  // namespace frictherm::mechanics

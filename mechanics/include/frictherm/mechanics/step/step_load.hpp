@@ -36,14 +36,9 @@ class StepLoad {
 
 /// The loads `sim` applies now, in registration order (loads/registry.cpp).
 template <int Dim>
-std::vector<const StepLoad<Dim>*> loads_for(const Simulation<Dim>& sim);
+std::vector<const StepLoad<Dim>*> loads_for(Simulation<Dim>& sim);
 
-/// In a load's file: its selection `select_fn` (the name registry.cpp lists) for 2D and 3D, from the
-/// static `Load<Dim>::select(const Simulation<Dim>&)`, which returns the load or null.
-#define FRICTHERM_STEP_LOAD_SELECTION(select_fn, Load)                                              \
-  template <int Dim>                                                                               \
-  const StepLoad<Dim>* select_fn(const Simulation<Dim>& sim) { return Load<Dim>::select(sim); }   \
-  template const StepLoad<2>* select_fn(const Simulation<2>&);                                    \
-  template const StepLoad<3>* select_fn(const Simulation<3>&);
+// A load's file defines its selection with FRICTHERM_STEP_COMPONENT_SELECTION
+// (step/component_registry.hpp).
 
 }  // namespace frictherm::mechanics

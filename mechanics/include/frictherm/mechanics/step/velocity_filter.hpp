@@ -36,14 +36,9 @@ class StepVelocityFilter {
 
 /// The velocity filters `sim` applies now, in registration order (filters/registry.cpp).
 template <int Dim>
-std::vector<const StepVelocityFilter<Dim>*> velocity_filters_for(const Simulation<Dim>& sim);
+std::vector<const StepVelocityFilter<Dim>*> velocity_filters_for(Simulation<Dim>& sim);
 
-/// In a filter's file: its selection `select_fn` (the name registry.cpp lists) for 2D and 3D, from
-/// the static `Filter<Dim>::select(const Simulation<Dim>&)`, which returns the filter or null.
-#define FRICTHERM_VELOCITY_FILTER_SELECTION(select_fn, Filter)                                             \
-  template <int Dim>                                                                                      \
-  const StepVelocityFilter<Dim>* select_fn(const Simulation<Dim>& sim) { return Filter<Dim>::select(sim); } \
-  template const StepVelocityFilter<2>* select_fn(const Simulation<2>&);                                  \
-  template const StepVelocityFilter<3>* select_fn(const Simulation<3>&);
+// A filter's file defines its selection with FRICTHERM_STEP_COMPONENT_SELECTION
+// (step/component_registry.hpp).
 
 }  // namespace frictherm::mechanics
