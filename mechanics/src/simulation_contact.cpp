@@ -19,7 +19,9 @@ namespace frictherm::mechanics {
 
 using contact_detail::PairContext;
 
-namespace {
+// In a named namespace, not an anonymous one: resolve_contact's lambdas capture it, and a member of
+// internal linkage in their closure types draws -Wsubobject-linkage (the template has external linkage).
+namespace contact_detail {
 
 // The first contact node group (in group order, so the same on any thread count) whose friction law threw.
 struct ContactFailure {
@@ -32,7 +34,9 @@ struct ContactFailure {
   }
 };
 
-}  // namespace
+}  // namespace contact_detail
+using contact_detail::ContactFailure;
+
 template <int Dim>
 void Simulation<Dim>::resolve_contact(ContactPass pass, double dt) {
   const bool heat = pass == ContactPass::updated;
