@@ -169,6 +169,7 @@ TEST(StepPhases, LoadsAtTheirHooks) {
 TEST(StepPhases, VelocityFiltersAtTheirHooks) {
   const auto run = [](ParticleUpdate update) {
     SimulationOptions o;
+    o.scheme = UpdateScheme::usl;  // the scenes' default (the library's is MUSL)
     o.particle_update = update;
     o.transfer_order = 2;
     Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
