@@ -207,8 +207,9 @@ std::optional<OutputQuantity> output_quantity(const std::string& name, int dim) 
   if (base == "fate") q->flags = {{0, "undecided"}, {1, "dying"}, {2, "runaway"}};  // HotSpotFate
   if (dot != std::string::npos) {  // a body (mean_temperature.block) or a material pair (base.block)
     const std::string part = name.substr(dot + 1);
-    const bool pair = part.find('.') != std::string::npos;
-    q->long_name += (pair ? " between " : " of ") + part;
+    const std::size_t second = part.find('.');
+    q->long_name += second == std::string::npos ? " of " + part
+                                                : " between " + part.substr(0, second) + " and " + part.substr(second + 1);
   }
   return q;
 }
