@@ -15,6 +15,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -114,10 +115,9 @@ void Simulation<Dim>::build_phases() {
   // step's stencils).
   const bool refresh = usl && !contact_methods_.empty() && !is_extended<Kernel>;
 
-  // The CFL step. With the last stress update's wave speeds current, the particle-to-grid scatter
-  // takes max_p c_p + |v_p| on its way (threads_.speed_max; a maximum is exact in any order) and the
-  // step is set after it: nothing before the contact passes reads it, and a pass over the particles
-  // of its own (on two threads a parallel region, on one 3 % of the 1 mm twin's step) is saved.
+  // The CFL step. With the wave speeds current, the particle-to-grid scatter takes max_p c_p + |v_p|
+  // (exact in any order) and the step is set at its phase's end (nothing reads it before): no pass of
+  // its own (on two threads a parallel region, on one 3 % of the 1 mm twin's step).
   const auto set_step = [this](StepContext& c, double cmax) {
     c.dt = std::min(time_step_for_speed(cmax), c.dt_limit);
     if (!(c.dt > 0.0) || !std::isfinite(c.dt)) {
@@ -131,13 +131,9 @@ void Simulation<Dim>::build_phases() {
     if (!c.speed_in_scatter) set_step(c, particle_speed_max());
   });
   P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
-  P.add("particle_to_grid", &T::particle_to_grid,
-        [this, usf](StepContext& c) { map_to_grid<Kernel>(!usf, c.speed_in_scatter); });
-  P.add("time_step_from_scatter", &T::time_step, [this, set_step](StepContext& c) {
-    if (!c.speed_in_scatter) return;
-    double cmax = 0.0;
-    for (const double c_part : threads_.speed_max) cmax = std::max(cmax, c_part);
-    set_step(c, cmax);
+  P.add("particle_to_grid", &T::particle_to_grid, [this, usf, set_step](StepContext& c) {
+    map_to_grid<Kernel>(!usf, c.speed_in_scatter);
+    if (c.speed_in_scatter) set_step(c, *std::max_element(threads_.speed_max.begin(), threads_.speed_max.end()));
   });
   contact(ContactHook::extrapolated);
   if (usf) {
@@ -386,6 +382,12 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
 template <int Dim>
 template <class Scatter>
 void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter, int threads) {
+  // Few shared slots (threads_for_slots) are summed after the region by one thread in thread order
+  // (the same bits), not after a barrier: with passive waits a barrier wakes a sleeping thread, which
+  // costs more than summing the 1 mm twin's ~4 x 10^3 shared slots on one (issue 35).
+  std::size_t shared_slots = 0;
+  for (const int f : threads_.partition.shared_fields) shared_slots += fields_[static_cast<std::size_t>(f)].count;
+  const bool sum_after = threads <= 1 || threads_for_slots(shared_slots, threads) <= 1;
   parallel_region(threads, [&] {
     for_each_part(threads_.partition, [&](int t) {
       clear_scatter_targets(t, which);
@@ -397,11 +399,13 @@ void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatt
         scatter(scatter_target(t, f), fields_[static_cast<std::size_t>(f)].index, m, kb, ke);
       }
     });
-    if (!threads_.partition.shared_fields.empty()) {
+    if (!threads_.partition.shared_fields.empty() && !sum_after) {
 #pragma omp barrier
       sum_shared_fields(which);
     }
   });
+  if (sum_after && !threads_.partition.shared_fields.empty())
+    parallel_region(1, [&] { sum_shared_fields(which); });  // its orphaned loop runs every slot
 }
 
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:
@@ -412,8 +416,7 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::map_to_grid(bool with_forces, bool take_speeds) {
   auto& st = stencils<Kernel>();
-  // take_speeds: each part's largest c_p + |v_p| (stable_time_step's, from the same values) into
-  // threads_.speed_max, from 0 as stable_time_step starts.
+  // take_speeds: each part's largest c_p + |v_p| (as stable_time_step, from 0) into threads_.speed_max.
   threads_.speed_max.assign(static_cast<std::size_t>(threads_.partition.threads), 0.0);
   double* const speed_max = threads_.speed_max.data();
   const std::size_t speed_count = threads_.speed_max.size();
