@@ -382,12 +382,6 @@ StencilView<Dim> Simulation<Dim>::current_stencils() {
 template <int Dim>
 template <class Scatter>
 void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatter&& scatter, int threads) {
-  // Few shared slots (threads_for_slots) are summed after the region by one thread in thread order
-  // (the same bits), not after a barrier: with passive waits a barrier wakes a sleeping thread, which
-  // costs more than summing the 1 mm twin's ~4 x 10^3 shared slots on one (issue 35).
-  std::size_t shared_slots = 0;
-  for (const int f : threads_.partition.shared_fields) shared_slots += fields_[static_cast<std::size_t>(f)].count;
-  const bool sum_after = threads <= 1 || threads_for_slots(shared_slots, threads) <= 1;
   parallel_region(threads, [&] {
     for_each_part(threads_.partition, [&](int t) {
       clear_scatter_targets(t, which);
@@ -399,13 +393,11 @@ void Simulation<Dim>::scatter_phase(Accumulated which, bool include_rigid, Scatt
         scatter(scatter_target(t, f), fields_[static_cast<std::size_t>(f)].index, m, kb, ke);
       }
     });
-    if (!threads_.partition.shared_fields.empty() && !sum_after) {
+    if (!threads_.partition.shared_fields.empty()) {
 #pragma omp barrier
       sum_shared_fields(which);
     }
   });
-  if (sum_after && !threads_.partition.shared_fields.empty())
-    parallel_region(1, [&] { sum_shared_fields(which); });  // its orphaned loop runs every slot
 }
 
 // Particle-to-grid of mass, momentum and (USL/MUSL) internal force and body force:
