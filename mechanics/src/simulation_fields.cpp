@@ -304,10 +304,14 @@ double Simulation<Dim>::apply_velocity_bc(std::vector<Vec<Dim>>& momentum, std::
       }
     });
   };
-  if (without_team(threads_.count)) {
+  // Below 2 x kSlotsPerThread slots on one thread, as the other element-wise node loops
+  // (threads_for_slots): on the 1 mm twin this region was a team wake per step for ~10^4 slots
+  // (grid update 27 -> 80 us/step on two threads; issue 35).
+  const int threads = threads_for_slots(nodes_.mass.size(), threads_.count);
+  if (without_team(threads)) {
     fields_pass(field_work, field_stop);
   } else {
-#pragma omp parallel num_threads(threads_.count) reduction(+ : field_work, field_stop)
+#pragma omp parallel num_threads(threads) reduction(+ : field_work, field_stop)
     fields_pass(field_work, field_stop);
   }
   if (stop) *stop += field_stop;
@@ -362,10 +366,11 @@ void Simulation<Dim>::apply_damping(double dt) {
       damp_node<Dim>(nodes_.force[s], nodes_.momentum[s], nodes_.mass[s], driven, c, dt, mmin_damped, removed);
     });
   };
-  if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
+  const int threads = threads_for_slots(nodes_.mass.size(), threads_.count);  // as apply_velocity_bc
+  if (without_team(threads)) {  // without a team (parallel_region.hpp)
     damp_pass(damped);
   } else {
-#pragma omp parallel num_threads(threads_.count) reduction(+ : damped)
+#pragma omp parallel num_threads(threads) reduction(+ : damped)
     damp_pass(damped);
   }
   work_books_.damping += damped;

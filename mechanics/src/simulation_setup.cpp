@@ -263,9 +263,23 @@ std::vector<ParticleLoad<Dim>> Simulation<Dim>::particle_loads() const {
 
 template <int Dim>
 double Simulation<Dim>::stable_time_step() const {
+  return time_step_for_speed(particle_speed_max());
+}
+
+// Whether the last stress update's wave speeds are every particle's: then the CFL speed is
+// max_p (c_p + |v_p|) over them, which the step's particle-to-grid scatter takes on its way (it reads
+// every particle with a field; the others are rigid, c_p = −∞), without a pass of its own.
+template <int Dim>
+bool Simulation<Dim>::wave_speeds_current() const {
+  return finalized_ && wave_speeds_.ready && wave_speeds_.speed.size() == p_.size();
+}
+
+// The largest c_p + |v_p| of the deformable particles (0 without any).
+template <int Dim>
+double Simulation<Dim>::particle_speed_max() const {
   double cmax = 0.0;
   const std::size_t n = p_.size();
-  if (finalized_ && wave_speeds_.ready && wave_speeds_.speed.size() == n) {
+  if (wave_speeds_current()) {
     // The wave speeds of the last stress update (rigid particles: −∞; the rigid loop below counts them).
     // One thread: no team (parallel_region.hpp); a maximum is exact in any order.
     if (without_team(threads_.count)) {
@@ -289,6 +303,13 @@ double Simulation<Dim>::stable_time_step() const {
       }
     }
   }
+  return cmax;
+}
+
+// The CFL step (Nairn 2018 eq. 45) for the particles' largest c_p + |v_p|, with the rigid materials'
+// speeds, the contact methods' bounds and factors and the damping bound.
+template <int Dim>
+double Simulation<Dim>::time_step_for_speed(double cmax) const {
   cmax = with_rigid_speeds(cmax, materials_, clock_.time);
   // The contact methods' bounds (penalty: light nodes under its springs) and wave-speed factors (a
   // penalty stiffer than the bodies), step/contact_method.hpp.

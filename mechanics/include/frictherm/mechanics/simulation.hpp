@@ -302,7 +302,13 @@ class Simulation {
   template <class Kernel> void contact_at_extrapolated(double dt);  // contact nodes, extents, first pass
   template <class Kernel> void stress_pass(double dt);  // USF, MUSL: the stress update alone
   void end_particle_update(StepContext& ctx, bool refreshed);  // time and step advance, particle checks
-  template <class Kernel> void map_to_grid(double dt, bool with_forces);
+  // stable_time_step in parts (simulation_setup.cpp): the step takes the particles' largest speed in
+  // its particle-to-grid scatter when the wave speeds are current (threads_.speed_max).
+  bool wave_speeds_current() const;
+  double particle_speed_max() const;             // max_p c_p + |v_p| (0 without deformable particles)
+  double time_step_for_speed(double cmax) const;  // the CFL step for it, with rigid, contact and damping bounds
+  /// take_speeds: also each part's largest c_p + |v_p| into threads_.speed_max (the CFL speed).
+  template <class Kernel> void map_to_grid(bool with_forces, bool take_speeds);
   template <class Kernel> void add_internal_forces();
   /// `evaluated`: this step's stencils of every particle (contact), or null to evaluate them here.
   template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);

@@ -16,6 +16,7 @@ struct StepContext {
   double dt_limit = 0.0;  // the caller's bound on the step (s)
   double dt = 0.0;        // the step, set by the time-step phase (s)
   double t = 0.0;         // the time at the start of the step (s)
+  bool speed_in_scatter = false;  // the particle-to-grid scatter takes the CFL speed; dt is set after it
   long bad = -1;          // grid-to-particle: the first particle with a non-finite state or outside the grid
   long beyond = -1;       // stress update: the first compressed past its Hugoniot's limit
 };
