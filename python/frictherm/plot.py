@@ -35,6 +35,31 @@ def particle_side(run, snap):
     return np.full(len(pos), math.sqrt(area / max(len(pos), 1)))
 
 
+def rigid_particles(run, snap):
+    """Boolean mask of the snapshot's particles of rigid materials (walls, pistons: /meta
+    material_kinds "rigid"). The pictures draw them in grey, under the others, and leave them out
+    of the colour scale: their fixed temperature or zero stress would otherwise stretch the scale
+    over the specimen's whole range (a 0.4 K hot spot under 293 K walls reads as one colour)."""
+    kinds = run.meta.get("material_kinds") if hasattr(run.meta, "get") else None
+    if not isinstance(kinds, (list, tuple)) or "material" not in snap:
+        return np.zeros(snap.particle_count, dtype=bool)
+    rigid = np.array([k == "rigid" for k in kinds] + [False])
+    material = np.asarray(snap["material"]).reshape(-1).astype(np.int64)
+    return rigid[np.clip(material, 0, len(kinds))]
+
+
+def _colour_range(values, rigid):
+    """(vmin, vmax) over the finite values of the non-rigid particles (all particles if all are rigid)."""
+    use = np.isfinite(values) & (~rigid if (~rigid).any() else True)
+    if not use.any():
+        return 0.0, 1.0
+    vmin, vmax = float(values[use].min()), float(values[use].max())
+    return vmin, (vmax if vmax > vmin else vmin + 1.0)
+
+
+_RIGID_COLOUR = "0.78"
+
+
 def _frame(fig, pos, side):
     ax = fig.add_axes(_BOX)
     pad = float(np.max(side)) if len(side) else 1.0
@@ -47,14 +72,17 @@ def _frame(fig, pos, side):
 
 def plot_particles(run, snap, field, out_png):
     """Particles as squares sized to their spacing, coloured by `field` (frictherm.fields names);
-    3D runs are projected on the x-y plane, highest z on top."""
+    particles of rigid materials in grey and out of the colour scale (rigid_particles). 3D runs are
+    projected on the x-y plane, highest z on top, rigid particles beneath the others (plot_slices
+    shows the inside)."""
     pos = snap["position"].astype(float)
     values, clabel = field_values(snap, field)
     side = particle_side(run, snap)
+    rigid = rigid_particles(run, snap)
     factor, lunit = scale_for(np.abs(pos[:, :2]).max(), "m")  # mm or µm axes for small specimens
     pos, side = pos * factor, side * factor
-    order = np.argsort(pos[:, 2]) if run.dim == 3 else np.arange(len(pos))
-    pos, values, side = pos[order], values[order], side[order]
+    order = np.lexsort((pos[:, 2], ~rigid)) if run.dim == 3 else np.arange(len(pos))
+    pos, values, side, rigid = pos[order], values[order], side[order], rigid[order]
     # Fixed axes boxes (no tight_layout or colorbar stealing space later), so that the data-unit to
     # point scale measured below is the one the figure is saved with.
     fig = plt.figure(figsize=(7.5, 6), dpi=120)
@@ -64,16 +92,19 @@ def plot_particles(run, snap, field, out_png):
     x0, x1 = ax.transData.transform([[0.0, 0.0], [1.0, 0.0]])[:, 0]
     points_per_unit = (x1 - x0) * 72.0 / fig.dpi
     sizes = (side * points_per_unit) ** 2
-    finite = np.isfinite(values)
-    vmin, vmax = (values[finite].min(), values[finite].max()) if finite.any() else (0.0, 1.0)
-    sc = ax.scatter(pos[:, 0], pos[:, 1], c=values, s=sizes, marker="s", linewidths=0, cmap="inferno",
-                    vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1.0)
+    vmin, vmax = _colour_range(values, rigid)
+    colours = plt.get_cmap("inferno")(np.clip((values - vmin) / (vmax - vmin), 0.0, 1.0))
+    colours[rigid] = matplotlib.colors.to_rgba(_RIGID_COLOUR)
+    ax.scatter(pos[:, 0], pos[:, 1], c=colours, s=sizes, marker="s", linewidths=0)
+    mappable = matplotlib.cm.ScalarMappable(matplotlib.colors.Normalize(vmin, vmax), "inferno")
     unit = unit_of(field)
-    fig.colorbar(sc, cax=cax).set_label(clabel + (f" ({unit})" if unit else ""))
+    fig.colorbar(mappable, cax=cax).set_label(clabel + (f" ({unit})" if unit else ""))
     ax.set_xlabel(f"x ({lunit})")
     ax.set_ylabel(f"y ({lunit})")
     what = "failure state" if snap.is_failure else f"snapshot {snap.label}"
-    ax.set_title(f"{clabel} at t = {snap.time:.4g} s (step {snap.step}, {what})")
+    tf, tunit = scale_for(snap.time, "s")
+    ax.set_title(f"{clabel} at t = {snap.time * tf:.4g} {tunit} (step {snap.step}, {what})"
+                 + (", rigid in grey" if rigid.any() else ""))
     fig.savefig(out_png)
     plt.close(fig)
 
@@ -81,36 +112,49 @@ def plot_particles(run, snap, field, out_png):
 def plot_slices(run, snap, field, out_png=None, count=3, axis=2):
     """A 3D run drawn as `count` slices normal to `axis` (default z) at evenly spaced levels inside
     the particles' extent, side by side with one colour scale: each panel shows the particles whose
-    centre is within half a particle spacing of its level. Axes in m with an SI prefix (mm, µm)
-    where it reads better. Returns the figure when out_png is None, else saves and closes it."""
+    centre is within half a particle spacing of its level, as squares of that spacing (rigid
+    materials in grey and out of the colour scale, rigid_particles). Axes in m with an SI prefix
+    (mm, µm) where it reads better. Returns the figure when out_png is None, else saves and closes it."""
     if run.dim != 3:
         raise ValueError("plot_slices draws 3D runs (this run is %dD)" % run.dim)
     pos = snap["position"].astype(float)
     values, clabel = field_values(snap, field)
     side = particle_side(run, snap)
+    rigid = rigid_particles(run, snap)
     lo, hi = pos[:, axis].min(), pos[:, axis].max()
     levels = lo + (hi - lo) * (np.arange(count) + 0.5) / count
     plane = [a for a in range(3) if a != axis]
     factor, lunit = scale_for(np.abs(pos[:, plane]).max(), "m")
-    finite = np.isfinite(values)
-    vmin, vmax = (values[finite].min(), values[finite].max()) if finite.any() else (0.0, 1.0)
-    fig, axes = plt.subplots(1, count, figsize=(4.2 * count + 1.2, 4.2), dpi=110, squeeze=False)
+    vmin, vmax = _colour_range(values, rigid)
+    cmap = plt.get_cmap("inferno")
+    colours = cmap(np.clip((values - vmin) / (vmax - vmin), 0.0, 1.0))
+    colours[rigid] = matplotlib.colors.to_rgba(_RIGID_COLOUR)
+    fig, axes = plt.subplots(1, count, figsize=(4.2 * count + 1.2, 4.6), dpi=110, squeeze=False)
+    fig.subplots_adjust(left=0.06, right=0.86, bottom=0.12, top=0.82, wspace=0.3)
+    pad = float(side.max())
     names = "xyz"
-    for ax, level in zip(axes.flat, levels):
-        near = np.abs(pos[:, axis] - level) <= 0.5 * side
-        sc = ax.scatter(pos[near, plane[0]] * factor, pos[near, plane[1]] * factor, c=values[near], s=8,
-                        marker="s", linewidths=0, cmap="inferno", vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1)
+    for ax in axes.flat:
         ax.set_aspect("equal")
-        pad = float(side.max())
         ax.set_xlim((pos[:, plane[0]].min() - pad) * factor, (pos[:, plane[0]].max() + pad) * factor)
         ax.set_ylim((pos[:, plane[1]].min() - pad) * factor, (pos[:, plane[1]].max() + pad) * factor)
+    fig.canvas.draw()  # applies the equal aspect, so the data-to-point scale below is the saved one
+    for ax, level in zip(axes.flat, levels):
+        x0, x1 = ax.transData.transform([[0.0, 0.0], [1.0, 0.0]])[:, 0]
+        points_per_unit = (x1 - x0) * 72.0 / fig.dpi
+        near = np.abs(pos[:, axis] - level) <= 0.5 * side
+        ax.scatter(pos[near, plane[0]] * factor, pos[near, plane[1]] * factor, c=colours[near],
+                   s=(side[near] * factor * points_per_unit) ** 2, marker="s", linewidths=0)
         lf, lu = scale_for(abs(level), "m")
         ax.set_title(f"{names[axis]} = {level * lf:.3g} {lu} ({int(near.sum())} particles)", fontsize=10)
         ax.set_xlabel(f"{names[plane[0]]} ({lunit})")
         ax.set_ylabel(f"{names[plane[1]]} ({lunit})")
+    cax = fig.add_axes([0.89, 0.12, 0.015, 0.7])
+    mappable = matplotlib.cm.ScalarMappable(matplotlib.colors.Normalize(vmin, vmax), cmap)
     unit = unit_of(field)
-    fig.colorbar(sc, ax=list(axes.flat), shrink=0.85).set_label(clabel + (f" ({unit})" if unit else ""))
-    fig.suptitle(f"{clabel} at t = {snap.time:.4g} s, slices normal to {names[axis]}", fontsize=11)
+    fig.colorbar(mappable, cax=cax).set_label(clabel + (f" ({unit})" if unit else ""))
+    tf, tunit = scale_for(snap.time, "s")
+    fig.suptitle(f"{clabel} at t = {snap.time * tf:.4g} {tunit}, slices normal to {names[axis]}"
+                 + (" (rigid in grey)" if rigid.any() else ""), fontsize=11)
     if out_png is None:
         return fig
     fig.savefig(out_png)
@@ -119,49 +163,104 @@ def plot_slices(run, snap, field, out_png=None, count=3, axis=2):
 
 
 # Panels of the grouped series figure, in this order: (unit, panel title). Columns of other units
-# go to panels of their own after these.
+# go to panels of their own after these. Energies (J) are split further by what they measure
+# (_ENERGY_PANELS), so that the frictional work and heat are never crowded out by the mechanical terms.
 _SERIES_PANELS = [("J", "energy"), ("K", "temperature"), ("W", "heat rate"), ("m", "length"),
-                  ("m/s", "velocity"), ("kg m/s", "momentum"), ("m^2", "area"), ("s", "time step"),
-                  ("1", "counts")]
+                  ("m/s", "velocity"), ("kg m/s", "momentum"), ("m^2", "area"), ("m^3", "volume"),
+                  ("s", "time step"), ("1", "counts")]
+_ENERGY_PANELS = [("dissipated energy", ("damping_work", "plastic_dissipation", "energy_lost", "numerical_dissipation",
+                                         "contact_normal_work", "boundary_stop_work")),
+                  ("frictional work and heat", ("friction_work", "heat_delivered", "thermal_energy_change"))]
 # SI prefixes for axes: the largest with values >= 1 (so a 3e-6 m displacement reads 3 µm).
 _PREFIXES = [(1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, "")]
 _SCALABLE = {"m", "s", "J", "W"}  # units a prefix reads well on (not K, m/s or counts)
+_POWERS = {"m^2": 2, "m^3": 3}  # areas and volumes: the prefix of the length (mm^2 = 1e-6 m^2)
+_SUPERSCRIPT = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
 
 
 def scale_for(values, unit):
-    """(factor, label unit) so that values * factor reads with an SI prefix: (1e6, 'µm') for
-    micrometres, (1e9, 'ns') for nanoseconds; (1, unit) for units without prefixes."""
+    """(factor, label unit) so that values * factor reads well: an SI prefix where the unit takes one
+    ((1e6, 'µm') for micrometres, (1e9, 'ns') for nanoseconds, (1e6, 'mm²') for square millimetres),
+    else a power of ten in the label when the values are far from 1 ((1e8, '10⁻⁸ kg m/s')), so
+    that an axis never carries matplotlib's offset text ('1e-8' above it); (1, unit) otherwise."""
     finite = np.abs(np.asarray(values, dtype=float))
     finite = finite[np.isfinite(finite) & (finite > 0)]
-    if unit not in _SCALABLE or not finite.size:
-        return 1.0, unit
+    if not finite.size:
+        return 1.0, unit.replace("^2", "²").replace("^3", "³")
     top = float(finite.max())
-    for size, prefix in _PREFIXES:
-        if top < 1000 * size:
-            return 1.0 / size, prefix + unit
-    return 1.0, unit
+    power = _POWERS.get(unit, 1)
+    if unit in _SCALABLE or unit in _POWERS:
+        base = "m" if unit in _POWERS else unit
+        for size, prefix in _PREFIXES:
+            if top ** (1.0 / power) < 1000 * size:  # an area's or volume's side decides its prefix
+                label = prefix + base + ("" if power == 1 else "²" if power == 2 else "³")
+                return float("%.12g" % (1.0 / size ** power)), label
+        return 1.0, unit
+    if unit in ("K", "1", ""):  # temperatures and counts read as they are
+        return 1.0, unit
+    exponent = int(math.floor(math.log10(top)))
+    if -3 <= exponent <= 3:
+        return 1.0, unit
+    return 10.0 ** -exponent, f"10{str(exponent).translate(_SUPERSCRIPT)} {unit}"
 
 
-def series_groups(run, columns=None):
-    """The series columns grouped by unit into panels: [(title, unit, [column, ...]), ...]; `time`
-    and `step` are left out."""
+def _panel_of(name, unit):
+    if unit == "J":
+        for title, prefixes in _ENERGY_PANELS:
+            if name.split(".", 1)[0].startswith(prefixes):
+                return title
+    return dict(_SERIES_PANELS).get(unit, unit or "other")
+
+
+def series_groups(run, columns=None, max_lines=8):
+    """The series columns grouped into panels by unit (and energies by what they measure):
+    [(title, unit, [column, ...]), ...]. `time` and `step` are left out, and so are columns without
+    a single finite value (e.g. the hottest hot spot's size before there is one) and per-body or
+    per-pair columns equal to their total (``friction_work_first.base.block`` when there is one
+    pair). Totals (names without a '.') come first and are always shown (a panel with more than
+    `max_lines` of them continues in a second panel); per-body and per-pair columns fill a panel
+    up to `max_lines`, and the title says how many of them were left out."""
     s = run.series
     columns = [c for c in (columns or s.columns) if c not in ("time", "step")]
-    groups = {}
+    kept = []
     for c in columns:
-        groups.setdefault(s.unit_of(c), []).append(c)
-    order = [u for u, _ in _SERIES_PANELS if u in groups] + [u for u in groups if u not in dict(_SERIES_PANELS)]
-    titles = dict(_SERIES_PANELS)
-    return [(titles.get(u, u or "other"), u, groups[u]) for u in order]
+        values = np.asarray(s[c], dtype=float)
+        if not np.isfinite(values).any():
+            continue
+        total = c.split(".", 1)[0]
+        if "." in c and total in s.columns and np.array_equal(values, np.asarray(s[total], dtype=float), equal_nan=True):
+            continue
+        kept.append(c)
+    panels = {}  # (title, unit): [columns]
+    for c in kept:
+        unit = s.unit_of(c)
+        panels.setdefault((_panel_of(c, unit), unit), []).append(c)
+    order = [u for u, _ in _SERIES_PANELS]
+    keys = sorted(panels, key=lambda k: (order.index(k[1]) if k[1] in order else len(order), list(panels).index(k)))
+    out = []
+    for title, unit in keys:
+        totals = [c for c in panels[(title, unit)] if "." not in c]
+        parts = [c for c in panels[(title, unit)] if "." in c]
+        chunks = [totals[i:i + max_lines] for i in range(0, len(totals), max_lines)] or [[]]
+        room = max_lines - len(chunks[-1])
+        shown, left = parts[:room], len(parts) - min(room, len(parts))
+        chunks[-1] = chunks[-1] + shown
+        for i, chunk in enumerate(chunks):
+            name = title if i == 0 else f"{title} (continued)"
+            if left and i == len(chunks) - 1:
+                name += f" ({len(shown)} of {len(parts)} per body shown)"
+            out.append((name, unit, chunk))
+    return out
 
 
 def plot_series(run, columns=None, out_png=None, max_lines=8):
-    """The series against time, grouped by unit into a few panels (energies, temperatures, heat
-    rates, displacements, ...), each line named by its long_name, axes in SI units with a prefix where
-    it reads better (µm, ns, mJ). Returns the figure when out_png is None (notebooks), else saves
-    and closes it. A panel shows at most `max_lines` lines (the first columns of its unit)."""
+    """The series against time, grouped into a few panels (energies, dissipated energy, frictional
+    work and heat, temperatures, heat rates, lengths, ...; series_groups), each line named by its
+    long_name, axes in SI units with a prefix where it reads better (µm, ns, mJ, mm²). Returns the
+    figure when out_png is None (notebooks), else saves and closes it. A panel shows at most
+    `max_lines` per-body lines (series_groups)."""
     s = run.series
-    groups = series_groups(run, columns)
+    groups = series_groups(run, columns, max_lines)
     time = s["time"].astype(float)
     tf, tunit = scale_for(time, "s")
     k = max(len(groups), 1)
@@ -169,14 +268,15 @@ def plot_series(run, columns=None, out_png=None, max_lines=8):
     nrows = int(math.ceil(k / ncols))
     fig, axes = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 3.3 * nrows), dpi=110, squeeze=False)
     for ax, (title, unit, names) in zip(axes.flat, groups):
-        names = names[:max_lines]
         yf, yunit = scale_for(np.concatenate([s[n].astype(float) for n in names]), unit)
         for n in names:
             label = s.long_names.get(n, n.replace("_", " "))
             ax.plot(time * tf, s[n].astype(float) * yf, lw=1.3, label=label)
         ax.set_title(title, fontsize=11)
         ax.set_xlabel(f"time ({tunit})")
-        ax.set_ylabel(f"{title} ({yunit})" if yunit and yunit != "1" else title)
+        quantity = title.split(" (", 1)[0]
+        ax.set_ylabel(f"{quantity} ({yunit})" if yunit and yunit != "1" else quantity)
+        ax.ticklabel_format(axis="y", useOffset=False)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="best", frameon=False)
     for ax in list(axes.flat)[len(groups):]:

@@ -66,3 +66,27 @@ def decomposed_pair(workdir):
     subprocess.run([mpiexec, "-n", "2", "--oversubscribe", "--allow-run-as-root", _exe(), "run", scene, "-o", decomposed,
                     "--quiet"], check=True)
     return serial, decomposed
+
+
+# A small 3D run with a rigid material: a rubber cube thrown at 1 m/s onto a rigid floor, 0.2 ms
+# (one snapshot at the end; 1440 particles, 288 of them the floor's). For the 3D pictures.
+CUBE_3D = {
+    "units": "SI", "dimension": 3,
+    "grid": {"lo": [0, 0, 0], "hi": [0.02, 0.02, 0.02], "cell_size": 0.002},
+    "materials": {"rubber": {"type": "neo_hookean", "density": 1100, "youngs_modulus": 5e6, "poisson_ratio": 0.4},
+                  "floor": {"type": "rigid", "boundary": True, "velocity": [None, None, 0.0]}},
+    "bodies": [{"name": "cube", "material": "rubber", "velocity": [0.0, 0.0, -1.0],
+                "shape": {"type": "box", "lo": [0.004, 0.004, 0.004], "hi": [0.016, 0.016, 0.012]}},
+               {"name": "floor", "material": "floor",
+                "shape": {"type": "box", "lo": [0.004, 0.004, 0.002], "hi": [0.016, 0.016, 0.004]}}],
+    "run": {"end_time": 2e-4}, "output": {"snapshot_count": 1}}
+
+
+@pytest.fixture(scope="session")
+def run_file_3d(workdir):
+    import json
+    scene, out = os.path.join(workdir, "cube_3d.json"), os.path.join(workdir, "cube_3d.h5")
+    with open(scene, "w") as f:
+        json.dump(CUBE_3D, f)
+    subprocess.run([_exe(), "run", scene, "-o", out, "--quiet", "--threads", "1"], check=True)
+    return out

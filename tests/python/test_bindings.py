@@ -116,3 +116,29 @@ def test_observer_exception_ends_the_run(workdir):
         frictherm.run(frictherm.load_scene(SCENE).set("run.end_time", END), output=out, threads=1, observer=observer)
     part = [f for f in os.listdir(workdir) if f.startswith("stopped.h5")]
     assert part, os.listdir(workdir)
+
+
+def test_ctrl_c_interrupts_the_run_cleanly(workdir):
+    """Ctrl-C (a real SIGINT to this process, sent from the observer at step 30): the run's own handler
+    takes it, ends the run after that step with status `interrupted` and a complete file, and
+    frictherm.run raises KeyboardInterrupt saying where the run is; Python's handler is back after.
+    (Were the signal left to Python's handler, the observer itself would raise, and the file would
+    not say `interrupted`.)"""
+    import signal
+    out = os.path.join(workdir, "ctrl_c.h5")
+    seen = []
+
+    def observer(step):
+        seen.append(step.step)
+        if step.step == 30:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    before = signal.getsignal(signal.SIGINT)
+    with pytest.raises(KeyboardInterrupt) as e:
+        frictherm.run(frictherm.load_scene(SCENE).set("run.end_time", END), output=out, threads=1, observer=observer)
+    assert "holds the run so far" in str(e.value) and out in str(e.value)
+    assert signal.getsignal(signal.SIGINT) is before
+    assert seen[-1] in (30, 31) and seen == list(range(1, seen[-1] + 1))  # ends after the current step
+    with frictherm.open(out) as r:
+        assert r.status == "interrupted"
+        assert r.series["step"][-1] == seen[-1] and len(r.snapshots) >= 1

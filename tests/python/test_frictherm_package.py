@@ -223,19 +223,76 @@ def test_decomposed_run_snapshots_join_the_rank_files(decomposed_pair):
 
 
 def test_series_figure_groups_columns_by_unit_with_prefixed_axes(run, tmp_path):
-    """frictherm.plot (issue 33 item 4): the series figure has one panel per unit (not one per column),
-    every column but time/step in exactly one panel of its own unit, and axes read with SI prefixes
-    (3e-6 m as 3 µm, 2e-8 s as 20 ns); with no file name the figure is returned (notebooks)."""
+    """frictherm.plot (issue 33 item 4): the series figure has a few panels of one unit each (energies
+    split into mechanical, dissipated, frictional work and heat), every column but time/step in exactly
+    one panel of its own unit unless it has no finite value or repeats its total (a per-pair column
+    with one pair), no total left out, and axes read with SI prefixes (3e-6 m as 3 µm, 2e-8 s as
+    20 ns, 4e-4 m^2 as 400 mm²) or a power of ten in the label; with no file name the figure is
+    returned (notebooks)."""
     from frictherm.plot import plot_series, scale_for, series_groups
+    s = run.series
     groups = series_groups(run)
     placed = [c for _, _, names in groups for c in names]
-    assert sorted(placed) == sorted(c for c in run.series.columns if c not in ("time", "step"))
-    assert all(run.series.unit_of(c) == unit for _, unit, names in groups for c in names)
-    assert len(groups) == len({unit for _, unit, _ in groups}) < len(placed)
+    assert len(placed) == len(set(placed))
+    for c in s.columns:
+        if c in ("time", "step") or c in placed:
+            continue
+        values, total = np.asarray(s[c], dtype=float), c.split(".", 1)[0]
+        assert not np.isfinite(values).any() or (
+            "." in c and np.array_equal(values, np.asarray(s[total], dtype=float), equal_nan=True)), c
+    assert all(s.unit_of(c) == unit for _, unit, names in groups for c in names)
+    panel = {c: title for title, _, names in groups for c in names}
+    assert panel["kinetic_energy"] == "energy" and panel["energy_lost"] == "dissipated energy"
+    assert panel["friction_work_first"] == panel["heat_delivered"] == "frictional work and heat"
+    assert all(len(names) <= 8 for _, _, names in groups) and len(groups) < len(placed) / 2
     assert scale_for([0.0, 3e-6], "m") == (1e6, "µm")
     factor, unit = scale_for([0.0, 2e-8], "s")
     assert unit == "ns" and abs(factor * 2e-8 - 20.0) < 1e-12
+    assert scale_for([4e-4], "m^2") == (1e6, "mm²") and scale_for([2e-15], "m^3") == (1e18, "µm³")
+    factor, unit = scale_for([-2.2e-8, 1e-9], "kg m/s")
+    assert unit == "10⁻⁸ kg m/s" and abs(factor * 2.2e-8 - 2.2) < 1e-12
     assert scale_for([1.0, 300.0], "K") == (1.0, "K")  # no prefixes on temperatures
     fig = plot_series(run)
-    assert len([ax for ax in fig.axes if ax.get_visible()]) == len(groups)
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(visible) == len(groups)
+    fig.canvas.draw()  # sets the tick labels and offset texts
+    for ax in visible:  # no offset text ("1e-8" above an axis): the scale is in the label
+        assert ax.yaxis.get_offset_text().get_text() == "", (ax.get_title(), ax.yaxis.get_offset_text().get_text())
     assert plot_series(run, None, str(tmp_path / "s.png")) is None and (tmp_path / "s.png").stat().st_size > 10000
+
+
+def test_3d_run_drawn_as_slices_with_rigid_particles_apart(run_file_3d, tmp_path):
+    """frictherm.plot.plot_slices (issue 33 item 4: a 3D run drawn as slices): three panels normal to z,
+    each with the particles within half a spacing of its level drawn as squares of that spacing (not
+    dots: the marker side in points equals the particle side times the axes' points per metre), axes
+    in mm; the rigid floor's particles are grey and out of the colour scale, which spans exactly the
+    cube's speeds (the floor's 0 m/s would otherwise stretch it)."""
+    import matplotlib
+    from frictherm.fields import field_values
+    from frictherm.plot import particle_side, plot_particles, plot_slices, rigid_particles
+    with frictherm.open(run_file_3d) as run:
+        snap = run.snapshot("last")
+        rigid = rigid_particles(run, snap)
+        assert rigid.sum() == 288 and (~rigid).sum() == 1152  # the 12 x 12 x 2 floor, the 12 x 12 x 8 cube
+        speed, _ = field_values(snap, "speed")
+        assert speed[rigid].max() == 0.0 and speed[~rigid].min() > 0.0
+        fig = plot_slices(run, snap, "speed")
+        panels = [ax for ax in fig.axes if ax.get_xlabel() == "x (mm)"]
+        assert len(panels) == 3 and all(ax.get_ylabel() == "y (mm)" for ax in panels)
+        side = float(particle_side(run, snap).max())
+        for ax in panels:
+            (dots,) = ax.collections
+            x0, x1 = ax.transData.transform([[0.0, 0.0], [1.0, 0.0]])[:, 0]
+            expected = side * 1e3 * (x1 - x0) * 72.0 / fig.dpi  # points (axes in mm)
+            assert np.allclose(np.sqrt(dots.get_sizes()), expected, rtol=0.02), (np.sqrt(dots.get_sizes()[:3]), expected)
+        (bar,) = [ax for ax in fig.axes if ax not in panels]
+        lo, hi = bar.get_ylim()
+        assert lo == pytest.approx(speed[~rigid].min(), rel=1e-12) and hi == pytest.approx(speed[~rigid].max(), rel=1e-12)
+        grey = matplotlib.colors.to_rgba("0.78")
+        # Particle centres span z = 2.5 ... 11.5 mm: the lowest slice (z = 4 mm) meets the floor's top
+        # layer, the highest (z = 10 mm) the cube only.
+        greys = [sum(tuple(c) == grey for c in ax.collections[0].get_facecolors()) for ax in panels]
+        assert greys[0] > 0 and greys[-1] == 0, greys
+        matplotlib.pyplot.close(fig)
+        plot_particles(run, snap, "speed", str(tmp_path / "p.png"))
+        assert (tmp_path / "p.png").stat().st_size > 10000
