@@ -53,7 +53,9 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them, and the sums of
   // quick_bound(); each heat-holding particle's stencil kept (copied from the step's, or evaluated
   // here) when a refresh may follow.
-  const int threads = assembly_detail::explicit_handoff_threads(p.size());
+  // The gather's passes are shared between threads (node ranges balanced by stencil counts) from 2
+  // threads on: every sum gets the same terms in the same order, so the count changes no result.
+  const int threads = assembly_detail::assembly_threads(p.size());
   holds_heat_.assign(p.size(), 0);
   holding_ = 0;
   listed_.clear();
@@ -72,14 +74,28 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     heat_capacity_[k] = mc;
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;
   }
-  if (stencils_kept_) {
-    mechanics::parallel_for(threads, p.size(), [&](std::size_t k) {
-      if (!holds_heat_[k]) return;
+  split_.clear();  // one thread, unless split below
+  if (threads <= 1 && stencils_kept_) {
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k]) continue;
       if (step_stencils) kept_stencils[k] = step_stencils[k];
       else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
-    });
+    }
   }
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  const int reach = stencil_reach<Dim, Kernel::K>(indexer_);
+  if (threads > 1) {  // the stencils kept and each one's first node, then the threads' node ranges
+    first_node_.assign(p.size(), static_cast<int>(n_nodes));  // past the grid: in no range
+    mechanics::parallel_for(threads, p.size(), [&](std::size_t k) {
+      if (!holds_heat_[k]) return;
+      if (stencils_kept_) {
+        if (step_stencils) kept_stencils[k] = step_stencils[k];
+        else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
+      }
+      first_node_[k] = node_span(stencils[k], indexer_)[0];
+    });
+    split_nodes<Kernel>(threads, static_cast<int>(n_nodes));
+  }
   if (threads <= 1) {  // the same sums without the range checks
     // The three sums of a node side by side (one or two cache lines per stencil row instead of three
     // to six: the three grid arrays together outgrow L2 in 3D), copied out after the pass.
@@ -103,20 +119,23 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       mct_[i] = sums[3 * i + 1];
       quick_sum_[i] = sums[3 * i + 2];
     }
-  } else
-  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
-    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-    if (!r.meets(node_span(st, indexer_))) return;
-    const double mc = heat_capacity_[k];
-    const double mct = mc * p.temperature[k];
-    const double quick = quick_weight(st, conductance_[k]);
-    for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
-      if (!r.holds(i)) return;
-      sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
-      mct_[static_cast<std::size_t>(i)] += mct * w;
-      quick_sum_[static_cast<std::size_t>(i)] += quick * g_l1<Dim>(gx, gy, gz);
+  } else {
+    double* const grid_mass = sys.grid_mass.data();
+    double* const mct = mct_.data();
+    double* const quick_sum = quick_sum_.data();
+    scatter_by_split<char>(split_, first_node_.data(), reach, listed_, [&](std::size_t k, const NodeRange& r, bool inside, char&) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      const double mc = heat_capacity_[k];
+      const double mct_p = mc * p.temperature[k];
+      const double quick = quick_weight(st, conductance_[k]);
+      for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+        if (!inside && !r.holds(i)) return;
+        grid_mass[i] += mc * w;
+        mct[i] += mct_p * w;
+        quick_sum[i] += quick * g_l1<Dim>(gx, gy, gz);
+      });
     });
-  });
+  }
   if (!(sys.particle_heat_capacity > 0.0))
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
 
@@ -199,10 +218,17 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (particle_scratch_[k] != 0.0) listed_.push_back(k);
-  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+  scatter_by_split<Expanded>(split_, first_node_.data(), reach, listed_, [&](std::size_t k, const NodeRange& r, bool inside, Expanded& e) {
     const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-    if (!r.meets(node_span(st, indexer_))) return;
     const int what = static_cast<int>(particle_scratch_[k]);
+    if (inside && what == 2 && whole_[k]) {  // the stencil walked directly, as on one thread: the same sums
+      double lo, hi, s_kept;
+      mechanics::Vec<Dim> grad;
+      look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
+      grad *= conductance_[k];
+      scatter_whole(st, sys.unknown, grad, force_.data());
+      return;
+    }
     if (what & 2) expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
     else expand<Kernel, false>(st, sys.unknown, e);
     if (what & 1) add_quick_lumping(st, conductance_[k], sys, e, 1.0, &r);
@@ -216,6 +242,34 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   });
   flux_temperature_ = sys.temperature;  // quiet_ and force_ hold for these temperatures
   first_force_ready_ = true;
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::split_nodes(int threads, int nodes) {
+  // Cuts between rows of the slowest axis at the stencils' middle rows' quantiles: each range holds
+  // ~as many stencils; only those across a cut (K − 1 rows of nodes) are walked by two threads.
+  split_.clear();
+  if (threads <= 1) return;
+  const int row = indexer_.stride[Dim - 1];
+  const int rows = nodes / row + Kernel::K;
+  split_rows_.assign(static_cast<std::size_t>(rows), 0);
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < first_node_.size(); ++k) {
+    if (!holds_heat_[k]) continue;
+    ++split_rows_[static_cast<std::size_t>(first_node_[k] / row + (Kernel::K - 1) / 2)];
+    ++total;
+  }
+  split_.push_back(0);
+  std::size_t below = 0;
+  int r = 0;
+  for (int t = 1; t < threads; ++t) {
+    const std::size_t want = total * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+    while (r < rows && below + static_cast<std::size_t>(split_rows_[static_cast<std::size_t>(r)]) <= want)
+      below += static_cast<std::size_t>(split_rows_[static_cast<std::size_t>(r++)]);
+    split_.push_back(std::min(nodes, std::max(split_.back(), r * row)));
+  }
+  split_.push_back(nodes);
 }
 
 template <int Dim>
