@@ -39,7 +39,9 @@ inline int assembly_threads(std::size_t particles) {
 /// expand every stencil and walk the particle list once per thread's node range: on the 1 mm twin
 /// (16,400 particles, 2 threads) the shared map back cost 5x the CPU of the one-thread one and the
 /// whole hand-off 780 us/step of wall time against 480 on one thread (perf, issue 35). Both give the
-/// same numbers (the same sums in particle order), so the count changes no result.
+/// same numbers (the same sums in particle order), so the count changes no result. The node-level
+/// operator's assembly after a gather is the exception: it runs on assembly_threads with node ranges
+/// cut by stencil counts (ExplicitConduction::split_nodes), which pays on 2 threads (handoff-s57).
 inline constexpr int kHandoffMinThreads = 3;
 inline int explicit_handoff_threads(std::size_t particles) {
   const int threads = assembly_threads(particles);

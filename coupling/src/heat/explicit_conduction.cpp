@@ -53,9 +53,7 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   // Pass 1: M_i and M_i T_i (eq. 38), in particle order as assemble_thermal sums them, and the sums of
   // quick_bound(); each heat-holding particle's stencil kept (copied from the step's, or evaluated
   // here) when a refresh may follow.
-  // The gather's passes are shared between threads (node ranges balanced by stencil counts) from 2
-  // threads on: every sum gets the same terms in the same order, so the count changes no result.
-  const int threads = assembly_detail::assembly_threads(p.size());
+  const int threads = assembly_detail::explicit_handoff_threads(p.size());
   holds_heat_.assign(p.size(), 0);
   holding_ = 0;
   listed_.clear();
@@ -194,6 +192,8 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     }
     flux_temperature_ = sys.temperature;
     first_force_ready_ = true;
+    // The node ranges of the node-level operator's assembly on 2 threads (assemble_node_operator).
+    split_nodes<Kernel>(assembly_detail::assembly_threads(p.size()), static_cast<int>(n_nodes));
     return;
   }
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
