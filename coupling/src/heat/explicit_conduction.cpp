@@ -193,7 +193,8 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     flux_temperature_ = sys.temperature;
     first_force_ready_ = true;
     // The node ranges of the node-level operator's assembly on 2 threads (assemble_node_operator).
-    split_nodes<Kernel>(assembly_detail::assembly_threads(p.size()), static_cast<int>(n_nodes));
+    if (stencils_kept_ && node_operator_on_)
+      split_nodes<Kernel>(assembly_detail::assembly_threads(p.size()), static_cast<int>(n_nodes));
     return;
   }
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the

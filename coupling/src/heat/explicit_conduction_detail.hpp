@@ -283,13 +283,15 @@ void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_
 // As scatter_by_node_ranges with the node ranges of `split` (thread t: [split[t], split[t + 1]), cut
 // by stencil counts: ExplicitConduction::split_nodes) and each stencil's grid nodes known as
 // [first[k], first[k] + reach] without reading it: body(k, range, inside, scratch) for the particles
-// that meet the range, inside when all of its nodes are in it. A smaller team than asked for takes
-// the ranges t, t + team, ... in turn: the same sums.
+// that meet the range, inside when all of its nodes are in it. On fewer threads than ranges (the
+// governor's count now) each thread takes the ranges t, t + team, ... in turn: the same sums.
+inline int split_team(int ranges) { return std::min(ranges, omp_get_max_threads()); }
+
 template <class Scratch, class Body>
 void scatter_by_split(const std::vector<int>& split, const int* first, int reach, const std::vector<std::size_t>& list,
                       Body&& body) {
   const int ranges = static_cast<int>(split.size()) - 1;
-  mechanics::parallel_region(ranges, [&] {
+  mechanics::parallel_region(split_team(ranges), [&] {
     Scratch scratch{};
     const int team = omp_get_num_threads();
     for (int t = omp_get_thread_num(); t < ranges; t += team) {

@@ -74,7 +74,7 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
     const int ranges = static_cast<int>(split_.size()) - 1;
     const int reach = stencil_reach<Dim, Kernel::K>(indexer_);
     const auto unknowns_before = [&](int g) { return static_cast<std::size_t>(g - dropped_before_[static_cast<std::size_t>(g)]); };
-    mechanics::parallel_region(ranges, [&] {
+    mechanics::parallel_region(split_team(ranges), [&] {
       Expanded e{};
       const int team = omp_get_num_threads();
       for (int t = omp_get_thread_num(); t < ranges; t += team) {
