@@ -253,14 +253,6 @@ inline std::array<int, 2> node_span(const mechanics::Stencil<Dim, Kernel>& st, c
 
 using assembly_detail::NodeRange;
 
-// node_span's last − first: the same for every stencil of a kernel.
-template <int Dim, int K>
-inline int stencil_reach(const mechanics::NodeIndexer<Dim>& ix) {
-  int reach = 0;
-  for (int d = 0; d < Dim; ++d) reach += (K - 1) * ix.stride[d];
-  return reach;
-}
-
 // body(k, range, scratch) for every particle k of `list` in order, on `threads` threads, each with
 // its own range of grid nodes (all of them on one thread) and its own Scratch: a scatter adds only
 // into the nodes (or the unknowns at the nodes) of its range, so each sum gets the same terms in the
@@ -280,30 +272,9 @@ void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_
   });
 }
 
-// As scatter_by_node_ranges with the node ranges of `split` (thread t: [split[t], split[t + 1]), cut
-// by stencil counts: ExplicitConduction::split_nodes) and each stencil's grid nodes known as
-// [first[k], first[k] + reach] without reading it: body(k, range, inside, scratch) for the particles
-// that meet the range, inside when all of its nodes are in it. On fewer threads than ranges (the
-// governor's count now) each thread takes the ranges t, t + team, ... in turn: the same sums.
-inline int split_team(int ranges) { return std::min(ranges, omp_get_max_threads()); }
-
-template <class Scratch, class Body>
-void scatter_by_split(const std::vector<int>& split, const int* first, int reach, const std::vector<std::size_t>& list,
-                      Body&& body) {
-  const int ranges = static_cast<int>(split.size()) - 1;
-  mechanics::parallel_region(split_team(ranges), [&] {
-    Scratch scratch{};
-    const int team = omp_get_num_threads();
-    for (int t = omp_get_thread_num(); t < ranges; t += team) {
-      const NodeRange r{split[static_cast<std::size_t>(t)], split[static_cast<std::size_t>(t) + 1]};
-      for (std::size_t k : list) {
-        const int f = first[k];
-        if (f >= r.hi || f + reach < r.lo) continue;
-        body(k, r, f >= r.lo && f + reach < r.hi, scratch);
-      }
-    }
-  });
-}
+using assembly_detail::scatter_by_split;
+using assembly_detail::split_team;
+using assembly_detail::stencil_reach;
 
 // Relative spread of a particle's nodal temperatures below which they are taken as equal in the
 // sub-steps: 256 ε, the order of the re-projection's own round-off (T_i = Σ m C T S / Σ m C S over

@@ -119,6 +119,34 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
   node_operator_ready_ = true;
 }
 
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::split_nodes(int threads, int nodes) {
+  // Cuts between rows of the slowest axis at the stencils' middle rows' quantiles: each range holds
+  // ~as many stencils; only those across a cut (K − 1 rows of nodes) are walked by two threads.
+  split_.clear();
+  if (threads <= 1) return;
+  const int row = indexer_.stride[Dim - 1];
+  const int rows = nodes / row + Kernel::K;
+  split_rows_.assign(static_cast<std::size_t>(rows), 0);
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < first_node_.size(); ++k) {
+    if (!holds_heat_[k]) continue;
+    ++split_rows_[static_cast<std::size_t>(first_node_[k] / row + (Kernel::K - 1) / 2)];
+    ++total;
+  }
+  split_.push_back(0);
+  std::size_t below = 0;
+  int r = 0;
+  for (int t = 1; t < threads; ++t) {
+    const std::size_t want = total * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+    while (r < rows && below + static_cast<std::size_t>(split_rows_[static_cast<std::size_t>(r)]) <= want)
+      below += static_cast<std::size_t>(split_rows_[static_cast<std::size_t>(r++)]);
+    split_.push_back(std::min(nodes, std::max(split_.back(), r * row)));
+  }
+  split_.push_back(nodes);
+}
+
 namespace {
 
 // Σ_j K_ij (T_j − T_i) over the compacted slots [s, end) of row i in slot order, a pair at temperatures
@@ -208,7 +236,10 @@ void ExplicitConduction<Dim>::node_operator_force(const NodalThermalSystem& sys,
   template void ExplicitConduction<D>::assemble_node_operator<mechanics::LinearKernel>(const NodalThermalSystem&, int); \
   template void ExplicitConduction<D>::assemble_node_operator<mechanics::UGIMPKernel>(const NodalThermalSystem&, int);  \
   template void ExplicitConduction<D>::assemble_node_operator<mechanics::QuadraticBSplineKernel>(                  \
-      const NodalThermalSystem&, int);
+      const NodalThermalSystem&, int);                                                                            \
+  template void ExplicitConduction<D>::split_nodes<mechanics::LinearKernel>(int, int);                             \
+  template void ExplicitConduction<D>::split_nodes<mechanics::UGIMPKernel>(int, int);                              \
+  template void ExplicitConduction<D>::split_nodes<mechanics::QuadraticBSplineKernel>(int, int);
 FRICTHERM_INSTANTIATE_NODE_OPERATOR(2)
 FRICTHERM_INSTANTIATE_NODE_OPERATOR(3)
 #undef FRICTHERM_INSTANTIATE_NODE_OPERATOR
