@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -352,5 +355,55 @@ TEST(MatrixFreeConduction, AutoPicksByWindowLength) {
     EXPECT_EQ(cp.books().matrix_free_windows, dt < 1.0 ? 5 : 0);
     EXPECT_EQ(cp.integrator().name(), "cvode_bdf");
     EXPECT_LT(std::fabs(fc::particle_thermal_energy(p, options("auto", 4).materials) - E0), 1e-12 * E0);
+  }
+}
+
+// The node-level operator's assembly runs on 2+ threads with node ranges cut by stencil counts
+// (split_nodes; on 3+ the gather too), each thread adding only into its own rows in particle order: a
+// slider of ~8,000 particles refreshed and re-gathered as it moves gives the same temperatures and
+// books bit for bit on 1, 2 and 3 threads, and with the count changed every window (the governor:
+// ranges cut for more threads than the assembly then gets) (handoff-s57).
+TEST(MatrixFreeConduction, SameNumbersOnOneTwoAndThreeThreads) {
+  auto T = [](const fm::Vec<2>& x) { return 300.0 + 20.0 * std::sin(300.0 * x[0]) * std::cos(500.0 * x[1]); };
+  fm::Particles<2> start;
+  fill_box<2>(start, {0.002, 0.002}, {0.058, 0.014}, 1e-3, 3, kRho, 0, T);  // base
+  const std::size_t first_moving = start.size();
+  fill_box<2>(start, {0.010, 0.014}, {0.030, 0.024}, 1e-3, 3, kRho, 0, T);  // slider
+  ASSERT_GE(start.size(), 6000u);
+  const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {60, 30});
+  const int threads_before = omp_get_max_threads();
+  std::vector<double> temperature[4];
+  long gathers[4], refreshes[4];
+  for (int threads = 1; threads <= 4; ++threads) {  // 4: 3, 1, 2, 3, 1, 2, ... by window
+    omp_set_num_threads(std::min(threads, 3));
+    fm::Particles<2> p = start;
+    fc::CouplerOptions opt = options("forward_euler", 4);
+    opt.reuse_distance = 0.01;
+    opt.matrix_free_node_operator = true;
+    fc::Coupler<2> cp(grid, fm::ShapeKind::ugimp, opt);
+    cp.start(p, 0.0);
+    std::vector<double> w(grid.node_count(), 0.0);
+    for (long k = 1; k <= 60; ++k) {
+      if (threads == 4) omp_set_num_threads(static_cast<int>(k % 3) + 1);
+      std::fill(w.begin(), w.end(), 0.0);
+      for (int i = 10 + static_cast<int>(k % 20); i < 31; i += 5) w[static_cast<std::size_t>(grid.node_index({i, 14}))] = 1e-3;
+      cp.after_step(p, w, 0.01 * static_cast<double>(k));
+      for (std::size_t i = first_moving; i < p.size(); ++i) p.position[i][0] += 3.3e-6;  // a refresh every ~3 windows
+    }
+    temperature[threads - 1].assign(p.temperature.begin(), p.temperature.end());
+    gathers[threads - 1] = cp.books().matrix_free_gathers;
+    refreshes[threads - 1] = cp.books().matrix_free_refreshes;
+    if (threads == 1) {
+      EXPECT_GT(cp.books().matrix_free_windows, 50);
+      EXPECT_GT(refreshes[0], 5);
+      EXPECT_GT(std::fabs(cp.particle_energy_change(p)), 0.0);
+    }
+  }
+  omp_set_num_threads(threads_before);
+  for (int t = 1; t < 4; ++t) {
+    SCOPED_TRACE(t + 1);
+    EXPECT_EQ(temperature[t], temperature[0]);
+    EXPECT_EQ(gathers[t], gathers[0]);
+    EXPECT_EQ(refreshes[t], refreshes[0]);
   }
 }

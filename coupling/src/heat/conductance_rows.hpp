@@ -1,6 +1,7 @@
 #pragma once
 // Internal to thermal_assembly.cpp: the conductance matrix K in CSR from the assembly's per-row sums,
-// with its rows shared between threads, and the thread ranges of the assembly's passes.
+// with its rows shared between threads, and the thread ranges of the assembly's passes and of the
+// explicit hand-off's split passes (scatter_by_split).
 #include <frictherm/mechanics/grid.hpp>
 #include <frictherm/mechanics/thread_partition.hpp>
 #include <frictherm/thermal/problem.hpp>
@@ -39,11 +40,46 @@ inline int assembly_threads(std::size_t particles) {
 /// expand every stencil and walk the particle list once per thread's node range: on the 1 mm twin
 /// (16,400 particles, 2 threads) the shared map back cost 5x the CPU of the one-thread one and the
 /// whole hand-off 780 us/step of wall time against 480 on one thread (perf, issue 35). Both give the
-/// same numbers (the same sums in particle order), so the count changes no result.
+/// same numbers (the same sums in particle order), so the count changes no result. The node-level
+/// operator's assembly after a gather is the exception: it runs on assembly_threads with node ranges
+/// cut by stencil counts (ExplicitConduction::split_nodes), which pays on 2 threads (handoff-s57).
 inline constexpr int kHandoffMinThreads = 3;
 inline int explicit_handoff_threads(std::size_t particles) {
   const int threads = assembly_threads(particles);
   return threads >= kHandoffMinThreads ? threads : 1;
+}
+
+// node_span's last − first: the same for every stencil of a kernel.
+template <int Dim, int K>
+inline int stencil_reach(const mechanics::NodeIndexer<Dim>& ix) {
+  int reach = 0;
+  for (int d = 0; d < Dim; ++d) reach += (K - 1) * ix.stride[d];
+  return reach;
+}
+
+// As explicit_detail::scatter_by_node_ranges with the node ranges of `split` (thread t:
+// [split[t], split[t + 1]), cut by stencil counts: ExplicitConduction::split_nodes) and each stencil's
+// grid nodes known as [first[k], first[k] + reach] without reading it: body(k, range, inside, scratch)
+// for the particles that meet the range, inside when all of its nodes are in it. On fewer threads than ranges (the
+// governor's count now) each thread takes the ranges t, t + team, ... in turn: the same sums.
+inline int split_team(int ranges) { return std::min(ranges, omp_get_max_threads()); }
+
+template <class Scratch, class Body>
+void scatter_by_split(const std::vector<int>& split, const int* first, int reach, const std::vector<std::size_t>& list,
+                      Body&& body) {
+  const int ranges = static_cast<int>(split.size()) - 1;
+  mechanics::parallel_region(split_team(ranges), [&] {
+    Scratch scratch{};
+    const int team = omp_get_num_threads();
+    for (int t = omp_get_thread_num(); t < ranges; t += team) {
+      const NodeRange r{split[static_cast<std::size_t>(t)], split[static_cast<std::size_t>(t) + 1]};
+      for (std::size_t k : list) {
+        const int f = first[k];
+        if (f >= r.hi || f + reach < r.lo) continue;
+        body(k, r, f >= r.lo && f + reach < r.hi, scratch);
+      }
+    }
+  });
 }
 
 /// K's sparsity pattern of the last assembly (per dimension and kernel, per calling thread): the

@@ -72,14 +72,28 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     heat_capacity_[k] = mc;
     conductance_[k] = m.conductivity > 0.0 ? p.volume[k] * m.conductivity : 0.0;
   }
-  if (stencils_kept_) {
-    mechanics::parallel_for(threads, p.size(), [&](std::size_t k) {
-      if (!holds_heat_[k]) return;
+  split_.clear();  // one thread, unless split below
+  if (threads <= 1 && stencils_kept_) {
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!holds_heat_[k]) continue;
       if (step_stencils) kept_stencils[k] = step_stencils[k];
       else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
-    });
+    }
   }
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
+  const int reach = stencil_reach<Dim, Kernel::K>(indexer_);
+  if (threads > 1) {  // the stencils kept and each one's first node, then the threads' node ranges
+    first_node_.assign(p.size(), static_cast<int>(n_nodes));  // past the grid: in no range
+    mechanics::parallel_for(threads, p.size(), [&](std::size_t k) {
+      if (!holds_heat_[k]) return;
+      if (stencils_kept_) {
+        if (step_stencils) kept_stencils[k] = step_stencils[k];
+        else kept_stencils[k].evaluate(grid, p.position[k], p.half_size[k]);
+      }
+      first_node_[k] = node_span(stencils[k], indexer_)[0];
+    });
+    split_nodes<Kernel>(threads, static_cast<int>(n_nodes));
+  }
   if (threads <= 1) {  // the same sums without the range checks
     // The three sums of a node side by side (one or two cache lines per stencil row instead of three
     // to six: the three grid arrays together outgrow L2 in 3D), copied out after the pass.
@@ -103,20 +117,23 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
       mct_[i] = sums[3 * i + 1];
       quick_sum_[i] = sums[3 * i + 2];
     }
-  } else
-  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded&) {
-    const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-    if (!r.meets(node_span(st, indexer_))) return;
-    const double mc = heat_capacity_[k];
-    const double mct = mc * p.temperature[k];
-    const double quick = quick_weight(st, conductance_[k]);
-    for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
-      if (!r.holds(i)) return;
-      sys.grid_mass[static_cast<std::size_t>(i)] += mc * w;
-      mct_[static_cast<std::size_t>(i)] += mct * w;
-      quick_sum_[static_cast<std::size_t>(i)] += quick * g_l1<Dim>(gx, gy, gz);
+  } else {
+    double* const grid_mass = sys.grid_mass.data();
+    double* const mct = mct_.data();
+    double* const quick_sum = quick_sum_.data();
+    scatter_by_split<char>(split_, first_node_.data(), reach, listed_, [&](std::size_t k, const NodeRange& r, bool inside, char&) {
+      const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+      const double mc = heat_capacity_[k];
+      const double mct_p = mc * p.temperature[k];
+      const double quick = quick_weight(st, conductance_[k]);
+      for_each_node(st, indexer_, [&](int i, double w, double gx, double gy, double gz) {
+        if (!inside && !r.holds(i)) return;
+        grid_mass[i] += mc * w;
+        mct[i] += mct_p * w;
+        quick_sum[i] += quick * g_l1<Dim>(gx, gy, gz);
+      });
     });
-  });
+  }
   if (!(sys.particle_heat_capacity > 0.0))
     throw std::invalid_argument("thermal assembly: no particle of a material with thermal properties");
 
@@ -175,6 +192,9 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
     }
     flux_temperature_ = sys.temperature;
     first_force_ready_ = true;
+    // The node ranges of the node-level operator's assembly on 2 threads (assemble_node_operator).
+    if (stencils_kept_ && node_operator_on_)
+      split_nodes<Kernel>(assembly_detail::assembly_threads(p.size()), static_cast<int>(n_nodes));
     return;
   }
   // Each particle's look (threads by particles), then the lumping terms of quick_bound() and the
@@ -199,10 +219,17 @@ void ExplicitConduction<Dim>::gather_with(const mechanics::Grid<Dim>& grid, cons
   listed_.clear();
   for (std::size_t k = 0; k < p.size(); ++k)
     if (particle_scratch_[k] != 0.0) listed_.push_back(k);
-  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(n_nodes), listed_, [&](std::size_t k, const NodeRange& r, Expanded& e) {
+  scatter_by_split<Expanded>(split_, first_node_.data(), reach, listed_, [&](std::size_t k, const NodeRange& r, bool inside, Expanded& e) {
     const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-    if (!r.meets(node_span(st, indexer_))) return;
     const int what = static_cast<int>(particle_scratch_[k]);
+    if (inside && what == 2 && whole_[k]) {  // the stencil walked directly, as on one thread: the same sums
+      double lo, hi, s_kept;
+      mechanics::Vec<Dim> grad;
+      look_whole(st, sys.unknown, sys.temperature.data(), lo, hi, s_kept, grad);
+      grad *= conductance_[k];
+      scatter_whole(st, sys.unknown, grad, force_.data());
+      return;
+    }
     if (what & 2) expand<Kernel, true>(st, sys.unknown, e);  // S as expand<false> gives it
     else expand<Kernel, false>(st, sys.unknown, e);
     if (what & 1) add_quick_lumping(st, conductance_[k], sys, e, 1.0, &r);

@@ -272,6 +272,10 @@ void scatter_by_node_ranges(int threads, int nodes, const std::vector<std::size_
   });
 }
 
+using assembly_detail::scatter_by_split;
+using assembly_detail::split_team;
+using assembly_detail::stencil_reach;
+
 // Relative spread of a particle's nodal temperatures below which they are taken as equal in the
 // sub-steps: 256 ε, the order of the re-projection's own round-off (T_i = Σ m C T S / Σ m C S over
 // ~10–30 terms). At 300 K it is 1.7e-11 K.

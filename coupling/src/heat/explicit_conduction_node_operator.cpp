@@ -15,11 +15,6 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
   out_of_k_.clear();
   out_of_k_stencils_.clear();  // the walks kept for particles out of K (out_of_k_stencil)
   out_of_k_slot_.assign(holds_heat_.size(), -1);
-  node_k_.assign(n * offsets, 0.0);
-  node_col_.resize(n * offsets);
-  for (std::size_t u = 0; u < n; ++u)
-    std::fill(node_col_.begin() + static_cast<std::ptrdiff_t>(u * offsets),
-              node_col_.begin() + static_cast<std::ptrdiff_t>((u + 1) * offsets), static_cast<int>(u));
   const mechanics::Stencil<Dim, Kernel>* stencils = window_stencils<Kernel>();
   listed_.clear();
   in_node_k_.assign(holds_heat_.size(), 0);
@@ -29,32 +24,127 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
       in_node_k_[k] = 1;
     }
   node_force_.setZero(static_cast<Eigen::Index>(n));
-  // Each thread adds only into the rows of its grid nodes, over the particles in order: every K_ij
-  // gets the same terms in the same order on any number of threads.
-  scatter_by_node_ranges<Expanded>(threads, static_cast<int>(sys.unknown.size()), listed_,
-                                   [&](std::size_t k, const NodeRange& r, Expanded& e) {
-                                     const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
-                                     if (!r.meets(node_span(st, indexer_))) return;
-                                     add_to_node_operator(st, conductance_[k], sys.unknown, 1.0, e, &r);
-                                   });
-  // Compacted to the slots a particle joined (j ≠ i): the others add exactly 0 to f_i (T_i − T_i = 0,
-  // quiet), and the sum of the rest keeps the slot order, so f_i keeps its bits.
+  node_k_.resize(n * offsets);
+  node_col_.resize(n * offsets);
+  node_pos_.resize(n * offsets);
   row_start_.resize(n + 1);
-  node_pos_.assign(n * offsets, -1);
-  node_kc_.clear();
-  node_cc_.clear();
   row_start_[0] = 0;
-  for (std::size_t u = 0; u < n; ++u) {
-    for (std::size_t s = u * offsets; s < (u + 1) * offsets; ++s)
-      if (node_col_[s] != static_cast<int>(u)) {
+  // Rows [u0, u1): empty (K_ij = 0, j = i); then, after the scatter, each row's count of the slots a
+  // particle joined (j ≠ i) at row_start_[u + 1]; then, from the row starts, the compacted rows: the
+  // others add exactly 0 to f_i (T_i − T_i = 0, quiet), and the sum of the rest keeps the slot order,
+  // so f_i keeps its bits.
+  const auto clear_rows = [&](std::size_t u0, std::size_t u1) {
+    std::fill(node_k_.begin() + static_cast<std::ptrdiff_t>(u0 * offsets),
+              node_k_.begin() + static_cast<std::ptrdiff_t>(u1 * offsets), 0.0);
+    for (std::size_t u = u0; u < u1; ++u)
+      std::fill(node_col_.begin() + static_cast<std::ptrdiff_t>(u * offsets),
+                node_col_.begin() + static_cast<std::ptrdiff_t>((u + 1) * offsets), static_cast<int>(u));
+  };
+  const auto count_rows = [&](std::size_t u0, std::size_t u1) {
+    for (std::size_t u = u0; u < u1; ++u) {
+      int joined = 0;
+      for (std::size_t s = u * offsets; s < (u + 1) * offsets; ++s) joined += node_col_[s] != static_cast<int>(u);
+      row_start_[u + 1] = joined;
+    }
+  };
+  const auto compact_rows = [&](std::size_t u0, std::size_t u1) {
+    for (std::size_t u = u0; u < u1; ++u) {
+      int at = row_start_[u];
+      for (std::size_t s = u * offsets; s < (u + 1) * offsets; ++s) {
+        if (node_col_[s] == static_cast<int>(u)) {
+          node_pos_[s] = -1;
+          continue;
+        }
+        node_pos_[s] = at;
+        node_kc_[static_cast<std::size_t>(at)] = node_k_[s];
+        node_cc_[static_cast<std::size_t>(at++)] = node_col_[s];
+      }
+    }
+  };
+  const auto sum_starts = [&] {
+    for (std::size_t u = 0; u < n; ++u) row_start_[u + 1] += row_start_[u];
+    node_kc_.resize(static_cast<std::size_t>(row_start_[n]));
+    node_cc_.resize(static_cast<std::size_t>(row_start_[n]));
+  };
+  // Each thread adds only into the rows of its grid nodes, over the particles in order: every K_ij
+  // gets the same terms in the same order on any number of threads. The gather's node ranges when it
+  // split them (first_node_ kept up to date by refresh; a range's unknowns are those of its grid
+  // nodes, numbered in grid-node order), else one thread.
+  if (split_.size() > 2) {
+    const int ranges = static_cast<int>(split_.size()) - 1;
+    const int reach = stencil_reach<Dim, Kernel::K>(indexer_);
+    const auto unknowns_before = [&](int g) { return static_cast<std::size_t>(g - dropped_before_[static_cast<std::size_t>(g)]); };
+    mechanics::parallel_region(split_team(ranges), [&] {
+      Expanded e{};
+      const int team = omp_get_num_threads();
+      for (int t = omp_get_thread_num(); t < ranges; t += team) {
+        const NodeRange r{split_[static_cast<std::size_t>(t)], split_[static_cast<std::size_t>(t) + 1]};
+        const std::size_t u0 = unknowns_before(r.lo), u1 = unknowns_before(r.hi);
+        clear_rows(u0, u1);
+        for (std::size_t k : listed_) {
+          const int f = first_node_[k];
+          if (f >= r.hi || f + reach < r.lo) continue;
+          add_to_node_operator(stencils[k], conductance_[k], sys.unknown, 1.0, e, &r);
+        }
+        count_rows(u0, u1);
+      }
+#pragma omp barrier
+#pragma omp single
+      sum_starts();  // (implicit barrier)
+      for (int t = omp_get_thread_num(); t < ranges; t += team)
+        compact_rows(unknowns_before(split_[static_cast<std::size_t>(t)]), unknowns_before(split_[static_cast<std::size_t>(t) + 1]));
+    });
+  } else {
+    clear_rows(0, n);
+    scatter_by_node_ranges<Expanded>(threads, static_cast<int>(sys.unknown.size()), listed_,
+                                     [&](std::size_t k, const NodeRange& r, Expanded& e) {
+                                       const mechanics::Stencil<Dim, Kernel>& st = stencils[k];
+                                       if (!r.meets(node_span(st, indexer_))) return;
+                                       add_to_node_operator(st, conductance_[k], sys.unknown, 1.0, e, &r);
+                                     });
+    node_kc_.clear();  // compacted in one pass
+    node_cc_.clear();
+    for (std::size_t u = 0; u < n; ++u) {
+      for (std::size_t s = u * offsets; s < (u + 1) * offsets; ++s) {
+        node_pos_[s] = -1;
+        if (node_col_[s] == static_cast<int>(u)) continue;
         node_pos_[s] = static_cast<int>(node_kc_.size());
         node_kc_.push_back(node_k_[s]);
         node_cc_.push_back(node_col_[s]);
       }
-    row_start_[u + 1] = static_cast<int>(node_kc_.size());
+      row_start_[u + 1] = static_cast<int>(node_kc_.size());
+    }
   }
   node_compact_ = true;
   node_operator_ready_ = true;
+}
+
+template <int Dim>
+template <class Kernel>
+void ExplicitConduction<Dim>::split_nodes(int threads, int nodes) {
+  // Cuts between rows of the slowest axis at the stencils' middle rows' quantiles: each range holds
+  // ~as many stencils; only those across a cut (K − 1 rows of nodes) are walked by two threads.
+  split_.clear();
+  if (threads <= 1) return;
+  const int row = indexer_.stride[Dim - 1];
+  const int rows = nodes / row + Kernel::K;
+  split_rows_.assign(static_cast<std::size_t>(rows), 0);
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < first_node_.size(); ++k) {
+    if (!holds_heat_[k]) continue;
+    ++split_rows_[static_cast<std::size_t>(first_node_[k] / row + (Kernel::K - 1) / 2)];
+    ++total;
+  }
+  split_.push_back(0);
+  std::size_t below = 0;
+  int r = 0;
+  for (int t = 1; t < threads; ++t) {
+    const std::size_t want = total * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+    while (r < rows && below + static_cast<std::size_t>(split_rows_[static_cast<std::size_t>(r)]) <= want)
+      below += static_cast<std::size_t>(split_rows_[static_cast<std::size_t>(r++)]);
+    split_.push_back(std::min(nodes, std::max(split_.back(), r * row)));
+  }
+  split_.push_back(nodes);
 }
 
 namespace {
@@ -146,7 +236,10 @@ void ExplicitConduction<Dim>::node_operator_force(const NodalThermalSystem& sys,
   template void ExplicitConduction<D>::assemble_node_operator<mechanics::LinearKernel>(const NodalThermalSystem&, int); \
   template void ExplicitConduction<D>::assemble_node_operator<mechanics::UGIMPKernel>(const NodalThermalSystem&, int);  \
   template void ExplicitConduction<D>::assemble_node_operator<mechanics::QuadraticBSplineKernel>(                  \
-      const NodalThermalSystem&, int);
+      const NodalThermalSystem&, int);                                                                            \
+  template void ExplicitConduction<D>::split_nodes<mechanics::LinearKernel>(int, int);                             \
+  template void ExplicitConduction<D>::split_nodes<mechanics::UGIMPKernel>(int, int);                              \
+  template void ExplicitConduction<D>::split_nodes<mechanics::QuadraticBSplineKernel>(int, int);
 FRICTHERM_INSTANTIATE_NODE_OPERATOR(2)
 FRICTHERM_INSTANTIATE_NODE_OPERATOR(3)
 #undef FRICTHERM_INSTANTIATE_NODE_OPERATOR

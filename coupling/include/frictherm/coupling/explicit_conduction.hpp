@@ -200,6 +200,9 @@ class ExplicitConduction {
   /// issue 35: the same sums), with the window's stencils and M of the gather.
   template <class Kernel>
   void make_bounds(const NodalThermalSystem& sys);
+  /// split_ for `threads` from first_node_ of the heat-holding particles (one cut if threads <= 1).
+  template <class Kernel>
+  void split_nodes(int threads, int nodes);
   /// Whether an unknown of the stencil's nodes changed (changed_before_ of this pass, by grid node).
   template <class Kernel>
   bool any_changed(const mechanics::Stencil<Dim, Kernel>& st) const;
@@ -270,6 +273,10 @@ class ExplicitConduction {
   std::vector<int> dropped_before_;           // grid nodes < i that are not unknowns (by the gather)
   std::vector<unsigned char> whole_;          // by heat-holding particle: whole() of its window stencil
   std::vector<int> first_node_;               // by heat-holding particle: its window stencil's first grid node
+  // The gather's shared passes on 2+ threads: thread t's grid nodes [split_[t], split_[t + 1]), cut
+  // between node rows (slowest axis) so each holds ~as many stencils (split_nodes); empty: one thread.
+  std::vector<int> split_;
+  std::vector<int> split_rows_;               // scratch of split_nodes: stencils by middle row
   // Threads (issue 35): each pass's per-particle work is shared by particle ranges; its sums into
   // nodes by node (or unknown) ranges, each thread adding only into its own nodes, over the particles
   // in order, so every sum has the same terms in the same order on any number of threads.
