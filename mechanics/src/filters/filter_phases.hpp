@@ -21,7 +21,7 @@ struct VelocityFilterPhases {
   static void add_filter(UpdateScheme scheme, ShapeKind shape, Sim& sim, PhaseList& P) {
     const auto phase = [&sim](auto kernel) -> std::function<void(StepContext&)> {
       using Kernel = decltype(kernel);
-      return [&sim](StepContext&) { sim.template filter_velocities<Kernel>(); };
+      return [&sim](StepContext&) { sim.filter_grid_velocity(sim.template stencils<Kernel>()); };
     };
     P.add("velocity_filter", scheme == UpdateScheme::usl ? &StepPhaseTimes::stress_update : &StepPhaseTimes::grid_to_particle,
           shape == ShapeKind::extended_bspline ? phase(ExtendedBSplineKernel{}) : dispatch_shape(shape, phase));
