@@ -7,6 +7,7 @@
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/step_load.hpp>
 #include <frictherm/mechanics/step/component_registry.hpp>
+#include <frictherm/mechanics/step/step_kernel.hpp>
 
 namespace frictherm::mechanics {
 
@@ -19,12 +20,11 @@ class ParticleLoads final : public StepLoad<Dim> {
   void add_phases(LoadHook at, ShapeKind shape, Sim& sim, PhaseList& P) const override {
     if (at != LoadHook::forces) return;
     // The scatter reads the step's stencils: the kernel is chosen here, once per list.
-    const auto phase = [&sim](auto kernel) -> std::function<void(StepContext&)> {
-      using Kernel = decltype(kernel);
-      return [&sim](StepContext& c) { map_to_grid<Kernel>(sim, c.t); };
-    };
     P.add("external_loads", &StepPhaseTimes::particle_to_grid,
-          shape == ShapeKind::extended_bspline ? phase(ExtendedBSplineKernel{}) : dispatch_shape(shape, phase));
+          step_kernel_phase(shape, [&sim](auto kernel) -> std::function<void(StepContext&)> {
+            using Kernel = decltype(kernel);
+            return [&sim](StepContext& c) { map_to_grid<Kernel>(sim, c.t); };
+          }));
   }
 
   static const StepLoad<Dim>* select(Sim& sim) {

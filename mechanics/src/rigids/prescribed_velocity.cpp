@@ -13,6 +13,7 @@
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/component_registry.hpp>
 #include <frictherm/mechanics/step/rigid_driver.hpp>
+#include <frictherm/mechanics/step/step_kernel.hpp>
 
 #include <algorithm>
 #include <cstdint>
@@ -30,12 +31,11 @@ class PrescribedRigidVelocity final : public StepRigidDriver<Dim> {
     using T = StepPhaseTimes;
     if (at == RigidHook::drive) {
       // The nodes a particle drives come from its stencil: the kernel is chosen here, once per list.
-      const auto phase = [&sim](auto kernel) -> std::function<void(StepContext&)> {
-        using Kernel = decltype(kernel);
-        return [&sim](StepContext& c) { drive<Kernel>(sim, c.t); };
-      };
       P.add("rigid_conditions", &T::shape_functions,
-            shape == ShapeKind::extended_bspline ? phase(ExtendedBSplineKernel{}) : dispatch_shape(shape, phase));
+            step_kernel_phase(shape, [&sim](auto kernel) -> std::function<void(StepContext&)> {
+              using Kernel = decltype(kernel);
+              return [&sim](StepContext& c) { drive<Kernel>(sim, c.t); };
+            }));
     } else if (at == RigidHook::particle_update && pass_moves) {
       P.add("rigid_motion", &T::stress_update, [&sim](StepContext& c) { set_motions(sim, c.t, c.dt); });
     } else if (at == RigidHook::moved && !pass_moves) {
