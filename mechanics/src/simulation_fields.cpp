@@ -1,5 +1,5 @@
 // Velocity fields and the grid momentum update: the layout of the fields' slots, the per-thread
-// buffer reduction, velocity boundary conditions, p ← p + f dt, and rigid-body motion.
+// buffer reduction, velocity boundary conditions, p ← p + f dt (the rigid bodies' motion: rigids/).
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
@@ -408,22 +408,6 @@ void Simulation<Dim>::nodal_velocities() {
 }
 
 template <int Dim>
-typename Simulation<Dim>::RigidMotion Simulation<Dim>::rigid_motion(std::size_t m, double t, double dt) const {
-  const Material& mat = materials_[m];
-  return {mat.rigid_velocity_at(t).template head<Dim>(),
-          ((mat.rigid_velocity_at(t + dt) + mat.rigid_velocity_at(t)) * 0.5 * dt).template head<Dim>()};
-}
-
-template <int Dim>
-void Simulation<Dim>::move_rigid_particles(double dt, double t) {
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (!materials_[m].is_rigid()) continue;
-    const RigidMotion r = rigid_motion(m, t, dt);
-    for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) r.move(p_.velocity[k], p_.position[k]);
-  }
-}
-
-template <int Dim>
 void Simulation<Dim>::check_particle(long bad, double /*dt*/) const {
   long k = bad;
   // Rigid particles are checked here; particles are grouped by material (finalize), so only the rigid
@@ -489,8 +473,6 @@ template struct NodalFields<3>;
   template void Simulation<D>::apply_damping(double);                                                         \
   template void Simulation<D>::advance_grid_momentum(double);                                                 \
   template void Simulation<D>::nodal_velocities();                                                            \
-  template void Simulation<D>::move_rigid_particles(double, double);                                          \
-  template Simulation<D>::RigidMotion Simulation<D>::rigid_motion(std::size_t, double, double) const;         \
   template void Simulation<D>::check_particle(long, double) const;                                            \
   template void Simulation<D>::throw_beyond_hugoniot(long) const;
 FRICTHERM_INSTANTIATE_FIELDS(2)

@@ -4,7 +4,8 @@
 // particle's stencil and its nodes' velocities once and costs one parallel region instead of two.
 // Particle by particle the arithmetic is that of the separate loops, so the results are the same.
 // With `refresh` (USL with contact) the pass also evaluates each moved particle's stencil for the next
-// step while its position is at hand, and moves the rigid materials' particles and evaluates theirs:
+// step while its position is at hand, and moves the rigid materials' particles (by the motions the
+// rigid driver set: rigids/prescribed_velocity.cpp) and evaluates theirs:
 // the start of the next step and the heat hand-off after it need not pass over the particles again.
 #include <frictherm/mechanics/constitutive/stress_update.hpp>
 #include <frictherm/mechanics/loads/grid_loads.hpp>
@@ -81,12 +82,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   constexpr bool refreshable = Kinematics && !std::is_same_v<Stencils, PrecomputedStencils<Dim>>;
   refresh = refresh && refreshable;
   const std::size_t nm = materials_.size();
-  if (refresh) {
-    layout_.rigid_motion.resize(nm);
-    step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
-    for (std::size_t m = 0; m < nm; ++m)
-      if (materials_[m].is_rigid()) layout_.rigid_motion[m] = rigid_motion(m, clock_.time, dt);
-  }
+  if (refresh) step_detail::StencilBoxes<Dim>::clear(layout_.box_lo, layout_.box_hi);
   const Grid<Dim> grid = grid_;  // a local copy (see evaluate_stencils)
   [[maybe_unused]] const auto next_stencils = [&] {
     if constexpr (refreshable) return st.data();

@@ -7,7 +7,6 @@
 // of multimaterial contact. With the extended B-spline the weights are precomputed per step
 // (simulation_ebs.cpp) and the same loops read them.
 #include <frictherm/mechanics/errors.hpp>
-#include <frictherm/mechanics/loads/grid_loads.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
 
@@ -36,15 +35,6 @@ void for_each_part(const ThreadPartition& partition, Fn&& fn) {
   for (int t = omp_get_thread_num(); t < partition.threads; t += omp_get_num_threads()) fn(t);
 }
 }  // namespace
-
-template <int Dim>
-template <class Kernel>
-auto& Simulation<Dim>::stencils() {
-  if constexpr (std::is_same_v<Kernel, LinearKernel>) return stencil_store_.linear;
-  else if constexpr (std::is_same_v<Kernel, UGIMPKernel>) return stencil_store_.ugimp;
-  else if constexpr (is_extended<Kernel>) return stencil_store_.extended;
-  else return stencil_store_.quadratic;
-}
 
 template <int Dim>
 double Simulation<Dim>::step(double dt_limit) {
@@ -102,7 +92,9 @@ std::vector<const char*> Simulation<Dim>::step_phase_names() {
 // conditions and the boundary points' move where the stress update's velocity is on the grid. The
 // loads (step/step_load.hpp, loads/) add theirs at `load(LoadHook::...)`: point loads and tractions
 // into the forces, damping after the velocity conditions; the velocity filters (step/velocity_filter.hpp,
-// filters/) at `filter(FilterHook::...)`: XPIC's start velocity, XPIC/FMPM after nodal_velocities.
+// filters/) at `filter(FilterHook::...)`: XPIC's start velocity, XPIC/FMPM after nodal_velocities; the
+// rigid drivers (step/rigid_driver.hpp, rigids/) at `rigid(RigidHook::...)`: the rigid velocities onto
+// the grid at the step's start, the rigid particles moved after the particle pass (or by it: refresh).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
@@ -125,6 +117,10 @@ void Simulation<Dim>::build_phases() {
   // step's stencils and boxes and moves the rigid particles (nothing after it in the step needs this
   // step's stencils).
   const bool refresh = usl && !contact_methods_.empty() && !is_extended<Kernel>;
+  const std::vector<const StepRigidDriver<Dim>*> rigids = rigid_drivers_for(*this);  // rigids/
+  const auto rigid = [&](RigidHook at) {
+    for (const StepRigidDriver<Dim>* r : rigids) r->add_phases(at, refresh, opt_.shape, *this, P);
+  };
 
   // The CFL step. With the wave speeds current, the particle-to-grid scatter takes max_p c_p + |v_p|
   // (exact in any order) and the step is set at its phase's end (nothing reads it before): no pass of
@@ -141,7 +137,11 @@ void Simulation<Dim>::build_phases() {
     c.speed_in_scatter = wave_speeds_current() && c.dt_limit > 0.0;
     if (!c.speed_in_scatter) set_step(c, particle_speed_max());
   });
-  P.add("shape_functions", &T::shape_functions, [this](StepContext& c) { prepare_step<Kernel>(c.t); });
+  P.add("shape_functions", &T::shape_functions, [this](StepContext&) { prepare_step<Kernel>(); });
+  rigid(RigidHook::drive);
+  // Per field: EBS rebuilt (keeping the driven nodes), node boxes laid out, weights flattened.
+  if constexpr (is_extended<Kernel>)
+    P.add("extended_stencils", &T::shape_functions, [this](StepContext&) { prepare_extended_stencils(); });
   P.add("particle_to_grid", &T::particle_to_grid, [this, usf, set_step](StepContext& c) {
     map_to_grid<Kernel>(!usf, c.speed_in_scatter);
     if (c.speed_in_scatter) set_step(c, *std::max_element(threads_.speed_max.begin(), threads_.speed_max.end()));
@@ -162,6 +162,7 @@ void Simulation<Dim>::build_phases() {
   contact(ContactHook::updated);
   P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
   filter(FilterHook::velocities);
+  rigid(RigidHook::particle_update);
   if (usl) {  // grid-to-particle and stress update in one pass over the stencils
     P.add("particle_update", &T::stress_update, [this, refresh](StepContext& c) {
       const ParticlePassResult r = particle_pass<true, true>(c.dt, stencils<Kernel>(), refresh);
@@ -173,8 +174,7 @@ void Simulation<Dim>::build_phases() {
       c.bad = particle_pass<true, false>(c.dt, stencils<Kernel>()).bad;
     });
   }
-  if (!refresh)
-    P.add("move_rigid_particles", &T::grid_to_particle, [this](StepContext& c) { move_rigid_particles(c.dt, c.t); });
+  rigid(RigidHook::moved);
   P.add("end_particle_update", &T::grid_to_particle, [this, refresh](StepContext& c) { end_particle_update(c, refresh); });
   if (musl) {
     P.add("remap_momentum", &T::particle_to_grid, [this](StepContext&) { remap_momentum<Kernel>(); });
@@ -185,12 +185,12 @@ void Simulation<Dim>::build_phases() {
   }
 }
 
-// The start of a step: threads for this step's particle count, the thread partition, the rigid
-// fields' velocities, the stencils (EBS: rebuilt per field; contact: with the per-material boxes of
-// nodes and the field layout) and the nodes driven by rigid boundary materials.
+// The start of a step: threads for this step's particle count, the thread partition and the stencils
+// (contact: with the per-material boxes of nodes and the field layout; EBS: its own phase after the
+// rigid drivers', extended_stencils).
 template <int Dim>
 template <class Kernel>
-void Simulation<Dim>::prepare_step(double t) {
+void Simulation<Dim>::prepare_step() {
   // Below ~2000 particles per thread the fork/join and the scatter-buffer reduction cost more than
   // the particle work they share.
   const int max_threads = omp_get_max_threads();
@@ -200,24 +200,13 @@ void Simulation<Dim>::prepare_step(double t) {
     for (auto& tn : threads_.nodes) tn.resize(nodes_.mass.size(), contact_setup_.enabled);
   }
   update_partition();
-  for (std::size_t f = 0; f < fields_.size(); ++f)
-    if (fields_[f].rigid)
-      layout_.field_velocity[f] = materials_[static_cast<std::size_t>(fields_[f].material)].rigid_velocity_at(t).template head<Dim>();
-  // Nodes driven by rigid boundary materials (EBS keeps them); with contact from the stencils the step
-  // evaluates anyway.
-  if constexpr (is_extended<Kernel>) {
-    map_rigid_particles<Kernel>(t, nullptr);
-    prepare_extended_stencils();  // per field: EBS rebuilt, node boxes laid out, weights flattened
-  } else {
+  if constexpr (!is_extended<Kernel>) {
     auto& st = stencils<Kernel>();
     if (st.size() != p_.size()) st.resize(p_.size()), stencil_store_.current = false;
     if (contact_setup_.enabled) {
       // Unless current_stencils() evaluated them after the last step (same positions, same numbers).
       if (!stencil_store_.current) evaluate_stencils<Kernel>();  // also the per-material boxes of nodes
       layout_fields(layout_.box_lo, layout_.box_hi);
-      map_rigid_particles<Kernel>(t, st.data());
-    } else {
-      map_rigid_particles<Kernel>(t, nullptr);
     }
   }
   if (!contact_methods_.empty()) {  // the step's frictional work, of every contact method
@@ -525,55 +514,6 @@ void Simulation<Dim>::add_internal_forces() {
   }, threads_.count);
 }
 
-// Rigid materials without a velocity field of their own (all of them without contact, boundary ones
-// with contact): every node they touch takes their prescribed velocity components.
-template <int Dim>
-template <class Kernel>
-void Simulation<Dim>::map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated) {
-  std::fill(conditions_.rigid_mask.begin(), conditions_.rigid_mask.end(), std::uint8_t{0});
-  for (std::size_t m = 0; m < materials_.size(); ++m) {
-    if (!materials_[m].is_rigid() || layout_.field_of_material[m] >= 0) continue;
-    const Vec<Dim> v = materials_[m].rigid_velocity_at(t).template head<Dim>();
-    std::uint8_t bits = 0;
-    for (int d = 0; d < Dim; ++d)
-      if (materials_[m].rigid_controls[static_cast<std::size_t>(d)]) bits |= static_cast<std::uint8_t>(1u << d);
-    Stencil<Dim, Kernel> own;
-    for (std::size_t k = layout_.material_begin[m]; k < layout_.material_end[m]; ++k) {
-      if (!evaluated) own.evaluate(grid_, p_.position[k], p_.half_size[k]);
-      const Stencil<Dim, Kernel>& s = evaluated ? evaluated[k] : own;
-      s.for_each(grid_, [&](int i, double S, const Vec<Dim>&) {
-        if (S > 0.0) {
-          conditions_.rigid_mask[static_cast<std::size_t>(i)] |= bits;
-          for (int d = 0; d < Dim; ++d)
-            if (bits & (1u << d)) conditions_.rigid_velocity[static_cast<std::size_t>(i)][d] = v[d];
-        }
-      });
-    }
-  }
-}
-
-// XPIC/FMPM: the grid velocity filtered over the step's stencils (simulation_transfer.cpp).
-template <int Dim>
-template <class Kernel>
-void Simulation<Dim>::filter_velocities() {
-  filter_grid_velocity(stencils<Kernel>());
-}
-
-// Point loads and tractions into the nodal forces (the kernel shared with the decomposed step:
-// loads/grid_loads.hpp).
-template <int Dim>
-template <class Kernel>
-void Simulation<Dim>::map_external_loads(double t) {
-  auto& st = stencils<Kernel>();
-  for (const auto& L : conditions_.resolved_loads) {
-    const Vec<Dim> f = load_force<Dim>(L.force, *L.scale, t);
-    const int fi = layout_.field_of_material[static_cast<std::size_t>(p_.material[L.particle])];
-    if (fi < 0) continue;
-    add_load_to_grid<Dim>(st[L.particle], fields_[static_cast<std::size_t>(fi)].index, f,
-                          [&](int i) -> Vec<Dim>& { return nodes_.force[i]; });
-  }
-}
-
 // MUSL: nodal momentum rebuilt from the updated particle velocities, p_i = Σ S_ip m_p v_p (the MUSL
 // list then resolves contact again on the remapped momenta).
 template <int Dim>
@@ -599,15 +539,7 @@ void Simulation<Dim>::remap_momentum() {
   template void Simulation<D>::contact_at_extrapolated<LinearKernel>(double); \
   template void Simulation<D>::contact_at_extrapolated<UGIMPKernel>(double); \
   template void Simulation<D>::contact_at_extrapolated<QuadraticBSplineKernel>(double); \
-  template void Simulation<D>::contact_at_extrapolated<ExtendedBSplineKernel>(double); \
-  template void Simulation<D>::map_external_loads<LinearKernel>(double); \
-  template void Simulation<D>::map_external_loads<UGIMPKernel>(double); \
-  template void Simulation<D>::map_external_loads<QuadraticBSplineKernel>(double); \
-  template void Simulation<D>::map_external_loads<ExtendedBSplineKernel>(double); \
-  template void Simulation<D>::filter_velocities<LinearKernel>(); \
-  template void Simulation<D>::filter_velocities<UGIMPKernel>(); \
-  template void Simulation<D>::filter_velocities<QuadraticBSplineKernel>(); \
-  template void Simulation<D>::filter_velocities<ExtendedBSplineKernel>();
+  template void Simulation<D>::contact_at_extrapolated<ExtendedBSplineKernel>(double);
 FRICTHERM_INSTANTIATE_STEP(2)
 FRICTHERM_INSTANTIATE_STEP(3)
 #undef FRICTHERM_INSTANTIATE_STEP

@@ -44,17 +44,17 @@ TEST(StepPhases, ListsPerScheme) {
   auto join = [](Names a, const Names& b) { return a.insert(a.end(), b.begin(), b.end()), a; };
   EXPECT_EQ(names(UpdateScheme::usl, false),
             join(join({"time_step", "shape_functions", "particle_to_grid"}, grid),
-                 {"particle_update", "move_rigid_particles", "end_particle_update"}));
+                 {"particle_update", "end_particle_update"}));
   EXPECT_EQ(names(UpdateScheme::usf, false),
             join(join({"time_step", "shape_functions", "particle_to_grid", "velocity_from_momentum", "stress_update",
                        "internal_forces"},
                       grid),
-                 {"grid_to_particle", "move_rigid_particles", "end_particle_update"}));
+                 {"grid_to_particle", "end_particle_update"}));
   EXPECT_EQ(names(UpdateScheme::musl, false),
             join(join({"time_step", "shape_functions", "particle_to_grid"}, grid),
-                 {"grid_to_particle", "move_rigid_particles", "end_particle_update", "remap_momentum",
+                 {"grid_to_particle", "end_particle_update", "remap_momentum",
                   "velocity_from_momentum", "stress_update"}));
-  // Contact: a pass after each momentum projection; USL's particle pass moves the rigid particles.
+  // Contact: a pass after each momentum projection. (No rigid material: no rigid driver's phases.)
   EXPECT_EQ(names(UpdateScheme::usl, true),
             Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_conditions",
                    "momentum_update", "contact_updated", "nodal_velocities", "particle_update",
@@ -62,11 +62,11 @@ TEST(StepPhases, ListsPerScheme) {
   EXPECT_EQ(names(UpdateScheme::musl, true),
             Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_conditions",
                    "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle",
-                   "move_rigid_particles", "end_particle_update", "remap_momentum", "contact_remapped",
+                   "end_particle_update", "remap_momentum", "contact_remapped",
                    "velocity_from_momentum", "stress_update"}));
   // Damping: one phase between the velocity conditions and the momentum update.
   const Names damped = names(UpdateScheme::usl, false, 100.0);
-  ASSERT_EQ(damped.size(), 10u);
+  ASSERT_EQ(damped.size(), 9u);
   EXPECT_EQ(damped[4], "damping");
 }
 
@@ -103,11 +103,11 @@ TEST(StepPhases, ContactMethodsAtTheirHooks) {
   EXPECT_EQ(names_with_penalty(UpdateScheme::usf, true),
             Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_from_momentum",
                    "stress_update", "internal_forces", "move_boundary_points", "penalty_forces", "velocity_conditions",
-                   "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle", "move_rigid_particles",
+                   "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle", 
                    "end_particle_update"}));
   const Names musl = {"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "penalty_forces",
                       "velocity_conditions", "momentum_update", "contact_updated", "nodal_velocities",
-                      "grid_to_particle", "move_rigid_particles", "end_particle_update", "remap_momentum",
+                      "grid_to_particle", "end_particle_update", "remap_momentum",
                       "contact_remapped", "velocity_from_momentum", "move_boundary_points", "stress_update"};
   EXPECT_EQ(names_with_penalty(UpdateScheme::musl, true), musl);
   // Every pair in penalty contact: the same list (the multimaterial passes find no contact node).
@@ -161,7 +161,7 @@ TEST(StepPhases, LoadsAtTheirHooks) {
   EXPECT_EQ(load_names(), Names({"particle_loads", "mass_damping"}));
   EXPECT_EQ(steps, Names({"time_step", "shape_functions", "particle_to_grid", "velocity_from_momentum", "stress_update",
                           "internal_forces", "external_loads", "velocity_conditions", "damping", "momentum_update",
-                          "nodal_velocities", "grid_to_particle", "move_rigid_particles", "end_particle_update"}));
+                          "nodal_velocities", "grid_to_particle", "end_particle_update"}));
 }
 
 // The grid-velocity filters (step/velocity_filter.hpp): XPIC keeps the start velocity before the
@@ -184,11 +184,65 @@ TEST(StepPhases, VelocityFiltersAtTheirHooks) {
   EXPECT_EQ(xpic, Names{"xpic"});
   EXPECT_EQ(xpic_steps, Names({"time_step", "shape_functions", "particle_to_grid", "start_velocity", "velocity_conditions",
                                "momentum_update", "nodal_velocities", "velocity_filter", "particle_update",
-                               "move_rigid_particles", "end_particle_update"}));
+                               "end_particle_update"}));
   const auto [fmpm, fmpm_steps] = run(ParticleUpdate::fmpm);
   EXPECT_EQ(fmpm, Names{"fmpm"});
   EXPECT_EQ(fmpm_steps, Names({"time_step", "shape_functions", "particle_to_grid", "velocity_conditions",
                                "momentum_update", "nodal_velocities", "velocity_filter", "particle_update",
-                               "move_rigid_particles", "end_particle_update"}));
+                               "end_particle_update"}));
   EXPECT_EQ(run(ParticleUpdate::flip).first, Names{});
+}
+
+// The rigid drivers (step/rigid_driver.hpp): a rigid wall with a prescribed velocity puts its velocity
+// onto the grid after shape_functions (EBS: before the basis, which keeps the driven nodes) and moves
+// its particles after the particle pass, or under USL with contact sets the motions the particle pass
+// applies; a scene without rigid materials has no driver.
+TEST(StepPhases, RigidDriversAtTheirHooks) {
+  const auto run = [](UpdateScheme scheme, bool contact, ShapeKind shape, bool wall) {
+    SimulationOptions o;
+    o.scheme = scheme;
+    o.shape = shape;
+    Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(0.1, 0.1), IVec<2>{10, 10}), o);
+    const int a = sim.add_material(elastic("a"));
+    sim.add_body("a", *make_box<2>(Vec<2>(0.2, 0.2), Vec<2>(0.45, 0.6), a), 2, Vec<2>(0.0, 0.0));
+    if (wall) {
+      Material rigid = elastic("wall");
+      rigid.kind = MaterialKind::rigid;
+      rigid.rigid_velocity = {TimeFunction::constant(-1.0), TimeFunction::constant(0.0)};
+      const int w = sim.add_material(rigid);
+      sim.add_body("wall", *make_box<2>(Vec<2>(0.55, 0.2), Vec<2>(0.7, 0.6), w), 2, Vec<2>(-1.0, 0.0));
+    }
+    if (contact) sim.enable_contact(ContactOptions{});
+    Names steps, drivers;
+    for (const char* n : sim.step_phase_names()) steps.emplace_back(n);
+    for (const StepRigidDriver<2>* r : rigid_drivers_for(sim)) drivers.emplace_back(r->name());
+    return std::make_pair(drivers, steps);
+  };
+  const auto [usl, usl_steps] = run(UpdateScheme::usl, false, ShapeKind::ugimp, true);
+  EXPECT_EQ(usl, Names{"prescribed_velocity"});
+  EXPECT_EQ(usl_steps, Names({"time_step", "shape_functions", "rigid_conditions", "particle_to_grid", "velocity_conditions",
+                              "momentum_update", "nodal_velocities", "particle_update", "move_rigid_particles",
+                              "end_particle_update"}));
+  // USL with contact: the particle pass moves the wall's particles by the motions set before it.
+  EXPECT_EQ(run(UpdateScheme::usl, true, ShapeKind::ugimp, true).second,
+            Names({"time_step", "shape_functions", "rigid_conditions", "particle_to_grid", "contact_extrapolated",
+                   "velocity_conditions", "momentum_update", "contact_updated", "nodal_velocities", "rigid_motion",
+                   "particle_update", "end_particle_update"}));
+  EXPECT_EQ(run(UpdateScheme::musl, true, ShapeKind::ugimp, true).second,
+            Names({"time_step", "shape_functions", "rigid_conditions", "particle_to_grid", "contact_extrapolated",
+                   "velocity_conditions", "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle",
+                   "move_rigid_particles", "end_particle_update", "remap_momentum", "contact_remapped",
+                   "velocity_from_momentum", "stress_update"}));
+  // EBS: the driven nodes before the basis is rebuilt (extended_stencils keeps them).
+  EXPECT_EQ(run(UpdateScheme::usl, false, ShapeKind::extended_bspline, true).second,
+            Names({"time_step", "shape_functions", "rigid_conditions", "extended_stencils", "particle_to_grid",
+                   "velocity_conditions", "momentum_update", "nodal_velocities", "particle_update",
+                   "move_rigid_particles", "end_particle_update"}));
+  EXPECT_EQ(run(UpdateScheme::usl, false, ShapeKind::extended_bspline, false).second,
+            Names({"time_step", "shape_functions", "extended_stencils", "particle_to_grid", "velocity_conditions",
+                   "momentum_update", "nodal_velocities", "particle_update", "end_particle_update"}));
+  const auto [none, none_steps] = run(UpdateScheme::usl, false, ShapeKind::ugimp, false);
+  EXPECT_EQ(none, Names{});
+  EXPECT_EQ(none_steps, Names({"time_step", "shape_functions", "particle_to_grid", "velocity_conditions", "momentum_update",
+                               "nodal_velocities", "particle_update", "end_particle_update"}));
 }

@@ -9,6 +9,7 @@
 #include <frictherm/mechanics/simulation.hpp>
 #include <frictherm/mechanics/step/contact_method.hpp>
 #include <frictherm/mechanics/step/component_registry.hpp>
+#include <frictherm/mechanics/step/step_kernel.hpp>
 
 namespace frictherm::mechanics {
 
@@ -44,12 +45,10 @@ class MultimaterialContactMethod final : public StepContactMethod<Dim> {
  private:
   // The first pass reads the step's stencils: the kernel is chosen here, once per scene.
   static std::function<void(StepContext&)> extrapolated_pass(Sim& sim, ShapeKind shape) {
-    const auto pass = [&sim](auto kernel) -> std::function<void(StepContext&)> {
+    return step_kernel_phase(shape, [&sim](auto kernel) -> std::function<void(StepContext&)> {
       using Kernel = decltype(kernel);
       return [&sim](StepContext& c) { sim.template contact_at_extrapolated<Kernel>(c.dt); };
-    };
-    if (shape == ShapeKind::extended_bspline) return pass(ExtendedBSplineKernel{});
-    return dispatch_shape(shape, pass);
+    });
   }
 };
 

@@ -139,7 +139,7 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<StressLaw> laws;
   bool has_mie_gruneisen = false;
   // Rigid materials (velocity boundary conditions on the nodes they touch, as the serial
-  // map_rigid_particles / apply_velocity_bc / nodal_velocities): per axis d and local node, the largest
+  // rigid_conditions / apply_velocity_bc / nodal_velocities): per axis d and local node, the largest
   // rigid material prescribing component d whose particles' stencils reach the node with S > 0 (−1:
   // none; the serial loop lets the last material win), completed at the owners in sum_to_owners;
   // per owned node the driven components (bit d) and their prescribed velocity at the step's start.

@@ -77,7 +77,7 @@ void DecomposedMpm<Dim>::Impl::velocity_from_momentum(double /*dt*/) {
 // USF phase, local: the slots' forces from the stress the stress update left,
 // f_i = Σ (S_ip m_p g − V_p σ_p G_ip) over the deformable particles' start-of-step stencils (Nairn 2018
 // eq. 3), then the loads of this rank's particles (as the serial add_internal_forces, then
-// map_external_loads). The slots' other values stay (forces_to_owners sends the forces only).
+// particle loads, loads/particle_loads.cpp). The slots' other values stay (forces_to_owners sends the forces only).
 template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::internal_forces(double /*dt*/) {

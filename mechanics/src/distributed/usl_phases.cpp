@@ -69,7 +69,7 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
   if (has_rigid)
     for (int d = 0; d < Dim; ++d) std::fill(driver[static_cast<std::size_t>(d)].begin(), driver[static_cast<std::size_t>(d)].end(), -1);
   const NodeIndexer<Dim> local_ix = local_indexer();
-  // A rigid wall's particle marks the nodes it drives (the serial map_rigid_particles: nodes with
+  // A rigid wall's particle marks the nodes it drives (the serial rigid_conditions: nodes with
   // S > 0, the components its material prescribes).
   const auto mark_drives = [&](PetscInt k, const auto& s) {
     const Material& m = materials[static_cast<std::size_t>(f.material[k])];
@@ -83,7 +83,7 @@ void DecomposedMpm<Dim>::Impl::particle_to_grid(double /*dt*/) {
     });
   };
   // Extended B-splines: the rigid walls mark their drives with the plain quadratic B-spline (the serial
-  // map_rigid_particles with ExtendedBSplineKernel's Stencil), then the bases over all ranks and every
+  // rigid_conditions with ExtendedBSplineKernel's Stencil), then the bases over all ranks and every
   // other particle's entries (extended_bsplines.cpp).
   if constexpr (extended) {
     if (has_rigid) {
@@ -350,7 +350,7 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   for (std::size_t n = 0; n < local_loads.size(); ++n)
     load_start_position[n] = Eigen::Map<const Vec<Dim>>(f.x + Dim * local_loads[n].first);
   for (PetscInt k = 0; k < f.n; ++k) {
-    if (rigid(f.material[k])) {  // the serial move_rigid_particles: v(t), x += ½ (v(t) + v(t + dt)) dt
+    if (rigid(f.material[k])) {  // the serial move_rigid_particles (rigids/): v(t), x += ½ (v(t) + v(t + dt)) dt
       const Material& m = materials[static_cast<std::size_t>(f.material[k])];
       const Vec<Dim> v0 = m.rigid_velocity_at(time).template head<Dim>();
       const Vec<Dim> dx = ((m.rigid_velocity_at(time + dt) + m.rigid_velocity_at(time)) * 0.5 * dt).template head<Dim>();

@@ -3,6 +3,7 @@
 // the Neumann-series filter pass over the step's stencils, timed with the particle pass that reads the
 // filtered velocity (USL: the combined particle_update, else grid_to_particle).
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/step/step_kernel.hpp>
 #include <frictherm/mechanics/step/velocity_filter.hpp>
 
 #include <functional>
@@ -19,12 +20,11 @@ struct VelocityFilterPhases {
   /// The filter of order opt.transfer_order on `start` (XPIC: v^n) or v^{n+1} (FMPM): the kernel is
   /// chosen here, once per list.
   static void add_filter(UpdateScheme scheme, ShapeKind shape, Sim& sim, PhaseList& P) {
-    const auto phase = [&sim](auto kernel) -> std::function<void(StepContext&)> {
-      using Kernel = decltype(kernel);
-      return [&sim](StepContext&) { sim.template filter_velocities<Kernel>(); };
-    };
     P.add("velocity_filter", scheme == UpdateScheme::usl ? &StepPhaseTimes::stress_update : &StepPhaseTimes::grid_to_particle,
-          shape == ShapeKind::extended_bspline ? phase(ExtendedBSplineKernel{}) : dispatch_shape(shape, phase));
+          step_kernel_phase(shape, [&sim](auto kernel) -> std::function<void(StepContext&)> {
+            using Kernel = decltype(kernel);
+            return [&sim](StepContext&) { sim.filter_grid_velocity(sim.template stencils<Kernel>()); };
+          }));
   }
 };
 

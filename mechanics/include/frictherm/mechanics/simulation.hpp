@@ -47,6 +47,7 @@
 #include <frictherm/mechanics/state/work_books.hpp>
 #include <frictherm/mechanics/step/contact_method.hpp>
 #include <frictherm/mechanics/step/phase_list.hpp>
+#include <frictherm/mechanics/step/rigid_driver.hpp>
 #include <frictherm/mechanics/step/step_load.hpp>
 #include <frictherm/mechanics/step/velocity_filter.hpp>
 #include <frictherm/mechanics/step_timing.hpp>
@@ -107,6 +108,9 @@ class MassDamping;
 // The grid-velocity filters (step/velocity_filter.hpp; mechanics/src/filters/).
 template <int Dim>
 struct VelocityFilterPhases;
+// The rigid drivers (step/rigid_driver.hpp; mechanics/src/rigids/).
+template <int Dim>
+class PrescribedRigidVelocity;
 
 template <int Dim>
 class Simulation {
@@ -290,6 +294,7 @@ class Simulation {
   friend class ParticleLoads<Dim>;
   friend class MassDamping<Dim>;
   friend struct VelocityFilterPhases<Dim>;
+  friend class PrescribedRigidVelocity<Dim>;
   using ContactEntry = typename ContactNodeState<Dim>::Entry;
   using ContactNodeListing = typename ContactNodeState<Dim>::Listing;
   using ContactThreadWork = typename ContactNodeState<Dim>::ThreadWork;
@@ -298,7 +303,7 @@ class Simulation {
   template <class Kernel> void build_phases();
   void build_phases();
   long phase_key() const;
-  template <class Kernel> void prepare_step(double t);  // stencils, field layout, rigid-driven nodes
+  template <class Kernel> void prepare_step();  // threads, partition, stencils, field layout
   template <class Kernel> void contact_at_extrapolated(double dt);  // contact nodes, extents, first pass
   template <class Kernel> void stress_pass(double dt);  // USF, MUSL: the stress update alone
   void end_particle_update(StepContext& ctx, bool refreshed);  // time and step advance, particle checks
@@ -310,10 +315,6 @@ class Simulation {
   /// take_speeds: also each part's largest c_p + |v_p| into threads_.speed_max (the CFL speed).
   template <class Kernel> void map_to_grid(bool with_forces, bool take_speeds);
   template <class Kernel> void add_internal_forces();
-  /// `evaluated`: this step's stencils of every particle (contact), or null to evaluate them here.
-  template <class Kernel> void map_rigid_particles(double t, const Stencil<Dim, Kernel>* evaluated);
-  template <class Kernel> void map_external_loads(double t);
-  template <class Kernel> void filter_velocities();  // XPIC/FMPM: filter_grid_velocity on the step's stencils
   template <class Kernel> void remap_momentum();
   /// The particle loops after the grid update (simulation_particle_pass.cpp): grid-to-particle
   /// (Kinematics), stress update from nodes_.velocity (Stress), or both in one pass (USL).
@@ -322,14 +323,15 @@ class Simulation {
     long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
   };
   /// `refresh` (grid-to-particle with Stencil arrays): also the next step's stencils at the moved
-  /// positions, the rigid materials moved (move_rigid_particles) and layout_.box_lo/layout_.box_hi, in the same pass.
+  /// positions, the rigid materials moved (by layout_.rigid_motion, which the rigid driver sets:
+  /// rigids/prescribed_velocity.cpp) and layout_.box_lo/layout_.box_hi, in the same pass.
   template <bool Kinematics, bool Stress, class Stencils>
   ParticlePassResult particle_pass(double dt, Stencils& st, bool refresh = false);
   void throw_beyond_hugoniot(long particle) const;  // particle >= 0: compressed past its Hugoniot's limit
-  template <class Kernel> auto& stencils();  // vector of Stencil, or PrecomputedStencils for EBS
+  /// The step's stencils of kernel `Kernel`: vector of Stencil, or PrecomputedStencils for EBS.
+  template <class Kernel> StencilArray<Dim, Kernel>& stencils() { return stencil_store_.template of<Kernel>(); }
   template <class Kernel> void evaluate_stencils();  // all particles; with contact also layout_.box_lo/layout_.box_hi
   void prepare_extended_stencils();  // EBS: rebuild per field, lay out the fields, flatten the weights
-  template <class Kernel> void map_rigid_fields();
   void init_fields();
   void layout_fields(const std::vector<IVec<Dim>>& lo, const std::vector<IVec<Dim>>& hi);
   // Scatters under the thread partition (threads_.partition, thread_partition.hpp; simulation_fields.cpp):
@@ -372,10 +374,7 @@ class Simulation {
                            std::vector<int>& mats, std::vector<int>& entries) const;
   void compute_contact_normals();                                // extent separation: contact_nodes_.entry_normal
   template <class Stencils> void measure_contact_extents(const Stencils& st);  // extent separation: contact_extents.cpp
-  void move_rigid_particles(double dt, double t);
-  using RigidMotion = RigidBodyMotion<Dim>;
   using ResolvedLoad = typename LoadsAndConditions<Dim>::ResolvedLoad;
-  RigidMotion rigid_motion(std::size_t material, double t, double dt) const;
   void check_penalty_settings(const ContactPairSettings& s, int a, int b) const;  // throws std::invalid_argument
   void setup_penalty();                          // finalize(): penalty pairs and boundary points
   void apply_penalty_forces();                   // step: detection, forces into nodes_.force, heat

@@ -1,6 +1,6 @@
 #pragma once
-// The loads of the grid update, written once for the serial Simulation (simulation_step.cpp
-// map_external_loads, simulation_particle_pass.cpp, simulation_fields.cpp apply_damping) and the
+// The loads of the grid update, written once for the serial Simulation
+// (loads/particle_loads.cpp, simulation_particle_pass.cpp, simulation_fields.cpp apply_damping) and the
 // decomposed step (distributed/usl_phases.cpp): point loads and tractions resolved to particles
 // (ParticleLoad, loads.hpp) scattered into the nodal forces, their work, and the mass-proportional
 // damping of the nodal momenta. Each engine passes its own storage (accessors), the arithmetic is here.

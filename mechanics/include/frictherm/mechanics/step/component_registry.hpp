@@ -1,8 +1,9 @@
 #pragma once
 // What the step's component registries share (issue 32; docs/step.md): the contact methods
-// (contact_methods/registry.cpp), the loads (loads/registry.cpp) and the grid-velocity filters
-// (filters/registry.cpp) each list their components' selections, functions that return the component
-// for a simulation that uses it or null; a new component is its file plus one line in its registry.
+// (contact_methods/registry.cpp), the loads (loads/registry.cpp), the grid-velocity filters
+// (filters/registry.cpp) and the rigid drivers (rigids/registry.cpp) each list their components'
+// selections, functions that return the component for a simulation that uses it or null; a new
+// component is its file plus one line in its registry.
 #include <cstddef>
 #include <vector>
 
