@@ -574,16 +574,6 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh(
 }
 
 template <int Dim>
-void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
-  if (heat_capacity_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
-  const auto n = static_cast<Eigen::Index>(sys.size());
-  if (next_mct_.size() != n) throw std::logic_error("ExplicitConduction::reproject: the sums are of other unknowns");
-  first_force_ready_ = false;
-  // The eq. 38 sums, kept with the particles' temperatures by the gather, refresh and map_back.
-  for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
-}
-
-template <int Dim>
 double ExplicitConduction<Dim>::lambda_bound(const NodalThermalSystem& sys, const std::vector<FixedNode>& fixed) {
   if (!bounds_ready_)
     mechanics::dispatch_shape(kind_, [&](auto kernel) { make_bounds<decltype(kernel)>(sys); });

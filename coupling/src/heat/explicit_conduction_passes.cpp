@@ -1,6 +1,6 @@
 // The forward-Euler sub-steps of a matrix-free conduction window and the change mapped back to the
 // particles (explicit_conduction.hpp; Nairn et al. 2018 eqs. 37–38), with the stencils of the gather
-// (explicit_conduction.cpp).
+// (explicit_conduction.cpp), and the re-projection of the kept eq. 38 sums (reproject).
 #include <array>
 #include "explicit_conduction_detail.hpp"
 
@@ -535,13 +535,24 @@ void ExplicitConduction<Dim>::map_back_with(mechanics::Particles<Dim>& p, const 
   });
 }
 
+template <int Dim>
+void ExplicitConduction<Dim>::reproject(const mechanics::Particles<Dim>& p, NodalThermalSystem& sys) {
+  if (heat_capacity_.size() != p.size()) throw std::logic_error("ExplicitConduction::reproject: no gather for these particles");
+  const auto n = static_cast<Eigen::Index>(sys.size());
+  if (next_mct_.size() != n) throw std::logic_error("ExplicitConduction::reproject: the sums are of other unknowns");
+  first_force_ready_ = false;
+  // The eq. 38 sums, kept with the particles' temperatures by the gather, refresh and map_back.
+  for (Eigen::Index u = 0; u < n; ++u) sys.temperature[u] = next_mct_[u] / sys.mass[u];
+}
+
 #define FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(D)                                                                    \
   template Eigen::VectorXd ExplicitConduction<D>::advance(const NodalThermalSystem&, const Eigen::VectorXd&,      \
                                                           const Eigen::VectorXd&, const std::vector<FixedNode>&,  \
                                                           double, long);                                          \
   template double ExplicitConduction<D>::map_back(mechanics::Particles<D>&, const NodalThermalSystem&,            \
                                                 const Eigen::VectorXd&, double, const Eigen::VectorXd*,         \
-                                                const std::vector<FacePull<D>::Held>*);
+                                                const std::vector<FacePull<D>::Held>*);           \
+  template void ExplicitConduction<D>::reproject(const mechanics::Particles<D>&, NodalThermalSystem&);
 FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(2)
 FRICTHERM_INSTANTIATE_EXPLICIT_PASSES(3)
 #undef FRICTHERM_INSTANTIATE_EXPLICIT_PASSES
