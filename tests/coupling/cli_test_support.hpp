@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the tests of the frictherm program (test_cli*.cpp, test_cli_mpi.cpp, test_cli_mpirun.cpp):
-// a shell command's exit code and everything it printed, and a fresh folder per test.
+// a shell command's exit code and everything it printed, a fresh folder per test, and a small scene.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -74,5 +74,16 @@ class MpirunScratchTest : public ScratchDirTest {
     ScratchDirTest::SetUp();
   }
 };
+
+/// The program tests' small scene: a block moving at 1 m/s, a few dozen steps, four snapshots.
+inline constexpr const char* kTinyScene = R"({
+  "dimension": 2,
+  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
+  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
+  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
+              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
+  "run": {"end_time": 2e-3, "threads": 1},
+  "output": {"snapshot_count": 4}
+})";
 
 }  // namespace frictherm::test

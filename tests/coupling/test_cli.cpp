@@ -32,16 +32,7 @@ class Cli : public frictherm::test::ScratchDirTest {
   Cli() : ScratchDirTest("frictherm_cli_") {}
 };
 
-const char* const kTinyScene = R"({
-  // a small block moving slowly: a few dozen steps
-  "dimension": 2,
-  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
-  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
-  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
-              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
-  "run": {"end_time": 2e-3, "threads": 1},
-  "output": {"snapshot_count": 4}
-})";
+using frictherm::test::kTinyScene;
 
 // A body thrown at 2000 m/s leaves the grid after about 30 steps (t ~ 4e-4 s), after several snapshots.
 const char* const kBlowUpScene = R"({

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "cli_test_support.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -42,15 +44,7 @@ Result validate(const std::string& scene, const std::string& sets) {
   return r;
 }
 
-const char* const kBase = R"({
-  "dimension": 2,
-  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
-  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
-  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
-              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
-  "run": {"end_time": 2e-3, "threads": 1},
-  "output": {"snapshot_count": 4}
-})";
+const char* const kBase = frictherm::test::kTinyScene;
 
 class Limits : public ::testing::Test {
  protected:

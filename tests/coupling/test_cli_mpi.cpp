@@ -32,15 +32,7 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 
 // A small block moving slowly: a few dozen steps. The ensemble's seed key is the snapshot count, a
 // harmless integer that changes each member's steps (snapshot times shorten steps).
-const char* const kTinyScene = R"({
-  "dimension": 2,
-  "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
-  "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
-  "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
-              "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
-  "run": {"end_time": 2e-3, "threads": 1},
-  "output": {"snapshot_count": 4}
-})";
+using frictherm::test::kTinyScene;
 
 class CliMpi : public frictherm::test::ScratchDirTest {
  protected:
