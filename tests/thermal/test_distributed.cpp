@@ -26,12 +26,7 @@ using thermal_test::Material;
 
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
-
-double global_max(double x) {
-  double out = 0.0;
-  MPI_Allreduce(&x, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return out;
-}
+using frictherm::test::global_max;
 
 // This rank's share of a serial grid: the balanced row partition of its nodes.
 struct Part {

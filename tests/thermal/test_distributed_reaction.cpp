@@ -35,12 +35,7 @@ using thermal_test::Material;
 
 using frictherm::test::comm_rank;
 using frictherm::test::comm_size;
-
-double global_max(double x) {
-  double out = 0.0;
-  MPI_Allreduce(&x, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return out;
-}
+using frictherm::test::global_max;
 
 constexpr double kTheta = 15000.0;                   // Θ (K)
 const double kZ = 300.0 * std::exp(kTheta / 380.0);  // k(380 K) = 300 /s
