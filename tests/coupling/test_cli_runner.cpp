@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include "cli_test_support.hpp"
+
 #include <filesystem>
 #include <sstream>
 #include <unistd.h>
@@ -16,16 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The program tests' small scene (cli_test_support.hpp) with snapshots every 0.3 ms and no series.
 fc::Json tiny_scene() {
-  return fc::Json::parse(R"({
-    "dimension": 2,
-    "grid": {"lo": [0, 0], "hi": [0.1, 0.05], "cell_size": 0.01},
-    "materials": {"soft": {"type": "linear_elastic", "density": 1000, "youngs_modulus": 1e6, "poisson_ratio": 0.3}},
-    "bodies": [{"name": "block", "material": "soft", "velocity": [1, 0],
-                "shape": {"type": "rectangle", "lo": [0.02, 0.01], "hi": [0.06, 0.04]}}],
-    "run": {"end_time": 2e-3, "threads": 1},
-    "output": {"snapshot_interval": 3e-4, "series_interval": 0}
-  })");
+  fc::Json j = fc::Json::parse(frictherm::test::kTinyScene);
+  j["output"] = fc::Json::parse(R"({"snapshot_interval": 3e-4, "series_interval": 0})");
+  return j;
 }
 
 /// (step, time) of every regular snapshot, in order.

@@ -102,18 +102,9 @@ void ExplicitConduction<Dim>::assemble_node_operator(const NodalThermalSystem& s
                                        if (!r.meets(node_span(st, indexer_))) return;
                                        add_to_node_operator(st, conductance_[k], sys.unknown, 1.0, e, &r);
                                      });
-    node_kc_.clear();  // compacted in one pass
-    node_cc_.clear();
-    for (std::size_t u = 0; u < n; ++u) {
-      for (std::size_t s = u * offsets; s < (u + 1) * offsets; ++s) {
-        node_pos_[s] = -1;
-        if (node_col_[s] == static_cast<int>(u)) continue;
-        node_pos_[s] = static_cast<int>(node_kc_.size());
-        node_kc_.push_back(node_k_[s]);
-        node_cc_.push_back(node_col_[s]);
-      }
-      row_start_[u + 1] = static_cast<int>(node_kc_.size());
-    }
+    count_rows(0, n);  // the same three steps as the split path, on every row
+    sum_starts();
+    compact_rows(0, n);
   }
   node_compact_ = true;
   node_operator_ready_ = true;
