@@ -421,6 +421,7 @@ void Simulation<Dim>::map_to_grid(bool with_forces, bool take_speeds) {
   const bool fused = contact_setup_.enabled && !is_extended<Kernel> && contact_nodes_.reach_share > 0.5;
   contact_nodes_.terms_scattered = fused;
   const bool displacement = contact_setup_.options.separation == SeparationMethod::displacement;
+  const bool weightless = !is_extended<Kernel> && (g.array() == 0.0).all();
   scatter_phase(Accumulated{true, true, true, fused}, true,
                 [&](NodalFields<Dim>& acc, const NodeIndexer<Dim>& ix, std::size_t m, std::size_t kb, std::size_t ke) {
     if (take_speeds) {  // the part holding [kb, ke): the one whose range starts at or before kb
@@ -466,7 +467,10 @@ void Simulation<Dim>::map_to_grid(bool with_forces, bool take_speeds) {
     double* const domain = acc.domain.data();
     Vec<Dim>* const mass_position = acc.mass_position.data();
     Vec<Dim>* const domain_gradient = acc.domain_gradient.data();
-    const auto scatter = [&](auto with_forces_here, auto with_contact_terms) {
+    // Without gravity (3D PBX) the body force S m_p g is +0 and f_i + (+0 − V σ G) = f_i − V σ G in
+    // every bit: the sums start at +0 and never become −0, and the kernels' S are ≥ 0 (not EBS's,
+    // which keeps the full form). 3 multiplications and 3 additions less per node.
+    const auto scatter = [&](auto with_forces_here, auto with_contact_terms, auto with_gravity) {
       for (std::size_t k = kb; k < ke; ++k) {
         const double mp = p_.mass[k];
         const Vec<Dim> mv = mp * p_.velocity[k];
@@ -479,7 +483,10 @@ void Simulation<Dim>::map_to_grid(bool with_forces, bool take_speeds) {
         stk[k].for_each(index, [&](int i, double S, const Vec<Dim>& G) {
           mass[i] += S * mp;
           momentum[i] += S * mv;
-          if constexpr (decltype(with_forces_here)::value) force[i] += S * mg - Vsig * G;
+          if constexpr (decltype(with_forces_here)::value) {
+            if constexpr (decltype(with_gravity)::value) force[i] += S * mg - Vsig * G;
+            else force[i] -= Vsig * G;
+          }
           if constexpr (decltype(with_contact_terms)::value) {  // as contact_at_extrapolated scatters them
             mass_position[i] += S * mx;
             domain[i] += S * Vp;
@@ -488,12 +495,16 @@ void Simulation<Dim>::map_to_grid(bool with_forces, bool take_speeds) {
         });
       }
     };
+    const std::true_type yes;
+    const std::false_type no;
     if (fused) {
-      if (forces) scatter(std::true_type{}, std::true_type{});
-      else scatter(std::false_type{}, std::true_type{});
+      if (!forces) scatter(no, yes, yes);
+      else if (weightless) scatter(yes, yes, no);
+      else scatter(yes, yes, yes);
     } else {
-      if (forces) scatter(std::true_type{}, std::false_type{});
-      else scatter(std::false_type{}, std::false_type{});
+      if (!forces) scatter(no, no, yes);
+      else if (weightless) scatter(yes, no, no);
+      else scatter(yes, no, yes);
     }
   }, threads_.count);
 }
