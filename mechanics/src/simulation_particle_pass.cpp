@@ -204,23 +204,6 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           continue;
         }
       }
-      if constexpr (Dim == 3) {
-        if (law.mie_gruneisen()) {  // the 3D PBX materials: parameters in a local copy, as in 2D
-          const MieGruneisenParams params = mat.mie_gruneisen;
-          const double min_J = law.min_J;
-          run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()), [&](std::size_t k, const Mat<Dim>& L) {
-            // The particle's state in locals, stored back after the update (which no store of it can
-            // then make the compiler reload).
-            Mat<Dim> F = Fp[k], sigma = sigma_p[k];
-            double V = Vp[k], szz = szz_p[k], ep = ep_p[k], e = e_p[k], wp = wp_p[k], c = cp[k];
-            const bool ok = update_stress_mie_gruneisen<Dim>(params, min_J, L, dt, StressState<Dim>{F, V, V0p[k], sigma, szz, ep, e, wp, c});
-            Fp[k] = F, sigma_p[k] = sigma;
-            Vp[k] = V, szz_p[k] = szz, ep_p[k] = ep, e_p[k] = e, wp_p[k] = wp, cp[k] = c;
-            return ok;
-          });
-          continue;
-        }
-      }
       run(ix, kb, ke, Mat<Dim>(Mat<Dim>::Zero()),
           [&](std::size_t k, const Mat<Dim>& L) { return update_stress<Dim>(mat, law, an, L, dt, state(k)); });
     }

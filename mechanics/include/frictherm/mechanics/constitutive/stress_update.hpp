@@ -46,36 +46,24 @@ struct StressState {
   double& wave_speed;      // c_p of the new state (m/s), for the CFL step
 };
 
-/// F ← (I + L dt) F and V = det(F) V0 (the start of every update below).
-template <int Dim>
-FRICTHERM_ALWAYS_INLINE void deformation_update(const Mat<Dim>& L, double dt, const StressState<Dim>& s) {
-  const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
-  Mat<Dim> F_new;
-  product_into<Dim>(A, s.F, F_new);  // F_new = A F, inlined (small_products.hpp)
-  s.F = F_new;
-  s.volume = s.F.determinant() * s.initial_volume;
-}
-
-/// The Mie-Grüneisen update of update_stress (the same arithmetic) from the material's parameters:
-/// `params` best a local copy in a particle loop, as for update_stress_plane_strain below.
-template <int Dim>
-FRICTHERM_ALWAYS_INLINE bool update_stress_mie_gruneisen(const MieGruneisenParams& params, double min_J,
-                                                         const Mat<Dim>& L, double dt, const StressState<Dim>& s) {
-  deformation_update<Dim>(L, dt, s);
-  double wp = 0.0;  // plastic work per unit current volume (J/m^3)
-  const bool ok = mie_gruneisen_update<Dim>(L, dt, s.volume / s.initial_volume, params, min_J, s.stress, s.stress_zz,
-                                            s.plastic_strain, s.internal_energy, wp, &s.wave_speed) == MieGruneisenStatus::ok;
-  s.plastic_work += wp * s.volume;
-  return ok;
-}
-
 /// The update of a deformable particle from its velocity gradient L over dt; false: compressed past
 /// its Hugoniot's limit (the state is then left as mie_gruneisen_update leaves it).
 template <int Dim>
 FRICTHERM_ALWAYS_INLINE bool update_stress(const Material& mat, const StressLaw& law, Analysis an, const Mat<Dim>& L,
                                            double dt, const StressState<Dim>& s) {
-  if (law.kind == MaterialKind::mie_gruneisen) return update_stress_mie_gruneisen<Dim>(mat.mie_gruneisen, law.min_J, L, dt, s);
-  deformation_update<Dim>(L, dt, s);
+  const Mat<Dim> A = Mat<Dim>::Identity() + dt * L;
+  Mat<Dim> F_new;
+  product_into<Dim>(A, s.F, F_new);  // F_new = A F, inlined (small_products.hpp)
+  s.F = F_new;
+  s.volume = s.F.determinant() * s.initial_volume;
+  if (law.kind == MaterialKind::mie_gruneisen) {
+    double wp = 0.0;  // plastic work per unit current volume (J/m^3)
+    const bool ok = mie_gruneisen_update<Dim>(L, dt, s.volume / s.initial_volume, mat.mie_gruneisen, law.min_J, s.stress,
+                                              s.stress_zz, s.plastic_strain, s.internal_energy, wp,
+                                              &s.wave_speed) == MieGruneisenStatus::ok;
+    s.plastic_work += wp * s.volume;
+    return ok;
+  }
   if (law.kind == MaterialKind::neo_hookean) {
     neo_hookean_stress<Dim>(s.F, law.lambda, law.mu, s.stress, s.stress_zz);
     s.wave_speed = mat.wave_speed(an, s.volume / s.initial_volume);
