@@ -244,8 +244,16 @@ int main(int argc, char** argv) {
     }
   }
   const char* wp = std::getenv("OMP_WAIT_POLICY");
-  std::printf("bench_coupled: sliding-block twin; OMP_WAIT_POLICY=%s; %ld online CPUs\n", wp ? wp : "(unset)",
-              sysconf(_SC_NPROCESSORS_ONLN));
+  // The instruction set the build targets (FRICTHERM_NATIVE=ON: -march=native; docs/performance.md).
+#if defined(__AVX512F__)
+  const char* isa = "AVX-512 (native build)";
+#elif defined(__AVX2__)
+  const char* isa = "AVX2 (native build)";
+#else
+  const char* isa = "x86-64 baseline (SSE2)";
+#endif
+  std::printf("bench_coupled: sliding-block twin; OMP_WAIT_POLICY=%s; %ld online CPUs; %s\n", wp ? wp : "(unset)",
+              sysconf(_SC_NPROCESSORS_ONLN), isa);
   if (!dim2) cells.clear();
   for (const double h : cells) {
     const double end_time = h > 0.003 ? end5 : end1;

@@ -31,6 +31,10 @@ sundials_config=$(compgen -G "/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" ||
                   compgen -G "$(pwd)/.deps/sundials/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" || true)
 sundials=()
 if [ -n "$sundials_config" ]; then sundials=(-DSUNDIALS_DIR="$(dirname "$(echo "$sundials_config" | head -1)")"); fi
+# FRICTHERM_NATIVE=ON scripts/build.sh: the build optimised for this machine (-march=native: AVX2/AVX-512
+# and FMA where the CPU has them; outputs equal to round-off, docs/performance.md "Native builds").
+native=()
+if [ -n "${FRICTHERM_NATIVE:-}" ]; then native=(-DFRICTHERM_NATIVE="$FRICTHERM_NATIVE"); fi
 # A new build folder uses Ninja when installed (scripts/install_deps.sh installs ninja-build): unlike
 # CMake's Makefiles, it compiles a library's sources while the libraries it links are still compiling,
 # so both cores stay busy to the end (an existing folder keeps its generator).
@@ -42,11 +46,11 @@ if [ "$mode" = --program ]; then
     options=(-DFRICTHERM_BUILD_TESTS=OFF -DFRICTHERM_BUILD_BENCH=OFF -DFRICTHERM_WITH_MPI=OFF -DFRICTHERM_PYTHON=OFF)
   fi
   if [ "$step" != compile ]; then
-    cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${options[@]}"
+    cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${native[@]}" "${options[@]}"
   fi
   if [ "$step" != configure ]; then cmake --build "$build" -j "$jobs" --target frictherm; fi
 else
-  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" \
+  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${native[@]}" \
         -DFRICTHERM_BUILD_TESTS=ON -DFRICTHERM_BUILD_BENCH=ON -DFRICTHERM_WITH_MPI=ON -DFRICTHERM_PYTHON=ON
   cmake --build "$build" -j "$jobs"
 fi
