@@ -255,56 +255,6 @@ double DecomposedHeat::rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, co
   return rise;
 }
 
-// Pass 1: M_i and M_i T_i (eq. 38) on the ghosted box, completed at the owners; the unknowns
-// (select_unknowns' rule, max over ranks), T_i on them, M_i on the ghosted box.
-template <int Dim>
-void DecomposedHeat::gather_mass(mechanics::DecomposedMpm<Dim>& mpm) {
-  const MPI_Comm comm = mpm.communicator();
-  const std::size_t no = mpm.owned_local_nodes().size(), nl = static_cast<std::size_t>(mpm.local_node_count());
-  const typename mechanics::DecomposedMpm<Dim>::Stencils& st = mpm.current_stencils();
-  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
-  const std::vector<double> T = mpm.particle_scalar(scalar_);
-  const std::size_t np = T.size();
-  capacity_.assign(np, 0.0);
-  local_.assign(2 * nl, 0.0);
-  double particle_capacity = 0.0;
-  for (std::size_t k = 0; k < np; ++k) {
-    const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
-    if (!m.conducts) continue;
-    const double mc = P.mass[k] * m.heat_capacity, mct = mc * T[k];
-    capacity_[k] = mc;
-    particle_capacity += mc;
-    for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
-      const auto i = static_cast<std::size_t>(st.node[static_cast<std::size_t>(a)]);
-      local_[2 * i] += mc * st.S[static_cast<std::size_t>(a)];
-      local_[2 * i + 1] += mct * st.S[static_cast<std::size_t>(a)];
-    }
-  }
-  std::vector<double> mass_temp;
-  mpm.sum_to_owned(local_, 2, mass_temp);
-  double sums[3] = {0.0, particle_capacity, 0.0};  // Σ M_i, Σ m C, max M
-  for (std::size_t q = 0; q < no; ++q) sums[0] += mass_temp[2 * q], sums[2] = std::max(sums[2], mass_temp[2 * q]);
-  double reduced[2] = {sums[0], sums[1]};
-  MPI_Allreduce(MPI_IN_PLACE, reduced, 2, MPI_DOUBLE, MPI_SUM, comm);
-  MPI_Allreduce(MPI_IN_PLACE, &sums[2], 1, MPI_DOUBLE, MPI_MAX, comm);
-  if (!(reduced[1] > 0.0)) throw std::invalid_argument("decomposed heat: no particle of a material with thermal properties");
-  books_.max_capacity_residual = std::max(books_.max_capacity_residual, std::fabs(reduced[0] - reduced[1]) / reduced[1]);
-  threshold_ = opt_.assembly.active_mass_fraction * sums[2];
-  M_.assign(no, 0.0);
-  T0_.assign(no, 0.0);
-  double least[2] = {std::numeric_limits<double>::infinity(), 0.0};  // smallest unknown M, nodes dropped
-  for (std::size_t q = 0; q < no; ++q) {
-    M_[q] = mass_temp[2 * q];
-    if (is_unknown(M_[q])) T0_[q] = mass_temp[2 * q + 1] / M_[q], least[0] = std::min(least[0], M_[q]);
-    else if (M_[q] > 0.0) least[1] += 1.0;
-  }
-  MPI_Allreduce(MPI_IN_PLACE, &least[0], 1, MPI_DOUBLE, MPI_MIN, comm);
-  MPI_Allreduce(MPI_IN_PLACE, &least[1], 1, MPI_DOUBLE, MPI_SUM, comm);
-  min_unknown_mass_ = least[0];
-  books_.dropped_nodes = static_cast<long>(least[1]);
-  mpm.owned_to_local(M_, 1, local_M_);  // the same values at every rank's ghosts: the same unknowns
-}
-
 // The unknowns' global ids: this rank's owned unknowns in owned-node order after those of the lower
 // ranks (the row ranges DistributedProblem needs), and the owners' ids on the ghosted box.
 template <int Dim>
@@ -332,87 +282,6 @@ void DecomposedHeat::number_unknowns(mechanics::DecomposedMpm<Dim>& mpm) {
     number_serially(comm, owned_grid_nodes(mpm), n);
 }
 
-// Pass 1 (gather_mass) and pass 2: each heat-holding particle's kept nodes (unknowns), the lumped
-// gradients G' and V_p k_p, and the bound of λ_max(M⁻¹K) over all ranks (the smaller of the two bounds
-// of ExplicitConduction::keep). What a window and the continuation's first assembly start from.
-template <int Dim>
-double DecomposedHeat::gather_window(mechanics::DecomposedMpm<Dim>& mpm) {
-  using Vec = mechanics::Vec<Dim>;
-  using GMap = Eigen::Map<Vec>;
-  const MPI_Comm comm = mpm.communicator();
-  const std::size_t no = mpm.owned_local_nodes().size(), nl = static_cast<std::size_t>(mpm.local_node_count());
-  gather_mass(mpm);  // pass 1: M_, T0_, local_M_, capacity_
-  const typename mechanics::DecomposedMpm<Dim>::Stencils& st = mpm.current_stencils();
-  const mechanics::DecomposedLocalParticles P = mpm.local_particle_data();
-  const std::size_t np = capacity_.size();
-  const std::vector<double>& M = M_;
-  auto unknown = [this](double m) { return is_unknown(m); };
-
-  // Pass 2: each heat-holding particle's kept nodes (unknowns), the lumped gradients G' and the two
-  // bounds of λ_max(M⁻¹K) of ExplicitConduction::keep (Gershgorin row sums and Cauchy–Schwarz).
-  const std::size_t entries = st.node.size();  // at most every stencil entry is kept
-  kept_first_.resize(np + 1);
-  kept_first_[0] = 0;
-  kept_node_.resize(entries);
-  kept_S_.resize(entries);
-  kept_G_.resize(Dim * entries);
-  kept_norm_.resize(entries);
-  auto G = [this](std::size_t a) { return GMap(kept_G_.data() + Dim * a); };
-  conductance_.assign(np, 0.0);
-  local_.assign(2 * nl, 0.0);
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < np; ++k) {
-    const std::size_t begin = kept;
-    if (capacity_[k] > 0.0) {
-      double s_kept = 0.0;
-      Vec g_dropped = Vec::Zero();
-      for (int a = st.first[k]; a < st.first[k + 1]; ++a) {
-        const auto ua = static_cast<std::size_t>(a);
-        const int i = st.node[ua];
-        if (unknown(local_M_[static_cast<std::size_t>(i)])) {
-          s_kept += st.S[ua];
-          kept_node_[kept] = i;
-          kept_S_[kept] = st.S[ua];
-          G(kept) = st.G[ua];
-          ++kept;
-        } else {
-          g_dropped += st.G[ua];
-        }
-      }
-      const ThermalProperties& m = opt_.materials[static_cast<std::size_t>(P.material[k])];
-      const std::size_t end = kept;
-      if (m.conductivity > 0.0 && end > begin && s_kept > 0.0) {
-        if (end - begin < static_cast<std::size_t>(st.first[k + 1] - st.first[k]))
-          for (std::size_t a = begin; a < end; ++a) G(a) += (kept_S_[a] / s_kept) * g_dropped;  // lump
-        conductance_[k] = P.volume[k] * m.conductivity;  // V_p k_p
-        double gsum = 0.0, g2m = 0.0;
-        for (std::size_t a = begin; a < end; ++a) {
-          const double g = G(a).norm();
-          kept_norm_[a] = g;
-          gsum += g;
-          g2m += g * g / local_M_[static_cast<std::size_t>(kept_node_[a])];
-        }
-        for (std::size_t a = begin; a < end; ++a) {
-          const auto i = static_cast<std::size_t>(kept_node_[a]);
-          local_[2 * i] += conductance_[k] * kept_norm_[a] * gsum;
-          local_[2 * i + 1] += conductance_[k] * g2m;
-        }
-      }
-    }
-    kept_first_[k + 1] = static_cast<int>(kept);
-  }
-  std::vector<double> bounds;
-  mpm.sum_to_owned(local_, 2, bounds);
-  double lam[2] = {0.0, 0.0};  // Gershgorin, Rayleigh: maxima over the unknowns of all ranks
-  for (std::size_t q = 0; q < no; ++q) {
-    if (!unknown(M[q]) || is_held(q)) continue;  // rows of fixed nodes do not move: λ = 0 (as the serial bounds)
-    lam[0] = std::max(lam[0], bounds[2 * q] / M[q]);
-    lam[1] = std::max(lam[1], bounds[2 * q + 1]);
-  }
-  MPI_Allreduce(MPI_IN_PLACE, lam, 2, MPI_DOUBLE, MPI_MAX, comm);
-  return std::min(lam[0], lam[1]);
-}
-
 template <int Dim>
 void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0,
                                double dt) {
@@ -424,9 +293,7 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
     throw std::invalid_argument("decomposed heat: " + std::to_string(joules.size()) + " nodal heats for " +
                                 std::to_string(no) + " owned nodes");
   if (!(dt > 0.0)) throw std::invalid_argument("decomposed heat: window " + std::to_string(dt) + " s (expected > 0)");
-  const double lambda = gather_window(mpm);  // passes 1 and 2: M_, T0_, local_M_, capacity_, kept entries
-  std::vector<double> T = mpm.particle_scalar(scalar_);
-  const std::size_t np = T.size();
+  std::vector<double> T;
   const std::vector<double>& M = M_;
   auto unknown = [this](double m) { return is_unknown(m); };
   auto G = [this](std::size_t a) { return GMap(kept_G_.data() + Dim * a); };
@@ -436,18 +303,24 @@ void DecomposedHeat::window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::ve
   // (skipped without looking when the last bound puts it beyond twice that), else the assembled path.
   // Only with the "substep" policy and the Gershgorin estimate: "refuse", "unguarded" and "power" run
   // the serial Scheme on the assembled rows, as the serial Coupler.
-  const thermal::IntegratorOptions& io = opt_.integrator_options;
-  const bool fe = (opt_.integrator == "forward_euler" || opt_.integrator == "auto") &&
-                  io.fe_stability_policy == "substep" && io.fe_limit_estimate == "gershgorin";
+  // With coupling.reuse_distance the serial reuse of the last gather decides (reuse_window,
+  // decomposed_gather.cpp); it leaves the kept entries at the positions the window integrates from.
   const auto limit = static_cast<double>(opt_.matrix_free_max_substeps);
-  bool matrix_free = fe && opt_.matrix_free_max_substeps > 0 && !reaction_active() &&
-                     !(last_lambda_ > 0.0 && dt / (opt_.fe_safety * 2.0 / last_lambda_) > 2.0 * limit);
+  bool matrix_free = false;
   long n = 1;
-  if (matrix_free) {
-    last_lambda_ = lambda;
-    n = thermal::forward_euler_substeps(dt, lambda, opt_.fe_safety, opt_.integrator_options.fe_max_dt);  // as the serial window
-    matrix_free = n <= opt_.matrix_free_max_substeps;
+  if (reuse_on()) {
+    matrix_free = reuse_window(mpm, dt, n);
+  } else {
+    const double lambda = gather_window(mpm);  // passes 1 and 2: M_, T0_, local_M_, capacity_, kept entries
+    matrix_free = matrix_free_allowed() && !(last_lambda_ > 0.0 && dt / (opt_.fe_safety * 2.0 / last_lambda_) > 2.0 * limit);
+    if (matrix_free) {
+      last_lambda_ = lambda;
+      n = thermal::forward_euler_substeps(dt, lambda, opt_.fe_safety, opt_.integrator_options.fe_max_dt);  // as the serial window
+      matrix_free = n <= opt_.matrix_free_max_substeps;
+    }
   }
+  T = mpm.particle_scalar(scalar_);
+  const std::size_t np = T.size();
 
   // The heat: q_i = W_i / Δt on the owned unknowns. Work on a node that is not an unknown goes, as the
   // serial distribute_heat moves it, to the unknowns among its lattice neighbours (one node away along

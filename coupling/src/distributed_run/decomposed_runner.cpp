@@ -172,6 +172,7 @@ void DecomposedRun<Dim>::build() {
     h.integrator_options = c.integrator_options;
     h.preconditioner = s_.thermal.preconditioner;
     h.matrix_free_max_substeps = c.matrix_free_max_substeps;
+    h.reuse_distance = detail::gather_reuse(s_) ? c.reuse_distance : 0.0;
     h.window = c.window;
     h.plastic = c.plastic;
     h.subgrid_relaxation_time = c.subgrid_relaxation_time;

@@ -40,6 +40,12 @@ bool interface_temperature(const Scene& scene) {
   return scene.thermal.enabled && scene.thermal.coupler.interface_temperature.enabled;
 }
 
+bool gather_reuse(const Scene& scene) {
+  const CouplerOptions& c = scene.thermal.coupler;
+  return scene.thermal.enabled && scene.thermal.reuse_distance_given && c.reuse_distance > 0.0 &&
+         (c.integrator == "forward_euler" || c.integrator == "auto");
+}
+
 bool interface_reaction(const Scene& scene) {
   return interface_temperature(scene) && scene.thermal.coupler.reaction.enabled;
 }
@@ -124,6 +130,14 @@ typename mechanics::DecomposedMpm<Dim>::Options decomposed_options(const Scene& 
   // The particle's body (the serial Particles::body; exact as a double): the series' per-body means
   // and the snapshots' body field (issue 32).
   o.particle_scalars.emplace_back("body");
+  // Where each particle was last gathered (DecomposedHeatOptions::reuse_scalar), its V_p and Rayleigh
+  // term then; stencils there lie up to reuse_distance (≤ 0.5) cells from its current ones, so they
+  // may reach one node beyond the kernel's reach: one more ghost layer.
+  if (gather_reuse(scene)) {
+    for (int d = 0; d < Dim; ++d) o.particle_scalars.push_back("gathered_at_" + std::to_string(d));
+    o.particle_scalars.insert(o.particle_scalars.end(), {"gathered_at_volume", "gathered_at_rayleigh"});
+    o.extra_ghost_width = 1;
+  }
   return o;
 }
 
@@ -161,6 +175,7 @@ std::vector<typename mechanics::DecomposedMpm<Dim>::Particle> scene_particles(
         if (scene.thermal.enabled && scene.thermal.coupler.reaction.enabled) q.scalars.push_back(0.0);  // fresh
         if (interface_reaction(scene)) q.scalars.insert(q.scalars.end(), {0.0, -1.0});  // fresh, no reading yet
         q.scalars.push_back(static_cast<double>(p.body[k]));
+        if (gather_reuse(scene)) q.scalars.insert(q.scalars.end(), Dim + 2, 0.0);  // not gathered yet
       }
       for (const mechanics::ParticleLoad<Dim>& L : sim->particle_loads()) {
         packed.push_back(static_cast<double>(L.particle));
@@ -205,8 +220,8 @@ FRICTHERM_INSTANTIATE_DECOMPOSED_SETUP(3)
 void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const DecomposedHeat& heat, double pending,
                                     double particle_reaction_heat, long hotspots_seen) {
   const DecomposedHeatBooks& b = heat.books();
-  // The serial EnergyBooks from the books summed over ranks. Every matrix-free window gathers its
-  // particles afresh (no reuse, no partial refresh); the assembly residual is the worst of the heat
+  // The serial EnergyBooks from the books summed over ranks. Without the reuse every matrix-free window
+  // gathers its particles afresh (no partial refresh); the assembly residual is the worst of the heat
   // capacity's partition of unity and K·1 = 0 (assembled windows), as the serial Coupler's.
   EnergyBooks e;
   e.work_received = b.work_received;
@@ -225,8 +240,10 @@ void write_decomposed_heat_metadata(H5Output& out, const Scene& scene, const Dec
   e.max_assembly_residual = std::max(b.max_capacity_residual, b.max_row_sum_residual);
   e.matrix_free_windows = b.windows - b.assembled_windows;
   e.matrix_free_substeps = b.substeps;
-  e.matrix_free_gathers = e.matrix_free_windows;
-  e.matrix_free_refreshes = 0;
+  // With the reuse (gather_reuse) the gathers and refreshes counted as the serial Coupler counts them.
+  const bool reuse = gather_reuse(scene);
+  e.matrix_free_gathers = reuse ? b.gathers : e.matrix_free_windows;
+  e.matrix_free_refreshes = reuse ? b.refreshes : 0;
   write_thermal_metadata(out, ThermalMetadata{scene.thermal.coupler, scene.thermal.heating_order, e,
                                               heat.integrator_stats(),  // global counts
                                               particle_reaction_heat, pending, b.particle_energy_change,

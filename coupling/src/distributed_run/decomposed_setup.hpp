@@ -23,6 +23,10 @@ mechanics::Grid<Dim> scene_grid(const Scene& scene);
 bool plastic_heating(const Scene& scene);
 /// Whether the scene has the sub-cell interface temperature (thermal on, coupling.interface_temperature).
 bool interface_temperature(const Scene& scene);
+/// Whether the decomposed heat reuses the last matrix-free gather (coupling.reuse_distance > 0 set by
+/// the scene, forward_euler or auto; DecomposedHeatOptions::reuse_distance): its particle scalars and
+/// one more ghost layer. The serial default is not applied to a scene that does not set it.
+bool gather_reuse(const Scene& scene);
 
 /// The decomposed engine's options for a supported scene; the particles carry two scalars,
 /// "temperature" and "reference_temperature" (T_p and its initial value T0_p, K), and with plastic

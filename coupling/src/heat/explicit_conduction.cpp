@@ -419,14 +419,11 @@ typename ExplicitConduction<Dim>::Refresh ExplicitConduction<Dim>::refresh_with(
       }
     }
 #endif
-    for (; k < p.size(); ++k) {
-      bool within = std::fabs(now_at[k][0] - at[k][0]) <= max_shift;
-      for (int d = 1; d < Dim; ++d) within &= std::fabs(now_at[k][d] - at[k][d]) <= max_shift;
-      if (!within && holds[k]) moved_.push_back(k);
-    }
+    for (; k < p.size(); ++k)
+      if (moved_beyond(now_at[k].data(), at[k].data(), max_shift) && holds[k]) moved_.push_back(k);
   }
   if (moved_.empty()) return Refresh::kept;
-  if (4 * moved_.size() > holding_) return Refresh::regather;  // a full gather costs less
+  if (too_many_moved(moved_.size(), holding_)) return Refresh::regather;  // a full gather costs less
 
   // M_i on every node (eq. 38): each moved particle's weights at its last gather out, at its
   // position now in (the step's stencils when given: the same numbers as evaluating them here).

@@ -3,7 +3,6 @@
 // support is refused with the scene key, its value and the way out (the serial run).
 #include <frictherm/coupling/decomposed_support.hpp>
 
-#include <sstream>
 #include <string>
 
 namespace frictherm::coupling {
@@ -11,13 +10,6 @@ namespace frictherm::coupling {
 namespace {
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
-
-std::string number(double v) {
-  std::ostringstream o;
-  o.precision(9);
-  o << v;
-  return o.str();
-}
 
 // "KEY: VALUE is not supported in a decomposed run (expected ...); the serial run (without mpirun,
 // or mpirun -n 1) supports it".
@@ -61,20 +53,14 @@ std::string contact_refusal(const Scene& s) {
 }
 
 std::string thermal_refusal(const Scene& s) {
-  const ThermalSceneSpec& t = s.thermal;
-  if (!t.enabled) return "";
-  const CouplerOptions& c = t.coupler;
+  if (!s.thermal.enabled) return "";
   // Every integrator name runs (DecomposedHeat: matrix-free forward Euler, or the distributed integrator
   // of that name on the assembled rows); every linear solver: "klu", the serial sparse direct solve, as
   // MUMPS' sparse direct LU of I − γJ over the ranks preconditioning PCG (make_distributed_integrator).
-  const thermal::IntegratorOptions& io = c.integrator_options;
   // Matrix-free windows with the serial "substep" policy and the Gershgorin estimate; every other
   // policy and estimate runs, as serially, the serial forward Euler Scheme on the assembled rows
   // ("refuse" stops every rank alike: the limit is reduced over ranks; "power" iterates with reduced
   // dot products from the serial start vector: DistributedProblem::lambda_max_power).
-  const bool matrix_free = (c.integrator == "forward_euler" || c.integrator == "auto") &&
-                           c.matrix_free_max_substeps > 0 && io.fe_stability_policy == "substep" &&
-                           io.fe_limit_estimate == "gershgorin";
   // thermal.forward_euler.max_dt caps the sub-steps of both paths (as the serial Coupler's window).
   // Fixed-temperature faces run (DecomposedHeat: the serial for_each_fixed_node, both paths).
   // The reaction runs on assembled windows (DecomposedHeat, decomposed_reaction.cpp; the distributed
@@ -85,12 +71,9 @@ std::string thermal_refusal(const Scene& s) {
   // (patch_length > 0) from every rank's heated nodes gathered; its checkpoints hold each rank's
   // histories (resumed on the rank count that wrote them).
   // Every window policy runs (every_step, every_n_steps, adaptive: DecomposedHeat::after_step). Matrix-free
-  // windows gather every window: the serial reuse of the last gather is not decomposed. The default
-  // reuse distance is a speed-up of the serial run, so a scene that does not set it runs (gathering
-  // every window, the exact form); one that asks for reuse is told.
-  if (matrix_free && c.reuse_distance != 0.0 && t.reuse_distance_given)
-    return refuse("coupling.reuse_distance", number(c.reuse_distance),
-                  "0 or no key: the gather every window, or an integrator other than forward_euler and auto");
+  // windows reuse the last gather as the serial ones when the scene sets coupling.reuse_distance > 0
+  // (DecomposedHeat::reuse_window, the particles' gather positions in particle scalars); without the
+  // key they gather every window (the serial default reuse distance is not applied there).
   // Plastic heating and the sub-grid relaxation run (DecomposedHeat, decomposed_sources.cpp).
   // The continuation runs (DecomposedHeat::continue_thermal, the fates reduced over ranks), with
   // checkpoints during the loading and at its end (a resume from the end reruns the continuation).

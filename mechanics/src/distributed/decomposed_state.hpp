@@ -339,6 +339,7 @@ struct DecomposedMpm<Dim>::Impl {
   int scalars = 0;                       // particle scalars per particle (opt.particle_scalars)
   Stencils current;                      // current_stencils(), valid until the next step or add
   bool current_valid = false;
+  void stencils_at(const double* x, Stencils& out) const;  // transfer.cpp (x null: the current positions)
   std::vector<int> owned_local_int;      // owned_local as int (owned_local_nodes())
   std::vector<Stencil<Dim, LinearKernel>> stencils_linear;
   std::vector<Stencil<Dim, UGIMPKernel>> stencils_ugimp;

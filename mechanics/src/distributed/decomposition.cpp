@@ -142,7 +142,8 @@ DecomposedMpm<Dim>::DecomposedMpm(MPI_Comm comm, const Grid<Dim>& grid, const st
   if (options.shape == ShapeKind::extended_bspline && !(options.ebs_occupation >= 0.0 && options.ebs_occupation <= 1.0))
     throw std::invalid_argument("decomposed mechanics: ebs_occupation " + std::to_string(options.ebs_occupation) +
                                 " (expected a number in [0, 1])");
-  s.width = stencil_reach(options.shape);
+  if (options.extra_ghost_width < 0) throw std::invalid_argument("decomposed mechanics: extra_ghost_width < 0");
+  s.width = stencil_reach(options.shape) + options.extra_ghost_width;
   s.comm = comm;
   MPI_Comm_rank(comm, &s.rank);
   MPI_Comm_size(comm, &s.size);

@@ -85,24 +85,23 @@ DecomposedLocalParticles DecomposedMpm<Dim>::local_particle_data(bool kinematics
   return out;
 }
 
+// S_ip and G_ip of this rank's particles at x (Dim values per particle, swarm order) with their
+// half-widths, in the local numbering (current_stencils at the current positions, stencils_at).
 template <int Dim>
-const typename DecomposedMpm<Dim>::Stencils& DecomposedMpm<Dim>::current_stencils() {
-  Impl& s = *impl_;
-  if (s.current_valid) return s.current;
-  dispatch_shape(s.opt.shape, [&](auto kernel) {
+void DecomposedMpm<Dim>::Impl::stencils_at(const double* x, Stencils& c) const {
+  dispatch_shape(opt.shape, [&](auto kernel) {
     using Kernel = decltype(kernel);
-    SwarmFields f(s.swarm);
-    Stencils& c = s.current;
+    SwarmFields f(swarm);
     const auto n = static_cast<std::size_t>(f.n);
     c.first.assign(1, 0);
     c.node.clear();
     c.S.clear();
     c.G.clear();
-    const NodeIndexer<Dim> ix = s.local_indexer();
+    const NodeIndexer<Dim> ix = local_indexer();
     Stencil<Dim, Kernel> st;
     for (std::size_t k = 0; k < n; ++k) {
-      st.evaluate(s.grid, Eigen::Map<const Vec<Dim>>(f.x + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
-      if (!s.in_box(st))
+      st.evaluate(grid, Eigen::Map<const Vec<Dim>>((x ? x : f.x) + Dim * k), Eigen::Map<const Vec<Dim>>(f.half_size + Dim * k));
+      if (!in_box(st))
         throw std::logic_error("decomposed mechanics: particle " + std::to_string(f.id[k]) +
                                " reaches nodes outside its rank's ghosted box (not migrated?)");
       st.for_each(ix, [&](int i, double S, const Vec<Dim>& G) {
@@ -113,8 +112,24 @@ const typename DecomposedMpm<Dim>::Stencils& DecomposedMpm<Dim>::current_stencil
       c.first.push_back(static_cast<int>(c.node.size()));
     }
   });
+}
+
+template <int Dim>
+const typename DecomposedMpm<Dim>::Stencils& DecomposedMpm<Dim>::current_stencils() {
+  Impl& s = *impl_;
+  if (s.current_valid) return s.current;
+  s.stencils_at(nullptr, s.current);
   s.current_valid = true;
   return s.current;
+}
+
+template <int Dim>
+typename DecomposedMpm<Dim>::Stencils DecomposedMpm<Dim>::stencils_at(const std::vector<double>& x) const {
+  if (x.size() != Dim * local_particles())
+    throw std::invalid_argument("decomposed mechanics: stencils_at takes Dim positions per local particle");
+  Stencils c;
+  impl_->stencils_at(x.data(), c);
+  return c;
 }
 
 template <int Dim>
@@ -204,6 +219,7 @@ void DecomposedMpm<Dim>::owned_to_local(const std::vector<double>& owned, int co
   template void DecomposedMpm<D>::set_particle_scalar(int, const std::vector<double>&);                \
   template DecomposedLocalParticles DecomposedMpm<D>::local_particle_data(bool) const;                     \
   template const DecomposedMpm<D>::Stencils& DecomposedMpm<D>::current_stencils();                     \
+  template DecomposedMpm<D>::Stencils DecomposedMpm<D>::stencils_at(const std::vector<double>&) const; \
   template int DecomposedMpm<D>::local_node_count() const;                                             \
   template const std::vector<int>& DecomposedMpm<D>::owned_local_nodes() const;                        \
   template const Grid<D>& DecomposedMpm<D>::grid() const;                                               \

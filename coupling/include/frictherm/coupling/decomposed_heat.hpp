@@ -19,7 +19,10 @@
 //     thermal::DistributedIntegrator of the scene's name ("auto": cvode_bdf) on N_Vector_Parallel,
 //     the Krylov path preconditioned by a PETSc PC (jacobi, bjacobi, hypre BoomerAMG);
 //
-// and T_p += Σ_i S_ip ΔT_i (design §4, ghost ΔT_i from the owners). Windows as the serial Coupler:
+// and T_p += Σ_i S_ip ΔT_i (design §4, ghost ΔT_i from the owners). With reuse_distance > 0 the
+// matrix-free windows reuse the last gather as the serial ones (ExplicitConduction::refresh): S_ip,
+// G'_ip, M_i and the bounds from where each particle was last gathered, the decisions over all ranks
+// (decomposed_gather.cpp). Windows as the serial Coupler:
 // every step, every n steps, or adaptive (closed when the pending heat would raise some node by more
 // than max_temperature_rise, estimated as W_i / M_i with M of the last window: Coupler::mass_estimate
 // over the node's lattice neighbours; or after max_duration / max_steps), and by the caller.
@@ -42,7 +45,7 @@
 // same nodes, held in both paths). The sub-cell interface temperature on the owned nodes
 // (decomposed_interface.cpp) and the Arrhenius reaction with λ_p as a particle scalar
 // (decomposed_reaction.cpp), as the serial Coupler. Differences from the serial Coupler: that
-// refusal; the reuse of matrix-free gathers is absent; the KLU solver's place is taken by MUMPS' sparse
+// refusal; the KLU solver's place is taken by MUMPS' sparse
 // direct LU preconditioning PCG (docs/distributed_coupling.md, docs/distributed_run.md).
 #include <frictherm/coupling/coupler.hpp>
 #include <frictherm/coupling/distributed.hpp>
@@ -82,6 +85,13 @@ struct DecomposedHeatOptions {
   thermal::IntegratorOptions integrator_options;
   std::string preconditioner = "jacobi";  // of the Krylov path: "jacobi", "bjacobi" or "hypre"
   long matrix_free_max_substeps = 64;     // CouplerOptions::matrix_free_max_substeps (0: never matrix-free)
+  /// CouplerOptions::reuse_distance (cells; 0: every matrix-free window gathers afresh): the serial
+  /// reuse of the last matrix-free gather (ExplicitConduction::refresh, decomposed_gather.cpp), each
+  /// particle's gather position, V_p and Rayleigh bound term in the particle scalars named
+  /// reuse_scalar + "_0" … "_<Dim-1>", "_volume", "_rayleigh" (they migrate with the particles; the
+  /// mechanics' ghosted box one node wider: DecomposedMpm::Options::extra_ghost_width).
+  double reuse_distance = 0.0;
+  std::string reuse_scalar = "gathered_at";
   WindowPolicy window;                    // every_step (default), every_n_steps, adaptive
   /// Plastic heating (CouplerOptions::plastic): after every step β Δw_p S_ip on the nodes joins the
   /// pending heat (decomposed_sources.cpp); Δw_p against the particle scalar named below, which
@@ -133,6 +143,7 @@ struct DecomposedHeatBooks {
   long steps = 0;                       // mechanics steps seen (after_step)
   double min_window = 0.0, max_window = 0.0;  // s (0 before the first window)
   long dropped_nodes = 0;               // last window: nodes with mass that are not unknowns
+  long gathers = 0, refreshes = 0;      // with reuse_distance: matrix-free gathers, refreshes (EnergyBooks)
   long exchanges = 0;                   // grid exchanges (sum_to_owned, owned_to_local): 4 + 2 n per window (+1 relocating, +1 per step with plastic heating)
 };
 
@@ -244,6 +255,13 @@ class DecomposedHeat {
                            {"books/dropped_nodes", &b.dropped_nodes}, {"books/exchanges", &b.exchanges},
                            {"window/steps", &window_steps_}})
       v(name, *x);
+    if (opt_.reuse_distance > 0.0) {  // the reuse (decomposed_gather.cpp): its counts
+      v("books/gathers", b.gathers);
+      v("books/refreshes", b.refreshes);
+      // As the serial resume (Coupler::visit_state assembles, a new Coupler has no bound yet): the
+      // first window after it gathers anew.
+      if constexpr (std::decay_t<V>::reading) reuse_gathered_ = reuse_quick_ = reuse_exact_ = false, last_lambda_ = 0.0;
+    }
     v("window/pending", pending_);
     v("gather/M", M_);
     v("gather/T", T0_);
@@ -273,8 +291,17 @@ class DecomposedHeat {
   bool is_held(std::size_t u) const { return !face_temperature_.empty() && !std::isnan(face_temperature_[u]); }
   template <int Dim>
   void window_on(mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& joules, double t0, double dt);
-  template <int Dim> void gather_mass(mechanics::DecomposedMpm<Dim>& mpm);
-  template <int Dim> double gather_window(mechanics::DecomposedMpm<Dim>& mpm);
+  // decomposed_gather.cpp: the gather (pass 1 M_i and T_i; pass 2 the kept entries and the bounds of
+  // λ_max(M⁻¹K)) from the particles' current stencils or from `at` (their stencils where last gathered),
+  // and the reuse of the last gather (reuse_window: the serial Coupler::matrix_free_window's decisions).
+  template <int Dim>
+  void gather_mass(mechanics::DecomposedMpm<Dim>& mpm, const typename mechanics::DecomposedMpm<Dim>::Stencils* at = nullptr);
+  template <int Dim>
+  double gather_window(mechanics::DecomposedMpm<Dim>& mpm,
+                       const typename mechanics::DecomposedMpm<Dim>::Stencils* at = nullptr);
+  bool matrix_free_allowed() const;
+  bool reuse_on() const { return opt_.reuse_distance > 0.0 && matrix_free_allowed(); }
+  template <int Dim> bool reuse_window(mechanics::DecomposedMpm<Dim>& mpm, double dt, long& substeps);
   template <int Dim> void continue_on(mechanics::DecomposedMpm<Dim>& mpm, double time);
   template <int Dim> double mass_estimate(const mechanics::DecomposedMpm<Dim>& mpm, std::size_t owned) const;
   template <int Dim> double rise_of_step(const mechanics::DecomposedMpm<Dim>& mpm, const std::vector<double>& work) const;
@@ -336,6 +363,19 @@ class DecomposedHeat {
   double time_ = 0.0, window_start_ = 0.0, max_rise_ = 0.0;
   long window_steps_ = 0;
   double last_lambda_ = 0.0;  // λ bound of the last matrix-free decision (Coupler::last_lambda_bound_)
+  // The reuse (reuse_distance): the particle scalars (Dim gather positions, V_p, Rayleigh term), and
+  // the serial Coupler's and ExplicitConduction's state: a gather to reuse, last_lambda_ the quick
+  // bound, the exact bounds made since the gather, heat-holding particles (all ranks), M_peak / M,
+  // and by owned node M_peak since the bounds and whether it was an unknown of the gather.
+  std::vector<int> reuse_scalars_;
+  bool reuse_gathered_ = false, reuse_quick_ = false, reuse_exact_ = false;
+  double reuse_holding_ = 0.0, rayleigh_scale_ = 1.0;
+  std::vector<double> mass_peak_, gathered_unknown_;
+  // gather_window with reuse: V_p by particle (its gather's), the Rayleigh terms to sum (NaN: anew),
+  // the new ones, and the maxima over ranks: Gershgorin, Rayleigh, quick, Rayleigh of the kept terms.
+  const std::vector<double>* gather_volume_ = nullptr;
+  std::vector<double> rayleigh_kept_, rayleigh_fresh_;
+  double bounds_[4] = {0.0, 0.0, 0.0, 0.0};
   std::unique_ptr<DecomposedAssembledSolve> assembled_;  // the distributed integrator (assembled path)
   // The last window's (or interval's) end T_i per owned node and whether it was assembled (its problem
   // kept in assembled_): where the continuation starts (Coupler::nodal_temperature_, system_assembled_).

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -74,6 +75,17 @@ class ExplicitConduction {
                   mechanics::ShapeKind shape, const std::vector<ThermalProperties>& materials,
                   const AssemblyOptions& options, NodalThermalSystem& sys, double max_shift,
                   const mechanics::StencilView<Dim>& stencils = {});
+
+  /// refresh()'s decisions, also those of the decomposed run's reuse (DecomposedHeat, so that both
+  /// decide alike): a particle last gathered at `at` is gathered again at `now` (Dim coordinates each)
+  /// when some coordinate moved by more than max_shift; a full gather is asked for when more than a
+  /// quarter of the heat-holding particles would be gathered again.
+  static bool moved_beyond(const double* now, const double* at, double max_shift) {
+    bool within = std::fabs(now[0] - at[0]) <= max_shift;
+    for (int d = 1; d < Dim; ++d) within &= std::fabs(now[d] - at[d]) <= max_shift;
+    return !within;
+  }
+  static bool too_many_moved(std::size_t moved, std::size_t holding) { return 4 * moved > holding; }
 
   /// With the kept stencils and M (refresh() kept or refreshed): T_i from the current particle
   /// temperatures (eq. 38) into sys.temperature. M, the unknowns and the bounds stay. The sums

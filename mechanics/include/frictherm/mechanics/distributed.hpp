@@ -252,6 +252,9 @@ class DecomposedMpm {
     /// Per-particle scalars the swarm carries for coupled physics (e.g. "temperature"): registered as
     /// one swarm field, migrated with the particles, untouched by the step.
     std::vector<std::string> particle_scalars;
+    /// Ghost layers beyond the kernel's reach (stencil_width() = reach + this): stencils at positions
+    /// up to this many cells from the current ones stay in the ghosted box (stencils_at).
+    int extra_ghost_width = 0;
   };
 
   /// The shape functions of this rank's particles at their current positions (after the last step's
@@ -360,6 +363,10 @@ class DecomposedMpm {
   /// S_ip and G_ip at the particles' current positions, evaluated once after each step (the serial
   /// Stencil, as the step evaluates them).
   const Stencils& current_stencils();
+  /// The same at positions x (Dim values per local particle, swarm order; the particles' own
+  /// half-widths), e.g. where each was last gathered; std::logic_error if a stencil leaves the ghosted
+  /// box (Options::extra_ghost_width widens it).
+  Stencils stencils_at(const std::vector<double>& x) const;
   /// Nodes of the ghosted box (the local numbering) and, per owned node (x fastest over
   /// owned_nodes()), its local node.
   int local_node_count() const;
