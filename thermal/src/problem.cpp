@@ -132,10 +132,7 @@ void Problem::check_source_vector(const Eigen::VectorXd& q, const char* what) co
 
 void Problem::set_source(Eigen::VectorXd q) {
   check_source_vector(q, "set_source");
-  q0_ = std::move(q);
-  q1_ = q0_;
-  ramp_t0_ = ramp_t1_ = 0.0;
-  has_source_ = true;
+  source_.set_constant(std::move(q));
 }
 
 void Problem::set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1, double t0, double t1) {
@@ -146,25 +143,19 @@ void Problem::set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1, double t0,
     os << "set_source_ramp: need finite t1 > t0, got [" << t0 << ", " << t1 << "]";
     fail(os.str());
   }
-  q0_ = std::move(q0);
-  q1_ = std::move(q1);
-  ramp_t0_ = t0;
-  ramp_t1_ = t1;
-  has_source_ = true;
+  source_.set_ramp(std::move(q0), std::move(q1), t0, t1);
 }
 
 void Problem::clear_source() {
-  has_source_ = false;
-  q0_.resize(0);
-  q1_.resize(0);
+  source_ = SourceRamp{};
 }
 
 Eigen::VectorXd Problem::source(double t) const {
-  if (!has_source_) return Eigen::VectorXd::Zero(size());
-  if (ramp_t1_ <= ramp_t0_) return q0_;
+  if (!source_.active) return Eigen::VectorXd::Zero(size());
+  if (!source_.ramped()) return source_.q0;
   // Linear waveform over the window, clamped outside it.
-  const double s = std::clamp((t - ramp_t0_) / (ramp_t1_ - ramp_t0_), 0.0, 1.0);
-  return q0_ + s * (q1_ - q0_);
+  const double s = source_.fraction(t);
+  return source_.q0 + s * (source_.q1 - source_.q0);
 }
 
 void Problem::set_dirichlet(Index node, double temperature) {
@@ -290,13 +281,11 @@ void Problem::transport_heat_rate(double t, const Eigen::Ref<const Eigen::Vector
   // w = −K T + q(t) + f + hA ⊙ (T_inf − T)   (eq. 37 right-hand side plus boundaries)
   w.noalias() = -(k_ * temperature);
   w += flux_ + ha_tinf_ - ha_.cwiseProduct(temperature);
-  if (has_source_) {
-    if (ramp_t1_ <= ramp_t0_) {
-      w += q0_;
-    } else {
-      const double s = std::clamp((t - ramp_t0_) / (ramp_t1_ - ramp_t0_), 0.0, 1.0);
-      w += (1.0 - s) * q0_ + s * q1_;
-    }
+  if (source_.ramped()) {
+    const double s = source_.fraction(t);
+    w += (1.0 - s) * source_.q0 + s * source_.q1;
+  } else if (source_.active) {
+    w += source_.q0;
   }
   for (Index d : dirichlet_nodes_) w[d] = 0.0;
 }

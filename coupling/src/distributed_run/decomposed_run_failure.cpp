@@ -9,7 +9,7 @@ template <int Dim>
 void DecomposedRun<Dim>::write_failure(long step, double time) {
   const std::vector<typename Mpm::Particle> all = mpm_->gather();
   if (rank_ != 0 || !out_) return;
-  try {
+  detail::write_failure_record(*out_, step, time, r_.message, [&] {
     const std::size_t n = all.size();
     std::vector<double> position(n * Dim), velocity(n * 3, 0.0);
     std::vector<std::int32_t> material(n);
@@ -20,19 +20,10 @@ void DecomposedRun<Dim>::write_failure(long step, double time) {
       }
       material[k] = all[k].material;
     }
-    out_->begin_failure(step, time, r_.message);
     out_->snapshot_field("position", position.data(), n, Dim);
     out_->snapshot_field("velocity", velocity.data(), n, 3);
     out_->snapshot_field("material", material.data(), n);
-    out_->end_snapshot();
-  } catch (const std::exception& e) {
-    r_.message += std::string(" (the failing state was not written: ") + e.what() + ")";
-  }
-  try {
-    out_->write_metadata("failure", r_.message);
-  } catch (const std::exception& e) {  // finish_output says that the result is incomplete
-    note_write_error(e.what());
-  }
+  }, [&](const char* what) { note_write_error(what); });  // finish_output says that the result is incomplete
 }
 
 template <int Dim>

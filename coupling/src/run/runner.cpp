@@ -212,18 +212,11 @@ class Run {
     progress.finish();
     r_.status = RunResult::Status::failed;
     r_.message = message;
-    try {
-      out_->begin_failure(step, time, message);
-      detail::write_fields<Dim>(*out_, *sim_, snapshot_field_names(Dim));
-      out_->end_snapshot();
-    } catch (const std::exception& e) {
-      r_.message += std::string(" (the failing state was not written: ") + e.what() + ")";
-    }
-    try {
-      out_->write_metadata("failure", r_.message);
-    } catch (const std::exception& e) {  // the end of execute() says that the result is incomplete
-      if (write_error_.empty()) write_error_ = e.what();
-    }
+    detail::write_failure_record(
+        *out_, step, time, r_.message, [&] { detail::write_fields<Dim>(*out_, *sim_, snapshot_field_names(Dim)); },
+        [&](const char* what) {  // the end of execute() says that the result is incomplete
+          if (write_error_.empty()) write_error_ = what;
+        });
   }
 
   std::string write_error_;  // the first write that failed while the run was being ended

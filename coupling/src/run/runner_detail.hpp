@@ -62,6 +62,27 @@ template <int Dim>
 std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemory& memory,
                                mechanics::HeatingOrder order);
 
+/// A failed run's record (serial and decomposed runs): the failing state under /failure, its fields
+/// written by write_state into the open snapshot, and `message` as the metadata "failure". A state
+/// that cannot be written is named in `message`; a message that cannot be written goes to
+/// on_write_error (the run's end then says that the result is incomplete).
+template <class WriteState, class OnWriteError>
+void write_failure_record(H5Output& out, long step, double time, std::string& message, WriteState&& write_state,
+                          OnWriteError&& on_write_error) {
+  try {
+    out.begin_failure(step, time, message);
+    write_state();
+    out.end_snapshot();
+  } catch (const std::exception& e) {
+    message += std::string(" (the failing state was not written: ") + e.what() + ")";
+  }
+  try {
+    out.write_metadata("failure", message);
+  } catch (const std::exception& e) {
+    on_write_error(e.what());
+  }
+}
+
 /// Writes the named per-particle fields of the current state into the open snapshot.
 template <int Dim>
 void write_fields(H5Output& out, const mechanics::Simulation<Dim>& sim, const std::vector<std::string>& fields);

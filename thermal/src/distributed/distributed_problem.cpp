@@ -106,7 +106,7 @@ DistributedProblem::DistributedProblem(MPI_Comm comm, Index global_size, Index f
 
   fixed_.assign(static_cast<std::size_t>(n), 0);
   fixed_value_ = Eigen::VectorXd::Zero(n);
-  q0_ = q1_ = Eigen::VectorXd::Zero(n);
+  source_.q0 = source_.q1 = Eigen::VectorXd::Zero(n);
 
   // Owner of each ghost for the traffic figures.
   std::vector<int> owner_of_count(static_cast<std::size_t>(ranks_), 0);
@@ -186,9 +186,7 @@ void DistributedProblem::set_source(Eigen::VectorXd q) {
   if (q.size() != local_size() || !q.allFinite()) {
     fail("set_source: need " + std::to_string(local_size()) + " finite owned values [W]");
   }
-  q0_ = q1_ = std::move(q);
-  ramp_t0_ = ramp_t1_ = 0.0;
-  has_source_ = true;
+  source_.set_constant(std::move(q));
 }
 
 void DistributedProblem::set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1, double t0, double t1) {
@@ -196,22 +194,11 @@ void DistributedProblem::set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1,
     fail("set_source_ramp: need q0, q1 with " + std::to_string(local_size()) + " finite owned values [W]");
   }
   if (!(std::isfinite(t0) && std::isfinite(t1) && t1 > t0)) fail("set_source_ramp: need finite t1 > t0");
-  q0_ = std::move(q0);
-  q1_ = std::move(q1);
-  ramp_t0_ = t0;
-  ramp_t1_ = t1;
-  has_source_ = true;
+  source_.set_ramp(std::move(q0), std::move(q1), t0, t1);
 }
 
 void DistributedProblem::source(double t, Eigen::Ref<Eigen::VectorXd> q) const {
-  if (!has_source_) {
-    q.setZero();
-  } else if (ramp_t1_ <= ramp_t0_) {
-    q = q0_;
-  } else {
-    const double s = std::clamp((t - ramp_t0_) / (ramp_t1_ - ramp_t0_), 0.0, 1.0);
-    q = (1.0 - s) * q0_ + s * q1_;  // as Problem::transport_heat_rate
-  }
+  source_.evaluate(t, q);  // as Problem::transport_heat_rate
   for (Index d : dirichlet_local_) q[d] = 0.0;
 }
 
@@ -267,8 +254,10 @@ void DistributedProblem::heat_rate(double t, const double* temperature, double* 
   const Index n = local_size();
   const double* kv = k_.valuePtr();
   double s = 0.0;
-  const bool ramp = has_source_ && ramp_t1_ > ramp_t0_;
-  if (ramp) s = std::clamp((t - ramp_t0_) / (ramp_t1_ - ramp_t0_), 0.0, 1.0);
+  const bool ramp = source_.ramped();
+  if (ramp) s = source_.fraction(t);
+  const double* q0 = source_.q0.data();
+  const double* q1 = source_.q1.data();
   for (Index i = 0; i < n; ++i) {
     if (fixed_[static_cast<std::size_t>(i)]) {
       w[i] = 0.0;
@@ -280,7 +269,7 @@ void DistributedProblem::heat_rate(double t, const double* temperature, double* 
       acc += kv[e] * (c < n ? temperature[c] : g[c - n]);
     }
     double wi = -acc;
-    if (has_source_) wi += ramp ? (1.0 - s) * q0_[i] + s * q1_[i] : q0_[i];
+    if (source_.active) wi += ramp ? (1.0 - s) * q0[i] + s * q1[i] : q0[i];
     w[i] = wi;
   }
 }
@@ -296,10 +285,10 @@ double DistributedProblem::thermal_energy(const Eigen::VectorXd& temperature) co
 double DistributedProblem::source_heat(double t0, double t1) const {
   // q is piecewise linear in t (kinks at the ramp ends): the midpoint rule is exact per piece.
   double local = 0.0;
-  if (has_source_ && t1 > t0) {
+  if (source_.active && t1 > t0) {
     std::vector<double> cuts{t0};
-    if (ramp_t1_ > ramp_t0_) {
-      for (double c : {ramp_t0_, ramp_t1_}) {
+    if (source_.ramped()) {
+      for (double c : {source_.t0, source_.t1}) {
         if (c > t0 && c < t1) cuts.push_back(c);
       }
     }

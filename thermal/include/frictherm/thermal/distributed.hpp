@@ -18,6 +18,7 @@
 
 #include "frictherm/thermal/integrator.hpp"
 #include "frictherm/thermal/reaction.hpp"
+#include "frictherm/thermal/source_ramp.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -142,9 +143,7 @@ class DistributedProblem {
   Index global_size_ = 0, first_ = 0;
   Eigen::VectorXd mass_;
   SparseMatrix k_;
-  bool has_source_ = false;
-  Eigen::VectorXd q0_, q1_;
-  double ramp_t0_ = 0.0, ramp_t1_ = 0.0;
+  SourceRamp source_;
   bool has_reaction_ = false;
   Reaction reaction_;
   std::vector<unsigned char> fixed_;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "frictherm/thermal/reaction.hpp"
+#include "frictherm/thermal/source_ramp.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -49,7 +50,7 @@ class Problem {
   // at q1 after t1. Requires t1 > t0.
   void set_source_ramp(Eigen::VectorXd q0, Eigen::VectorXd q1, double t0, double t1);
   void clear_source();
-  bool has_source() const { return has_source_; }
+  bool has_source() const { return source_.active; }
   // q(t), the total source per node (zeros without a source).
   Eigen::VectorXd source(double t) const;
 
@@ -124,9 +125,7 @@ class Problem {
 
   Eigen::VectorXd mass_;
   SparseMatrix k_;
-  bool has_source_ = false;
-  Eigen::VectorXd q0_, q1_;
-  double ramp_t0_ = 0.0, ramp_t1_ = 0.0;
+  SourceRamp source_;
   std::vector<unsigned char> fixed_;
   std::vector<Index> dirichlet_nodes_;
   Eigen::VectorXd fixed_value_;
