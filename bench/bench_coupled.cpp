@@ -244,11 +244,11 @@ int main(int argc, char** argv) {
     }
   }
   const char* wp = std::getenv("OMP_WAIT_POLICY");
-  // The instruction set the build targets (FRICTHERM_NATIVE=ON: -march=native; docs/performance.md).
+  // The instruction set the build targets (FRICTHERM_ARCH, cmake/Arch.cmake; docs/performance.md).
 #if defined(__AVX512F__)
-  const char* isa = "AVX-512 (native build)";
-#elif defined(__AVX2__)
-  const char* isa = "AVX2 (native build)";
+  const char* isa = "AVX-512 (FRICTHERM_ARCH=native)";
+#elif defined(__AVX2__) && defined(__FMA__)
+  const char* isa = "x86-64-v3: AVX2 + FMA";
 #else
   const char* isa = "x86-64 baseline (SSE2)";
 #endif

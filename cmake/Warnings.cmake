@@ -3,8 +3,5 @@ function(frictherm_set_warnings target)
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
                            -Wnon-virtual-dtor -Wcast-align -Wunused -Woverloaded-virtual)
-    if(FRICTHERM_NATIVE)
-      target_compile_options(${target} PRIVATE -march=native)
-    endif()
   endif()
 endfunction()

@@ -31,10 +31,11 @@ sundials_config=$(compgen -G "/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" ||
                   compgen -G "$(pwd)/.deps/sundials/usr/lib/*/cmake/sundials/SUNDIALSConfig.cmake" || true)
 sundials=()
 if [ -n "$sundials_config" ]; then sundials=(-DSUNDIALS_DIR="$(dirname "$(echo "$sundials_config" | head -1)")"); fi
-# FRICTHERM_NATIVE=ON scripts/build.sh: the build optimised for this machine (-march=native: AVX2/AVX-512
-# and FMA where the CPU has them; outputs equal to round-off, docs/performance.md "Native builds").
+# FRICTHERM_ARCH=portable|auto|x86-64-v3|native scripts/build.sh: the instruction set (cmake/Arch.cmake;
+# default portable: SSE2, the same bits on every machine; auto: AVX2 + FMA when this machine runs them,
+# 9-15 % faster, outputs equal to round-off; docs/performance.md "Instruction sets").
 native=()
-if [ -n "${FRICTHERM_NATIVE:-}" ]; then native=(-DFRICTHERM_NATIVE="$FRICTHERM_NATIVE"); fi
+if [ -n "${FRICTHERM_ARCH:-}" ]; then native=(-DFRICTHERM_ARCH="$FRICTHERM_ARCH"); fi
 # A new build folder uses Ninja when installed (scripts/install_deps.sh installs ninja-build): unlike
 # CMake's Makefiles, it compiles a library's sources while the libraries it links are still compiling,
 # so both cores stay busy to the end (an existing folder keeps its generator).
