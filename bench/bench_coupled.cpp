@@ -18,6 +18,7 @@
 // 3D: 100 steps. --repeat N (default 3): the idle cases N times, interleaved; the median-CPU run of
 // each stands for it. --dims 2 or 3: one of the two cases only.
 #include "cpu_time.hpp"
+#include <frictherm/coupling/instruction_set.hpp>
 #include <frictherm/coupling/runner.hpp>
 #include <frictherm/coupling/scene.hpp>
 #include <frictherm/coupling/thread_policy.hpp>
@@ -244,16 +245,9 @@ int main(int argc, char** argv) {
     }
   }
   const char* wp = std::getenv("OMP_WAIT_POLICY");
-  // The instruction set the build targets (FRICTHERM_ARCH, cmake/Arch.cmake; docs/performance.md).
-#if defined(__AVX512F__)
-  const char* isa = "AVX-512 (FRICTHERM_ARCH=native)";
-#elif defined(__AVX2__) && defined(__FMA__)
-  const char* isa = "x86-64-v3: AVX2 + FMA";
-#else
-  const char* isa = "x86-64 baseline (SSE2)";
-#endif
   std::printf("bench_coupled: sliding-block twin; OMP_WAIT_POLICY=%s; %ld online CPUs; %s\n", wp ? wp : "(unset)",
-              sysconf(_SC_NPROCESSORS_ONLN), isa);
+              sysconf(_SC_NPROCESSORS_ONLN),
+              frictherm::coupling::instruction_set());
   if (!dim2) cells.clear();
   for (const double h : cells) {
     const double end_time = h > 0.003 ? end5 : end1;

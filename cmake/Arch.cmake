@@ -37,7 +37,7 @@ if(_frictherm_arch STREQUAL "auto")
   include(CheckCXXCompilerFlag)
   check_cxx_compiler_flag(-march=x86-64-v3 FRICTHERM_COMPILER_HAS_X86_64_V3)
   if(FRICTHERM_COMPILER_HAS_X86_64_V3)
-    # Does this machine run what -march=x86-64-v3 emits? (AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C)
+    # Does this machine run what -march=x86-64-v3 emits? (arch_check.cpp asks AVX2, FMA, BMI1 and BMI2)
     try_run(_frictherm_v3_runs _frictherm_v3_compiles ${CMAKE_BINARY_DIR}/arch_check
             ${CMAKE_CURRENT_LIST_DIR}/arch_check.cpp)
     if(_frictherm_v3_compiles AND _frictherm_v3_runs EQUAL 0)

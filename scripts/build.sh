@@ -34,8 +34,8 @@ if [ -n "$sundials_config" ]; then sundials=(-DSUNDIALS_DIR="$(dirname "$(echo "
 # FRICTHERM_ARCH=portable|auto|x86-64-v3|native scripts/build.sh: the instruction set (cmake/Arch.cmake;
 # default portable: SSE2, the same bits on every machine; auto: AVX2 + FMA when this machine runs them,
 # 9-15 % faster, outputs equal to round-off; docs/performance.md "Instruction sets").
-native=()
-if [ -n "${FRICTHERM_ARCH:-}" ]; then native=(-DFRICTHERM_ARCH="$FRICTHERM_ARCH"); fi
+arch=()
+if [ -n "${FRICTHERM_ARCH:-}" ]; then arch=(-DFRICTHERM_ARCH="$FRICTHERM_ARCH"); fi
 # A new build folder uses Ninja when installed (scripts/install_deps.sh installs ninja-build): unlike
 # CMake's Makefiles, it compiles a library's sources while the libraries it links are still compiling,
 # so both cores stay busy to the end (an existing folder keeps its generator).
@@ -47,11 +47,11 @@ if [ "$mode" = --program ]; then
     options=(-DFRICTHERM_BUILD_TESTS=OFF -DFRICTHERM_BUILD_BENCH=OFF -DFRICTHERM_WITH_MPI=OFF -DFRICTHERM_PYTHON=OFF)
   fi
   if [ "$step" != compile ]; then
-    cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${native[@]}" "${options[@]}"
+    cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${arch[@]}" "${options[@]}"
   fi
   if [ "$step" != configure ]; then cmake --build "$build" -j "$jobs" --target frictherm; fi
 else
-  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${native[@]}" \
+  cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${sundials[@]}" "${arch[@]}" \
         -DFRICTHERM_BUILD_TESTS=ON -DFRICTHERM_BUILD_BENCH=ON -DFRICTHERM_WITH_MPI=ON -DFRICTHERM_PYTHON=ON
   cmake --build "$build" -j "$jobs"
 fi

@@ -3,6 +3,7 @@
 
 #include "run/particle_output.hpp"
 
+#include <frictherm/coupling/instruction_set.hpp>
 #include <frictherm/coupling/microstructure.hpp>
 
 #include <omp.h>
@@ -199,17 +200,7 @@ void write_start_metadata(H5Output& out, const Scene& s, const RunLayout<Dim>& r
   for (const auto& o : s.overrides) overrides += (overrides.empty() ? "" : "\n") + o.path + "=" + o.value;
   if (!overrides.empty()) out.write_metadata("overrides", overrides);
   out.write_metadata("version", FRICTHERM_VERSION);
-  // The instruction set the program was built for (cmake/Arch.cmake): outputs are the same bit for bit
-  // between builds of one set and equal to round-off between sets.
-#if defined(__AVX512F__)
-  out.write_metadata("instruction_set", "avx512");
-#elif defined(__AVX2__) && defined(__FMA__)
-  out.write_metadata("instruction_set", "x86-64-v3");
-#elif defined(__x86_64__)
-  out.write_metadata("instruction_set", "x86-64");
-#else
-  out.write_metadata("instruction_set", "compiler default");
-#endif
+  out.write_metadata("instruction_set", instruction_set());  // cmake/Arch.cmake
   out.write_metadata("command_line", options.command_line);
   char date[64] = "";
   const std::time_t now = std::time(nullptr);
