@@ -85,7 +85,11 @@ endfunction()
 function(frictherm_add_mpi_test name source library)
   add_executable(test_${name} ${source})
   target_link_libraries(test_${name} PRIVATE ${library} GTest::gtest)
-  frictherm_set_warnings(test_${name})
+  if(library MATCHES "^frictherm_(mechanics|coupling)")  # tests/CMakeLists.txt
+    frictherm_test_program(test_${name} MECHANICS)
+  else()
+    frictherm_test_program(test_${name})
+  endif()
   set(environment "OMP_NUM_THREADS=1;OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_MCA_mpi_yield_when_idle=1")
   # Oversubscribed ranks wait for each other in every collective: 120 s covers a busy 2-core machine
   # (they take 1–20 s); instrumented code runs 10–50 times slower, so the sanitizer build allows 1200 s.
