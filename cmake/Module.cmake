@@ -90,7 +90,7 @@ function(frictherm_add_mpi_test name source library)
   else()
     frictherm_test_program(test_${name})
   endif()
-  set(environment "OMP_NUM_THREADS=1;OMPI_MCA_rmaps_base_oversubscribe=1;OMPI_MCA_mpi_yield_when_idle=1")
+  set(environment "${FRICTHERM_MPI_TEST_ENVIRONMENT};OMPI_MCA_rmaps_base_oversubscribe=1")  # tests/CMakeLists.txt
   # Oversubscribed ranks wait for each other in every collective: 120 s covers a busy 2-core machine
   # (they take 1–20 s); instrumented code runs 10–50 times slower, so the sanitizer build allows 1200 s.
   set(timeout 120)

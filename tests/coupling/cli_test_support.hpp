@@ -34,9 +34,11 @@ inline Result shell(const std::string& cmd) {
 
 /// `mpirun` with `ranks` processes on any machine (oversubscribed: 4 ranks on 2 cores; as root Open
 /// MPI wants --allow-run-as-root), one OpenMP thread each, waiting ranks yielding their core (Open MPI
-/// polls busily unless it counts more ranks than slots, and other processes may hold the cores).
+/// polls busily unless it counts more ranks than slots, and other processes may hold the cores), over
+/// the single-node transports (FRICTHERM_MPI_TEST_ENVIRONMENT in tests/CMakeLists.txt says why).
 inline std::string mpirun_command(int ranks) {
-  std::string cmd = "env OMP_NUM_THREADS=1 OMPI_MCA_mpi_yield_when_idle=1 mpirun --oversubscribe -n " + std::to_string(ranks);
+  std::string cmd = "env OMP_NUM_THREADS=1 OMPI_MCA_mpi_yield_when_idle=1 OMPI_MCA_pml=ob1 OMPI_MCA_btl=self,vader"
+                    " mpirun --oversubscribe -n " + std::to_string(ranks);
   if (geteuid() == 0) cmd += " --allow-run-as-root";
   return cmd;
 }

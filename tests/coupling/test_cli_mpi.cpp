@@ -51,8 +51,9 @@ std::string mpirun() {
   const Result which = shell("command -v mpirun");
   if (which.code != 0 || which.output.empty()) return "";
   // 2 processes even on a 1-core machine; waiting ranks yield their core (Open MPI polls busily unless
-  // it counts more ranks than slots, and other processes may hold the cores: issue 34).
-  std::string cmd = "env OMPI_MCA_mpi_yield_when_idle=1 mpirun --oversubscribe";
+  // it counts more ranks than slots, and other processes may hold the cores: issue 34), over the
+  // single-node transports (FRICTHERM_MPI_TEST_ENVIRONMENT in tests/CMakeLists.txt).
+  std::string cmd = "env OMPI_MCA_mpi_yield_when_idle=1 OMPI_MCA_pml=ob1 OMPI_MCA_btl=self,vader mpirun --oversubscribe";
   if (geteuid() == 0) cmd += " --allow-run-as-root";  // Open MPI refuses root otherwise
   return cmd;
 }

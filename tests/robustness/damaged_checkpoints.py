@@ -397,7 +397,8 @@ def run_decomposed(exe, top, full, verbose, jobs):
     """The decomposed seed's corpus; returns the failures."""
     seed = os.path.join(top, "decomposed")
     os.makedirs(seed)
-    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_MCA_mpi_yield_when_idle="1")
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_MCA_mpi_yield_when_idle="1", OMPI_MCA_pml="ob1",
+               OMPI_MCA_btl="self,vader")  # FRICTHERM_MPI_TEST_ENVIRONMENT (tests/CMakeLists.txt)
     p = subprocess.run(mpirun(2) + [exe, "run", str(DECOMPOSED_SCENE), "-q", "-o", "R.h5", "--set", "run.end_time=2e-4",
                                     "--set", "run.checkpoint_interval=1e-4"], cwd=seed, env=env, capture_output=True,
                        timeout=300)
