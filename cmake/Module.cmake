@@ -85,11 +85,7 @@ endfunction()
 function(frictherm_add_mpi_test name source library)
   add_executable(test_${name} ${source})
   target_link_libraries(test_${name} PRIVATE ${library} GTest::gtest)
-  if(library MATCHES "^frictherm_(mechanics|coupling)")  # tests/CMakeLists.txt
-    frictherm_test_program(test_${name} MECHANICS)
-  else()
-    frictherm_test_program(test_${name})
-  endif()
+  frictherm_test_program(test_${name})  # tests/CMakeLists.txt
   set(environment "${FRICTHERM_MPI_TEST_ENVIRONMENT};OMPI_MCA_rmaps_base_oversubscribe=1")  # tests/CMakeLists.txt
   # Oversubscribed ranks wait for each other in every collective: 120 s covers a busy 2-core machine
   # (they take 1–20 s); instrumented code runs 10–50 times slower, so the sanitizer build allows 1200 s.
