@@ -125,6 +125,10 @@ std::string list(const std::vector<std::string>& names) {
 /// assignments, several results, and values that are negative or not finite.
 void check_expression(const std::string& expression, const std::map<std::string, double>& constants) {
   const std::string key = "sliding_traction";
+  // The expression as the messages quote it: a long one cut to its start and its length.
+  const std::string quoted = expression.size() <= 160 ? expression
+                                                      : expression.substr(0, 120) + "... (" +
+                                                            std::to_string(expression.size()) + " characters)";
   if (expression.find_first_not_of(" \t\r\n") == std::string::npos)
     refuse(key, "expected an expression in N (Pa), A (m^2) and v (m/s), got an empty string");
   double N = 0.0, A = 0.0, v = 0.0;
@@ -142,7 +146,7 @@ void check_expression(const std::string& expression, const std::map<std::string,
       std::vector<std::string> known;
       for (const auto& c : constants) known.push_back(c.first);
       refuse(key, std::string(unknown.size() == 1 ? "unknown variable " : "unknown variables ") + list(unknown) +
-                      " in \"" + expression + "\" (the variables are N [Pa], A [m^2], v [m/s]; constants: " +
+                      " in \"" + quoted + "\" (the variables are N [Pa], A [m^2], v [m/s]; constants: " +
                       (known.empty() ? "none given" : list(known)) + ")");
     }
     const double Ns[] = {0.0, 1.0, 1e6, 1e9}, As[] = {1e-10, 1e-6, 1.0}, vs[] = {0.0, 1e-3, 1.0, 1e3};
@@ -154,15 +158,15 @@ void check_expression(const std::string& expression, const std::map<std::string,
           const std::string at = "N = " + number_text(n) + " Pa, A = " + number_text(a) + " m^2, v = " + number_text(s) + " m/s";
           if (p.GetNumResults() != 1)
             refuse(key, "expected one expression, got " + std::to_string(p.GetNumResults()) +
-                            " separated by commas in \"" + expression + "\"");
-          if (N != n || A != a || v != s) refuse(key, "the expression \"" + expression + "\" assigns to a variable");
+                            " separated by commas in \"" + quoted + "\"");
+          if (N != n || A != a || v != s) refuse(key, "the expression \"" + quoted + "\" assigns to a variable");
           if (!(std::isfinite(S) && S >= 0.0))
-            refuse(key, "the sliding traction \"" + expression + "\" gives S = " + number_text(S) + " Pa at " + at +
+            refuse(key, "the sliding traction \"" + quoted + "\" gives S = " + number_text(S) + " Pa at " + at +
                             " (expected finite and >= 0 at the sample points N in {0, 1, 1e6, 1e9} Pa, A in "
                             "{1e-10, 1e-6, 1} m^2, v in {0, 1e-3, 1, 1e3} m/s)");
         }
   } catch (const mu::Parser::exception_type& e) {
-    refuse(key, "cannot parse \"" + expression + "\": " + e.GetMsg() + " (muParser, position " +
+    refuse(key, "cannot parse \"" + quoted + "\": " + e.GetMsg() + " (muParser, position " +
                     std::to_string(e.GetPos()) + " counting from 0)");
   }
 }

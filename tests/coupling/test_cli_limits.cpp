@@ -86,7 +86,10 @@ TEST_F(Limits, ResourceBombsRefusedBeforeAllocation) {
   // The same under a key the scene does not have (or has as null): an array made from nothing.
   expect_refused("--set 'extra[100000000]=1'", "--set extra[100000000]", "beyond the end of an array of 0");
   expect_refused("--set 'bodies[0].spin[50000000]=1'", "--set bodies[0].spin[50000000]", "beyond the end of an array of 0");
-  expect_refused("--set 'extra[9999999999999999999]9=1'", "--set extra[9999999999999999999]9", "beyond the end");
+  expect_refused("--set 'extra[9999999999999999999][9]=1'", "--set extra[9999999999999999999][9]", "beyond the end");
+  // A path that goes on after ']' without '.' or '[' (once read as extra[...].9).
+  expect_refused("--set 'extra[9999999999999999999]9=1'", "--set extra[9999999999999999999]9",
+                 "expected '.' or '[' after ']'");
 }
 
 // Contact keeps materials x materials tables (pair settings index, pair work books; per contact

@@ -111,7 +111,7 @@ TEST(SceneValidation, VectorLengthMustMatchDimension) {
   Json s = good_scene();
   s["grid"]["lo"] = {0, 0, 0};
   EXPECT_EQ(scene_error(s),
-            "grid.lo: expected an array of 2 numbers (one per dimension), got an array of 3 elements");
+            "grid.lo: expected an array of 2 numbers (one per dimension), got [0, 0, 0]");
   s = good_scene();
   s["bodies"][0]["velocity"] = {1.0};
   EXPECT_THAT(scene_error(s), StartsWith("bodies[0].velocity: expected an array of 2 numbers"));

@@ -339,6 +339,19 @@ CASES += [
     ("continuation duration 1e300", thermal_scene().replace('"duration": 0.001', '"duration": 1e300'), {},
      ["validate", "SCENE"], "coupling.continuation.duration"),
     ("thermal rtol 1e-300", thermal_scene(rtol=1e-300), {}, ["validate", "SCENE"], "thermal.rtol"),
+    # Found by exploratory testing (session 63): each was accepted, or refused only when the run started.
+    ("polygon with its vertices on one line",
+     scene(bodies=[{"name": "bar", "material": "soft",
+                    "shape": {"type": "polygon", "vertices": [[0.01, 0.01], [0.02, 0.02], [0.03, 0.03]]}}]),
+     {}, ["validate", "SCENE"], "bodies[0].shape.vertices: expected a polygon that encloses an area"),
+    ("interface patch 200,000,000 cells across",
+     json.dumps(dict(json.loads(thermal_scene()),
+                     coupling={"interface_temperature": {"patch_length": 1e6}})),
+     {}, ["validate", "SCENE"], "coupling.interface_temperature.patch_length: expected at most 64 cells"),
+    ("--set null on an array element", scene(), {}, ["validate", "SCENE", "--set", "bodies[0]=null"],
+     "--set bodies[0]=null: null removes an object's key"),
+    ("--set without '.' after ']'", scene(), {}, ["validate", "SCENE", "--set", "bodies[0]velocity=[1,0]"],
+     "--set bodies[0]velocity: expected '.' or '['"),
 ]
 
 # --- inputs of continue, resume and export-csv are never replaced, --force or not (issue 34) -----
@@ -350,6 +363,15 @@ THERMAL = json.dumps(dict(json.loads(scene()),
                           coupling={"continuation": {"duration": 1e-3, "intervals": 2}},
                           run={"end_time": 5e-4, "threads": 1}))
 CASES += [
+    # The XDMF files a result is published with are results too (session 63: a serial run replaced them):
+    # -o R.xdmf names an HDF5 result, which a later -o R.h5 must not write its XDMF file over.
+    ("run -o R.h5 beside another run's R.xdmf", scene(), {}, ["run", "SCENE", "-o", "R.h5"], "'R.xdmf' exists",
+     [["run", "SCENE", "-o", "R.xdmf", "-q"]]),
+    ("run -o R.h5 beside an R_reference.xdmf", scene(), {}, ["run", "SCENE", "-o", "R.h5"], "'R_reference.xdmf' exists",
+     [lambda d: open(os.path.join(d, "R_reference.xdmf"), "w").write("notes")]),
+    ("run --force of the scene R_nodes.xdmf", scene(), {}, ["run", "R_nodes.xdmf", "-o", "R.h5", "--force"],
+     "refusing to write 'R_nodes.xdmf'",
+     [lambda d: shutil.copyfile(os.path.join(d, "scene.json"), os.path.join(d, "R_nodes.xdmf"))]),
     ("continue -o its input", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5"], "refusing to write 'R.h5'",
      RESULT_SETUP),
     ("continue -o its input --force", THERMAL, {}, ["continue", "R.h5", "-o", "R.h5", "--force"],

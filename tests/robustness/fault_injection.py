@@ -214,7 +214,8 @@ def main():
     # An interrupted result to resume: SIGTERM at half the run (it writes its final checkpoint).
     interrupted = os.path.join(top, "interrupted")
     shutil.copytree(ref, interrupted)
-    for n in ("R.h5", "R.xdmf", "R_reference.xdmf", "R.h5.checkpoint", "C.h5", "C.xdmf", "C_reference.xdmf", "C.h5.checkpoint"):
+    for n in ("R.h5", "R.xdmf", "R_reference.xdmf", "R_nodes.xdmf", "R.h5.checkpoint",
+              "C.h5", "C.xdmf", "C_reference.xdmf", "C_nodes.xdmf", "C.h5.checkpoint"):
         if os.path.exists(os.path.join(interrupted, n)):
             os.remove(os.path.join(interrupted, n))
     p = subprocess.Popen([exe, "run", "s.json", "-o", "R.h5", "-q"], cwd=interrupted, stderr=subprocess.DEVNULL)
@@ -267,7 +268,7 @@ def main():
                                 break
                     finish(exe, case, folder, ["resume", "R.h5", "-q"], "R", reference_run)
             else:
-                for n in ("C.h5", "C.xdmf", "C_reference.xdmf", "C.h5.checkpoint"):
+                for n in ("C.h5", "C.xdmf", "C_reference.xdmf", "C_nodes.xdmf", "C.h5.checkpoint"):
                     if os.path.exists(os.path.join(folder, n)):
                         os.remove(os.path.join(folder, n))
                 inputs = files_of(folder, ["R.h5", "R.xdmf", "R_reference.xdmf", "R.h5.checkpoint"])

@@ -192,11 +192,20 @@ bool DecomposedHeat::after_step(double dt, bool must_close) {
     case WindowPolicy::Kind::every_step: close = true; break;
     case WindowPolicy::Kind::every_n_steps: close = close || window_steps_ >= p.steps; break;
     case WindowPolicy::Kind::adaptive: {
-      double rise = mpm3_ ? rise_of_step(*mpm3_, work) : rise_of_step(*mpm2_, work);
-      MPI_Allreduce(MPI_IN_PLACE, &rise, 1, MPI_DOUBLE, MPI_MAX, communicator());
-      max_rise_ = std::max(max_rise_, rise);
+      // The step's largest rise estimate and (max_travel) conducting particle speed, over every rank.
+      double largest[2] = {mpm3_ ? rise_of_step(*mpm3_, work) : rise_of_step(*mpm2_, work), 0.0};
+      if (p.max_travel > 0.0) {
+        std::vector<std::uint8_t> conducting(opt_.materials.size());
+        for (std::size_t m = 0; m < conducting.size(); ++m) conducting[m] = opt_.materials[m].conducts;
+        largest[1] = mpm3_ ? mpm3_->local_speed_max(conducting) : mpm2_->local_speed_max(conducting);
+      }
+      MPI_Allreduce(MPI_IN_PLACE, largest, 2, MPI_DOUBLE, MPI_MAX, communicator());
+      max_rise_ = std::max(max_rise_, largest[0]);
+      max_speed_ = std::max(max_speed_, largest[1]);
+      const double h = mpm3_ ? mpm3_->grid().min_cell_size() : mpm2_->grid().min_cell_size();
       close = close || max_rise_ >= p.max_temperature_rise || time_ - window_start_ >= p.max_duration * (1.0 - 1e-12) ||
-              (p.max_steps > 0 && window_steps_ >= p.max_steps);
+              (p.max_steps > 0 && window_steps_ >= p.max_steps) ||
+              (p.max_travel > 0.0 && max_speed_ * (time_ - window_start_) >= p.max_travel * h);
       break;
     }
   }
@@ -216,6 +225,7 @@ bool DecomposedHeat::close_window() {
   window_start_ = time_;
   window_steps_ = 0;
   max_rise_ = 0.0;
+  max_speed_ = 0.0;
   if (mpm3_) interface_update(*mpm3_);  // as the serial Coupler::update_interface_and_hotspots
   else interface_update(*mpm2_);
   return true;

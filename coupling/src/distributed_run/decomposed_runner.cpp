@@ -136,8 +136,10 @@ void DecomposedRun<Dim>::check_output_files() {
       check_output_folder(r_.output, o_.output.empty() ? "output.file" : "output file");
       const std::vector<std::string> inputs = scene_input_files(s_);
       claim_ = std::make_unique<OutputClaim>(r_.output);
+      const std::vector<std::string> companions = xdmf_paths_for(r_.output);
       for (const std::string& f : decomposed_output_files(r_.output, size_))
-        check_output_path(f, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
+        (std::find(companions.begin(), companions.end(), f) != companions.end() ? check_companion_path : check_output_path)(
+            f, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
       check_output_path(checkpoint_file_, inputs, true, "");  // every run may write one: an interrupted run does
     } catch (const std::exception& e) {
       error = e.what();
@@ -183,7 +185,7 @@ void DecomposedRun<Dim>::build() {
     try {
       heat_ = std::make_unique<DecomposedHeat>(*mpm_, h);
     } catch (const std::invalid_argument& e) {
-      throw SceneError(std::string("thermal.materials: ") + e.what());
+      throw SceneError::at_key("thermal.materials", e.what());
     }
     hot_ = std::make_unique<detail::DecomposedHotSpots<Dim>>(s_, *mpm_);
     hot_->update(*mpm_, 0.0);  // the initial hot spots, as the serial Coupler::start
@@ -386,7 +388,8 @@ FRICTHERM_INSTANTIATE_DECOMPOSED_RUN(3)
 namespace frictherm::coupling {
 
 std::vector<std::string> decomposed_output_files(const std::string& out, int ranks) {
-  std::vector<std::string> files{out, xdmf_path_for(out)};
+  std::vector<std::string> files{out};
+  for (const std::string& f : xdmf_paths_for(out)) files.push_back(f);
   for (int r = 0; r < ranks; ++r) files.push_back(DecomposedOutput::rank_file(decomposed::output_base(out), r));
   return files;
 }

@@ -15,6 +15,18 @@ namespace {
 // Partition of unity and zero row sums hold to round-off; anything larger is a bug, not physics.
 constexpr double kAssemblyTolerance = 1e-10;
 
+// max |v_p| over the particles whose material conducts (WindowPolicy::max_travel).
+template <int Dim>
+double conducting_speed_max(const std::vector<mechanics::Vec<Dim>>& velocity, const std::vector<std::int32_t>& material,
+                            const std::vector<ThermalProperties>& materials) {
+  double v2 = 0.0;
+  for (std::size_t k = 0; k < velocity.size(); ++k) {
+    const auto m = static_cast<std::size_t>(material[k]);
+    if (m < materials.size() && materials[m].conducts) v2 = std::max(v2, velocity[k].squaredNorm());
+  }
+  return std::sqrt(v2);
+}
+
 }  // namespace
 
 void check_window_options(const WindowPolicy& w, long matrix_free_max_substeps, const std::string& who) {
@@ -23,6 +35,8 @@ void check_window_options(const WindowPolicy& w, long matrix_free_max_substeps, 
   if (w.kind == WindowPolicy::Kind::adaptive && !(w.max_temperature_rise > 0.0))
     throw std::invalid_argument(who + ": adaptive windows need max_temperature_rise > 0");
   if (!(w.max_duration > 0.0)) throw std::invalid_argument(who + ": max_duration must be > 0");
+  if (!(w.max_travel >= 0.0 && std::isfinite(w.max_travel)))
+    throw std::invalid_argument(who + ": max_travel must be finite and >= 0");
   if (matrix_free_max_substeps < 0) throw std::invalid_argument(who + ": matrix_free_max_substeps must be >= 0");
 }
 
@@ -56,6 +70,7 @@ void Coupler<Dim>::start(const mechanics::Particles<Dim>& p, double time) {
   window_start_ = time;
   window_steps_ = 0;
   max_rise_ = 0.0;
+  max_speed_ = 0.0;
   pending_.clear();
   pending_plastic_ = 0.0;
   books_ = EnergyBooks{};
@@ -311,8 +326,10 @@ bool Coupler<Dim>::after_step(mechanics::Particles<Dim>& p, const std::vector<do
       if (pending_plastic_ != 0.0)  // plastic heat can sit on any node: scan them all
         for (std::size_t i = 0; i < acc.size(); ++i)
           if (acc[i] != 0.0) max_rise_ = std::max(max_rise_, std::fabs(acc[i]) / mass_estimate(i));
+      if (w.max_travel > 0.0) max_speed_ = std::max(max_speed_, conducting_speed_max(p.velocity, p.material, opt_.materials));
       close = max_rise_ >= w.max_temperature_rise || time - window_start_ >= w.max_duration * (1.0 - 1e-12) ||
-              (w.max_steps > 0 && window_steps_ >= w.max_steps);
+              (w.max_steps > 0 && window_steps_ >= w.max_steps) ||
+              (w.max_travel > 0.0 && max_speed_ * (time - window_start_) >= w.max_travel * grid_.min_cell_size());
       break;
     }
   }
@@ -342,6 +359,7 @@ bool Coupler<Dim>::close_window(mechanics::Particles<Dim>& p, double time) {
   window_start_ = time;
   window_steps_ = 0;
   max_rise_ = 0.0;
+  max_speed_ = 0.0;
   update_interface_and_hotspots(p, time);
   return true;
 }

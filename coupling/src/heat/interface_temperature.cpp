@@ -6,6 +6,7 @@
 #include <utility>
 #include <array>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -57,10 +58,12 @@ void InterfaceTemperature<Dim>::start_sides(const mechanics::Grid<Dim>& grid, do
   patch_area_ = 0.0;
   if (options.patch_length > 0.0) {
     const double radius = 0.5 * std::max(options.patch_length, 2.0 * h_);
-    if (radius > 32.0 * h_)  // 65^Dim offsets a node: beyond that a patch is not an interface spot
-      throw std::invalid_argument("coupling.interface_temperature.patch_length: " + std::to_string(options.patch_length) +
-                                  " m is " + std::to_string(options.patch_length / h_) +
-                                  " cells across; expected at most 64 cells");
+    if (radius > 32.0 * h_) {  // 65^Dim offsets a node: beyond that a patch is not an interface spot
+      std::ostringstream msg;
+      msg << "coupling.interface_temperature.patch_length: " << options.patch_length << " m is "
+          << options.patch_length / h_ << " cells across; expected at most 64 cells";
+      throw std::invalid_argument(msg.str());
+    }
     patch_area_ = (Dim == 2 ? 2.0 * radius * thickness : 3.141592653589793 * radius * radius);
     mechanics::IVec<Dim> reach{};
     int count = 1;

@@ -82,6 +82,19 @@ void check_output_path(const std::string& path, const std::vector<std::string>& 
                       " to replace it, or choose another output file)");
 }
 
+void check_companion_path(const std::string& path, const std::vector<std::string>& inputs, bool overwrite,
+                          const std::string& how_to_overwrite) {
+  bool xdmf_text = false;
+  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    char head[256] = {};
+    const std::size_t n = std::fread(head, 1, sizeof head - 1, f);
+    std::fclose(f);
+    const std::string start(head, n);
+    xdmf_text = start.rfind("<?xml", 0) == 0 && start.find("<Xdmf") != std::string::npos;
+  }
+  check_output_path(path, inputs, overwrite || xdmf_text, how_to_overwrite);
+}
+
 void check_output_folder(const std::string& path, const std::string& what) {
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))

@@ -159,6 +159,10 @@ std::string xdmf_nodes_path_for(const std::string& h5_path) {
   return x.substr(0, x.size() - 5) + "_nodes.xdmf";
 }
 
+std::vector<std::string> xdmf_paths_for(const std::string& h5_path) {
+  return {xdmf_path_for(h5_path), xdmf_reference_path_for(h5_path), xdmf_nodes_path_for(h5_path)};
+}
+
 std::string xdmf_path_for(const std::string& h5_path) {
   for (const char* ext : {".h5", ".hdf5", ".he5"}) {
     const std::size_t len = std::strlen(ext);

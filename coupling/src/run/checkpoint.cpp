@@ -484,8 +484,14 @@ Scene checkpoint_scene(const std::string& path, const std::vector<SceneOverride>
   } catch (const OutputError&) {
     throw;
   } catch (const std::exception& e) {
+    // A file the scene reads (an image body's shape.file), relative to the scene's folder, that is
+    // gone or unreadable now: the checkpoint is intact, the file has to come back.
+    const std::string what = e.what();
+    if (what.find(".file: ") != std::string::npos)
+      throw OutputError("checkpoint '" + path + "': the scene stored in /scene reads a file that cannot be read now (" +
+                        what + "); the checkpoint itself is intact: restore that file, relative to '" + dir + "'");
     throw OutputError("checkpoint '" + path + "': the scene stored in /scene with /scene_overrides does not parse (" +
-                      e.what() + "); the checkpoint is damaged");
+                      what + "); the checkpoint is damaged");
   }
   overrides.insert(overrides.end(), more.begin(), more.end());
   return parse_scene(text, shown, dir, name, overrides);

@@ -251,8 +251,11 @@ class Run {
     check_output_folder(r_.output, o_.output.empty() ? "output.file" : "output file");
     std::vector<std::string> inputs = scene_input_files(s_);
     if (!o_.resume_checkpoint.empty()) inputs.push_back(o_.resume_checkpoint);
+    // The result and the XDMF files published with it (an existing OUT.xdmf may be another run's
+    // result: `-o OUT.xdmf` names an HDF5 file so).
     check_output_path(r_.output, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
-    check_output_path(xdmf_path_for(r_.output), inputs, true, "");
+    for (const std::string& f : xdmf_paths_for(r_.output))
+      check_companion_path(f, inputs, overwrite(), "--force or \"output\": {\"overwrite\": true}");
     {  // every run may write one: an interrupted run always does
       std::vector<std::string> others;  // a resumed run may go on replacing its own checkpoint
       for (const std::string& f : inputs)

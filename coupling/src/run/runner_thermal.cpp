@@ -32,7 +32,7 @@ ThermalRun<Dim>::ThermalRun(const Scene& scene, mechanics::Simulation<Dim>& sim)
   try {
     coupler_.start(sim.particles(), sim.time());
   } catch (const std::invalid_argument& e) {
-    throw SceneError(std::string("thermal.materials: ") + e.what());
+    throw SceneError::at_key("thermal.materials", e.what());
   }
 }
 

@@ -46,6 +46,12 @@ std::string describe_json(const Json& v) {
     }
     case Json::value_t::array: {
       const std::size_t n = v.size();
+      // A short array of numbers (a point, a box corner, a range) is shown as its values.
+      if (n > 0 && n <= 4 && std::all_of(v.begin(), v.end(), [](const Json& e) { return e.is_number(); })) {
+        std::string list = "[";
+        for (std::size_t i = 0; i < n; ++i) list += (i ? ", " : "") + describe_json(v[i]);
+        return list + "]";
+      }
       return n == 1 ? "an array of 1 element" : "an array of " + std::to_string(n) + " elements";
     }
     case Json::value_t::object: return "an object";

@@ -90,6 +90,17 @@ void parse_polygon(const JsonReader& shape, int dim, ShapeSpec& out) {
     const auto p = v.as_vector(2);
     out.vertices.push_back({p[0], p[1]});
   }
+  // Vertices on one line (or on one point) enclose nothing, yet the even-odd test would let the
+  // lattice points on that line in, each with a full particle's volume.
+  const auto& v0 = out.vertices[0];
+  const auto& far = *std::max_element(out.vertices.begin(), out.vertices.end(), [&](const auto& a, const auto& b) {
+    return std::hypot(a[0] - v0[0], a[1] - v0[1]) < std::hypot(b[0] - v0[0], b[1] - v0[1]);
+  });
+  const double dx = far[0] - v0[0], dy = far[1] - v0[1], span2 = dx * dx + dy * dy;
+  bool flat = true;
+  for (const auto& q : out.vertices)
+    flat = flat && std::fabs(dx * (q[1] - v0[1]) - dy * (q[0] - v0[0])) <= 1e-12 * span2;
+  if (flat) verts.fail("expected a polygon that encloses an area, but its vertices lie on one line");
   read_z_range(shape, dim, out);
   out.box_lo = {out.vertices[0][0], out.vertices[0][1], out.z_lo};
   out.box_hi = {out.vertices[0][0], out.vertices[0][1], out.z_hi};

@@ -48,6 +48,7 @@ double pair_table_bytes(const Scene& s, int threads) {
 }
 
 std::string bytes_text(double b) {
+  if (b < 1e5) return format_number(b) + " bytes";  // run.max_memory: 1 is a byte, not "0 MB"
   if (b >= 1e9) return format_number(std::round(b / 1e8) / 10.0) + " GB";
   return format_number(std::round(b / 1e5) / 10.0) + " MB";
 }

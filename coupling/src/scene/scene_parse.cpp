@@ -268,7 +268,7 @@ Json::json_pointer pointer_of(const std::string& path) {
       if (i > 0 && path[i - 1] == ']') continue;
       flush();
     } else if (c == '[') {
-      flush();
+      if (!(i > 0 && path[i - 1] == ']')) flush();  // a[1][2]: the second index right after the first
       const std::size_t close = path.find(']', i);
       if (close == std::string::npos) throw SceneError("--set " + path + ": missing ']'");
       token = path.substr(i + 1, close - i - 1);
@@ -276,6 +276,8 @@ Json::json_pointer pointer_of(const std::string& path) {
         throw SceneError("--set " + path + ": expected an index in [...]");
       flush();
       i = close;
+      if (i + 1 < path.size() && path[i + 1] != '.' && path[i + 1] != '[')
+        throw SceneError("--set " + path + ": expected '.' or '[' after ']', e.g. bodies[0].velocity");
     } else {
       token += c;
     }
@@ -316,7 +318,11 @@ void apply_overrides(Json& doc, const std::vector<SceneOverride>& overrides) {
       const Json::json_pointer ptr = pointer_of(o.path);
       check_indices(doc, ptr, o.path);
       if (value.is_null()) {  // KEY=null removes an object key (nothing to do when it is absent)
-        if (doc.contains(ptr) && doc.at(ptr.parent_pointer()).is_object()) doc.at(ptr.parent_pointer()).erase(ptr.back());
+        const Json::json_pointer parent = ptr.parent_pointer();
+        if (doc.contains(parent) && doc.at(parent).is_array())
+          throw SceneError("--set " + o.path + "=null: null removes an object's key; an array element cannot be " +
+                           "removed (give it a value, or set the whole array)");
+        if (doc.contains(ptr) && doc.at(parent).is_object()) doc.at(parent).erase(ptr.back());
       } else {
         doc[ptr] = value;
       }
@@ -400,7 +406,8 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   // Thermal properties are given per declared material; grain materials take their template's.
   const std::vector<mechanics::Material> declared(s.materials.begin(),
                                                   s.materials.begin() + static_cast<long>(ctx.declared_materials));
-  s.thermal = parse_thermal_sections(root, s.dimension, declared, s.options.thickness);  // scene_thermal.cpp
+  s.thermal = parse_thermal_sections(root, s.dimension, declared, s.options.thickness,  // scene_thermal.cpp
+                                     *std::min_element(s.cell_size.begin(), s.cell_size.begin() + s.dimension));
   detail::extend_grain_thermal(s, ctx);
   s.cost = estimate_scene_cost(s);  // before any particle or grid array exists
   check_scene_cost(s, s.cost);

@@ -472,6 +472,20 @@ double DecomposedMpm<Dim>::total_momentum_scale() const {
 }
 
 template <int Dim>
+double DecomposedMpm<Dim>::local_speed_max(const std::vector<std::uint8_t>& counted) const {
+  SwarmFields f(impl_->swarm);
+  double v2 = 0.0;
+  for (PetscInt k = 0; k < f.n; ++k) {
+    const auto m = static_cast<std::size_t>(f.material[k]);
+    if (m >= counted.size() || !counted[m]) continue;
+    double s = 0.0;
+    for (int d = 0; d < Dim; ++d) s += f.velocity[Dim * k + d] * f.velocity[Dim * k + d];
+    v2 = std::max(v2, s);
+  }
+  return std::sqrt(v2);
+}
+
+template <int Dim>
 std::vector<typename DecomposedMpm<Dim>::Particle> DecomposedMpm<Dim>::gather() const {
   constexpr int D = Dim, DD = Dim * Dim;
   // Doubles per particle: mass, volume, x, v, l_p, σ, σ_zz, material, ε̄p, e, plastic work, the scalars.

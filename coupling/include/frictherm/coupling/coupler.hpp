@@ -55,6 +55,11 @@ struct WindowPolicy {
   double max_temperature_rise = 1.0;
   double max_duration = std::numeric_limits<double>::infinity();  // adaptive: longest window (s)
   long max_steps = 0;                                              // adaptive: most steps (0: no limit)
+  /// adaptive: close when the fastest conducting particle may have travelled this many cells (the
+  /// smallest cell edge) since the window opened, estimated as max |v_p| over the window's steps times
+  /// its duration (an upper bound). A node's pending heat goes to the particles on it at the window's
+  /// end, so a slider that moved on leaves part of its heat behind (docs/coupling.md). 0: no limit.
+  double max_travel = 0.0;
 };
 
 /// Throws std::invalid_argument, the message starting with `who`, when the window policy or the
@@ -267,6 +272,7 @@ class Coupler {
   double window_start_ = 0.0;
   long window_steps_ = 0;
   double max_rise_ = 0.0;               // adaptive estimate for the open window (K)
+  double max_speed_ = 0.0;              // adaptive: the largest max_p |v_p| of the open window (m/s)
   double initial_energy_ = 0.0;
   EnergyBooks books_;
   thermal::IntegratorStats stats_offset_;  // integrators before the current one, and restored counts
@@ -302,6 +308,7 @@ void Coupler<Dim>::visit_state(V&& v, const mechanics::Particles<Dim>& particles
   v("window_start", window_start_);
   v("window_steps", window_steps_);
   v("max_rise", max_rise_);
+  v("max_speed", max_speed_);
   v("initial_energy", initial_energy_);
   EnergyBooks& b = books_;
   for (auto [name, x] : {std::pair<const char*, double*>{"books/work_received", &b.work_received},

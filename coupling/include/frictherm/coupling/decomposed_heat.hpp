@@ -247,6 +247,7 @@ class DecomposedHeat {
                            {"books/reaction_heat_released", &b.reaction_heat_released},
                            {"window/pending_plastic", &pending_plastic_},
                            {"window/time", &time_}, {"window/start", &window_start_}, {"window/max_rise", &max_rise_},
+                           {"window/max_speed", &max_speed_},
                            {"window/last_lambda", &last_lambda_}, {"gather/threshold", &threshold_},
                            {"gather/min_unknown_mass", &min_unknown_mass_}})
       v(name, *x);
@@ -361,6 +362,7 @@ class DecomposedHeat {
   std::vector<double> pending_;
   double pending_plastic_ = 0.0;  // of it, plastic heat (J, over ranks)
   double time_ = 0.0, window_start_ = 0.0, max_rise_ = 0.0;
+  double max_speed_ = 0.0;  // adaptive max_travel: the largest conducting particle speed of the window (m/s)
   long window_steps_ = 0;
   double last_lambda_ = 0.0;  // λ bound of the last matrix-free decision (Coupler::last_lambda_bound_)
   // The reuse (reuse_distance): the particle scalars (Dim gather positions, V_p, Rayleigh term), and

@@ -50,8 +50,8 @@ struct DecomposedRunError : std::runtime_error {
 /// (docs/robustness.md). The per-step observer is not supported (std::invalid_argument).
 RunResult run_scene_decomposed(MPI_Comm comm, const Scene& scene, const RunOptions& options);
 
-/// The files a decomposed run writes for output `out` with `ranks` processes: out, the XDMF file
-/// and every rank file.
+/// The files a decomposed run writes for output `out` with `ranks` processes: out, its XDMF files
+/// (xdmf_paths_for) and every rank file.
 std::vector<std::string> decomposed_output_files(const std::string& out, int ranks);
 
 }  // namespace frictherm::coupling

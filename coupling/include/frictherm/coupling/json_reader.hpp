@@ -48,6 +48,13 @@ class SceneError : public std::runtime_error {
  public:
   explicit SceneError(const std::string& message) : std::runtime_error(escape_control_characters(message)) {}
   explicit SceneError(const char* message) : SceneError(std::string(message)) {}
+  /// A scene the heat hand-off refused when it started (std::invalid_argument of the coupler):
+  /// under `key` (e.g. "thermal.materials"), unless the message names its own key path already.
+  static SceneError at_key(const std::string& key, const std::string& message) {
+    for (const char* section : {"thermal.", "coupling.", "contact.", "grid.", "bodies", "materials."})
+      if (message.rfind(section, 0) == 0) return SceneError(message);
+    return SceneError(key + ": " + message);
+  }
 };
 
 /// A closed, open or half-open interval of allowed numbers.

@@ -28,6 +28,13 @@ bool same_path(const std::string& a, const std::string& b);
 void check_output_path(const std::string& path, const std::vector<std::string>& inputs, bool overwrite,
                        const std::string& how_to_overwrite);
 
+/// check_output_path for the XDMF files published with a result (xdmf_paths_for): an existing one that
+/// is an XDMF text (what a run leaves beside its result) is replaced without `overwrite`, as before;
+/// anything else there (another run's HDF5 result named OUT.xdmf, a user's file) is refused unless
+/// `overwrite`, and an input always.
+void check_companion_path(const std::string& path, const std::vector<std::string>& inputs, bool overwrite,
+                          const std::string& how_to_overwrite);
+
 /// What an existing file holds, read from its content (not its name): a checkpoint of frictherm
 /// (root attribute "format" with /marks or /mechanics), a result (root "format" with /meta or
 /// /series), another HDF5 file (a decomposed run's rank file, a foreign file), or none of these.

@@ -40,9 +40,12 @@ struct ThermalSceneSpec {
 };
 
 /// Reads `thermal` and `coupling` from the scene root (both optional). `materials` are the scene's
-/// materials (ids = positions), `thickness` the 2D thickness. Throws SceneError naming the key path.
+/// materials (ids = positions), `thickness` the 2D thickness, `min_cell_size` the grid's smallest cell
+/// edge (0: not known; the keys measured in cells are then checked when the run starts). Throws
+/// SceneError naming the key path.
 ThermalSceneSpec parse_thermal_sections(const JsonReader& root, int dimension,
-                                        const std::vector<mechanics::Material>& materials, double thickness);
+                                        const std::vector<mechanics::Material>& materials, double thickness,
+                                        double min_cell_size = 0.0);
 
 const char* to_string(WindowPolicy::Kind kind);
 

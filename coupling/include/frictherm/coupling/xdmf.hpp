@@ -61,6 +61,11 @@ std::string xdmf_nodes_path_for(const std::string& h5_path);
 /// `initial_position` field), for a displacement warp in ParaView (docs/output.md "In ParaView").
 std::string xdmf_reference_path_for(const std::string& h5_path);
 
+/// The XDMF files a result RUN.h5 is published with (publish_with_xdmf): RUN.xdmf, RUN_reference.xdmf
+/// and RUN_nodes.xdmf. A run checks each as it checks RUN.h5 (check_output_path): never an input, an
+/// existing one replaced only when asked.
+std::vector<std::string> xdmf_paths_for(const std::string& h5_path);
+
 /// Escapes &, <, >, " and ' for XML text and attribute values.
 std::string xml_escape(const std::string& text);
 

@@ -310,6 +310,8 @@ class DecomposedMpm {
   double total_mass() const;
   Vec<Dim> total_momentum() const;
   double total_momentum_scale() const;  // Σ m_p |v_p|
+  /// max |v_p| over this rank's particles whose material m has counted[m] != 0 (not collective).
+  double local_speed_max(const std::vector<std::uint8_t>& counted) const;
   /// Velocity fields per node (1 without contact, one per material with it).
   int velocity_fields() const;
   /// Frictional work of the last step at this rank's owned nodes (J; x fastest over owned_nodes()),
