@@ -352,6 +352,11 @@ CASES += [
      "--set bodies[0]=null: null removes an object's key"),
     ("--set without '.' after ']'", scene(), {}, ["validate", "SCENE", "--set", "bodies[0]velocity=[1,0]"],
      "--set bodies[0]velocity: expected '.' or '['"),
+    ("a thermal section without a heated particle",
+     scene(materials={"wall": {"type": "rigid", "velocity": [1, 0]}},
+           bodies=[{"name": "w", "material": "wall", "shape": {"type": "rectangle", "lo": [0.01, 0.01], "hi": [0.03, 0.04]}}],
+           thermal={"materials": {}}),
+     {}, ["validate", "SCENE"], "thermal.materials: no particle has a material with thermal properties"),
 ]
 
 # --- inputs of continue, resume and export-csv are never replaced, --force or not (issue 34) -----

@@ -31,6 +31,18 @@ void describe(const Scene& s, std::ostream& out) {
   const auto sim = build_simulation<Dim>(s);
   const auto& grid = sim->grid();
   const auto& p = sim->particles();
+  // As the run's thermal start (thermal_assembly.cpp) refuses it, so that validate says it first.
+  if (s.thermal.enabled) {
+    const auto& props = s.thermal.coupler.materials;
+    bool heated = false;
+    for (std::size_t k = 0; k < p.size() && !heated; ++k) {
+      const auto m = static_cast<std::size_t>(p.material[k]);
+      heated = m < props.size() && props[m].conducts && p.mass[k] > 0.0;
+    }
+    if (!heated)
+      throw SceneError("thermal.materials: no particle has a material with thermal properties (heat_capacity, "
+                       "conductivity); expected at least one body of a listed material");
+  }
   auto row = [&out](const std::string& label) -> std::ostream& {
     return out << std::left << std::setw(12) << label << ' ';
   };
