@@ -195,9 +195,11 @@ bool DecomposedHeat::after_step(double dt, bool must_close) {
       // The step's largest rise estimate and (max_travel) conducting particle speed, over every rank.
       double largest[2] = {mpm3_ ? rise_of_step(*mpm3_, work) : rise_of_step(*mpm2_, work), 0.0};
       if (p.max_travel > 0.0) {
-        std::vector<std::uint8_t> conducting(opt_.materials.size());
-        for (std::size_t m = 0; m < conducting.size(); ++m) conducting[m] = opt_.materials[m].conducts;
-        largest[1] = mpm3_ ? mpm3_->local_speed_max(conducting) : mpm2_->local_speed_max(conducting);
+        if (conducting_.size() != opt_.materials.size()) {  // once: the materials do not change
+          conducting_.resize(opt_.materials.size());
+          for (std::size_t m = 0; m < conducting_.size(); ++m) conducting_[m] = opt_.materials[m].conducts;
+        }
+        largest[1] = mpm3_ ? mpm3_->local_speed_max(conducting_) : mpm2_->local_speed_max(conducting_);
       }
       MPI_Allreduce(MPI_IN_PLACE, largest, 2, MPI_DOUBLE, MPI_MAX, communicator());
       max_rise_ = std::max(max_rise_, largest[0]);

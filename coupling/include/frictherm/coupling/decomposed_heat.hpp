@@ -363,6 +363,7 @@ class DecomposedHeat {
   double pending_plastic_ = 0.0;  // of it, plastic heat (J, over ranks)
   double time_ = 0.0, window_start_ = 0.0, max_rise_ = 0.0;
   double max_speed_ = 0.0;  // adaptive max_travel: the largest conducting particle speed of the window (m/s)
+  std::vector<std::uint8_t> conducting_;  // per material: 1 if it conducts (the max_travel speed's mask)
   long window_steps_ = 0;
   double last_lambda_ = 0.0;  // λ bound of the last matrix-free decision (Coupler::last_lambda_bound_)
   // The reuse (reuse_distance): the particle scalars (Dim gather positions, V_p, Rayleigh term), and
