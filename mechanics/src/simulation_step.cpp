@@ -9,6 +9,7 @@
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
+#include <frictherm/mechanics/step/scheme_order.hpp>
 
 #include "stencil_access.hpp"
 
@@ -83,44 +84,30 @@ std::vector<const char*> Simulation<Dim>::step_phase_names() {
   return names;
 }
 
-// The step's phase lists. USF: stress from the extrapolated grid velocities, then the forces; USL:
-// forces from the start-of-step stress, the stress update after the grid update (with the
-// grid-to-particle update in one pass); MUSL: as USL, then the momenta remapped from the updated
-// particles and the stress from their velocities. The contact methods (step/contact_method.hpp,
-// contact_methods/) add their phases at the hooks `contact(ContactHook::...)` below: multimaterial
+// The step's phase lists, in the order step/scheme_order.hpp writes once for both engines: the serial
+// engine adds its own phases (SchemePhase) and nothing at the exchange points. The contact methods
+// (step/contact_method.hpp, contact_methods/) add their phases at the ContactHooks: multimaterial
 // contact a pass after each momentum projection, penalty contact its forces before the velocity
 // conditions and the boundary points' move where the stress update's velocity is on the grid. The
-// loads (step/step_load.hpp, loads/) add theirs at `load(LoadHook::...)`: point loads and tractions
-// into the forces, damping after the velocity conditions; the velocity filters (step/velocity_filter.hpp,
-// filters/) at `filter(FilterHook::...)`: XPIC's start velocity, XPIC/FMPM after nodal_velocities; the
-// rigid drivers (step/rigid_driver.hpp, rigids/) at `rigid(RigidHook::...)`: the rigid velocities onto
-// the grid at the step's start, the rigid particles moved after the particle pass (or by it: refresh).
+// loads (step/step_load.hpp, loads/) add theirs at the LoadHooks: point loads and tractions into the
+// forces, damping after the velocity conditions; the velocity filters (step/velocity_filter.hpp,
+// filters/) at the FilterHooks: XPIC's start velocity, XPIC/FMPM after nodal_velocities; the rigid
+// drivers (step/rigid_driver.hpp, rigids/) at the RigidHooks: the rigid velocities onto the grid at the
+// step's start, the rigid particles moved after the particle pass (or by it: refresh).
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::build_phases() {
   using T = StepPhaseTimes;
   PhaseList& P = schedule_.phases;
   const UpdateScheme scheme = opt_.scheme;
-  const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl, musl = scheme == UpdateScheme::musl;
-  const auto contact = [&](ContactHook at) {
-    for (const StepContactMethod<Dim>* m : contact_methods_) m->add_phases(at, scheme, opt_.shape, *this, P);
-  };
-  const std::vector<const StepLoad<Dim>*> loads = loads_for(*this);  // step/step_load.hpp, loads/
-  const auto load = [&](LoadHook at) {
-    for (const StepLoad<Dim>* l : loads) l->add_phases(at, opt_.shape, *this, P);
-  };
+  const bool usf = scheme == UpdateScheme::usf, usl = scheme == UpdateScheme::usl;
+  const std::vector<const StepLoad<Dim>*> loads = loads_for(*this);                         // loads/
   const std::vector<const StepVelocityFilter<Dim>*> filters = velocity_filters_for(*this);  // filters/
-  const auto filter = [&](FilterHook at) {
-    for (const StepVelocityFilter<Dim>* f : filters) f->add_phases(at, scheme, opt_.shape, *this, P);
-  };
+  const std::vector<const StepRigidDriver<Dim>*> rigids = rigid_drivers_for(*this);         // rigids/
   // USL with contact (the velocity fields per material): the particle pass also evaluates the next
   // step's stencils and boxes and moves the rigid particles (nothing after it in the step needs this
   // step's stencils).
   const bool refresh = usl && !contact_methods_.empty() && !is_extended<Kernel>;
-  const std::vector<const StepRigidDriver<Dim>*> rigids = rigid_drivers_for(*this);  // rigids/
-  const auto rigid = [&](RigidHook at) {
-    for (const StepRigidDriver<Dim>* r : rigids) r->add_phases(at, refresh, opt_.shape, *this, P);
-  };
 
   // The CFL step. With the wave speeds current, the particle-to-grid scatter takes max_p c_p + |v_p|
   // (exact in any order) and the step is set at its phase's end (nothing reads it before): no pass of
@@ -133,56 +120,91 @@ void Simulation<Dim>::build_phases() {
       throw SimulationError(msg.str(), clock_.step, clock_.time, -1);
     }
   };
-  P.add("time_step", &T::time_step, [this, set_step](StepContext& c) {
-    c.speed_in_scatter = wave_speeds_current() && c.dt_limit > 0.0;
-    if (!c.speed_in_scatter) set_step(c, particle_speed_max());
-  });
-  P.add("shape_functions", &T::shape_functions, [this](StepContext&) { prepare_step<Kernel>(); });
-  rigid(RigidHook::drive);
-  // Per field: EBS rebuilt (keeping the driven nodes), node boxes laid out, weights flattened.
-  if constexpr (is_extended<Kernel>)
-    P.add("extended_stencils", &T::shape_functions, [this](StepContext&) { prepare_extended_stencils(); });
-  P.add("particle_to_grid", &T::particle_to_grid, [this, usf, set_step](StepContext& c) {
-    map_to_grid<Kernel>(!usf, c.speed_in_scatter);
-    if (c.speed_in_scatter) set_step(c, *std::max_element(threads_.speed_max.begin(), threads_.speed_max.end()));
-  });
-  contact(ContactHook::extrapolated);
-  if (usf) {
-    P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
-    P.add("stress_update", &T::stress_update, [this](StepContext& c) { stress_pass<Kernel>(c.dt); });
-    P.add("internal_forces", &T::particle_to_grid, [this](StepContext&) { add_internal_forces<Kernel>(); });
-    contact(ContactHook::stress_velocity);
-  }
-  load(LoadHook::forces);
-  contact(ContactHook::forces);
-  filter(FilterHook::start_velocity);
-  P.add("velocity_conditions", &T::grid_update, [this](StepContext& c) { apply_grid_velocity_conditions(c.dt); });
-  load(LoadHook::conditioned_forces);
-  P.add("momentum_update", &T::grid_update, [this](StepContext& c) { advance_grid_momentum(c.dt); });
-  contact(ContactHook::updated);
-  P.add("nodal_velocities", &T::grid_update, [this](StepContext&) { nodal_velocities(); });
-  filter(FilterHook::velocities);
-  rigid(RigidHook::particle_update);
-  if (usl) {  // grid-to-particle and stress update in one pass over the stencils
-    P.add("particle_update", &T::stress_update, [this, refresh](StepContext& c) {
-      const ParticlePassResult r = particle_pass<true, true>(c.dt, stencils<Kernel>(), refresh);
-      c.bad = r.bad, c.beyond = r.beyond;
-    });
-    contact(ContactHook::stress_velocity);
-  } else {
-    P.add("grid_to_particle", &T::grid_to_particle, [this](StepContext& c) {
-      c.bad = particle_pass<true, false>(c.dt, stencils<Kernel>()).bad;
-    });
-  }
-  rigid(RigidHook::moved);
-  P.add("end_particle_update", &T::grid_to_particle, [this, refresh](StepContext& c) { end_particle_update(c, refresh); });
-  if (musl) {
-    P.add("remap_momentum", &T::particle_to_grid, [this](StepContext&) { remap_momentum<Kernel>(); });
-    contact(ContactHook::remapped);
-    P.add("velocity_from_momentum", &T::grid_update, [this](StepContext&) { velocity_from_momentum(); });
-    contact(ContactHook::stress_velocity);
-    P.add("stress_update", &T::stress_update, [this](StepContext& c) { stress_pass<Kernel>(c.dt); });
-  }
+  struct SerialEngine {
+    Simulation& sim;
+    PhaseList& P;
+    UpdateScheme scheme;
+    bool usf, refresh;
+    const std::vector<const StepLoad<Dim>*>& loads;
+    const std::vector<const StepVelocityFilter<Dim>*>& filters;
+    const std::vector<const StepRigidDriver<Dim>*>& rigids;
+    decltype(set_step) set;
+    void operator()(ContactHook at) {
+      for (const StepContactMethod<Dim>* m : sim.contact_methods_) m->add_phases(at, scheme, sim.opt_.shape, sim, P);
+    }
+    void operator()(LoadHook at) {
+      for (const StepLoad<Dim>* l : loads) l->add_phases(at, sim.opt_.shape, sim, P);
+    }
+    void operator()(FilterHook at) {
+      for (const StepVelocityFilter<Dim>* f : filters) f->add_phases(at, scheme, sim.opt_.shape, sim, P);
+    }
+    void operator()(RigidHook at) {
+      for (const StepRigidDriver<Dim>* r : rigids) r->add_phases(at, refresh, sim.opt_.shape, sim, P);
+    }
+    void operator()(ExchangeHook) {}  // one process: nothing to exchange
+    void operator()(SchemePhase phase) {
+      Simulation* const s = &sim;
+      switch (phase) {
+        case SchemePhase::time_step:
+          P.add("time_step", &T::time_step, [s, set = set](StepContext& c) {
+            c.speed_in_scatter = s->wave_speeds_current() && c.dt_limit > 0.0;
+            if (!c.speed_in_scatter) set(c, s->particle_speed_max());
+          });
+          break;
+        case SchemePhase::shape_functions:
+          P.add("shape_functions", &T::shape_functions, [s](StepContext&) { s->template prepare_step<Kernel>(); });
+          break;
+        case SchemePhase::extended_stencils:  // per field: EBS rebuilt (keeping the driven nodes), boxes, weights
+          if constexpr (is_extended<Kernel>)
+            P.add("extended_stencils", &T::shape_functions, [s](StepContext&) { s->prepare_extended_stencils(); });
+          break;
+        case SchemePhase::particle_to_grid:
+          P.add("particle_to_grid", &T::particle_to_grid, [s, usf = usf, set = set](StepContext& c) {
+            s->template map_to_grid<Kernel>(!usf, c.speed_in_scatter);
+            if (c.speed_in_scatter)
+              set(c, *std::max_element(s->threads_.speed_max.begin(), s->threads_.speed_max.end()));
+          });
+          break;
+        case SchemePhase::velocity_from_momentum:
+          P.add("velocity_from_momentum", &T::grid_update, [s](StepContext&) { s->velocity_from_momentum(); });
+          break;
+        case SchemePhase::stress_update:
+          P.add("stress_update", &T::stress_update, [s](StepContext& c) { s->template stress_pass<Kernel>(c.dt); });
+          break;
+        case SchemePhase::internal_forces:
+          P.add("internal_forces", &T::particle_to_grid, [s](StepContext&) { s->template add_internal_forces<Kernel>(); });
+          break;
+        case SchemePhase::velocity_conditions:
+          P.add("velocity_conditions", &T::grid_update, [s](StepContext& c) { s->apply_grid_velocity_conditions(c.dt); });
+          break;
+        case SchemePhase::momentum_update:
+          P.add("momentum_update", &T::grid_update, [s](StepContext& c) { s->advance_grid_momentum(c.dt); });
+          break;
+        case SchemePhase::nodal_velocities:
+          P.add("nodal_velocities", &T::grid_update, [s](StepContext&) { s->nodal_velocities(); });
+          break;
+        case SchemePhase::particle_update:  // grid-to-particle and stress update in one pass over the stencils
+          P.add("particle_update", &T::stress_update, [s, refresh = refresh](StepContext& c) {
+            const ParticlePassResult r = s->template particle_pass<true, true>(c.dt, s->template stencils<Kernel>(), refresh);
+            c.bad = r.bad, c.beyond = r.beyond;
+          });
+          break;
+        case SchemePhase::grid_to_particle:
+          P.add("grid_to_particle", &T::grid_to_particle, [s](StepContext& c) {
+            c.bad = s->template particle_pass<true, false>(c.dt, s->template stencils<Kernel>()).bad;
+          });
+          break;
+        case SchemePhase::end_particle_update:
+          P.add("end_particle_update", &T::grid_to_particle, [s, refresh = refresh](StepContext& c) { s->end_particle_update(c, refresh); });
+          break;
+        case SchemePhase::remap_momentum:
+          P.add("remap_momentum", &T::particle_to_grid, [s](StepContext&) { s->template remap_momentum<Kernel>(); });
+          break;
+      }
+    }
+  };
+  SerialEngine engine{*this, P, scheme, usf, refresh, loads, filters, rigids, set_step};
+  add_scheme_phases(usf, scheme == UpdateScheme::musl, engine);
 }
 
 // The start of a step: threads for this step's particle count, the thread partition and the stencils

@@ -102,8 +102,8 @@ TEST(StepPhases, ContactMethodsAtTheirHooks) {
                    "move_boundary_points", "end_particle_update"}));
   EXPECT_EQ(names_with_penalty(UpdateScheme::usf, true),
             Names({"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "velocity_from_momentum",
-                   "stress_update", "internal_forces", "move_boundary_points", "penalty_forces", "velocity_conditions",
-                   "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle", 
+                   "move_boundary_points", "stress_update", "internal_forces", "penalty_forces", "velocity_conditions",
+                   "momentum_update", "contact_updated", "nodal_velocities", "grid_to_particle",
                    "end_particle_update"}));
   const Names musl = {"time_step", "shape_functions", "particle_to_grid", "contact_extrapolated", "penalty_forces",
                       "velocity_conditions", "momentum_update", "contact_updated", "nodal_velocities",

@@ -23,7 +23,7 @@ class PenaltyContactMethod final : public StepContactMethod<Dim> {
       case ContactHook::forces:  // point forces into the nodal forces (Kakouris 2024 eq. 36)
         P.add("penalty_forces", &T::contact, [&sim](StepContext&) { sim.apply_penalty_forces(); });
         break;
-      case ContactHook::stress_velocity: {  // timed with the phase before it
+      case ContactHook::stress_velocity: {  // timed with contact (USF), the particle pass (USL), the grid update (MUSL)
         double T::*timer = scheme == UpdateScheme::usf ? &T::contact : scheme == UpdateScheme::usl ? &T::grid_to_particle : &T::grid_update;
         P.add("move_boundary_points", timer, [&sim](StepContext& c) { sim.move_boundary_points(c.dt, c.t); });
         break;

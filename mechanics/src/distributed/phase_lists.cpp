@@ -1,12 +1,15 @@
-// The decomposed step's phase lists (frictherm/mechanics/distributed.hpp): USL, MUSL and USF, each
-// the serial list (mechanics/src/simulation_step.cpp) with the exchange phases inserted, run in order
-// and timed per phase_names() entry. The phases are in usl_phases.cpp (the USL ones),
+// The decomposed step's phase lists (frictherm/mechanics/distributed.hpp): USL, MUSL and USF in the
+// order step/scheme_order.hpp writes once for both engines, with the exchange phases at its exchange
+// points, run in order and timed per phase_names() entry. The phases are in usl_phases.cpp (the USL ones),
 // scheme_phases.cpp (what MUSL and USF add), contact_phases.cpp, contact_extents.cpp,
 // penalty_phases.cpp, sparse_exchange.cpp and decomposition.cpp (migrate).
 #include "distributed/decomposed_state.hpp"
 
+#include <frictherm/mechanics/step/scheme_order.hpp>
+
 #include <mpi.h>
 
+#include <initializer_list>
 #include <vector>
 
 namespace frictherm::mechanics {
@@ -36,59 +39,105 @@ void DecomposedMpm<Dim>::step(double dt) {
       void (Impl::*run)(double);
       int name;
     };
-    // The serial lists (simulation_step.cpp, build_phases) with the exchanges inserted. Without
-    // contact (one velocity field) the per-field exchanges and the contact phases have nothing to do,
-    // without penalty contact its phases, under FLIP the velocity filter's.
-    const bool usf = s.opt.usf, usl = !s.opt.usf && !s.opt.musl, musl = s.opt.musl;
     thread_local std::vector<Phase> P;  // reused from step to step
     P.clear();
-    P.push_back({&Impl::template particle_to_grid<Kernel>, 0});  // USF: m and p only
-    // MUSL with several fields: the slots as particle_to_grid left them, for the remap.
-    if (musl) P.push_back({&Impl::keep_grid_values, 0});
-    P.insert(P.end(), {{&Impl::sum_to_owners, 1},
-                       {&Impl::exchange_field_ranges, 2},
-                       {&Impl::fields_to_owners, 3},
-                       {&Impl::find_contact_nodes, 4},
-                       {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
-                       {&Impl::contact_extrapolated, 5}});
-    // USF: the stress from the extrapolated velocities (their ghost update first; the post-condition
-    // momenta kept), the penalty contact's points moved with them, then the forces from the new stress
-    // and the loads, summed to the owners (scheme_phases.cpp). Timed with particle_to_grid and
-    // sum_to_owners (as the serial internal_forces).
-    if (usf)
-      P.insert(P.end(), {{&Impl::velocity_from_momentum, 15},
-                         {&Impl::move_boundary_points, 17},
-                         {&Impl::ghost_velocities, 9},
-                         {&Impl::fields_to_ghosts, 10},
-                         {&Impl::template stress_update<Kernel>, 12},
-                         {&Impl::template internal_forces<Kernel>, 0},
-                         {&Impl::forces_to_owners, 1}});
-    P.insert(P.end(), {{&Impl::penalty_forces, 16},  // penalty contact (penalty_phases.cpp)
-                       {&Impl::start_velocity, 6},  // XPIC's v^n (velocity_filter.cpp)
-                       {&Impl::momentum_update, 6},
-                       {&Impl::contact_updated, 7},
-                       {&Impl::nodal_velocities, 8},
-                       {&Impl::ghost_velocities, 9},
-                       {&Impl::fields_to_ghosts, 10},
-                       {&Impl::template velocity_filter<Kernel>, 11},  // XPIC/FMPM
-                       {&Impl::template grid_to_particle<Kernel>, 11}});
-    if (usl)  // the points with v^{n+1}, then the stress from it
-      P.insert(P.end(), {{&Impl::move_boundary_points, 17}, {&Impl::template stress_update<Kernel>, 12}});
-    // MUSL: the momenta remapped from the updated particles with their exchange (sum to the owners,
-    // the per-field entries, multimaterial contact on the remapped momenta), the velocity conditions
-    // and v_i = p_i/m_i, the points moved with them, the ghost update and the stress from them. The
-    // remapped contact pass is timed with the extrapolated one (both change momenta only).
-    if (musl)
-      P.insert(P.end(), {{&Impl::template remap_momentum<Kernel>, 14},
-                         {&Impl::sum_to_owners, 1},
-                         {&Impl::fields_to_owners, 3},
-                         {&Impl::contact_remapped, 5},
-                         {&Impl::velocity_from_momentum, 15},
-                         {&Impl::move_boundary_points, 17},
-                         {&Impl::ghost_velocities, 9},
-                         {&Impl::fields_to_ghosts, 10},
-                         {&Impl::template stress_update<Kernel>, 12}});
-    P.push_back({&Impl::migrate, 13});
+    // The decomposed engine's phases at the points of the step (step/scheme_order.hpp, the order the
+    // serial list has too), the exchanges inserted. Without contact (one velocity field) the per-field
+    // exchanges and the contact phases have nothing to do, without penalty contact its phases, under
+    // FLIP the velocity filter's. The velocity conditions, the loads and the damping are in its
+    // particle_to_grid, internal_forces and momentum_update (one pass over the owned nodes).
+    struct DecomposedEngine {
+      std::vector<Phase>& P;
+      bool musl;
+      void add(std::initializer_list<Phase> phases) { P.insert(P.end(), phases); }
+      void operator()(SchemePhase phase) {
+        switch (phase) {
+          case SchemePhase::particle_to_grid:  // USF: m and p only
+            add({{&Impl::template particle_to_grid<Kernel>, 0}});
+            break;
+          case SchemePhase::velocity_from_momentum:
+            add({{&Impl::velocity_from_momentum, 15}});
+            break;
+          case SchemePhase::stress_update:
+            add({{&Impl::template stress_update<Kernel>, 12}});
+            break;
+          case SchemePhase::internal_forces:  // timed with particle_to_grid (as the serial one)
+            add({{&Impl::template internal_forces<Kernel>, 0}});
+            break;
+          case SchemePhase::momentum_update:
+            add({{&Impl::momentum_update, 6}});
+            break;
+          case SchemePhase::nodal_velocities:
+            add({{&Impl::nodal_velocities, 8}});
+            break;
+          case SchemePhase::particle_update:  // the serial one-pass update as its two passes
+            add({{&Impl::template grid_to_particle<Kernel>, 11}, {&Impl::template stress_update<Kernel>, 12}});
+            break;
+          case SchemePhase::grid_to_particle:
+            add({{&Impl::template grid_to_particle<Kernel>, 11}});
+            break;
+          case SchemePhase::remap_momentum:
+            add({{&Impl::template remap_momentum<Kernel>, 14}});
+            break;
+          case SchemePhase::time_step:            // set by the caller (DecomposedMpm::stable_time_step)
+          case SchemePhase::shape_functions:      // in particle_to_grid
+          case SchemePhase::extended_stencils:    // in particle_to_grid (extended_bsplines.cpp)
+          case SchemePhase::velocity_conditions:  // in momentum_update
+          case SchemePhase::end_particle_update:  // in grid_to_particle and migrate
+            break;
+        }
+      }
+      void operator()(ExchangeHook at) {
+        switch (at) {
+          case ExchangeHook::projected:
+            // MUSL with several fields: the slots as particle_to_grid left them, for the remap.
+            if (musl) add({{&Impl::keep_grid_values, 0}});
+            add({{&Impl::sum_to_owners, 1}, {&Impl::exchange_field_ranges, 2}, {&Impl::fields_to_owners, 3}});
+            break;
+          case ExchangeHook::forces:
+            add({{&Impl::forces_to_owners, 1}});
+            break;
+          case ExchangeHook::velocities:
+            add({{&Impl::ghost_velocities, 9}, {&Impl::fields_to_ghosts, 10}});
+            break;
+          case ExchangeHook::remapped:
+            add({{&Impl::sum_to_owners, 1}, {&Impl::fields_to_owners, 3}});
+            break;
+          case ExchangeHook::migrate:
+            add({{&Impl::migrate, 13}});
+            break;
+        }
+      }
+      void operator()(ContactHook at) {
+        switch (at) {
+          case ContactHook::extrapolated:  // multimaterial contact (contact_phases.cpp, contact_extents.cpp)
+            add({{&Impl::find_contact_nodes, 4},
+                 {&Impl::template measure_contact_extents<Kernel>, 4},  // extent separation
+                 {&Impl::contact_extrapolated, 5}});
+            break;
+          case ContactHook::stress_velocity:  // penalty contact (penalty_phases.cpp)
+            add({{&Impl::move_boundary_points, 17}});
+            break;
+          case ContactHook::forces:
+            add({{&Impl::penalty_forces, 16}});
+            break;
+          case ContactHook::updated:
+            add({{&Impl::contact_updated, 7}});
+            break;
+          case ContactHook::remapped:  // timed with the extrapolated pass (both change momenta only)
+            add({{&Impl::contact_remapped, 5}});
+            break;
+        }
+      }
+      void operator()(FilterHook at) {  // velocity_filter.cpp
+        if (at == FilterHook::start_velocity) add({{&Impl::start_velocity, 6}});  // XPIC's v^n
+        if (at == FilterHook::velocities) add({{&Impl::template velocity_filter<Kernel>, 11}});  // XPIC/FMPM
+      }
+      void operator()(LoadHook) {}   // in particle_to_grid, internal_forces and momentum_update
+      void operator()(RigidHook) {}  // the drive in momentum_update and nodal_velocities, the motion in grid_to_particle
+    };
+    DecomposedEngine engine{P, s.opt.musl};
+    add_scheme_phases(s.opt.usf, s.opt.musl, engine);
     for (const Phase& phase : P) {
       const double t0 = MPI_Wtime();
       (s.*phase.run)(dt);

@@ -19,11 +19,11 @@ enum class UpdateScheme;  // simulation.hpp
 template <int Dim>
 class Simulation;
 
-/// The points of the step where a contact method's phases go (simulation_step.cpp build_phases;
-/// docs/step.md lists where each scheme puts them).
+/// The points of the step where a contact method's phases go (step/scheme_order.hpp, the order both
+/// engines build; docs/step.md lists where each scheme puts them).
 enum class ContactHook {
   extrapolated,     // after the momentum projection particle_to_grid
-  stress_velocity,  // the velocity the stress update uses is on the grid: USF after internal_forces,
+  stress_velocity,  // the velocity the stress update uses is on the grid: USF after velocity_from_momentum,
                     // USL after particle_update, MUSL after the remap's velocity_from_momentum
   forces,           // into the nodal forces, after the external loads and before the velocity conditions
   updated,          // after the momentum update

@@ -18,7 +18,7 @@ namespace frictherm::mechanics {
 template <int Dim>
 class Simulation;
 
-/// The points of the step where a rigid driver's phases go (simulation_step.cpp build_phases).
+/// The points of the step where a rigid driver's phases go (step/scheme_order.hpp, the order both engines build).
 enum class RigidHook {
   drive,            // the step's start, after shape_functions (before EBS builds its basis, which keeps
                     // the driven nodes): the rigid velocities at t onto the grid

@@ -16,7 +16,7 @@ namespace frictherm::mechanics {
 template <int Dim>
 class Simulation;
 
-/// The points of the step where a load's phases go (simulation_step.cpp build_phases).
+/// The points of the step where a load's phases go (step/scheme_order.hpp, the order both engines build).
 enum class LoadHook {
   forces,             // into the nodal forces: after the internal forces (USF) and before the contact
                       // methods' forces (penalty) and the velocity conditions

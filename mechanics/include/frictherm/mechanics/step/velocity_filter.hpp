@@ -17,7 +17,7 @@ enum class UpdateScheme;  // simulation.hpp
 template <int Dim>
 class Simulation;
 
-/// The points of the step where a filter's phases go (simulation_step.cpp build_phases).
+/// The points of the step where a filter's phases go (step/scheme_order.hpp, the order both engines build).
 enum class FilterHook {
   start_velocity,  // before the velocity conditions: the momenta the update starts from
   velocities       // after nodal_velocities: v^{n+1} on the grid, before the particles read it
