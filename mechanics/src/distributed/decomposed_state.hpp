@@ -458,6 +458,8 @@ struct DecomposedMpm<Dim>::Impl {
   void fields_to_owners(double dt);
   void find_contact_nodes(double dt);
   void contact_extrapolated(double dt);
+  void velocity_conditions(double dt);
+  void damping(double dt);
   void momentum_update(double dt);
   void contact_updated(double dt);
   void contact_remapped(double dt);  // MUSL: contact on the remapped momenta

@@ -1,8 +1,8 @@
 // The decomposed step's mechanical energy books (DecomposedMpm::energy_balance; docs/output.md "Energy
 // balance", docs/distributed_run.md): the serial Simulation::energy_balance's quantities from the same
 // kernels (energy/energy_books.hpp). The work terms are booked inside the step where the serial step
-// books them: the loads' work in grid_to_particle, the damping's and the rigid drives' in
-// momentum_update, the rigid contact partners' in the updated contact pass (usl_phases.cpp,
+// books them: the loads' work in grid_to_particle, the rigid drives' in velocity_conditions and the
+// damping's in damping, the rigid contact partners' in the updated contact pass (usl_phases.cpp,
 // contact_phases.cpp), each at the rank that owns the node or holds the particle, so the sum over ranks
 // counts each once. What is here sums this rank's particles and reduces over ranks.
 #include "distributed/decomposed_state.hpp"

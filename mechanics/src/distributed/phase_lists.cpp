@@ -44,8 +44,8 @@ void DecomposedMpm<Dim>::step(double dt) {
     // The decomposed engine's phases at the points of the step (step/scheme_order.hpp, the order the
     // serial list has too), the exchanges inserted. Without contact (one velocity field) the per-field
     // exchanges and the contact phases have nothing to do, without penalty contact its phases, under
-    // FLIP the velocity filter's. The velocity conditions, the loads and the damping are in its
-    // particle_to_grid, internal_forces and momentum_update (one pass over the owned nodes).
+    // FLIP the velocity filter's. The point loads and tractions are in its particle_to_grid and
+    // internal_forces (added to the slots before the sums to the owners).
     struct DecomposedEngine {
       std::vector<Phase>& P;
       bool musl;
@@ -63,6 +63,9 @@ void DecomposedMpm<Dim>::step(double dt) {
             break;
           case SchemePhase::internal_forces:  // timed with particle_to_grid (as the serial one)
             add({{&Impl::template internal_forces<Kernel>, 0}});
+            break;
+          case SchemePhase::velocity_conditions:  // timed with momentum_update
+            add({{&Impl::velocity_conditions, 6}});
             break;
           case SchemePhase::momentum_update:
             add({{&Impl::momentum_update, 6}});
@@ -82,7 +85,6 @@ void DecomposedMpm<Dim>::step(double dt) {
           case SchemePhase::time_step:            // set by the caller (DecomposedMpm::stable_time_step)
           case SchemePhase::shape_functions:      // in particle_to_grid
           case SchemePhase::extended_stencils:    // in particle_to_grid (extended_bsplines.cpp)
-          case SchemePhase::velocity_conditions:  // in momentum_update
           case SchemePhase::end_particle_update:  // in grid_to_particle and migrate
             break;
         }
@@ -133,8 +135,10 @@ void DecomposedMpm<Dim>::step(double dt) {
         if (at == FilterHook::start_velocity) add({{&Impl::start_velocity, 6}});  // XPIC's v^n
         if (at == FilterHook::velocities) add({{&Impl::template velocity_filter<Kernel>, 11}});  // XPIC/FMPM
       }
-      void operator()(LoadHook) {}   // in particle_to_grid, internal_forces and momentum_update
-      void operator()(RigidHook) {}  // the drive in momentum_update and nodal_velocities, the motion in grid_to_particle
+      void operator()(LoadHook at) {  // point loads and tractions: in particle_to_grid and internal_forces
+        if (at == LoadHook::conditioned_forces) add({{&Impl::damping, 6}});  // timed with momentum_update
+      }
+      void operator()(RigidHook) {}  // the drive in velocity_conditions and nodal_velocities, the motion in grid_to_particle
     };
     DecomposedEngine engine{P, s.opt.musl};
     add_scheme_phases(s.opt.usf, s.opt.musl, engine);

@@ -246,13 +246,18 @@ void DecomposedMpm<Dim>::Impl::sum_to_owners(double /*dt*/) {
   petsc_check(DMLocalToGlobalEnd(da, local, ADD_VALUES, global), "DMLocalToGlobalEnd");
 }
 
-// Phase 7, owned nodes: velocity conditions of the fixed faces on p_i and f_i (the serial
-// apply_velocity_bc: fixed components of both zeroed), the damping, then p_i^{n+1} = p_i^n + f_i dt.
+// The grid update on the owned nodes, in the serial list's three phases (step/scheme_order.hpp):
+// velocity_conditions, damping (at LoadHook::conditioned_forces) and momentum_update. Each visits
+// the owned fields in the same order and does at a node what the serial phase of its name does, so
+// a node's arithmetic and the books' sums are in the serial order.
+
+// The velocity conditions on p_i and f_i: a rigid partner's field m v_rigid with no force, driven
+// components the rigid velocity (the change a force, the rigid work booked), fixed components of both
+// zeroed (the serial apply_velocity_bc).
 template <int Dim>
-void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
+void DecomposedMpm<Dim>::Impl::velocity_conditions(double dt) {
   constexpr int momentum = Dof::momentum, force = Dof::force;
-  const bool damped = damping_active(opt.damping_rate, opt.damping_until, time);
-  double removed = 0.0, driven_work = 0.0, stopped = 0.0;
+  double driven_work = 0.0, stopped = 0.0;
   // The start-of-step momentum of the stops (the serial apply_velocity_bc): without the extrapolated
   // contact pass's change at a group entry.
   const double* const mt_begin = mt_values.data();
@@ -285,16 +290,40 @@ void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
     }
     for (int d = 0; d < Dim; ++d)
       if (fixed & (1u << d)) node[momentum + d] = node[force + d] = 0.0;
-    // Mass-proportional damping after the velocity conditions, on the components they leave free
-    // (the serial apply_damping's kernel).
-    if (damped)
-      damp_node<Dim>(node + force, node + momentum, node[Dof::mass], driven, opt.damping_rate, dt, empty_node_mass, removed);
-    for (int d = 0; d < Dim; ++d) node[momentum + d] += node[force + d] * dt;
+  });
+  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
+  rigid_work += driven_work;
+  boundary_stop_work += stopped;
+}
+
+// Mass-proportional damping after the velocity conditions, on the components they leave free (the
+// serial apply_damping's kernel, loads/mass_damping.cpp); not on a rigid partner's field.
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::damping(double dt) {
+  if (!damping_active(opt.damping_rate, opt.damping_until, time)) return;
+  double removed = 0.0;
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(global, &a), "VecGetArray");
+  for_each_owned_field(a, [&](PetscInt q, double* node, int field) {
+    if (partner(field)) return;
+    const std::uint8_t driven = has_rigid ? drive_mask[static_cast<std::size_t>(q)] : 0;
+    damp_node<Dim>(node + Dof::force, node + Dof::momentum, node[Dof::mass], driven, opt.damping_rate, dt,
+                   empty_node_mass, removed);
   });
   petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
   damping_work += removed;
-  rigid_work += driven_work;
-  boundary_stop_work += stopped;
+}
+
+// p_i^{n+1} = p_i^n + f_i dt (a rigid partner's field keeps m v_rigid).
+template <int Dim>
+void DecomposedMpm<Dim>::Impl::momentum_update(double dt) {
+  PetscScalar* a = nullptr;
+  petsc_check(VecGetArray(global, &a), "VecGetArray");
+  for_each_owned_field(a, [&](PetscInt, double* node, int field) {
+    if (partner(field)) return;
+    for (int d = 0; d < Dim; ++d) node[Dof::momentum + d] += node[Dof::force + d] * dt;
+  });
+  petsc_check(VecRestoreArray(global, &a), "VecRestoreArray");
 }
 
 // Phase 9, owned nodes: v_i = p_i^{n+1}/m_i, a_i = f_i/m_i per field, into the slots of p and f; fields
@@ -467,6 +496,8 @@ double DecomposedMpm<Dim>::damping_work() const {
   template double DecomposedMpm<D>::external_work() const;             \
   template double DecomposedMpm<D>::damping_work() const;              \
   template void DecomposedMpm<D>::Impl::sum_to_owners(double);         \
+  template void DecomposedMpm<D>::Impl::velocity_conditions(double);   \
+  template void DecomposedMpm<D>::Impl::damping(double);               \
   template void DecomposedMpm<D>::Impl::momentum_update(double);       \
   template void DecomposedMpm<D>::Impl::nodal_velocities(double);      \
   template void DecomposedMpm<D>::Impl::ghost_velocities(double);
