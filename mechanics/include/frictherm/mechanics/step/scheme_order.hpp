@@ -5,9 +5,9 @@
 // phases (SchemePhase), the components' hooks (contact methods, loads, velocity filters, rigid drivers)
 // and the exchange points of a decomposed run (ExchangeHook). The serial engine
 // (simulation_step.cpp build_phases) adds nothing at an exchange point; the decomposed one
-// (distributed/phase_lists.cpp) adds its sums to the owners, ghost updates and migration there, and its
-// grid update takes the velocity conditions, the loads and the damping into momentum_update. An
-// engine adds nothing at a point it does not act on.
+// (distributed/phase_lists.cpp) adds its sums to the owners, ghost updates and migration there (its
+// point loads and tractions stay inside its particle_to_grid and internal_forces, added before the
+// sums). An engine adds nothing at a point it does not act on.
 #include <frictherm/mechanics/step/contact_method.hpp>
 #include <frictherm/mechanics/step/rigid_driver.hpp>
 #include <frictherm/mechanics/step/step_load.hpp>
@@ -43,8 +43,8 @@ enum class ExchangeHook {
 };
 
 /// Hands the points of the step of the update scheme (USF when `usf`, MUSL when `musl`, else USL) to
-/// `engine` in order: engine(SchemePhase),
-/// engine(ContactHook), engine(LoadHook), engine(FilterHook), engine(RigidHook), engine(ExchangeHook).
+/// `engine` in order: engine(SchemePhase), engine(ContactHook), engine(LoadHook), engine(FilterHook),
+/// engine(RigidHook), engine(ExchangeHook).
 /// USF: the stress from the extrapolated grid velocities, then the forces; USL: the forces from the
 /// start-of-step stress, the stress after the grid update (with grid-to-particle in one pass); MUSL: as
 /// USL, then the momenta remapped from the updated particles and the stress from their velocities.
