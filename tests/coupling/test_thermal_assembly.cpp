@@ -229,6 +229,36 @@ TEST(HeatHandoff, AccumulatorSumsEnergy) {
 }
 
 // T_p += Σ_i S_ip ΔT_i conserves Σ m_p C_p T_p exactly: Σ_p m_p C_p ΔT_p = Σ_i M_i ΔT_i.
+// The particle book differences two sums of Σ m C T. Early in a 3D run (pbx_3d.json after 100 steps)
+// the heat is 1/5000 of that sum over 85,000 particles of equal mass at 293.15 or 300 K, and a plain
+// loop's rounding (its terms alike, so it adds up: about 1e-12 of the sum) was 8.6e-9 of the heat.
+// Here the same: 120,000 such particles, heat 1/5000 of Σ m C T, spread unevenly; the book's change
+// must be the particles' exact Σ m C (T1 − T0) to 1e-10 (a plain loop misses by 6e-9 here, the
+// compensated sum by about 1e-14).
+TEST(IncrementalMapping, ParticleEnergyBookKeepsSmallHeatAgainstLargeContent) {
+  const std::vector<fc::ThermalProperties> mats{{true, 950.0, 0.4}, {true, 2280.0, 0.2}};
+  fm::Particles<3> p;
+  const std::size_t n = 120000;
+  for (std::size_t k = 0; k < n; ++k) {
+    p.add(fm::Vec<3>::Zero(), fm::Vec<3>::Constant(5e-7), 1e-14, 1e-18, static_cast<int>(k % 5 == 0), 0,
+          k % 3 == 0 ? 293.15 : 300.0);
+  }
+  const double e0 = fc::particle_thermal_energy(p, mats);
+  std::vector<double> T0(p.temperature.begin(), p.temperature.end());
+  for (std::size_t k = 0; k < n; ++k) {  // ΔT from 0 to 0.54 K
+    const double x = static_cast<double>(k);
+    p.temperature[k] += 0.18 * std::pow(std::sin(0.011 * x), 8) * (k % 7 == 0 ? 3.0 : 1.0);
+  }
+  long double exact = 0.0L;  // each T1 − T0 is exact (Sterbenz); long double for the sum
+  for (std::size_t k = 0; k < n; ++k)
+    exact += static_cast<long double>(p.mass[k] * mats[static_cast<std::size_t>(p.material[k])].heat_capacity *
+                                      (p.temperature[k] - T0[k]));
+  const double heat = static_cast<double>(exact);
+  ASSERT_GT(heat, 1.5e-4 * e0);
+  ASSERT_LT(heat, 3e-4 * e0);
+  EXPECT_NEAR(fc::particle_thermal_energy(p, mats) - e0, heat, 1e-10 * heat);
+}
+
 TEST(IncrementalMapping, ParticleEnergyChangeEqualsNodalEnergyChange) {
   const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
   const auto mats = two_materials();

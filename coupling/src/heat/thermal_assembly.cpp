@@ -1,6 +1,7 @@
 // Nodal thermal mass, temperature and conductance from particles (Nairn et al. 2018 eq. 38), and
 // the incremental particle update T_p += Σ_i S_ip ΔT_i (design §4).
 #include <frictherm/coupling/thermal_assembly.hpp>
+#include <frictherm/mechanics/energy/compensated_sum.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
 
 #include "conductance_rows.hpp"
@@ -397,12 +398,12 @@ double add_nodal_change_to_particles(const mechanics::Grid<Dim>& grid, mechanics
 
 template <int Dim>
 double particle_thermal_energy(const mechanics::Particles<Dim>& p, const std::vector<ThermalProperties>& materials) {
-  double e = 0.0;
+  mechanics::CompensatedSum e;  // the books difference two such sums (compensated_sum.hpp)
   for (std::size_t k = 0; k < p.size(); ++k) {
     const ThermalProperties& m = thermal_properties_of(materials, p.material[k]);
-    if (m.conducts) e += p.mass[k] * m.heat_capacity * p.temperature[k];
+    if (m.conducts) e.add(p.mass[k] * m.heat_capacity * p.temperature[k]);
   }
-  return e;
+  return e.value();
 }
 
 #define FRICTHERM_INSTANTIATE_ASSEMBLY(D)                                                                       \
