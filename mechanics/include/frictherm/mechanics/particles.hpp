@@ -24,7 +24,8 @@ struct Particles {
   std::vector<double> stress_zz;           // out-of-plane Cauchy stress in 2D (plane strain), 0 in 3D
   std::vector<double> temperature;         // T_p (K)
   std::vector<double> plastic_strain;      // equivalent plastic strain (0 for elastic materials)
-  std::vector<double> internal_energy;     // specific internal energy e (J/kg) of equation-of-state materials
+  std::vector<double> internal_energy;     // equation of state: specific internal energy e (J/kg);
+                                           // linear elastic: its stress's work per unit V0 (J/m^3)
   std::vector<double> plastic_work;        // plastic work done on the particle since the start (J)
   std::vector<std::int32_t> material;      // material id
   std::vector<std::int32_t> body;          // body id

@@ -54,17 +54,18 @@ inline double mie_gruneisen_stored_energy(const Material& m, double mass, double
 }
 }  // namespace energy_detail
 
-/// One particle's share of the books' stored energy (J): ½ σ:ε V (linear elastic, ε from σ through
-/// the compliance), W(F) V0 (neo-Hookean, Kakouris 2024 eq. 46), the equation-of-state energy m e − W_p
+/// One particle's share of the books' stored energy (J): the work its stress has done, V0 w (linear
+/// elastic: add_stress_work, stress_update.hpp; its hypoelastic law has no closed form that is that
+/// work), W(F) V0 (neo-Hookean, Kakouris 2024 eq. 46), the equation-of-state energy m e − W_p
 /// plus the shear energy V s:s/(4G) (Mie-Grüneisen); 0 for a rigid material.
 template <int Dim>
-inline double particle_stored_energy(const Material& m, Analysis analysis, double mass, double volume,
+inline double particle_stored_energy(const Material& m, Analysis /*analysis*/, double mass, double volume,
                                      double initial_volume, const Mat<Dim>& F, const Mat<Dim>& sigma,
                                      double sigma_zz, double internal_energy, double plastic_work) {
   if (m.kind == MaterialKind::neo_hookean)
     return initial_volume * neo_hookean_energy_density<Dim>(F, m.lame_lambda(), m.shear_modulus());
-  if (m.kind == MaterialKind::linear_elastic)
-    return volume * linear_elastic_energy_density<Dim>(sigma, sigma_zz, m.youngs_modulus, m.poisson_ratio, analysis);
+  if (m.kind == MaterialKind::linear_elastic)  // the stress's work (add_stress_work, stress_update.hpp)
+    return initial_volume * internal_energy;
   if (m.kind == MaterialKind::mie_gruneisen)
     return energy_detail::mie_gruneisen_stored_energy<Dim>(m, mass, volume, internal_energy, plastic_work, sigma,
                                                            sigma_zz);
