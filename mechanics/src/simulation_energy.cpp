@@ -14,7 +14,7 @@ template <int Dim>
 double Simulation<Dim>::strain_energy() const {
   double e = 0.0;
   for (std::size_t k = 0; k < p_.size(); ++k)
-    e += particle_stored_energy<Dim>(materials_[static_cast<std::size_t>(p_.material[k])], opt_.analysis, p_.mass[k],
+    e += particle_stored_energy<Dim>(materials_[static_cast<std::size_t>(p_.material[k])], p_.mass[k],
                                      p_.volume[k], p_.initial_volume[k], p_.deformation_gradient[k], p_.stress[k],
                                      p_.stress_zz[k], p_.internal_energy[k], p_.plastic_work[k]);
   return e;

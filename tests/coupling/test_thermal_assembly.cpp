@@ -228,7 +228,6 @@ TEST(HeatHandoff, AccumulatorSumsEnergy) {
   EXPECT_THROW(acc.add(w), std::invalid_argument);
 }
 
-// T_p += Σ_i S_ip ΔT_i conserves Σ m_p C_p T_p exactly: Σ_p m_p C_p ΔT_p = Σ_i M_i ΔT_i.
 // The particle book differences two sums of Σ m C T. Early in a 3D run (pbx_3d.json after 100 steps)
 // the heat is 1/5000 of that sum over 85,000 particles of equal mass at 293.15 or 300 K, and a plain
 // loop's rounding (its terms alike, so it adds up: about 1e-12 of the sum) was 8.6e-9 of the heat.
@@ -259,6 +258,7 @@ TEST(IncrementalMapping, ParticleEnergyBookKeepsSmallHeatAgainstLargeContent) {
   EXPECT_NEAR(fc::particle_thermal_energy(p, mats) - e0, heat, 1e-10 * heat);
 }
 
+// T_p += Σ_i S_ip ΔT_i conserves Σ m_p C_p T_p exactly: Σ_p m_p C_p ΔT_p = Σ_i M_i ΔT_i.
 TEST(IncrementalMapping, ParticleEnergyChangeEqualsNodalEnergyChange) {
   const auto grid = make_grid<2>({0.0, 0.0}, 1e-3, {10, 8});
   const auto mats = two_materials();

@@ -26,7 +26,7 @@ std::array<double, 3> DecomposedMpm<Dim>::Impl::particle_books() const {
   for (PetscInt k = 0; k < f.n; ++k) {
     const std::size_t m = static_cast<std::size_t>(f.material[k]);
     if (!materials[m].is_rigid()) e[0] += 0.5 * f.mass[k] * Eigen::Map<const Vec<Dim>>(f.velocity + Dim * k).squaredNorm();
-    e[1] += particle_stored_energy<Dim>(materials[m], opt.analysis, f.mass[k], f.volume[k], f.volume0[k],
+    e[1] += particle_stored_energy<Dim>(materials[m], f.mass[k], f.volume[k], f.volume0[k],
                                         Eigen::Map<const Mat<Dim>>(f.F + Dim * Dim * k),
                                         Eigen::Map<const Mat<Dim>>(f.stress + Dim * Dim * k), f.stress_zz[k],
                                         f.internal_energy[k], f.plastic_work[k]);

@@ -59,7 +59,7 @@ inline double mie_gruneisen_stored_energy(const Material& m, double mass, double
 /// work), W(F) V0 (neo-Hookean, Kakouris 2024 eq. 46), the equation-of-state energy m e − W_p
 /// plus the shear energy V s:s/(4G) (Mie-Grüneisen); 0 for a rigid material.
 template <int Dim>
-inline double particle_stored_energy(const Material& m, Analysis /*analysis*/, double mass, double volume,
+inline double particle_stored_energy(const Material& m, double mass, double volume,
                                      double initial_volume, const Mat<Dim>& F, const Mat<Dim>& sigma,
                                      double sigma_zz, double internal_energy, double plastic_work) {
   if (m.kind == MaterialKind::neo_hookean)
