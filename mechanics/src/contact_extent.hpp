@@ -41,28 +41,59 @@ void side_normals(const std::vector<ContactSide<Dim>>& sides, const std::vector<
 /// No particle measured yet (the start of every maximum).
 inline constexpr double kNoExtent = -std::numeric_limits<double>::infinity();
 
+/// The directions each side's extents are measured along: its normal n̂, then each axis d with
+/// n̂_d ≠ 0, signed as n̂_d (towards the partners). Per side, own and other hold one maximum per
+/// direction, in this order.
+template <int Dim>
+inline constexpr int kExtentDirections = 1 + Dim;
+
 /// One particle (centre x, half-sizes l, of velocity field `field`) that gives a contact node a
 /// weight, against the node's `count` entries (entry j of field field_of(j), normal normal[j]; a zero
-/// normal is skipped): with r = Σ_d l_d |n̂_d| its half-extent along n̂,
-/// own[j] = max(own[j], x·n̂ + r) for its own field, other[j] = max(other[j], r − x·n̂) for the others.
+/// normal is skipped): along each direction e of kExtentDirections (n̂, then the signed axes) with
+/// r = Σ_d l_d |e_d| its half-extent along e, own[j][e] = max(own[j][e], x·e + r) for its own field,
+/// other[j][e] = max(other[j][e], r − x·e) for the others.
 template <int Dim, class FieldOf>
 void add_particle_extent(const Vec<Dim>& x, const Vec<Dim>& l, int field, int count, const FieldOf& field_of,
                          const Vec<Dim>* normal, double* own, double* other) {
+  constexpr int S = kExtentDirections<Dim>;
   for (int j = 0; j < count; ++j) {
     const Vec<Dim>& n = normal[j];
     if (n.squaredNorm() == 0.0) continue;  // a sliver, or no normal
     const double centre = x.dot(n), half = l.cwiseProduct(n).cwiseAbs().sum();
-    if (field_of(j) == field)
-      own[j] = std::max(own[j], centre + half);
-    else
-      other[j] = std::max(other[j], half - centre);
+    double* mine = field_of(j) == field ? own + S * j : nullptr;
+    double* theirs = mine ? nullptr : other + S * j;
+    if (mine) mine[0] = std::max(mine[0], centre + half);
+    else theirs[0] = std::max(theirs[0], half - centre);
+    for (int d = 0; d < Dim; ++d) {
+      if (n[d] == 0.0) continue;
+      const double c = n[d] > 0.0 ? x[d] : -x[d];
+      if (mine) mine[1 + d] = std::max(mine[1 + d], c + l[d]);
+      else theirs[1 + d] = std::max(theirs[1 + d], l[d] - c);
+    }
   }
 }
 
 /// The gap between a side's surface and its partners' along its normal, −(own + other) (< 0 where
-/// they overlap), or NaN when either was not measured (ContactSide::extent_gap).
-inline double extent_gap(double own, double other) {
-  return std::isfinite(own) && std::isfinite(other) ? -(own + other) : std::numeric_limits<double>::quiet_NaN();
+/// they overlap), or NaN when either was not measured (ContactSide::extent_gap). own, other: one
+/// side's kExtentDirections maxima.
+template <int Dim>
+inline double extent_gap(const double* own, const double* other) {
+  return std::isfinite(own[0]) && std::isfinite(other[0]) ? -(own[0] + other[0])
+                                                          : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// The largest gap along the signed axes, −(own + other) on each measured one (−inf: none): domains
+/// an axis separates are apart however the normal leans (disjoint projections, disjoint sets). At a
+/// body's corner facing another's across an open gap the normal leans ~45° and the projections on
+/// it overlap, so the normal's gap alone called the bodies touching there (a frictionless bar impact
+/// across a gap of half a cell started at once, and lost twice the energy: docs/contact.md,
+/// "Contact detection"). ContactSide::extent_axis_gap.
+template <int Dim>
+inline double extent_axis_gap(const double* own, const double* other) {
+  double gap = -std::numeric_limits<double>::infinity();
+  for (int e = 1; e < kExtentDirections<Dim>; ++e)
+    if (std::isfinite(own[e]) && std::isfinite(other[e])) gap = std::max(gap, -(own[e] + other[e]));
+  return gap;
 }
 
 }  // namespace frictherm::mechanics::contact_detail

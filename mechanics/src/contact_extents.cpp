@@ -4,7 +4,9 @@
 // material a to its partners (eq. 7, as resolve_contact computes it),
 //   gap = min over the partners' particles of (x_p·n̂ − r_p)  −  max over a's particles of (x_p·n̂ + r_p),
 // r_p = Σ_d l_{p,d} |n̂_d| the half-extent of particle p's domain (half-sizes l_p) along n̂, over the
-// particles that give the node a weight. Touching flat surfaces have gap = 0 whatever their offset
+// particles that give the node a weight; the same along each coordinate axis (signed towards the
+// partners), and the detection takes the largest of these gaps (contact_extent.hpp extent_axis_gap:
+// domains an axis separates are apart, whatever the normal). Touching flat surfaces have gap = 0 whatever their offset
 // from the grid lines, so a material that reaches a node only as a sliver of its edge row is still
 // seen in contact there, where the centre-of-mass test puts it ≈ 1.25 h away.
 #include <frictherm/mechanics/simulation.hpp>
@@ -27,9 +29,10 @@ template <class Stencils>
 void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
   compute_contact_normals();
   const std::size_t entries = contact_nodes_.entries.size();
+  constexpr std::size_t stride = contact_detail::kExtentDirections<Dim>;  // maxima per entry
   constexpr double none = -std::numeric_limits<double>::infinity();
-  contact_nodes_.entry_extent_own.assign(entries, none);
-  contact_nodes_.entry_extent_other.assign(entries, none);
+  contact_nodes_.entry_extent_own.assign(stride * entries, none);
+  contact_nodes_.entry_extent_other.assign(stride * entries, none);
   if (entries == 0) return;
   if (static_cast<int>(contact_nodes_.extent_thread.size()) < threads_.count - 1) contact_nodes_.extent_thread.resize(static_cast<std::size_t>(threads_.count - 1));
   // Per slot: 1 if its node has two or more fields with mass (the nodes add_particle_extent is
@@ -57,9 +60,9 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
     double* other = contact_nodes_.entry_extent_other.data();
     if (tid > 0) {
       std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(tid - 1)];
-      buf.assign(2 * entries, none);
+      buf.assign(2 * stride * entries, none);
       own = buf.data();
-      other = buf.data() + entries;
+      other = buf.data() + stride * entries;
     }
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const int f = layout_.field_of_material[m];
@@ -84,16 +87,17 @@ void Simulation<Dim>::measure_contact_extents(const Stencils& st) {
           const int begin = contact_nodes_.node_entry_cursor[node] - c;  // the node's run (find_contact_nodes)
           const ContactEntry* run = contact_nodes_.entries.data() + begin;
           contact_detail::add_particle_extent<Dim>(x, l, f, c, [run](int j) { return run[j].field; },
-                                                   contact_nodes_.entry_normal.data() + begin, own + begin, other + begin);
+                                                   contact_nodes_.entry_normal.data() + begin, own + stride * begin,
+                                                   other + stride * begin);
         });
       }
     }
   });
   for (int t = 0; t + 1 < threads; ++t) {
     const std::vector<double>& buf = contact_nodes_.extent_thread[static_cast<std::size_t>(t)];
-    for (std::size_t q = 0; q < entries; ++q) {
+    for (std::size_t q = 0; q < stride * entries; ++q) {
       contact_nodes_.entry_extent_own[q] = std::max(contact_nodes_.entry_extent_own[q], buf[q]);
-      contact_nodes_.entry_extent_other[q] = std::max(contact_nodes_.entry_extent_other[q], buf[entries + q]);
+      contact_nodes_.entry_extent_other[q] = std::max(contact_nodes_.entry_extent_other[q], buf[stride * entries + q]);
     }
   }
 }

@@ -195,7 +195,8 @@ PairChange<Dim> pair_contact(const ContactSide<Dim>& a, const ContactSide<Dim>& 
   else if (c.separation == SeparationMethod::displacement)  // eqs. 9–10
     separation = (b.mass_position / b.mass - a.mass_position / a.mass).dot(n);
   else if (c.separation == SeparationMethod::extent)  // particle domains, contact_extents.cpp
-    separation = std::isnan(a.extent_gap) ? -1.0 : a.extent_gap - c.extent_tolerance * h_perp;
+    separation = std::isnan(a.extent_gap) ? -1.0
+                                          : std::max(a.extent_gap, a.extent_axis_gap) - c.extent_tolerance * h_perp;
   // A material holding under light_touch_fraction of the pair's mass at the node reaches it with the
   // tails of its particles' shape functions only: its mass centroid there sits about a cell from its
   // surface, so eqs. 8–10 call it separated however far it has pressed into its partner's cell. Left

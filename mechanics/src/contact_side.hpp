@@ -26,6 +26,10 @@ struct ContactSide {
   /// Extent separation: the gap between this material's particle domains and its partners' along
   /// the normal from this material to them (m, < 0 where they overlap); NaN when not measured.
   double extent_gap = std::numeric_limits<double>::quiet_NaN();
+  /// The same gap measured along the coordinate axes (the largest, contact_extent.hpp
+  /// extent_axis_gap; −inf: none): the detection takes the larger of the two, the closing approach
+  /// (contact_pair.hpp) the normal's.
+  double extent_axis_gap = -std::numeric_limits<double>::infinity();
   /// Below ContactOptions::sliver_fraction of the node's mass: kept from interpenetrating, never
   /// given friction (a sliver's contact area ~ its overlap but its mass ~ overlap², so any area-based
   /// law would stick it and its shape-function gradient would strain its particles). A deformable

@@ -187,7 +187,9 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
                                           std::vector<int>& slots, std::vector<int>& mats, std::vector<int>& entries) const {
   const std::size_t e = contact_nodes_.groups[group], end = contact_nodes_.groups[group + 1];
   sides.clear(), slots.clear(), mats.clear(), entries.clear();
-  const bool extents = contact_setup_.options.separation == SeparationMethod::extent && contact_nodes_.entry_extent_own.size() == contact_nodes_.entries.size();
+  const bool extents = contact_setup_.options.separation == SeparationMethod::extent &&
+                       contact_nodes_.entry_extent_own.size() ==
+                           contact_detail::kExtentDirections<Dim> * contact_nodes_.entries.size();
   double node_mass = 0.0;
   for (std::size_t q = e; q < end; ++q) node_mass += nodes_.mass[static_cast<std::size_t>(contact_nodes_.entries[q].slot)];
   int guarded = 0;
@@ -214,7 +216,12 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
       sd.rigid_acceleration = (mat.rigid_velocity_at(clock_.time + dt).template head<Dim>() - layout_.field_velocity[f]) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
-      sd.extent_gap = contact_detail::extent_gap(contact_nodes_.entry_extent_own[q], contact_nodes_.entry_extent_other[q]);
+      {
+      const double* own = contact_nodes_.entry_extent_own.data() + contact_detail::kExtentDirections<Dim> * q;
+      const double* other = contact_nodes_.entry_extent_other.data() + contact_detail::kExtentDirections<Dim> * q;
+      sd.extent_gap = contact_detail::extent_gap<Dim>(own, other);
+      sd.extent_axis_gap = contact_detail::extent_axis_gap<Dim>(own, other);
+    }
     sides.push_back(sd);
     slots.push_back(slot);
     mats.push_back(fields_[f].material);

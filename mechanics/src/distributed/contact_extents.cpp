@@ -39,6 +39,7 @@ template <int Dim>
 template <class Kernel>
 void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
   using contact_detail::kNoExtent;
+  constexpr std::size_t stride = contact_detail::kExtentDirections<Dim>;  // maxima per item (and per mt entry)
   if (!opt.contact || fields == 1 || opt.contact_options.separation != SeparationMethod::extent) return;
   const std::size_t entries_here = mt_field.size();
   mt_normal.assign(entries_here, Vec<Dim>::Zero());
@@ -55,7 +56,7 @@ void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
   extent_field.clear(), extent_normal.clear(), extent_own.clear(), extent_other.clear(), extent_entry.clear();
   const auto add_item = [&](int field, const Vec<Dim>& n, std::size_t e) {
     extent_field.push_back(field), extent_normal.push_back(n), extent_entry.push_back(e);
-    extent_own.push_back(kNoExtent), extent_other.push_back(kNoExtent);
+    extent_own.insert(extent_own.end(), stride, kNoExtent), extent_other.insert(extent_other.end(), stride, kNoExtent);
   };
   entry_group.assign(entries_here, 0);
   for (std::size_t g = 0; g + 1 < mt_first.size(); ++g)
@@ -76,18 +77,18 @@ void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
   }
   const std::size_t owned_items = extent_field.size();
   MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_INT, MPI_MAX, comm);
-  mt_extent_own.assign(entries_here, kNoExtent);
-  mt_extent_other.assign(entries_here, kNoExtent);
+  mt_extent_own.assign(stride * entries_here, kNoExtent);
+  mt_extent_other.assign(stride * entries_here, kNoExtent);
   if (most == 0) return;  // no contact node with a normal on any rank
   if (most != extent_unit_items) {  // (the star forests that used the old units are destroyed)
     free_extent_units();
     MPI_Type_contiguous(most * (1 + Dim), MPI_DOUBLE, &extent_list_unit);
     MPI_Type_commit(&extent_list_unit);
-    MPI_Type_contiguous(most * 2, MPI_DOUBLE, &extent_max_unit);
+    MPI_Type_contiguous(most * 2 * static_cast<int>(stride), MPI_DOUBLE, &extent_max_unit);
     MPI_Type_commit(&extent_max_unit);
     extent_unit_items = most;
   }
-  const std::size_t K = static_cast<std::size_t>(most), list_unit = K * (1 + Dim), max_unit = 2 * K;
+  const std::size_t K = static_cast<std::size_t>(most), list_unit = K * (1 + Dim), max_unit = 2 * stride * K;
   // 2. The lists to the leaves: each received entry's root holds its node's list (field −1: no item).
   const std::size_t roots = mt_recv_entry.size(), leaves = send_slot.size();
   extent_root.assign(roots * list_unit, -1.0);
@@ -139,7 +140,7 @@ void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
         const int* item_field = extent_field.data() + i;
         contact_detail::add_particle_extent<Dim>(x, hs, field, static_cast<int>(extent_count[static_cast<std::size_t>(l)]),
                                                  [item_field](int j) { return item_field[j]; }, extent_normal.data() + i,
-                                                 extent_own.data() + i, extent_other.data() + i);
+                                                 extent_own.data() + stride * i, extent_other.data() + stride * i);
       });
     }
   }
@@ -150,8 +151,8 @@ void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
     const std::size_t l = static_cast<std::size_t>(slot_node[send_slot[i]]);
     double* b = extent_leaf.data() + i * max_unit;
     for (PetscInt j = 0; extent_start[l] >= 0 && j < extent_count[l]; ++j) {
-      const std::size_t it = static_cast<std::size_t>(extent_start[l] + j);
-      b[2 * j] = extent_own[it], b[2 * j + 1] = extent_other[it];
+      const std::size_t it = static_cast<std::size_t>(extent_start[l] + j), jj = static_cast<std::size_t>(j);
+      for (std::size_t e = 0; e < stride; ++e) b[2 * stride * jj + e] = extent_own[stride * it + e], b[2 * stride * jj + stride + e] = extent_other[stride * it + e];
     }
   }
   extent_root.assign(roots * max_unit, kNoExtent);
@@ -163,14 +164,18 @@ void DecomposedMpm<Dim>::Impl::measure_contact_extents(double /*dt*/) {
     const std::size_t l = static_cast<std::size_t>(mt_l[entry_group[mt_recv_entry[r]]]);
     const double* b = extent_root.data() + r * max_unit;
     for (PetscInt j = 0; extent_start[l] >= 0 && j < extent_count[l]; ++j) {
-      const std::size_t it = static_cast<std::size_t>(extent_start[l] + j);
-      extent_own[it] = std::max(extent_own[it], b[2 * j]);
-      extent_other[it] = std::max(extent_other[it], b[2 * j + 1]);
+      const std::size_t it = static_cast<std::size_t>(extent_start[l] + j), jj = static_cast<std::size_t>(j);
+      for (std::size_t e = 0; e < stride; ++e) {
+        extent_own[stride * it + e] = std::max(extent_own[stride * it + e], b[2 * stride * jj + e]);
+        extent_other[stride * it + e] = std::max(extent_other[stride * it + e], b[2 * stride * jj + stride + e]);
+      }
     }
   }
   for (std::size_t i = 0; i < owned_items; ++i) {
-    mt_extent_own[extent_entry[i]] = extent_own[i];
-    mt_extent_other[extent_entry[i]] = extent_other[i];
+    for (std::size_t e = 0; e < stride; ++e) {
+      mt_extent_own[stride * extent_entry[i] + e] = extent_own[stride * i + e];
+      mt_extent_other[stride * extent_entry[i] + e] = extent_other[stride * i + e];
+    }
   }
 }
 

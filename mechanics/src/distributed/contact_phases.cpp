@@ -128,7 +128,8 @@ long DecomposedMpm<Dim>::Impl::gather_sides(std::size_t g, double dt, std::vecto
   constexpr int mass = Dof::mass, momentum = Dof::momentum, force = Dof::force;
   constexpr int mass_position = Dof::mass_position, domain = Dof::domain, domain_gradient = Dof::domain_gradient;
   const ContactOptions& co = opt.contact_options;
-  const bool extents = co.separation == SeparationMethod::extent && mt_extent_own.size() == mt_field.size();
+  const bool extents = co.separation == SeparationMethod::extent &&
+                       mt_extent_own.size() == contact_detail::kExtentDirections<Dim> * mt_field.size();
   auto at = [&](std::size_t e) { return mt_values.data() + e * static_cast<std::size_t>(per_field); };
   double node_mass = 0.0;
   for (std::size_t e = mt_first[g]; e < mt_first[g + 1]; ++e) {
@@ -161,7 +162,12 @@ long DecomposedMpm<Dim>::Impl::gather_sides(std::size_t g, double dt, std::vecto
       sd.rigid_acceleration = (mat.rigid_velocity_at(time + dt).template head<Dim>() - sd.rigid_velocity) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces
-      sd.extent_gap = contact_detail::extent_gap(mt_extent_own[e], mt_extent_other[e]);
+      {
+      const double* own = mt_extent_own.data() + contact_detail::kExtentDirections<Dim> * e;
+      const double* other = mt_extent_other.data() + contact_detail::kExtentDirections<Dim> * e;
+      sd.extent_gap = contact_detail::extent_gap<Dim>(own, other);
+      sd.extent_axis_gap = contact_detail::extent_axis_gap<Dim>(own, other);
+    }
     sides.push_back(sd);
     mats.push_back(material);
     entries.push_back(e);

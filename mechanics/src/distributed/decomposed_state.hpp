@@ -280,8 +280,9 @@ struct DecomposedMpm<Dim>::Impl {
   std::vector<int> pair_index;
   std::vector<std::array<std::size_t, 2>> contact_nodes;  // (owned node q, group of mt_*)
   // Extent separation (contact_extents.cpp): per mt entry the normal to its partners and the maxima
-  // of its own particles' and its partners' extents along it (kNoExtent: none measured); per local
-  // node its list of (field, normal, own, other) items in extent_* (extent_start, −1: none).
+  // of its own particles' and its partners' extents along it and along the signed axes
+  // (kExtentDirections each; kNoExtent: none measured); per local node its list of (field, normal,
+  // own, other) items in extent_* (extent_start, −1: none).
   std::vector<Vec<Dim>> mt_normal;
   std::vector<double> mt_extent_own, mt_extent_other;
   std::vector<int> extent_field;

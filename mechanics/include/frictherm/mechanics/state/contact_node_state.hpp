@@ -53,7 +53,8 @@ struct ContactNodeState {
   std::vector<std::uint16_t> node_field_count;  // per grid node: fields with mass (find_contact_nodes)
   std::vector<int> node_entry_cursor;           // per grid node: next entry of its run, −1: none
   // Extent separation, per contact entry: the normal from its material to its partners, and the
-  // largest extents of its own particle domains along it and of its partners' along its reverse.
+  // largest extents of its own particle domains along it and of its partners' along its reverse, then
+  // the same along each signed axis (contact_extent.hpp kExtentDirections values per entry).
   std::vector<Vec<Dim>> entry_normal;
   std::vector<double> entry_extent_own, entry_extent_other;
   std::vector<std::vector<double>> extent_thread;  // per-thread maxima (threads 1..n-1), own then other
