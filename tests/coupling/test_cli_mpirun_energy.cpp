@@ -85,15 +85,15 @@ class MpirunEnergyBooks : public frictherm::test::MpirunCompare {
 
   // energy_lost − damping_work − plastic_dissipation − W − contact_normal_work − boundary_stop_work =
   // numerical_dissipation on every row of
-  // `file`, W the frictional work of the order handed to the heat (second: these runs have none; 0
-  // without contact), to 1e-12 of the row's largest term: the columns are written from one set of
+  // `file`, W the frictional work of the books' order (the scene's heating order; these runs name
+  // none and use USL, whose default is the first order; 0 without contact), to 1e-12 of the row's largest term: the columns are written from one set of
   // sums, so only the round-off of the three subtractions (a few ε of that term) may remain.
   void expect_identity(const std::string& file, bool contact) const {
     const std::vector<double> lost = column(file, "energy_lost"), damping = column(file, "damping_work");
     const std::vector<double> plastic = column(file, "plastic_dissipation");
     const std::vector<double> numerical = column(file, "numerical_dissipation");
     const std::vector<double> normal = column(file, "contact_normal_work"), stop = column(file, "boundary_stop_work");
-    const std::vector<double> W = contact ? column(file, "friction_work_second") : std::vector<double>(lost.size(), 0.0);
+    const std::vector<double> W = contact ? column(file, "friction_work_first") : std::vector<double>(lost.size(), 0.0);
     ASSERT_FALSE(lost.empty()) << file;
     double worst = 0.0;
     for (std::size_t k = 0; k < lost.size(); ++k) {

@@ -65,6 +65,7 @@ TEST(SceneThermalRun, SlidingBlockEnergyBooksCloseForEveryWindowPolicy) {
     s["thermal"]["materials"] = mats;
     s["coupling"] = Json::object();
     s["coupling"]["window"] = Json::parse(window);
+    s["coupling"]["heating_order"] = "second";  // the column read below
     s["output"] = Json::parse(R"({"snapshot_count": 2})");
     fc::RunOptions opt;
     opt.output = (dir / "books.h5").string();

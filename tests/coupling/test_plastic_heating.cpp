@@ -41,7 +41,7 @@ Json impact_scene(bool friction, double beta) {
     ],
     "thermal": {"integrator": "cvode_bdf", "rtol": 1e-8, "atol": 1e-8,
                 "materials": {"hmx": {"heat_capacity": 950, "conductivity": 0.45}}},
-    "coupling": {"window": {"policy": "every_n_steps", "steps": 5}, "plastic_heating": true},
+    "coupling": {"window": {"policy": "every_n_steps", "steps": 5}, "plastic_heating": true, "heating_order": "second"},
     "solver": {"shape_function": "ugimp", "cfl": 0.4},
     "run": {"end_time": 3e-6},
     "output": {"snapshot_count": 2}

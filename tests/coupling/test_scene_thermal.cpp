@@ -103,6 +103,28 @@ TEST(SceneThermal, DefaultsAndAbsence) {
   EXPECT_EQ(fc::parse_scene(s.dump()).thermal.coupler.window.steps, 12);
 }
 
+// coupling.heating_order, when the scene names none, follows the update scheme (docs/coupling.md,
+// "Which heating order"): first under USL and USF, second under MUSL; a named order is kept, and the
+// books of a run without a thermal section use the same default.
+TEST(SceneThermal, HeatingOrderDefaultFollowsTheScheme) {
+  Json s = good_scene();
+  s["thermal"] = Json::parse(R"({"materials": {"steel": {"heat_capacity": 490, "conductivity": 45}}})");
+  const auto order = [&](const char* scheme) {
+    s["solver"]["scheme"] = scheme;
+    return fc::parse_scene(s.dump()).thermal.heating_order;
+  };
+  EXPECT_EQ(order("usl"), fc::HeatingOrder::first);
+  EXPECT_EQ(order("usf"), fc::HeatingOrder::first);
+  EXPECT_EQ(order("musl"), fc::HeatingOrder::second);
+  s["coupling"] = Json::parse(R"({"heating_order": "second"})");
+  EXPECT_EQ(order("usl"), fc::HeatingOrder::second);
+  s["coupling"] = Json::parse(R"({"heating_order": "first"})");
+  EXPECT_EQ(order("musl"), fc::HeatingOrder::first);
+  s.erase("coupling");
+  s.erase("thermal");
+  EXPECT_EQ(order("usl"), fc::HeatingOrder::first);
+}
+
 TEST(SceneThermal, ErrorsNameTheKeyPath) {
   struct Bad {
     const char* pointer;

@@ -130,7 +130,7 @@ void DecomposedRun<Dim>::series(double time) {
   // The energy books (the serial series_row's columns and definitions, DecomposedMpm::energy_balance),
   // with the frictional work of the order handed to the heat (second without heat, as the serial run).
   const mechanics::EnergyBalance books =
-      mpm_->energy_balance(heat_ ? s_.thermal.heating_order : mechanics::HeatingOrder::second);
+      mpm_->energy_balance(s_.thermal.heating_order);
   // The serial strain_energy and total_energy columns leave out the penalty springs' energy, which
   // the books' stored energy holds (the same on every rank).
   const mechanics::PenaltyContact<Dim>* pc = mpm_->penalty_contact();
@@ -156,8 +156,8 @@ void DecomposedRun<Dim>::series(double time) {
     const mechanics::DecomposedContactStats cs = mpm_->contact_stats();
     row.insert(row.end(), {static_cast<double>(cs.contact_nodes), static_cast<double>(cs.sliding_nodes)});
     bodies.append_velocities(row);
-    // The work handed to the heat (second order without heat, as the energy books above).
-    const bool first = heat_ && s_.thermal.heating_order == mechanics::HeatingOrder::first;
+    // The work handed to the heat (the scene's heating order, also without heat, as the books above).
+    const bool first = s_.thermal.heating_order == mechanics::HeatingOrder::first;
     detail::append_heat_rates(row, work[first ? 0 : 1], time_, series_memory_);  // the serial sim.time()
   }
   if (pc) detail::append_penalty_row(row, *pc, mpm_->boundary_points());

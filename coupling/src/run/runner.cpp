@@ -456,10 +456,9 @@ class Run {
   double loading_solve_seconds_ = 0.0;  // of which inside the integrator
   double continuation_seconds_ = 0.0;
   detail::SeriesMemory series_memory_;  // the previous series row, for the contact_heat_rate columns
-  // The frictional work that becomes heat: the thermal section's heating order, else second order.
-  mechanics::HeatingOrder heating_order() const {
-    return thermal_ ? thermal_->heating_order() : mechanics::HeatingOrder::second;
-  }
+  // The frictional work that becomes heat (and that the books count): the scene's heating order, also
+  // without a thermal section (its default follows the update scheme, scene_parse.cpp).
+  mechanics::HeatingOrder heating_order() const { return thermal_ ? thermal_->heating_order() : s_.thermal.heating_order; }
   double output_seconds_ = 0.0;         // series rows and snapshots
   Clock::time_point last_flush_ = Clock::now();  // series rows written and file flushed
   bool checkpoints_ = false;

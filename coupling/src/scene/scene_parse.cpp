@@ -409,6 +409,14 @@ Scene parse_scene(const std::string& text, const std::string& source, const std:
   s.thermal = parse_thermal_sections(root, s.dimension, declared, s.options.thickness,  // scene_thermal.cpp
                                      *std::min_element(s.cell_size.begin(), s.cell_size.begin() + s.dimension));
   detail::extend_grain_thermal(s, ctx);
+  // coupling.heating_order, when the scene names none, follows the update scheme: the first-order work
+  // (Nairn 2018 eq. 27) under USL and USF, where it converges faster in C and in h than the second
+  // order; the second order (eqs. 34/36) under MUSL, the paper's scheme, where the first order is far
+  // too high at large steps (docs/coupling.md, "Which heating order").
+  const auto coupling = root.find("coupling");
+  if (!(coupling && coupling->is_object() && coupling->find("heating_order")))
+    s.thermal.heating_order = s.options.scheme == mechanics::UpdateScheme::musl ? mechanics::HeatingOrder::second
+                                                                                : mechanics::HeatingOrder::first;
   s.cost = estimate_scene_cost(s);  // before any particle or grid array exists
   check_scene_cost(s, s.cost);
   return s;
