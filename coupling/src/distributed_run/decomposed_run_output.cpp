@@ -128,7 +128,7 @@ void DecomposedRun<Dim>::series(double time) {
   }
   MPI_Allreduce(MPI_IN_PLACE, P, Dim, MPI_DOUBLE, MPI_SUM, comm_);
   // The energy books (the serial series_row's columns and definitions, DecomposedMpm::energy_balance),
-  // with the frictional work of the order handed to the heat (second without heat, as the serial run).
+  // with the frictional work of the scene's heating order (also without heat, as the serial run).
   const mechanics::EnergyBalance books =
       mpm_->energy_balance(s_.thermal.heating_order);
   // The serial strain_energy and total_energy columns leave out the penalty springs' energy, which
