@@ -59,17 +59,13 @@ void add_particle_extent(const Vec<Dim>& x, const Vec<Dim>& l, int field, int co
   for (int j = 0; j < count; ++j) {
     const Vec<Dim>& n = normal[j];
     if (n.squaredNorm() == 0.0) continue;  // a sliver, or no normal
-    const double centre = x.dot(n), half = l.cwiseProduct(n).cwiseAbs().sum();
-    double* mine = field_of(j) == field ? own + S * j : nullptr;
-    double* theirs = mine ? nullptr : other + S * j;
-    if (mine) mine[0] = std::max(mine[0], centre + half);
-    else theirs[0] = std::max(theirs[0], half - centre);
-    for (int d = 0; d < Dim; ++d) {
-      if (n[d] == 0.0) continue;
-      const double c = n[d] > 0.0 ? x[d] : -x[d];
-      if (mine) mine[1 + d] = std::max(mine[1 + d], c + l[d]);
-      else theirs[1 + d] = std::max(theirs[1 + d], l[d] - c);
-    }
+    // own: x·e + r; the partners': r − x·e (the sign of the centre flips)
+    const bool mine = field_of(j) == field;
+    const double sign = mine ? 1.0 : -1.0;
+    double* m = (mine ? own : other) + S * j;
+    m[0] = std::max(m[0], sign * x.dot(n) + l.cwiseProduct(n).cwiseAbs().sum());
+    for (int d = 0; d < Dim; ++d)
+      if (n[d] != 0.0) m[1 + d] = std::max(m[1 + d], sign * (n[d] > 0.0 ? x[d] : -x[d]) + l[d]);
   }
 }
 
@@ -94,6 +90,15 @@ inline double extent_axis_gap(const double* own, const double* other) {
   for (int e = 1; e < kExtentDirections<Dim>; ++e)
     if (std::isfinite(own[e]) && std::isfinite(other[e])) gap = std::max(gap, -(own[e] + other[e]));
   return gap;
+}
+
+/// A side's two gaps (ContactSide::extent_gap, extent_axis_gap) from entry q's maxima in the
+/// per-entry arrays own and other (kExtentDirections values each), as both steps store them.
+template <int Dim, class Side>
+inline void set_extent_gaps(Side& side, const double* own, const double* other, std::size_t q) {
+  own += kExtentDirections<Dim> * q, other += kExtentDirections<Dim> * q;
+  side.extent_gap = extent_gap<Dim>(own, other);
+  side.extent_axis_gap = extent_axis_gap<Dim>(own, other);
 }
 
 }  // namespace frictherm::mechanics::contact_detail

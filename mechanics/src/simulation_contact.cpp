@@ -216,12 +216,8 @@ int Simulation<Dim>::gather_contact_sides(std::size_t group, double dt, std::vec
       sd.rigid_acceleration = (mat.rigid_velocity_at(clock_.time + dt).template head<Dim>() - layout_.field_velocity[f]) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces, −(own + partners') extents
-      {
-      const double* own = contact_nodes_.entry_extent_own.data() + contact_detail::kExtentDirections<Dim> * q;
-      const double* other = contact_nodes_.entry_extent_other.data() + contact_detail::kExtentDirections<Dim> * q;
-      sd.extent_gap = contact_detail::extent_gap<Dim>(own, other);
-      sd.extent_axis_gap = contact_detail::extent_axis_gap<Dim>(own, other);
-    }
+      contact_detail::set_extent_gaps<Dim>(sd, contact_nodes_.entry_extent_own.data(),
+                                           contact_nodes_.entry_extent_other.data(), q);
     sides.push_back(sd);
     slots.push_back(slot);
     mats.push_back(fields_[f].material);

@@ -162,12 +162,7 @@ long DecomposedMpm<Dim>::Impl::gather_sides(std::size_t g, double dt, std::vecto
       sd.rigid_acceleration = (mat.rigid_velocity_at(time + dt).template head<Dim>() - sd.rigid_velocity) / dt;
     }
     if (extents)  // contact_extents.cpp: the gap between the surfaces
-      {
-      const double* own = mt_extent_own.data() + contact_detail::kExtentDirections<Dim> * e;
-      const double* other = mt_extent_other.data() + contact_detail::kExtentDirections<Dim> * e;
-      sd.extent_gap = contact_detail::extent_gap<Dim>(own, other);
-      sd.extent_axis_gap = contact_detail::extent_axis_gap<Dim>(own, other);
-    }
+      contact_detail::set_extent_gaps<Dim>(sd, mt_extent_own.data(), mt_extent_other.data(), e);
     sides.push_back(sd);
     mats.push_back(material);
     entries.push_back(e);
