@@ -94,10 +94,22 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   if (blocked) threads_.work_blocks.assign(threads_.pass_split.blocks(), 0.0);
   // The loads' work below, force · the displacement this pass gives: the loaded particles' positions
   // before it (reused from step to step: no allocation once grown).
-  thread_local std::vector<Vec<Dim>> load_start_position;
+  // With them, the grid acceleration at each loaded particle, a_p = Σ_i S_ip a_i, from this step's
+  // stencil (the pass may overwrite it with the next step's): load_work's mean displacement.
+  thread_local std::vector<Vec<Dim>> load_start_position, load_acceleration;
   if constexpr (Kinematics) {
     load_start_position.resize(conditions_.resolved_loads.size());
-    for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) load_start_position[j] = p_.position[conditions_.resolved_loads[j].particle];
+    load_acceleration.resize(conditions_.resolved_loads.size());
+    for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) {
+      const std::size_t k = conditions_.resolved_loads[j].particle;
+      load_start_position[j] = p_.position[k];
+      load_acceleration[j] = Vec<Dim>::Zero();
+      const int f = layout_.field_of_material[static_cast<std::size_t>(p_.material[k])];
+      if (f >= 0)
+        stk[k].for_each(fields_[static_cast<std::size_t>(f)].index, [&](int i, double S, const Vec<Dim>&) {
+          load_acceleration[j] += S * acceleration[i];
+        });
+    }
   }
   double* const work_block = threads_.work_blocks.data();
 
@@ -231,7 +243,8 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   if constexpr (Kinematics) {
     for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) {
       const ResolvedLoad& L = conditions_.resolved_loads[j];
-      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, clock_.time), p_.position[L.particle] - load_start_position[j]);
+      work += load_work<Dim>(load_force<Dim>(L.force, *L.scale, clock_.time), p_.position[L.particle] - load_start_position[j],
+                             load_acceleration[j], dt);
     }
     work_books_.external += work;
   }

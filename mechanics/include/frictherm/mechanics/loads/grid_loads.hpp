@@ -25,15 +25,21 @@ inline void add_load_to_grid(const Stencil& stencil, const Indexer& index, const
   stencil.for_each(index, [&](int i, double S, const Vec<Dim>&) { force_at(i) += S * F; });
 }
 
-/// The work of a load over a step, F(t) · Δx_p (the energy books' external work; t the step's start,
-/// Δx_p = dt Σ_i S_ip v_i^{n+1} the particle's displacement in the step). The load enters the grid as
-/// f_i = S_ip F, so this is Σ_i f_i · v_i^{n+1} dt, the work the grid receives; the particle's own
-/// (FLIP) velocity carries modes the grid does not see, and F · v_p dt summed over a long run under a
-/// constant load drifted from F · Δx (the undamped oscillating block at 1.25 mm, C = 0.0125: 190 mJ
-/// of an external work that should stay constant after the preload ramp, docs/contact.md).
+/// The work of a load over a step (the energy books' external work; t the step's start, F = F(t) the
+/// force the step applies): F · Δx̄_p, Δx̄_p = Δx_p − ½ dt² a_p = dt Σ_i S_ip ½(v_i^L + v_i^{n+1}), the
+/// particle's displacement at the mean of its nodes' start (lumped) and end velocities (Δx_p = dt Σ_i
+/// S_ip v_i^{n+1} its displacement in the step, a_p = Σ_i S_ip a_i its grid acceleration). The load
+/// enters the grid as f_i = S_ip F, and the kinetic energy it gives a node over the step is exactly
+/// f_i · ½(v_i^L + v_i^{n+1}) dt (½ m (v⁺² − v⁻²) = m Δv · v̄). Booked at the end velocity, F · Δx_p,
+/// the work gained ½ dt F · Δv_p per step: a sum that telescopes under a constant load but under a
+/// ramp adds ½ dt ∫ v dF, an O(dt) drift of the books' energy lost (the undamped oscillating block's
+/// 0.25 ms preload ramp, 2.5 mm, C = 0.5: 2.7 mJ, half its frictional heat; docs/output.md). The
+/// particle's own (FLIP) velocity is not used: it carries modes the grid does not see, and F · v_p dt
+/// summed over a long run under a constant load drifted from F · Δx (the undamped oscillating block at
+/// 1.25 mm, C = 0.0125: 190 mJ of an external work that should stay constant after the preload ramp).
 template <int Dim>
-inline double load_work(const Vec<Dim>& F, const Vec<Dim>& displacement) {
-  return F.dot(displacement);
+inline double load_work(const Vec<Dim>& F, const Vec<Dim>& displacement, const Vec<Dim>& acceleration, double dt) {
+  return F.dot(displacement - (0.5 * dt * dt) * acceleration);
 }
 
 /// Whether the mass-proportional damping acts in the step starting at t.
