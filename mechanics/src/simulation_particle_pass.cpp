@@ -103,12 +103,10 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     for (std::size_t j = 0; j < conditions_.resolved_loads.size(); ++j) {
       const std::size_t k = conditions_.resolved_loads[j].particle;
       load_start_position[j] = p_.position[k];
-      load_acceleration[j] = Vec<Dim>::Zero();
       const int f = layout_.field_of_material[static_cast<std::size_t>(p_.material[k])];
-      if (f >= 0)
-        stk[k].for_each(fields_[static_cast<std::size_t>(f)].index, [&](int i, double S, const Vec<Dim>&) {
-          load_acceleration[j] += S * acceleration[i];
-        });
+      load_acceleration[j] = f < 0 ? Vec<Dim>(Vec<Dim>::Zero())
+                                   : load_point_acceleration<Dim>(stk[k], fields_[static_cast<std::size_t>(f)].index,
+                                                                  [&](int i) -> const Vec<Dim>& { return acceleration[i]; });
     }
   }
   double* const work_block = threads_.work_blocks.data();

@@ -403,11 +403,10 @@ void DecomposedMpm<Dim>::Impl::grid_to_particle(double dt) {
   if (filter) petsc_check(VecRestoreArrayRead(filter_local, &vstar), "VecRestoreArrayRead");
   for (std::size_t n = 0; n < local_loads.size(); ++n) {  // the loads' work, F · Δx̄_p (the serial pass)
     const auto& [k, j] = local_loads[n];
-    Vec<Dim> acc = Vec<Dim>::Zero();  // a_p = Σ_i S_ip a_i, the same start-of-step stencil
-    st[static_cast<std::size_t>(k)].for_each(boxes[static_cast<std::size_t>(field_of(f.material[k]))].index,
-                                             [&](int slot, double S, const Vec<Dim>&) {
-                                               acc += S * Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + acceleration);
-                                             });
+    const Vec<Dim> acc = load_point_acceleration<Dim>(  // the same start-of-step stencil
+        st[static_cast<std::size_t>(k)], boxes[static_cast<std::size_t>(field_of(f.material[k]))].index, [&](int slot) {
+          return Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + acceleration);
+        });
     external_work += load_work<Dim>(load_force<Dim>(loads[j].force, loads[j].scale, time),
                                     Vec<Dim>(Eigen::Map<const Vec<Dim>>(f.x + Dim * k)) - load_start_position[n], acc, dt);
   }
