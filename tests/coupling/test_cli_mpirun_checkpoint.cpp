@@ -209,12 +209,12 @@ TEST_F(CliMpirunCheckpoint, InterruptedAndResumedRunEqualsTheUninterruptedRun) {
 // uninterrupted run writes 992.
 TEST_F(CliMpirunCheckpoint, PenaltyContactResumesToTheUninterruptedRun) {
   const std::string penalty = " --set contact.method=penalty";
-  // 1e-2 s (about 4 s on 2 ranks): mpirun hands its SIGINT on to the ranks only after
-  // odls_base_sigkill_timeout (1 s), so a run that ends within a second of its first checkpoint (3e-3 s
-  // took 1.2 s) finishes before the signal reaches it.
-  run_full("2e-4", "1e-2", penalty);
+  // 2e-2 s: mpirun hands its SIGINT on to the ranks only after odls_base_sigkill_timeout (1 s), so a run
+  // that ends within a second of its first checkpoint (3e-3 s took 1.2 s) finishes before the signal
+  // reaches it; 1e-2 s was stopped at 8.4e-3 s in session 70, too near its end.
+  run_full("2e-4", "2e-2", penalty);
   if (HasFatalFailure()) return;
-  const std::string log = run_and_stop("2e-4", "1e-2", "kill -INT $pid", 0.0, penalty);
+  const std::string log = run_and_stop("2e-4", "2e-2", "kill -INT $pid", 0.0, penalty);
   ASSERT_THAT(log, HasSubstr("interrupted by SIG")) << "the run must be stopped before its end";
   const std::vector<double> t = read_doubles(path("part.h5"), "/series/time");
   ASSERT_FALSE(t.empty());
