@@ -38,6 +38,7 @@ EnergyBalance Simulation<Dim>::energy_balance(HeatingOrder order) const {
   b.damping_work = work_books_.damping;
   b.contact_normal_work = work_books_.contact_normal;
   b.boundary_stop_work = work_books_.boundary_stop;
+  b.stored_lead = work_books_.stored_lead;
   b.plastic_work = plastic_work();
   b.friction_work = contact_setup_.enabled ? cumulative_frictional_work(order) : 0.0;
   return b;

@@ -38,20 +38,27 @@ template <int Dim>
 FRICTHERM_ALWAYS_INLINE void add_gradient(Mat<Dim>& L, const Vec<Dim>& v, const Vec<Dim>& G) {
   L.noalias() += v * G.transpose();
 }
+
+// σ:L in either form of the velocity gradient (stress_update.hpp's stress_power).
+FRICTHERM_ALWAYS_INLINE double stress_power_of(const Mat<2>& sigma, const VelocityGradient2& L) { return stress_power(sigma, L); }
+template <int Dim>
+FRICTHERM_ALWAYS_INLINE double stress_power_of(const Mat<Dim>& sigma, const Mat<Dim>& L) { return stress_power<Dim>(sigma, L); }
 }  // namespace
 
 // Grid-to-particle (Kinematics; FLIP): v_p += dt Σ S_ip a_i, x_p += dt Σ S_ip v_i^{n+1}; with a PIC
 // relaxation time τ, v_p ← (1 − α) v_p + α Σ S_ip v_i^{n+1}, α = 1 − e^(−dt/τ), which damps the particle
 // velocity modes the grid cannot see at a rate independent of the time step; XPIC/FMPM from the
 // filtered velocity. Stress update (Stress): L_p = Σ_i v_i ⊗ G_ip, F ← (I + L dt) F, V = det(F) V0,
-// then the material's stress. Returns the first particle with a non-finite state or outside the grid
-// and the first compressed past its Hugoniot's limit (−1: none).
+// then the material's stress. Returns the first particle with a non-finite state or outside the grid,
+// the first compressed past its Hugoniot's limit (−1: none) and the stress power Σ V σ:L after the
+// update (the energy books' stored_lead, energy_books.hpp).
 template <int Dim>
 template <bool Kinematics, bool Stress, class Stencils>
 typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(double dt, Stencils& st, bool refresh) {
   long first_bad = std::numeric_limits<long>::max();  // min-reduction identity
   long last_beyond = -1;                              // max-reduction identity
   double external_work = 0.0;
+  double stress_power = 0.0;  // Σ_p V_p σ_p:L_p of the updated particles (the books' stored_lead)
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const double pic = pic_blend_fraction(dt, opt_.pic_relaxation_time);
   const ParticleUpdate update = opt_.particle_update;
@@ -92,6 +99,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   // block order after the pass: the same sum wherever the split's boundaries are (thread_partition.hpp).
   const bool blocked = threads_.pass_split.threads > 1;
   if (blocked) threads_.work_blocks.assign(threads_.pass_split.blocks(), 0.0);
+  if (blocked && Stress) threads_.power_blocks.assign(threads_.pass_split.blocks(), 0.0);
   // The loads' work below, force · the displacement this pass gives: the loaded particles' positions
   // before it (reused from step to step: no allocation once grown).
   // With them, the grid acceleration at each loaded particle, a_p = Σ_i S_ip a_i, from this step's
@@ -110,11 +118,12 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     }
   }
   double* const work_block = threads_.work_blocks.data();
+  double* const power_block = threads_.power_blocks.data();
 
   // The region's body: its own minimum, maximum and sum (in registers) into the reduction's.
-  const auto pass = [&](long& bad_out, long& beyond_out, double& work_out) {
+  const auto pass = [&](long& bad_out, long& beyond_out, double& work_out, double& power_out) {
   long bad = std::numeric_limits<long>::max(), beyond = -1;
-  double work = 0.0;
+  double work = 0.0, power = 0.0;
   thread_local step_detail::StencilBoxes<Dim> boxes;
   if (refresh) boxes.reset(nm);
   for_each_part(threads_.pass_split, [&](int t) {
@@ -123,6 +132,10 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     auto add_work = [&](std::size_t k, double w) {
       if (blocked) work_block[k / PassSplit::kBlock] += w;
       else work += w;
+    };
+    [[maybe_unused]] auto add_power = [&](std::size_t k, double w) {
+      if (blocked) power_block[k / PassSplit::kBlock] += w;
+      else power += w;
     };
     // Particle k at its new position: its stencil for the next step, and its material's box.
     [[maybe_unused]] auto refresh_stencil = [&](std::size_t k, IVec<Dim>& lo, IVec<Dim>& hi) {
@@ -164,8 +177,10 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           if (!ok) bad = std::min(bad, static_cast<long>(k));
           else if (refresh) refresh_stencil(k, lo, hi);  // (a bad particle stops the run: check_particle)
         }
-        if constexpr (Stress)
+        if constexpr (Stress) {
           if (!stress(k, L)) beyond = std::max(beyond, static_cast<long>(k));
+          add_power(k, Vp[k] * stress_power_of(sigma_p[k], L));
+        }
       }
       if (refresh) boxes.merge(m, lo, hi);
     };
@@ -226,16 +241,19 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   bad_out = std::min(bad_out, bad);
   beyond_out = std::max(beyond_out, beyond);
   work_out += work;
+  power_out += power;
   };
   if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
-    pass(first_bad, last_beyond, external_work);
+    pass(first_bad, last_beyond, external_work, stress_power);
   } else {
-#pragma omp parallel num_threads(threads_.count) reduction(min : first_bad) reduction(max : last_beyond) reduction(+ : external_work)
-    pass(first_bad, last_beyond, external_work);
+#pragma omp parallel num_threads(threads_.count) reduction(min : first_bad) reduction(max : last_beyond) reduction(+ : external_work, stress_power)
+    pass(first_bad, last_beyond, external_work, stress_power);
   }
   double work = external_work;
   if (blocked) {
     for (const double w : threads_.work_blocks) work += w;
+    if constexpr (Stress)
+      for (const double w : threads_.power_blocks) stress_power += w;
     threads_.pass_split.rebalance(layout_.material_begin, layout_.material_end, layout_.field_of_material);
   }
   if constexpr (Kinematics) {
@@ -247,7 +265,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     work_books_.external += work;
   }
   if constexpr (Stress) wave_speeds_.ready = true;
-  return {first_bad == std::numeric_limits<long>::max() ? -1 : first_bad, last_beyond};
+  return {first_bad == std::numeric_limits<long>::max() ? -1 : first_bad, last_beyond, stress_power};
 }
 
 #define FRICTHERM_INSTANTIATE_PASS_FOR(D, ...)                                                          \

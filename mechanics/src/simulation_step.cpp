@@ -6,6 +6,7 @@
 // (layout_.field_of_material), so the same loops serve the shared single field and the per-material fields
 // of multimaterial contact. With the extended B-spline the weights are precomputed per step
 // (simulation_ebs.cpp) and the same loops read them.
+#include <frictherm/mechanics/energy/energy_books.hpp>
 #include <frictherm/mechanics/errors.hpp>
 #include <frictherm/mechanics/parallel_region.hpp>
 #include <frictherm/mechanics/simulation.hpp>
@@ -187,6 +188,7 @@ void Simulation<Dim>::build_phases() {
           P.add("particle_update", &T::stress_update, [s, refresh = refresh](StepContext& c) {
             const ParticlePassResult r = s->template particle_pass<true, true>(c.dt, s->template stencils<Kernel>(), refresh);
             c.bad = r.bad, c.beyond = r.beyond;
+            s->work_books_.stored_lead = stored_energy_lead(true, c.dt, r.stress_power);
           });
           break;
         case SchemePhase::grid_to_particle:
@@ -322,7 +324,9 @@ void Simulation<Dim>::contact_at_extrapolated(double dt) {
 template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::stress_pass(double dt) {
-  throw_beyond_hugoniot(particle_pass<false, true>(dt, stencils<Kernel>()).beyond);
+  const ParticlePassResult r = particle_pass<false, true>(dt, stencils<Kernel>());
+  work_books_.stored_lead = stored_energy_lead(opt_.scheme != UpdateScheme::usf, dt, r.stress_power);
+  throw_beyond_hugoniot(r.beyond);
 }
 
 // After grid-to-particle: the step's time and count advance, a particle with a non-finite state or

@@ -169,7 +169,7 @@ _SERIES_PANELS = [("J", "energy"), ("K", "temperature"), ("W", "heat rate"), ("m
                   ("m/s", "velocity"), ("kg m/s", "momentum"), ("m^2", "area"), ("m^3", "volume"),
                   ("s", "time step"), ("1", "counts")]
 _ENERGY_PANELS = [("dissipated energy", ("damping_work", "plastic_dissipation", "energy_lost", "numerical_dissipation",
-                                         "contact_normal_work", "boundary_stop_work")),
+                                         "contact_normal_work", "boundary_stop_work", "stored_energy_lead")),
                   ("frictional work and heat", ("friction_work", "heat_delivered", "thermal_energy_change"))]
 # SI prefixes for axes: the largest with values >= 1 (so a 3e-6 m displacement reads 3 µm).
 _PREFIXES = [(1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, "")]

@@ -127,7 +127,7 @@ TEST_F(Cli, RunWritesHdf5AndExportCsv) {
   ASSERT_EQ(csv.code, 0) << csv.output;
   EXPECT_THAT(csv.output, StartsWith("time,step,dt,kinetic_energy,strain_energy,total_energy,external_work,"
                                      "momentum_x,momentum_y,rigid_work,damping_work,plastic_dissipation,energy_lost,"
-                                     "numerical_dissipation,contact_normal_work,boundary_stop_work,mean_temperature.block,"
+                                     "numerical_dissipation,contact_normal_work,boundary_stop_work,stored_energy_lead,mean_temperature.block,"
                                      "mean_displacement_x.block,"
                                      "mean_displacement_y.block\n"));
   std::istringstream lines(csv.output);

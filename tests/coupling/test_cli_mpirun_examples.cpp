@@ -55,7 +55,7 @@ bool is_count(const std::string& c) { return c == "contact_nodes" || c == "slidi
 bool is_energy(const std::string& c) {
   for (const char* e : {"kinetic_energy", "strain_energy", "total_energy", "external_work", "rigid_work", "damping_work",
                         "plastic_dissipation", "energy_lost", "numerical_dissipation", "contact_normal_work",
-                        "boundary_stop_work"})
+                        "boundary_stop_work", "stored_energy_lead"})
     if (c == e) return true;
   return false;
 }

@@ -88,15 +88,16 @@ TEST_F(Runner, LandsExactlyOnSnapshotTimesAndEndTime) {
   // series_interval 0: one row per step plus t = 0.
   const fc::SeriesTable series = fc::read_series(r.output);
   EXPECT_EQ(series.rows(), static_cast<std::size_t>(r.steps) + 1);
-  ASSERT_EQ(series.names.size(), 19u);
+  ASSERT_EQ(series.names.size(), 20u);
   EXPECT_EQ(series.names[0], "time");
   EXPECT_EQ(series.names[8], "momentum_y");
   EXPECT_EQ(series.names[9], "rigid_work");  // the energy balance follows the momenta
   EXPECT_EQ(series.names[13], "numerical_dissipation");
   EXPECT_EQ(series.names[14], "contact_normal_work");
   EXPECT_EQ(series.names[15], "boundary_stop_work");
-  EXPECT_EQ(series.names[16], "mean_temperature.block");
-  EXPECT_EQ(series.names[18], "mean_displacement_y.block");
+  EXPECT_EQ(series.names[16], "stored_energy_lead");
+  EXPECT_EQ(series.names[17], "mean_temperature.block");
+  EXPECT_EQ(series.names[19], "mean_displacement_y.block");
   // momentum of the freely moving block is conserved
   EXPECT_NEAR(series.columns[7].back(), series.columns[7].front(), 1e-12);
 }

@@ -157,7 +157,9 @@ TEST(InterfaceTemperature, ConstantFluxIntoTwoHalfSpaces) {
       EXPECT_LT(tr.worst_interface, 0.03) << "h = " << h;
       EXPECT_LT(tr.worst_interface, 0.25 * tr.worst_grid) << "h = " << h;  // far closer than the grid alone
       EXPECT_LT(tr.worst_grid, previous) << "h = " << h;  // and the grid converges towards it
-      if (h < 0.9e-6) EXPECT_LT(tr.worst_interface, previous_interface) << "h = " << h;  // converging
+      if (h < 0.9e-6) {
+        EXPECT_LT(tr.worst_interface, previous_interface) << "h = " << h;  // converging
+      }
       previous = tr.worst_grid;
       previous_interface = tr.worst_interface;
       EXPECT_LT(tr.books_gap, 1e-6);

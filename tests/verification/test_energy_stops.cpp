@@ -134,18 +134,26 @@ TEST(EnergyStops, FrictionlessBarsImpactBooksTheNormalStop) {
 
 // A bar run at 2 m/s into a rigid wall at rest (a velocity condition on the nodes its particles
 // touch, as the PBX's walls): the wall does no work, and the stop's booking is most of what the bar
-// loses. Measured after 2.5 transits L/c (MUSL, C = 0.5): h = 2 mm lost 0.0321 J of 1.6 J,
-// boundary_stop_work 0.0260 J (81 %); h = 1 mm (0.8 J) lost 0.00456 J, stop 0.00165 J (36 %); C = 0.1
-// at 2 mm: 0.0395 / 0.0316 J (80 %). USL (not asserted): 0.0574 / 0.0277 J at 2 mm, C = 0.5.
+// loses. Measured after 2.5 transits L/c, the bar still against the wall (MUSL): h = 2 mm, C = 0.5
+// lost 0.0410 J of 1.6 J, boundary_stop_work 0.0260 J (63 %); C = 0.1 0.0427 / 0.0316 J (74 %);
+// h = 1 mm (0.8 J), C = 0.5: 0.00651 / 0.00165 J (25 %). The loss is the same at both C within 4 %
+// since the books take the stored energy's half-step lead off (energy_books.hpp, stored_lead; a
+// compression wave converts the kinetic energy at P = F V ≈ 10 kW here, ½ dt P ≈ 9 mJ at C = 0.5):
+// before, the stored energy booked half a step ahead made the loss 0.0321 J at C = 0.5 and 0.0395 J
+// at C = 0.1 (19 % apart), and jump by ±0.01 J whenever a wave front reached an end of the bar.
 // The same bar into a fixed face of the grid loses 0.6 % of its energy (USL; MUSL 0.1 %) and books no
 // stop: the face zeroes its nodes' force, so the particles never receive a stop there.
 TEST(EnergyStops, RigidWallBooksTheStopAndFixedFaceKeepsTheEnergy) {
-  for (double C : {0.5, 0.1}) {
+  double lost[2] = {};
+  for (int i = 0; i < 2; ++i) {
+    const double C = i == 0 ? 0.5 : 0.1;
     const Books b = wall(C, 0.002, UpdateScheme::musl, 2.5, true);
-    EXPECT_GT(b.stop, 0.6 * b.lost) << C;
+    EXPECT_GT(b.stop, 0.55 * b.lost) << C;
     EXPECT_LT(b.stop, b.lost) << C;
-    EXPECT_LT(std::fabs(b.remainder), 0.3 * b.lost) << C;
+    EXPECT_LT(std::fabs(b.remainder), 0.45 * b.lost) << C;
+    lost[i] = b.lost;
   }
+  EXPECT_NEAR(lost[0], lost[1], 0.08 * lost[1]);  // the books' loss, not the step's: measured 4 %
   const Books fine = wall(0.5, 0.001, UpdateScheme::musl, 2.5, true);
   EXPECT_GT(fine.stop, 0.0);
   EXPECT_LT(fine.stop, fine.lost);

@@ -139,7 +139,8 @@ void DecomposedRun<Dim>::series(double time) {
                           books.kinetic + strain, books.external_work};
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   row.insert(row.end(), {books.rigid_work, books.damping_work, books.plastic_work, books.lost(),
-                         books.numerical_dissipation(), books.contact_normal_work, books.boundary_stop_work});
+                         books.numerical_dissipation(), books.contact_normal_work, books.boundary_stop_work,
+                         books.stored_lead});
   const detail::BodySums<Dim> bodies = body_sums(p);
   bodies.append_means(row);
   if (s_.contact.enabled) {  // the serial series_row's contact columns, from sums over ranks

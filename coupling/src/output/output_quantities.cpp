@@ -34,6 +34,7 @@ const std::map<std::string, Entry>& catalogue() {
       {"numerical_dissipation", {"J", "numerical dissipation"}},
       {"contact_normal_work", {"J", "energy removed by the normal contact impulses"}},
       {"boundary_stop_work", {"J", "energy removed by the velocity conditions' stops"}},
+      {"stored_energy_lead", {"J", "stored energy's half-step lead over the kinetic energy (taken off in energy_lost)"}},
       {"mean_temperature", {"K", "mean temperature"}},
       {"mean_displacement_x", {"m", "mean displacement x"}},
       {"mean_displacement_y", {"m", "mean displacement y"}},

@@ -22,7 +22,7 @@ std::vector<std::string> series_names(int dim) {
   for (int d = 0; d < dim; ++d) n.emplace_back(axes[d]);
   // The energy balance (mechanics::EnergyBalance, docs/output.md "Energy balance").
   for (const char* c : {"rigid_work", "damping_work", "plastic_dissipation", "energy_lost", "numerical_dissipation",
-                        "contact_normal_work", "boundary_stop_work"})
+                        "contact_normal_work", "boundary_stop_work", "stored_energy_lead"})
     n.emplace_back(c);
   return n;
 }
@@ -119,7 +119,7 @@ std::vector<double> series_row(const mechanics::Simulation<Dim>& sim, SeriesMemo
   for (int d = 0; d < Dim; ++d) row.push_back(P[d]);
   const mechanics::EnergyBalance e = sim.energy_balance(order);
   row.insert(row.end(), {e.rigid_work, e.damping_work, e.plastic_work, e.lost(), e.numerical_dissipation(),
-                         e.contact_normal_work, e.boundary_stop_work});
+                         e.contact_normal_work, e.boundary_stop_work, e.stored_lead});
   const BodySums<Dim> bodies = body_sums(sim);
   bodies.append_means(row);
   if (!sim.contact_enabled()) return row;

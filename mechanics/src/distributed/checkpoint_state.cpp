@@ -71,6 +71,7 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.rigid_work = s.rigid_work;
   c.contact_normal_work = s.contact_normal_work;
   c.boundary_stop_work = s.boundary_stop_work;
+  c.stored_lead = s.stored_lead;
   c.initial_energy = s.initial_energy;
   c.empty_node_mass = s.empty_node_mass;
   c.work_first = s.work_first;
@@ -156,6 +157,7 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.rigid_work = c.rigid_work;
   s.contact_normal_work = c.contact_normal_work;
   s.boundary_stop_work = c.boundary_stop_work;
+  s.stored_lead = c.stored_lead;
   s.initial_energy = c.initial_energy;
   s.empty_node_mass = c.empty_node_mass;
   s.work_first = c.work_first;

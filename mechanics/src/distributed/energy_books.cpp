@@ -50,7 +50,7 @@ template <int Dim>
 EnergyBalance DecomposedMpm<Dim>::energy_balance(HeatingOrder order) const {
   const Impl& s = *impl_;
   const std::array<double, 3> p = s.particle_books();
-  double v[9] = {p[0],
+  double v[10] = {p[0],
                  p[1],
                  p[2],
                  s.external_work,
@@ -58,8 +58,9 @@ EnergyBalance DecomposedMpm<Dim>::energy_balance(HeatingOrder order) const {
                  s.damping_work,
                  order == HeatingOrder::first ? s.cumulative_first : s.cumulative_second,
                  s.contact_normal_work,
-                 s.boundary_stop_work};
-  MPI_Allreduce(MPI_IN_PLACE, v, 9, MPI_DOUBLE, MPI_SUM, s.comm);
+                 s.boundary_stop_work,
+                 s.stored_lead};
+  MPI_Allreduce(MPI_IN_PLACE, v, 10, MPI_DOUBLE, MPI_SUM, s.comm);
   EnergyBalance b;
   b.kinetic = v[0];
   b.stored = v[1] + (s.penalty ? s.penalty->stored_energy() : 0.0);  // + the penalty springs' (every rank's)
@@ -71,6 +72,7 @@ EnergyBalance DecomposedMpm<Dim>::energy_balance(HeatingOrder order) const {
   b.friction_work = v[6];
   b.contact_normal_work = v[7];
   b.boundary_stop_work = v[8];
+  b.stored_lead = v[9];
   return b;
 }
 

@@ -263,6 +263,7 @@ class Simulation {
     v("contact_normal_work", work_books_.contact_normal);
     v("boundary_stop_work", work_books_.boundary_stop);
     v("initial_energy", work_books_.initial_energy);
+    v("stored_energy_lead", work_books_.stored_lead);  // (a checkpoint before it: 0, checkpoint_io.hpp)
     v("work_first", contact_books_.work_first);
     v("work_second", contact_books_.work_second);
     v("pair_work_first", contact_books_.pair_work_first);
@@ -321,6 +322,7 @@ class Simulation {
   struct ParticlePassResult {
     long bad = -1;     // the first particle with a non-finite state or outside the grid (check_particle)
     long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
+    double stress_power = 0.0;  // Σ_p V_p σ_p:L_p after the stress update (W; 0 without it)
   };
   /// `refresh` (grid-to-particle with Stencil arrays): also the next step's stencils at the moved
   /// positions, the rigid materials moved (by layout_.rigid_motion, which the rigid driver sets:

@@ -15,6 +15,7 @@ struct StepThreads {
   ThreadPartition partition;       // each thread's particles, the fields threads share
   PassSplit pass_split;            // each thread's particles in the particle passes (timed, rebalanced)
   std::vector<double> work_blocks;  // the particle pass's external work per PassSplit block (threads > 1)
+  std::vector<double> power_blocks;  // its stress power Σ V σ:L per PassSplit block (threads > 1)
   std::vector<double> speed_max;    // per ThreadPartition part: its particles' largest c_p + |v_p| (the CFL speed)
   std::vector<NodalFields<Dim>> nodes;  // per-thread scatter buffers (threads 1..n-1), shared fields only
 };

@@ -14,6 +14,7 @@ struct WorkBooks {
   double contact_normal = 0.0;  // removed by the normal contact impulses (normal_stop_work)
   double boundary_stop = 0.0;   // removed by the velocity conditions (condition_stop_work)
   double initial_energy = std::numeric_limits<double>::quiet_NaN();  // kinetic + stored before the first step
+  double stored_lead = 0.0;     // the last stress update's stored energy ahead of the velocities (EnergyBalance)
 };
 
 }  // namespace frictherm::mechanics
