@@ -58,7 +58,9 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   long first_bad = std::numeric_limits<long>::max();  // min-reduction identity
   long last_beyond = -1;                              // max-reduction identity
   double external_work = 0.0;
-  double stress_power = 0.0;  // Σ_p V_p σ_p:L_p of the updated particles (the books' stored_lead)
+  // Σ_p V_p σ_p:L_p of the updated particles after the update and (stress-only passes: USF's books)
+  // before it: the books' stored_lead (advance_stored_lead).
+  double stress_power = 0.0, stress_power_start = 0.0;
   const Vec<Dim> g = opt_.gravity.template head<Dim>();
   const double pic = pic_blend_fraction(dt, opt_.pic_relaxation_time);
   const ParticleUpdate update = opt_.particle_update;
@@ -99,7 +101,7 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   // block order after the pass: the same sum wherever the split's boundaries are (thread_partition.hpp).
   const bool blocked = threads_.pass_split.threads > 1;
   if (blocked) threads_.work_blocks.assign(threads_.pass_split.blocks(), 0.0);
-  if (blocked && Stress) threads_.power_blocks.assign(threads_.pass_split.blocks(), 0.0);
+  if (blocked && Stress) threads_.power_blocks.assign(2 * threads_.pass_split.blocks(), 0.0);  // (end, start) per block
   // The loads' work below, force · the displacement this pass gives: the loaded particles' positions
   // before it (reused from step to step: no allocation once grown).
   // With them, the grid acceleration at each loaded particle, a_p = Σ_i S_ip a_i, from this step's
@@ -121,9 +123,9 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   double* const power_block = threads_.power_blocks.data();
 
   // The region's body: its own minimum, maximum and sum (in registers) into the reduction's.
-  const auto pass = [&](long& bad_out, long& beyond_out, double& work_out, double& power_out) {
+  const auto pass = [&](long& bad_out, long& beyond_out, double& work_out, double& power_out, double& start_out) {
   long bad = std::numeric_limits<long>::max(), beyond = -1;
-  double work = 0.0, power = 0.0;
+  double work = 0.0, power = 0.0, start = 0.0;
   thread_local step_detail::StencilBoxes<Dim> boxes;
   if (refresh) boxes.reset(nm);
   for_each_part(threads_.pass_split, [&](int t) {
@@ -133,9 +135,9 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
       if (blocked) work_block[k / PassSplit::kBlock] += w;
       else work += w;
     };
-    [[maybe_unused]] auto add_power = [&](std::size_t k, double w) {
-      if (blocked) power_block[k / PassSplit::kBlock] += w;
-      else power += w;
+    [[maybe_unused]] auto add_power = [&](std::size_t k, double w, int which) {  // which: 0 end, 1 start
+      if (blocked) power_block[2 * (k / PassSplit::kBlock) + static_cast<std::size_t>(which)] += w;
+      else (which == 0 ? power : start) += w;
     };
     // Particle k at its new position: its stencil for the next step, and its material's box.
     [[maybe_unused]] auto refresh_stencil = [&](std::size_t k, IVec<Dim>& lo, IVec<Dim>& hi) {
@@ -178,8 +180,9 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
           else if (refresh) refresh_stencil(k, lo, hi);  // (a bad particle stops the run: check_particle)
         }
         if constexpr (Stress) {
+          if constexpr (!Kinematics) add_power(k, Vp[k] * stress_power_of(sigma_p[k], L), 1);  // before the update
           if (!stress(k, L)) beyond = std::max(beyond, static_cast<long>(k));
-          add_power(k, Vp[k] * stress_power_of(sigma_p[k], L));
+          add_power(k, Vp[k] * stress_power_of(sigma_p[k], L), 0);
         }
       }
       if (refresh) boxes.merge(m, lo, hi);
@@ -242,18 +245,22 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
   beyond_out = std::max(beyond_out, beyond);
   work_out += work;
   power_out += power;
+  start_out += start;
   };
   if (without_team(threads_.count)) {  // without a team (parallel_region.hpp)
-    pass(first_bad, last_beyond, external_work, stress_power);
+    pass(first_bad, last_beyond, external_work, stress_power, stress_power_start);
   } else {
-#pragma omp parallel num_threads(threads_.count) reduction(min : first_bad) reduction(max : last_beyond) reduction(+ : external_work, stress_power)
-    pass(first_bad, last_beyond, external_work, stress_power);
+#pragma omp parallel num_threads(threads_.count) reduction(min : first_bad) reduction(max : last_beyond) reduction(+ : external_work, stress_power, stress_power_start)
+    pass(first_bad, last_beyond, external_work, stress_power, stress_power_start);
   }
   double work = external_work;
   if (blocked) {
     for (const double w : threads_.work_blocks) work += w;
     if constexpr (Stress)
-      for (const double w : threads_.power_blocks) stress_power += w;
+      for (std::size_t b = 0; b < threads_.power_blocks.size(); b += 2) {
+        stress_power += threads_.power_blocks[b];
+        stress_power_start += threads_.power_blocks[b + 1];
+      }
     threads_.pass_split.rebalance(layout_.material_begin, layout_.material_end, layout_.field_of_material);
   }
   if constexpr (Kinematics) {
@@ -265,7 +272,8 @@ typename Simulation<Dim>::ParticlePassResult Simulation<Dim>::particle_pass(doub
     work_books_.external += work;
   }
   if constexpr (Stress) wave_speeds_.ready = true;
-  return {first_bad == std::numeric_limits<long>::max() ? -1 : first_bad, last_beyond, stress_power};
+  return {first_bad == std::numeric_limits<long>::max() ? -1 : first_bad, last_beyond,
+          StressPower{stress_power_start, stress_power}};
 }
 
 #define FRICTHERM_INSTANTIATE_PASS_FOR(D, ...)                                                          \

@@ -188,7 +188,8 @@ void Simulation<Dim>::build_phases() {
           P.add("particle_update", &T::stress_update, [s, refresh = refresh](StepContext& c) {
             const ParticlePassResult r = s->template particle_pass<true, true>(c.dt, s->template stencils<Kernel>(), refresh);
             c.bad = r.bad, c.beyond = r.beyond;
-            s->work_books_.stored_lead = stored_energy_lead(true, c.dt, r.stress_power);
+            advance_stored_lead(true, c.dt, r.stress_power, s->work_books_.stored_lead, s->work_books_.stress_power,
+                                s->work_books_.stress_dt);
           });
           break;
         case SchemePhase::grid_to_particle:
@@ -325,7 +326,8 @@ template <int Dim>
 template <class Kernel>
 void Simulation<Dim>::stress_pass(double dt) {
   const ParticlePassResult r = particle_pass<false, true>(dt, stencils<Kernel>());
-  work_books_.stored_lead = stored_energy_lead(opt_.scheme != UpdateScheme::usf, dt, r.stress_power);
+  advance_stored_lead(opt_.scheme != UpdateScheme::usf, dt, r.stress_power, work_books_.stored_lead,
+                      work_books_.stress_power, work_books_.stress_dt);
   throw_beyond_hugoniot(r.beyond);
 }
 

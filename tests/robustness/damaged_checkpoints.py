@@ -87,7 +87,7 @@ def harmless(name, label):
 # seed with their types and shapes, so the flip changed an unused byte (free space, padding, a
 # checksum-free header field the library does not read). A flip inside a dataset's stored data
 # (its chunk, checksum included) must be refused since checkpoints carry Fletcher32 checksums
-# (format 3; docs/robustness.md).
+# (format 3 and later; docs/robustness.md).
 FLIP_OK = "flip"
 
 
@@ -124,7 +124,7 @@ def walk(f):
 
 
 def replace(f, name, data, dtype=None):
-    """Rewrites dataset `name` with `data`, with a Fletcher32 checksum as frictherm writes them (format 3)
+    """Rewrites dataset `name` with `data`, with a Fletcher32 checksum as frictherm writes them (format 3 on)
     when it holds values, so that the damage itself, not the missing checksum, is what is refused."""
     del f[name]
     data = numpy.asarray(data, dtype=dtype)
@@ -224,7 +224,7 @@ def attribute_damages():
         out.append((a, "a string", set_attr(a, numpy.bytes_(b"2"))))
         out.append((a, "a float 2.5", set_attr(a, numpy.float64(2.5))))
         out.append((a, "an array", set_attr(a, numpy.array([2, 2], dtype=numpy.int32))))
-    for v in (1, 2, 4, -1, 2**31 - 1):  # 2: a checkpoint before checksums (refused, docs/checkpoints.md)
+    for v in (1, 2, 3, 5, -1, 2**31 - 1):  # 2, 3: checkpoints of older versions (refused, docs/checkpoints.md)
         out.append(("format", f"= {v}", set_attr("format", numpy.int32(v))))
     for v in (3, 0, 1, -7):
         out.append(("dimension", f"= {v}", set_attr("dimension", numpy.int32(v))))

@@ -72,7 +72,10 @@ TEST(EnergyBalance, RigidPistonWorkIsTheBarsEnergy) {
   // Measured (h = 2 / 1 / 0.5 mm): rigid work − analytic +1.29 / +0.24 / +0.08 % (velocity condition),
   // −0.93 / −0.52 / −1.88 % (contact); remainder +1.53 / +0.71 / +0.39 % and −0.12 / −0.02 / +0.04 %
   // before boundary_stop_work; with it (h = 2 / 1 mm) the velocity condition books a stop of 1.47 /
-  // 0.59 % of the work and leaves 0.064 / 0.123 %.
+  // 0.59 % of the work and leaves 0.064 / 0.123 %. With the stored energy's half-step lead taken off
+  // (energy_books.hpp: ½ dt F V under the piston's constant power, 1/(2N) of the work over N steps)
+  // the remainders are +0.301 / +0.220 % (velocity condition) and +0.136 / +0.082 % (contact): a
+  // loss in every case, falling with h, where the contact variant booked a gain before.
   double stop_coarse = 0.0;
   for (int refine : {1, 2})
     for (bool contact : {false, true}) {
@@ -84,17 +87,17 @@ TEST(EnergyBalance, RigidPistonWorkIsTheBarsEnergy) {
       EXPECT_NEAR(r.kinetic, 0.5 * r.analytic, 0.03 * r.analytic) << contact;
       EXPECT_NEAR(r.stored, 0.5 * r.analytic, 0.03 * r.analytic) << contact;
       // The books close: what the scheme loses is at most 2 % of the work, and never a gain beyond
-      // 0.5 % (the contact variant's −0.12 %).
+      // 0.05 % (measured: none).
       EXPECT_LT(r.remainder, 0.02 * r.rigid_work) << contact;
-      EXPECT_GT(r.remainder, -0.005 * r.rigid_work) << contact;
+      EXPECT_GT(r.remainder, -0.0005 * r.rigid_work) << contact;
       if (!contact && refine == 1) stop_coarse = r.stop / r.rigid_work;
       // The velocity condition's loss is the driven nodes' (the particles beside them take the jump
-      // to V through FLIP), and boundary_stop_work books it: what is left is under 0.25 % of the work
-      // (measured 0.064 / 0.123 %, against 1.53 / 0.71 % without the term). First order in h, so
+      // to V through FLIP), and boundary_stop_work books it: what is left is under 0.4 % of the work
+      // (measured 0.301 / 0.220 %, against 1.53 / 0.71 % without the term). First order in h, so
       // halving the cell halves it (measured 0.40). Through contact the piston is no velocity condition.
       if (!contact) {
         EXPECT_GT(r.stop, 0.0);
-        EXPECT_LT(std::fabs(r.remainder), 0.0025 * r.rigid_work);
+        EXPECT_LT(std::fabs(r.remainder), 0.004 * r.rigid_work);
       } else {
         EXPECT_EQ(r.stop, 0.0);
       }
@@ -193,4 +196,78 @@ TEST(EnergyBalance, RampedTractionBooksNoDriftInItsWork) {
     EXPECT_GT(r.remainder, -0.0005 * r.external) << cfl;
     EXPECT_LT(r.remainder, 0.005 * r.external) << cfl;
   }
+}
+
+namespace {
+
+struct VibratingBar {
+  double initial = 0.0, worst_lost = 0.0, worst_without_lead = 0.0;
+  double worst_drop = 0.0, worst_drop_without_lead = 0.0;  // the largest fall of energy_lost from one step to the next
+};
+
+// examples/bar_vibration.json: an aluminium bar 1 m × 40 mm (plane strain, ν = 0), fixed in x at
+// x = 0, released with v = 1 m/s everywhere, MUSL, uGIMP, C = 0.5: free vibration in its fundamental
+// mode and the harmonics the start excites, for 1.5 periods 4L/c. Every `cut`-th step is cut short
+// to land on an output time, as `frictherm run` does for its snapshots. The largest |energy_lost| over
+// the steps after the first fifth, with the books' stored_lead and without it.
+VibratingBar vibrate_bar(UpdateScheme scheme) {
+  SimulationOptions o;
+  o.scheme = scheme;
+  o.cfl = 0.5;
+  o.thickness = 0.05;
+  const double h = 0.005;
+  Simulation<2> sim(Grid<2>(Vec<2>(0, 0), Vec<2>(h, h), IVec<2>{240, 20}), o);
+  Material al;
+  al.name = "aluminium", al.density = 2700.0, al.youngs_modulus = 70e9, al.poisson_ratio = 0.0;
+  const int m = sim.add_material(al);
+  sim.add_body("bar", *make_box<2>(Vec<2>(0.0, 0.03), Vec<2>(1.0, 0.07), m), 2, Vec<2>(1.0, 0.0));
+  sim.fix_face(FixedFace{0, false, {{true, false, false}}});
+  const double t_end = 1.571e-3, every = t_end / 40;
+  VibratingBar r;
+  double next = every, last = 0.0, last_without = 0.0;
+  while (sim.time() < t_end * (1 - 1e-12)) {
+    sim.step(std::min(next, t_end) - sim.time());  // a step at most up to the next output time
+    if (sim.time() >= next * (1 - 1e-12)) next += every;
+    const EnergyBalance e = sim.energy_balance(HeatingOrder::second);
+    r.initial = e.initial;
+    const double lost = e.lost(), without = e.lost() - e.stored_lead;
+    if (sim.time() >= 0.2 * t_end) {
+      r.worst_lost = std::max(r.worst_lost, std::fabs(lost));
+      r.worst_without_lead = std::max(r.worst_without_lead, std::fabs(without));
+      r.worst_drop = std::max(r.worst_drop, last - lost);
+      r.worst_drop_without_lead = std::max(r.worst_drop_without_lead, last_without - without);
+    }
+    last = lost, last_without = without;
+  }
+  std::printf("[energy balance, vibrating bar, %s] initial %.6g J: largest |energy lost| %.3g J (%.2e of it), "
+              "largest fall from a step to the next %.3g J; without the stored energy's lead %.3g J (%.2e), fall %.3g J\n",
+              scheme == UpdateScheme::musl ? "MUSL" : scheme == UpdateScheme::usl ? "USL" : "USF", r.initial,
+              r.worst_lost, r.worst_lost / r.initial, r.worst_drop, r.worst_without_lead, r.worst_without_lead / r.initial,
+              r.worst_drop_without_lead);
+  return r;
+}
+
+}  // namespace
+
+// A bar in free vibration, and its books must say what it loses at every step, not only on average:
+// kinetic and stored energy must be taken at the same time. The stress update books the stored energy
+// half a step ahead of the velocities (USF: behind; energy_books.hpp, stored_lead). Measured (2.7 J):
+//  * MUSL loses nothing: |energy_lost| ≤ 1.5e-4 J (5.4e-5 of the energy) with the lead taken off,
+//    6.6e-3 J (2.4e-3) without it, the step-to-step swing docs/output.md used to warn about;
+//  * USL dissipates 1.2 % of the energy over the 1.5 periods (the scheme's own loss), and the books
+//    now show it growing smoothly: it never falls by more than 1.2e-5 J from one step to the next,
+//    where without the lead it fell by up to 5.1e-4 J;
+//  * USF: |energy_lost| ≤ 2.1e-3 J with the lead, 6.6e-3 J without (its end-of-step power is known
+//    only at the next update, so the steps cut short to land on output times leave spikes of 1.8e-3 J).
+TEST(EnergyBalance, VibratingBarBooksNoLossAtAnyStep) {
+  const VibratingBar musl = vibrate_bar(UpdateScheme::musl);
+  EXPECT_LT(musl.worst_lost, 3e-4 * musl.initial);
+  EXPECT_GT(musl.worst_without_lead, 10.0 * musl.worst_lost);  // the lead is what keeps it there
+  const VibratingBar usl = vibrate_bar(UpdateScheme::usl);
+  EXPECT_GT(usl.worst_lost, 0.005 * usl.initial);  // the scheme's loss, booked
+  EXPECT_LT(usl.worst_drop, 5e-5 * usl.initial);   // and never given back by the books
+  EXPECT_GT(usl.worst_drop_without_lead, 5.0 * usl.worst_drop);
+  const VibratingBar usf = vibrate_bar(UpdateScheme::usf);
+  EXPECT_LT(usf.worst_lost, 1.5e-3 * usf.initial);
+  EXPECT_GT(usf.worst_without_lead, 2.0 * usf.worst_lost);
 }

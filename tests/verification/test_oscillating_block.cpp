@@ -24,8 +24,12 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
 
 using frictherm::verification::OscillatingBlock;
+using frictherm::verification::OscillatingBlockVariant;
 
 TEST(OscillatingBlock, SecondOrderHeatingConvergesFaster) {
   const OscillatingBlock::Work ref = OscillatingBlock::run(0.0125);
@@ -102,9 +106,11 @@ TEST(OscillatingBlock, DefaultsStayStableAtSmallCfl) {
 // energy, ½ σ:ε V, which missed about |ε|/3 of the stress's work (docs/output.md, "Stored energy of a
 // hypoelastic material"). With the stress's work booked instead: −1.94 mJ at C = 0.5 (the explicit
 // update gains a little) and +0.59 mJ at C = 0.05, of about 1170 mJ the load puts in over the
-// interval. Bound: at each C the scheme's loss or gain stays under 0.4 % of the load's work (the free
-// slivers lost 18.8 and 28.5 mJ at C = 0.1 and 0.05, 1.6 % and 2.4 %), and at C = 0.05 it is not
-// above 2.5 times its size at C = 0.5.
+// interval; with the stored energy taken at the velocities' time (energy_books.hpp, stored_lead: the
+// −1.94 mJ "gain" was the stored energy booked half a step ahead under the ramp's loading power)
+// +0.32 mJ at C = 0.5 and +0.82 mJ at C = 0.05 (0.03 and 0.07 %). Bound: at each C the scheme's loss
+// or gain stays under 0.4 % of the load's work (the free slivers lost 18.8 and 28.5 mJ at C = 0.1 and
+// 0.05, 1.6 % and 2.4 %), at C = 0.05 under 0.15 %, and no gain beyond 0.05 %.
 TEST(OscillatingBlock, BondedPushersLoseNoMoreAsCflFalls) {
   using namespace frictherm::mechanics;
   frictherm::verification::OscillatingBlockVariant v;
@@ -131,5 +137,55 @@ TEST(OscillatingBlock, BondedPushersLoseNoMoreAsCflFalls) {
   ASSERT_GT(coarse.work, 0.0);
   EXPECT_LT(std::fabs(coarse.dissipation), 0.004 * coarse.work);
   EXPECT_LT(std::fabs(fine.dissipation), 0.004 * fine.work);
-  EXPECT_LT(fine.dissipation, 2.5 * std::fabs(coarse.dissipation));
+  EXPECT_LT(fine.dissipation, 0.0015 * fine.work);
+  EXPECT_GT(coarse.dissipation, -0.0005 * coarse.work);
+  EXPECT_GT(fine.dissipation, -0.0005 * fine.work);
+}
+
+namespace {
+using namespace frictherm::mechanics;
+// The undamped block's books at every step: the largest excess of the frictional heat (order `order`)
+// over the energy the mechanics lost, and the heat at the end (J).
+struct HeatAgainstLoss {
+  double worst_excess = -std::numeric_limits<double>::infinity(), heat = 0.0;
+};
+HeatAgainstLoss heat_against_loss(double cfl, const OscillatingBlockVariant& v, HeatingOrder order) {
+  auto sim = OscillatingBlock::make(cfl, ShapeKind::ugimp, v);
+  HeatAgainstLoss r;
+  const double end = OscillatingBlock::push_end(v);
+  while (sim->time() < end * (1 - 1e-12)) {
+    sim->step(end - sim->time());
+    const EnergyBalance e = sim->energy_balance(order);
+    r.worst_excess = std::max(r.worst_excess, e.friction_work - e.lost());
+    r.heat = e.friction_work;
+  }
+  return r;
+}
+}  // namespace
+
+// Frictional heat is paid for by the mechanics at every step, not only at the end (issue 31): the
+// paper's undamped set-up rings at 100 MPa after its preload ramp, and the books must not show more
+// heat than the bodies lost at any step. Before the books took off the stored energy's half-step lead
+// (energy_books.hpp, stored_lead) the heat exceeded the loss during the ramp by 3.84 mJ (first order,
+// USL with extent detection, the scene defaults, C = 0.5), 40 % of the whole run's heat; now the
+// largest excess is 1.7e-4 mJ (extent) and 6e-5 mJ (displacement) at C = 0.5, 0 at C = 0.1, of
+// 7.9–9.5 mJ of heat. Bound: 0.1 % of the run's heat, both orders, USL (the default scheme) with
+// either separation. MUSL is not asserted: on this set-up it creates energy (the largest excess is
+// 18.7 / 1.96 mJ with extent detection and 76.9 / 6.7 mJ with displacement at C = 0.5 / 0.1, the
+// energy lost falling below zero after the ramp; with the pushers held still it still gains 12 mJ, so
+// it is not the pushers' work): docs/contact.md, "Known limitations".
+TEST(OscillatingBlock, HeatNeverExceedsTheEnergyLost) {
+  std::vector<OscillatingBlockVariant> variants(2);
+  variants[0].scheme = UpdateScheme::usl, variants[0].separation = SeparationMethod::extent;
+  variants[1].scheme = UpdateScheme::usl, variants[1].separation = SeparationMethod::displacement;
+  for (const OscillatingBlockVariant& v : variants)
+    for (double cfl : {0.5, 0.1})
+      for (HeatingOrder order : {HeatingOrder::first, HeatingOrder::second}) {
+        const HeatAgainstLoss r = heat_against_loss(cfl, v, order);
+        std::printf("[oscillating block, USL %s, C = %g, order %d] heat %.4g mJ, largest excess over the energy lost %.3g mJ\n",
+                    v.separation == SeparationMethod::extent ? "extent" : "displacement", cfl,
+                    order == HeatingOrder::first ? 1 : 2, 1e3 * r.heat, 1e3 * r.worst_excess);
+        EXPECT_GT(r.heat, 0.005);  // J: the run's heat (7.9–9.5 mJ)
+        EXPECT_LT(r.worst_excess, 0.001 * r.heat) << cfl;
+      }
 }

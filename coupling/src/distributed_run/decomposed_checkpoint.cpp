@@ -162,9 +162,11 @@ Handle open_global(const std::string& path, int dim, long& ranks, long& generati
   Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
   if (const long format = read_int_attribute(f.get(), path, "format"); format != ckpt::kFormat)
     throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + " (expected " +
-                             std::to_string(ckpt::kFormat) + (format == 2 ? ": format 2 was written before checkpoints "
-                             "carried checksums; resume it with the version that wrote it, or run the scene again)" :
-                             "; written by another frictherm version)"));
+                             std::to_string(ckpt::kFormat) +
+                             (ckpt::older_format_reason(format).empty()
+                                  ? std::string("; written by another frictherm version)")
+                                  : ": " + ckpt::older_format_reason(format) +
+                                        "; resume it with the version that wrote it, or run the scene again)"));
   if (H5Aexists(f.get(), "ranks") <= 0)
     throw std::runtime_error("checkpoint '" + path + "' was written by a serial run: resume it without mpirun");
   ckpt::check_objects(f.get(), path);

@@ -38,7 +38,8 @@ class Redistribution {
     for (auto& r : acc_.integers) r.second.clear();
     acc_.cumulative_first = acc_.cumulative_second = 0.0;
     acc_.external_work = acc_.damping_work = acc_.rigid_work = 0.0;
-    acc_.contact_normal_work = acc_.boundary_stop_work = acc_.stored_lead = 0.0;
+    acc_.contact_normal_work = acc_.boundary_stop_work = acc_.stored_lead = acc_.stress_power = 0.0;
+    acc_.stress_dt = 0.0;
     acc_.work_first.clear();
     acc_.work_second.clear();
     acc_.pair_first.clear();
@@ -101,6 +102,9 @@ class Redistribution {
       acc_.boundary_stop_work += w;
       r("mechanics/stored_energy_lead", w);
       acc_.stored_lead += w;
+      r("mechanics/stress_power", w);
+      acc_.stress_power += w;
+      r("mechanics/stress_dt", acc_.stress_dt);  // the step: the same in every file
       for (auto [name, sum] : {std::pair<const char*, std::vector<double>*>{"mechanics/pair_work_first", &acc_.pair_first},
                                {"mechanics/pair_work_second", &acc_.pair_second}}) {
         std::vector<double> pw;

@@ -108,6 +108,8 @@ void DecomposedRun<Dim>::visit_rank_state(const V& v) {
   v("mechanics/contact_normal_work", st.contact_normal_work);
   v("mechanics/boundary_stop_work", st.boundary_stop_work);
   v("mechanics/stored_energy_lead", st.stored_lead);
+  v("mechanics/stress_power", st.stress_power);
+  v("mechanics/stress_dt", st.stress_dt);
   v("mechanics/initial_energy", st.initial_energy);
   v("mechanics/empty_node_mass", st.empty_node_mass);
   v("mechanics/work_first", st.work_first);

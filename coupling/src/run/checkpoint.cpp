@@ -254,10 +254,9 @@ Handle open_checkpoint(const std::string& path, int dimension) {
   Handle f{check_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path, "cannot open the checkpoint"), H5Fclose};
   const long format = ckpt::read_int_attribute(f.get(), path, "format");
   if (format == ckpt::kFormat) ckpt::check_objects(f.get(), path);
-  if (format == 2)  // before issue 34: no checksums, no /reaction/enabled
-    throw std::runtime_error("checkpoint '" + path + "': format 2, written by a frictherm version before checkpoints "
-                             "carried checksums (expected format " + std::to_string(ckpt::kFormat) +
-                             ": a Fletcher32 checksum on every dataset); resume it with the version that wrote it, "
+  if (const std::string why = ckpt::older_format_reason(format); !why.empty())
+    throw std::runtime_error("checkpoint '" + path + "': " + why + " (expected format " +
+                             std::to_string(ckpt::kFormat) + "); resume it with the version that wrote it, "
                              "or run the scene again");
   if (format != ckpt::kFormat)
     throw std::runtime_error("checkpoint '" + path + "': format " + std::to_string(format) + " (expected " +

@@ -18,9 +18,17 @@
 
 namespace frictherm::coupling::ckpt {
 
+/// 4: the energy books' stored-energy lead and the stress power it follows (energy_books.hpp);
 /// 3: every non-empty dataset carries a Fletcher32 checksum (chunked), /reaction/enabled (issue 34);
 /// 2: thermal coupler, penalty contact and output marks; 1: mechanics only. Serial and decomposed.
-constexpr int kFormat = 3;
+constexpr int kFormat = 4;
+/// Why a checkpoint of an older format is refused (empty for a format this version never wrote).
+inline std::string older_format_reason(long format) {
+  if (format == 3)
+    return "format 3 was written before the energy books kept the stored energy's lead over the velocities";
+  if (format == 2) return "format 2 was written before checkpoints carried checksums";
+  return "";
+}
 /// A checkpoint dataset is one chunk (and one checksum) up to this size, more chunks beyond.
 constexpr hsize_t kChunkBytes = hsize_t{64} << 20;
 
@@ -137,13 +145,6 @@ struct Reader {
                     "cannot read '" + shown(name) + "'");
   }
   void operator()(const char* name, double& x) const {
-    // Books added after checkpoints were first written read as 0 from an older checkpoint: the
-    // stored energy's lead (energy_books.hpp) is the last step's, made again by the next step.
-    const std::string key(name);
-    if ((key == "stored_energy_lead" || key == "mechanics/stored_energy_lead") && H5Lexists(group, name, H5P_DEFAULT) <= 0) {
-      x = 0.0;
-      return;
-    }
     scalar(name, H5T_NATIVE_DOUBLE, x);
     if (finite) require_finite(file, shown(name), &x, 1, allowed_sentinel);
   }

@@ -72,6 +72,8 @@ typename DecomposedMpm<Dim>::CheckpointState DecomposedMpm<Dim>::checkpoint_stat
   c.contact_normal_work = s.contact_normal_work;
   c.boundary_stop_work = s.boundary_stop_work;
   c.stored_lead = s.stored_lead;
+  c.stress_power = s.last_stress_power;
+  c.stress_dt = s.last_stress_dt;
   c.initial_energy = s.initial_energy;
   c.empty_node_mass = s.empty_node_mass;
   c.work_first = s.work_first;
@@ -158,6 +160,8 @@ void DecomposedMpm<Dim>::restore_checkpoint_state(const CheckpointState& c, bool
   s.contact_normal_work = c.contact_normal_work;
   s.boundary_stop_work = c.boundary_stop_work;
   s.stored_lead = c.stored_lead;
+  s.last_stress_power = c.stress_power;
+  s.last_stress_dt = c.stress_dt;
   s.initial_energy = c.initial_energy;
   s.empty_node_mass = c.empty_node_mass;
   s.work_first = c.work_first;

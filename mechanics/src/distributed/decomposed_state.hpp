@@ -329,8 +329,8 @@ struct DecomposedMpm<Dim>::Impl {
   // This rank's energy removed by the normal contact impulses (the updated pass, owned nodes) and by
   // the velocity conditions' stops (the momentum update, owned nodes): energy_books.hpp, contact_pair.hpp.
   double contact_normal_work = 0.0, boundary_stop_work = 0.0;
-  // This rank's share of the books' stored_lead after the last stress update (energy_books.hpp).
-  double stored_lead = 0.0;
+  // This rank's share of the books' stored_lead and of the last stress update's power (energy_books.hpp).
+  double stored_lead = 0.0, last_stress_power = 0.0, last_stress_dt = 0.0;
   // Per group entry (mt_field), the extrapolated contact pass's momentum change this step: the
   // velocity conditions' stops are measured from the momentum the particles brought (the serial
   // ContactNodeState::extrapolated_change). Recorded while recording_start_change.

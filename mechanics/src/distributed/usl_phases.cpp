@@ -423,7 +423,7 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
   constexpr int velocity = Dof::velocity;
   const Analysis an = opt.analysis;
   beyond = -1;
-  double power = 0.0;  // Σ V σ:L after the update, as the serial particle pass (the books' stored_lead)
+  StressPower power;  // Σ V σ:L before and after the update, as the serial particle pass (the books' stored_lead)
   {
     SwarmFields f(swarm);
     const auto& st = stencils<Kernel>();
@@ -447,8 +447,9 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
           sk.for_each(ix, [&](int slot, double, const Vec<2>& G) {
             L.add(Vec<2>(Eigen::Map<const Vec<2>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)), G);
           });
+          power.start += f.volume[k] * stress_power(sigma, L);
           ok = update_stress_plane_strain(mat.mie_gruneisen, laws[m].min_J, L, dt, state);
-          power += f.volume[k] * stress_power(sigma, L);
+          power.end += f.volume[k] * stress_power(sigma, L);
         }
       }
       if (Dim != 2 || !laws[m].mie_gruneisen()) {
@@ -457,8 +458,9 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
           L.noalias() += Vec<Dim>(Eigen::Map<const Vec<Dim>>(node_values(a, static_cast<std::size_t>(slot)) + velocity)) *
                          G.transpose();
         });
+        power.start += f.volume[k] * stress_power<Dim>(sigma, L);
         ok = update_stress<Dim>(mat, laws[m], an, L, dt, state);
-        power += f.volume[k] * stress_power<Dim>(sigma, L);
+        power.end += f.volume[k] * stress_power<Dim>(sigma, L);
       }
       if (!ok) beyond = std::max(beyond, static_cast<long>(f.id[k]));
       Eigen::Map<Mat<Dim>>(f.F + Dim * Dim * k) = F;
@@ -466,7 +468,7 @@ void DecomposedMpm<Dim>::Impl::stress_update(double dt) {
     }
     petsc_check(VecRestoreArrayRead(local, &a), "VecRestoreArrayRead");
   }
-  stored_lead = stored_energy_lead(!opt.usf, dt, power);
+  advance_stored_lead(!opt.usf, dt, power, stored_lead, last_stress_power, last_stress_dt);
   if (!has_mie_gruneisen) return;
   long worst = beyond;
   MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_LONG, MPI_MAX, comm);

@@ -400,7 +400,7 @@ class DecomposedMpm {
     double time = 0.0, cumulative_first = 0.0, cumulative_second = 0.0, empty_node_mass = 0.0;
     double external_work = 0.0, damping_work = 0.0, rigid_work = 0.0;  // this rank's part of the books
     double contact_normal_work = 0.0, boundary_stop_work = 0.0;        // (EnergyBalance's terms)
-    double stored_lead = 0.0;                                           // this rank's part of it
+    double stored_lead = 0.0, stress_power = 0.0, stress_dt = 0.0;      // this rank's parts of them
     double initial_energy = std::numeric_limits<double>::quiet_NaN();  // the books' start (every rank's)
     std::vector<double> work_first, work_second;
     std::vector<double> pair_first, pair_second;  // this rank's part of the pair books (materials² or empty)

@@ -263,7 +263,9 @@ class Simulation {
     v("contact_normal_work", work_books_.contact_normal);
     v("boundary_stop_work", work_books_.boundary_stop);
     v("initial_energy", work_books_.initial_energy);
-    v("stored_energy_lead", work_books_.stored_lead);  // (a checkpoint before it: 0, checkpoint_io.hpp)
+    v("stored_energy_lead", work_books_.stored_lead);  // (checkpoint format 4, checkpoint_io.hpp)
+    v("stress_power", work_books_.stress_power);
+    v("stress_dt", work_books_.stress_dt);
     v("work_first", contact_books_.work_first);
     v("work_second", contact_books_.work_second);
     v("pair_work_first", contact_books_.pair_work_first);
@@ -322,7 +324,7 @@ class Simulation {
   struct ParticlePassResult {
     long bad = -1;     // the first particle with a non-finite state or outside the grid (check_particle)
     long beyond = -1;  // the first compressed past its Hugoniot's limit (throw_beyond_hugoniot)
-    double stress_power = 0.0;  // Σ_p V_p σ_p:L_p after the stress update (W; 0 without it)
+    StressPower stress_power;  // Σ_p V_p σ_p:L_p before (stress-only passes) and after the update (W)
   };
   /// `refresh` (grid-to-particle with Stencil arrays): also the next step's stencils at the moved
   /// positions, the rigid materials moved (by layout_.rigid_motion, which the rigid driver sets:

@@ -14,7 +14,9 @@ struct WorkBooks {
   double contact_normal = 0.0;  // removed by the normal contact impulses (normal_stop_work)
   double boundary_stop = 0.0;   // removed by the velocity conditions (condition_stop_work)
   double initial_energy = std::numeric_limits<double>::quiet_NaN();  // kinetic + stored before the first step
-  double stored_lead = 0.0;     // the last stress update's stored energy ahead of the velocities (EnergyBalance)
+  double stored_lead = 0.0;     // the stored energy ahead of the velocities (EnergyBalance, advance_stored_lead)
+  double stress_power = 0.0;    // Σ V σ:L after the last stress update (W; advance_stored_lead)
+  double stress_dt = 0.0;       // that update's step (s)
 };
 
 }  // namespace frictherm::mechanics
